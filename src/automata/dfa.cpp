@@ -1,0 +1,260 @@
+// Subset construction, minimisation and canonical numbering.
+//
+// determinize() is the textbook subset construction over ε-closed sets of NFA states, with a
+// budget: past Limits::max_states DFA states it stops and says which option raises the budget
+// (RE2's DFA gives up the same way when it runs out of memory). minimize() refines the partition
+// {accepting, rejecting} by the classes of each state's four successors until it is stable
+// (Moore's algorithm: the same minimal automaton as Hopcroft's, simpler, and fast at the sizes
+// path classes have), then numbers the states canonically.
+#include "automata/dfa.h"
+
+#include <algorithm>
+#include <array>
+#include <deque>
+#include <unordered_map>
+
+namespace pathex {
+namespace {
+
+struct VecHash {
+  std::size_t operator()(const std::vector<int>& v) const {
+    std::size_t h = 1469598103934665603ULL;
+    for (int x : v) h = (h ^ static_cast<std::size_t>(x)) * 1099511628211ULL;
+    return h;
+  }
+};
+
+struct ArrHash {
+  std::size_t operator()(const std::array<int, 5>& v) const {
+    std::size_t h = 1469598103934665603ULL;
+    for (int x : v) h = (h ^ static_cast<std::size_t>(x)) * 1099511628211ULL;
+    return h;
+  }
+};
+
+// States reachable from the start, renumbered breadth-first in letter order. Applied to a minimal
+// DFA this is the canonical numbering.
+Dfa renumber_from_start(const Dfa& d) {
+  std::vector<int> id(static_cast<std::size_t>(d.num_states), -1);
+  std::vector<int> order;
+  order.reserve(static_cast<std::size_t>(d.num_states));
+  id[static_cast<std::size_t>(d.start)] = 0;
+  order.push_back(d.start);
+  for (std::size_t q = 0; q < order.size(); ++q) {
+    for (int l = 0; l < kNumLetters; ++l) {
+      const int t = d.step(order[q], l);
+      if (id[static_cast<std::size_t>(t)] < 0) {
+        id[static_cast<std::size_t>(t)] = static_cast<int>(order.size());
+        order.push_back(t);
+      }
+    }
+  }
+  Dfa out;
+  out.num_states = static_cast<int>(order.size());
+  out.start = 0;
+  out.next.resize(order.size() * kNumLetters);
+  out.accept.resize(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    out.accept[i] = d.accept[static_cast<std::size_t>(order[i])];
+    for (int l = 0; l < kNumLetters; ++l)
+      out.next[i * kNumLetters + static_cast<std::size_t>(l)] = id[static_cast<std::size_t>(d.step(order[i], l))];
+  }
+  return out;
+}
+
+}  // namespace
+
+bool Dfa::accepts(std::string_view letters) const {
+  int s = start;
+  for (char c : letters) {
+    const auto l = letter_from_char(c);
+    if (!l) return false;
+    s = step(s, *l);
+  }
+  return accept[static_cast<std::size_t>(s)] != 0;
+}
+
+std::vector<std::uint8_t> Dfa::live() const {
+  // Backward reachability from accepting states.
+  std::vector<std::vector<int>> preds(static_cast<std::size_t>(num_states));
+  for (int s = 0; s < num_states; ++s)
+    for (int l = 0; l < kNumLetters; ++l) preds[static_cast<std::size_t>(step(s, l))].push_back(s);
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(num_states), 0);
+  std::vector<int> stack;
+  for (int s = 0; s < num_states; ++s)
+    if (accept[static_cast<std::size_t>(s)]) { out[static_cast<std::size_t>(s)] = 1; stack.push_back(s); }
+  while (!stack.empty()) {
+    const int s = stack.back();
+    stack.pop_back();
+    for (int p : preds[static_cast<std::size_t>(s)])
+      if (!out[static_cast<std::size_t>(p)]) { out[static_cast<std::size_t>(p)] = 1; stack.push_back(p); }
+  }
+  return out;
+}
+
+int Dfa::live_count() const {
+  int n = 0;
+  for (auto b : live()) n += b;
+  return n;
+}
+
+Result<Dfa> determinize(const Nfa& n, const Limits& limits) {
+  std::vector<int> stamp(n.states.size(), -1);
+  int epoch = 0;
+  std::vector<int> stack;
+  // ε-closure of `seeds`, sorted so it can key the map.
+  auto closure = [&](std::vector<int>& set) {
+    ++epoch;
+    stack.clear();
+    for (int s : set) {
+      if (stamp[static_cast<std::size_t>(s)] != epoch) { stamp[static_cast<std::size_t>(s)] = epoch; stack.push_back(s); }
+    }
+    set.clear();
+    while (!stack.empty()) {
+      const int s = stack.back();
+      stack.pop_back();
+      set.push_back(s);
+      for (int t : n.states[static_cast<std::size_t>(s)].eps)
+        if (stamp[static_cast<std::size_t>(t)] != epoch) { stamp[static_cast<std::size_t>(t)] = epoch; stack.push_back(t); }
+    }
+    std::sort(set.begin(), set.end());
+  };
+
+  std::unordered_map<std::vector<int>, int, VecHash> ids;
+  std::vector<std::vector<int>> sets;
+  Dfa d;
+  auto intern = [&](std::vector<int>&& set) -> int {
+    auto it = ids.find(set);
+    if (it != ids.end()) return it->second;
+    const int id = static_cast<int>(sets.size());
+    bool acc = false;
+    for (int s : set) acc = acc || s == n.accept;
+    d.accept.push_back(acc ? 1 : 0);
+    ids.emplace(set, id);
+    sets.push_back(std::move(set));
+    return id;
+  };
+
+  std::vector<int> init{n.start};
+  closure(init);
+  d.start = intern(std::move(init));
+  std::array<std::vector<int>, kNumLetters> targets;
+  for (std::size_t q = 0; q < sets.size(); ++q) {
+    for (auto& t : targets) t.clear();
+    for (int s : sets[q])
+      for (const auto& [mask, t] : n.states[static_cast<std::size_t>(s)].edges)
+        for (int l = 0; l < kNumLetters; ++l)
+          if (mask & (1u << l)) targets[static_cast<std::size_t>(l)].push_back(t);
+    for (int l = 0; l < kNumLetters; ++l) {
+      std::vector<int> set = targets[static_cast<std::size_t>(l)];
+      closure(set);
+      const int id = intern(std::move(set));
+      d.next.push_back(id);
+      if (sets.size() > limits.max_states)
+        return make_error(ErrorCode::kLimit, limit_message("the DFA", limits.max_states, "states", "--max-states"));
+    }
+  }
+  d.num_states = static_cast<int>(sets.size());
+  return d;
+}
+
+std::vector<int> refine_partition(const std::vector<std::int32_t>& next, const std::vector<int>& labels,
+                                  int* blocks) {
+  const std::size_t n = labels.size();
+  std::vector<int> cls(n);
+  int count = 0;
+  {
+    std::unordered_map<int, int> ids;
+    for (std::size_t s = 0; s < n; ++s) {
+      auto [it, inserted] = ids.emplace(labels[s], count);
+      if (inserted) ++count;
+      cls[s] = it->second;
+    }
+  }
+  std::unordered_map<std::array<int, 5>, int, ArrHash> sig;
+  std::vector<int> next_cls(n);
+  while (true) {
+    sig.clear();
+    sig.reserve(n);
+    int next_count = 0;
+    for (std::size_t s = 0; s < n; ++s) {
+      std::array<int, 5> key{cls[s], 0, 0, 0, 0};
+      for (std::size_t l = 0; l < kNumLetters; ++l) key[l + 1] = cls[static_cast<std::size_t>(next[s * kNumLetters + l])];
+      auto [it, inserted] = sig.emplace(key, next_count);
+      if (inserted) ++next_count;
+      next_cls[s] = it->second;
+    }
+    cls.swap(next_cls);
+    if (next_count == count) break;
+    count = next_count;
+  }
+  *blocks = count;
+  return cls;
+}
+
+Dfa minimize(const Dfa& in) {
+  const Dfa d = renumber_from_start(in);  // drops unreachable states
+  const std::size_t n = static_cast<std::size_t>(d.num_states);
+  int count = 0;
+  const std::vector<int> cls = refine_partition(d.next, std::vector<int>(d.accept.begin(), d.accept.end()), &count);
+  Dfa q;
+  q.num_states = count;
+  q.start = cls[static_cast<std::size_t>(d.start)];
+  q.next.assign(static_cast<std::size_t>(count) * kNumLetters, 0);
+  q.accept.assign(static_cast<std::size_t>(count), 0);
+  for (std::size_t s = 0; s < n; ++s) {
+    const std::size_t c = static_cast<std::size_t>(cls[s]);
+    q.accept[c] = d.accept[s];
+    for (int l = 0; l < kNumLetters; ++l)
+      q.next[c * kNumLetters + static_cast<std::size_t>(l)] = cls[static_cast<std::size_t>(d.next[s * kNumLetters + static_cast<std::size_t>(l)])];
+  }
+  return renumber_from_start(q);
+}
+
+Result<Dfa> compile(const Regex& r, const Limits& limits) {
+  Result<Nfa> n = build_nfa(r, limits);
+  if (!n) return n.error();
+  Result<Dfa> d = determinize(*n, limits);
+  if (!d) {
+    Error e = d.error();
+    e.source = r.source;
+    e.column = r.source.empty() ? 0 : 1;
+    return e;
+  }
+  return minimize(*d);
+}
+
+std::string to_dot(const Dfa& d, const std::string& title) {
+  const std::vector<std::uint8_t> live = d.live();
+  std::string out = "digraph pathex {\n  rankdir=LR;\n  label=\"";
+  for (char c : title) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  out += "\";\n  node [shape=circle];\n  start [shape=point];\n";
+  for (int s = 0; s < d.num_states; ++s) {
+    if (!live[static_cast<std::size_t>(s)]) continue;
+    out += "  q" + std::to_string(s) + " [label=\"" + std::to_string(s) + "\"" +
+           (d.accept[static_cast<std::size_t>(s)] ? ", shape=doublecircle" : "") + "];\n";
+  }
+  if (live[static_cast<std::size_t>(d.start)]) out += "  start -> q" + std::to_string(d.start) + ";\n";
+  for (int s = 0; s < d.num_states; ++s) {
+    if (!live[static_cast<std::size_t>(s)]) continue;
+    // One edge per target, labelled with all letters that lead there.
+    std::vector<std::pair<int, std::string>> edges;
+    for (int l = 0; l < kNumLetters; ++l) {
+      const int t = d.step(s, l);
+      if (!live[static_cast<std::size_t>(t)]) continue;
+      bool merged = false;
+      for (auto& [to, label] : edges)
+        if (to == t) { label += std::string(",") + letter_char(l); merged = true; }
+      if (!merged) edges.push_back({t, std::string(1, letter_char(l))});
+    }
+    for (const auto& [to, label] : edges)
+      out += "  q" + std::to_string(s) + " -> q" + std::to_string(to) + " [label=\"" + label + "\"];\n";
+  }
+  out += "}\n";
+  return out;
+}
+
+}  // namespace pathex

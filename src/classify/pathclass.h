@@ -1,0 +1,79 @@
+// Path classes: expressions turned into sets of valid full paths.
+//
+// compile_class() is the one road from text to language: parse (full or Heckbert notation),
+// compile to a minimal DFA, reverse if the expression is written eye-first, expand Heckbert's
+// L and E into the light and sensor letter pairs, and intersect with the universe
+// U = L[SD]{4,}E. Named classes ($name) come from a ClassTable: the built-ins plus, in order,
+// the entries of a class file, each of which may refer to the ones before it.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "alphabet/alphabet.h"
+#include "automata/dfa.h"
+#include "core/error.h"
+#include "core/limits.h"
+#include "regex/ast.h"
+
+namespace pathex {
+
+enum class Notation { kFull, kHeckbert };
+
+// Which lights and sensors Heckbert notation (and a scene) may put at the ends. Default: all.
+struct EndTypes {
+  std::vector<LightType> lights{kAllLightTypes.begin(), kAllLightTypes.end()};
+  std::vector<SensorType> sensors{kAllSensorTypes.begin(), kAllSensorTypes.end()};
+};
+
+struct ClassOptions {
+  Notation notation = Notation::kFull;
+  EndTypes ends;
+  Limits limits;
+};
+
+struct PathClass {
+  std::string name;         // "" for an anonymous expression
+  std::string text;         // as written
+  std::string description;  // for built-ins and class-file entries that have one
+  Notation notation = Notation::kFull;
+  Regex ast;                // the parse, names expanded
+  bool eye_first = false;   // written E…L; the language is the reversal
+  Dfa dfa;                  // minimal DFA of the class: full paths, ∩ U
+};
+
+class ClassTable;
+
+Result<PathClass> compile_class(std::string_view text, const ClassOptions& options,
+                                const ClassTable* names = nullptr);
+
+// Built-in and user-defined names. Lookups see the built-ins and every class added so far.
+class ClassTable {
+ public:
+  // A table holding only the built-ins ($all, $local, $emission, $direct, $indirect, $caustic).
+  static const ClassTable& builtins();
+  ClassTable();
+
+  // Compiles `text` under `name` (which must be new) and appends it.
+  Result<const PathClass*> add(const std::string& name, std::string_view text, const ClassOptions& options,
+                               std::string description = "");
+  const PathClass* find(std::string_view name) const;
+  // The classes added by the user, in order (built-ins excluded).
+  const std::vector<std::unique_ptr<PathClass>>& user_classes() const { return user_; }
+  // Built-ins in their documented order.
+  const std::vector<std::unique_ptr<PathClass>>& builtin_classes() const { return builtin_; }
+
+ private:
+  struct BuiltinTag {};
+  explicit ClassTable(BuiltinTag);
+  bool is_builtin_table_ = false;
+  std::vector<std::unique_ptr<PathClass>> builtin_;
+  std::vector<std::unique_ptr<PathClass>> user_;
+};
+
+// The classic Heckbert universe L[SD]*E mapped to full paths: L (light pairs) [SD]* (sensor pairs) E.
+Dfa ends_universe(const EndTypes& ends);
+
+}  // namespace pathex

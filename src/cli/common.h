@@ -1,0 +1,45 @@
+// What every subcommand shares: limit options, notation options, error reporting and the
+// exit-code convention (0 success, 1 a negative answer, 2 bad input or usage).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "classify/pathclass.h"
+#include "core/error.h"
+#include "core/limits.h"
+
+namespace pathex::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitNo = 1;
+inline constexpr int kExitBadInput = 2;
+
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+struct NotationOptions {
+  std::string notation = "full";
+  std::vector<std::string> lights;
+  std::vector<std::string> sensors;
+};
+
+void add_limit_options(CLI::App* app, Limits* limits);
+void add_notation_options(CLI::App* app, NotationOptions* n);
+// Turns the notation options into ClassOptions, or an error naming the bad value.
+Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limits);
+
+// Prints "pathex: error: <rendered error>" to stderr and returns kExitBadInput.
+int report(const Error& e);
+
+// Registration of each subcommand (one file each).
+Command add_explain(CLI::App& app);
+Command add_match(CLI::App& app);
+Command add_classify(CLI::App& app);
+
+}  // namespace pathex::cli

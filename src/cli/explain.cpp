@@ -1,0 +1,130 @@
+// pathex explain EXPR: everything the engine knows about one path class.
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "automata/ops.h"
+#include "cli/common.h"
+#include "io/class_file.h"
+
+namespace pathex::cli {
+namespace {
+
+struct ExplainArgs {
+  std::string expr;
+  std::string classes_file;
+  int max_len = 12;
+  int members = 5;
+  bool json = false;
+  bool dot = false;
+  NotationOptions notation;
+  Limits limits;
+};
+
+nlohmann::json count_json(const BigUint& b) {
+  std::uint64_t v = 0;
+  if (b.to_u64(&v)) return v;
+  return b.to_string();  // exact, as a decimal string, when it does not fit 64 bits
+}
+
+nlohmann::json chains_json(const std::string& path) {
+  nlohmann::json arr = nlohmann::json::array();
+  Result<FullPath> p = parse_full_path(path, path.size());
+  if (!p) return arr;
+  for (const Chain& c : chains(*p)) arr.push_back({{"letters", c.letters}, {"from", c.from}, {"to", c.to}});
+  return arr;
+}
+
+std::string chains_text(const std::string& path) {
+  Result<FullPath> p = parse_full_path(path, path.size());
+  if (!p) return "";
+  std::string s;
+  for (const Chain& c : chains(*p)) {
+    if (!s.empty()) s += ' ';
+    s += c.letters + "(" + std::to_string(c.from) + ".." + std::to_string(c.to) + ")";
+  }
+  return s;
+}
+
+int run(const ExplainArgs& a) {
+  Result<ClassOptions> opts = class_options(a.notation, a.limits);
+  if (!opts) return report(opts.error());
+  ClassTable table;
+  if (!a.classes_file.empty()) {
+    Result<bool> r = read_class_file(a.classes_file, *opts, &table);
+    if (!r) return report(r.error());
+  }
+  Result<PathClass> pc = compile_class(a.expr, *opts, &table);
+  if (!pc) return report(pc.error());
+  const Dfa& d = pc->dfa;
+  if (a.dot) {
+    std::cout << to_dot(d, a.expr);
+    return kExitOk;
+  }
+  const bool finite = is_finite(d);
+  const bool empty = is_empty(d);
+  const std::vector<BigUint> counts = count_by_length(d, a.max_len);
+  const std::vector<std::string> members = enumerate_members(d, std::max(a.max_len, 64), static_cast<std::size_t>(a.members));
+  const std::string normal = to_string(pc->ast);
+
+  if (a.json) {
+    nlohmann::json j;
+    j["expression"] = a.expr;
+    j["normal_form"] = normal;
+    j["notation"] = a.notation.notation;
+    j["eye_first"] = pc->eye_first;
+    j["dfa_states"] = d.num_states;
+    j["live_states"] = d.live_count();
+    j["empty"] = empty;
+    j["finite"] = finite;
+    nlohmann::json counts_j = nlohmann::json::object();
+    for (std::size_t n = 0; n < counts.size(); ++n)
+      if (!counts[n].is_zero()) counts_j[std::to_string(n)] = count_json(counts[n]);
+    j["counts_by_length"] = counts_j;
+    j["max_len"] = a.max_len;
+    nlohmann::json ms = nlohmann::json::array();
+    for (const std::string& m : members) ms.push_back({{"path", m}, {"chains", chains_json(m)}});
+    j["shortest_members"] = ms;
+    std::cout << j.dump(2) << "\n";
+    return kExitOk;
+  }
+  std::cout << "expression    " << a.expr << "\n";
+  std::cout << "normal form   " << normal << (pc->eye_first ? "   (eye-first: denotes the reversed paths)" : "") << "\n";
+  std::cout << "notation      " << a.notation.notation << "\n";
+  std::cout << "minimal DFA   " << d.num_states << " states (" << d.live_count() << " live)\n";
+  std::cout << "language      " << (empty ? "empty" : finite ? "finite" : "infinite") << "\n";
+  std::cout << "members by length (letters: count, up to " << a.max_len << ")\n ";
+  bool any = false;
+  for (std::size_t n = 0; n < counts.size(); ++n) {
+    if (counts[n].is_zero()) continue;
+    std::cout << " " << n << ": " << counts[n].to_string();
+    any = true;
+  }
+  std::cout << (any ? "" : " none") << "\n";
+  std::cout << "shortest members\n";
+  if (members.empty()) std::cout << "  none\n";
+  for (const std::string& m : members) std::cout << "  " << m << "   chains " << chains_text(m) << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+Command add_explain(CLI::App& app) {
+  auto args = std::make_shared<ExplainArgs>();
+  CLI::App* sub = app.add_subcommand("explain", "Show a path class: normal form, minimal DFA, counts, shortest members");
+  sub->footer("Example:\n  pathex explain 'L.*DD.*E'\n  pathex explain --notation heckbert --light point --sensor pinhole 'LS+DE'\n"
+              "  pathex explain --dot 'LDS*DE' | dot -Tsvg > dfa.svg");
+  sub->add_option("EXPR", args->expr, "Path expression (see grammar/pathex.ebnf)")->required();
+  sub->add_option("--classes", args->classes_file, "Class file whose names ($name) the expression may use");
+  sub->add_option("--max-len", args->max_len, "Count members up to this many letters")->capture_default_str()
+      ->check(CLI::Range(0, 10000));
+  sub->add_option("--members", args->members, "How many shortest members to list")->capture_default_str()
+      ->check(CLI::Range(0, 100000));
+  sub->add_flag("--json", args->json, "Machine-readable output");
+  sub->add_flag("--dot", args->dot, "Print the minimal DFA as Graphviz instead");
+  add_notation_options(sub, &args->notation);
+  add_limit_options(sub, &args->limits);
+  return {sub, [args] { return run(*args); }};
+}
+
+}  // namespace pathex::cli
