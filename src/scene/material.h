@@ -6,6 +6,7 @@
 // of the component that carried the transport.
 #pragma once
 
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -54,13 +55,18 @@ inline Letter letter_of(const BasicMaterial& m) {
 
 // The letters a material can give (bit per letter), the union over a mixture's components.
 inline LetterMask letters_of(const Material& m) {
-  if (const auto* mix = std::get_if<Mixture>(&m)) {
-    LetterMask out = 0;
-    for (const auto& c : mix->components)
-      if (c.weight > 0.0f) out = static_cast<LetterMask>(out | (1u << letter_of(c.material)));
-    return out;
-  }
-  return std::visit([](const auto& b) -> LetterMask { return static_cast<LetterMask>(1u << letter_of(BasicMaterial{b})); }, m);
+  return std::visit(
+      [](const auto& k) -> LetterMask {
+        if constexpr (std::is_same_v<std::decay_t<decltype(k)>, Mixture>) {
+          LetterMask out = 0;
+          for (const auto& c : k.components)
+            if (c.weight > 0.0f) out = static_cast<LetterMask>(out | (1u << letter_of(c.material)));
+          return out;
+        } else {
+          return static_cast<LetterMask>(1u << letter_of(BasicMaterial{k}));
+        }
+      },
+      m);
 }
 
 }  // namespace pathex
