@@ -41,5 +41,8 @@ int report(const Error& e);
 Command add_explain(CLI::App& app);
 Command add_match(CLI::App& app);
 Command add_classify(CLI::App& app);
+Command add_query(CLI::App& app);
+Command add_check(CLI::App& app);
+Command add_renderers(CLI::App& app);
 
 }  // namespace pathex::cli

@@ -6,6 +6,7 @@
 #include "automata/ops.h"
 #include "cli/common.h"
 #include "io/class_file.h"
+#include "io/reach_json.h"
 
 namespace pathex::cli {
 namespace {
@@ -20,12 +21,6 @@ struct ExplainArgs {
   NotationOptions notation;
   Limits limits;
 };
-
-nlohmann::json count_json(const BigUint& b) {
-  std::uint64_t v = 0;
-  if (b.to_u64(&v)) return v;
-  return b.to_string();  // exact, as a decimal string, when it does not fit 64 bits
-}
 
 nlohmann::json chains_json(const std::string& path) {
   nlohmann::json arr = nlohmann::json::array();
@@ -77,9 +72,9 @@ int run(const ExplainArgs& a) {
     j["live_states"] = d.live_count();
     j["empty"] = empty;
     j["finite"] = finite;
-    nlohmann::json counts_j = nlohmann::json::object();
+    nlohmann::json counts_j = nlohmann::json::array();
     for (std::size_t n = 0; n < counts.size(); ++n)
-      if (!counts[n].is_zero()) counts_j[std::to_string(n)] = count_json(counts[n]);
+      if (!counts[n].is_zero()) counts_j.push_back({{"length", n}, {"count", count_json(counts[n])}});
     j["counts_by_length"] = counts_j;
     j["max_len"] = a.max_len;
     nlohmann::json ms = nlohmann::json::array();

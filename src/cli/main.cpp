@@ -11,7 +11,8 @@ int main(int argc, char** argv) {
                "Example: pathex explain 'L.*DD.*E'"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "pathex 0.1.0");
-  std::vector<Command> commands = {add_explain(app), add_match(app), add_classify(app)};
+  std::vector<Command> commands = {add_explain(app), add_match(app), add_classify(app),
+                                   add_query(app), add_check(app), add_renderers(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

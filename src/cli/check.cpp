@@ -1,0 +1,296 @@
+// pathex check: the CI gate. A check file lists cases (renderer, optional scene and bound) and
+// their requirements; every requirement is decided exactly, and a failure names the verdict
+// found and the shortest counterexample with its chains.
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "automata/ops.h"
+#include "cli/common.h"
+#include "cli/reach_common.h"
+#include "io/atomic_file.h"
+#include "io/class_file.h"
+#include "io/junit.h"
+#include "io/reach_json.h"
+
+namespace pathex::cli {
+namespace {
+
+struct CheckArgs {
+  std::string file;
+  bool json = false;
+  std::string junit;
+  Limits limits;
+};
+
+struct Requirement {
+  std::string pointer;
+  bool covers_scene = false;
+  std::string cls;
+  std::string verdict;  // reachable, not-unreachable, unreachable, partial, empty
+  std::string describe() const {
+    return covers_scene ? "covers the scene" : cls + " is " + verdict;
+  }
+};
+
+struct Case {
+  std::string pointer;
+  std::string name;
+  std::string renderer;
+  std::string scene;
+  std::optional<int> max_bounces;
+  Notation notation = Notation::kFull;
+  std::string classes;
+  std::vector<Requirement> require;
+};
+
+struct Outcome {
+  const Case* c = nullptr;
+  const Requirement* r = nullptr;
+  bool passed = false;
+  std::string verdict;
+  std::optional<Witness> counterexample;
+  double time_s = 0.0;
+};
+
+Error bad(const std::string& file, const std::string& pointer, std::string message) {
+  Error e = make_error(ErrorCode::kBadFile, std::move(message));
+  e.where = file + ":" + pointer;
+  return e;
+}
+
+// Relative paths in a check file are tried against the check file's folder, then the current one.
+std::string resolve(const std::string& check_file, const std::string& p) {
+  namespace fs = std::filesystem;
+  if (p.empty() || fs::path(p).is_absolute()) return p;
+  const fs::path beside = fs::path(check_file).parent_path() / p;
+  std::error_code ec;
+  if (fs::exists(beside, ec)) return beside.string();
+  return p;
+}
+
+Result<std::vector<Case>> parse_check(const std::string& text, const std::string& file) {
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& ex) {
+    return bad(file, "/", std::string("not valid JSON: ") + ex.what());
+  }
+  if (!doc.is_object()) return bad(file, "/", "expected an object with a \"cases\" array");
+  for (const auto& [k, v] : doc.items())
+    if (k != "cases" && k != "$schema" && k != "description")
+      return bad(file, "/" + k, "unknown key '" + k + "', expected cases");
+  if (!doc.contains("cases") || !doc["cases"].is_array()) return bad(file, "/cases", "expected an array of cases");
+  std::vector<Case> cases;
+  const auto& arr = doc["cases"];
+  for (std::size_t i = 0; i < arr.size(); ++i) {
+    const std::string ptr = "/cases/" + std::to_string(i);
+    const auto& jc = arr[i];
+    if (!jc.is_object()) return bad(file, ptr, "expected an object with name, renderer and require");
+    for (const auto& [k, v] : jc.items())
+      if (k != "name" && k != "renderer" && k != "scene" && k != "max_bounces" && k != "require" && k != "notation" &&
+          k != "classes" && k != "description")
+        return bad(file, ptr + "/" + k,
+                   "unknown key '" + k + "', expected one of name, renderer, scene, max_bounces, require, notation, classes, description");
+    Case c;
+    c.pointer = ptr;
+    if (!jc.contains("name") || !jc["name"].is_string()) return bad(file, ptr + "/name", "expected a string case name");
+    c.name = jc["name"];
+    if (!jc.contains("renderer") || !jc["renderer"].is_string())
+      return bad(file, ptr + "/renderer", "expected a renderer: a built-in profile name or a profile file");
+    c.renderer = jc["renderer"];
+    if (c.renderer.find('/') != std::string::npos || c.renderer.ends_with(".json")) c.renderer = resolve(file, c.renderer);
+    if (jc.contains("scene")) {
+      if (!jc["scene"].is_string()) return bad(file, ptr + "/scene", "expected a scene file path");
+      c.scene = resolve(file, jc["scene"]);
+    }
+    if (jc.contains("classes")) {
+      if (!jc["classes"].is_string()) return bad(file, ptr + "/classes", "expected a class file path");
+      c.classes = resolve(file, jc["classes"]);
+    }
+    if (jc.contains("max_bounces") && !jc["max_bounces"].is_null()) {
+      const auto& m = jc["max_bounces"];
+      if (!m.is_number_integer() || m.get<long long>() < 0 || m.get<long long>() > 10000)
+        return bad(file, ptr + "/max_bounces", "expected a non-negative integer, found " + m.dump());
+      c.max_bounces = m.get<int>();
+    }
+    if (jc.contains("notation")) {
+      if (jc["notation"] == "full") c.notation = Notation::kFull;
+      else if (jc["notation"] == "heckbert") c.notation = Notation::kHeckbert;
+      else return bad(file, ptr + "/notation", "expected \"full\" or \"heckbert\"");
+    }
+    if (!jc.contains("require") || !jc["require"].is_array() || jc["require"].empty())
+      return bad(file, ptr + "/require", "expected a non-empty array of requirements");
+    const auto& reqs = jc["require"];
+    for (std::size_t j = 0; j < reqs.size(); ++j) {
+      const std::string rp = ptr + "/require/" + std::to_string(j);
+      const auto& jr = reqs[j];
+      if (!jr.is_object()) return bad(file, rp, "expected {\"class\": …, \"verdict\": …} or {\"covers-scene\": true}");
+      Requirement r;
+      r.pointer = rp;
+      for (const auto& [k, v] : jr.items())
+        if (k != "class" && k != "verdict" && k != "covers-scene")
+          return bad(file, rp + "/" + k, "unknown key '" + k + "', expected class and verdict, or covers-scene");
+      if (jr.contains("covers-scene")) {
+        if (jr["covers-scene"] != true) return bad(file, rp + "/covers-scene", "expected true");
+        if (jr.contains("class") || jr.contains("verdict"))
+          return bad(file, rp, "covers-scene stands alone: no class or verdict beside it");
+        r.covers_scene = true;
+      } else {
+        if (!jr.contains("class") || !jr["class"].is_string())
+          return bad(file, rp + "/class", "expected a class: an expression or a $name");
+        if (!jr.contains("verdict") || !jr["verdict"].is_string())
+          return bad(file, rp + "/verdict", "expected a verdict: reachable, not-unreachable, unreachable, partial or empty");
+        r.cls = jr["class"];
+        r.verdict = jr["verdict"];
+        if (r.verdict != "reachable" && r.verdict != "not-unreachable" && r.verdict != "unreachable" &&
+            r.verdict != "partial" && r.verdict != "empty")
+          return bad(file, rp + "/verdict",
+                     "unknown verdict '" + r.verdict + "', expected reachable, not-unreachable, unreachable, partial or empty");
+      }
+      c.require.push_back(std::move(r));
+    }
+    cases.push_back(std::move(c));
+  }
+  return cases;
+}
+
+bool satisfies(const std::string& wanted, Verdict v) {
+  if (wanted == "reachable") return v == Verdict::kReachable;
+  if (wanted == "not-unreachable") return v == Verdict::kReachable || v == Verdict::kPartial;
+  if (wanted == "unreachable") return v == Verdict::kUnreachable || v == Verdict::kEmpty;
+  return to_string(v) == wanted;
+}
+
+std::string chains_text(const std::vector<ChainEvidence>& chains) {
+  std::string s;
+  for (const ChainEvidence& c : chains)
+    s += (s.empty() ? "" : " ") + c.chain.letters + "(" + std::to_string(c.chain.from) + ".." + std::to_string(c.chain.to) + ")";
+  return s;
+}
+
+int run(const CheckArgs& a) {
+  std::string text;
+  Result<bool> read = read_text_file(a.file, &text);
+  if (!read) return report(read.error());
+  Result<std::vector<Case>> cases = parse_check(text, a.file);
+  if (!cases) return report(cases.error());
+
+  ReachCache cache(a.limits);
+  std::vector<Outcome> outcomes;
+  for (const Case& c : *cases) {
+    ReachSetup setup;
+    if (int rc = prepare_reach(cache, {c.renderer}, c.scene, c.max_bounces, &setup)) return rc;
+    ClassOptions copts;
+    copts.limits = a.limits;
+    copts.notation = c.notation;
+    if (setup.scene_ends) copts.ends = *setup.scene_ends;
+    ClassTable table;
+    if (!c.classes.empty()) {
+      Result<bool> r = read_class_file(c.classes, copts, &table);
+      if (!r) return report(r.error());
+    }
+    const CompiledProfile& cp = setup.compiled.front();
+    for (const Requirement& r : c.require) {
+      const auto t0 = std::chrono::steady_clock::now();
+      Outcome o;
+      o.c = &c;
+      o.r = &r;
+      QueryOptions qo;
+      qo.max_bounces = c.max_bounces;
+      qo.universe = setup.universe;
+      qo.witnesses = 1;
+      qo.max_len = 0;
+      qo.limits = a.limits;
+      Result<PathClass> pc = r.covers_scene ? compile_class("$all", copts, &table) : compile_class(r.cls, copts, &table);
+      if (!pc) {
+        Error e = pc.error();
+        e.where = a.file + ":" + r.pointer + (r.covers_scene ? "" : "/class");
+        return report(e);
+      }
+      Result<QueryResult> q = query(*pc, cp, qo);
+      if (!q) return report(q.error());
+      o.verdict = to_string(q->verdict);
+      o.passed = r.covers_scene ? (q->verdict == Verdict::kReachable || q->verdict == Verdict::kEmpty)
+                                : satisfies(r.verdict, q->verdict);
+      if (!o.passed) {
+        // The counterexample: for "reachable"-like requirements an unreachable path, else a reachable one.
+        const bool want_reach = r.covers_scene || r.verdict == "reachable" || r.verdict == "not-unreachable";
+        const std::vector<Witness>& side = want_reach ? q->unreachable : q->reachable;
+        if (!side.empty()) o.counterexample = side.front();
+      }
+      o.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      outcomes.push_back(std::move(o));
+    }
+  }
+
+  int failed = 0;
+  std::vector<JUnitCase> junit;
+  nlohmann::json jcases = nlohmann::json::array();
+  for (const Outcome& o : outcomes) {
+    failed += o.passed ? 0 : 1;
+    std::string message = o.r->describe() + ": found " + o.verdict;
+    std::string details;
+    if (o.counterexample) {
+      const Witness& w = *o.counterexample;
+      details = "shortest counterexample " + w.path + ", chains " + chains_text(w.chains) +
+                (w.reason.empty() ? "; sampled by " + [&] {
+                  std::string s;
+                  for (const std::string& st : w.strategies) s += (s.empty() ? "" : ", ") + st;
+                  return s;
+                }() : "; " + w.reason);
+    } else if (!o.passed && o.verdict == "empty") {
+      details = "the class has no path in this universe";
+    }
+    junit.push_back({o.c->name, o.r->describe(), o.time_s, !o.passed, message, details});
+    if (a.json) {
+      nlohmann::json jr = {{"case", o.c->name}, {"renderer", o.c->renderer}, {"requirement", o.r->describe()},
+                           {"passed", o.passed}, {"verdict", o.verdict}};
+      jr["scene"] = o.c->scene.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.c->scene);
+      jr["max_bounces"] = o.c->max_bounces ? nlohmann::json(*o.c->max_bounces) : nlohmann::json(nullptr);
+      if (o.counterexample) {
+        nlohmann::json chains = nlohmann::json::array();
+        for (const ChainEvidence& c : o.counterexample->chains) chains.push_back(to_json(c));
+        jr["counterexample"] = {{"path", o.counterexample->path}, {"chains", chains}};
+        if (o.counterexample->reason.empty()) jr["counterexample"]["strategies"] = o.counterexample->strategies;
+        else jr["counterexample"]["reason"] = o.counterexample->reason;
+      }
+      jcases.push_back(jr);
+    } else {
+      std::cout << (o.passed ? "PASS  " : "FAIL  ") << o.c->name << ": " << o.r->describe() << " (" << o.verdict << ")\n";
+      if (!o.passed && !details.empty()) std::cout << "      " << details << "\n";
+    }
+  }
+  const int passed = static_cast<int>(outcomes.size()) - failed;
+  if (a.json) {
+    std::cout << nlohmann::json{{"file", a.file}, {"passed", passed}, {"failed", failed}, {"requirements", jcases}}.dump(2)
+              << "\n";
+  } else {
+    std::cout << "check: " << passed << " passed, " << failed << " failed\n";
+  }
+  if (!a.junit.empty()) {
+    Result<bool> w = write_file_atomic(a.junit, junit_xml(a.file, junit));
+    if (!w) return report(w.error());
+  }
+  return failed ? kExitNo : kExitOk;
+}
+
+}  // namespace
+
+Command add_check(CLI::App& app) {
+  auto args = std::make_shared<CheckArgs>();
+  CLI::App* sub = app.add_subcommand("check", "CI gate: decide every requirement of a check file; exit 1 if any fails");
+  sub->footer("Example:\n  pathex check samples/checks/samples.json --junit report.xml\n"
+              "Check file: {\"cases\": [{\"name\": \"ptnee-ortho\", \"renderer\": \"pt-nee\", \"scene\": \"samples/scenes/mirror-ortho.json\",\n"
+              "  \"max_bounces\": 8, \"require\": [{\"class\": \"LSDSDE\", \"verdict\": \"reachable\"}, {\"covers-scene\": true}]}]}\n"
+              "Verdicts: reachable, not-unreachable, unreachable (also partial, empty). Exit 0 all pass, 1 a failure, 2 bad input.");
+  sub->add_option("FILE", args->file, "Check file (grammar/check.schema.json)")->required();
+  sub->add_flag("--json", args->json, "Machine-readable report");
+  sub->add_option("--junit", args->junit, "Also write a JUnit XML report here");
+  add_limit_options(sub, &args->limits);
+  return {sub, [args] { return run(*args); }};
+}
+
+}  // namespace pathex::cli

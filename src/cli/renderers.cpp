@@ -1,0 +1,71 @@
+// pathex renderers: the built-in profiles, their strategies and what they can reach.
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "automata/ops.h"
+#include "cli/common.h"
+#include "io/profile_json.h"
+#include "io/reach_json.h"
+#include "reach/query.h"
+
+namespace pathex::cli {
+namespace {
+
+struct RenderersArgs {
+  bool json = false;
+  int witnesses = 3;
+  Limits limits;
+};
+
+int run(const RenderersArgs& a) {
+  const Dfa local = dfa_intersect(compile_class("L.*DD.*E", ClassOptions{})->dfa, dfa_universe());
+  nlohmann::json arr = nlohmann::json::array();
+  for (const Profile& p : builtin_profiles(a.limits)) {
+    Result<CompiledProfile> cp = compile_profile(p, std::nullopt, a.limits);
+    if (!cp) return report(cp.error());
+    const Dfa missed = dfa_difference(dfa_universe(), cp->reachable);
+    const std::vector<std::string> misses = enumerate_members(missed, 16, static_cast<std::size_t>(a.witnesses));
+    const bool is_local = is_equivalent(cp->reachable, local);
+    const bool within_local = is_subset(cp->reachable, local);
+    const std::string relation = is_local ? "exactly the local paths L.*DD.*E"
+                                 : within_local ? "a proper subset of the local paths L.*DD.*E"
+                                                : "beyond local sampling (uses connectors)";
+    if (a.json) {
+      nlohmann::json j = {{"name", p.name}, {"description", p.description}, {"source", p.source}};
+      j["max_bounces"] = p.max_bounces ? nlohmann::json(*p.max_bounces) : nlohmann::json(nullptr);
+      nlohmann::json st = nlohmann::json::array();
+      for (const Strategy& s : p.strategies) st.push_back(to_json(s));
+      j["strategies"] = st;
+      j["reachable"] = {{"dfa_states", cp->reachable.num_states}, {"relation", relation},
+                        {"equals_local", is_local}, {"shortest_unreachable", misses}};
+      arr.push_back(j);
+      continue;
+    }
+    std::cout << p.name << (p.max_bounces ? "   (max_bounces " + std::to_string(*p.max_bounces) + ")" : "") << "\n  "
+              << p.description << "\n";
+    for (const Strategy& s : p.strategies) std::cout << "    " << s.name << " " << s.describe() << "\n";
+    std::cout << "  reaches " << relation << " (minimal DFA " << cp->reachable.num_states << " states)\n";
+    std::cout << "  shortest unreachable paths:";
+    for (const std::string& m : misses) std::cout << " " << m;
+    std::cout << (misses.empty() ? " none" : "") << "\n\n";
+  }
+  if (a.json) std::cout << arr.dump(2) << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+Command add_renderers(CLI::App& app) {
+  auto args = std::make_shared<RenderersArgs>();
+  CLI::App* sub = app.add_subcommand("renderers", "List the built-in renderer profiles, their strategies and reachable languages");
+  sub->footer("Example:\n  pathex renderers\n  pathex renderers --json | jq '.[].name'\n"
+              "Profiles are the JSON files in samples/renderers (schema: grammar/profile.schema.json).");
+  sub->add_flag("--json", args->json, "Machine-readable output");
+  sub->add_option("--witnesses", args->witnesses, "Shortest unreachable paths to list per profile")->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  add_limit_options(sub, &args->limits);
+  return {sub, [args] { return run(*args); }};
+}
+
+}  // namespace pathex::cli
