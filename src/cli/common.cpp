@@ -19,10 +19,10 @@ void add_notation_options(CLI::App* app, NotationOptions* n) {
   app->add_option("--notation", n->notation, "full (L c0 c1 … E) or heckbert (L w E, one letter per interior vertex)")
       ->check(CLI::IsMember({"full", "heckbert"}))->capture_default_str();
   app->add_option("--light", n->lights, "Light types for Heckbert notation: area, distant, point, laser (default all)")
-      ->delimiter(',');
+      ->delimiter(',')->allow_extra_args(false);
   app->add_option("--sensor", n->sensors,
                   "Sensor types for Heckbert notation: lens, pinhole, orthographic, spotmeter (default all)")
-      ->delimiter(',');
+      ->delimiter(',')->allow_extra_args(false);
 }
 
 Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limits) {

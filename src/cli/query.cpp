@@ -141,7 +141,8 @@ Command add_query(CLI::App& app) {
               "  pathex query --scene samples/scenes/mirror-ortho.json --renderer bdpt '$caustic'\n"
               "Without --renderer, pt, pt-nee, lt and bdpt are compared side by side.");
   sub->add_option("EXPR", args->exprs, "Path expressions (full notation unless --notation heckbert)")->required();
-  sub->add_option("--renderer", args->renderers, "Built-in profile name (see `pathex renderers`) or profile file; repeatable");
+  sub->add_option("--renderer", args->renderers, "Built-in profile name (see `pathex renderers`) or profile file; repeatable")
+      ->allow_extra_args(false);
   sub->add_option("--scene", args->scene, "Restrict the universe to this scene's lights, sensor and materials");
   sub->add_option("--max-bounces", args->max_bounces, "Only paths with at most N interior vertices; overrides the profiles' bound")
       ->check(CLI::Range(0, 10000));
