@@ -1,0 +1,342 @@
+// histogram.json writer and reader. The reader checks every value's type and reports the first
+// problem with the JSON pointer of the value, like the other JSON readers of pathex.
+#include "io/histogram_json.h"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+namespace pathex {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+json rgb_json(const Rgb& c) { return json::array({c[0], c[1], c[2]}); }
+json exact_rgb_json(const ExactRgb& c) {
+  return json::array({exact_to_string(c[0]), exact_to_string(c[1]), exact_to_string(c[2])});
+}
+json stderr_json(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+void put_estimate(json& j, const Estimate& e) {
+  j["estimate"] = rgb_json(e.rgb);
+  j["luminance"] = e.luminance;
+  j["stderr"] = stderr_json(e.std_error);
+  j["samples"] = e.samples;
+}
+
+// Reads typed values out of a document, remembering the first error (with its JSON pointer).
+class Reader {
+ public:
+  explicit Reader(const std::string& filename) : filename_(filename) {}
+
+  bool failed() const { return error_.has_value(); }
+  const Error& error() const { return *error_; }
+
+  void fail(const std::string& pointer, const std::string& message) {
+    if (error_) return;
+    Error e = make_error(ErrorCode::kBadFile, message);
+    e.where = filename_ + ":" + (pointer.empty() ? "/" : pointer);
+    error_ = std::move(e);
+  }
+
+  const json* field(const json& obj, const std::string& ptr, const char* key) {
+    if (!obj.is_object()) {
+      fail(ptr, "expected an object");
+      return nullptr;
+    }
+    auto it = obj.find(key);
+    if (it == obj.end()) {
+      fail(ptr, std::string("missing key \"") + key + "\"");
+      return nullptr;
+    }
+    return &*it;
+  }
+  std::string str(const json& obj, const std::string& ptr, const char* key) {
+    const json* v = field(obj, ptr, key);
+    if (v == nullptr) return {};
+    if (!v->is_string()) {
+      fail(ptr + "/" + key, "expected a string");
+      return {};
+    }
+    return v->get<std::string>();
+  }
+  std::uint64_t uint(const json& v, const std::string& ptr) {
+    if (!v.is_number_unsigned()) {
+      fail(ptr, "expected a non-negative integer");
+      return 0;
+    }
+    return v.get<std::uint64_t>();
+  }
+  std::uint64_t uint(const json& obj, const std::string& ptr, const char* key) {
+    const json* v = field(obj, ptr, key);
+    return v != nullptr ? uint(*v, ptr + "/" + key) : 0;
+  }
+  double number(const json& v, const std::string& ptr) {
+    if (!v.is_number()) {
+      fail(ptr, "expected a number");
+      return 0;
+    }
+    return v.get<double>();
+  }
+  double number(const json& obj, const std::string& ptr, const char* key) {
+    const json* v = field(obj, ptr, key);
+    return v != nullptr ? number(*v, ptr + "/" + key) : 0;
+  }
+  bool boolean(const json& obj, const std::string& ptr, const char* key) {
+    const json* v = field(obj, ptr, key);
+    if (v == nullptr) return false;
+    if (!v->is_boolean()) {
+      fail(ptr + "/" + key, "expected true or false");
+      return false;
+    }
+    return v->get<bool>();
+  }
+  const json* array(const json& obj, const std::string& ptr, const char* key, std::size_t size = kAnySize) {
+    const json* v = field(obj, ptr, key);
+    if (v == nullptr) return nullptr;
+    if (!v->is_array() || (size != kAnySize && v->size() != size)) {
+      fail(ptr + "/" + key,
+           size == kAnySize ? "expected an array" : "expected an array of " + std::to_string(size) + " elements");
+      return nullptr;
+    }
+    return v;
+  }
+  ExactSum exact(const json& v, const std::string& ptr) {
+    std::optional<ExactSum> e;
+    if (v.is_string()) e = exact_from_string(v.get<std::string>());
+    if (!e) {
+      fail(ptr, "expected an exact sum: \"0\" or a signed hexadecimal string such as \"0x1f\" or \"-0x1f\"");
+      return 0;
+    }
+    return *e;
+  }
+  ExactRgb exact_rgb(const json& v, const std::string& ptr) {
+    if (!v.is_array() || v.size() != 3) {
+      fail(ptr, "expected an array of 3 exact sums");
+      return {};
+    }
+    return {exact(v[0], ptr + "/0"), exact(v[1], ptr + "/1"), exact(v[2], ptr + "/2")};
+  }
+
+  Estimate estimate(const json& obj, const std::string& ptr, bool samples_required) {
+    Estimate e;
+    if (const json* rgb = array(obj, ptr, "estimate", 3))
+      for (std::size_t i = 0; i < 3; ++i) e.rgb[i] = number((*rgb)[i], ptr + "/estimate/" + std::to_string(i));
+    e.luminance = number(obj, ptr, "luminance");
+    if (const json* se = field(obj, ptr, "stderr"); se != nullptr && !se->is_null())
+      e.std_error = number(*se, ptr + "/stderr");
+    if (samples_required || (obj.is_object() && obj.contains("samples"))) e.samples = uint(obj, ptr, "samples");
+    return e;
+  }
+
+  static constexpr std::size_t kAnySize = static_cast<std::size_t>(-1);
+
+ private:
+  const std::string& filename_;
+  std::optional<Error> error_;
+};
+
+}  // namespace
+
+json to_json(const HistogramReport& r, const Histogram* raw) {
+  json doc = json::object();
+  doc["scene"] = r.run.scene;
+  doc["renderer"] = r.run.renderer;
+  doc["spp"] = r.run.spp;
+  doc["seed"] = r.run.seed;
+  doc["threads"] = r.run.threads;
+  doc["time_s"] = r.run.time_s;
+  doc["complete"] = r.run.complete;
+  doc["nonfinite_samples"] = r.nonfinite_samples;
+  json total = json::object();
+  put_estimate(total, r.total);
+  doc["total"] = std::move(total);
+  json classes = json::array();
+  for (const ClassEstimate& c : r.classes) {
+    json j = json::object();
+    j["name"] = c.name;
+    j["expr"] = c.expr;
+    put_estimate(j, c.estimate);
+    j["share"] = c.share;
+    classes.push_back(std::move(j));
+  }
+  doc["classes"] = std::move(classes);
+  json paths = json::array();
+  for (const PathEstimate& p : r.paths) {
+    json j = json::object();
+    j["path"] = p.path;
+    put_estimate(j, p.estimate);
+    json strategies = json::object();
+    for (const auto& [name, share] : p.strategies) strategies[name] = share;
+    j["strategies"] = std::move(strategies);
+    paths.push_back(std::move(j));
+  }
+  doc["paths"] = std::move(paths);
+  if (raw != nullptr) doc["raw"] = raw_to_json(*raw);
+  return doc;
+}
+
+std::string histogram_json_text(const HistogramReport& report, const Histogram* raw) {
+  return to_json(report, raw).dump(2) + "\n";
+}
+
+json raw_to_json(const Histogram& h) {
+  json raw = json::object();
+  raw["format"] = 1;
+  raw["fraction_bits"] = kFractionBits;
+  raw["batches"] = h.num_batches();
+  raw["strategies"] = h.layout().strategies;
+  json batch_samples = json::array();
+  for (int b = 0; b < h.num_batches(); ++b) batch_samples.push_back(h.batch_samples(b));
+  raw["batch_samples"] = std::move(batch_samples);
+  raw["nonfinite"] = h.nonfinite();
+  raw["magnitude"] = exact_to_string(h.magnitude());
+  // Paths by string, so that the section is the same whatever order the paths were first seen in.
+  std::vector<Histogram::PathId> order(static_cast<std::size_t>(h.num_paths()));
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<Histogram::PathId>(i);
+  std::sort(order.begin(), order.end(), [&](auto a, auto b) { return h.path(a) < h.path(b); });
+  json paths = json::array();
+  for (Histogram::PathId p : order) {
+    json j = json::object();
+    j["path"] = h.path(p);
+    json counts = json::array(), sums = json::array(), strategy_sums = json::array();
+    for (int b = 0; b < h.num_batches(); ++b) {
+      counts.push_back(h.cell(p, b).contributions);
+      sums.push_back(exact_rgb_json(h.cell(p, b).sum));
+    }
+    for (int s = 0; s < h.num_strategies(); ++s) strategy_sums.push_back(exact_rgb_json(h.strategy_sum(p, s)));
+    j["contributions"] = std::move(counts);
+    j["sums"] = std::move(sums);
+    j["strategy_sums"] = std::move(strategy_sums);
+    paths.push_back(std::move(j));
+  }
+  raw["paths"] = std::move(paths);
+  return raw;
+}
+
+Result<Histogram> raw_from_json(const json& raw, const std::string& filename, const std::string& ptr) {
+  Reader rd(filename);
+  if (!raw.is_object()) rd.fail(ptr, "expected an object");
+  if (!rd.failed() && rd.uint(raw, ptr, "format") != 1) rd.fail(ptr + "/format", "expected format 1");
+  if (!rd.failed() && rd.uint(raw, ptr, "fraction_bits") != static_cast<std::uint64_t>(kFractionBits))
+    rd.fail(ptr + "/fraction_bits", "expected " + std::to_string(kFractionBits));
+  HistogramLayout layout;
+  const std::uint64_t batches = rd.failed() ? 0 : rd.uint(raw, ptr, "batches");
+  if (!rd.failed() && (batches < 1 || batches > 1000000)) rd.fail(ptr + "/batches", "expected 1 to 1000000 batches");
+  layout.num_batches = static_cast<int>(batches);
+  if (const json* s = rd.failed() ? nullptr : rd.array(raw, ptr, "strategies")) {
+    for (std::size_t i = 0; i < s->size(); ++i) {
+      if (!(*s)[i].is_string()) rd.fail(ptr + "/strategies/" + std::to_string(i), "expected a strategy name");
+      else layout.strategies.push_back((*s)[i].get<std::string>());
+    }
+  }
+  if (rd.failed()) return rd.error();
+  const std::size_t B = static_cast<std::size_t>(batches);
+  const std::size_t S = layout.strategies.size();
+  Histogram h(layout);
+  if (const json* n = rd.array(raw, ptr, "batch_samples", B))
+    for (std::size_t b = 0; b < B; ++b)
+      h.add_samples(static_cast<int>(b), rd.uint((*n)[b], ptr + "/batch_samples/" + std::to_string(b)));
+  h.add_nonfinite(rd.uint(raw, ptr, "nonfinite"));
+  if (const json* m = rd.field(raw, ptr, "magnitude")) h.add_magnitude(rd.exact(*m, ptr + "/magnitude"));
+  if (const json* paths = rd.array(raw, ptr, "paths")) {
+    for (std::size_t i = 0; i < paths->size() && !rd.failed(); ++i) {
+      const json& pj = (*paths)[i];
+      const std::string pp = ptr + "/paths/" + std::to_string(i);
+      const std::string path = rd.str(pj, pp, "path");
+      if (rd.failed()) break;
+      if (h.find(path)) {
+        rd.fail(pp + "/path", "path \"" + path + "\" appears twice");
+        break;
+      }
+      const Histogram::PathId id = h.intern(path);
+      const json* counts = rd.array(pj, pp, "contributions", B);
+      const json* sums = rd.array(pj, pp, "sums", B);
+      const json* ssums = rd.array(pj, pp, "strategy_sums", S);
+      if (rd.failed()) break;
+      for (std::size_t b = 0; b < B; ++b) {
+        const std::string bs = std::to_string(b);
+        h.add_cell(id, static_cast<int>(b), rd.exact_rgb((*sums)[b], pp + "/sums/" + bs),
+                   rd.uint((*counts)[b], pp + "/contributions/" + bs));
+      }
+      for (std::size_t s = 0; s < S; ++s)
+        h.add_strategy_sum(id, static_cast<int>(s),
+                           rd.exact_rgb((*ssums)[s], pp + "/strategy_sums/" + std::to_string(s)));
+    }
+  }
+  if (rd.failed()) return rd.error();
+  return h;
+}
+
+Result<HistogramFile> histogram_from_json(const json& doc, const std::string& filename) {
+  Reader rd(filename);
+  HistogramFile file;
+  HistogramReport& r = file.report;
+  if (!doc.is_object()) {
+    rd.fail("", "expected a JSON object (a histogram.json document)");
+    return rd.error();
+  }
+  r.run.scene = rd.str(doc, "", "scene");
+  r.run.renderer = rd.str(doc, "", "renderer");
+  r.run.spp = rd.uint(doc, "", "spp");
+  r.run.seed = rd.uint(doc, "", "seed");
+  if (const json* t = rd.field(doc, "", "threads")) {
+    if (!t->is_number_integer() || t->get<std::int64_t>() < 0 || t->get<std::int64_t>() > 1 << 20)
+      rd.fail("/threads", "expected a thread count");
+    else
+      r.run.threads = t->get<int>();
+  }
+  r.run.time_s = rd.number(doc, "", "time_s");
+  r.run.complete = rd.boolean(doc, "", "complete");
+  r.nonfinite_samples = rd.uint(doc, "", "nonfinite_samples");
+  if (const json* t = rd.field(doc, "", "total")) r.total = rd.estimate(*t, "/total", /*samples_required=*/false);
+  if (const json* classes = rd.array(doc, "", "classes")) {
+    for (std::size_t i = 0; i < classes->size() && !rd.failed(); ++i) {
+      const json& cj = (*classes)[i];
+      const std::string cp = "/classes/" + std::to_string(i);
+      ClassEstimate c;
+      c.name = rd.str(cj, cp, "name");
+      c.expr = rd.str(cj, cp, "expr");
+      c.estimate = rd.estimate(cj, cp, /*samples_required=*/true);
+      c.share = rd.number(cj, cp, "share");
+      r.classes.push_back(std::move(c));
+    }
+  }
+  if (const json* paths = rd.array(doc, "", "paths")) {
+    for (std::size_t i = 0; i < paths->size() && !rd.failed(); ++i) {
+      const json& pj = (*paths)[i];
+      const std::string pp = "/paths/" + std::to_string(i);
+      PathEstimate p;
+      p.path = rd.str(pj, pp, "path");
+      p.estimate = rd.estimate(pj, pp, /*samples_required=*/true);
+      if (const json* s = rd.field(pj, pp, "strategies")) {
+        if (!s->is_object()) rd.fail(pp + "/strategies", "expected an object of strategy shares");
+        else
+          for (const auto& [name, share] : s->items())
+            p.strategies.emplace_back(name, rd.number(share, pp + "/strategies/" + name));
+      }
+      r.paths.push_back(std::move(p));
+    }
+  }
+  if (rd.failed()) return rd.error();
+  if (auto it = doc.find("raw"); it != doc.end()) {
+    Result<Histogram> h = raw_from_json(*it, filename, "/raw");
+    if (!h) return h.error();
+    file.raw = std::move(h).value();
+  }
+  return file;
+}
+
+Result<HistogramFile> parse_histogram_json(const std::string& text, const std::string& filename) {
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& ex) {
+    Error e = make_error(ErrorCode::kBadFile, std::string("not valid JSON: ") + ex.what());
+    e.where = filename;
+    return e;
+  }
+  return histogram_from_json(doc, filename);
+}
+
+}  // namespace pathex

@@ -1,0 +1,65 @@
+// histogram.json: the path-class histogram of a render (issue 4 "Outputs"), and back.
+//
+// Keys (stable; objects are written in this order):
+//
+//   scene              string   the scene file (or the embedded default's name)
+//   renderer           string   the renderer profile's name
+//   spp                integer  samples per pixel
+//   seed               integer
+//   threads            integer
+//   time_s             number   wall-clock render time in seconds
+//   complete           bool     false when the render was interrupted and wrote what it had
+//   nonfinite_samples  integer  contributions that were NaN, infinite or ≥ 2^50 (never added; must be 0)
+//   total    {estimate [r,g,b], luminance, stderr, samples}
+//   classes  [{name, expr, estimate [r,g,b], luminance, stderr, samples, share}]   in class-file order
+//   paths    [{path, estimate [r,g,b], luminance, stderr, samples, strategies {name: share}}]
+//            sorted by luminance, largest first
+//   raw      optional: the exact accumulator state, for merging (below)
+//
+// An estimate is the mean pixel value over the image (RGB, and its Rec. 709 luminance); stderr is
+// the standard error of the luminance by batch means (null when fewer than two batches hold
+// samples); samples counts nonzero contributions; a class's share is its luminance over the
+// total's; a path's strategies give each strategy's share of the path's luminance. `samples` in
+// `total` is an addition to the keys listed in issue 4.
+//
+// The optional "raw" section carries the Histogram itself — per path and batch the exact
+// fixed-point sums (as the signed hexadecimal strings of exact_to_string) and contribution
+// counts, per path and strategy the exact sums, per batch the sample counts — so that the outputs
+// of separate processes can be parsed back and merged exactly (Histogram::merge):
+//
+//   raw {format: 1, fraction_bits: 64, batches: B, strategies: [names], batch_samples: [B ints],
+//        nonfinite: n, magnitude: "0x…",
+//        paths: [{path, contributions: [B ints], sums: [B × [r,g,b]], strategy_sums: [S × [r,g,b]]}]}
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "classify/histogram.h"
+#include "core/error.h"
+
+namespace pathex {
+
+struct HistogramFile {
+  HistogramReport report;
+  std::optional<Histogram> raw;  // when the document has a "raw" section
+};
+
+// The document; with `raw`, also its "raw" section.
+nlohmann::ordered_json to_json(const HistogramReport& report, const Histogram* raw = nullptr);
+// The document as text, two-space indented, ending in a newline.
+std::string histogram_json_text(const HistogramReport& report, const Histogram* raw = nullptr);
+
+nlohmann::ordered_json raw_to_json(const Histogram& histogram);
+
+// Parses a document written by to_json. Errors name `filename` and the JSON pointer of the
+// offending value. Unknown keys are ignored (later versions may add keys).
+Result<HistogramFile> histogram_from_json(const nlohmann::ordered_json& doc, const std::string& filename);
+Result<HistogramFile> parse_histogram_json(const std::string& text, const std::string& filename);
+// The "raw" section alone; `pointer` is where it sits in the document, for messages.
+Result<Histogram> raw_from_json(const nlohmann::ordered_json& raw, const std::string& filename,
+                                const std::string& pointer = "/raw");
+
+}  // namespace pathex

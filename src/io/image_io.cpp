@@ -1,0 +1,245 @@
+// OpenEXR and PNG encoding in memory (so that write_file_atomic can place the file whole), EXR
+// reading, and the preview tone mapping. OpenEXR reports errors by exceptions; they are caught
+// here and turned into Error values naming the file.
+#include "io/image_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <half.h>
+#include <png.h>
+
+#include "io/atomic_file.h"
+
+namespace pathex {
+namespace {
+
+Error file_error(const std::string& path, std::string message) {
+  Error e = make_error(ErrorCode::kBadFile, std::move(message));
+  e.where = path;
+  return e;
+}
+
+// An OpenEXR output stream into a string.
+class MemoryOStream : public Imf::OStream {
+ public:
+  MemoryOStream() : Imf::OStream("<memory>") {}
+  void write(const char c[], int n) override {
+    const auto count = static_cast<std::size_t>(n);
+    if (pos_ + count > bytes_.size()) bytes_.resize(pos_ + count);
+    std::memcpy(bytes_.data() + pos_, c, count);
+    pos_ += count;
+  }
+  uint64_t tellp() override { return pos_; }
+  void seekp(uint64_t pos) override { pos_ = static_cast<std::size_t>(pos); }
+  std::string take() { return std::move(bytes_); }
+
+ private:
+  std::string bytes_;
+  std::size_t pos_ = 0;
+};
+
+Result<bool> check_layers(const std::vector<ImageLayer>& layers) {
+  if (layers.empty()) return make_error(ErrorCode::kUsage, "no image layers to write");
+  const int w = layers[0].image.width, h = layers[0].image.height;
+  if (w <= 0 || h <= 0) return make_error(ErrorCode::kUsage, "cannot write an empty image");
+  std::set<std::string> names;
+  for (const ImageLayer& l : layers) {
+    if (l.name.empty()) return make_error(ErrorCode::kUsage, "an image layer has no name");
+    if (!names.insert(l.name).second)
+      return make_error(ErrorCode::kUsage, "two image layers are named '" + l.name + "'");
+    if (l.image.width != w || l.image.height != h ||
+        l.image.rgb.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3)
+      return make_error(ErrorCode::kUsage, "image layer '" + l.name + "' does not have the size of the others");
+  }
+  return true;
+}
+
+double srgb_encode(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055; }
+
+}  // namespace
+
+// --- OpenEXR ---
+
+Result<std::string> encode_exr(const std::vector<ImageLayer>& layers, const ExrOptions& options) {
+  if (Result<bool> ok = check_layers(layers); !ok) return ok.error();
+  const int w = layers[0].image.width, h = layers[0].image.height;
+  const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  const Imf::PixelType type = options.half ? Imf::HALF : Imf::FLOAT;
+  const std::size_t size = options.half ? sizeof(half) : sizeof(float);
+  try {
+    Imf::Header header(w, h);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    // Half channels need their own buffers; float channels point straight into the layers.
+    std::vector<std::vector<half>> halves;
+    Imf::FrameBuffer frame;
+    static const char* const kChannel[3] = {"R", "G", "B"};
+    for (const ImageLayer& l : layers) {
+      const char* base = reinterpret_cast<const char*>(l.image.rgb.data());
+      std::size_t x_stride = 3 * sizeof(float);
+      if (options.half) {
+        halves.emplace_back(pixels * 3);
+        for (std::size_t i = 0; i < pixels * 3; ++i) halves.back()[i] = half(l.image.rgb[i]);
+        base = reinterpret_cast<const char*>(halves.back().data());
+        x_stride = 3 * sizeof(half);
+      }
+      for (std::size_t c = 0; c < 3; ++c) {
+        const std::string name = l.name + "." + kChannel[c];
+        header.channels().insert(name, Imf::Channel(type));
+        frame.insert(name, Imf::Slice(type, const_cast<char*>(base + c * size), x_stride,
+                                      x_stride * static_cast<std::size_t>(w)));
+      }
+    }
+    MemoryOStream out;
+    {
+      Imf::OutputFile file(out, header);
+      file.setFrameBuffer(frame);
+      file.writePixels(h);
+    }  // the destructor completes the file (line offset table)
+    return out.take();
+  } catch (const std::exception& ex) {
+    return make_error(ErrorCode::kBadFile, std::string("OpenEXR could not encode the image: ") + ex.what());
+  }
+}
+
+Result<bool> write_exr(const std::string& path, const std::vector<ImageLayer>& layers, const ExrOptions& options) {
+  Result<std::string> bytes = encode_exr(layers, options);
+  if (!bytes) {
+    Error e = bytes.error();
+    e.where = path;
+    return e;
+  }
+  return write_file_atomic(path, *bytes);
+}
+
+Result<ExrChannels> read_exr(const std::string& path) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    ExrChannels out;
+    out.width = dw.max.x - dw.min.x + 1;
+    out.height = dw.max.y - dw.min.y + 1;
+    const std::size_t pixels = static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height);
+    Imf::FrameBuffer frame;
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+      std::vector<float>& data = out.channels[it.name()];
+      data.assign(pixels, 0.0f);
+      frame.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, data.data(), dw));
+    }
+    file.setFrameBuffer(frame);
+    file.readPixels(dw.min.y, dw.max.y);
+    return out;
+  } catch (const std::exception& ex) {
+    return file_error(path, std::string("cannot read the EXR file: ") + ex.what());
+  }
+}
+
+Result<std::vector<ImageLayer>> read_exr_layers(const std::string& path) {
+  Result<ExrChannels> exr = read_exr(path);
+  if (!exr) return exr.error();
+  std::vector<ImageLayer> layers;
+  for (const auto& [name, data] : exr->channels) {
+    if (name.size() < 3 || name.substr(name.size() - 2) != ".R") continue;
+    const std::string layer = name.substr(0, name.size() - 2);
+    auto g = exr->channels.find(layer + ".G"), b = exr->channels.find(layer + ".B");
+    if (g == exr->channels.end() || b == exr->channels.end()) continue;
+    ImageLayer l;
+    l.name = layer;
+    l.image.width = exr->width;
+    l.image.height = exr->height;
+    l.image.rgb.resize(data.size() * 3);
+    for (std::size_t i = 0; i < data.size(); ++i) {
+      l.image.rgb[3 * i] = data[i];
+      l.image.rgb[3 * i + 1] = g->second[i];
+      l.image.rgb[3 * i + 2] = b->second[i];
+    }
+    layers.push_back(std::move(l));
+  }
+  return layers;
+}
+
+// --- PNG previews ---
+
+double preview_exposure(const RgbImage& total) {
+  const std::size_t pixels = total.rgb.size() / 3;
+  std::vector<double> lum;
+  lum.reserve(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const double l = luminance({total.rgb[3 * i], total.rgb[3 * i + 1], total.rgb[3 * i + 2]});
+    lum.push_back(std::isfinite(l) ? l : 0.0);
+  }
+  if (lum.empty()) return 1;
+  // Nearest rank: the smallest value with at least 99 % of the pixels at or below it.
+  const std::size_t rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(lum.size()))) - 1;
+  std::nth_element(lum.begin(), lum.begin() + static_cast<std::ptrdiff_t>(rank), lum.end());
+  const double p99 = lum[rank];
+  if (p99 > 0) return 1 / p99;
+  const double top = *std::max_element(lum.begin(), lum.end());
+  return top > 0 ? 1 / top : 1;
+}
+
+std::vector<std::uint8_t> tonemap_srgb8(const RgbImage& image, double exposure) {
+  std::vector<std::uint8_t> out(image.rgb.size());
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) {
+    double v = image.rgb[i] * exposure;
+    v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0;  // NaN and ±inf never reach a finished image
+    out[i] = static_cast<std::uint8_t>(std::lround(255 * srgb_encode(v)));
+  }
+  return out;
+}
+
+Result<std::string> encode_png(int width, int height, const std::vector<std::uint8_t>& rgb8) {
+  if (width <= 0 || height <= 0 ||
+      rgb8.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3)
+    return make_error(ErrorCode::kUsage, "the PNG pixels do not match its size");
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  image.width = static_cast<png_uint_32>(width);
+  image.height = static_cast<png_uint_32>(height);
+  image.format = PNG_FORMAT_RGB;
+  png_alloc_size_t size = 0;
+  // The first call measures, the second writes.
+  if (!png_image_write_to_memory(&image, nullptr, &size, 0, rgb8.data(), 0, nullptr))
+    return make_error(ErrorCode::kBadFile, std::string("libpng could not encode the image: ") + image.message);
+  std::string bytes(size, '\0');
+  if (!png_image_write_to_memory(&image, bytes.data(), &size, 0, rgb8.data(), 0, nullptr))
+    return make_error(ErrorCode::kBadFile, std::string("libpng could not encode the image: ") + image.message);
+  bytes.resize(size);
+  return bytes;
+}
+
+Result<bool> write_png(const std::string& path, const RgbImage& image, double exposure) {
+  Result<std::string> bytes = encode_png(image.width, image.height, tonemap_srgb8(image, exposure));
+  if (!bytes) {
+    Error e = bytes.error();
+    e.where = path;
+    return e;
+  }
+  return write_file_atomic(path, *bytes);
+}
+
+Result<bool> write_previews(const std::string& dir, const std::vector<ImageLayer>& layers) {
+  if (Result<bool> ok = check_layers(layers); !ok) {
+    Error e = ok.error();
+    e.where = dir;
+    return e;
+  }
+  auto total = std::find_if(layers.begin(), layers.end(), [](const ImageLayer& l) { return l.name == "total"; });
+  const double exposure = preview_exposure((total != layers.end() ? *total : layers[0]).image);
+  for (const ImageLayer& l : layers) {
+    Result<bool> ok = write_png((dir.empty() ? std::string(".") : dir) + "/" + l.name + ".png", l.image, exposure);
+    if (!ok) return ok;
+  }
+  return true;
+}
+
+}  // namespace pathex

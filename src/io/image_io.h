@@ -1,0 +1,56 @@
+// Image outputs of `pathex trace`: one multi-layer OpenEXR file (a layer per class plus "total",
+// channels "<layer>.R", "<layer>.G", "<layer>.B") and an 8-bit sRGB PNG preview per layer.
+//
+// Every writer encodes in memory and hands the bytes to write_file_atomic (io/atomic_file.h), so
+// an output file is written whole or not at all (DESIGN §12). Errors are values naming the path.
+//
+// Previews share one exposure, chosen so that the 99th percentile of the total's luminance maps
+// to 1 (preview_exposure), so class previews are comparable with the total and with each other;
+// values are then encoded with the sRGB transfer curve and clamped to [0, 1].
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "classify/image.h"
+#include "core/error.h"
+
+namespace pathex {
+
+// --- OpenEXR ---
+
+struct ExrOptions {
+  bool half = false;  // 16-bit half channels instead of 32-bit float (values above 65504 become inf)
+};
+
+// The EXR file's bytes. All layers must have the same nonzero size and distinct, nonempty names.
+Result<std::string> encode_exr(const std::vector<ImageLayer>& layers, const ExrOptions& options = {});
+Result<bool> write_exr(const std::string& path, const std::vector<ImageLayer>& layers, const ExrOptions& options = {});
+
+// Every channel of a scanline or tiled EXR file, as floats, row-major from the top of the data
+// window. For reading outputs back (tests, references, merging).
+struct ExrChannels {
+  int width = 0;
+  int height = 0;
+  std::map<std::string, std::vector<float>> channels;  // by full channel name, e.g. "caustic.R"
+};
+Result<ExrChannels> read_exr(const std::string& path);
+// The layers of a file written by write_exr: every "<layer>.R/.G/.B" triple, by layer name.
+Result<std::vector<ImageLayer>> read_exr_layers(const std::string& path);
+
+// --- PNG previews ---
+
+// 1 / (the 99th percentile, nearest rank, of the pixel luminances of `total`); if that is not
+// positive, 1 / the largest luminance; if that is not positive either, 1.
+double preview_exposure(const RgbImage& total);
+// Pixels times exposure, sRGB-encoded, clamped, rounded to 8 bits; RGB interleaved.
+std::vector<std::uint8_t> tonemap_srgb8(const RgbImage& image, double exposure);
+// An 8-bit RGB PNG (the file's bytes).
+Result<std::string> encode_png(int width, int height, const std::vector<std::uint8_t>& rgb8);
+Result<bool> write_png(const std::string& path, const RgbImage& image, double exposure);
+// DIR/<layer>.png for every layer, with the exposure of the layer named "total" (else the first).
+Result<bool> write_previews(const std::string& dir, const std::vector<ImageLayer>& layers);
+
+}  // namespace pathex
