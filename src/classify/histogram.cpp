@@ -77,7 +77,7 @@ ExactSum add_saturating(ExactSum a, ExactSum b, ExactSum cap) { return b >= cap 
 
 }  // namespace
 
-void Histogram::add(PathId id, int batch, int strategy, const ExactRgb& c) {
+void Histogram::add_exact(PathId id, int batch, int strategy, const ExactRgb& c) {
   if (is_zero(c)) return;
   Cell& cell = cells_[cell_index(id, batch)];
   add_to(cell.sum, c);

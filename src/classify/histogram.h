@@ -143,12 +143,12 @@ class Histogram {
       ++nonfinite_;
       return false;
     }
-    add(id, batch, strategy, *e);
+    add_exact(id, batch, strategy, *e);
     return true;
   }
   // The same for a contribution already converted (so that it is rounded once for the histogram
   // and the images). An all-zero contribution is ignored.
-  void add(PathId id, int batch, int strategy, const ExactRgb& c);
+  void add_exact(PathId id, int batch, int strategy, const ExactRgb& c);
   // Registers n finished samples of `batch`, whether they contributed or not: n_b above.
   void add_samples(int batch, std::uint64_t n) { batch_samples_[static_cast<std::size_t>(batch)] += n; }
   // Counts non-finite contributions that the caller rejected itself (e.g. after to_exact()).

@@ -1,0 +1,532 @@
+// Path-class histograms and per-class images: exact fixed-point sums, batch-means statistics
+// against closed forms and the textbook standard error, exact and order-independent merging,
+// non-finite contributions, class shares, and lock-free image accumulation.
+#include "classify/histogram.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <thread>
+
+#include "classify/image.h"
+#include "io/histogram_json.h"
+
+namespace pathex {
+namespace {
+
+// A small, fully specified generator (splitmix64), so that the statistical tests are the same
+// on every platform.
+struct Rng {
+  std::uint64_t state;
+  std::uint64_t next() {
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }
+};
+
+Rgb gray(double v) { return {v, v, v}; }
+
+// --- exact sums ---
+
+TEST(ExactSum, RoundsOnceToTheGridAndConvertsBack) {
+  for (double v : {0.0, 0.5, -3.25, 1234567.875, -0x1p-64, 0x1p49}) {
+    std::optional<ExactRgb> e = to_exact({v, v, v});
+    ASSERT_TRUE(e) << v;
+    EXPECT_EQ(to_double((*e)[0]), v) << "grid values are exact";
+  }
+  EXPECT_EQ(to_double((*to_exact(gray(1e-30)))[0]), 0.0) << "below the grid's resolution";
+  EXPECT_EQ((*to_exact(gray(0x1p-65 * 3)))[0], ExactSum{2}) << "1.5 grid steps round to nearest even";
+  const double inf = std::numeric_limits<double>::infinity();
+  for (double bad : {std::nan(""), inf, -inf, kMaxContribution, -kMaxContribution})
+    EXPECT_FALSE(to_exact({0.0, bad, 0.0})) << bad;
+}
+
+TEST(ExactSum, TextRoundTrip) {
+  const ExactSum top = static_cast<ExactSum>(1) << 127;
+  for (ExactSum v : {ExactSum{0}, ExactSum{1}, ExactSum{0} - 1, static_cast<ExactSum>(0x1f) << 70, top - 1, top})
+    EXPECT_EQ(exact_from_string(exact_to_string(v)), v) << exact_to_string(v);
+  EXPECT_EQ(exact_to_string(ExactSum{0} - 31), "-0x1f");
+  EXPECT_EQ(exact_to_string(ExactSum{1} << 64), "0x10000000000000000");  // the value 1.0
+  EXPECT_EQ(exact_to_string(top), "-0x80000000000000000000000000000000");
+  for (const char* bad : {"", "1", "0x", "0X1", "0x1G", "--0x1", "0x100000000000000000000000000000000",
+                          "0x80000000000000000000000000000000"})
+    EXPECT_FALSE(exact_from_string(bad)) << bad;
+}
+
+// --- batch means ---
+
+TEST(BatchMeans, EqualBatchesGiveTheTextbookFormula) {
+  // Four batches of 10 samples with batch means 1, 2, 3, 4: the mean is 2.5 and
+  // stderr² = Σ (X_b − X̄)² / (B (B − 1)) = 5 / 12.
+  std::vector<ExactRgb> sums;
+  for (double s : {10.0, 20.0, 30.0, 40.0}) sums.push_back(*to_exact(gray(s)));
+  Estimate e = batch_means(sums, {10, 10, 10, 10}, 7);
+  EXPECT_DOUBLE_EQ(e.luminance, 2.5);
+  EXPECT_DOUBLE_EQ(e.rgb[0], 2.5);
+  EXPECT_NEAR(e.std_error, std::sqrt(5.0 / 12.0), 1e-15);
+  EXPECT_EQ(e.samples, 7u);
+}
+
+TEST(BatchMeans, UnequalBatchesUseTheUnbiasedWeightedForm) {
+  // n = (1, 3), S = (2, 3): N = 4, X̄ = 5/4, Σ (S_b − n_b X̄)² = 9/8, N² − Σ n_b² = 6: stderr² = 3/16.
+  Estimate e = batch_means({*to_exact(gray(2)), *to_exact(gray(3))}, {1, 3}, 4);
+  EXPECT_DOUBLE_EQ(e.luminance, 1.25);
+  EXPECT_NEAR(e.std_error, std::sqrt(3.0 / 16.0), 1e-15);
+}
+
+TEST(BatchMeans, OneNonEmptyBatchHasNoErrorEstimate) {
+  Estimate e = batch_means({*to_exact(gray(3)), ExactRgb{}}, {3, 0}, 3);
+  EXPECT_DOUBLE_EQ(e.luminance, 1.0);
+  EXPECT_TRUE(std::isnan(e.std_error));
+  Estimate none = batch_means({ExactRgb{}, ExactRgb{}}, {0, 0}, 0);
+  EXPECT_EQ(none.luminance, 0.0);
+  EXPECT_TRUE(std::isnan(none.std_error));
+}
+
+// Samples of U(0,1) (variance 1/12) through the whole Histogram pipeline: one run's batch-means
+// stderr against the true σ/√N and against the textbook sample stderr of the same data.
+TEST(BatchMeans, MatchesTheTextbookStandardErrorOnSyntheticData) {
+  const int B = 32, per_batch = 1000;
+  const double N = B * per_batch;
+  Histogram h(HistogramLayout{B, {}});
+  const Histogram::PathId id = h.intern("LSDDSE");
+  Rng rng{42};
+  double sum = 0, sum2 = 0;
+  for (int b = 0; b < B; ++b) {
+    for (int i = 0; i < per_batch; ++i) {
+      const double u = rng.uniform();
+      sum += u;
+      sum2 += u * u;
+      ASSERT_TRUE(h.add(id, b, Histogram::kNoStrategy, gray(u)));
+    }
+    h.add_samples(b, per_batch);
+  }
+  Result<HistogramReport> r = make_report(h, RunInfo{}, nullptr, {});
+  ASSERT_TRUE(r) << r.error().render();
+  const double truth = std::sqrt(1.0 / 12.0 / N);
+  const double textbook = std::sqrt((sum2 - sum * sum / N) / (N - 1) / N);
+  // The batch-means estimate of a standard error has a relative standard deviation of about
+  // 1/√(2(B−1)) = 12.7 %; allow three of those.
+  const double tol = 3 / std::sqrt(2.0 * (B - 1));
+  EXPECT_NEAR(r->total.std_error / truth, 1.0, tol);
+  EXPECT_NEAR(r->total.std_error / textbook, 1.0, tol);
+  EXPECT_NEAR(r->total.luminance, 0.5, 3 * truth);
+  EXPECT_NEAR(r->total.rgb[0], sum / N, 1e-12) << "the exact sum against a naive floating-point one";
+  EXPECT_EQ(r->total.samples, static_cast<std::uint64_t>(N));
+}
+
+// Many independent runs: the mean of stderr² is σ²/N (the estimator is unbiased) and the 95 %
+// interval X̄ ± t·stderr covers the true mean about 95 % of the time.
+TEST(BatchMeans, IsUnbiasedAndCoversOverManyRuns) {
+  const int B = 32, per_batch = 20, runs = 500;
+  const double N = B * per_batch, sigma2 = 1.0 / 12.0;
+  Rng rng{7};
+  double ratio_sum = 0;
+  int covered = 0;
+  for (int run = 0; run < runs; ++run) {
+    Histogram h(HistogramLayout{B, {}});
+    const Histogram::PathId id = h.intern("LDDDSE");
+    for (int b = 0; b < B; ++b) {
+      for (int i = 0; i < per_batch; ++i) ASSERT_TRUE(h.add(id, b, Histogram::kNoStrategy, gray(rng.uniform())));
+      h.add_samples(b, per_batch);
+    }
+    Result<HistogramReport> r = make_report(h, RunInfo{}, nullptr, {});
+    ASSERT_TRUE(r);
+    ratio_sum += r->total.std_error * r->total.std_error / (sigma2 / N);
+    if (std::fabs(r->total.luminance - 0.5) <= 2.040 * r->total.std_error) ++covered;  // t(31), 95 %
+  }
+  // stderr²·N/σ² has relative standard deviation √(2/(B−1)) per run; allow four standard errors
+  // of the mean over the runs.
+  EXPECT_NEAR(ratio_sum / runs, 1.0, 4 * std::sqrt(2.0 / (B - 1) / runs));
+  // Coverage 0.95, binomial standard error √(0.95·0.05/500) ≈ 0.0097; four of them.
+  EXPECT_NEAR(static_cast<double>(covered) / runs, 0.95, 0.04);
+}
+
+// --- merging ---
+
+struct Sample {
+  std::string path;
+  int batch;
+  int strategy;
+  Rgb value;
+};
+
+// A stream of contributions over a wide dynamic range (1e-9 … 1e9), so that floating-point
+// summation would depend on the order.
+std::vector<Sample> sample_stream(int n, int batches) {
+  const std::vector<std::string> paths = {"LDDDSE", "LSDDSE", "LDDSDDSE", "LSDSDDSE", "LDDDDDSE", "LDSDDE", "LSSDDE"};
+  Rng rng{2024};
+  std::vector<Sample> out;
+  for (int i = 0; i < n; ++i) {
+    Sample s;
+    s.path = paths[rng.next() % paths.size()];
+    s.batch = static_cast<int>(static_cast<std::int64_t>(i) * batches / n);
+    s.strategy = static_cast<int>(rng.next() % 3);
+    for (double& c : s.value) c = std::exp((rng.uniform() - 0.5) * 41);
+    if (i % 97 == 0) s.value[1] = -s.value[1];  // negative components are summed exactly too
+    out.push_back(s);
+  }
+  return out;
+}
+
+HistogramLayout stream_layout() { return HistogramLayout{8, {"emitter-hit", "nee", "light-tracing"}}; }
+
+Histogram accumulate(const std::vector<Sample>& stream, std::size_t begin, std::size_t end) {
+  Histogram h(stream_layout());
+  for (std::size_t i = begin; i < end; ++i) {
+    const Sample& s = stream[i];
+    EXPECT_TRUE(h.add(h.intern(s.path), s.batch, s.strategy, s.value));
+    h.add_samples(s.batch, 1);
+  }
+  return h;
+}
+
+void expect_same_state(const Histogram& a, const Histogram& b) {
+  ASSERT_EQ(a.num_paths(), b.num_paths());
+  EXPECT_EQ(a.nonfinite(), b.nonfinite());
+  EXPECT_TRUE(a.magnitude() == b.magnitude());
+  for (int bt = 0; bt < a.num_batches(); ++bt) EXPECT_EQ(a.batch_samples(bt), b.batch_samples(bt));
+  for (Histogram::PathId p = 0; p < a.num_paths(); ++p) {
+    std::optional<Histogram::PathId> q = b.find(a.path(p));
+    ASSERT_TRUE(q) << a.path(p);
+    for (int bt = 0; bt < a.num_batches(); ++bt) {
+      EXPECT_TRUE(a.cell(p, bt).sum == b.cell(*q, bt).sum) << a.path(p) << " batch " << bt;
+      EXPECT_EQ(a.cell(p, bt).contributions, b.cell(*q, bt).contributions);
+    }
+    for (int s = 0; s < a.num_strategies(); ++s) EXPECT_TRUE(a.strategy_sum(p, s) == b.strategy_sum(*q, s));
+  }
+}
+
+std::string report_text(const Histogram& h) {
+  Result<HistogramReport> r = make_report(h, RunInfo{}, nullptr, {});
+  EXPECT_TRUE(r);
+  return r ? histogram_json_text(*r) : "";
+}
+
+TEST(HistogramMerge, IsExactWhateverTheShardSplitAndOrder) {
+  const std::vector<Sample> stream = sample_stream(20000, 8);
+  const Histogram whole = accumulate(stream, 0, stream.size());
+  const std::string whole_text = report_text(whole);
+  Rng rng{99};
+  for (int shards : {2, 3, 7, 16}) {
+    // Random cut points: shards need not align with batches.
+    std::vector<std::size_t> cuts = {0, stream.size()};
+    for (int i = 1; i < shards; ++i) cuts.push_back(rng.next() % stream.size());
+    std::sort(cuts.begin(), cuts.end());
+    std::vector<Histogram> parts;
+    for (std::size_t i = 0; i + 1 < cuts.size(); ++i) parts.push_back(accumulate(stream, cuts[i], cuts[i + 1]));
+    for (bool reversed : {false, true}) {
+      Histogram merged(stream_layout());
+      for (std::size_t i = 0; i < parts.size(); ++i) {
+        const Histogram& part = parts[reversed ? parts.size() - 1 - i : i];
+        ASSERT_TRUE(merged.merge(part));
+      }
+      SCOPED_TRACE(std::to_string(shards) + (reversed ? " shards, reversed" : " shards"));
+      expect_same_state(whole, merged);
+      EXPECT_EQ(report_text(merged), whole_text) << "the report is a function of the exact sums";
+    }
+  }
+}
+
+TEST(HistogramMerge, ThreadsWithOneShardEachGiveBitIdenticalResults) {
+  const std::vector<Sample> stream = sample_stream(12000, 8);
+  std::string reference;
+  for (int threads : {1, 2, 4}) {
+    std::vector<Histogram> shards(static_cast<std::size_t>(threads), Histogram(stream_layout()));
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t) {
+      workers.emplace_back([&, t] {
+        Histogram& h = shards[static_cast<std::size_t>(t)];
+        for (std::size_t i = static_cast<std::size_t>(t); i < stream.size(); i += static_cast<std::size_t>(threads)) {
+          h.add(h.intern(stream[i].path), stream[i].batch, stream[i].strategy, stream[i].value);
+          h.add_samples(stream[i].batch, 1);
+        }
+      });
+    }
+    for (std::thread& w : workers) w.join();
+    Histogram merged(stream_layout());
+    for (const Histogram& s : shards) ASSERT_TRUE(merged.merge(s));
+    const std::string text = report_text(merged);
+    if (reference.empty()) reference = text;
+    EXPECT_EQ(text, reference) << threads << " threads";
+  }
+}
+
+TEST(HistogramMerge, EstimateAgreesWithAPlainSum) {
+  const std::vector<Sample> stream = sample_stream(5000, 8);
+  const Histogram h = accumulate(stream, 0, stream.size());
+  long double sum = 0;
+  for (const Sample& s : stream) sum += s.value[0];
+  Result<HistogramReport> r = make_report(h, RunInfo{}, nullptr, {});
+  ASSERT_TRUE(r);
+  EXPECT_NEAR(r->total.rgb[0], static_cast<double>(sum / stream.size()), 1e-12 * std::fabs(r->total.rgb[0]));
+}
+
+TEST(HistogramMerge, RefusesADifferentLayout) {
+  Histogram a(HistogramLayout{8, {"nee"}}), b(HistogramLayout{16, {"nee"}}), c(HistogramLayout{8, {"bdpt"}});
+  Result<bool> r = a.merge(b);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kUsage);
+  EXPECT_EQ(r.error().message,
+            "cannot merge histograms with different layouts (batch count or strategy list differ)");
+  EXPECT_FALSE(a.merge(c));
+}
+
+// --- non-finite contributions ---
+
+TEST(Histogram, NonFiniteContributionsAreCountedAndNeverAdded) {
+  Histogram clean(HistogramLayout{2, {"nee"}}), dirty(HistogramLayout{2, {"nee"}});
+  for (Histogram* h : {&clean, &dirty}) {
+    const Histogram::PathId id = h->intern("LDDDSE");
+    EXPECT_TRUE(h->add(id, 0, 0, gray(2.0)));
+    EXPECT_TRUE(h->add(id, 1, 0, {1.0, 0.5, 0.25}));
+    h->add_samples(0, 2);
+    h->add_samples(1, 2);
+  }
+  const Histogram::PathId id = dirty.intern("LDDDSE");
+  EXPECT_FALSE(dirty.add(id, 0, 0, {std::nan(""), 1.0, 1.0}));
+  EXPECT_FALSE(dirty.add(id, 1, 0, {1.0, INFINITY, 1.0}));
+  EXPECT_FALSE(dirty.add(id, 1, 0, {1.0, 1.0, -INFINITY}));
+  EXPECT_FALSE(dirty.add(dirty.intern("LSDDSE"), 0, 0, gray(1e300)));
+  dirty.add_nonfinite(2);  // rejected by the caller itself
+  EXPECT_EQ(dirty.nonfinite(), 6u);
+  EXPECT_EQ(clean.nonfinite(), 0u);
+  Result<HistogramReport> rc = make_report(clean, RunInfo{}, nullptr, {});
+  Result<HistogramReport> rd = make_report(dirty, RunInfo{}, nullptr, {});
+  ASSERT_TRUE(rc && rd);
+  EXPECT_EQ(rd->nonfinite_samples, 6u);
+  EXPECT_EQ(rd->total.rgb, rc->total.rgb);
+  EXPECT_EQ(rd->total.samples, 2u);
+  EXPECT_DOUBLE_EQ(rd->total.rgb[0], 3.0 / 4);
+  // The path that only ever received a rejected contribution is known but carries nothing.
+  ASSERT_EQ(rd->paths.size(), 2u);
+  EXPECT_EQ(rd->paths[1].path, "LSDDSE");
+  EXPECT_EQ(rd->paths[1].estimate.samples, 0u);
+  EXPECT_EQ(rd->paths[1].estimate.luminance, 0.0);
+}
+
+TEST(Histogram, ZeroContributionsAreNotCounted) {
+  Histogram h(HistogramLayout{1, {}});
+  const Histogram::PathId id = h.intern("LDDDSE");
+  EXPECT_TRUE(h.add(id, 0, Histogram::kNoStrategy, gray(0.0)));
+  EXPECT_TRUE(h.add(id, 0, Histogram::kNoStrategy, gray(1e-25)));  // rounds to zero on the grid
+  EXPECT_EQ(h.cell(id, 0).contributions, 0u);
+}
+
+// --- classes, shares and strategies ---
+
+struct Classes {
+  ClassTable table;
+  std::vector<const PathClass*> list;
+  std::vector<ClassInfo> info;
+  std::optional<Classifier> classifier;
+  Classes(std::initializer_list<std::pair<const char*, const char*>> defs) {
+    for (const auto& [name, expr] : defs) {
+      Result<const PathClass*> c = table.add(name, expr, ClassOptions{});
+      EXPECT_TRUE(c) << c.error().render();
+      list.push_back(*c);
+      info.push_back({name, expr});
+    }
+    Result<Classifier> cl = Classifier::build(list, Limits{});
+    EXPECT_TRUE(cl);
+    classifier = std::move(cl).value();
+  }
+};
+
+TEST(HistogramReport, SharesOfAPartitionSumToOne) {
+  // Point-like lights (c0 = S) and area-like lights (c0 = D) partition every valid path;
+  // "everything" overlaps both.
+  Classes classes({{"point", "LS.*E"}, {"area", "LD.*E"}, {"everything", "L.*E"}});
+  const std::vector<Sample> stream = sample_stream(4000, 8);
+  const Histogram h = accumulate(stream, 0, stream.size());
+  Result<HistogramReport> r = make_report(h, RunInfo{}, &*classes.classifier, classes.info);
+  ASSERT_TRUE(r) << r.error().render();
+  ASSERT_EQ(r->classes.size(), 3u);
+  EXPECT_EQ(r->classes[0].name, "point");
+  EXPECT_EQ(r->classes[0].expr, "LS.*E");
+  EXPECT_NEAR(r->classes[0].share + r->classes[1].share, 1.0, 1e-12);
+  EXPECT_GT(r->classes[0].share, 0.1);
+  EXPECT_GT(r->classes[1].share, 0.1);
+  EXPECT_NEAR(r->classes[2].share, 1.0, 1e-15);
+  EXPECT_EQ(r->classes[0].estimate.samples + r->classes[1].estimate.samples, r->total.samples);
+  // A class's estimate is the sum of its paths' estimates.
+  double point = 0;
+  for (const PathEstimate& p : r->paths)
+    if (p.path[1] == 'S') point += p.estimate.rgb[2];
+  EXPECT_NEAR(r->classes[0].estimate.rgb[2], point, 1e-12 * std::fabs(point));
+  // And its stderr comes from its own batch sums: the union of the partition has the total's.
+  EXPECT_EQ(r->classes[2].estimate.std_error, r->total.std_error);
+}
+
+TEST(HistogramReport, StrategySharesAndOrdering) {
+  Histogram h(HistogramLayout{2, {"nee", "emitter-hit", "light-tracing"}});
+  const Histogram::PathId a = h.intern("LDDDSE"), b = h.intern("LSDDSE"), c = h.intern("LDDDDSE");
+  ASSERT_TRUE(h.add(a, 0, 0, gray(3.0)));
+  ASSERT_TRUE(h.add(a, 1, 2, gray(1.0)));
+  ASSERT_TRUE(h.add(b, 0, 1, gray(1.0)));
+  ASSERT_TRUE(h.add(c, 1, 1, gray(1.0)));  // ties with b: ordered by path string
+  h.add_samples(0, 1);
+  h.add_samples(1, 1);
+  Result<HistogramReport> r = make_report(h, RunInfo{}, nullptr, {});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->paths.size(), 3u);
+  EXPECT_EQ(r->paths[0].path, "LDDDSE");
+  EXPECT_EQ(r->paths[1].path, "LDDDDSE");
+  EXPECT_EQ(r->paths[2].path, "LSDDSE");
+  ASSERT_EQ(r->paths[0].strategies.size(), 2u) << "only the strategies that contributed";
+  EXPECT_EQ(r->paths[0].strategies[0].first, "nee");
+  EXPECT_NEAR(r->paths[0].strategies[0].second, 0.75, 1e-15);
+  EXPECT_EQ(r->paths[0].strategies[1].first, "light-tracing");
+  EXPECT_NEAR(r->paths[0].strategies[1].second, 0.25, 1e-15);
+  ASSERT_EQ(r->paths[2].strategies.size(), 1u);
+  EXPECT_EQ(r->paths[2].strategies[0].first, "emitter-hit");
+  EXPECT_EQ(r->paths[2].strategies[0].second, 1.0);
+  EXPECT_DOUBLE_EQ(r->paths[0].estimate.luminance, 2.0);
+  EXPECT_DOUBLE_EQ(r->total.luminance, 3.0);
+}
+
+TEST(HistogramReport, RejectsContributionsWithoutSamples) {
+  Histogram h(HistogramLayout{4, {}});
+  ASSERT_TRUE(h.add(h.intern("LDDDSE"), 3, Histogram::kNoStrategy, gray(1)));
+  h.add_samples(0, 10);
+  Result<HistogramReport> r = make_report(h, RunInfo{}, nullptr, {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kUsage);
+  EXPECT_EQ(r.error().message, "batch 3 holds contributions but no samples were registered for it");
+}
+
+TEST(HistogramReport, RefusesSumsThatMayHaveOverflowed) {
+  Histogram h(HistogramLayout{1, {}});
+  const Histogram::PathId id = h.intern("LDDDSE");
+  h.add_samples(0, 1);
+  // Each contribution adds 3·2^49 to the magnitude; 2^63 / (3·2^49) ≈ 5461.3.
+  for (int i = 0; i < 5461; ++i) ASSERT_TRUE(h.add(id, 0, Histogram::kNoStrategy, gray(0x1p49)));
+  EXPECT_FALSE(h.may_overflow());
+  EXPECT_TRUE(make_report(h, RunInfo{}, nullptr, {}));
+  ASSERT_TRUE(h.add(id, 0, Histogram::kNoStrategy, gray(0x1p49)));
+  EXPECT_TRUE(h.may_overflow());
+  Result<HistogramReport> r = make_report(h, RunInfo{}, nullptr, {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kLimit);
+}
+
+TEST(Histogram, BatchOfPassCoversContiguousRanges) {
+  std::vector<int> counts(32, 0);
+  for (std::uint64_t pass = 0; pass < 100; ++pass) ++counts[static_cast<std::size_t>(batch_of_pass(pass, 100, 32))];
+  EXPECT_EQ(*std::min_element(counts.begin(), counts.end()), 3);
+  EXPECT_EQ(*std::max_element(counts.begin(), counts.end()), 4);
+  EXPECT_EQ(batch_of_pass(0, 100, 32), 0);
+  EXPECT_EQ(batch_of_pass(99, 100, 32), 31);
+  EXPECT_EQ(batch_of_pass(3, 4, 32), 24) << "fewer passes than batches leaves gaps";
+}
+
+TEST(Histogram, RecordsClassSetsWhenGivenAClassifier) {
+  Classes classes({{"point", "LS.*E"}, {"area", "LD.*E"}});
+  Histogram h(HistogramLayout{}, &*classes.classifier);
+  const Histogram::PathId p = h.intern("LSDDSE"), a = h.intern("LDDDSE");
+  EXPECT_EQ(classes.classifier->members(h.class_set(p)), std::vector<int>{0});
+  EXPECT_EQ(classes.classifier->members(h.class_set(a)), std::vector<int>{1});
+  EXPECT_EQ(h.intern("LSDDSE"), p);
+}
+
+// --- images ---
+
+TEST(ClassImages, ConcurrentAddsAreExactAndIndependentOfTheThreadCount) {
+  // Values just below 1 with a full fraction make the low word wrap on almost every add, which
+  // exercises the carry into the high word under contention.
+  const int kAdds = 20000;
+  std::vector<ExactRgb> values;
+  Rng rng{5};
+  for (int i = 0; i < kAdds; ++i) {
+    const double v = 1 - rng.uniform() * 1e-3;
+    values.push_back(*to_exact({v, -v, v * 1e6}));
+  }
+  ExactRgb expected{};
+  for (const ExactRgb& v : values) add_to(expected, v);
+  for (int threads : {1, 2, 4}) {
+    ClassImages images(2, 1, nullptr, {});
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t)
+      workers.emplace_back([&, t] {
+        for (int i = t; i < kAdds; i += threads) images.add(1, 0, 0, values[static_cast<std::size_t>(i)]);
+      });
+    for (std::thread& w : workers) w.join();
+    EXPECT_TRUE(images.sum(0, 1, 0) == expected) << threads << " threads";
+    EXPECT_TRUE(is_zero(images.sum(0, 0, 0)));
+  }
+}
+
+TEST(ClassImages, ContributionsLandInTheTotalAndTheirClassesLayers) {
+  Classes classes({{"point", "LS.*E"}, {"area", "LD.*E"}, {"long", "L.{6,}E"}});
+  ClassImages images(3, 2, &*classes.classifier, {2, 0});  // layers: total, long, point
+  ASSERT_EQ(images.num_layers(), 3);
+  EXPECT_EQ(images.layer_name(0), "total");
+  EXPECT_EQ(images.layer_name(1), "long");
+  EXPECT_EQ(images.layer_name(2), "point");
+  Histogram h(HistogramLayout{}, &*classes.classifier);
+  const ExactRgb one = *to_exact(gray(1.0)), two = *to_exact({2.0, 0.0, 0.5});
+  EXPECT_TRUE(images.add(0, 0, h.class_set(h.intern("LSDDSE")), one));     // point only
+  EXPECT_TRUE(images.add(2, 1, h.class_set(h.intern("LSDSDDSE")), two));   // point and long
+  EXPECT_TRUE(images.add(2, 1, h.class_set(h.intern("LDDDSE")), one));     // area: total only
+  EXPECT_FALSE(images.add(3, 0, 0, one)) << "outside the image";
+  EXPECT_FALSE(images.add(0, -1, 0, one));
+  EXPECT_EQ(to_double(images.sum(0, 2, 1)), (Rgb{3.0, 1.0, 1.5}));
+  EXPECT_EQ(to_double(images.sum(1, 2, 1)), (Rgb{2.0, 0.0, 0.5}));
+  EXPECT_EQ(to_double(images.sum(2, 2, 1)), (Rgb{2.0, 0.0, 0.5}));
+  EXPECT_EQ(to_double(images.sum(2, 0, 0)), (Rgb{1.0, 1.0, 1.0}));
+  EXPECT_TRUE(is_zero(images.sum(1, 0, 0)));
+  ImageLayer total = images.layer(0, 0.5);
+  EXPECT_EQ(total.name, "total");
+  EXPECT_EQ(total.image.width, 3);
+  EXPECT_EQ(total.image.at(2, 1, 0), 1.5f);
+  EXPECT_EQ(total.image.at(0, 0, 1), 0.5f);
+  EXPECT_EQ(total.image.at(1, 0, 1), 0.0f);
+}
+
+TEST(ClassImages, PixelSumFlushEqualsDirectAddsAndTheTotalMatchesTheHistogram) {
+  Classes classes({{"point", "LS.*E"}, {"area", "LD.*E"}});
+  ClassImages direct(4, 4, &*classes.classifier, {0, 1}), buffered(4, 4, &*classes.classifier, {0, 1});
+  Histogram h(HistogramLayout{4, {}}, &*classes.classifier);
+  ClassImages::PixelSum pixel(buffered);
+  const std::vector<Sample> stream = sample_stream(3000, 4);
+  for (std::size_t i = 0; i < stream.size(); ++i) {
+    const Sample& s = stream[i];
+    const int x = static_cast<int>(i / 16 % 4), y = static_cast<int>(i / 64 % 4);  // 16 contributions per pixel visit
+    const ExactRgb c = *to_exact(s.value);
+    const Histogram::PathId id = h.intern(s.path);
+    h.add_exact(id, s.batch, Histogram::kNoStrategy, c);
+    h.add_samples(s.batch, 1);
+    direct.add(x, y, h.class_set(id), c);
+    pixel.add(h.class_set(id), c);
+    if (i % 16 == 15 || i + 1 == stream.size()) {
+      EXPECT_TRUE(pixel.flush(buffered, x, y));
+    }
+  }
+  ExactRgb image_total{};
+  for (int l = 0; l < 3; ++l)
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) {
+        EXPECT_TRUE(direct.sum(l, x, y) == buffered.sum(l, x, y));
+        if (l == 0) add_to(image_total, direct.sum(0, x, y));
+      }
+  ExactRgb histogram_total{};
+  for (Histogram::PathId p = 0; p < h.num_paths(); ++p)
+    for (int b = 0; b < h.num_batches(); ++b) add_to(histogram_total, h.cell(p, b).sum);
+  EXPECT_TRUE(image_total == histogram_total) << "the same contributions, rounded once, summed exactly";
+  ASSERT_TRUE(direct.merge(buffered));
+  EXPECT_TRUE(direct.sum(1, 1, 1) == [&] {
+    ExactRgb twice = buffered.sum(1, 1, 1);
+    add_to(twice, buffered.sum(1, 1, 1));
+    return twice;
+  }());
+  ClassImages other(4, 3, nullptr, {});
+  EXPECT_FALSE(direct.merge(other));
+}
+
+}  // namespace
+}  // namespace pathex
