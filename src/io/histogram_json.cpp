@@ -61,11 +61,11 @@ class Reader {
     return v->get<std::string>();
   }
   std::uint64_t uint(const json& v, const std::string& ptr) {
-    if (!v.is_number_unsigned()) {
-      fail(ptr, "expected a non-negative integer");
-      return 0;
-    }
-    return v.get<std::uint64_t>();
+    // Integers parsed from text are unsigned when non-negative; built in memory they may be signed.
+    if (v.is_number_unsigned()) return v.get<std::uint64_t>();
+    if (v.is_number_integer() && v.get<std::int64_t>() >= 0) return static_cast<std::uint64_t>(v.get<std::int64_t>());
+    fail(ptr, "expected a non-negative integer");
+    return 0;
   }
   std::uint64_t uint(const json& obj, const std::string& ptr, const char* key) {
     const json* v = field(obj, ptr, key);
