@@ -102,7 +102,7 @@ inline int batch_of_pass(std::uint64_t pass, std::uint64_t spp, int num_batches)
 // --- the accumulator ---
 
 struct HistogramLayout {
-  int num_batches = kDefaultBatches;
+  int num_batches = kDefaultBatches;    // B ≥ 1; at least 2 for a standard error
   std::vector<std::string> strategies;  // strategy id = index; shares are reported under these names
   bool operator==(const HistogramLayout&) const = default;
 };
@@ -135,7 +135,8 @@ class Histogram {
   std::uint32_t class_set(PathId id) const { return sets_[static_cast<std::size_t>(id)]; }
 
   // --- accumulation (not thread-safe: one writer per Histogram) ---
-  // Adds a contribution of path `id` from a sample in `batch` sampled by `strategy`. Returns
+  // Adds a contribution of path `id` from a sample in `batch` (0 ≤ batch < B) sampled by
+  // `strategy` (an index into the layout's strategies, or kNoStrategy); unchecked. Returns
   // false, counting it in nonfinite(), when it is not finite or too large (see to_exact()).
   bool add(PathId id, int batch, int strategy, const Rgb& c) {
     std::optional<ExactRgb> e = to_exact(c);

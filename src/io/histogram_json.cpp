@@ -2,6 +2,7 @@
 // problem with the JSON pointer of the value, like the other JSON readers of pathex.
 #include "io/histogram_json.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
