@@ -1,15 +1,27 @@
-// Recursive-descent parser for path expressions. Precedence, loosest first:
+// Recursive-descent parser for path expressions (grammar/pathex.ebnf). Precedence, loosest first:
 //   alternation `|`, intersection `&`, concatenation, prefix `~`, postfix `* + ? {n} {n,} {n,m}`.
-// Each level is one function. Nesting is bounded by Limits::max_depth (checked on the height of
-// every node built, so `~~~~S` and `S****` count as well as parentheses) and repetition counts by
-// Limits::max_repeat: a hostile expression fails with a located error, never a stack overflow.
+// Each level is one function. Nesting is bounded by Limits::max_depth twice over: on the way
+// down, every open '(' and pending '~' counts one level, so the recursion itself is bounded (a
+// hostile `((((…` or `~~~~…` fails with a located error instead of overflowing the stack); on the
+// way up, the height of every node built is checked, so `S****` counts as well. Repetition counts
+// are bounded by Limits::max_repeat.
+//
+// Error messages say what was found and what was expected; the column is that of the offending
+// character, or of the opening bracket for an unclosed '(', '[' or '{', or one past the end when
+// the text stops too early. grammar/corpus/invalid.json pins every message and column.
 #include "regex/parser.h"
 
 #include <cctype>
+#include <cstdio>
 #include <string>
 
 namespace pathex {
 namespace {
+
+constexpr const char* kOperand = "a letter, '.', '[', '(', '~' or '$name'";
+
+bool is_name_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+bool is_name_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; }
 
 class Parser {
  public:
@@ -20,13 +32,13 @@ class Parser {
 
   Result<Regex> run() {
     skip_space();
-    if (at_end()) return fail(1, "empty expression, expected a letter, '.', '[', '(', '~' or '$name'");
-    int root = parse_alt();
+    if (at_end()) return fail(1, std::string("empty expression, expected ") + kOperand);
+    const int root = parse_alt();
     if (failed_) return err_;
     skip_space();
     if (!at_end()) {
-      if (peek() == ')') return fail(col(), "unmatched ')'");
-      return fail(col(), "unexpected '" + std::string(1, peek()) + "'");
+      unexpected_after_operand();
+      return err_;
     }
     out_.root = root;
     return std::move(out_);
@@ -41,6 +53,23 @@ class Parser {
     while (!at_end() && std::isspace(static_cast<unsigned char>(peek()))) ++pos_;
   }
 
+  // The character at the cursor as messages show it: 'x'; a whole UTF-8 sequence such as 'Ψ'
+  // rather than its first byte; "byte 0x01" for a control or stray byte; "the end".
+  std::string found() const {
+    if (at_end()) return "the end";
+    const auto c = static_cast<unsigned char>(peek());
+    std::size_t n = 1;
+    if (c >= 0xC0 && c <= 0xF7) {
+      while (n < 4 && pos_ + n < text_.size() && (static_cast<unsigned char>(text_[pos_ + n]) & 0xC0) == 0x80) ++n;
+    }
+    if ((c >= 0x80 && n == 1) || c < 0x20 || c == 0x7F) {
+      char buf[16];
+      std::snprintf(buf, sizeof buf, "byte 0x%02X", static_cast<unsigned>(c));
+      return buf;
+    }
+    return "'" + std::string(text_.substr(pos_, n)) + "'";
+  }
+
   Error fail(int column, std::string message, ErrorCode code = ErrorCode::kSyntax) {
     if (!failed_) {
       failed_ = true;
@@ -52,49 +81,77 @@ class Parser {
     return err_;
   }
 
+  void fail_depth(int column) {
+    fail(column, limit_message("nesting depth", static_cast<std::size_t>(limits_.max_depth), "levels", "--max-depth"),
+         ErrorCode::kLimit);
+  }
+
   int add(Node n, int column) {
     n.column = column;
     const int i = out_.add(std::move(n));
-    if (out_.at(i).height > limits_.max_depth && !failed_)
-      fail(column, limit_message("nesting depth", static_cast<std::size_t>(limits_.max_depth), "levels", "--max-depth"),
-           ErrorCode::kLimit);
+    if (out_.at(i).height > limits_.max_depth) fail_depth(column);
     return i;
   }
 
-  // Starts an atom? (Used to decide whether concatenation continues.)
+  // Entering a '(' or '~' at `column`: one more level of recursion.
+  bool descend(int column) {
+    if (++nesting_ >= limits_.max_depth) {
+      fail_depth(column);
+      return false;
+    }
+    return true;
+  }
+
+  // Starts an atom? (Used to decide whether concatenation continues.) Any letter does, so that
+  // lowercase and unknown letters get their own message from parse_atom.
   bool starts_term() const {
     if (at_end()) return false;
     const char c = peek();
     return c == '(' || c == '[' || c == '.' || c == '~' || c == '$' || std::isalpha(static_cast<unsigned char>(c));
   }
 
+  // A complete operand was parsed and the next character can neither continue nor end it.
+  void unexpected_after_operand() {
+    const char c = peek();
+    if (c == ')' && open_groups_ == 0) {
+      fail(col(), "unmatched ')'");
+    } else if (c == ']' || c == '}') {
+      fail(col(), std::string("unmatched '") + c + "'");
+    } else {
+      fail(col(), "unexpected " + found() + ", expected an operand (L E S D . [ ( ~ $name), an operator (| & * + ? {) or " +
+                      (open_groups_ > 0 ? "')'" : "the end"));
+    }
+  }
+
   // --- grammar ---
   // alt := and ('|' and)*
   int parse_alt() {
+    skip_space();
     const int column = col();
     Node n;
     n.kind = NodeKind::kAlt;
-    n.kids.push_back(parse_and());
+    n.kids.push_back(parse_and(""));
     skip_space();
     while (!failed_ && !at_end() && peek() == '|') {
       ++pos_;
-      n.kids.push_back(parse_and());
+      n.kids.push_back(parse_and("'|'"));
       skip_space();
     }
     if (failed_) return -1;
     return n.kids.size() == 1 ? n.kids[0] : add(std::move(n), column);
   }
 
-  // and := cat ('&' cat)*
-  int parse_and() {
+  // and := cat ('&' cat)*. `after` names the operator before it, for messages ("" at the start).
+  int parse_and(const char* after) {
+    skip_space();
     const int column = col();
     Node n;
     n.kind = NodeKind::kAnd;
-    n.kids.push_back(parse_cat());
+    n.kids.push_back(parse_cat(after));
     skip_space();
     while (!failed_ && !at_end() && peek() == '&') {
       ++pos_;
-      n.kids.push_back(parse_cat());
+      n.kids.push_back(parse_cat("'&'"));
       skip_space();
     }
     if (failed_) return -1;
@@ -102,15 +159,19 @@ class Parser {
   }
 
   // cat := unary unary*
-  int parse_cat() {
+  int parse_cat(const char* after) {
     skip_space();
     const int column = col();
     if (!starts_term()) {
-      if (at_end()) fail(col(), "expected a letter, '.', '[', '(', '~' or '$name' before the end");
-      else if (peek() == ')') fail(col(), "expected a letter, '.', '[', '(', '~' or '$name' before ')'");
-      else if (peek() == '*' || peek() == '+' || peek() == '?' || peek() == '{')
-        fail(col(), "'" + std::string(1, peek()) + "' has nothing to repeat");
-      else fail(col(), "unexpected '" + std::string(1, peek()) + "', expected a letter, '.', '[', '(', '~' or '$name'");
+      const char c = at_end() ? '\0' : peek();
+      if (c == '*' || c == '+' || c == '?' || c == '{') {
+        fail(col(), "'" + std::string(1, c) + "' has nothing to repeat");
+      } else if (c == ')' && open_groups_ == 0) {
+        fail(col(), "unmatched ')'");
+      } else {
+        fail(col(), std::string("expected ") + kOperand + (*after ? std::string(" after ") + after : std::string()) +
+                        ", found " + found());
+      }
       return -1;
     }
     Node n;
@@ -129,14 +190,15 @@ class Parser {
     skip_space();
     if (!at_end() && peek() == '~') {
       const int column = col();
+      if (!descend(column)) return -1;
       ++pos_;
       skip_space();
       if (!starts_term()) {
-        if (at_end()) fail(col(), "'~' needs an operand");
-        else fail(col(), "'~' needs an operand, found '" + std::string(1, peek()) + "'");
+        fail(col(), "'~' needs an operand, found " + found());
         return -1;
       }
       const int kid = parse_unary();
+      --nesting_;
       if (failed_) return -1;
       Node n;
       n.kind = NodeKind::kNot;
@@ -171,14 +233,9 @@ class Parser {
     return failed_ ? -1 : cur;
   }
 
+  // The cursor is on a digit. Reads the number, failing as soon as it exceeds max_repeat.
   bool parse_number(int* out) {
-    skip_space();
     const int column = col();
-    if (at_end() || !std::isdigit(static_cast<unsigned char>(peek()))) {
-      if (at_end()) fail(col(), "expected a number in '{}' before the end");
-      else fail(col(), "expected a number in '{}', found '" + std::string(1, peek()) + "'");
-      return false;
-    }
     long long v = 0;
     while (!at_end() && std::isdigit(static_cast<unsigned char>(peek()))) {
       v = v * 10 + (peek() - '0');
@@ -193,27 +250,45 @@ class Parser {
     return true;
   }
 
+  bool is_digit() const { return !at_end() && std::isdigit(static_cast<unsigned char>(peek())); }
+
+  // '{' n '}' | '{' n ',' '}' | '{' n ',' m '}'. Running out of text anywhere inside is an
+  // unclosed '{', reported at the '{' like an unclosed '(' or '['.
   bool parse_braces(int* min, int* max) {
     const int open = col();
+    auto unclosed = [&] {
+      fail(open, "missing '}' to close this '{'");
+      return false;
+    };
     ++pos_;  // '{'
+    skip_space();
+    if (at_end()) return unclosed();
+    if (!is_digit()) {
+      fail(col(), "expected a number after '{', found " + found());
+      return false;
+    }
     if (!parse_number(min)) return false;
     skip_space();
-    if (!at_end() && peek() == '}') { ++pos_; *max = *min; return true; }
-    if (at_end() || peek() != ',') {
-      if (at_end()) fail(open, "missing '}' to close '{'");
-      else fail(col(), "expected ',' or '}' in repetition, found '" + std::string(1, peek()) + "'");
+    if (at_end()) return unclosed();
+    if (peek() == '}') { ++pos_; *max = *min; return true; }
+    if (peek() != ',') {
+      fail(col(), "expected ',' or '}' in repetition, found " + found());
       return false;
     }
     ++pos_;  // ','
     skip_space();
-    if (!at_end() && peek() == '}') { ++pos_; *max = kUnbounded; return true; }
-    skip_space();
+    if (at_end()) return unclosed();
+    if (peek() == '}') { ++pos_; *max = kUnbounded; return true; }
+    if (!is_digit()) {
+      fail(col(), "expected a number or '}' after ',', found " + found());
+      return false;
+    }
     const int max_col = col();
     if (!parse_number(max)) return false;
     skip_space();
-    if (at_end() || peek() != '}') {
-      if (at_end()) fail(open, "missing '}' to close '{'");
-      else fail(col(), "expected '}' in repetition, found '" + std::string(1, peek()) + "'");
+    if (at_end()) return unclosed();
+    if (peek() != '}') {
+      fail(col(), "expected '}' in repetition, found " + found());
       return false;
     }
     ++pos_;
@@ -225,7 +300,8 @@ class Parser {
     return true;
   }
 
-  // atom := letter | '.' | set | '(' alt ')' | '$' name
+  // atom := letter | '.' | set | '(' alt ')' | '$' name. The cursor is on a character for which
+  // starts_term() holds.
   int parse_atom() {
     skip_space();
     const int column = col();
@@ -235,20 +311,29 @@ class Parser {
     if (c == '.') { ++pos_; n.mask = kScatterMask; return add(std::move(n), column); }
     if (c == '[') return parse_set();
     if (c == '(') {
+      if (!descend(column)) return -1;
       ++pos_;
       skip_space();
       if (!at_end() && peek() == ')') {
         fail(col(), "empty group '()', expected an expression inside");
         return -1;
       }
+      ++open_groups_;
       const int inner = parse_alt();
       if (failed_) return -1;
       skip_space();
-      if (at_end() || peek() != ')') {
+      if (at_end()) {
         fail(column, "missing ')' to close this '('");
         return -1;
       }
+      if (peek() != ')') {
+        // Something inside the group that cannot continue it: point at that, not at the '('.
+        unexpected_after_operand();
+        return -1;
+      }
       ++pos_;
+      --open_groups_;
+      --nesting_;
       return inner;
     }
     if (c == '$') return parse_name();
@@ -265,6 +350,7 @@ class Parser {
     return -1;
   }
 
+  // set := '[' '^'? letter+ ']' with whitespace allowed between the letters; "[^" is one token.
   int parse_set() {
     const int open = col();
     ++pos_;  // '['
@@ -281,15 +367,22 @@ class Parser {
       if (!l) {
         if (std::islower(static_cast<unsigned char>(c)))
           fail(col(), "lowercase letter '" + std::string(1, c) + "' in set: letters are uppercase L E S D");
+        else if (c == '^')
+          fail(col(), "'^' negates a set only right after '[', as in [^S]");
+        else if (std::isalpha(static_cast<unsigned char>(c)))
+          fail(col(), "unknown letter '" + std::string(1, c) + "' in set, expected one of L E S D or ']'");
         else
-          fail(col(), "unexpected '" + std::string(1, c) + "' in set, expected one of L E S D or ']'");
+          fail(col(), "unexpected " + found() + " in set, expected one of L E S D or ']'");
         return -1;
       }
       m |= static_cast<LetterMask>(1u << *l);
       any = true;
       ++pos_;
     }
-    if (!any) { fail(col(), "empty set '[]', expected at least one of L E S D"); return -1; }
+    if (!any) {
+      fail(col(), std::string("empty set '") + (negate ? "[^]" : "[]") + "', expected at least one of L E S D");
+      return -1;
+    }
     ++pos_;  // ']'
     Node n;
     n.kind = NodeKind::kSet;
@@ -298,27 +391,30 @@ class Parser {
     return add(std::move(n), open);
   }
 
+  // name-ref := '$' name, name := [A-Za-z_][A-Za-z0-9_-]*. Resolved here and grafted in.
   int parse_name() {
     const int column = col();
     ++pos_;  // '$'
-    const std::size_t start = pos_;
-    while (!at_end() && (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_' || peek() == '-')) ++pos_;
-    if (pos_ == start) {
-      fail(column, "'$' must be followed by a class name");
+    if (at_end() || !is_name_start(peek())) {
+      fail(col(), "expected a class name after '$' (a letter or '_', then letters, digits, '_' or '-'), found " +
+                      found());
       return -1;
     }
+    const std::size_t start = pos_;
+    while (!at_end() && is_name_char(peek())) ++pos_;
     const std::string_view name = text_.substr(start, pos_ - start);
     const Regex* def = names_ ? names_(name) : nullptr;
     if (!def) {
-      fail(column, "unknown class name '$" + std::string(name) + "'", ErrorCode::kUnknownName);
+      fail(column,
+           "unknown class name '$" + std::string(name) + "', expected a built-in name or one defined earlier in the class file",
+           ErrorCode::kUnknownName);
       return -1;
     }
     // Graft, then record the column of the reference on the grafted root for error reporting.
     const int root = out_.graft(*def, def->root);
     out_.nodes[static_cast<std::size_t>(root)].column = column;
     if (out_.at(root).height > limits_.max_depth) {
-      fail(column, limit_message("nesting depth", static_cast<std::size_t>(limits_.max_depth), "levels", "--max-depth"),
-           ErrorCode::kLimit);
+      fail_depth(column);
       return -1;
     }
     return root;
@@ -328,6 +424,8 @@ class Parser {
   const Limits& limits_;
   const NameLookup& names_;
   std::size_t pos_ = 0;
+  int nesting_ = 0;      // open '(' and pending '~' on the recursion stack
+  int open_groups_ = 0;  // open '(' only: decides between "unmatched ')'" and "expected ')'"
   Regex out_;
   bool failed_ = false;
   Error err_;
