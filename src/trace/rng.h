@@ -1,0 +1,145 @@
+// Per-sample random numbers for the tracer, and the standard warps of the unit square.
+//
+// Counter-based, not stateful: the d-th number used by sample s of pixel p under seed k is a pure
+// function
+//
+//     u(k, p, s, d) = top24( splitmix64_output(key(k, p, s), d) ) · 2^-24,
+//     key(k, p, s)  = mix(mix(mix(k + C0) ^ (p + C1)) ^ (s + C2)),
+//
+// where mix is Stafford's "Mix13" 64-bit finaliser (the output function of SplitMix64, a
+// bijection with full avalanche) and splitmix64_output(key, d) = mix(key + (d + 1)·γ) with γ the
+// golden-ratio increment, i.e. the (d+1)-th output of a SplitMix64 generator seeded with `key`.
+// Nothing depends on which thread draws a sample or in which order, so renders are bit-identical
+// for every thread count (DESIGN §7: estimates must not depend on how work was split).
+//
+// Floats are the top 24 bits times 2^-24: every value k / 2^24 is exactly representable, the
+// largest is 1 − 2^-24, so 1.0 is never returned and 0.0 is (with probability 2^-24). Callers that
+// divide by u or take log(u) must guard 0 themselves.
+//
+// The second half of this file maps uniform numbers to the distributions the BSDFs, lights and
+// sensors sample (cosine hemisphere, sphere, cone, disk, triangle); each comes with its density so
+// that sampling and pdf evaluation cannot disagree.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+namespace pathex {
+
+// --- counter-based random numbers ---
+
+// Stafford's Mix13, the SplitMix64 finaliser: a bijection on 64-bit words in which every input
+// bit affects every output bit with probability close to 1/2. mix64(0) == 0, hence the offsets.
+constexpr std::uint64_t mix64(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+inline constexpr std::uint64_t kGoldenGamma = 0x9e3779b97f4a7c15ULL;
+
+// The key of one sample's stream. Asymmetric in its arguments: (p, s) and (s, p) differ.
+constexpr std::uint64_t stream_key(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample) {
+  std::uint64_t h = mix64(seed + 0x243f6a8885a308d3ULL);          // offsets: digits of pi
+  h = mix64(h ^ (pixel + 0x13198a2e03707344ULL));
+  return mix64(h ^ (sample + 0xa4093822299f31d0ULL));
+}
+
+// 64 random bits: dimension `dim` of the stream `key`.
+constexpr std::uint64_t stream_bits(std::uint64_t key, std::uint64_t dim) {
+  return mix64(key + (dim + 1) * kGoldenGamma);
+}
+
+// The top 24 bits as a float in [0, 1): exact, and never 1.0.
+constexpr float bits_to_unit_float(std::uint64_t bits) {
+  return static_cast<float>(bits >> 40) * 0x1p-24f;
+}
+
+inline constexpr float kOneMinusEpsilon = 1.0f - 0x1p-24f;  // the largest float below 1
+
+// One sample's random numbers, drawn in order of dimension. Copying a Sampler copies its position;
+// set_dimension() gives a strategy a fixed block of dimensions (e.g. 2 per bounce) so that two
+// strategies never consume each other's numbers.
+class Sampler {
+ public:
+  Sampler(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample)
+      : key_(stream_key(seed, pixel, sample)) {}
+
+  float get1d() { return bits_to_unit_float(stream_bits(key_, dim_++)); }
+  glm::vec2 get2d() {
+    const float a = get1d();
+    return {a, get1d()};
+  }
+  // The number at an absolute dimension, without moving the cursor.
+  float at(std::uint64_t dim) const { return bits_to_unit_float(stream_bits(key_, dim)); }
+
+  std::uint64_t dimension() const { return dim_; }
+  void set_dimension(std::uint64_t dim) { dim_ = dim; }
+  std::uint64_t key() const { return key_; }
+
+ private:
+  std::uint64_t key_;
+  std::uint64_t dim_ = 0;
+};
+
+// --- warps of the unit square ---
+
+inline constexpr float kPi = std::numbers::pi_v<float>;
+inline constexpr float kInvPi = std::numbers::inv_pi_v<float>;
+
+inline float safe_sqrt(float x) { return std::sqrt(std::max(x, 0.0f)); }
+
+// Shirley–Chiu concentric map of [0,1)^2 onto the unit disk: area preserving up to a constant
+// (density 1/π on the disk) and low distortion, so stratification survives.
+inline glm::vec2 sample_concentric_disk(glm::vec2 u) {
+  const float a = 2.0f * u.x - 1.0f;
+  const float b = 2.0f * u.y - 1.0f;
+  if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
+  float r, theta;
+  if (std::abs(a) > std::abs(b)) {
+    r = a;
+    theta = (kPi / 4.0f) * (b / a);
+  } else {
+    r = b;
+    theta = kPi / 2.0f - (kPi / 4.0f) * (a / b);
+  }
+  return {r * std::cos(theta), r * std::sin(theta)};
+}
+
+// Cosine-weighted direction about +z (Malley's method); density cos θ / π. z may be 0 at the rim.
+inline glm::vec3 sample_cosine_hemisphere(glm::vec2 u) {
+  const glm::vec2 d = sample_concentric_disk(u);
+  return {d.x, d.y, safe_sqrt(1.0f - d.x * d.x - d.y * d.y)};
+}
+inline float cosine_hemisphere_pdf(float cos_theta) { return std::max(cos_theta, 0.0f) * kInvPi; }
+
+// Uniform direction on the unit sphere; density 1 / (4π).
+inline glm::vec3 sample_uniform_sphere(glm::vec2 u) {
+  const float z = 1.0f - 2.0f * u.x;
+  const float r = safe_sqrt(1.0f - z * z);
+  const float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline constexpr float kUniformSpherePdf = 0.25f * std::numbers::inv_pi_v<float>;
+
+// Uniform direction in the cone of half-angle acos(cos_max) about +z; density 1 / (2π(1 − cos_max)).
+inline glm::vec3 sample_uniform_cone(glm::vec2 u, float cos_max) {
+  const float z = 1.0f - u.x * (1.0f - cos_max);
+  const float r = safe_sqrt(1.0f - z * z);
+  const float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f - cos_max)); }
+
+// Uniform barycentrics (b0, b1) on a triangle, b2 = 1 − b0 − b1 (the square-root-free fold).
+inline glm::vec2 sample_uniform_triangle(glm::vec2 u) {
+  if (u.x + u.y < 1.0f) return u;
+  return {1.0f - u.x, 1.0f - u.y};
+}
+
+}  // namespace pathex
