@@ -1,0 +1,130 @@
+// BSDF sampling and evaluation for every Material kind (scene/material.h): pure functions of the
+// material, the two directions and the normals, so that the integrator, the tests and any MIS
+// weight computation all see the same numbers.
+//
+// Conventions (pbrt's). `wo` and `wi` are unit vectors pointing *away* from the surface point:
+// `wo` back along the path already built, `wi` the new direction. `ns` is the unit shading
+// normal and `ng` the unit geometric normal. Everything is computed in the shading frame; `ng`
+// only rejects directions that would leak through the real surface (a reflection must leave on
+// wo's side of ng, a refraction on the other side): sample() returns nullopt for them and eval()
+// and pdf() return 0, consistently.
+//
+// Sidedness. Diffuse, mirror and glossy are two-sided: the normal is flipped to wo's side. A
+// dielectric is oriented: `ns` points to the outside (index 1), the inside has index `ior`.
+//
+// Dirac deltas (mirror, smooth dielectric; DESIGN §7 "MIS": handled symbolically). For a delta
+// the BSDF is f · δ_σ(wi − w_delta), a Dirac in solid angle with weight f = R / |cos θi|, so the
+// throughput update f · |cos θi| / pdf is one formula for both kinds; `pdf` is then the discrete
+// probability of having chosen that delta, never a huge number. eval() and pdf() see only the
+// finite components: a generic wi never lies on a delta direction.
+//
+// Mixtures (material.h: weights w_j ≥ 0, Σ w_j = W ≤ 1, the rest absorbed). sample() picks
+// component j with probability w_j / W, so it never returns nullopt for the absorbed share; the
+// absorption is carried by the weights in `f` instead (Σ w_j f_j), which keeps the estimator
+// unbiased and avoids the variance of killing paths. For a finite component the returned f and
+// pdf are those of *all* finite components together (one-sample balance heuristic over the lobes,
+// as pbrt's BSDF does), so sample().f == eval() and sample().pdf == pdf() exactly; the letter is
+// D either way, since every finite kind is D. For a delta component f = w_j f_j and pdf =
+// (w_j / W) · p_j. The sampled vertex's letter is the chosen component's (DESIGN §7 "Labelling").
+//
+// Radiance and importance (Veach §5.2). Refraction compresses radiance by (η_wo / η_wi)^2 but not
+// importance: in TransportMode::kRadiance (eye subpaths: wo towards the camera) the transmitted f
+// carries 1/η'^2 with η' = η_wi / η_wo; in kImportance (light subpaths) it does not. Every other
+// kind is symmetric. The extra factor that shading normals cause for importance transport is
+// shading_normal_correction(), applied by the integrator.
+//
+// Robustness (DESIGN §10). GGX is evaluated in forms that stay finite as roughness → 1e-4 (D from
+// the half-vector's tangent components, not 1 − cos²) and at grazing angles (Λ without
+// cancellation); roughness is clamped below at kMinGlossyRoughness. A direction exactly in the
+// tangent plane (cos θ == 0 to float precision) carries nothing: sample() returns nullopt.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "alphabet/alphabet.h"
+#include "scene/material.h"
+
+namespace pathex {
+
+enum class TransportMode : std::uint8_t {
+  kRadiance,    // eye subpaths: the path carries radiance towards the camera
+  kImportance,  // light subpaths: the path carries importance towards the light
+};
+
+// The kind of lobe a sample came from (pbrt's BxDFFlags, reduced to what occurs here).
+enum class Lobe : std::uint8_t {
+  kDiffuseReflection,
+  kGlossyReflection,
+  kSpecularReflection,
+  kSpecularTransmission,
+};
+
+inline constexpr float kMinGlossyRoughness = 1e-6f;
+
+struct BsdfSample {
+  glm::vec3 wi{0.0f};      // unit, away from the surface
+  glm::vec3 f{0.0f};       // finite: eval(wo, wi); delta: the Dirac's weight R / |cos θi|
+  float pdf = 0.0f;        // finite: pdf(wo, wi) (solid angle); delta: discrete probability
+  float pdf_rev = 0.0f;    // the same for sampling wo from wi (BDPT's reverse density)
+  glm::vec3 weight{0.0f};  // f · |cos θi| / pdf, computed without dividing by tiny cosines
+  float eta = 1.0f;        // η_wi / η_wo across a refraction, 1 for reflection
+  Letter letter = kD;      // kD for finite lobes, kS for deltas
+  bool is_delta = false;
+  Lobe lobe = Lobe::kDiffuseReflection;
+  int component = 0;       // index into Mixture::components; 0 for a basic material
+};
+
+namespace bsdf {
+
+// Sample wi given wo. `u_component` picks the mixture component (and then, rescaled, the
+// reflection/refraction choice of a dielectric); `u` drives the direction within the lobe.
+// nullopt when the sampled direction carries nothing (below the surface, leaking through ng,
+// grazing exactly, zero-weight material).
+std::optional<BsdfSample> sample(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
+                                 const glm::vec3& ng, float u_component, glm::vec2 u,
+                                 TransportMode mode);
+
+// The BSDF summed over the finite components, weighted by the mixture weights. Reciprocal:
+// eval(wo, wi) == eval(wi, wo) bit for bit.
+glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+               const glm::vec3& ng);
+inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi,
+                      const glm::vec3& n) {
+  return eval(m, wo, wi, n, n);
+}
+
+// Solid-angle density with which sample() produces wi through a finite component, including the
+// probability of picking that component. Deltas contribute nothing here (see component_probability).
+float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+          const glm::vec3& ng);
+inline float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& n) {
+  return pdf(m, wo, wi, n, n);
+}
+
+// The discrete probability that sample() picks the delta lobe `lobe` of component `component`
+// given wo (what BsdfSample::pdf holds for that delta); 0 if that lobe is not a delta of that
+// component. For BDPT, which recomputes a specular vertex's densities in the reverse direction.
+float component_probability(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
+                            int component, Lobe lobe);
+
+// True if the material has at least one finite (D) component with non-zero weight: only then can
+// a join (shadow ray, connection) at a vertex on it carry energy.
+bool has_finite_component(const Material& m);
+
+// Exact unpolarised Fresnel reflectance of a smooth dielectric interface. `cos_i` is the cosine
+// between the incident direction and the normal on the outside; negative means incidence from
+// inside. `eta` is η_inside / η_outside. Returns exactly 1 beyond the critical angle.
+float fresnel_dielectric(float cos_i, float eta);
+
+// Veach's correction for shading normals in importance transport (thesis §5.3, pbrt-v3's
+// CorrectShadingNormal): multiply a light subpath's throughput f · |wi·ns| / pdf by
+// |wo·ns| |wi·ng| / (|wo·ng| |wi·ns|). 1 for radiance transport and whenever ns == ng.
+float shading_normal_correction(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+                                const glm::vec3& ng, TransportMode mode);
+
+}  // namespace bsdf
+}  // namespace pathex

@@ -1,0 +1,816 @@
+// BSDFs (trace/bsdf.h) against closed forms and against each other: white-furnace energy
+// conservation, reciprocity, sample() versus pdf() by chi-square, sample() versus eval(), exact
+// Fresnel and total internal reflection, the radiance/importance asymmetry of refraction, the
+// glossy lobe's limit as roughness → 1e-4, mixture letter frequencies, grazing angles, and the
+// orthonormal frame the BSDFs are written in.
+//
+// Tolerances: Monte Carlo means within kZ = 4 standard errors (estimated from the same samples);
+// chi-square statistics below the critical value at z = 5 (false-alarm probability ~3e-7,
+// Wilson–Hilferty). All random numbers come from fixed seeds, so every run is identical.
+#include "trace/bsdf.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "trace/frame.h"
+#include "trace/rng.h"
+
+namespace pathex {
+namespace {
+
+constexpr double kZ = 4.0;
+constexpr double kPiD = std::numbers::pi;
+const glm::vec3 kUp(0.0f, 0.0f, 1.0f);
+
+// A unit direction at polar angle theta (degrees) from +z and azimuth phi (degrees).
+glm::vec3 polar(double theta_deg, double phi_deg = 0.0) {
+  const double t = theta_deg * kPiD / 180.0, p = phi_deg * kPiD / 180.0;
+  return glm::vec3(static_cast<float>(std::sin(t) * std::cos(p)),
+                   static_cast<float>(std::sin(t) * std::sin(p)), static_cast<float>(std::cos(t)));
+}
+
+glm::vec3 mirror_of(const glm::vec3& w, const glm::vec3& n) { return 2.0f * glm::dot(w, n) * n - w; }
+
+bool finite3(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+Material mixture(std::vector<Mixture::Component> components) {
+  Mixture m;
+  m.components = std::move(components);
+  return m;
+}
+
+// --- statistics ---
+
+struct Estimate {
+  double mean = 0.0;
+  double se = 0.0;
+};
+
+struct Accumulator {
+  double sum = 0.0, sum2 = 0.0;
+  std::uint64_t n = 0;
+  void add(double x) {
+    sum += x;
+    sum2 += x * x;
+    ++n;
+  }
+  Estimate estimate() const {
+    const double mean = sum / static_cast<double>(n);
+    const double var = std::max(0.0, sum2 / static_cast<double>(n) - mean * mean);
+    return {mean, std::sqrt(var / static_cast<double>(n))};
+  }
+};
+
+double chi2_critical(double k, double z) {
+  const double h = 2.0 / (9.0 * k);
+  return k * std::pow(1.0 - h + z * std::sqrt(h), 3.0);
+}
+
+// Chi-square of observed against expected counts, pooling cells expected below 5 (pbrt's
+// chi2test); a cell with nothing expected but something observed is an immediate failure.
+struct Chi2 {
+  double statistic = 0.0;
+  double critical = 0.0;
+  bool impossible_count = false;
+};
+Chi2 chi2_test(const std::vector<double>& observed, const std::vector<double>& expected) {
+  std::vector<std::size_t> order(observed.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return expected[a] < expected[b]; });
+  Chi2 r;
+  double pooled_o = 0.0, pooled_e = 0.0;
+  int cells = 0;
+  for (std::size_t i : order) {
+    if (expected[i] <= 0.0) {
+      if (observed[i] > 0.0) r.impossible_count = true;
+      continue;
+    }
+    if (expected[i] < 5.0 || pooled_e > 0.0) {
+      pooled_o += observed[i];
+      pooled_e += expected[i];
+      if (pooled_e >= 5.0) {
+        r.statistic += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
+        ++cells;
+        pooled_o = pooled_e = 0.0;
+      }
+      continue;
+    }
+    r.statistic += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+    ++cells;
+  }
+  if (pooled_e > 0.0) {
+    r.statistic += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
+    ++cells;
+  }
+  r.critical = chi2_critical(std::max(cells - 1, 1), 5.0);
+  return r;
+}
+
+// sample() against pdf(): the directions of n samples of `sampled` binned over the sphere
+// (equal-area bins in cos θ × φ about the normal), plus one cell for all delta samples and one for
+// "no sample". Expected counts integrate pdf() of `m` over each bin (midpoint rule on a 6 × 6
+// sub-grid); the delta cell expects n · Σ component_probability; "no sample" gets the rest.
+Chi2 chi2_sample_vs_pdf(const Material& sampled, const Material& m, const glm::vec3& wo,
+                        const glm::vec3& n, std::uint64_t seed, int samples) {
+  constexpr int kU = 40, kPhi = 80, kSub = 6;
+  const Frame frame = Frame::from_normal(n);
+  std::vector<double> observed(kU * kPhi + 2, 0.0), expected(kU * kPhi + 2, 0.0);
+  for (int i = 0; i < samples; ++i) {
+    Sampler s(seed, 0, static_cast<std::uint64_t>(i));
+    const float uc = s.get1d();
+    const auto r = bsdf::sample(sampled, wo, n, n, uc, s.get2d(), TransportMode::kRadiance);
+    if (!r) {
+      observed[kU * kPhi + 1] += 1.0;
+    } else if (r->is_delta) {
+      observed[kU * kPhi] += 1.0;
+    } else {
+      const glm::vec3 l = frame.to_local(r->wi);
+      const double u = std::clamp(static_cast<double>(l.z), -1.0, 1.0);
+      double phi = std::atan2(static_cast<double>(l.y), static_cast<double>(l.x));
+      if (phi < 0.0) phi += 2.0 * kPiD;
+      const int iu = std::min(static_cast<int>((u + 1.0) / 2.0 * kU), kU - 1);
+      const int ip = std::min(static_cast<int>(phi / (2.0 * kPiD) * kPhi), kPhi - 1);
+      observed[static_cast<std::size_t>(iu * kPhi + ip)] += 1.0;
+    }
+  }
+  double total = 0.0;
+  const double du = 2.0 / kU, dphi = 2.0 * kPiD / kPhi;
+  for (int iu = 0; iu < kU; ++iu) {
+    for (int ip = 0; ip < kPhi; ++ip) {
+      double integral = 0.0;
+      for (int a = 0; a < kSub; ++a) {
+        for (int b = 0; b < kSub; ++b) {
+          const double u = -1.0 + (iu + (a + 0.5) / kSub) * du;
+          const double phi = (ip + (b + 0.5) / kSub) * dphi;
+          const double r = std::sqrt(std::max(0.0, 1.0 - u * u));
+          const glm::vec3 wi = frame.to_world(glm::vec3(static_cast<float>(r * std::cos(phi)),
+                                                        static_cast<float>(r * std::sin(phi)),
+                                                        static_cast<float>(u)));
+          integral += bsdf::pdf(m, wo, wi, n);
+        }
+      }
+      integral *= du * dphi / (kSub * kSub);
+      expected[static_cast<std::size_t>(iu * kPhi + ip)] = integral * samples;
+      total += integral;
+    }
+  }
+  double p_delta = 0.0;
+  const int components = std::holds_alternative<Mixture>(m)
+                             ? static_cast<int>(std::get<Mixture>(m).components.size())
+                             : 1;
+  for (int c = 0; c < components; ++c)
+    for (Lobe lobe : {Lobe::kSpecularReflection, Lobe::kSpecularTransmission})
+      p_delta += bsdf::component_probability(m, wo, n, c, lobe);
+  expected[kU * kPhi] = p_delta * samples;
+  expected[kU * kPhi + 1] = std::max(0.0, 1.0 - total - p_delta) * samples;
+  return chi2_test(observed, expected);
+}
+Chi2 chi2_sample_vs_pdf(const Material& m, const glm::vec3& wo, const glm::vec3& n,
+                        std::uint64_t seed, int samples) {
+  return chi2_sample_vs_pdf(m, m, wo, n, seed, samples);
+}
+
+// Mean of sample().weight (first channel), a nullopt counting 0: the directional albedo.
+Estimate albedo_by_sampling(const Material& m, const glm::vec3& wo, const glm::vec3& n,
+                            std::uint64_t seed, int samples,
+                            TransportMode mode = TransportMode::kRadiance) {
+  Accumulator acc;
+  for (int i = 0; i < samples; ++i) {
+    Sampler s(seed, 1, static_cast<std::uint64_t>(i));
+    const float uc = s.get1d();
+    const auto r = bsdf::sample(m, wo, n, n, uc, s.get2d(), mode);
+    acc.add(r ? r->weight.x : 0.0);
+  }
+  return acc.estimate();
+}
+
+// ∫ eval · |cos| over the sphere with uniformly distributed directions: independent of sample().
+Estimate albedo_by_uniform_eval(const Material& m, const glm::vec3& wo, const glm::vec3& n,
+                                std::uint64_t seed, int samples) {
+  Accumulator acc;
+  for (int i = 0; i < samples; ++i) {
+    Sampler s(seed, 2, static_cast<std::uint64_t>(i));
+    const glm::vec3 wi = sample_uniform_sphere(s.get2d());
+    acc.add(bsdf::eval(m, wo, wi, n).x * std::abs(glm::dot(wi, n)) * 4.0 * kPiD);
+  }
+  return acc.estimate();
+}
+
+// The classic microfacet estimator (Walter et al. 2007): m drawn from D(m) cos θm with the
+// textbook GGX D written out here in double precision, wi the reflection of wo about m, density
+// D cos θm / (4 |wo·m|). Uses only eval() of the code under test, and wo in the +z frame.
+Estimate albedo_by_classic_ggx(const Material& m, float alpha, const glm::vec3& wo,
+                               std::uint64_t seed, int samples) {
+  Accumulator acc;
+  const double a2 = static_cast<double>(alpha) * alpha;
+  for (int i = 0; i < samples; ++i) {
+    Sampler s(seed, 3, static_cast<std::uint64_t>(i));
+    const glm::vec2 u = s.get2d();
+    const double tan2 = a2 * u.x / (1.0 - u.x);
+    const double cos_m = 1.0 / std::sqrt(1.0 + tan2);
+    const double sin_m = std::sqrt(std::max(0.0, 1.0 - cos_m * cos_m));
+    const double phi = 2.0 * kPiD * u.y;
+    const glm::vec3 mh(static_cast<float>(sin_m * std::cos(phi)),
+                       static_cast<float>(sin_m * std::sin(phi)), static_cast<float>(cos_m));
+    const double wo_m = glm::dot(wo, mh);
+    const glm::vec3 wi = mirror_of(wo, mh);
+    if (wo_m <= 0.0 || wi.z <= 0.0f) {
+      acc.add(0.0);
+      continue;
+    }
+    const double c4 = cos_m * cos_m * cos_m * cos_m;
+    const double d = 1.0 / (kPiD * a2 * c4 * (1.0 + tan2 / a2) * (1.0 + tan2 / a2));
+    const double p = d * cos_m / (4.0 * wo_m);
+    acc.add(bsdf::eval(m, wo, wi, kUp).x * wi.z / p);
+  }
+  return acc.estimate();
+}
+
+void expect_agree(const Estimate& a, const Estimate& b, const char* what) {
+  EXPECT_NEAR(a.mean, b.mean, kZ * std::sqrt(a.se * a.se + b.se * b.se) + 1e-6)
+      << what << ": " << a.mean << " ± " << a.se << " vs " << b.mean << " ± " << b.se;
+}
+
+// --- frame ---
+
+TEST(Frame, IsOrthonormalAndRightHandedEverywhere) {
+  std::vector<glm::vec3> normals = {kUp, -kUp, glm::normalize(glm::vec3(1e-7f, 0.0f, -1.0f)),
+                                    glm::vec3(1.0f, 0.0f, 0.0f), glm::vec3(0.0f, -1.0f, 0.0f)};
+  for (int i = 0; i < 1000; ++i) {
+    Sampler s(21, 0, static_cast<std::uint64_t>(i));
+    normals.push_back(sample_uniform_sphere(s.get2d()));
+  }
+  for (const glm::vec3& n : normals) {
+    const Frame f = Frame::from_normal(n);
+    EXPECT_NEAR(glm::dot(f.s, f.s), 1.0f, 1e-5f);
+    EXPECT_NEAR(glm::dot(f.t, f.t), 1.0f, 1e-5f);
+    EXPECT_NEAR(glm::dot(f.s, f.t), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::dot(f.s, n), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::dot(f.t, n), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::length(glm::cross(f.s, f.t) - n), 0.0f, 1e-5f) << "right-handed";
+    const glm::vec3 v(0.3f, -0.5f, 0.81f);
+    EXPECT_NEAR(glm::length(f.to_world(f.to_local(v)) - v), 0.0f, 1e-5f);
+    EXPECT_NEAR(f.to_local(n).z, 1.0f, 1e-6f);
+  }
+  const Frame g = Frame::from_normal_tangent(kUp, glm::vec3(1.0f, 0.0f, 0.3f));
+  EXPECT_EQ(g.s, glm::vec3(1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(g.t, glm::vec3(0.0f, 1.0f, 0.0f));
+}
+
+// --- Lambertian ---
+
+TEST(Diffuse, WhiteFurnaceAndSampleWeights) {
+  const Material m = Diffuse{glm::vec3(0.7f, 0.5f, 1.0f)};
+  for (double theta : {0.0, 45.0, 89.0}) {
+    const glm::vec3 wo = polar(theta, 30.0);
+    const Estimate by_eval = albedo_by_uniform_eval(m, wo, kUp, 1, 200'000);
+    EXPECT_NEAR(by_eval.mean, 0.7, kZ * by_eval.se) << theta;
+    for (int i = 0; i < 1000; ++i) {
+      Sampler s(2, 0, static_cast<std::uint64_t>(i));
+      const float uc = s.get1d();
+      const auto r = bsdf::sample(m, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+      ASSERT_TRUE(r);
+      EXPECT_NEAR(r->weight.x, 0.7f, 1e-5f);
+      EXPECT_NEAR(r->weight.y, 0.5f, 1e-5f);
+      EXPECT_EQ(r->letter, kD);
+      EXPECT_FALSE(r->is_delta);
+      EXPECT_EQ(r->lobe, Lobe::kDiffuseReflection);
+      EXPECT_GT(r->wi.z, 0.0f);
+      EXPECT_EQ(r->f, bsdf::eval(m, wo, r->wi, kUp));
+      EXPECT_EQ(r->pdf, bsdf::pdf(m, wo, r->wi, kUp));
+      EXPECT_EQ(r->pdf_rev, bsdf::pdf(m, r->wi, wo, kUp));
+      EXPECT_NEAR(r->pdf, r->wi.z / kPi, 1e-6f);
+    }
+  }
+}
+
+TEST(Diffuse, IsTwoSidedAndZeroAcrossTheSurface) {
+  const Material m = Diffuse{glm::vec3(0.5f)};
+  const glm::vec3 below_o = polar(120.0, 10.0), below_i = polar(160.0, 200.0);
+  EXPECT_FLOAT_EQ(bsdf::eval(m, below_o, below_i, kUp).x, 0.5f / kPi);
+  EXPECT_FLOAT_EQ(bsdf::pdf(m, below_o, below_i, kUp), std::abs(below_i.z) / kPi);
+  EXPECT_EQ(bsdf::eval(m, polar(30.0), below_i, kUp), glm::vec3(0.0f));
+  EXPECT_EQ(bsdf::pdf(m, polar(30.0), below_i, kUp), 0.0f);
+  const auto r = bsdf::sample(m, below_o, kUp, kUp, 0.3f, {0.2f, 0.7f}, TransportMode::kRadiance);
+  ASSERT_TRUE(r);
+  EXPECT_LT(r->wi.z, 0.0f) << "sampled on wo's side";
+}
+
+// --- glossy (GGX) ---
+
+TEST(Glossy, WhiteFurnaceAgreesWithTheClassicEstimatorAndNeverExceedsOne) {
+  // With reflectance 1 Schlick's F is 1 and the albedo is the GGX single-scattering albedo: at
+  // most 1, and below it by the energy lost to masking. Three estimators must agree: sample()
+  // weights (visible normals), eval() under classic D·cos sampling, eval() under uniform sampling.
+  for (float alpha : {0.05f, 0.2f, 0.5f, 1.0f}) {
+    const Material m = Glossy{glm::vec3(1.0f), alpha};
+    for (double theta : {0.0, 45.0, 80.0}) {
+      const glm::vec3 wo = polar(theta, 70.0);
+      const Estimate by_sample = albedo_by_sampling(m, wo, kUp, 3, 200'000);
+      const Estimate by_classic = albedo_by_classic_ggx(m, alpha, wo, 4, 400'000);
+      expect_agree(by_sample, by_classic, "visible normals vs classic");
+      if (alpha >= 0.2f) {
+        const Estimate by_uniform = albedo_by_uniform_eval(m, wo, kUp, 5, 400'000);
+        expect_agree(by_sample, by_uniform, "visible normals vs uniform");
+      }
+      EXPECT_LE(by_sample.mean, 1.0 + kZ * by_sample.se) << alpha << " " << theta;
+      if (alpha <= 0.05f && theta < 50.0) {
+        EXPECT_GT(by_sample.mean, 0.99) << "a nearly smooth lobe loses almost nothing";
+      }
+    }
+  }
+}
+
+TEST(Glossy, AlphaOneAtNormalIncidenceHasAClosedFormAlbedo) {
+  // For alpha = 1, D(m) = 1/π, so visible normals seen from the zenith are cosine distributed and
+  // wi = reflect(z, m) stays above the surface iff θm < 45°: probability 1/2. With G1(z) = 1 and
+  // Λ(wi) = (1/cos θi − 1)/2, the albedo E[G2/G1] becomes ∫0^1 x/(1 + x) dx = 1 − ln 2.
+  const Material m = Glossy{glm::vec3(1.0f), 1.0f};
+  constexpr int kN = 400'000;
+  Accumulator albedo, produced;
+  for (int i = 0; i < kN; ++i) {
+    Sampler s(40, 0, static_cast<std::uint64_t>(i));
+    const float uc = s.get1d();
+    const auto r = bsdf::sample(m, kUp, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+    albedo.add(r ? r->weight.x : 0.0);
+    produced.add(r ? 1.0 : 0.0);
+  }
+  EXPECT_NEAR(albedo.estimate().mean, 1.0 - std::log(2.0), kZ * albedo.estimate().se);
+  EXPECT_NEAR(produced.estimate().mean, 0.5, kZ * produced.estimate().se);
+}
+
+TEST(Glossy, SampleValuesAreEvalAndPdf) {
+  const Material m = Glossy{glm::vec3(0.9f, 0.6f, 0.3f), 0.3f};
+  const glm::vec3 n = glm::normalize(glm::vec3(0.2f, -0.4f, 0.9f));
+  const Frame frame = Frame::from_normal(n);
+  const glm::vec3 wo = frame.to_world(polar(50.0, 10.0));
+  int produced = 0;
+  for (int i = 0; i < 2000; ++i) {
+    Sampler s(6, 0, static_cast<std::uint64_t>(i));
+    const float uc = s.get1d();
+    const auto r = bsdf::sample(m, wo, n, n, uc, s.get2d(), TransportMode::kRadiance);
+    if (!r) continue;
+    ++produced;
+    EXPECT_EQ(r->f, bsdf::eval(m, wo, r->wi, n));
+    EXPECT_EQ(r->pdf, bsdf::pdf(m, wo, r->wi, n));
+    EXPECT_EQ(r->pdf_rev, bsdf::pdf(m, r->wi, wo, n));
+    const glm::vec3 expected_weight = r->f * std::abs(glm::dot(r->wi, n)) / r->pdf;
+    EXPECT_NEAR(r->weight.y, expected_weight.y, 1e-5f * expected_weight.y);
+    EXPECT_EQ(r->letter, kD);
+    EXPECT_EQ(r->lobe, Lobe::kGlossyReflection);
+    EXPECT_GT(glm::dot(r->wi, n), 0.0f);
+  }
+  EXPECT_GT(produced, 1700) << "about 7 % of the reflections leave below the horizon";
+}
+
+TEST(Glossy, NearDeltaRoughnessConvergesToTheMirror) {
+  // Roughness 1e-4: every sample is finite, leaves within a few alpha of the mirror direction,
+  // and the albedo is Schlick's F at wo (1 for reflectance 1, the mirror's value).
+  const glm::vec3 wo = polar(60.0, 20.0);
+  const glm::vec3 wr = mirror_of(wo, kUp);
+  const float schlick = 0.5f + 0.5f * std::pow(1.0f - 0.5f, 5.0f);  // R0 = 0.5 at cos θ = 1/2
+  for (float alpha : {1e-4f, 0.0f /* clamped to kMinGlossyRoughness */}) {
+    const Material white = Glossy{glm::vec3(1.0f), alpha};
+    const Material grey = Glossy{glm::vec3(0.5f), alpha};
+    // GGX has heavy tails: P(tan θm > k α) = 1 / (1 + k²) under D cos θm, so wi stays within
+    // 20 alpha of the mirror direction (θm within 10 alpha) in about 99 % of the samples.
+    const double cone = 20.0 * std::max(alpha, kMinGlossyRoughness);
+    int near_mirror = 0;
+    constexpr int kN = 2000;
+    for (int i = 0; i < kN; ++i) {
+      Sampler s(7, 0, static_cast<std::uint64_t>(i));
+      const float uc = s.get1d();
+      const auto r = bsdf::sample(white, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+      ASSERT_TRUE(r) << i;
+      ASSERT_TRUE(finite3(r->f) && std::isfinite(r->pdf) && finite3(r->weight));
+      const double angle = 2.0 * std::asin(std::min(1.0, 0.5 * glm::length(glm::dvec3(r->wi - wr))));
+      near_mirror += angle < cone;
+      EXPECT_NEAR(r->weight.x, 1.0f, 1e-3f);
+      EXPECT_EQ(r->letter, kD) << "still a finite lobe";
+      const auto g = bsdf::sample(grey, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+      ASSERT_TRUE(g);
+      EXPECT_NEAR(g->weight.x, schlick, 1e-3f);
+    }
+    EXPECT_GT(near_mirror, 0.97 * kN) << alpha;
+  }
+  // The albedo approaches the mirror's as the roughness decreases.
+  const Material mirror = Mirror{glm::vec3(1.0f)};
+  const double mirror_albedo = albedo_by_sampling(mirror, wo, kUp, 8, 1000).mean;
+  EXPECT_EQ(mirror_albedo, 1.0);
+  double previous = 1.0;
+  for (float alpha : {0.1f, 0.01f, 1e-3f, 1e-4f}) {
+    const double a = albedo_by_sampling(Glossy{glm::vec3(1.0f), alpha}, wo, kUp, 8, 20'000).mean;
+    const double gap = std::abs(a - mirror_albedo);
+    EXPECT_LE(gap, previous) << alpha;
+    previous = gap;
+  }
+  EXPECT_LT(previous, 1e-3);
+}
+
+TEST(Glossy, ReciprocityIsExact) {
+  for (float alpha : {1e-4f, 0.05f, 0.3f, 1.0f}) {
+    const Material m = Glossy{glm::vec3(0.9f, 0.5f, 0.2f), alpha};
+    for (int i = 0; i < 2000; ++i) {
+      Sampler s(9, 0, static_cast<std::uint64_t>(i));
+      glm::vec3 a = sample_uniform_sphere(s.get2d()), b = sample_uniform_sphere(s.get2d());
+      if (a.z * b.z < 0.0f) b.z = -b.z;  // same side, either side
+      const glm::vec3 fab = bsdf::eval(m, a, b, kUp), fba = bsdf::eval(m, b, a, kUp);
+      EXPECT_EQ(fab.x, fba.x);
+      EXPECT_EQ(fab.y, fba.y);
+      EXPECT_EQ(fab.z, fba.z);
+      EXPECT_TRUE(finite3(fab));
+    }
+  }
+}
+
+TEST(Glossy, TwoSidedMatchesTheMirroredConfiguration) {
+  const Material m = Glossy{glm::vec3(0.8f), 0.4f};
+  const glm::vec3 wo = polar(40.0, 15.0), wi = polar(55.0, 170.0);
+  const glm::vec3 wo_b(wo.x, wo.y, -wo.z), wi_b(wi.x, wi.y, -wi.z);
+  EXPECT_NEAR(bsdf::eval(m, wo_b, wi_b, kUp).x, bsdf::eval(m, wo, wi, kUp).x,
+              1e-5f * bsdf::eval(m, wo, wi, kUp).x);
+  EXPECT_NEAR(bsdf::pdf(m, wo_b, wi_b, kUp), bsdf::pdf(m, wo, wi, kUp),
+              1e-5f * bsdf::pdf(m, wo, wi, kUp));
+}
+
+// --- mirror ---
+
+TEST(MirrorBsdf, ReflectsExactlyWithSymbolicDelta) {
+  const Material m = Mirror{glm::vec3(0.9f, 0.8f, 0.7f)};
+  const glm::vec3 n = glm::normalize(glm::vec3(0.3f, 0.1f, 1.0f));
+  const glm::vec3 wo = glm::normalize(glm::vec3(-0.5f, 0.2f, 0.6f));
+  const auto r = bsdf::sample(m, wo, n, n, 0.42f, {0.1f, 0.9f}, TransportMode::kRadiance);
+  ASSERT_TRUE(r);
+  EXPECT_TRUE(r->is_delta);
+  EXPECT_EQ(r->letter, kS);
+  EXPECT_EQ(r->lobe, Lobe::kSpecularReflection);
+  EXPECT_EQ(r->pdf, 1.0f);
+  EXPECT_EQ(r->pdf_rev, 1.0f);
+  EXPECT_EQ(r->weight, glm::vec3(0.9f, 0.8f, 0.7f));
+  EXPECT_NEAR(glm::length(r->wi - mirror_of(wo, n)), 0.0f, 1e-6f);
+  EXPECT_NEAR(r->f.x * std::abs(glm::dot(r->wi, n)), 0.9f, 1e-6f) << "f = R / |cos|";
+  // Deltas are invisible to eval() and pdf(), even exactly at the mirror direction.
+  EXPECT_EQ(bsdf::eval(m, wo, r->wi, n), glm::vec3(0.0f));
+  EXPECT_EQ(bsdf::pdf(m, wo, r->wi, n), 0.0f);
+  EXPECT_EQ(bsdf::component_probability(m, wo, n, 0, Lobe::kSpecularReflection), 1.0f);
+  EXPECT_EQ(bsdf::component_probability(m, wo, n, 0, Lobe::kSpecularTransmission), 0.0f);
+  EXPECT_FALSE(bsdf::has_finite_component(m));
+}
+
+// --- smooth dielectric ---
+
+TEST(Fresnel, NormalIncidenceIsTheClosedForm) {
+  for (float eta : {1.0f, 1.33f, 1.5f, 2.4f}) {
+    const float r = (eta - 1.0f) / (eta + 1.0f);
+    EXPECT_EQ(bsdf::fresnel_dielectric(1.0f, eta), r * r) << eta;
+    EXPECT_NEAR(bsdf::fresnel_dielectric(-1.0f, eta), r * r, 1e-7f) << "from inside, " << eta;
+  }
+  EXPECT_NEAR(bsdf::fresnel_dielectric(0.3f, 1.0f), 0.0f, 1e-7f) << "index-matched: no reflection";
+}
+
+TEST(Fresnel, BrewsterAngleAndGrazingIncidence) {
+  // At Brewster's angle tan θ = η the p-polarised part vanishes: F = ((1 − η²)/(1 + η²))² / 2.
+  const float eta = 1.5f;
+  const float cos_b = 1.0f / std::sqrt(1.0f + eta * eta);
+  const float rs = (1.0f - eta * eta) / (1.0f + eta * eta);
+  EXPECT_NEAR(bsdf::fresnel_dielectric(cos_b, eta), 0.5f * rs * rs, 1e-6f);
+  EXPECT_NEAR(bsdf::fresnel_dielectric(1e-6f, eta), 1.0f, 1e-5f);
+  EXPECT_LT(bsdf::fresnel_dielectric(1e-6f, eta), 1.0f);
+}
+
+TEST(Fresnel, TotalInternalReflectionBeyondTheCriticalAngle) {
+  const float eta = 1.5f;
+  const double critical = std::asin(1.0 / eta) * 180.0 / kPiD;  // 41.81°
+  for (double theta : {critical + 1e-3, 50.0, 70.0, 89.9}) {
+    const float cos_i = -static_cast<float>(std::cos(theta * kPiD / 180.0));
+    EXPECT_EQ(bsdf::fresnel_dielectric(cos_i, eta), 1.0f) << theta;
+  }
+  EXPECT_LT(bsdf::fresnel_dielectric(-static_cast<float>(std::cos((critical - 0.05) * kPiD / 180.0)), eta),
+            1.0f);
+  // Sampling from inside beyond the critical angle always reflects, with the tint as weight.
+  const Material m = Dielectric{eta, glm::vec3(0.9f)};
+  const glm::vec3 wo = -polar(50.0, 30.0);  // inside: below the outward normal
+  for (int i = 0; i < 1000; ++i) {
+    Sampler s(10, 0, static_cast<std::uint64_t>(i));
+    const float uc = s.get1d();
+    const auto r = bsdf::sample(m, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->lobe, Lobe::kSpecularReflection);
+    EXPECT_EQ(r->pdf, 1.0f);
+    EXPECT_EQ(r->weight, glm::vec3(0.9f));
+    EXPECT_EQ(r->eta, 1.0f);
+    EXPECT_LT(r->wi.z, 0.0f);
+  }
+}
+
+TEST(DielectricBsdf, ReflectsWithFresnelProbabilityAndRefractsBySnell) {
+  const float eta = 1.5f;
+  const Material m = Dielectric{eta, glm::vec3(1.0f, 0.9f, 0.8f)};
+  for (bool outside : {true, false}) {
+    const glm::vec3 wo = outside ? polar(30.0, 45.0) : -polar(25.0, 45.0);
+    const float f_refl = bsdf::fresnel_dielectric(wo.z, eta);
+    const float eta_rel = outside ? eta : 1.0f / eta;
+    constexpr int kN = 100'000;
+    int reflected = 0;
+    for (int i = 0; i < kN; ++i) {
+      Sampler s(11, outside ? 0 : 1, static_cast<std::uint64_t>(i));
+      const float uc = s.get1d();
+      const glm::vec2 u = s.get2d();
+      const auto r = bsdf::sample(m, wo, kUp, kUp, uc, u, TransportMode::kRadiance);
+      const auto q = bsdf::sample(m, wo, kUp, kUp, uc, u, TransportMode::kImportance);
+      ASSERT_TRUE(r && q);
+      EXPECT_TRUE(r->is_delta);
+      EXPECT_EQ(r->letter, kS);
+      EXPECT_EQ(r->lobe, q->lobe) << "the mode does not change the choice";
+      EXPECT_NEAR(r->f.x * std::abs(r->wi.z) / r->pdf, r->weight.x, 1e-5f);
+      if (r->lobe == Lobe::kSpecularReflection) {
+        ++reflected;
+        EXPECT_FLOAT_EQ(r->pdf, f_refl);
+        EXPECT_EQ(r->weight, glm::vec3(1.0f, 0.9f, 0.8f));
+        EXPECT_NEAR(glm::length(r->wi - mirror_of(wo, kUp)), 0.0f, 1e-6f);
+      } else {
+        EXPECT_FLOAT_EQ(r->pdf, 1.0f - f_refl);
+        EXPECT_NEAR(r->pdf_rev, r->pdf, 1e-5f) << "Fresnel transmittance is symmetric";
+        EXPECT_LT(r->wi.z * wo.z, 0.0f) << "crosses the surface";
+        EXPECT_FLOAT_EQ(r->eta, eta_rel);
+        // Snell: sin θo = η' sin θi (η' = η_wi / η_wo), in the plane of incidence.
+        const float sin_o = std::sqrt(wo.x * wo.x + wo.y * wo.y);
+        const float sin_i = std::sqrt(r->wi.x * r->wi.x + r->wi.y * r->wi.y);
+        EXPECT_NEAR(sin_o, eta_rel * sin_i, 1e-5f);
+        EXPECT_NEAR(glm::dot(glm::cross(wo, kUp), r->wi), 0.0f, 1e-6f);
+        // Radiance is scaled by 1/η'^2 across the interface, importance is not.
+        EXPECT_NEAR(r->weight.y, 0.9f / (eta_rel * eta_rel), 1e-6f);
+        EXPECT_NEAR(q->weight.y, 0.9f, 1e-6f);
+        EXPECT_NEAR(q->f.y, r->f.y * eta_rel * eta_rel, 1e-5f * q->f.y);
+      }
+    }
+    const double p = f_refl;
+    EXPECT_NEAR(reflected / double(kN), p, kZ * std::sqrt(p * (1.0 - p) / kN)) << outside;
+  }
+}
+
+TEST(DielectricBsdf, FurnaceInBothTransportModes) {
+  // Importance: R + T = 1 for every sample. Radiance: E[weight] = F + (1 − F)/η'^2.
+  const float eta = 1.5f;
+  const Material m = Dielectric{eta, glm::vec3(1.0f)};
+  for (double theta : {0.0, 60.0, 89.0}) {
+    const glm::vec3 wo = polar(theta, 5.0);
+    const Estimate imp = albedo_by_sampling(m, wo, kUp, 12, 50'000, TransportMode::kImportance);
+    EXPECT_NEAR(imp.mean, 1.0, 1e-6) << theta;
+    const Estimate rad = albedo_by_sampling(m, wo, kUp, 12, 200'000, TransportMode::kRadiance);
+    const double f = bsdf::fresnel_dielectric(wo.z, eta);
+    EXPECT_NEAR(rad.mean, f + (1.0 - f) / (eta * eta), kZ * rad.se + 1e-6) << theta;
+  }
+}
+
+// --- sample() against pdf() ---
+
+TEST(SampleVersusPdf, ChiSquareForEveryFiniteKindAndAMixture) {
+  struct Case {
+    const char* name;
+    Material material;
+    double theta;
+  };
+  const Material mix = mixture({{0.3f, Diffuse{glm::vec3(0.8f)}},
+                                {0.4f, Glossy{glm::vec3(0.9f), 0.3f}},
+                                {0.2f, Mirror{glm::vec3(1.0f)}}});
+  const std::vector<Case> cases = {
+      {"diffuse 10", Diffuse{}, 10.0},          {"diffuse 85", Diffuse{}, 85.0},
+      {"diffuse below", Diffuse{}, 150.0},      {"glossy 0.2 at 20", Glossy{glm::vec3(1.0f), 0.2f}, 20.0},
+      {"glossy 0.2 at 70", Glossy{glm::vec3(1.0f), 0.2f}, 70.0},
+      {"glossy 0.5 at 45", Glossy{glm::vec3(1.0f), 0.5f}, 45.0},
+      {"glossy 1.0 at 85", Glossy{glm::vec3(1.0f), 1.0f}, 85.0},
+      {"glossy 0.5 below", Glossy{glm::vec3(1.0f), 0.5f}, 130.0},
+      {"mixture at 30", mix, 30.0},             {"mixture at 80", mix, 80.0},
+  };
+  std::uint64_t seed = 100;
+  for (const Case& c : cases) {
+    const glm::vec3 n = glm::normalize(glm::vec3(0.1f, 0.2f, 1.0f));
+    const glm::vec3 wo = Frame::from_normal(n).to_world(polar(c.theta, 25.0));
+    const Chi2 r = chi2_sample_vs_pdf(c.material, wo, n, seed++, 400'000);
+    EXPECT_FALSE(r.impossible_count) << c.name;
+    EXPECT_LT(r.statistic, r.critical) << c.name << ": chi-square " << r.statistic;
+  }
+}
+
+TEST(SampleVersusPdf, AWrongPdfIsDetected) {
+  // The harness above can fail: samples of one lobe against a slightly different density (GGX
+  // roughness 0.5 vs 0.55; the dielectric's reflection share overstated by a mirror component).
+  const glm::vec3 wo = polar(45.0, 25.0);
+  const Chi2 rough = chi2_sample_vs_pdf(Glossy{glm::vec3(1.0f), 0.5f}, Glossy{glm::vec3(1.0f), 0.55f},
+                                        wo, kUp, 30, 400'000);
+  EXPECT_GT(rough.statistic, rough.critical);
+  const Material mix = mixture({{0.5f, Diffuse{}}, {0.5f, Mirror{}}});
+  const Material skewed = mixture({{0.45f, Diffuse{}}, {0.55f, Mirror{}}});
+  const Chi2 delta = chi2_sample_vs_pdf(mix, skewed, wo, kUp, 31, 400'000);
+  EXPECT_GT(delta.statistic, delta.critical);
+}
+
+// --- mixtures ---
+
+TEST(MixtureBsdf, LettersFollowTheWeights) {
+  // Components picked with probability w_j / Σw: with Σw = 1 these are the weights themselves.
+  const Material m = mixture({{0.5f, Diffuse{glm::vec3(1.0f)}},
+                              {0.3f, Dielectric{1.5f, glm::vec3(1.0f)}},
+                              {0.2f, Mirror{glm::vec3(1.0f)}}});
+  const glm::vec3 wo = polar(45.0, 60.0);
+  constexpr int kN = 200'000;
+  int count[3] = {0, 0, 0}, letters_s = 0;
+  for (int i = 0; i < kN; ++i) {
+    Sampler s(13, 0, static_cast<std::uint64_t>(i));
+    const float uc = s.get1d();
+    const auto r = bsdf::sample(m, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+    ASSERT_TRUE(r);
+    ++count[r->component];
+    letters_s += r->letter == kS;
+    EXPECT_EQ(r->letter, r->component == 0 ? kD : kS);
+    EXPECT_EQ(r->is_delta, r->component != 0);
+  }
+  const double w[3] = {0.5, 0.3, 0.2};
+  for (int j = 0; j < 3; ++j)
+    EXPECT_NEAR(count[j] / double(kN), w[j], kZ * std::sqrt(w[j] * (1 - w[j]) / kN)) << j;
+  EXPECT_NEAR(letters_s / double(kN), 0.5, kZ * std::sqrt(0.25 / kN));
+}
+
+TEST(MixtureBsdf, AbsorptionIsCarriedByTheWeights) {
+  // 50 % diffuse + 10 % mirror, 40 % absorbed: components at 5/6 and 1/6, never nullopt, and
+  // every sample's weight is exactly the albedo 0.6 (white components).
+  const Material m = mixture({{0.5f, Diffuse{glm::vec3(1.0f)}}, {0.1f, Mirror{glm::vec3(1.0f)}}});
+  const glm::vec3 wo = polar(30.0);
+  constexpr int kN = 100'000;
+  int mirror = 0;
+  for (int i = 0; i < kN; ++i) {
+    Sampler s(14, 0, static_cast<std::uint64_t>(i));
+    const float uc = s.get1d();
+    const auto r = bsdf::sample(m, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+    ASSERT_TRUE(r);
+    EXPECT_NEAR(r->weight.x, 0.6f, 1e-5f);
+    if (r->is_delta) {
+      ++mirror;
+      EXPECT_FLOAT_EQ(r->pdf, 1.0f / 6.0f);
+      EXPECT_FLOAT_EQ(r->pdf, bsdf::component_probability(m, wo, kUp, 1, Lobe::kSpecularReflection));
+    } else {
+      EXPECT_EQ(r->f, bsdf::eval(m, wo, r->wi, kUp));
+      EXPECT_FLOAT_EQ(r->f.x, 0.5f / kPi);
+      EXPECT_FLOAT_EQ(r->pdf, (5.0f / 6.0f) * r->wi.z / kPi);
+    }
+  }
+  EXPECT_NEAR(mirror / double(kN), 1.0 / 6.0, kZ * std::sqrt((1.0 / 6) * (5.0 / 6) / kN));
+  EXPECT_TRUE(bsdf::has_finite_component(m));
+}
+
+TEST(MixtureBsdf, FiniteLobesAreCombinedAndReciprocal) {
+  const Material m = mixture({{0.4f, Diffuse{glm::vec3(0.6f)}},
+                              {0.4f, Glossy{glm::vec3(0.9f), 0.25f}},
+                              {0.2f, Dielectric{1.4f, glm::vec3(1.0f)}}});
+  const Diffuse d{glm::vec3(0.6f)};
+  const Glossy g{glm::vec3(0.9f), 0.25f};
+  const glm::vec3 wo = polar(35.0, 80.0);
+  for (int i = 0; i < 500; ++i) {
+    Sampler s(15, 0, static_cast<std::uint64_t>(i));
+    glm::vec3 wi = sample_uniform_sphere(s.get2d());
+    wi.z = std::abs(wi.z);
+    const glm::vec3 f = bsdf::eval(m, wo, wi, kUp);
+    const glm::vec3 expected = 0.4f * bsdf::eval(d, wo, wi, kUp) + 0.4f * bsdf::eval(g, wo, wi, kUp);
+    EXPECT_NEAR(f.x, expected.x, 1e-6f * (1.0f + expected.x));
+    EXPECT_NEAR(bsdf::pdf(m, wo, wi, kUp),
+                0.4f * bsdf::pdf(d, wo, wi, kUp) + 0.4f * bsdf::pdf(g, wo, wi, kUp),
+                1e-5f * (1.0f + bsdf::pdf(m, wo, wi, kUp)));
+    EXPECT_EQ(f, bsdf::eval(m, wi, wo, kUp));
+    const float uc = s.get1d();
+    const auto r = bsdf::sample(m, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+    if (r && !r->is_delta) {
+      EXPECT_EQ(r->f, bsdf::eval(m, wo, r->wi, kUp));
+      EXPECT_EQ(r->pdf, bsdf::pdf(m, wo, r->wi, kUp));
+    }
+  }
+  // The dielectric's probabilities are scaled by its pick probability.
+  const float f_refl = bsdf::fresnel_dielectric(wo.z, 1.4f);
+  EXPECT_FLOAT_EQ(bsdf::component_probability(m, wo, kUp, 2, Lobe::kSpecularReflection),
+                  0.2f * f_refl);
+  EXPECT_FLOAT_EQ(bsdf::component_probability(m, wo, kUp, 2, Lobe::kSpecularTransmission),
+                  0.2f * (1.0f - f_refl));
+  EXPECT_EQ(bsdf::component_probability(m, wo, kUp, 0, Lobe::kSpecularReflection), 0.0f);
+  EXPECT_EQ(bsdf::component_probability(m, wo, kUp, 7, Lobe::kSpecularReflection), 0.0f);
+}
+
+TEST(MixtureBsdf, NoWeightMeansNoSample) {
+  const Material empty = mixture({});
+  const Material zero = mixture({{0.0f, Diffuse{}}, {0.0f, Mirror{}}});
+  for (const Material& m : {empty, zero}) {
+    EXPECT_FALSE(bsdf::sample(m, polar(10.0), kUp, kUp, 0.5f, {0.5f, 0.5f}, TransportMode::kRadiance));
+    EXPECT_EQ(bsdf::eval(m, polar(10.0), polar(20.0, 180.0), kUp), glm::vec3(0.0f));
+    EXPECT_EQ(bsdf::pdf(m, polar(10.0), polar(20.0, 180.0), kUp), 0.0f);
+    EXPECT_FALSE(bsdf::has_finite_component(m));
+  }
+  // A zero-weight component is never picked, even at the ends of [0, 1).
+  const Material m = mixture({{0.0f, Diffuse{}}, {0.7f, Mirror{}}, {0.0f, Diffuse{}}});
+  for (float uc : {0.0f, 0.5f, kOneMinusEpsilon}) {
+    const auto r = bsdf::sample(m, polar(10.0), kUp, kUp, uc, {0.5f, 0.5f}, TransportMode::kRadiance);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->component, 1);
+    EXPECT_NEAR(r->weight.x, 0.7f, 1e-6f);
+  }
+}
+
+// --- numerically hard cases (DESIGN §10) ---
+
+TEST(Grazing, EveryKindStaysFiniteAtCosOneInAMillion) {
+  const float c = 1e-6f;
+  const glm::vec3 wo_grazing = glm::normalize(glm::vec3(1.0f, 0.0f, c));
+  const std::vector<Material> materials = {
+      Diffuse{},
+      Mirror{},
+      Dielectric{1.5f, glm::vec3(1.0f)},
+      Glossy{glm::vec3(1.0f), 1e-4f},
+      Glossy{glm::vec3(1.0f), 0.5f},
+      mixture({{0.5f, Diffuse{}}, {0.2f, Glossy{glm::vec3(0.5f), 1e-3f}}, {0.3f, Dielectric{}}})};
+  for (const Material& m : materials) {
+    for (const glm::vec3& wo : {wo_grazing, -wo_grazing}) {
+      int produced = 0;
+      for (int i = 0; i < 5000; ++i) {
+        Sampler s(16, 0, static_cast<std::uint64_t>(i));
+        const float uc = s.get1d();
+        const glm::vec2 u = s.get2d();
+        for (TransportMode mode : {TransportMode::kRadiance, TransportMode::kImportance}) {
+          const auto r = bsdf::sample(m, wo, kUp, kUp, uc, u, mode);
+          if (!r) continue;
+          ++produced;
+          ASSERT_TRUE(finite3(r->f) && finite3(r->weight) && std::isfinite(r->pdf) &&
+                      std::isfinite(r->pdf_rev))
+              << m.index() << " " << i;
+          ASSERT_GT(r->pdf, 0.0f);
+          ASSERT_LE(r->weight.x, 2.25f + 1e-3f);  // at most 1/η'^2, leaving glass in radiance mode
+          ASSERT_NEAR(glm::length(r->wi), 1.0f, 1e-5f);
+        }
+        // Grazing wi, too.
+        const glm::vec3 wi = glm::normalize(glm::vec3(std::cos(6.0f * u.x), std::sin(6.0f * u.x),
+                                                      std::copysign(c, wo.z)));
+        ASSERT_TRUE(finite3(bsdf::eval(m, wo, wi, kUp)));
+        ASSERT_TRUE(std::isfinite(bsdf::pdf(m, wo, wi, kUp)));
+      }
+      EXPECT_GT(produced, 0) << m.index();
+    }
+  }
+  // A direction exactly in the tangent plane carries nothing.
+  EXPECT_FALSE(bsdf::sample(Diffuse{}, glm::vec3(1.0f, 0.0f, 0.0f), kUp, kUp, 0.5f, {0.5f, 0.5f},
+                            TransportMode::kRadiance));
+}
+
+TEST(GeometricNormal, ReflectionNeverLeaksThroughTheSurface) {
+  // A shading normal tilted 45° from the geometric one: a reflection must stay on wo's side of ng.
+  const glm::vec3 ng = kUp;
+  const glm::vec3 ns = glm::normalize(glm::vec3(1.0f, 0.0f, 1.0f));
+  const glm::vec3 wo = glm::normalize(glm::vec3(1.0f, 0.0f, 1.2f));
+  int rejected = 0;
+  for (const Material& m : std::vector<Material>{Diffuse{}, Glossy{glm::vec3(1.0f), 0.3f}, Mirror{}}) {
+    int produced = 0;
+    for (int i = 0; i < 5000; ++i) {
+      Sampler s(17, 0, static_cast<std::uint64_t>(i));
+      const float uc = s.get1d();
+      const auto r = bsdf::sample(m, wo, ns, ng, uc, s.get2d(), TransportMode::kRadiance);
+      if (!r) {
+        ++rejected;
+        continue;
+      }
+      ++produced;
+      EXPECT_GT(glm::dot(r->wi, ng), 0.0f);
+      if (!r->is_delta) {
+        EXPECT_EQ(r->f, bsdf::eval(m, wo, r->wi, ns, ng));
+      }
+    }
+    EXPECT_GT(produced, 0) << m.index();
+  }
+  EXPECT_GT(rejected, 0) << "the lobes about ns do reach below ng here";
+  // Same side of ns but across ng: nothing.
+  const glm::vec3 across = glm::normalize(glm::vec3(1.0f, 0.0f, -0.2f));
+  ASSERT_GT(glm::dot(across, ns), 0.0f);
+  EXPECT_EQ(bsdf::eval(Diffuse{}, wo, across, ns, ng), glm::vec3(0.0f));
+  EXPECT_EQ(bsdf::pdf(Diffuse{}, wo, across, ns, ng), 0.0f);
+}
+
+TEST(ShadingNormalCorrection, IsVeachsAdjointFactor) {
+  const glm::vec3 ng = kUp;
+  const glm::vec3 ns = glm::normalize(glm::vec3(0.3f, 0.0f, 1.0f));
+  const glm::vec3 wo = polar(40.0, 10.0), wi = polar(70.0, 200.0);
+  EXPECT_EQ(bsdf::shading_normal_correction(wo, wi, ns, ng, TransportMode::kRadiance), 1.0f);
+  EXPECT_EQ(bsdf::shading_normal_correction(wo, wi, ng, ng, TransportMode::kImportance), 1.0f);
+  const float expected = std::abs(glm::dot(wo, ns) * glm::dot(wi, ng)) /
+                         std::abs(glm::dot(wo, ng) * glm::dot(wi, ns));
+  EXPECT_FLOAT_EQ(bsdf::shading_normal_correction(wo, wi, ns, ng, TransportMode::kImportance),
+                  expected);
+  EXPECT_NE(expected, 1.0f);
+}
+
+}  // namespace
+}  // namespace pathex
