@@ -1,5 +1,7 @@
 #include "classify/pathclass.h"
 
+#include <cctype>
+
 #include "automata/ops.h"
 #include "regex/parser.h"
 
@@ -78,11 +80,13 @@ Result<PathClass> compile_class(std::string_view text, const ClassOptions& optio
   const ClassTable& table = names ? *names : ClassTable::builtins();
   Error notation_error;
   bool notation_mismatch = false;
+  std::string mismatched_name;
   NameLookup lookup = [&](std::string_view name) -> const Regex* {
     const PathClass* c = table.find(name);
     if (!c) return nullptr;
     if (c->notation != options.notation && !notation_mismatch) {
       notation_mismatch = true;
+      mismatched_name = "$" + std::string(name);
       notation_error.message = "'$" + std::string(name) + "' is written in " +
                                (c->notation == Notation::kFull ? "full" : "Heckbert") +
                                " notation and cannot be used in a " +
@@ -93,10 +97,19 @@ Result<PathClass> compile_class(std::string_view text, const ClassOptions& optio
   Result<Regex> ast = parse(text, options.limits, lookup);
   if (!ast) return ast.error();
   if (notation_mismatch) {
-    // Point at the first '$' that refers to the other notation.
+    // Point at the first reference to the name in the other notation: "$name" not followed by
+    // another name character (so "$a" is not found inside "$ab").
+    std::size_t at = text.find(mismatched_name);
+    while (at != std::string_view::npos) {
+      const std::size_t end = at + mismatched_name.size();
+      const bool name_goes_on = end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) ||
+                                                      text[end] == '_' || text[end] == '-');
+      if (!name_goes_on) break;
+      at = text.find(mismatched_name, at + 1);
+    }
     Error e = make_error(ErrorCode::kUnknownName, notation_error.message);
     e.source = std::string(text);
-    e.column = static_cast<int>(text.find('$')) + 1;
+    e.column = static_cast<int>(at == std::string_view::npos ? text.find('$') : at) + 1;
     return e;
   }
   Result<Dfa> raw = compile(*ast, options.limits);

@@ -309,6 +309,18 @@ TEST(CliExplain, NotationAndUsageErrors) {
             "expression\n"
             "  LS+DE|$local\n"
             "        ^\n");
+  // The caret goes under the reference in the other notation, not under the first '$'.
+  const fs::path mixed_file = temp_dir() / "mixed.json";
+  write(mixed_file, R"({"classes": [{"name": "h", "expr": "LSDE", "notation": "heckbert"}]})");
+  const CliRun second = pathex({"explain", "--notation", "heckbert", "--classes", mixed_file.string(), "$h | $local"});
+  EXPECT_EQ(second.code, 2);
+  EXPECT_EQ(second.err,
+            "pathex: error: column 6: '$local' is written in full notation and cannot be used in a Heckbert-notation "
+            "expression\n"
+            "  $h | $local\n"
+            "       ^\n");
+  EXPECT_EQ(pathex({"explain", "--notation", "heckbert", "--classes", mixed_file.string(), "$h|LS+DE"}).code, 0);
+
   const CliRun light = pathex({"explain", "--light", "point", "LSDE"});
   EXPECT_EQ(light.code, 2);
   EXPECT_EQ(light.err, "pathex: error: --light and --sensor apply to --notation heckbert only\n");
