@@ -1,0 +1,539 @@
+// Emission and importance functions (see emitters.h for the conventions: symbolic deltas, the
+// starting throughput `weight`, the image-mean normalisation of W_e).
+#include "trace/emitters.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "trace/frame.h"
+#include "trace/rng.h"
+
+namespace pathex {
+namespace {
+
+bool finite_vec(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+bool is_black(const glm::vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+
+bool in_unit_square(glm::vec2 r) { return r.x >= 0.0f && r.x < 1.0f && r.y >= 0.0f && r.y < 1.0f; }
+
+// Unit direction and length of `v`, or false when v is zero or not finite.
+bool unit_and_length(const glm::vec3& v, glm::vec3* dir, float* length) {
+  const float len = glm::length(v);
+  if (!(len > 0.0f) || !std::isfinite(len)) return false;
+  *dir = v / len;
+  *length = len;
+  return true;
+}
+
+// Film coordinates (2x − 1, 1 − 2y) of a raster position, and back.
+glm::vec2 raster_to_film(glm::vec2 r) { return {2.0f * r.x - 1.0f, 1.0f - 2.0f * r.y}; }
+glm::vec2 film_to_raster(glm::vec2 f) { return {0.5f * (f.x + 1.0f), 0.5f * (1.0f - f.y)}; }
+
+// --- perspective image geometry shared by the pinhole and the thin lens ---
+
+struct Perspective {
+  glm::vec3 forward, right, up;
+  float tan_half_x, tan_half_y;
+  float image_area() const { return 4.0f * tan_half_x * tan_half_y; }
+  // The unit-distance image point of a raster position, as a direction from the centre.
+  glm::vec3 direction(glm::vec2 raster) const {
+    const glm::vec2 f = raster_to_film(raster);
+    return glm::normalize(forward + (f.x * tan_half_x) * right + (f.y * tan_half_y) * up);
+  }
+  // The raster position of a direction with positive cos θ = dot(w, forward).
+  glm::vec2 raster(const glm::vec3& w, float cos_theta) const {
+    return film_to_raster({glm::dot(w, right) / (cos_theta * tan_half_x),
+                           glm::dot(w, up) / (cos_theta * tan_half_y)});
+  }
+};
+
+Perspective perspective(const PinholeParams& p) {
+  return {p.forward, p.right, p.up, p.tan_half_x, p.tan_half_y};
+}
+Perspective perspective(const ThinLensParams& p) {
+  return {p.forward, p.right, p.up, p.tan_half_x, p.tan_half_y};
+}
+
+// 1 / (A cos⁴θ) and 1 / (A cos³θ), the pinhole's importance and direction density.
+float perspective_we(float area, float cos_theta) {
+  const float c2 = cos_theta * cos_theta;
+  return 1.0f / (area * c2 * c2);
+}
+float perspective_pdf_dir(float area, float cos_theta) {
+  return 1.0f / (area * cos_theta * cos_theta * cos_theta);
+}
+
+float lens_area(const ThinLensParams& p) { return kPi * p.lens_radius * p.lens_radius; }
+
+}  // namespace
+
+float area_to_solid_angle(float pdf_area, float distance, float abs_cos) {
+  if (!(abs_cos > 0.0f)) return 0.0f;
+  return pdf_area * (distance * distance) / abs_cos;
+}
+
+// --- area light ---
+
+glm::vec3 emitted_radiance(const AreaLightParams& p, const glm::vec3& n, const glm::vec3& w) {
+  const float c = glm::dot(n, w);
+  if (c > 0.0f || (p.two_sided && c < 0.0f)) return p.radiance;
+  return glm::vec3(0.0f);
+}
+
+std::optional<EndpointRay> sample_ray(const AreaLightParams& p, const SurfacePoint& x, glm::vec2 u) {
+  if (!(x.pdf_area > 0.0f) || !std::isfinite(x.pdf_area)) return std::nullopt;
+  float side = 1.0f;
+  if (p.two_sided) {  // pick a side with u.x and stretch it back to [0, 1)
+    side = u.x < 0.5f ? 1.0f : -1.0f;
+    u.x = std::min(u.x < 0.5f ? 2.0f * u.x : 2.0f * u.x - 1.0f, kOneMinusEpsilon);
+  }
+  const glm::vec3 local = sample_cosine_hemisphere(u);
+  if (!(local.z > 0.0f)) return std::nullopt;
+  const Frame frame = Frame::from_normal(x.normal * side);
+  EndpointRay r;
+  r.origin = x.position;
+  r.direction = glm::normalize(frame.to_world(local));
+  r.normal = x.normal;
+  r.value = p.radiance;
+  const float sides = p.two_sided ? 2.0f : 1.0f;
+  r.pdf = {x.pdf_area, local.z * kInvPi / sides, false, false};
+  // Le cos / (p_A cos / (π · sides)) without the cosines.
+  r.weight = p.radiance * (kPi * sides / x.pdf_area);
+  r.pos_letter = AreaLightParams::kPosLetter;
+  r.dir_letter = AreaLightParams::kDirLetter;
+  return r;
+}
+
+RayPdf pdf_ray(const AreaLightParams& p, const SurfacePoint& x, const glm::vec3& direction) {
+  const float c = glm::dot(x.normal, direction);
+  const bool emits = c > 0.0f || (p.two_sided && c < 0.0f);
+  const float sides = p.two_sided ? 2.0f : 1.0f;
+  return {x.pdf_area, emits ? std::abs(c) * kInvPi / sides : 0.0f, false, false};
+}
+
+std::optional<EndpointConnection> connect(const AreaLightParams& p, const SurfacePoint& x,
+                                          const glm::vec3& ref) {
+  EndpointConnection c;
+  if (!unit_and_length(x.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  const float cos_l = std::abs(glm::dot(x.normal, c.wi));
+  c.value = emitted_radiance(p, x.normal, -c.wi);
+  if (!(cos_l > 0.0f) || is_black(c.value) || !(x.pdf_area > 0.0f)) return std::nullopt;
+  c.position = x.position;
+  c.normal = x.normal;
+  c.pdf_dir = area_to_solid_angle(x.pdf_area, c.distance, cos_l);
+  c.weight = c.value * (cos_l / (c.distance * c.distance * x.pdf_area));
+  c.delta = false;
+  c.ray_pdf = pdf_ray(p, x, -c.wi);
+  if (!finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
+  return c;
+}
+
+// --- point light ---
+
+std::optional<EndpointRay> sample_ray(const PointLightParams& p, glm::vec2 u) {
+  EndpointRay r;
+  r.origin = p.position;
+  r.direction = sample_uniform_sphere(u);
+  r.value = p.intensity;
+  r.pdf = {1.0f, kUniformSpherePdf, true, false};
+  r.weight = p.intensity * (4.0f * kPi);
+  r.pos_letter = PointLightParams::kPosLetter;
+  r.dir_letter = PointLightParams::kDirLetter;
+  return r;
+}
+
+RayPdf pdf_ray(const PointLightParams&, const glm::vec3&) {
+  return {1.0f, kUniformSpherePdf, true, false};
+}
+
+std::optional<EndpointConnection> connect(const PointLightParams& p, const glm::vec3& ref) {
+  EndpointConnection c;
+  if (!unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  c.position = p.position;
+  c.value = p.intensity;
+  c.weight = p.intensity / (c.distance * c.distance);
+  c.delta = true;
+  c.ray_pdf = pdf_ray(p, -c.wi);
+  if (!finite_vec(c.weight)) return std::nullopt;
+  return c;
+}
+
+glm::vec3 power(const PointLightParams& p) { return p.intensity * (4.0f * kPi); }
+
+// --- spot light ---
+
+float spot_falloff(const SpotLightParams& p, float cos_theta) {
+  if (!(cos_theta > p.cos_total)) return 0.0f;  // the cone's boundary itself emits nothing
+  if (cos_theta >= p.cos_falloff_start) return 1.0f;
+  const float t = (cos_theta - p.cos_total) / (p.cos_falloff_start - p.cos_total);
+  return t * t * (3.0f - 2.0f * t);
+}
+
+glm::vec3 intensity(const SpotLightParams& p, const glm::vec3& direction) {
+  return p.intensity * spot_falloff(p, glm::dot(direction, p.axis));
+}
+
+std::optional<EndpointRay> sample_ray(const SpotLightParams& p, glm::vec2 u) {
+  const glm::vec3 local = sample_uniform_cone(u, p.cos_total);
+  EndpointRay r;
+  r.origin = p.position;
+  r.direction = glm::normalize(Frame::from_normal(p.axis).to_world(local));
+  r.value = p.intensity * spot_falloff(p, local.z);
+  if (is_black(r.value)) return std::nullopt;  // the cone's rim, where the falloff is 0
+  const float pdf_dir = uniform_cone_pdf(p.cos_total);
+  r.pdf = {1.0f, pdf_dir, true, false};
+  r.weight = r.value / pdf_dir;
+  r.pos_letter = SpotLightParams::kPosLetter;
+  r.dir_letter = SpotLightParams::kDirLetter;
+  return r;
+}
+
+RayPdf pdf_ray(const SpotLightParams& p, const glm::vec3& direction) {
+  const bool inside = glm::dot(direction, p.axis) > p.cos_total;
+  return {1.0f, inside ? uniform_cone_pdf(p.cos_total) : 0.0f, true, false};
+}
+
+std::optional<EndpointConnection> connect(const SpotLightParams& p, const glm::vec3& ref) {
+  EndpointConnection c;
+  if (!unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  c.value = intensity(p, -c.wi);
+  if (is_black(c.value)) return std::nullopt;
+  c.position = p.position;
+  c.weight = c.value / (c.distance * c.distance);
+  c.delta = true;
+  c.ray_pdf = pdf_ray(p, -c.wi);
+  if (!finite_vec(c.weight)) return std::nullopt;
+  return c;
+}
+
+glm::vec3 power(const SpotLightParams& p) {
+  return p.intensity * (2.0f * kPi * (1.0f - 0.5f * (p.cos_falloff_start + p.cos_total)));
+}
+
+// --- distant light through an aperture ---
+
+namespace {
+glm::vec3 aperture_normal(const DistantLightParams& p) {
+  return glm::normalize(glm::cross(p.edge1, p.edge2));
+}
+float aperture_area(const DistantLightParams& p) { return glm::length(glm::cross(p.edge1, p.edge2)); }
+
+// Parallelogram coordinates (a, b) of a point in the aperture's plane.
+glm::vec2 aperture_coords(const DistantLightParams& p, const glm::vec3& x) {
+  const glm::vec3 d = x - p.corner;
+  const float e11 = glm::dot(p.edge1, p.edge1), e12 = glm::dot(p.edge1, p.edge2),
+              e22 = glm::dot(p.edge2, p.edge2);
+  const float d1 = glm::dot(d, p.edge1), d2 = glm::dot(d, p.edge2);
+  const float det = e11 * e22 - e12 * e12;
+  return {(d1 * e22 - d2 * e12) / det, (d2 * e11 - d1 * e12) / det};
+}
+}  // namespace
+
+std::optional<EndpointRay> sample_ray(const DistantLightParams& p, glm::vec2 u) {
+  const float area = aperture_area(p);
+  if (!(area > 0.0f)) return std::nullopt;
+  const glm::vec3 n = aperture_normal(p);
+  EndpointRay r;
+  r.origin = p.corner + u.x * p.edge1 + u.y * p.edge2;
+  r.direction = p.direction;
+  r.normal = n;
+  r.value = p.irradiance;
+  r.pdf = {1.0f / area, 1.0f, false, true};
+  r.weight = p.irradiance * (std::abs(glm::dot(n, p.direction)) * area);
+  if (is_black(r.weight)) return std::nullopt;  // light parallel to the aperture
+  r.pos_letter = DistantLightParams::kPosLetter;
+  r.dir_letter = DistantLightParams::kDirLetter;
+  return r;
+}
+
+RayPdf pdf_ray(const DistantLightParams& p, const glm::vec3& origin) {
+  const float area = aperture_area(p);
+  const glm::vec2 ab = aperture_coords(p, origin);
+  const bool inside = area > 0.0f && ab.x >= 0.0f && ab.x < 1.0f && ab.y >= 0.0f && ab.y < 1.0f;
+  return {inside ? 1.0f / area : 0.0f, 1.0f, false, true};
+}
+
+std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm::vec3& ref) {
+  const float area = aperture_area(p);
+  if (!(area > 0.0f)) return std::nullopt;
+  const glm::vec3 n = aperture_normal(p);
+  // ref − t · direction lies in the aperture's plane: t = dot(ref − corner, n) / dot(direction, n).
+  const float denom = glm::dot(p.direction, n);
+  if (denom == 0.0f) return std::nullopt;
+  const float t = glm::dot(ref - p.corner, n) / denom;
+  if (!(t > 0.0f) || !std::isfinite(t)) return std::nullopt;
+  EndpointConnection c;
+  c.position = ref - t * p.direction;
+  const glm::vec2 ab = aperture_coords(p, c.position);
+  if (!(ab.x >= 0.0f && ab.x < 1.0f && ab.y >= 0.0f && ab.y < 1.0f)) return std::nullopt;
+  c.normal = n;
+  c.wi = -p.direction;
+  c.distance = t;
+  c.value = p.irradiance;
+  c.weight = p.irradiance;  // E: the irradiance on a surface facing the light
+  c.delta = true;
+  c.ray_pdf = {1.0f / area, 1.0f, false, true};
+  return c;
+}
+
+glm::vec3 power(const DistantLightParams& p) {
+  if (!(aperture_area(p) > 0.0f)) return glm::vec3(0.0f);
+  return p.irradiance * (aperture_area(p) * std::abs(glm::dot(p.direction, aperture_normal(p))));
+}
+
+// --- laser ---
+
+std::optional<EndpointRay> sample_ray(const LaserParams& p) {
+  EndpointRay r;
+  r.origin = p.position;
+  r.direction = p.direction;
+  r.value = p.power;
+  r.pdf = pdf_ray(p);
+  r.weight = p.power;
+  r.pos_letter = LaserParams::kPosLetter;
+  r.dir_letter = LaserParams::kDirLetter;
+  return r;
+}
+
+RayPdf pdf_ray(const LaserParams&) { return {1.0f, 1.0f, true, true}; }
+
+std::optional<EndpointConnection> connect(const LaserParams&, const glm::vec3&) {
+  return std::nullopt;
+}
+
+glm::vec3 power(const LaserParams& p) { return p.power; }
+
+// --- pinhole ---
+
+std::optional<EndpointRay> sample_ray(const PinholeParams& p, glm::vec2 raster) {
+  const Perspective cam = perspective(p);
+  EndpointRay r;
+  r.origin = p.position;
+  r.direction = cam.direction(raster);
+  r.normal = p.forward;
+  const float cos_theta = glm::dot(r.direction, p.forward);
+  if (!(cos_theta > 0.0f)) return std::nullopt;
+  const float area = cam.image_area();
+  r.value = glm::vec3(perspective_we(area, cos_theta));
+  r.pdf = {1.0f, perspective_pdf_dir(area, cos_theta), true, false};
+  r.weight = glm::vec3(1.0f);  // We cos / p_dir = 1 exactly
+  r.pos_letter = PinholeParams::kPosLetter;
+  r.dir_letter = PinholeParams::kDirLetter;
+  r.raster = raster;
+  return r;
+}
+
+glm::vec3 importance(const PinholeParams& p, const glm::vec3& direction, glm::vec2* raster) {
+  const float cos_theta = glm::dot(direction, p.forward);
+  if (!(cos_theta > 0.0f)) return glm::vec3(0.0f);
+  const Perspective cam = perspective(p);
+  const glm::vec2 r = cam.raster(direction, cos_theta);
+  if (!in_unit_square(r)) return glm::vec3(0.0f);
+  if (raster) *raster = r;
+  return glm::vec3(perspective_we(cam.image_area(), cos_theta));
+}
+
+RayPdf pdf_ray(const PinholeParams& p, const glm::vec3& direction) {
+  glm::vec2 raster;
+  if (is_black(importance(p, direction, &raster))) return {1.0f, 0.0f, true, false};
+  const float cos_theta = glm::dot(direction, p.forward);
+  return {1.0f, perspective_pdf_dir(perspective(p).image_area(), cos_theta), true, false};
+}
+
+std::optional<EndpointConnection> connect(const PinholeParams& p, const glm::vec3& ref) {
+  EndpointConnection c;
+  if (!unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  c.value = importance(p, -c.wi, &c.raster);
+  if (is_black(c.value)) return std::nullopt;
+  const float cos_theta = glm::dot(-c.wi, p.forward);
+  c.position = p.position;
+  c.normal = p.forward;
+  c.weight = c.value * (cos_theta / (c.distance * c.distance));
+  c.delta = true;
+  c.ray_pdf = pdf_ray(p, -c.wi);
+  if (!finite_vec(c.weight)) return std::nullopt;
+  return c;
+}
+
+// --- thin lens ---
+
+glm::vec3 lens_point(const ThinLensParams& p, glm::vec2 u_lens) {
+  const glm::vec2 d = sample_concentric_disk(u_lens) * p.lens_radius;
+  return p.position + d.x * p.right + d.y * p.up;
+}
+
+std::optional<EndpointRay> sample_ray(const ThinLensParams& p, glm::vec2 raster, glm::vec2 u_lens) {
+  if (!(p.lens_radius > 0.0f) || !(p.focus_distance > 0.0f)) return std::nullopt;
+  const Perspective cam = perspective(p);
+  // The point on the plane of focus that the pinhole ray through the lens centre would reach.
+  const glm::vec3 pinhole_dir = cam.direction(raster);
+  const glm::vec3 focus =
+      p.position + pinhole_dir * (p.focus_distance / glm::dot(pinhole_dir, p.forward));
+  EndpointRay r;
+  r.origin = lens_point(p, u_lens);
+  float dist;
+  if (!unit_and_length(focus - r.origin, &r.direction, &dist)) return std::nullopt;
+  r.normal = p.forward;
+  const float cos_theta = glm::dot(r.direction, p.forward);
+  if (!(cos_theta > 0.0f)) return std::nullopt;
+  const float area = cam.image_area();
+  const float a_lens = lens_area(p);
+  r.value = glm::vec3(perspective_we(area, cos_theta) / a_lens);
+  r.pdf = {1.0f / a_lens, perspective_pdf_dir(area, cos_theta), false, false};
+  r.weight = glm::vec3(1.0f);  // We cos / (p_pos p_dir) = 1 exactly
+  r.pos_letter = ThinLensParams::kPosLetter;
+  r.dir_letter = ThinLensParams::kDirLetter;
+  r.raster = raster;
+  return r;
+}
+
+glm::vec3 importance(const ThinLensParams& p, const glm::vec3& origin, const glm::vec3& direction,
+                     glm::vec2* raster) {
+  const float cos_theta = glm::dot(direction, p.forward);
+  if (!(cos_theta > 0.0f) || !(p.lens_radius > 0.0f)) return glm::vec3(0.0f);
+  // Off the lens there is no importance (the tolerance admits lens_point()'s rounding at the rim).
+  const glm::vec3 off = origin - p.position;
+  const float lu = glm::dot(off, p.right), lv = glm::dot(off, p.up);
+  if (!(lu * lu + lv * lv <= p.lens_radius * p.lens_radius * (1.0f + 1e-5f))) return glm::vec3(0.0f);
+  // Where the ray meets the plane of focus, seen from the lens centre.
+  const glm::vec3 focus = origin + direction * (p.focus_distance / cos_theta);
+  const glm::vec3 v = focus - p.position;
+  const float depth = glm::dot(v, p.forward);
+  if (!(depth > 0.0f)) return glm::vec3(0.0f);
+  const Perspective cam = perspective(p);
+  const glm::vec2 r = film_to_raster({glm::dot(v, p.right) / (depth * p.tan_half_x),
+                                      glm::dot(v, p.up) / (depth * p.tan_half_y)});
+  if (!in_unit_square(r)) return glm::vec3(0.0f);
+  if (raster) *raster = r;
+  return glm::vec3(perspective_we(cam.image_area(), cos_theta) / lens_area(p));
+}
+
+RayPdf pdf_ray(const ThinLensParams& p, const glm::vec3& origin, const glm::vec3& direction) {
+  glm::vec2 raster;
+  if (is_black(importance(p, origin, direction, &raster))) return {0.0f, 0.0f, false, false};
+  const float cos_theta = glm::dot(direction, p.forward);
+  return {1.0f / lens_area(p), perspective_pdf_dir(perspective(p).image_area(), cos_theta), false,
+          false};
+}
+
+namespace {
+// The join of `ref` to the lens point `x`.
+std::optional<EndpointConnection> connect_lens_point(const ThinLensParams& p, const glm::vec3& x,
+                                                     const glm::vec3& ref) {
+  EndpointConnection c;
+  if (!unit_and_length(x - ref, &c.wi, &c.distance)) return std::nullopt;
+  c.value = importance(p, x, -c.wi, &c.raster);
+  if (is_black(c.value)) return std::nullopt;
+  const float cos_lens = glm::dot(-c.wi, p.forward);
+  const float a_lens = lens_area(p);
+  c.position = x;
+  c.normal = p.forward;
+  c.pdf_dir = area_to_solid_angle(1.0f / a_lens, c.distance, cos_lens);
+  c.weight = c.value * (cos_lens * a_lens / (c.distance * c.distance));
+  c.delta = false;
+  c.ray_pdf = pdf_ray(p, x, -c.wi);
+  if (!finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
+  return c;
+}
+}  // namespace
+
+std::optional<EndpointConnection> connect(const ThinLensParams& p, glm::vec2 u_lens,
+                                          const glm::vec3& ref) {
+  if (!(p.lens_radius > 0.0f)) return std::nullopt;
+  return connect_lens_point(p, lens_point(p, u_lens), ref);
+}
+
+std::optional<EndpointConnection> hit_lens(const ThinLensParams& p, const glm::vec3& origin,
+                                           const glm::vec3& direction) {
+  if (!(p.lens_radius > 0.0f)) return std::nullopt;
+  const float denom = glm::dot(direction, p.forward);
+  if (denom == 0.0f) return std::nullopt;
+  const float t = glm::dot(p.position - origin, p.forward) / denom;
+  if (!(t > 0.0f) || !std::isfinite(t)) return std::nullopt;
+  const glm::vec3 x = origin + t * direction;
+  const glm::vec3 off = x - p.position;
+  const float u = glm::dot(off, p.right), v = glm::dot(off, p.up);
+  if (!(u * u + v * v < p.lens_radius * p.lens_radius)) return std::nullopt;
+  return connect_lens_point(p, x, origin);
+}
+
+// --- orthographic ---
+
+namespace {
+float film_area(const OrthographicParams& p) { return 4.0f * p.half_width * p.half_height; }
+}  // namespace
+
+std::optional<EndpointRay> sample_ray(const OrthographicParams& p, glm::vec2 raster) {
+  const float area = film_area(p);
+  if (!(area > 0.0f)) return std::nullopt;
+  const glm::vec2 f = raster_to_film(raster);
+  EndpointRay r;
+  r.origin = p.position + (f.x * p.half_width) * p.right + (f.y * p.half_height) * p.up;
+  r.direction = p.forward;
+  r.normal = p.forward;
+  r.value = glm::vec3(1.0f / area);
+  r.pdf = {1.0f / area, 1.0f, false, true};
+  r.weight = glm::vec3(1.0f);  // We · 1 / (1/A · 1) = 1 exactly
+  r.pos_letter = OrthographicParams::kPosLetter;
+  r.dir_letter = OrthographicParams::kDirLetter;
+  r.raster = raster;
+  return r;
+}
+
+RayPdf pdf_ray(const OrthographicParams& p, const glm::vec3& origin) {
+  const float area = film_area(p);
+  const glm::vec3 d = origin - p.position;
+  const glm::vec2 r =
+      film_to_raster({glm::dot(d, p.right) / p.half_width, glm::dot(d, p.up) / p.half_height});
+  const bool inside = area > 0.0f && in_unit_square(r);
+  return {inside ? 1.0f / area : 0.0f, 1.0f, false, true};
+}
+
+std::optional<EndpointConnection> connect(const OrthographicParams& p, const glm::vec3& ref) {
+  const float area = film_area(p);
+  if (!(area > 0.0f)) return std::nullopt;
+  const glm::vec3 d = ref - p.position;
+  const float depth = glm::dot(d, p.forward);
+  if (!(depth > 0.0f) || !std::isfinite(depth)) return std::nullopt;
+  EndpointConnection c;
+  c.raster =
+      film_to_raster({glm::dot(d, p.right) / p.half_width, glm::dot(d, p.up) / p.half_height});
+  if (!in_unit_square(c.raster)) return std::nullopt;
+  c.position = ref - depth * p.forward;
+  c.normal = p.forward;
+  c.wi = -p.forward;
+  c.distance = depth;
+  c.value = glm::vec3(1.0f / area);
+  c.weight = c.value;  // We: the film point's share of the image mean
+  c.delta = true;
+  c.ray_pdf = {1.0f / area, 1.0f, false, true};
+  return c;
+}
+
+// --- spot meter ---
+
+std::optional<EndpointRay> sample_ray(const SpotMeterParams& p) {
+  EndpointRay r;
+  r.origin = p.position;
+  r.direction = p.direction;
+  r.value = glm::vec3(1.0f);
+  r.pdf = pdf_ray(p);
+  r.weight = glm::vec3(1.0f);
+  r.pos_letter = SpotMeterParams::kPosLetter;
+  r.dir_letter = SpotMeterParams::kDirLetter;
+  r.raster = {0.5f, 0.5f};
+  return r;
+}
+
+RayPdf pdf_ray(const SpotMeterParams&) { return {1.0f, 1.0f, true, true}; }
+
+std::optional<EndpointConnection> connect(const SpotMeterParams&, const glm::vec3&) {
+  return std::nullopt;
+}
+
+}  // namespace pathex

@@ -1,0 +1,268 @@
+// Emission (lights) and importance (sensors) as plain functions over plain parameter structs: the
+// integrator maps scene objects to these structs, so this file depends on no scene type.
+//
+// Every endpoint has a spatial and a directional part (Veach §8.3.2: L_e = L_e⁽⁰⁾ L_e⁽¹⁾,
+// W_e = W_e⁽⁰⁾ W_e⁽¹⁾), each either a finite density (letter D) or a Dirac delta (letter S); the
+// letters are the kPosLetter / kDirLetter of each struct and match alphabet.h's light_letters()
+// and sensor_letters() (DESIGN §1):
+//
+//   area light  D D   cosine-weighted emission from a point the integrator chose on the surface
+//   point light S D   isotropic intensity I [W/sr]
+//   spot light  S D   intensity I times a cone falloff (smoothstep, or a hard edge)
+//   distant     D S   irradiance E [W/m²] in one direction, entering through an aperture
+//   laser       S S   power Φ [W] along one ray
+//   thin lens   D D   pinhole  D S   orthographic  S D   spot meter  S S   (sensors: dir, pos)
+//
+// Each kind offers
+//   sample_ray(...)  -> EndpointRay: the first ray of a light or eye subpath, with the densities
+//                      of its origin and direction and its starting throughput `weight`;
+//   pdf_ray(...)     -> RayPdf: the same densities for a given ray (BDPT's reverse densities);
+//   connect(...)     -> EndpointConnection: a point on the endpoint joined to a reference point
+//                      (next-event estimation for lights; the t = 1 splat for sensors), or
+//                      nullopt where no join exists (a laser or a spot meter has probability 0
+//                      of passing through a given point);
+//   and the value: emitted_radiance(), intensity(), importance().
+//
+// Deltas are symbolic (DESIGN §7): a Dirac part reports density 1 (its discrete probability) with
+// its delta flag set, and its value is the delta's weight. Hence `weight = value · |cos| /
+// (pdf.pos · pdf.dir)` holds for every kind, where cos is taken between the ray and `normal`
+// (1 when the endpoint has no surface: point, spot, laser, spot meter; a pinhole uses its viewing
+// axis, as pbrt does). MIS code must compare delta flags, never the densities of Dirac parts.
+//
+// Sensors measure the mean over the image: W_e is normalised so that ∫ W_e cos dσ dA = 1 over the
+// whole film (pbrt's convention, W_e = 1 / (A_img cos⁴θ) for a pinhole with A_img the image area
+// at unit distance), and the film position `raster` ∈ [0,1)² (x right, y down) is chosen by the
+// integrator, uniformly over the image; densities are for that choice. A pixel's measurement is
+// the image's times the number of pixels, restricted to the pixel; that factor cancels in every
+// weight and every MIS ratio.
+//
+// Units: radiance Le, intensity I, irradiance E and power Φ as RGB; lengths in scene units.
+// Directions are unit vectors and frames orthonormal (preconditions, not checked here: the scene
+// loader validates them).
+#pragma once
+
+#include <optional>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "alphabet/alphabet.h"
+
+namespace pathex {
+
+// Densities of an emission or importance ray, with the Dirac parts flagged.
+struct RayPdf {
+  float pos = 0.0f;        // area density of the origin [1/area]; 1 if delta_pos
+  float dir = 0.0f;        // solid-angle density of the direction [1/sr]; 1 if delta_dir
+  bool delta_pos = false;
+  bool delta_dir = false;
+};
+
+// The first ray of a light subpath (from a light) or an eye subpath (from a sensor).
+struct EndpointRay {
+  glm::vec3 origin{0.0f};
+  glm::vec3 direction{0.0f};  // unit
+  glm::vec3 normal{0.0f};     // surface normal at the origin; zero when there is no surface
+  glm::vec3 value{0.0f};      // Le or We along the ray (for Dirac parts: their weight)
+  RayPdf pdf;
+  glm::vec3 weight{0.0f};     // value · |cos| / (pdf.pos · pdf.dir): the starting throughput
+  Letter pos_letter = kD;     // c0 for a light, c(k+2) for a sensor
+  Letter dir_letter = kD;     // c1 for a light, c(k+1) for a sensor
+  glm::vec2 raster{0.0f};     // sensors: the film position of the ray, [0,1)^2
+};
+
+// A point on a light or sensor joined to a reference point `ref` in the scene.
+struct EndpointConnection {
+  glm::vec3 position{0.0f};   // on the light / sensor
+  glm::vec3 normal{0.0f};     // its surface normal, zero when there is none
+  glm::vec3 wi{0.0f};         // unit, from ref towards position
+  float distance = 0.0f;      // |position − ref|: the shadow ray's length
+  glm::vec3 value{0.0f};      // Le(position → ref) or We(position → ref)
+  // The contribution is f(ref) · |cos θ_ref| · weight (times visibility): value · G / p with the
+  // geometry term G lacking ref's cosine, or for a Dirac join value times the delta's Jacobian.
+  glm::vec3 weight{0.0f};
+  float pdf_dir = 0.0f;       // solid-angle density of wi at ref for this join; 0 when `delta`
+  bool delta = false;         // wi was fixed (point-like position or single direction), not sampled
+  RayPdf ray_pdf;             // sample_ray's densities for the ray position → −wi
+  glm::vec2 raster{0.0f};     // sensors: where the join lands on the film
+};
+
+// A point on an emitting surface chosen by the integrator (e.g. uniformly by area over the
+// emissive triangles), with the area density of that choice.
+struct SurfacePoint {
+  glm::vec3 position{0.0f};
+  glm::vec3 normal{0.0f, 0.0f, 1.0f};  // unit; the emitting side of a one-sided light
+  float pdf_area = 0.0f;
+};
+
+// Solid-angle density at a point `distance` away, seen at `abs_cos` on the far side, of a point
+// chosen with area density `pdf_area`: pdf_area · d² / |cos|. 0 when abs_cos is 0.
+float area_to_solid_angle(float pdf_area, float distance, float abs_cos);
+
+// ---------------------------------------------------------------------------------------------
+// Lights
+// ---------------------------------------------------------------------------------------------
+
+// Diffuse (Lambertian) emitter, LDD. Shapes are the integrator's: it picks the SurfacePoint.
+struct AreaLightParams {
+  glm::vec3 radiance{1.0f};  // Le, constant over the surface and the emitting hemisphere
+  bool two_sided = false;    // emit on both sides of the normal
+  static constexpr Letter kPosLetter = kD;
+  static constexpr Letter kDirLetter = kD;
+};
+// Le(x, w) for a direction w leaving the surface with normal n.
+glm::vec3 emitted_radiance(const AreaLightParams& p, const glm::vec3& n, const glm::vec3& w);
+// Cosine-weighted direction (two-sided: a side with probability 1/2, chosen by u.x).
+std::optional<EndpointRay> sample_ray(const AreaLightParams& p, const SurfacePoint& x, glm::vec2 u);
+RayPdf pdf_ray(const AreaLightParams& p, const SurfacePoint& x, const glm::vec3& direction);
+// Next-event estimation towards x (also the MIS density of a BSDF-sampled ray that hits x).
+std::optional<EndpointConnection> connect(const AreaLightParams& p, const SurfacePoint& x,
+                                          const glm::vec3& ref);
+
+// Isotropic point light, LSD.
+struct PointLightParams {
+  glm::vec3 position{0.0f};
+  glm::vec3 intensity{1.0f};  // I [W/sr]
+  static constexpr Letter kPosLetter = kS;
+  static constexpr Letter kDirLetter = kD;
+};
+std::optional<EndpointRay> sample_ray(const PointLightParams& p, glm::vec2 u);
+RayPdf pdf_ray(const PointLightParams& p, const glm::vec3& direction);
+std::optional<EndpointConnection> connect(const PointLightParams& p, const glm::vec3& ref);
+glm::vec3 power(const PointLightParams& p);  // 4π I
+
+// Spot light, LSD: I(w) = intensity · falloff(cos θ), θ from the axis. falloff is 1 inside
+// cos_falloff_start, 0 outside cos_total, and smoothstep in between (pbrt-v4's SpotLight); with
+// cos_falloff_start == cos_total the edge is hard. Directions are sampled uniformly in the cone.
+struct SpotLightParams {
+  glm::vec3 position{0.0f};
+  glm::vec3 axis{0.0f, 0.0f, -1.0f};  // unit
+  glm::vec3 intensity{1.0f};          // on the axis [W/sr]
+  float cos_total = 0.5f;             // cosine of the cone's half-angle, in (−1, 1)
+  float cos_falloff_start = 0.5f;     // in [cos_total, 1]
+  static constexpr Letter kPosLetter = kS;
+  static constexpr Letter kDirLetter = kD;
+};
+float spot_falloff(const SpotLightParams& p, float cos_theta);
+glm::vec3 intensity(const SpotLightParams& p, const glm::vec3& direction);
+std::optional<EndpointRay> sample_ray(const SpotLightParams& p, glm::vec2 u);
+RayPdf pdf_ray(const SpotLightParams& p, const glm::vec3& direction);
+std::optional<EndpointConnection> connect(const SpotLightParams& p, const glm::vec3& ref);
+glm::vec3 power(const SpotLightParams& p);  // 2π I (1 − (cos_falloff_start + cos_total) / 2)
+
+// Distant light through an aperture, LDS: parallel light of irradiance E (measured perpendicular
+// to `direction`) entering the scene through the parallelogram corner + a·edge1 + b·edge2,
+// a, b ∈ [0, 1) (the sun through a window). The origin is uniform over the aperture.
+struct DistantLightParams {
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // unit, the way the light travels
+  glm::vec3 irradiance{1.0f};              // E [W/m²]
+  glm::vec3 corner{0.0f};
+  glm::vec3 edge1{1.0f, 0.0f, 0.0f};
+  glm::vec3 edge2{0.0f, 1.0f, 0.0f};
+  static constexpr Letter kPosLetter = kD;
+  static constexpr Letter kDirLetter = kS;
+};
+std::optional<EndpointRay> sample_ray(const DistantLightParams& p, glm::vec2 u);
+RayPdf pdf_ray(const DistantLightParams& p, const glm::vec3& origin);  // 0 outside the aperture
+// The projection join (the `distant-projection` connector, DESIGN §4): wi = −direction and the
+// aperture point on the line through ref; nullopt when that line misses the aperture or the
+// aperture is behind ref.
+std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm::vec3& ref);
+glm::vec3 power(const DistantLightParams& p);  // E · A · |cos(direction, aperture normal)|
+
+// Laser, LSS: power Φ along one ray. Nothing can be joined to it (connect() is always nullopt).
+struct LaserParams {
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // unit
+  glm::vec3 power{1.0f};                   // Φ [W]
+  static constexpr Letter kPosLetter = kS;
+  static constexpr Letter kDirLetter = kS;
+};
+std::optional<EndpointRay> sample_ray(const LaserParams& p);
+RayPdf pdf_ray(const LaserParams& p);
+std::optional<EndpointConnection> connect(const LaserParams& p, const glm::vec3& ref);
+glm::vec3 power(const LaserParams& p);
+
+// ---------------------------------------------------------------------------------------------
+// Sensors. raster (x, y) ∈ [0,1)^2 maps to the film point (2x − 1, 1 − 2y) in units of the half
+// extents along (right, up): x grows to the right, y grows downwards.
+// ---------------------------------------------------------------------------------------------
+
+// Pinhole, DSE: all rays leave `position`; the image spans ±tan_half_x, ±tan_half_y at unit
+// distance along forward. We = 1 / (A cos⁴θ), A = 4 tan_half_x tan_half_y.
+struct PinholeParams {
+  glm::vec3 position{0.0f};
+  glm::vec3 forward{0.0f, 0.0f, -1.0f};  // orthonormal frame: forward, right, up
+  glm::vec3 right{1.0f, 0.0f, 0.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  float tan_half_x = 1.0f;
+  float tan_half_y = 1.0f;
+  static constexpr Letter kPosLetter = kS;
+  static constexpr Letter kDirLetter = kD;
+};
+std::optional<EndpointRay> sample_ray(const PinholeParams& p, glm::vec2 raster);
+// We for a ray leaving the pinhole in `direction`, and its raster position; 0 outside the image.
+glm::vec3 importance(const PinholeParams& p, const glm::vec3& direction, glm::vec2* raster);
+RayPdf pdf_ray(const PinholeParams& p, const glm::vec3& direction);
+std::optional<EndpointConnection> connect(const PinholeParams& p, const glm::vec3& ref);
+
+// Thin lens, DDE: a lens disk of radius lens_radius > 0 centred on `position`, perpendicular to
+// forward, focused at focus_distance; the image (same extents as a pinhole's) is mapped onto the
+// plane of focus. We = 1 / (A A_lens cos⁴θ); the origin is uniform on the lens.
+struct ThinLensParams {
+  glm::vec3 position{0.0f};
+  glm::vec3 forward{0.0f, 0.0f, -1.0f};
+  glm::vec3 right{1.0f, 0.0f, 0.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  float tan_half_x = 1.0f;
+  float tan_half_y = 1.0f;
+  float lens_radius = 0.01f;
+  float focus_distance = 1.0f;
+  static constexpr Letter kPosLetter = kD;
+  static constexpr Letter kDirLetter = kD;
+};
+glm::vec3 lens_point(const ThinLensParams& p, glm::vec2 u_lens);  // uniform on the lens disk
+std::optional<EndpointRay> sample_ray(const ThinLensParams& p, glm::vec2 raster, glm::vec2 u_lens);
+// We for a ray leaving the lens at `origin` in `direction`, and its raster position.
+glm::vec3 importance(const ThinLensParams& p, const glm::vec3& origin, const glm::vec3& direction,
+                     glm::vec2* raster);
+RayPdf pdf_ray(const ThinLensParams& p, const glm::vec3& origin, const glm::vec3& direction);
+// Splat join through a lens point drawn from u_lens.
+std::optional<EndpointConnection> connect(const ThinLensParams& p, glm::vec2 u_lens,
+                                          const glm::vec3& ref);
+// A light subpath ray from `origin` along `direction` that crosses the lens disk (strategy t = 0):
+// the crossing as a join from origin (its pdf_dir is what connect() would have had).
+std::optional<EndpointConnection> hit_lens(const ThinLensParams& p, const glm::vec3& origin,
+                                           const glm::vec3& direction);
+
+// Orthographic, SDE: rays along forward from a film of half extents (half_width, half_height)
+// centred on `position`; origin uniform on the film, We = 1 / A_film.
+struct OrthographicParams {
+  glm::vec3 position{0.0f};
+  glm::vec3 forward{0.0f, 0.0f, -1.0f};
+  glm::vec3 right{1.0f, 0.0f, 0.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  float half_width = 1.0f;
+  float half_height = 1.0f;
+  static constexpr Letter kPosLetter = kD;
+  static constexpr Letter kDirLetter = kS;
+};
+std::optional<EndpointRay> sample_ray(const OrthographicParams& p, glm::vec2 raster);
+RayPdf pdf_ray(const OrthographicParams& p, const glm::vec3& origin);  // 0 off the film
+// The projection join (the `ortho-projection` connector): the film point whose ray passes through
+// ref, wi = −forward; nullopt when ref is behind the film or projects outside it.
+std::optional<EndpointConnection> connect(const OrthographicParams& p, const glm::vec3& ref);
+
+// Spot meter, SSE: measures the radiance along one ray (We = 1 for that ray). Nothing can be
+// joined to it (connect() is always nullopt).
+struct SpotMeterParams {
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};
+  static constexpr Letter kPosLetter = kS;
+  static constexpr Letter kDirLetter = kS;
+};
+std::optional<EndpointRay> sample_ray(const SpotMeterParams& p);
+RayPdf pdf_ray(const SpotMeterParams& p);
+std::optional<EndpointConnection> connect(const SpotMeterParams& p, const glm::vec3& ref);
+
+}  // namespace pathex

@@ -1,0 +1,525 @@
+// Lights and sensors (trace/emitters.h): letters and delta flags agree with alphabet.h, sampling
+// densities integrate to 1, sampled rays agree with pdf_ray(), starting throughputs average to the
+// emitted power, joins invert ray sampling, and the measurement equation gives the same closed
+// form from the eye side and from the light side for every sensor. Also the DESIGN §9 closed
+// forms (point light irradiance, distant light through a window) and grazing configurations.
+//
+// Tolerances: Monte Carlo means within kZ = 4 standard errors (estimated from the same samples);
+// fixed seeds throughout.
+#include "trace/emitters.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <optional>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "trace/frame.h"
+#include "trace/rng.h"
+
+namespace pathex {
+namespace {
+
+constexpr double kZ = 4.0;
+constexpr double kPiD = std::numbers::pi;
+
+struct Accumulator {
+  double sum = 0.0, sum2 = 0.0;
+  std::uint64_t n = 0;
+  void add(double x) {
+    sum += x;
+    sum2 += x * x;
+    ++n;
+  }
+  double mean() const { return sum / static_cast<double>(n); }
+  double se() const {
+    const double m = mean();
+    return std::sqrt(std::max(0.0, sum2 / static_cast<double>(n) - m * m) / static_cast<double>(n));
+  }
+};
+
+// Within kZ standard errors, plus float rounding (some estimators here are exact per sample).
+#define EXPECT_MC_NEAR(acc, expected)                                                  \
+  EXPECT_NEAR((acc).mean(), (expected), kZ * (acc).se() + 1e-5 * std::abs(expected)) \
+      << "standard error " << (acc).se()
+
+std::string letters(Letter first, Letter second) {
+  return {letter_char(first), letter_char(second)};
+}
+
+// Every sampled ray: letters are the struct's, delta flags say S exactly where the letter is S,
+// the weight is value · |cos| / (pdf.pos · pdf.dir), and pdf_ray() would give the same densities.
+template <class P>
+void expect_consistent(const EndpointRay& r, const RayPdf& again) {
+  EXPECT_EQ(r.pos_letter, P::kPosLetter);
+  EXPECT_EQ(r.dir_letter, P::kDirLetter);
+  EXPECT_EQ(r.pdf.delta_pos, P::kPosLetter == kS);
+  EXPECT_EQ(r.pdf.delta_dir, P::kDirLetter == kS);
+  if (r.pdf.delta_pos) {
+    EXPECT_EQ(r.pdf.pos, 1.0f);
+  }
+  if (r.pdf.delta_dir) {
+    EXPECT_EQ(r.pdf.dir, 1.0f);
+  }
+  const bool has_surface = glm::dot(r.normal, r.normal) > 0.0f;
+  const float cos_theta = has_surface ? std::abs(glm::dot(r.normal, r.direction)) : 1.0f;
+  const glm::vec3 w = r.value * (cos_theta / (r.pdf.pos * r.pdf.dir));
+  EXPECT_NEAR(r.weight.x, w.x, 1e-4f * std::abs(w.x));
+  EXPECT_NEAR(glm::length(r.direction), 1.0f, 1e-5f);
+  EXPECT_NEAR(again.pos, r.pdf.pos, 1e-5f * r.pdf.pos);
+  EXPECT_NEAR(again.dir, r.pdf.dir, 1e-4f * r.pdf.dir);
+  EXPECT_EQ(again.delta_pos, r.pdf.delta_pos);
+  EXPECT_EQ(again.delta_dir, r.pdf.delta_dir);
+}
+
+// A parallelogram corner + a e1 + b e2 (a, b ∈ [0,1)) hit by a ray, in the test's own code.
+std::optional<glm::vec3> hit_parallelogram(const glm::vec3& corner, const glm::vec3& e1,
+                                           const glm::vec3& e2, const glm::vec3& o,
+                                           const glm::vec3& d) {
+  const glm::vec3 n = glm::cross(e1, e2);
+  const float denom = glm::dot(d, n);
+  if (denom == 0.0f) return std::nullopt;
+  const float t = glm::dot(corner - o, n) / denom;
+  if (t <= 0.0f) return std::nullopt;
+  const glm::vec3 x = o + t * d;
+  const glm::vec3 rel = x - corner;
+  const float a = glm::dot(glm::cross(rel, e2), n) / glm::dot(n, n);
+  const float b = glm::dot(glm::cross(e1, rel), n) / glm::dot(n, n);
+  if (a < 0.0f || a >= 1.0f || b < 0.0f || b >= 1.0f) return std::nullopt;
+  return x;
+}
+
+// --- letters ---
+
+TEST(EmitterLetters, MatchTheAlphabet) {
+  EXPECT_EQ(letters(AreaLightParams::kPosLetter, AreaLightParams::kDirLetter),
+            light_letters(LightType::kArea));
+  EXPECT_EQ(letters(PointLightParams::kPosLetter, PointLightParams::kDirLetter),
+            light_letters(LightType::kPoint));
+  EXPECT_EQ(letters(SpotLightParams::kPosLetter, SpotLightParams::kDirLetter),
+            light_letters(LightType::kPoint));
+  EXPECT_EQ(letters(DistantLightParams::kPosLetter, DistantLightParams::kDirLetter),
+            light_letters(LightType::kDistant));
+  EXPECT_EQ(letters(LaserParams::kPosLetter, LaserParams::kDirLetter),
+            light_letters(LightType::kLaser));
+  // Sensors contribute c(k+1) (direction) then c(k+2) (position).
+  EXPECT_EQ(letters(ThinLensParams::kDirLetter, ThinLensParams::kPosLetter),
+            sensor_letters(SensorType::kLens));
+  EXPECT_EQ(letters(PinholeParams::kDirLetter, PinholeParams::kPosLetter),
+            sensor_letters(SensorType::kPinhole));
+  EXPECT_EQ(letters(OrthographicParams::kDirLetter, OrthographicParams::kPosLetter),
+            sensor_letters(SensorType::kOrthographic));
+  EXPECT_EQ(letters(SpotMeterParams::kDirLetter, SpotMeterParams::kPosLetter),
+            sensor_letters(SensorType::kSpotmeter));
+}
+
+// --- lights ---
+
+TEST(AreaLight, CosineEmissionWithDensitiesThatIntegrateToOne) {
+  for (bool two_sided : {false, true}) {
+    const AreaLightParams light{glm::vec3(2.0f, 1.0f, 0.5f), two_sided};
+    const SurfacePoint x{glm::vec3(1.0f, 2.0f, 3.0f), glm::normalize(glm::vec3(0.2f, -0.3f, 1.0f)),
+                         0.25f};
+    Accumulator cos_mean, below, integral;
+    for (int i = 0; i < 100'000; ++i) {
+      Sampler s(1, two_sided, static_cast<std::uint64_t>(i));
+      const auto r = sample_ray(light, x, s.get2d());
+      ASSERT_TRUE(r);
+      if (i < 2000) expect_consistent<AreaLightParams>(*r, pdf_ray(light, x, r->direction));
+      const float c = glm::dot(r->direction, x.normal);
+      cos_mean.add(std::abs(c));
+      below.add(c < 0.0f);
+      EXPECT_EQ(r->weight, light.radiance * (kPi * (two_sided ? 2.0f : 1.0f) / 0.25f));
+      // ∫ pdf_dir dσ over the sphere, by uniform directions.
+      const glm::vec3 w = sample_uniform_sphere(s.get2d());
+      integral.add(pdf_ray(light, x, w).dir * 4.0 * kPiD);
+    }
+    EXPECT_MC_NEAR(cos_mean, 2.0 / 3.0);
+    EXPECT_MC_NEAR(below, two_sided ? 0.5 : 0.0);
+    EXPECT_MC_NEAR(integral, 1.0);
+    EXPECT_EQ(emitted_radiance(light, x.normal, -x.normal),
+              two_sided ? light.radiance : glm::vec3(0.0f));
+  }
+  EXPECT_FALSE(sample_ray(AreaLightParams{}, SurfacePoint{glm::vec3(0.0f), glm::vec3(0, 0, 1), 0.0f},
+                          {0.5f, 0.5f}))
+      << "a zero-area light emits nothing";
+}
+
+TEST(AreaLight, IrradianceFromADiskMatchesTheClosedForm) {
+  // A disk of radius R and radiance Le facing a point on its axis at height h gives the point an
+  // irradiance of π Le R² / (h² + R²). Uniform area sampling of the disk, joined by connect().
+  const float R = 0.5f, h = 1.5f, Le = 3.0f;
+  const AreaLightParams light{glm::vec3(Le), false};
+  const glm::vec3 ref(0.0f), n_ref(0.0f, 0.0f, 1.0f);
+  const float kCosCone = std::cos(0.35f);
+  Accumulator e, solid_angle_integral;
+  for (int i = 0; i < 200'000; ++i) {
+    Sampler s(2, 0, static_cast<std::uint64_t>(i));
+    const glm::vec2 d = sample_concentric_disk(s.get2d()) * R;
+    const SurfacePoint x{glm::vec3(d.x, d.y, h), glm::vec3(0.0f, 0.0f, -1.0f),
+                         1.0f / (kPi * R * R)};
+    const auto c = connect(light, x, ref);
+    ASSERT_TRUE(c);
+    EXPECT_FALSE(c->delta);
+    e.add(c->weight.x * std::abs(glm::dot(c->wi, n_ref)));
+    // pdf_dir integrates to 1 over the directions that reach the disk: directions drawn
+    // uniformly in a cone just wider than the disk (half-angle 0.35 > atan(1/3)).
+    const glm::vec3 w = sample_uniform_cone(s.get2d(), kCosCone);
+    const auto hit = hit_parallelogram(glm::vec3(-R, -R, h), glm::vec3(2 * R, 0, 0),
+                                       glm::vec3(0, 2 * R, 0), ref, w);
+    double p = 0.0;
+    if (hit && glm::length(glm::vec2(hit->x, hit->y)) < R) {
+      const auto ch = connect(light, SurfacePoint{*hit, glm::vec3(0, 0, -1), 1.0f / (kPi * R * R)}, ref);
+      p = ch ? ch->pdf_dir : 0.0;
+    }
+    solid_angle_integral.add(p / uniform_cone_pdf(kCosCone));
+  }
+  EXPECT_MC_NEAR(e, kPiD * Le * R * R / (h * h + R * R));
+  EXPECT_MC_NEAR(solid_angle_integral, 1.0);
+  // Seen from behind a one-sided light: nothing.
+  EXPECT_FALSE(connect(light, SurfacePoint{glm::vec3(0, 0, h), glm::vec3(0, 0, 1), 1.0f}, ref));
+}
+
+TEST(PointLight, IsotropicPowerAndInverseSquareIrradiance) {
+  const PointLightParams light{glm::vec3(0.0f, 0.0f, 2.0f), glm::vec3(5.0f, 4.0f, 3.0f)};
+  Accumulator z;
+  for (int i = 0; i < 50'000; ++i) {
+    Sampler s(3, 0, static_cast<std::uint64_t>(i));
+    const auto r = sample_ray(light, s.get2d());
+    ASSERT_TRUE(r);
+    if (i < 1000) expect_consistent<PointLightParams>(*r, pdf_ray(light, r->direction));
+    EXPECT_EQ(r->weight, power(light));
+    z.add(r->direction.z);
+  }
+  EXPECT_MC_NEAR(z, 0.0);
+  EXPECT_NEAR(power(light).x, 4.0 * kPiD * 5.0, 1e-4);
+  // DESIGN §9: a point light at height h over a plane; at horizontal offset x the irradiance is
+  // I cos θ / d² with cos θ = h / d.
+  const glm::vec3 ref(1.5f, 0.0f, 0.0f);
+  const auto c = connect(light, ref);
+  ASSERT_TRUE(c);
+  EXPECT_TRUE(c->delta);
+  EXPECT_EQ(c->pdf_dir, 0.0f);
+  EXPECT_FLOAT_EQ(c->distance, 2.5f);
+  EXPECT_NEAR(glm::length(c->wi - glm::vec3(-0.6f, 0.0f, 0.8f)), 0.0f, 1e-6f);
+  EXPECT_FLOAT_EQ(c->weight.x * c->wi.z, 5.0f * 0.8f / 6.25f);
+  EXPECT_FALSE(connect(light, light.position)) << "a point at the light itself";
+}
+
+TEST(SpotLight, FalloffPowerAndConeDensity) {
+  SpotLightParams spot;
+  spot.position = glm::vec3(0.0f, 0.0f, 3.0f);
+  spot.axis = glm::normalize(glm::vec3(0.3f, 0.0f, -1.0f));
+  spot.intensity = glm::vec3(10.0f);
+  spot.cos_total = std::cos(0.6f);
+  spot.cos_falloff_start = std::cos(0.4f);
+  // smoothstep falloff: 1 inside, 0 outside, 1/2 halfway (in cosine) through the transition.
+  EXPECT_EQ(spot_falloff(spot, 1.0f), 1.0f);
+  EXPECT_EQ(spot_falloff(spot, spot.cos_falloff_start), 1.0f);
+  EXPECT_EQ(spot_falloff(spot, spot.cos_total), 0.0f);
+  EXPECT_NEAR(spot_falloff(spot, 0.5f * (spot.cos_total + spot.cos_falloff_start)), 0.5f, 1e-5f);
+  SpotLightParams hard = spot;
+  hard.cos_falloff_start = hard.cos_total;
+  EXPECT_EQ(spot_falloff(hard, std::nextafter(hard.cos_total, 1.0f)), 1.0f);
+  EXPECT_EQ(spot_falloff(hard, hard.cos_total), 0.0f);
+
+  for (const SpotLightParams& p : {spot, hard}) {
+    Accumulator weight, integral;
+    for (int i = 0; i < 200'000; ++i) {
+      Sampler s(4, 0, static_cast<std::uint64_t>(i));
+      const auto r = sample_ray(p, s.get2d());
+      if (r) {
+        if (i < 1000) expect_consistent<SpotLightParams>(*r, pdf_ray(p, r->direction));
+        EXPECT_GT(glm::dot(r->direction, p.axis), p.cos_total);
+      }
+      weight.add(r ? r->weight.x : 0.0);
+      integral.add(pdf_ray(p, sample_uniform_sphere(s.get2d())).dir * 4.0 * kPiD);
+    }
+    // Power 2π I (1 − (cos_start + cos_total)/2): the mean starting throughput.
+    EXPECT_MC_NEAR(weight, power(p).x);
+    EXPECT_NEAR(power(p).x,
+                2.0 * kPiD * 10.0 * (1.0 - 0.5 * (p.cos_falloff_start + p.cos_total)), 1e-3);
+    EXPECT_MC_NEAR(integral, 1.0);
+  }
+  // Joins: inside the cone the inverse-square law with the falloff, outside nothing.
+  const glm::vec3 on_axis = spot.position + 2.0f * spot.axis;
+  const auto c = connect(spot, on_axis);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->weight.x, 10.0f / 4.0f, 1e-5f);
+  EXPECT_FALSE(connect(spot, spot.position + glm::vec3(0.0f, 0.0f, 1.0f)));
+}
+
+TEST(DistantLight, ThroughAWindowIsECosThetaInsideTheProjection) {
+  // A 2 × 1 window in the plane z = 2, light travelling down and sideways (DESIGN §9).
+  DistantLightParams sun;
+  sun.direction = glm::normalize(glm::vec3(0.6f, 0.0f, -0.8f));
+  sun.irradiance = glm::vec3(7.0f);
+  sun.corner = glm::vec3(0.0f, 0.0f, 2.0f);
+  sun.edge1 = glm::vec3(2.0f, 0.0f, 0.0f);
+  sun.edge2 = glm::vec3(0.0f, 1.0f, 0.0f);
+  const glm::vec3 n_floor(0.0f, 0.0f, 1.0f);
+  // The window's projection onto the floor z = 0 is shifted by 2 · 0.6/0.8 = 1.5 along x.
+  const auto inside = connect(sun, glm::vec3(2.0f, 0.5f, 0.0f));
+  ASSERT_TRUE(inside);
+  EXPECT_TRUE(inside->delta);
+  EXPECT_EQ(inside->wi, -sun.direction);
+  EXPECT_NEAR(inside->distance, 2.5f, 1e-5f);
+  EXPECT_NEAR(glm::length(inside->position - glm::vec3(0.5f, 0.5f, 2.0f)), 0.0f, 1e-5f);
+  EXPECT_FLOAT_EQ(inside->weight.x * glm::dot(inside->wi, n_floor), 7.0f * 0.8f);
+  EXPECT_FALSE(connect(sun, glm::vec3(1.2f, 0.5f, 0.0f))) << "left of the projection";
+  EXPECT_FALSE(connect(sun, glm::vec3(3.6f, 0.5f, 0.0f))) << "right of the projection";
+  EXPECT_FALSE(connect(sun, glm::vec3(2.0f, 1.2f, 0.0f)));
+  EXPECT_FALSE(connect(sun, glm::vec3(0.5f, 0.5f, 3.0f))) << "above the window";
+  EXPECT_NEAR(power(sun).x, 7.0f * 2.0f * 0.8f, 1e-5f);
+
+  // Rays leave the window uniformly; where they land on the floor, the projection join finds the
+  // same window point. The aperture density integrates to 1 over a box around the window.
+  Accumulator integral;
+  for (int i = 0; i < 20'000; ++i) {
+    Sampler s(5, 0, static_cast<std::uint64_t>(i));
+    const auto r = sample_ray(sun, s.get2d());
+    ASSERT_TRUE(r);
+    if (i < 1000) expect_consistent<DistantLightParams>(*r, pdf_ray(sun, r->origin));
+    EXPECT_EQ(r->weight, power(sun));
+    const glm::vec3 floor = r->origin + (r->origin.z / 0.8f) * r->direction;
+    const auto c = connect(sun, floor);
+    ASSERT_TRUE(c) << i;
+    EXPECT_NEAR(glm::length(c->position - r->origin), 0.0f, 1e-5f);
+    const glm::vec2 u = s.get2d();
+    integral.add(pdf_ray(sun, glm::vec3(-1.0f + 4.0f * u.x, -1.0f + 3.0f * u.y, 2.0f)).pos * 12.0);
+  }
+  EXPECT_MC_NEAR(integral, 1.0);
+}
+
+TEST(DistantLight, NearlyParallelToTheApertureStaysFinite) {
+  DistantLightParams sun;
+  sun.direction = glm::normalize(glm::vec3(1.0f, 0.0f, -1e-6f));
+  sun.corner = glm::vec3(0.0f, 0.0f, 1.0f);
+  const auto r = sample_ray(sun, {0.3f, 0.7f});
+  ASSERT_TRUE(r);
+  EXPECT_TRUE(std::isfinite(r->weight.x));
+  EXPECT_NEAR(r->weight.x, 1e-6f, 1e-7f);
+  const auto c = connect(sun, glm::vec3(1e6f + 0.5f, 0.5f, 0.0f));  // a million units downstream
+  ASSERT_TRUE(c);
+  EXPECT_TRUE(std::isfinite(c->distance));
+  DistantLightParams degenerate;
+  degenerate.edge2 = degenerate.edge1;
+  EXPECT_FALSE(sample_ray(degenerate, {0.5f, 0.5f})) << "zero-area aperture";
+  EXPECT_EQ(power(degenerate), glm::vec3(0.0f));
+}
+
+TEST(Laser, OneRayAndNoJoin) {
+  const LaserParams laser{glm::vec3(1.0f), glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.25f)};
+  const auto r = sample_ray(laser);
+  ASSERT_TRUE(r);
+  expect_consistent<LaserParams>(*r, pdf_ray(laser));
+  EXPECT_EQ(r->origin, laser.position);
+  EXPECT_EQ(r->direction, laser.direction);
+  EXPECT_EQ(r->weight, glm::vec3(0.25f));
+  EXPECT_FALSE(connect(laser, glm::vec3(1.0f, 5.0f, 1.0f))) << "even on the beam: probability 0";
+}
+
+// --- sensors ---
+
+// A unit-radiance square light of side 2 centred on the camera axis at distance 4, facing the
+// camera: with a 90° field of view (tan_half = 1) it covers (0.5 / 2)^2 = 1/16 of the image, so
+// the image-mean measurement is Le / 16. The eye side gets it geometrically; the light side joins
+// uniformly sampled light points to the sensor (strategy t = 1): Le |cos_l| weight / p_A.
+constexpr float kLightDistance = 4.0f;
+SurfacePoint light_point(glm::vec2 u) {
+  return {glm::vec3(-1.0f + 2.0f * u.x, -1.0f + 2.0f * u.y, -kLightDistance),
+          glm::vec3(0.0f, 0.0f, 1.0f), 0.25f};
+}
+
+TEST(Pinhole, ImportanceIsNormalisedAndJoinsInvertRays) {
+  PinholeParams cam;  // at the origin looking down −z, 90° × 90°
+  Accumulator normalisation, integral;
+  for (int i = 0; i < 400'000; ++i) {
+    Sampler s(6, 0, static_cast<std::uint64_t>(i));
+    const glm::vec3 w = sample_uniform_sphere(s.get2d());
+    glm::vec2 raster;
+    const float we = importance(cam, w, &raster).x;
+    normalisation.add(we * std::max(0.0f, glm::dot(w, cam.forward)) * 4.0 * kPiD);
+    integral.add(pdf_ray(cam, w).dir * 4.0 * kPiD);
+  }
+  EXPECT_MC_NEAR(normalisation, 1.0);
+  EXPECT_MC_NEAR(integral, 1.0);
+  for (int i = 0; i < 1000; ++i) {
+    Sampler s(7, 0, static_cast<std::uint64_t>(i));
+    const glm::vec2 raster = s.get2d();
+    const auto r = sample_ray(cam, raster);
+    ASSERT_TRUE(r);
+    expect_consistent<PinholeParams>(*r, pdf_ray(cam, r->direction));
+    EXPECT_EQ(r->weight, glm::vec3(1.0f));
+    const auto c = connect(cam, r->origin + 3.0f * r->direction);
+    ASSERT_TRUE(c);
+    EXPECT_TRUE(c->delta);
+    EXPECT_NEAR(glm::length(c->raster - raster), 0.0f, 1e-5f);
+    EXPECT_NEAR(glm::length(c->wi + r->direction), 0.0f, 1e-5f);
+    EXPECT_NEAR(c->value.x, r->value.x, 1e-5f * r->value.x);
+  }
+  EXPECT_FALSE(connect(cam, glm::vec3(0.0f, 0.0f, 1.0f))) << "behind the camera";
+  EXPECT_FALSE(connect(cam, glm::vec3(2.0f, 0.0f, -1.0f))) << "outside the field of view";
+}
+
+TEST(Pinhole, MeasurementFromEitherEndIsTheClosedForm) {
+  PinholeParams cam;
+  // Eye side: the fraction of a 512 × 512 raster grid whose rays hit the square, exactly 1/16.
+  int hits = 0;
+  constexpr int kGrid = 512;
+  for (int y = 0; y < kGrid; ++y)
+    for (int x = 0; x < kGrid; ++x) {
+      const auto r = sample_ray(cam, glm::vec2(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f) /
+                                         static_cast<float>(kGrid));
+      hits += hit_parallelogram(glm::vec3(-1, -1, -kLightDistance), glm::vec3(2, 0, 0),
+                                glm::vec3(0, 2, 0), r->origin, r->direction)
+                  .has_value();
+    }
+  EXPECT_EQ(hits * 16, kGrid * kGrid);
+  // Light side.
+  Accumulator m;
+  for (int i = 0; i < 100'000; ++i) {
+    Sampler s(8, 0, static_cast<std::uint64_t>(i));
+    const SurfacePoint x = light_point(s.get2d());
+    const auto c = connect(cam, x.position);
+    m.add(c ? std::abs(glm::dot(x.normal, c->wi)) * c->weight.x / x.pdf_area : 0.0);
+  }
+  EXPECT_MC_NEAR(m, 1.0 / 16.0);
+}
+
+TEST(ThinLens, NormalisedFocusedAndMeasuresTheClosedForm) {
+  ThinLensParams cam;
+  cam.lens_radius = 0.2f;
+  cam.focus_distance = kLightDistance;
+  // ∫∫ We cos dσ dA = 1 over lens points and directions; pdf_ray integrates to 1 in both parts.
+  Accumulator normalisation, pos_integral, dir_integral;
+  for (int i = 0; i < 400'000; ++i) {
+    Sampler s(9, 0, static_cast<std::uint64_t>(i));
+    const glm::vec3 x = lens_point(cam, s.get2d());
+    const glm::vec3 w = sample_uniform_sphere(s.get2d());
+    glm::vec2 raster;
+    const double a_lens = kPiD * cam.lens_radius * cam.lens_radius;
+    normalisation.add(importance(cam, x, w, &raster).x * std::max(0.0f, glm::dot(w, cam.forward)) *
+                      4.0 * kPiD * a_lens);
+    dir_integral.add(pdf_ray(cam, x, w).dir * 4.0 * kPiD);
+    const glm::vec2 u = s.get2d();
+    const glm::vec3 y(-0.25f + 0.5f * u.x, -0.25f + 0.5f * u.y, 0.0f);  // 0.5 × 0.5 square
+    pos_integral.add(pdf_ray(cam, y, cam.forward).pos * 0.25);
+  }
+  EXPECT_MC_NEAR(normalisation, 1.0);
+  EXPECT_MC_NEAR(dir_integral, 1.0);
+  EXPECT_MC_NEAR(pos_integral, 1.0);
+  // Rays of one raster position meet on the plane of focus; importance() recovers the raster.
+  const glm::vec2 raster(0.3f, 0.8f);
+  std::optional<glm::vec3> meet;
+  for (int i = 0; i < 200; ++i) {
+    Sampler s(10, 0, static_cast<std::uint64_t>(i));
+    const auto r = sample_ray(cam, raster, s.get2d());
+    ASSERT_TRUE(r);
+    expect_consistent<ThinLensParams>(*r, pdf_ray(cam, r->origin, r->direction));
+    EXPECT_EQ(r->weight, glm::vec3(1.0f));
+    const glm::vec3 at_focus =
+        r->origin + r->direction * (kLightDistance / glm::dot(r->direction, cam.forward));
+    if (!meet) meet = at_focus;
+    EXPECT_NEAR(glm::length(at_focus - *meet), 0.0f, 2e-5f);
+    glm::vec2 back;
+    EXPECT_GT(importance(cam, r->origin, r->direction, &back).x, 0.0f);
+    EXPECT_NEAR(glm::length(back - raster), 0.0f, 1e-5f);
+    // A light subpath arriving along the reversed ray hits the lens where the ray left it.
+    const auto h = hit_lens(cam, r->origin + 2.0f * r->direction, -r->direction);
+    ASSERT_TRUE(h);
+    EXPECT_NEAR(glm::length(h->position - r->origin), 0.0f, 1e-5f);
+  }
+  // Light side of the measurement (the square at the plane of focus: a sharp image, 1/16), and
+  // the join density integrating to 1 over the directions that reach the lens.
+  Accumulator m, join_integral;
+  const glm::vec3 axis_point = cam.position + kLightDistance * cam.forward;
+  const float kCosCone = std::cos(0.06f);
+  for (int i = 0; i < 200'000; ++i) {
+    Sampler s(11, 0, static_cast<std::uint64_t>(i));
+    const SurfacePoint x = light_point(s.get2d());
+    const auto c = connect(cam, s.get2d(), x.position);
+    m.add(c ? std::abs(glm::dot(x.normal, c->wi)) * c->weight.x / x.pdf_area : 0.0);
+    // Directions uniform in a cone about the axis just wider than the lens (0.06 > atan(0.05)).
+    const glm::vec3 w = Frame::from_normal(-cam.forward).to_world(sample_uniform_cone(s.get2d(), kCosCone));
+    const auto h = hit_lens(cam, axis_point, w);
+    join_integral.add(h ? h->pdf_dir / uniform_cone_pdf(kCosCone) : 0.0);
+  }
+  EXPECT_MC_NEAR(m, 1.0 / 16.0);
+  EXPECT_MC_NEAR(join_integral, 1.0);
+}
+
+TEST(Orthographic, MeasurementProjectionAndDensities) {
+  OrthographicParams cam;  // 4 × 4 film at the origin looking down −z
+  cam.half_width = 2.0f;
+  cam.half_height = 2.0f;
+  Accumulator pos_integral;
+  for (int i = 0; i < 2000; ++i) {
+    Sampler s(12, 0, static_cast<std::uint64_t>(i));
+    const glm::vec2 raster = s.get2d();
+    const auto r = sample_ray(cam, raster);
+    ASSERT_TRUE(r);
+    expect_consistent<OrthographicParams>(*r, pdf_ray(cam, r->origin));
+    EXPECT_EQ(r->direction, cam.forward);
+    const auto c = connect(cam, r->origin + 5.0f * r->direction);
+    ASSERT_TRUE(c);
+    EXPECT_TRUE(c->delta);
+    EXPECT_EQ(c->wi, -cam.forward);
+    EXPECT_NEAR(c->distance, 5.0f, 1e-5f);
+    EXPECT_NEAR(glm::length(c->raster - raster), 0.0f, 1e-5f);
+    const glm::vec2 u = s.get2d();
+    pos_integral.add(pdf_ray(cam, glm::vec3(-3.0f + 6.0f * u.x, -3.0f + 6.0f * u.y, 0.0f)).pos * 36.0);
+  }
+  EXPECT_MC_NEAR(pos_integral, 1.0);
+  // The 2 × 2 unit-radiance square covers 1/4 of the film: every light-side sample says so.
+  for (int i = 0; i < 100; ++i) {
+    Sampler s(13, 0, static_cast<std::uint64_t>(i));
+    const SurfacePoint x = light_point(s.get2d());
+    const auto c = connect(cam, x.position);
+    ASSERT_TRUE(c);
+    EXPECT_FLOAT_EQ(std::abs(glm::dot(x.normal, c->wi)) * c->weight.x / x.pdf_area, 0.25f);
+  }
+  EXPECT_FALSE(connect(cam, glm::vec3(0.0f, 0.0f, 1.0f))) << "behind the film";
+  EXPECT_FALSE(connect(cam, glm::vec3(2.5f, 0.0f, -1.0f))) << "beside the film";
+}
+
+TEST(SpotMeter, OneRayAndNoJoin) {
+  const SpotMeterParams meter{glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(1.0f, 0.0f, 0.0f)};
+  const auto r = sample_ray(meter);
+  ASSERT_TRUE(r);
+  expect_consistent<SpotMeterParams>(*r, pdf_ray(meter));
+  EXPECT_EQ(r->weight, glm::vec3(1.0f));
+  EXPECT_FALSE(connect(meter, glm::vec3(5.0f, 1.0f, 0.0f)));
+}
+
+// --- numerically hard cases (DESIGN §10) ---
+
+TEST(Grazing, JoinsStayFiniteAtCosOneInAMillion) {
+  // An area light seen edge-on (cos = 1e-6 at the light) and a pinhole ray at the image corner.
+  const AreaLightParams light{glm::vec3(1.0f), false};
+  const glm::vec3 n = glm::normalize(glm::vec3(0.0f, 1e-6f, 1.0f));
+  const SurfacePoint x{glm::vec3(0.0f), n, 1.0f};
+  const auto c = connect(light, x, glm::vec3(0.0f, 10.0f, 0.0f));
+  ASSERT_TRUE(c);
+  EXPECT_TRUE(std::isfinite(c->pdf_dir) && std::isfinite(c->weight.x));
+  EXPECT_NEAR(c->weight.x, 1e-6f / 100.0f, 1e-9f);
+  EXPECT_NEAR(c->pdf_dir, 100.0f / 1e-6f, 1e6f);
+  // A camera ray through the image corner and a join from just inside it.
+  const PinholeParams cam;
+  const auto r = sample_ray(cam, {0.0f, 0.0f});
+  ASSERT_TRUE(r);
+  EXPECT_TRUE(std::isfinite(r->value.x) && std::isfinite(r->pdf.dir));
+  EXPECT_TRUE(connect(cam, glm::vec3(-0.999999f, 0.999999f, -1.0f)));
+  // A spot light joined at its rim carries nothing rather than something non-finite.
+  SpotLightParams spot;
+  spot.axis = glm::vec3(0.0f, 0.0f, -1.0f);
+  EXPECT_FALSE(connect(spot, glm::vec3(1.8f, 0.0f, -1.0f))) << "61° off the axis, cone of 60°";
+  EXPECT_TRUE(connect(spot, glm::vec3(1.7f, 0.0f, -1.0f))) << "59.5° off the axis";
+}
+
+}  // namespace
+}  // namespace pathex
