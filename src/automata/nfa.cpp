@@ -62,7 +62,8 @@ class Builder {
       case NodeKind::kNot: return 2;  // replaced by an embedded DFA; its size is checked when built
       case NodeKind::kRepeat: {
         const std::size_t one = estimate(n.kids[0]);
-        const std::size_t copies = static_cast<std::size_t>(n.max == kUnbounded ? n.min + 1 : n.max) + 1;
+        // min mandatory copies plus one looping copy, or max copies.
+        const std::size_t copies = static_cast<std::size_t>(n.max == kUnbounded ? n.min + 1 : n.max);
         return one != 0 && copies > cap / one ? cap : sat_add(2, one * copies);
       }
     }

@@ -92,7 +92,7 @@ Result<PathClass> compile_class(std::string_view text, const ClassOptions& optio
                                " notation and cannot be used in a " +
                                (options.notation == Notation::kFull ? "full" : "Heckbert") + "-notation expression";
     }
-    return &c->ast;
+    return &c->light_ast;
   };
   Result<Regex> ast = parse(text, options.limits, lookup);
   if (!ast) return ast.error();
@@ -132,6 +132,7 @@ Result<PathClass> compile_class(std::string_view text, const ClassOptions& optio
     lang = std::move(*full);
   }
   pc.dfa = dfa_intersect(lang, dfa_universe());
+  pc.light_ast = pc.eye_first ? reversed(*ast) : *ast;
   pc.ast = std::move(*ast);
   return pc;
 }

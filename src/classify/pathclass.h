@@ -41,6 +41,8 @@ struct PathClass {
   Notation notation = Notation::kFull;
   Regex ast;                // the parse, names expanded
   bool eye_first = false;   // written E…L; the language is the reversal
+  Regex light_ast;          // a tree of the class's language read light-first: ast, reversed if eye_first;
+                            // what `$name` stands for in later expressions
   Dfa dfa;                  // minimal DFA of the class: full paths, ∩ U
 };
 

@@ -38,6 +38,7 @@ int run(const ClassifyArgs& a) {
   while (std::getline(std::cin, line)) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;  // blank lines separate nothing
     Result<FullPath> p = parse_full_path(line, a.limits.max_length);
     if (!p) {
       Error e = p.error();

@@ -65,7 +65,10 @@ Result<bool> load_class_file(const std::string& text, const std::string& filenam
     if (!valid_name(name))
       return file_error(filename, ptr + "/name",
                         "invalid class name '" + name + "', expected a letter or '_' then letters, digits, '_' or '-'");
+    // Entries are full notation unless they say otherwise, whatever --notation says for the
+    // command line's own expressions: a class file means the same thing in every command.
     ClassOptions opts = options;
+    opts.notation = Notation::kFull;
     if (entry.contains("notation")) {
       const auto& n = entry["notation"];
       if (n == "full") opts.notation = Notation::kFull;

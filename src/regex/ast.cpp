@@ -83,6 +83,13 @@ void print(const Regex& r, int i, std::string& out) {
 
 }  // namespace
 
+Regex reversed(const Regex& r) {
+  Regex out = r;
+  for (Node& n : out.nodes)
+    if (n.kind == NodeKind::kConcat) std::reverse(n.kids.begin(), n.kids.end());
+  return out;
+}
+
 std::string dump(const Regex& r, int i) {
   const Node& n = r.at(i);
   auto kids = [&](const char* name) {

@@ -45,6 +45,10 @@ struct Regex {
   int graft(const Regex& other, int other_root);
 };
 
+// The tree of the reversed language: concatenations run backwards, everything else is kept
+// (reversal commutes with union, intersection, complement and repetition).
+Regex reversed(const Regex& r);
+
 // An S-expression dump that shows the tree's exact shape, for the grammar corpus and tests:
 // `LD*E` -> `cat{L star{D} E}`; sets print as `[DS]`, `.` as `[DS]`, repeats as `rep{2,4 x}`.
 std::string dump(const Regex& r);
