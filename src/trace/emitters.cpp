@@ -133,6 +133,10 @@ std::optional<EndpointConnection> connect(const AreaLightParams& p, const Surfac
   return c;
 }
 
+glm::vec3 power(const AreaLightParams& p, float area) {
+  return p.radiance * (kPi * std::max(area, 0.0f) * (p.two_sided ? 2.0f : 1.0f));
+}
+
 // --- point light ---
 
 std::optional<EndpointRay> sample_ray(const PointLightParams& p, glm::vec2 u) {

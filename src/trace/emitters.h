@@ -118,6 +118,8 @@ RayPdf pdf_ray(const AreaLightParams& p, const SurfacePoint& x, const glm::vec3&
 // Next-event estimation towards x (also the MIS density of a BSDF-sampled ray that hits x).
 std::optional<EndpointConnection> connect(const AreaLightParams& p, const SurfacePoint& x,
                                           const glm::vec3& ref);
+// Power of a light of total surface area `area`: π Le area, doubled when two-sided.
+glm::vec3 power(const AreaLightParams& p, float area);
 
 // Isotropic point light, LSD.
 struct PointLightParams {

@@ -573,6 +573,30 @@ TEST(DielectricBsdf, FurnaceInBothTransportModes) {
   }
 }
 
+TEST(DielectricBsdf, TenGlassInterfacesPreserveDirectionAndRadiance) {
+  // Five parallel slabs (ten interfaces), always refracting: the path leaves in its original
+  // direction, and the radiance factors 1/η² (entering) and η² (leaving) cancel exactly as a pair.
+  const float eta = 1.7f;
+  const Material glass = Dielectric{eta, glm::vec3(1.0f)};
+  const glm::vec3 d0 = -polar(50.0, 30.0);  // travelling down into the first slab
+  glm::vec3 d = d0;
+  double throughput = 1.0, transmittance = 1.0;
+  for (int interface = 0; interface < 10; ++interface) {
+    const glm::vec3 n = interface % 2 == 0 ? kUp : -kUp;  // top faces up, bottom faces down
+    const glm::vec3 wo = -d;
+    const auto r = bsdf::sample(glass, wo, n, n, kOneMinusEpsilon, {0.5f, 0.5f},
+                                TransportMode::kRadiance);
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->lobe, Lobe::kSpecularTransmission) << interface;
+    EXPECT_FLOAT_EQ(r->eta, interface % 2 == 0 ? eta : 1.0f / eta);
+    throughput *= r->weight.x * r->pdf;  // undo the choice probability: the physical factor
+    transmittance *= 1.0 - bsdf::fresnel_dielectric(glm::dot(wo, n), eta);
+    d = r->wi;
+  }
+  EXPECT_NEAR(glm::length(d - d0), 0.0f, 1e-5f);
+  EXPECT_NEAR(throughput, transmittance, 1e-5 * transmittance);
+}
+
 // --- sample() against pdf() ---
 
 TEST(SampleVersusPdf, ChiSquareForEveryFiniteKindAndAMixture) {

@@ -15,6 +15,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -134,6 +135,7 @@ TEST(AreaLight, CosineEmissionWithDensitiesThatIntegrateToOne) {
       cos_mean.add(std::abs(c));
       below.add(c < 0.0f);
       EXPECT_EQ(r->weight, light.radiance * (kPi * (two_sided ? 2.0f : 1.0f) / 0.25f));
+      EXPECT_EQ(r->weight, power(light, 4.0f)) << "area 4 sampled uniformly: p_A = 1/4";
       // ∫ pdf_dir dσ over the sphere, by uniform directions.
       const glm::vec3 w = sample_uniform_sphere(s.get2d());
       integral.add(pdf_ray(light, x, w).dir * 4.0 * kPiD);
@@ -182,6 +184,29 @@ TEST(AreaLight, IrradianceFromADiskMatchesTheClosedForm) {
   EXPECT_MC_NEAR(solid_angle_integral, 1.0);
   // Seen from behind a one-sided light: nothing.
   EXPECT_FALSE(connect(light, SurfacePoint{glm::vec3(0, 0, h), glm::vec3(0, 0, 1), 1.0f}, ref));
+}
+
+TEST(AreaLight, IrradianceIsScaleInvariantFromTinyToHugeScenes) {
+  // DESIGN §10: the disk configuration above scaled by 1e-4 and 1e+4 (the latter also moved 1e+5
+  // from the origin) gives the same irradiance, π Le R² / (h² + R²), and finite join densities.
+  const float Le = 1.0f;
+  const AreaLightParams light{glm::vec3(Le), false};
+  for (const auto& [scale, offset] : {std::pair{1e-4f, 0.0f}, std::pair{1e4f, 1e5f}}) {
+    const float R = 0.5f * scale, h = 1.5f * scale;
+    const glm::vec3 ref(offset, -offset, offset);
+    Accumulator e;
+    for (int i = 0; i < 50'000; ++i) {
+      Sampler s(20, 0, static_cast<std::uint64_t>(i));
+      const glm::vec2 d = sample_concentric_disk(s.get2d()) * R;
+      const SurfacePoint x{ref + glm::vec3(d.x, d.y, h), glm::vec3(0.0f, 0.0f, -1.0f),
+                           1.0f / (kPi * R * R)};
+      const auto c = connect(light, x, ref);
+      ASSERT_TRUE(c);
+      ASSERT_TRUE(std::isfinite(c->pdf_dir) && c->pdf_dir > 0.0f);
+      e.add(c->weight.x * std::abs(c->wi.z));
+    }
+    EXPECT_MC_NEAR(e, kPiD * 0.25 / (2.25 + 0.25)) << "scale " << scale;
+  }
 }
 
 TEST(PointLight, IsotropicPowerAndInverseSquareIrradiance) {
