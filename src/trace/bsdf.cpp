@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <type_traits>
 #include <variant>
 
@@ -255,7 +254,8 @@ std::optional<Pick> pick_component(const Mixture& mix, float u) {
   return Pick{&c.material, last, w / total, w, ur};
 }
 
-// Overload dispatch on the public variant without copying components.
+// The component to sample: a mixture's is referenced in place, a basic material (a few floats) is
+// copied into `storage` so that both cases continue as a BasicMaterial.
 std::optional<Pick> pick(const Material& m, float u, BasicMaterial* storage) {
   if (const auto* mix = std::get_if<Mixture>(&m)) return pick_component(*mix, u);
   std::visit(
