@@ -1,0 +1,614 @@
+// JSON scene loading with validation. A small reader walks the document and turns every
+// violation into one Error whose `where` is "file:/json/pointer" and whose message says what was
+// expected; unknown keys are errors, so a typo never silently does nothing.
+#include "scene/scene.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+#include <tiny_obj_loader.h>
+
+namespace pathex {
+namespace {
+
+using nlohmann::json;
+using glm::vec3;
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  Error fail(const std::string& pointer, std::string message) const {
+    Error e = make_error(ErrorCode::kBadFile, std::move(message));
+    e.where = file_ + ":" + (pointer.empty() ? "/" : pointer);
+    return e;
+  }
+
+  // The keys of `j` must be among `allowed` (plus "$schema" and "description").
+  Result<bool> keys(const json& j, const std::string& ptr, std::initializer_list<const char*> allowed) const {
+    if (!j.is_object()) return fail(ptr, "expected an object, found " + kind(j));
+    for (const auto& [key, value] : j.items()) {
+      bool ok = key == "$schema" || key == "description";
+      for (const char* a : allowed) ok = ok || key == a;
+      if (!ok) {
+        std::string list;
+        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+        return fail(ptr + "/" + key, "unknown key '" + key + "', expected one of " + list);
+      }
+    }
+    return true;
+  }
+
+  static std::string kind(const json& j) {
+    if (j.is_null()) return "null";
+    if (j.is_boolean()) return "a boolean";
+    if (j.is_number()) return "a number";
+    if (j.is_string()) return "a string";
+    if (j.is_array()) return "an array";
+    return "an object";
+  }
+
+  Result<double> number(const json& j, const std::string& key, const std::string& ptr, double lo, double hi,
+                        std::optional<double> fallback = std::nullopt) const {
+    const std::string p = ptr + "/" + key;
+    if (!j.contains(key)) {
+      if (fallback) return *fallback;
+      return fail(p, "missing " + key + ", expected a number");
+    }
+    const json& v = j.at(key);
+    if (!v.is_number()) return fail(p, "expected a number, found " + kind(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) return fail(p, "expected a finite number");
+    if (x < lo || x > hi) return fail(p, "expected a number in [" + fmt(lo) + ", " + fmt(hi) + "], found " + fmt(x));
+    return x;
+  }
+
+  Result<int> integer(const json& j, const std::string& key, const std::string& ptr, int lo, int hi, int fallback) const {
+    const std::string p = ptr + "/" + key;
+    if (!j.contains(key)) return fallback;
+    const json& v = j.at(key);
+    if (!v.is_number_integer()) return fail(p, "expected an integer, found " + kind(v));
+    const long long x = v.get<long long>();
+    if (x < lo || x > hi) return fail(p, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " + std::to_string(x));
+    return static_cast<int>(x);
+  }
+
+  // A 3-vector; `nonneg` for colours, `unit` requires a non-zero length (normalised by callers).
+  Result<vec3> vector3(const json& j, const std::string& key, const std::string& ptr, bool required,
+                       vec3 fallback = vec3(0.0f), bool nonneg = false, bool nonzero = false) const {
+    const std::string p = ptr + "/" + key;
+    if (!j.contains(key)) {
+      if (!required) return fallback;
+      return fail(p, "missing " + key + ", expected [x, y, z]");
+    }
+    const json& v = j.at(key);
+    if (!v.is_array() || v.size() != 3) return fail(p, "expected an array of 3 numbers, found " + kind(v));
+    vec3 out;
+    for (int i = 0; i < 3; ++i) {
+      const json& e = v[static_cast<std::size_t>(i)];
+      if (!e.is_number()) return fail(p + "/" + std::to_string(i), "expected a number, found " + kind(e));
+      const double x = e.get<double>();
+      if (!std::isfinite(x) || std::fabs(x) > 1e30) return fail(p + "/" + std::to_string(i), "expected a finite number");
+      if (nonneg && x < 0) return fail(p + "/" + std::to_string(i), "expected a non-negative number, found " + fmt(x));
+      out[i] = static_cast<float>(x);
+    }
+    if (nonzero && glm::dot(out, out) == 0.0f) return fail(p, "expected a non-zero vector");
+    return out;
+  }
+
+  Result<std::string> string(const json& j, const std::string& key, const std::string& ptr) const {
+    const std::string p = ptr + "/" + key;
+    if (!j.contains(key)) return fail(p, "missing " + key + ", expected a string");
+    if (!j.at(key).is_string()) return fail(p, "expected a string, found " + kind(j.at(key)));
+    return j.at(key).get<std::string>();
+  }
+
+  static std::string fmt(double x) {
+    std::ostringstream s;
+    s << x;
+    return s.str();
+  }
+
+ private:
+  std::string file_;
+};
+
+#define PATHEX_TRY(var, expr)      \
+  auto var##_r = (expr);           \
+  if (!var##_r) return var##_r.error(); \
+  auto var = std::move(*var##_r)
+
+Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::string& ptr) {
+  PATHEX_TRY(type, r.string(j, "type", ptr));
+  if (type == "diffuse") {
+    if (auto k = r.keys(j, ptr, {"type", "albedo"}); !k) return k.error();
+    PATHEX_TRY(albedo, r.vector3(j, "albedo", ptr, false, vec3(0.8f), true));
+    if (std::max(albedo.x, std::max(albedo.y, albedo.z)) > 1.0f) return r.fail(ptr + "/albedo", "expected values in [0, 1]");
+    return BasicMaterial{Diffuse{albedo}};
+  }
+  if (type == "mirror") {
+    if (auto k = r.keys(j, ptr, {"type", "reflectance"}); !k) return k.error();
+    PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(1.0f), true));
+    if (std::max(refl.x, std::max(refl.y, refl.z)) > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1]");
+    return BasicMaterial{Mirror{refl}};
+  }
+  if (type == "dielectric") {
+    if (auto k = r.keys(j, ptr, {"type", "ior", "tint"}); !k) return k.error();
+    PATHEX_TRY(ior, r.number(j, "ior", ptr, 1.0001, 10.0, 1.5));
+    PATHEX_TRY(tint, r.vector3(j, "tint", ptr, false, vec3(1.0f), true));
+    return BasicMaterial{Dielectric{static_cast<float>(ior), tint}};
+  }
+  if (type == "glossy") {
+    if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness"}); !k) return k.error();
+    PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(0.8f), true));
+    if (std::max(refl.x, std::max(refl.y, refl.z)) > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1]");
+    PATHEX_TRY(rough, r.number(j, "roughness", ptr, 1e-4, 1.0, 0.2));
+    return BasicMaterial{Glossy{refl, static_cast<float>(rough)}};
+  }
+  return r.fail(ptr + "/type", "unknown material type '" + type + "', expected diffuse, mirror, dielectric, glossy or mixture");
+}
+
+Result<Material> read_material(const Reader& r, const json& j, const std::string& ptr) {
+  if (!j.is_object()) return r.fail(ptr, "expected a material object, found " + Reader::kind(j));
+  PATHEX_TRY(type, r.string(j, "type", ptr));
+  if (type != "mixture") {
+    PATHEX_TRY(basic, read_basic(r, j, ptr));
+    return std::visit([](const auto& b) { return Material{b}; }, basic);
+  }
+  if (auto k = r.keys(j, ptr, {"type", "components"}); !k) return k.error();
+  if (!j.contains("components") || !j["components"].is_array() || j["components"].empty())
+    return r.fail(ptr + "/components", "expected a non-empty array of {weight, material}");
+  Mixture mix;
+  double total = 0;
+  for (std::size_t i = 0; i < j["components"].size(); ++i) {
+    const std::string cp = ptr + "/components/" + std::to_string(i);
+    const json& c = j["components"][i];
+    if (auto k = r.keys(c, cp, {"weight", "material"}); !k) return k.error();
+    PATHEX_TRY(weight, r.number(c, "weight", cp, 0.0, 1.0));
+    if (!c.contains("material")) return r.fail(cp + "/material", "missing material, expected a basic material object");
+    if (!c["material"].is_object()) return r.fail(cp + "/material", "expected a basic material object");
+    PATHEX_TRY(basic, read_basic(r, c["material"], cp + "/material"));
+    mix.components.push_back({static_cast<float>(weight), basic});
+    total += weight;
+  }
+  if (total > 1.0 + 1e-6) return r.fail(ptr + "/components", "the weights sum to " + Reader::fmt(total) + ", expected at most 1");
+  return Material{mix};
+}
+
+// A transform: {"translate": [..], "rotate": {"axis": [..], "degrees": a}, "scale": s or [..]}.
+Result<glm::mat4> read_transform(const Reader& r, const json& j, const std::string& ptr, bool* uniform, float* scale) {
+  if (auto k = r.keys(j, ptr, {"translate", "rotate", "scale"}); !k) return k.error();
+  glm::mat4 m(1.0f);
+  *uniform = true;
+  *scale = 1.0f;
+  PATHEX_TRY(t, r.vector3(j, "translate", ptr, false));
+  m = glm::translate(m, t);
+  if (j.contains("rotate")) {
+    const std::string rp = ptr + "/rotate";
+    if (auto k = r.keys(j["rotate"], rp, {"axis", "degrees"}); !k) return k.error();
+    PATHEX_TRY(axis, r.vector3(j["rotate"], "axis", rp, true, vec3(0.0f), false, true));
+    PATHEX_TRY(deg, r.number(j["rotate"], "degrees", rp, -3600, 3600));
+    m = glm::rotate(m, glm::radians(static_cast<float>(deg)), glm::normalize(axis));
+  }
+  if (j.contains("scale")) {
+    const json& s = j["scale"];
+    if (s.is_number()) {
+      PATHEX_TRY(sc, r.number(j, "scale", ptr, 1e-12, 1e12));
+      *scale = static_cast<float>(sc);
+      m = glm::scale(m, vec3(*scale));
+    } else {
+      PATHEX_TRY(sv, r.vector3(j, "scale", ptr, true));
+      if (sv.x <= 0 || sv.y <= 0 || sv.z <= 0) return r.fail(ptr + "/scale", "expected positive scale factors");
+      *uniform = sv.x == sv.y && sv.y == sv.z;
+      *scale = sv.x;
+      m = glm::scale(m, sv);
+    }
+  }
+  return m;
+}
+
+vec3 apply_point(const glm::mat4& m, vec3 p) { return vec3(m * glm::vec4(p, 1.0f)); }
+vec3 apply_vector(const glm::mat4& m, vec3 v) { return vec3(m * glm::vec4(v, 0.0f)); }
+
+Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file) {
+  const std::string path = (std::filesystem::path(base_dir) / file).string();
+  std::ifstream in(path);
+  if (!in) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+  // Check face indices ourselves first, so that an error names the OBJ line.
+  {
+    std::string line;
+    long long vertices = 0;
+    int line_no = 0;
+    while (std::getline(in, line)) {
+      ++line_no;
+      std::istringstream ls(line);
+      std::string tag;
+      ls >> tag;
+      if (tag == "v") {
+        ++vertices;
+      } else if (tag == "f") {
+        std::string item;
+        int n = 0;
+        while (ls >> item) {
+          ++n;
+          long long idx = 0;
+          try {
+            idx = std::stoll(item.substr(0, item.find('/')));
+          } catch (...) {
+            Error e = make_error(ErrorCode::kBadFile, "bad face index '" + item + "', expected a vertex number");
+            e.where = path + ":" + std::to_string(line_no);
+            return e;
+          }
+          const long long resolved = idx < 0 ? vertices + idx + 1 : idx;
+          if (idx == 0 || resolved < 1 || resolved > vertices) {
+            Error e = make_error(ErrorCode::kBadFile, "face index " + std::to_string(idx) + " is out of range, expected 1.." +
+                                                          std::to_string(vertices) + " (or a negative relative index)");
+            e.where = path + ":" + std::to_string(line_no);
+            return e;
+          }
+        }
+        if (n < 3) {
+          Error e = make_error(ErrorCode::kBadFile, "a face needs at least 3 vertices, found " + std::to_string(n));
+          e.where = path + ":" + std::to_string(line_no);
+          return e;
+        }
+      }
+    }
+  }
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = true;
+  config.vertex_color = false;
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromFile(path, config)) {
+    Error e = make_error(ErrorCode::kBadFile, "cannot read the mesh: " + reader.Error());
+    e.where = path;
+    return e;
+  }
+  MeshShape mesh;
+  mesh.file = file;
+  const auto& v = reader.GetAttrib().vertices;
+  for (std::size_t i = 0; i + 2 < v.size(); i += 3) {
+    const vec3 p(v[i], v[i + 1], v[i + 2]);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      Error e = make_error(ErrorCode::kBadFile, "vertex " + std::to_string(i / 3 + 1) + " is not finite");
+      e.where = path;
+      return e;
+    }
+    mesh.positions.push_back(p);
+  }
+  for (const auto& shape : reader.GetShapes())
+    for (std::size_t i = 0; i + 2 < shape.mesh.indices.size(); i += 3)
+      mesh.triangles.push_back(glm::uvec3(static_cast<unsigned>(shape.mesh.indices[i].vertex_index),
+                                          static_cast<unsigned>(shape.mesh.indices[i + 1].vertex_index),
+                                          static_cast<unsigned>(shape.mesh.indices[i + 2].vertex_index)));
+  if (mesh.triangles.empty()) return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces");
+  return mesh;
+}
+
+// Axis-aligned bounds of a shape, for the "camera sees nothing" check.
+void extend_bounds(const Shape& s, vec3& lo, vec3& hi) {
+  auto add = [&](vec3 p) { lo = glm::min(lo, p); hi = glm::max(hi, p); };
+  std::visit(
+      [&](const auto& g) {
+        using T = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<T, MeshShape>) {
+          for (const vec3& p : g.positions) add(p);
+        } else if constexpr (std::is_same_v<T, SphereShape>) {
+          add(g.center - vec3(g.radius));
+          add(g.center + vec3(g.radius));
+        } else if constexpr (std::is_same_v<T, QuadShape>) {
+          add(g.corner);
+          add(g.corner + g.edge1);
+          add(g.corner + g.edge2);
+          add(g.corner + g.edge1 + g.edge2);
+        } else {
+          add(g.center - vec3(g.radius));
+          add(g.center + vec3(g.radius));
+        }
+      },
+      s.geometry);
+}
+
+bool ray_hits_box(vec3 o, vec3 d, vec3 lo, vec3 hi) {
+  float t0 = 0.0f, t1 = 1e30f;
+  for (int i = 0; i < 3; ++i) {
+    if (std::fabs(d[i]) < 1e-12f) {
+      if (o[i] < lo[i] || o[i] > hi[i]) return false;
+      continue;
+    }
+    float a = (lo[i] - o[i]) / d[i], b = (hi[i] - o[i]) / d[i];
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+Result<Camera> read_camera(const Reader& r, const json& j, const std::string& ptr) {
+  Camera c;
+  PATHEX_TRY(type, r.string(j, "type", ptr));
+  if (type == "pinhole") {
+    c.type = SensorType::kPinhole;
+    if (auto k = r.keys(j, ptr, {"type", "position", "look_at", "up", "fov", "width", "height"}); !k) return k.error();
+  } else if (type == "lens") {
+    c.type = SensorType::kLens;
+    if (auto k = r.keys(j, ptr, {"type", "position", "look_at", "up", "fov", "width", "height", "aperture_radius", "focus_distance"}); !k)
+      return k.error();
+  } else if (type == "orthographic") {
+    c.type = SensorType::kOrthographic;
+    if (auto k = r.keys(j, ptr, {"type", "position", "look_at", "up", "film_width", "film_height", "width", "height"}); !k)
+      return k.error();
+  } else if (type == "spotmeter") {
+    c.type = SensorType::kSpotmeter;
+    if (auto k = r.keys(j, ptr, {"type", "position", "look_at", "up"}); !k) return k.error();
+  } else {
+    return r.fail(ptr + "/type", "unknown camera type '" + type + "', expected pinhole, lens, orthographic or spotmeter");
+  }
+  PATHEX_TRY(pos, r.vector3(j, "position", ptr, true));
+  PATHEX_TRY(look, r.vector3(j, "look_at", ptr, true));
+  PATHEX_TRY(up, r.vector3(j, "up", ptr, false, vec3(0.0f, 1.0f, 0.0f), false, true));
+  c.position = pos;
+  c.look_at = look;
+  c.up = up;
+  const vec3 fwd = look - pos;
+  if (glm::dot(fwd, fwd) == 0.0f) return r.fail(ptr + "/look_at", "look_at must differ from position");
+  if (glm::length(glm::cross(glm::normalize(fwd), glm::normalize(up))) < 1e-6f)
+    return r.fail(ptr + "/up", "up must not be parallel to the viewing direction");
+  if (c.type == SensorType::kPinhole || c.type == SensorType::kLens) {
+    PATHEX_TRY(fov, r.number(j, "fov", ptr, 1e-3, 179.0, 45.0));
+    c.fov_degrees = static_cast<float>(fov);
+  }
+  if (c.type == SensorType::kLens) {
+    PATHEX_TRY(ar, r.number(j, "aperture_radius", ptr, 1e-9, 1e9));
+    PATHEX_TRY(fd, r.number(j, "focus_distance", ptr, 1e-9, 1e12));
+    c.aperture_radius = static_cast<float>(ar);
+    c.focus_distance = static_cast<float>(fd);
+  }
+  if (c.type == SensorType::kOrthographic) {
+    PATHEX_TRY(fw, r.number(j, "film_width", ptr, 1e-12, 1e12));
+    PATHEX_TRY(fh, r.number(j, "film_height", ptr, 1e-12, 1e12));
+    c.film_width = static_cast<float>(fw);
+    c.film_height = static_cast<float>(fh);
+  }
+  if (c.type == SensorType::kSpotmeter) {
+    c.width = c.height = 1;
+  } else {
+    PATHEX_TRY(w, r.integer(j, "width", ptr, 1, 16384, 64));
+    PATHEX_TRY(h, r.integer(j, "height", ptr, 1, 16384, 64));
+    c.width = w;
+    c.height = h;
+  }
+  return c;
+}
+
+Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr) {
+  PATHEX_TRY(type, r.string(j, "type", ptr));
+  if (type == "point") {
+    if (auto k = r.keys(j, ptr, {"type", "position", "intensity"}); !k) return k.error();
+    PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
+    PATHEX_TRY(i, r.vector3(j, "intensity", ptr, true, vec3(0.0f), true));
+    return Light{PointLight{p, i}};
+  }
+  if (type == "spot") {
+    if (auto k = r.keys(j, ptr, {"type", "position", "direction", "intensity", "cone"}); !k) return k.error();
+    PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
+    PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
+    PATHEX_TRY(i, r.vector3(j, "intensity", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(cone, r.number(j, "cone", ptr, 1e-3, 180.0, 30.0));
+    return Light{SpotLight{p, glm::normalize(d), i, static_cast<float>(cone)}};
+  }
+  if (type == "distant") {
+    if (auto k = r.keys(j, ptr, {"type", "direction", "irradiance", "aperture"}); !k) return k.error();
+    PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
+    PATHEX_TRY(e, r.vector3(j, "irradiance", ptr, true, vec3(0.0f), true));
+    if (!j.contains("aperture")) return r.fail(ptr + "/aperture", "missing aperture, expected {corner, edge1, edge2}: the window the light enters through");
+    const std::string ap = ptr + "/aperture";
+    if (auto k = r.keys(j["aperture"], ap, {"corner", "edge1", "edge2"}); !k) return k.error();
+    PATHEX_TRY(c, r.vector3(j["aperture"], "corner", ap, true));
+    PATHEX_TRY(e1, r.vector3(j["aperture"], "edge1", ap, true, vec3(0.0f), false, true));
+    PATHEX_TRY(e2, r.vector3(j["aperture"], "edge2", ap, true, vec3(0.0f), false, true));
+    if (glm::length(glm::cross(e1, e2)) == 0.0f) return r.fail(ap, "the aperture's edges are parallel: its area is zero");
+    if (std::fabs(glm::dot(glm::normalize(glm::cross(e1, e2)), glm::normalize(d))) < 1e-6f)
+      return r.fail(ap, "the light's direction lies in the aperture's plane: no light passes through it");
+    return Light{DistantLight{glm::normalize(d), e, c, e1, e2}};
+  }
+  if (type == "laser") {
+    if (auto k = r.keys(j, ptr, {"type", "position", "direction", "power"}); !k) return k.error();
+    PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
+    PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
+    PATHEX_TRY(pw, r.vector3(j, "power", ptr, true, vec3(0.0f), true));
+    return Light{LaserLight{p, glm::normalize(d), pw}};
+  }
+  return r.fail(ptr + "/type", "unknown light type '" + type + "', expected point, spot, distant or laser (area lights are shapes with an emission)");
+}
+
+Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr, const Scene& scene,
+                         const std::string& base_dir) {
+  if (!j.is_object()) return r.fail(ptr, "expected a shape object, found " + Reader::kind(j));
+  PATHEX_TRY(type, r.string(j, "type", ptr));
+  Shape s;
+  s.pointer = ptr;
+  const std::initializer_list<const char*> common = {"type", "material", "emission", "two_sided", "transform"};
+  auto allowed = [&](std::initializer_list<const char*> extra) {
+    std::vector<const char*> all(common);
+    all.insert(all.end(), extra);
+    return all;
+  };
+  std::vector<const char*> keys;
+  if (type == "sphere") keys = allowed({"center", "radius"});
+  else if (type == "quad") keys = allowed({"corner", "edge1", "edge2"});
+  else if (type == "disk") keys = allowed({"center", "normal", "radius"});
+  else if (type == "mesh") keys = allowed({"file"});
+  else return r.fail(ptr + "/type", "unknown shape type '" + type + "', expected sphere, quad, disk or mesh");
+  for (const auto& [key, value] : j.items()) {
+    bool ok = key == "description";
+    for (const char* k : keys) ok = ok || key == k;
+    if (!ok) {
+      std::string list;
+      for (const char* k : keys) list += std::string(list.empty() ? "" : ", ") + k;
+      return r.fail(ptr + "/" + key, "unknown key '" + key + "', expected one of " + list);
+    }
+  }
+  PATHEX_TRY(mat, r.string(j, "material", ptr));
+  s.material = -1;
+  for (std::size_t i = 0; i < scene.material_names.size(); ++i)
+    if (scene.material_names[i] == mat) s.material = static_cast<int>(i);
+  if (s.material < 0) return r.fail(ptr + "/material", "unknown material '" + mat + "', expected a name defined in /materials");
+  PATHEX_TRY(em, r.vector3(j, "emission", ptr, false, vec3(0.0f), true));
+  s.emission = em;
+  if (j.contains("two_sided")) {
+    if (!j["two_sided"].is_boolean()) return r.fail(ptr + "/two_sided", "expected true or false");
+    s.two_sided = j["two_sided"].get<bool>();
+  }
+  glm::mat4 m(1.0f);
+  bool uniform = true;
+  float scale = 1.0f;
+  if (j.contains("transform")) {
+    PATHEX_TRY(t, read_transform(r, j["transform"], ptr + "/transform", &uniform, &scale));
+    m = t;
+  }
+  if (type == "sphere") {
+    PATHEX_TRY(c, r.vector3(j, "center", ptr, true));
+    PATHEX_TRY(rad, r.number(j, "radius", ptr, 1e-12, 1e12));
+    if (!uniform) return r.fail(ptr + "/transform/scale", "a sphere needs a uniform scale");
+    s.geometry = SphereShape{apply_point(m, c), static_cast<float>(rad) * scale};
+  } else if (type == "quad") {
+    PATHEX_TRY(c, r.vector3(j, "corner", ptr, true));
+    PATHEX_TRY(e1, r.vector3(j, "edge1", ptr, true, vec3(0.0f), false, true));
+    PATHEX_TRY(e2, r.vector3(j, "edge2", ptr, true, vec3(0.0f), false, true));
+    if (glm::length(glm::cross(e1, e2)) == 0.0f) return r.fail(ptr, "the quad's edges are parallel: its area is zero");
+    s.geometry = QuadShape{apply_point(m, c), apply_vector(m, e1), apply_vector(m, e2)};
+  } else if (type == "disk") {
+    PATHEX_TRY(c, r.vector3(j, "center", ptr, true));
+    PATHEX_TRY(n, r.vector3(j, "normal", ptr, true, vec3(0.0f), false, true));
+    PATHEX_TRY(rad, r.number(j, "radius", ptr, 1e-12, 1e12));
+    if (!uniform) return r.fail(ptr + "/transform/scale", "a disk needs a uniform scale");
+    const vec3 wn = glm::normalize(vec3(glm::transpose(glm::inverse(m)) * glm::vec4(n, 0.0f)));
+    s.geometry = DiskShape{apply_point(m, c), wn, static_cast<float>(rad) * scale};
+  } else {
+    PATHEX_TRY(file, r.string(j, "file", ptr));
+    PATHEX_TRY(mesh, load_obj(r, ptr, base_dir, file));
+    for (vec3& p : mesh.positions) p = apply_point(m, p);
+    s.geometry = std::move(mesh);
+  }
+  return s;
+}
+
+}  // namespace
+
+Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name) {
+  const Reader r(name);
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& ex) {
+    return r.fail("", std::string("not valid JSON: ") + ex.what());
+  }
+  if (auto k = r.keys(doc, "", {"camera", "materials", "shapes", "lights"}); !k) return k.error();
+  Scene scene;
+  scene.name = name;
+  // --- materials ---
+  if (!doc.contains("materials") || !doc["materials"].is_object() || doc["materials"].empty())
+    return r.fail("/materials", "expected an object of named materials, e.g. {\"white\": {\"type\": \"diffuse\"}}");
+  for (const auto& [mname, mj] : doc["materials"].items()) {
+    PATHEX_TRY(m, read_material(r, mj, "/materials/" + mname));
+    scene.material_names.push_back(mname);
+    scene.materials.push_back(std::move(m));
+  }
+  // --- shapes ---
+  if (!doc.contains("shapes") || !doc["shapes"].is_array()) return r.fail("/shapes", "expected an array of shapes");
+  if (doc["shapes"].empty()) return r.fail("/shapes", "the scene is empty: expected at least one shape");
+  for (std::size_t i = 0; i < doc["shapes"].size(); ++i) {
+    PATHEX_TRY(s, read_shape(r, doc["shapes"][i], "/shapes/" + std::to_string(i), scene, base_dir));
+    scene.shapes.push_back(std::move(s));
+  }
+  // --- lights ---
+  if (doc.contains("lights")) {
+    if (!doc["lights"].is_array()) return r.fail("/lights", "expected an array of lights");
+    for (std::size_t i = 0; i < doc["lights"].size(); ++i) {
+      const std::string ptr = "/lights/" + std::to_string(i);
+      if (!doc["lights"][i].is_object()) return r.fail(ptr, "expected a light object");
+      PATHEX_TRY(l, read_light(r, doc["lights"][i], ptr));
+      scene.lights.push_back(std::move(l));
+    }
+  }
+  bool any_light = !scene.lights.empty();
+  for (const Shape& s : scene.shapes) any_light = any_light || s.emissive();
+  if (!any_light) return r.fail("/lights", "the scene has no light: expected an entry in /lights or a shape with an emission");
+  // --- camera ---
+  if (!doc.contains("camera")) return r.fail("/camera", "missing camera, expected {type, position, look_at, …}");
+  PATHEX_TRY(cam, read_camera(r, doc["camera"], "/camera"));
+  scene.camera = cam;
+  // The camera must see some geometry: at least one of a grid of its rays reaches the bounds.
+  vec3 lo(1e30f), hi(-1e30f);
+  for (const Shape& s : scene.shapes) extend_bounds(s, lo, hi);
+  const vec3 fwd = glm::normalize(cam.look_at - cam.position);
+  const vec3 right = glm::normalize(glm::cross(fwd, cam.up));
+  const vec3 up = glm::cross(right, fwd);
+  const float ty = std::tan(glm::radians(cam.fov_degrees) * 0.5f);
+  const float tx = ty * static_cast<float>(cam.width) / static_cast<float>(cam.height);
+  bool sees = false;
+  for (int a = -4; a <= 4 && !sees; ++a)
+    for (int b = -4; b <= 4 && !sees; ++b) {
+      const float fa = static_cast<float>(a) / 4.0f, fb = static_cast<float>(b) / 4.0f;
+      vec3 o = cam.position, d = fwd;
+      switch (cam.type) {
+        case SensorType::kPinhole:
+        case SensorType::kLens: d = fwd + fa * tx * right + fb * ty * up; break;
+        case SensorType::kOrthographic: o = cam.position + fa * 0.5f * cam.film_width * right + fb * 0.5f * cam.film_height * up; break;
+        case SensorType::kSpotmeter: break;
+      }
+      sees = ray_hits_box(o, d, lo, hi);
+    }
+  if (!sees) return r.fail("/camera", "the camera sees no geometry: none of its rays reaches the scene's bounding box");
+  return scene;
+}
+
+Result<Scene> load_scene_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    Error e = make_error(ErrorCode::kBadFile, "cannot open the scene file");
+    e.where = path;
+    return e;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  return load_scene_json(ss.str(), dir.empty() ? "." : dir, path);
+}
+
+SceneTypes scene_types(const Scene& scene) {
+  SceneTypes t;
+  t.sensor = scene.camera.type;
+  for (const Light& l : scene.lights) {
+    std::visit(
+        [&](const auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, PointLight> || std::is_same_v<T, SpotLight>) t.lights.insert(LightType::kPoint);
+          else if constexpr (std::is_same_v<T, DistantLight>) t.lights.insert(LightType::kDistant);
+          else t.lights.insert(LightType::kLaser);
+        },
+        l);
+  }
+  for (const Shape& s : scene.shapes) {
+    if (s.emissive()) t.lights.insert(LightType::kArea);
+    t.interior = static_cast<LetterMask>(t.interior | letters_of(scene.materials[static_cast<std::size_t>(s.material)]));
+  }
+  return t;
+}
+
+std::string describe(const SceneTypes& t) {
+  std::string s = "lights";
+  for (LightType l : t.lights) s += " " + to_string(l);
+  s += "; sensor " + to_string(t.sensor) + "; materials";
+  if (t.interior & (1u << kD)) s += " D";
+  if (t.interior & (1u << kS)) s += " S";
+  return s;
+}
+
+}  // namespace pathex

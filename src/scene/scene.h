@@ -1,0 +1,105 @@
+// The scene model: plain values, loaded from JSON (schema: grammar/scene.schema.json) with OBJ
+// meshes through tinyobjloader. Every validation error names the file and the JSON pointer of
+// the offending value (or the OBJ file and line) and says what was expected (DESIGN §12).
+//
+// Kinds are closed sets behind one value: shapes, lights and materials are std::variants. Area
+// lights are shapes with an emission; the other lights are points, spots, distant lights
+// through an aperture and lasers. Exactly one sensor. Transforms are applied at load time, so
+// the model holds world-space geometry only.
+#pragma once
+
+#include <set>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "alphabet/alphabet.h"
+#include "core/error.h"
+#include "scene/material.h"
+
+namespace pathex {
+
+struct MeshShape {
+  std::string file;                      // as given, relative to the scene file
+  std::vector<glm::vec3> positions;
+  std::vector<glm::uvec3> triangles;
+};
+struct SphereShape {
+  glm::vec3 center{0.0f};
+  float radius = 1.0f;
+};
+struct QuadShape {  // corner, corner + edge1, corner + edge1 + edge2, corner + edge2
+  glm::vec3 corner{0.0f}, edge1{1.0f, 0.0f, 0.0f}, edge2{0.0f, 1.0f, 0.0f};
+};
+struct DiskShape {
+  glm::vec3 center{0.0f}, normal{0.0f, 1.0f, 0.0f};
+  float radius = 1.0f;
+};
+using ShapeGeometry = std::variant<MeshShape, SphereShape, QuadShape, DiskShape>;
+
+struct Shape {
+  ShapeGeometry geometry;
+  int material = 0;             // index into Scene::materials
+  glm::vec3 emission{0.0f};     // radiance Le; nonzero makes the shape an area light (LDD)
+  bool two_sided = false;       // emits from both sides
+  std::string pointer;          // "/shapes/3", for messages
+  bool emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
+};
+
+struct PointLight {   // LSD
+  glm::vec3 position{0.0f}, intensity{1.0f};  // W/sr
+};
+struct SpotLight {    // LSD: a point light restricted to a cone (hard edge)
+  glm::vec3 position{0.0f}, direction{0.0f, -1.0f, 0.0f}, intensity{1.0f};
+  float cone_degrees = 30.0f;  // half angle
+};
+struct DistantLight { // LDS: parallel light of irradiance E entering through a finite aperture
+  glm::vec3 direction{0.0f, -1.0f, 0.0f}, irradiance{1.0f};  // W/m² perpendicular to direction
+  glm::vec3 aperture_corner{0.0f}, aperture_edge1{1.0f, 0.0f, 0.0f}, aperture_edge2{0.0f, 0.0f, 1.0f};
+};
+struct LaserLight {   // LSS: one ray
+  glm::vec3 position{0.0f}, direction{0.0f, -1.0f, 0.0f}, power{1.0f};  // W
+};
+using Light = std::variant<PointLight, SpotLight, DistantLight, LaserLight>;
+
+struct Camera {
+  SensorType type = SensorType::kPinhole;
+  glm::vec3 position{0.0f}, look_at{0.0f, 0.0f, -1.0f}, up{0.0f, 1.0f, 0.0f};
+  float fov_degrees = 45.0f;        // pinhole, lens: vertical field of view
+  float aperture_radius = 0.0f;     // lens
+  float focus_distance = 1.0f;      // lens
+  float film_width = 1.0f, film_height = 1.0f;  // orthographic, world units
+  int width = 64, height = 64;      // spot meter: 1 x 1
+};
+
+struct Scene {
+  std::string name;
+  std::vector<std::string> material_names;
+  std::vector<Material> materials;
+  std::vector<Shape> shapes;
+  std::vector<Light> lights;
+  Camera camera;
+};
+
+// `base_dir` resolves relative mesh paths; `name` prefixes error locations.
+Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name);
+Result<Scene> load_scene_file(const std::string& path);
+
+// The scene embedded in the binary: a Cornell box with an area light, a mirror and a glass sphere.
+const char* default_scene_json();
+
+// What fixes the scene's universe (DESIGN §6): its light types, its sensor, the letters its
+// materials can produce.
+struct SceneTypes {
+  std::set<LightType> lights;
+  SensorType sensor = SensorType::kPinhole;
+  LetterMask interior = 0;
+};
+SceneTypes scene_types(const Scene& scene);
+// "lights area, point; sensor pinhole; materials D S"
+std::string describe(const SceneTypes& t);
+
+}  // namespace pathex
