@@ -44,5 +44,6 @@ Command add_classify(CLI::App& app);
 Command add_query(CLI::App& app);
 Command add_check(CLI::App& app);
 Command add_renderers(CLI::App& app);
+Command add_trace(CLI::App& app);
 
 }  // namespace pathex::cli

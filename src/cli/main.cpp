@@ -12,7 +12,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "pathex 0.1.0");
   std::vector<Command> commands = {add_explain(app), add_match(app), add_classify(app),
-                                   add_query(app), add_check(app), add_renderers(app)};
+                                   add_query(app), add_check(app), add_renderers(app), add_trace(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,206 @@
+// pathex trace: render a scene, label every sampled path, write the path-class histogram, the
+// per-class EXR and PNG previews, and print where the light went, class by class, next to what the
+// checker says the renderer can reach.
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "cli/common.h"
+#include "cli/reach_common.h"
+#include "io/atomic_file.h"
+#include "io/class_file.h"
+#include "io/histogram_json.h"
+#include "io/image_io.h"
+#include "io/profile_json.h"
+#include "scene/universe.h"
+#include "trace/render.h"
+
+namespace pathex::cli {
+namespace {
+
+struct TraceArgs {
+  std::string scene;
+  std::string renderer = "bdpt";
+  std::string classes_file;
+  std::string out = "pathex-out";
+  std::uint64_t spp = 16;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  int max_bounces = 16;
+  int top_paths = 8;
+  bool json = false;
+  bool quiet = false;
+  bool no_images = false;
+  Limits limits;
+};
+
+std::atomic<bool> g_cancel{false};
+extern "C" void on_sigint(int) { g_cancel.store(true); }
+
+std::string percent(double share) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f %%", 100.0 * share);
+  return buf;
+}
+
+std::string format_seconds(double s) {
+  char buf[32];
+  if (s < 60) std::snprintf(buf, sizeof buf, "%.0f s", s);
+  else std::snprintf(buf, sizeof buf, "%.0f min %02.0f s", std::floor(s / 60), std::fmod(s, 60));
+  return buf;
+}
+
+int run(const TraceArgs& a) {
+  // --- scene, profile, classes ---
+  Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
+                                        : load_scene_file(a.scene);
+  if (!scene) return report(scene.error());
+  const std::string scene_name = a.scene.empty() ? "default (embedded cornell)" : a.scene;
+  Result<Profile> profile = resolve_profile(a.renderer, a.limits);
+  if (!profile) return report(profile.error());
+  if (Result<StrategySet> runnable = runnable_strategies(*profile); !runnable) return report(runnable.error());
+
+  ClassOptions copts;
+  copts.limits = a.limits;
+  const SceneTypes types = scene_types(*scene);
+  copts.ends.lights.assign(types.lights.begin(), types.lights.end());
+  copts.ends.sensors = {types.sensor};
+  ClassTable table;
+  std::vector<const PathClass*> classes;
+  if (!a.classes_file.empty()) {
+    Result<bool> r = read_class_file(a.classes_file, copts, &table);
+    if (!r) return report(r.error());
+    for (const auto& c : table.user_classes()) classes.push_back(c.get());
+  } else {
+    for (const auto& c : ClassTable::builtins().builtin_classes())
+      if (c->name != "all") classes.push_back(c.get());
+  }
+  Result<Classifier> classifier = Classifier::build(classes, a.limits);
+  if (!classifier) return report(classifier.error());
+  std::vector<ClassInfo> infos;
+  for (const PathClass* c : classes) infos.push_back({c->name, c->text});
+
+  // --- render ---
+  RenderOptions ro;
+  ro.spp = a.spp;
+  ro.seed = a.seed;
+  ro.threads = a.threads;
+  ro.max_bounces = a.max_bounces;
+  for (int i = 0; i < classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
+  const bool show_progress = !a.quiet && ::isatty(STDERR_FILENO);
+  const auto start = std::chrono::steady_clock::now();
+  if (show_progress) {
+    ro.progress = [start](std::uint64_t done, std::uint64_t total) {
+      const double f = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
+      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const int bar = static_cast<int>(f * 30);
+      std::fprintf(stderr, "\r[%.*s%*s] %5.1f%%  %.2f M samples/s  %s left   ", bar, "##############################",
+                   30 - bar, "", 100 * f, el > 0 ? static_cast<double>(done) / el * 1e-6 : 0.0,
+                   format_seconds(f > 0 ? el / f - el : 0).c_str());
+      std::fflush(stderr);
+    };
+  }
+  g_cancel.store(false);
+  ro.cancel = &g_cancel;
+  std::signal(SIGINT, on_sigint);
+  Result<RenderOutput> out = render(*scene, *profile, &*classifier, ro);
+  std::signal(SIGINT, SIG_DFL);
+  if (show_progress) std::fprintf(stderr, "\r%70s\r", "");
+  if (!out) return report(out.error());
+
+  RunInfo info;
+  info.scene = scene_name;
+  info.renderer = profile->name;
+  info.spp = out->spp_done;
+  info.seed = a.seed;
+  info.threads = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
+  info.time_s = out->time_s;
+  info.complete = out->complete;
+  Result<HistogramReport> rep = make_report(out->histogram, info, &*classifier, infos);
+  if (!rep) return report(rep.error());
+
+  // --- outputs, each written whole or not at all ---
+  std::error_code ec;
+  std::filesystem::create_directories(a.out, ec);
+  if (ec) return report(make_error(ErrorCode::kBadFile, "cannot create the output folder " + a.out + ": " + ec.message()));
+  const std::string json_text = histogram_json_text(*rep);
+  if (Result<bool> w = write_file_atomic(a.out + "/histogram.json", json_text); !w) return report(w.error());
+  if (!a.no_images) {
+    const std::vector<ImageLayer> layers = out->images.layers(out->spp_done ? 1.0 / static_cast<double>(out->spp_done) : 0.0);
+    if (Result<bool> w = write_exr(a.out + "/classes.exr", layers); !w) return report(w.error());
+    if (Result<bool> w = write_previews(a.out, layers); !w) return report(w.error());
+  }
+  if (a.json) {
+    std::cout << json_text;
+    return out->complete ? kExitOk : kExitNo;
+  }
+
+  // --- the table: classes with the checker's verdict, then the most important exact paths ---
+  ReachCache cache(a.limits);
+  Result<const CompiledProfile*> cp = cache.compiled(a.renderer, a.max_bounces);
+  if (!cp) return report(cp.error());
+  QueryOptions qo;
+  qo.universe = scene_universe(types);
+  qo.max_bounces = a.max_bounces;
+  qo.witnesses = 0;
+  qo.max_len = 0;
+  std::cout << "scene " << scene_name << ", renderer " << profile->name << ", " << out->spp_done << " spp, "
+            << std::fixed << std::setprecision(2) << out->time_s << " s" << (out->complete ? "" : " (interrupted)")
+            << ", non-finite samples " << rep->nonfinite_samples << "\n";
+  std::cout << "image mean luminance " << std::setprecision(5) << rep->total.luminance << " ± " << rep->total.std_error
+            << "\n\n";
+  for (std::size_t i = 0; i < rep->classes.size(); ++i) {
+    const ClassEstimate& c = rep->classes[i];
+    Result<QueryResult> q = query(*classes[i], **cp, qo);
+    const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
+    std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0)
+              << "; " << profile->name << ": " << (q ? to_string(q->verdict) : "?") << "\n";
+  }
+  std::cout << "\nmost important paths\n";
+  for (std::size_t i = 0; i < rep->paths.size() && static_cast<int>(i) < a.top_paths; ++i) {
+    const PathEstimate& p = rep->paths[i];
+    const double share = rep->total.luminance > 0 ? p.estimate.luminance / rep->total.luminance : 0.0;
+    const double err = rep->total.luminance > 0 ? p.estimate.std_error / rep->total.luminance : 0.0;
+    std::cout << "  " << std::left << std::setw(16) << p.path << std::right << std::setw(8) << percent(share) << "  ±"
+              << percent(std::isfinite(err) ? err : 0.0) << "  via";
+    for (const auto& [name, s] : p.strategies) std::cout << " " << name << " " << percent(s);
+    std::cout << "\n";
+  }
+  std::cout << "\nwrote " << a.out << "/histogram.json" << (a.no_images ? "" : ", classes.exr and PNG previews") << "\n";
+  return out->complete ? kExitOk : kExitNo;
+}
+
+}  // namespace
+
+Command add_trace(CLI::App& app) {
+  auto args = std::make_shared<TraceArgs>();
+  CLI::App* sub = app.add_subcommand("trace", "Render a scene, label every path, write path-class histograms and images");
+  sub->footer("Example:\n  pathex trace                         # the embedded Cornell box\n"
+              "  pathex trace samples/scenes/point-mirror-caustic.json --renderer pt-nee --spp 64 --out out/\n"
+              "Writes DIR/histogram.json, DIR/classes.exr (a layer per class and the total) and DIR/<layer>.png.\n"
+              "Ctrl-C stops early and writes what was rendered, marked \"complete\": false (exit 1).");
+  sub->add_option("SCENE", args->scene, "Scene file (grammar/scene.schema.json); default: the embedded Cornell box");
+  sub->add_option("--renderer", args->renderer, "Renderer profile: built-in name or file")->capture_default_str();
+  sub->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 24));
+  sub->add_option("--classes", args->classes_file, "Class file; default: the built-in classes");
+  sub->add_option("--seed", args->seed, "Random seed")->capture_default_str();
+  sub->add_option("--threads", args->threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+  sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices (k - 1)")->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  sub->add_option("--out", args->out, "Output folder")->capture_default_str();
+  sub->add_option("--top", args->top_paths, "Exact paths to list")->capture_default_str()->check(CLI::Range(0, 100000));
+  sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
+  sub->add_flag("--quiet", args->quiet, "No progress bar");
+  sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs");
+  add_limit_options(sub, &args->limits);
+  return {sub, [args] { return run(*args); }};
+}
+
+}  // namespace pathex::cli

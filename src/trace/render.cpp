@@ -1,0 +1,816 @@
+// Bidirectional path sampling with full-path labels.
+//
+// For each pixel and pass: an eye subpath z0 z1 … from the sensor and a light subpath y0 y1 …
+// from a light, each extended by local sampling (BSDF sampling, Russian roulette after
+// RenderOptions::rr_depth vertices, at most max_bounces interior vertices on the full path).
+// Then every (s, t) pair the profile runs is evaluated: s = 0 an eye vertex on an area light,
+// s = 1 a fresh light sample (next-event estimation), t = 1 a fresh sensor sample (a splat), t = 0
+// a light vertex on a thin lens, otherwise a shadow ray between y(s-1) and z(t-1).
+//
+// Labels: each vertex keeps the letter of the scattering event sampled there (the component a
+// BSDF chose; a light's and a sensor's two letters). The full-path string of a connection is
+// those letters in light-to-eye order with the two join letters set to D (a join evaluates only
+// finite parts). A strategy (s', t') has nonzero density for that string exactly when the
+// profile runs it and the string's letters c(s') and c(s'+1) are both D; the power heuristic
+// sums over those strategies only, using the pdf-ratio recurrence of pbrt's BDPT with Dirac
+// densities kept symbolic (stored as 0, remapped to 1, and their strategies excluded by letter).
+#include "trace/render.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+
+#include "trace/bsdf.h"
+#include "trace/frame.h"
+#include "trace/render_scene.h"
+#include "trace/rng.h"
+
+namespace pathex {
+
+// --- strategies the tracer runs ---
+
+int StrategySet::find(int s, int t) const {
+  for (std::size_t i = 0; i < strategies.size(); ++i)
+    if (strategies[i].s.contains(s) && strategies[i].t.contains(t)) return static_cast<int>(i);
+  return -1;
+}
+
+Result<StrategySet> runnable_strategies(const Profile& profile) {
+  StrategySet set;
+  for (const Strategy& st : profile.strategies) {
+    if (st.connector != ConnectorKind::kNone)
+      return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' uses the connector '" + to_string(st.connector) +
+                                               "' (strategy '" + st.name +
+                                               "'), which the tracer does not run yet; it runs plain joins (s, DD, t) only");
+    set.strategies.push_back(st);
+  }
+  return set;
+}
+
+namespace {
+
+using glm::vec3;
+constexpr int kMaxVertices = 64;  // per subpath; max_bounces is clamped so paths fit
+
+float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+
+// --- vertices ---
+
+enum class Kind : std::uint8_t { kCamera, kLight, kSurface, kLens };
+
+struct Vertex {
+  Kind kind = Kind::kSurface;
+  vec3 p{0.0f};
+  vec3 n{0.0f};          // geometric normal (unit); zero for points (point, spot, pinhole, laser)
+  vec3 ns{0.0f};         // shading normal
+  vec3 beta{1.0f};       // throughput up to and including this vertex
+  float pdf_fwd = 0.0f;  // area density of sampling this vertex in its subpath's direction
+  float pdf_rev = 0.0f;  // area density of sampling it from the other direction
+  char letter = 'D';     // scattering letter: surface c_i; light c1 (direction); sensor c(k+1)
+  char pos_letter = 'D'; // lights c0 and sensors c(k+2)
+  int shape = -1;        // surfaces and area-light points
+  int light = -1;        // light vertices
+  bool has_normal() const { return n.x != 0.0f || n.y != 0.0f || n.z != 0.0f; }
+};
+
+// |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
+float abs_cos(const Vertex& v, const vec3& w) { return v.has_normal() ? std::fabs(glm::dot(v.n, w)) : 1.0f; }
+
+// Solid-angle density at `from` towards `to` as an area density at `to`.
+float to_area(float pdf_dir, const Vertex& from, const Vertex& to) {
+  const vec3 d = to.p - from.p;
+  const float d2 = glm::dot(d, d);
+  if (d2 == 0.0f) return 0.0f;
+  return pdf_dir * abs_cos(to, d / std::sqrt(d2)) / d2;
+}
+
+// --- the integrator ---
+
+class Integrator {
+ public:
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl)
+      : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), classifier_(cl) {
+    max_bounces_ = std::min(o.max_bounces, kMaxVertices - 3);
+    light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
+    lens_hits_ = cam_.type == SensorType::kLens && cam_.lens_radius > 0.0f;
+    bool any_t0 = false;
+    for (int s = 0; s < 2 * kMaxVertices; ++s) any_t0 = any_t0 || strategies.find(s, 0) >= 0;
+    lens_hits_ = lens_hits_ && any_t0;
+  }
+
+  struct Thread {
+    Histogram hist;
+    ClassImages::PixelSum pixel;
+    std::array<Vertex, kMaxVertices> eye, light;
+    std::string label;
+    std::uint64_t rays = 0;
+  };
+
+  // One sample: pixel (px, py), pass `pass`.
+  void sample(Thread& th, ClassImages& images, int px, int py, std::uint64_t pass) const;
+
+  // For the full path x0 … xk formed by connection (s, t) of the current subpaths: the sum, over
+  // every strategy (s', t') with s' + t' = s + t that the profile runs and whose join letters are
+  // D, of the MIS weight (s', t') computes when it samples the same vertices. Must be 1.
+  float weight_sum(Thread& th, int s, int t) const;
+  int trace_subpaths(Thread& th, Sampler& rng, int px, int py, int* ns) const {
+    const int nt = eye_subpath(th, rng, px, py);
+    *ns = light_subpath(th, rng);
+    return nt;
+  }
+
+ private:
+  // --- sensors ---
+  vec3 raster_dir(float rx, float ry) const {  // direction through raster point, z = 1 image plane
+    const float sx = (2.0f * rx / static_cast<float>(cam_.width) - 1.0f) * cam_.tan_x;
+    const float sy = (1.0f - 2.0f * ry / static_cast<float>(cam_.height)) * cam_.tan_y;
+    return cam_.forward + sx * cam_.right + sy * cam_.up;
+  }
+  // Raster position of a direction leaving the camera centre (pinhole) or, for a lens, of the
+  // focus-plane point the ray from `lens_point` reaches. False when outside the image.
+  bool raster_of(const vec3& lens_point, const vec3& dir, float* rx, float* ry) const {
+    const float c = glm::dot(dir, cam_.forward);
+    if (c <= 0.0f) return false;
+    vec3 q = dir / c;  // on the z = 1 plane, relative to lens_point
+    if (cam_.type == SensorType::kLens) {
+      const vec3 focus = lens_point + dir * (cam_.focus_distance / c);
+      q = (focus - cam_.position) / cam_.focus_distance;
+    }
+    const float sx = glm::dot(q, cam_.right) / cam_.tan_x, sy = glm::dot(q, cam_.up) / cam_.tan_y;
+    *rx = (sx + 1.0f) * 0.5f * static_cast<float>(cam_.width);
+    *ry = (1.0f - sy) * 0.5f * static_cast<float>(cam_.height);
+    return *rx >= 0.0f && *ry >= 0.0f && *rx < static_cast<float>(cam_.width) && *ry < static_cast<float>(cam_.height);
+  }
+  float lens_area() const { return kPi * cam_.lens_radius * cam_.lens_radius; }
+  // Importance per unit projected solid angle and lens area (pinhole, lens), 0 outside the image.
+  float importance(const vec3& lens_point, const vec3& dir) const {
+    float rx, ry;
+    if (!raster_of(lens_point, dir, &rx, &ry)) return 0.0f;
+    const float c = glm::dot(dir, cam_.forward);
+    const float w = 1.0f / (cam_.image_area() * c * c * c * c);
+    return cam_.type == SensorType::kLens ? w / lens_area() : w;
+  }
+  // Directional density of the sensor (solid angle): pinhole and lens 1/(A cos^3), deltas 0.
+  float sensor_pdf_dir(const vec3& dir) const {
+    if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return 0.0f;
+    float rx, ry;
+    const float c = glm::dot(dir, cam_.forward);
+    if (c <= 0.0f) return 0.0f;
+    (void)rx;
+    (void)ry;
+    return 1.0f / (cam_.image_area() * c * c * c);
+  }
+  float sensor_pdf_pos() const {
+    switch (cam_.type) {
+      case SensorType::kLens: return 1.0f / lens_area();
+      case SensorType::kOrthographic: return 1.0f / (cam_.film_width * cam_.film_height);
+      default: return 0.0f;  // a point: Dirac
+    }
+  }
+  std::string sensor_pair() const { return sensor_letters(cam_.type); }
+
+  // --- lights ---
+  float light_pdf_pos(const RenderLight& l) const {  // area density of the emitting point
+    switch (l.type) {
+      case EmitterKind::kArea: return 1.0f / rs_.geometry->shape_area(l.shape);
+      case EmitterKind::kDistant: return 1.0f / l.ap_area;
+      default: return 0.0f;  // Dirac
+    }
+  }
+  // Whether a light vertex emits towards `w` through its finite directional part: the emitting
+  // side of an area light, anywhere for a point light, inside a spot's cone. Dirac directions
+  // (distant, laser) have no finite part.
+  bool light_emits(const RenderLight& l, const Vertex& v, const vec3& w) const {
+    switch (l.type) {
+      case EmitterKind::kArea: {
+        const float c = glm::dot(v.n, w);
+        return c > 0.0f || (l.two_sided && c < 0.0f);
+      }
+      case EmitterKind::kPoint: return true;
+      case EmitterKind::kSpot: return glm::dot(w, l.direction) >= l.cos_cone;
+      default: return false;
+    }
+  }
+  // Emitted radiance (area) or intensity (point, spot) towards `w`.
+  vec3 light_emit(const RenderLight& l, const Vertex& v, const vec3& w) const {
+    return light_emits(l, v, w) ? l.power : vec3(0.0f);
+  }
+  float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
+    switch (l.type) {
+      case EmitterKind::kArea: {
+        const float c = glm::dot(v.n, w);
+        if (l.two_sided) return std::fabs(c) / (2.0f * kPi);
+        return c > 0.0f ? c / kPi : 0.0f;
+      }
+      case EmitterKind::kPoint: return 1.0f / (4.0f * kPi);
+      case EmitterKind::kSpot: return glm::dot(w, l.direction) >= l.cos_cone ? 1.0f / (2.0f * kPi * (1.0f - l.cos_cone)) : 0.0f;
+      default: return 0.0f;
+    }
+  }
+
+  // --- densities used by MIS ---
+  // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
+  float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const {
+    const vec3 wn = glm::normalize(next.p - v.p);
+    float pdf_dir = 0.0f;
+    switch (v.kind) {
+      case Kind::kCamera: pdf_dir = sensor_pdf_dir(wn); break;
+      case Kind::kLight: pdf_dir = light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn); break;
+      case Kind::kSurface: {
+        if (!prev) return 0.0f;
+        const vec3 wp = glm::normalize(prev->p - v.p);
+        pdf_dir = bsdf::pdf(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)], wp, wn, v.ns, v.n);
+        break;
+      }
+      case Kind::kLens: return 0.0f;
+    }
+    return to_area(pdf_dir, v, next);
+  }
+  // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
+  float pdf_light_origin(const Vertex& v) const {
+    const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
+    return light_pick_ * light_pdf_pos(rs_.lights[static_cast<std::size_t>(li)]);
+  }
+  // Area density at `next` of a light subpath leaving the light point `v` (an eye vertex on an
+  // area light) towards it.
+  float pdf_light_dir(const Vertex& v, const Vertex& next) const {
+    const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
+    const vec3 w = glm::normalize(next.p - v.p);
+    return to_area(light_pdf_dir(rs_.lights[static_cast<std::size_t>(li)], v, w), v, next);
+  }
+
+  // --- subpaths ---
+  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
+                  float pdf_dir, int max_vertices, TransportMode mode) const;
+  int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
+  int light_subpath(Thread& th, Sampler& rng) const;
+
+  // --- connections ---
+  void connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int px, int py, int batch) const;
+  float mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const;
+  // The full-path letters of the path made by s light and t eye vertices (with `sampled`
+  // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
+  std::string full_path(const Thread& th, int s, int t, const Vertex* sampled) const;
+  bool visible(Thread& th, const Vertex& a, const Vertex& b) const {
+    ++th.rays;
+    return rs_.geometry->visible(a.p, a.n, b.p, b.n);
+  }
+  void record(Thread& th, ClassImages& images, const std::string& path, int strategy, int batch, const vec3& c,
+              bool splat, float rx, float ry) const;
+
+  const RenderScene& rs_;
+  const RenderCamera& cam_;
+  const StrategySet& strategies_;
+  const RenderOptions& o_;
+  const Classifier* classifier_;
+  int max_bounces_ = 16;
+  float light_pick_ = 0.0f;
+  bool lens_hits_ = false;
+};
+
+int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
+                            float pdf_dir, int max_vertices, TransportMode mode) const {
+  vec3 beta = path[static_cast<std::size_t>(count - 1)].beta;
+  // `beta` passed in the first vertex already includes the first direction's weight: the caller
+  // stores it in path[count - 1].beta and we continue from there.
+  while (count < max_vertices) {
+    Vertex& prev = path[static_cast<std::size_t>(count - 1)];
+    ++th.rays;
+    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.has_normal() ? prev.n : vec3(0.0f));
+    // --- a light subpath may end on the lens (strategy t = 0) ---
+    if (mode == TransportMode::kImportance && lens_hits_) {
+      const float denom = glm::dot(d, cam_.forward);
+      if (denom < 0.0f) {
+        const float tl = glm::dot(cam_.position - o, cam_.forward) / denom;
+        const vec3 q = o + tl * d;
+        if (tl > 0.0f && (!hit || tl < hit->t) && glm::length(q - cam_.position) <= cam_.lens_radius) {
+          Vertex& v = path[static_cast<std::size_t>(count)];
+          v = Vertex{};
+          v.kind = Kind::kLens;
+          v.p = q;
+          v.n = cam_.forward;
+          v.ns = cam_.forward;
+          v.beta = beta;
+          v.pdf_fwd = to_area(pdf_dir, prev, v);
+          v.letter = 'D';
+          v.pos_letter = 'D';
+          return count + 1;
+        }
+      }
+    }
+    if (!hit) break;
+    Vertex& v = path[static_cast<std::size_t>(count)];
+    v = Vertex{};
+    v.kind = Kind::kSurface;
+    v.p = hit->position;
+    v.n = hit->normal;
+    v.ns = hit->shading_normal;
+    v.shape = hit->shape;
+    v.beta = beta;
+    v.pdf_fwd = to_area(pdf_dir, prev, v);
+    ++count;
+    if (count >= max_vertices) break;
+    // --- scatter ---
+    const Material& m = *rs_.material_of_shape[static_cast<std::size_t>(v.shape)];
+    const vec3 wo = -d;
+    const float u_comp = rng.get1d();
+    const glm::vec2 u = rng.get2d();
+    const std::optional<BsdfSample> bs = bsdf::sample(m, wo, v.ns, v.n, u_comp, u, mode);
+    if (!bs || is_black(bs->weight) || bs->pdf <= 0.0f) break;
+    v.letter = letter_char(bs->letter);
+    beta *= bs->weight * bsdf::shading_normal_correction(wo, bs->wi, v.ns, v.n, mode);
+    // A Dirac's densities stay symbolic: 0 here, remapped to 1 in the MIS ratios, and every
+    // strategy that would join at this vertex is excluded by its letter S.
+    pdf_dir = bs->is_delta ? 0.0f : bs->pdf;
+    const float pdf_rev_dir = bs->is_delta ? 0.0f : bs->pdf_rev;
+    prev.pdf_rev = to_area(pdf_rev_dir, v, prev);
+    // --- Russian roulette, never mislabelling: the vertices so far stay valid prefixes ---
+    if (count >= o_.rr_depth) {
+      const float q = std::max(0.05f, 1.0f - max_component(beta));
+      if (rng.get1d() < q) break;
+      beta /= 1.0f - q;
+    }
+    o = v.p;
+    d = bs->wi;
+    if (!std::isfinite(beta.x + beta.y + beta.z)) break;
+  }
+  return count;
+}
+
+int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
+  Vertex& z0 = th.eye[0];
+  z0 = Vertex{};
+  z0.kind = Kind::kCamera;
+  z0.beta = vec3(1.0f);
+  const std::string pair = sensor_pair();
+  z0.letter = pair[0];
+  z0.pos_letter = pair[1];
+  const glm::vec2 uf = rng.get2d();
+  const glm::vec2 ul = rng.get2d();
+  const float rx = static_cast<float>(px) + uf.x, ry = static_cast<float>(py) + uf.y;
+  vec3 o = cam_.position, d = cam_.forward;
+  float pdf_dir = 0.0f;
+  switch (cam_.type) {
+    case SensorType::kPinhole: {
+      d = glm::normalize(raster_dir(rx, ry));
+      pdf_dir = sensor_pdf_dir(d);
+      break;
+    }
+    case SensorType::kLens: {
+      const vec3 target = cam_.position + raster_dir(rx, ry) * cam_.focus_distance;
+      const glm::vec2 disk = sample_concentric_disk(ul) * cam_.lens_radius;
+      o = cam_.position + disk.x * cam_.right + disk.y * cam_.up;
+      d = glm::normalize(target - o);
+      z0.n = cam_.forward;
+      pdf_dir = sensor_pdf_dir(d);
+      break;
+    }
+    case SensorType::kOrthographic: {
+      const float sx = (2.0f * rx / static_cast<float>(cam_.width) - 1.0f) * 0.5f * cam_.film_width;
+      const float sy = (1.0f - 2.0f * ry / static_cast<float>(cam_.height)) * 0.5f * cam_.film_height;
+      o = cam_.position + sx * cam_.right + sy * cam_.up;
+      z0.n = cam_.forward;
+      pdf_dir = 0.0f;  // Dirac direction
+      break;
+    }
+    case SensorType::kSpotmeter: pdf_dir = 0.0f; break;
+  }
+  z0.p = o;
+  z0.ns = z0.n;
+  z0.pdf_fwd = sensor_pdf_pos();
+  // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
+  return random_walk(th, rng, th.eye, 1, o, d, pdf_dir, max_bounces_ + 2, TransportMode::kRadiance);
+}
+
+int Integrator::light_subpath(Thread& th, Sampler& rng) const {
+  if (rs_.lights.empty()) return 0;
+  const float ul = rng.get1d();
+  const std::size_t li = std::min(rs_.lights.size() - 1, static_cast<std::size_t>(ul * static_cast<float>(rs_.lights.size())));
+  const RenderLight& l = rs_.lights[li];
+  Vertex& y0 = th.light[0];
+  y0 = Vertex{};
+  y0.kind = Kind::kLight;
+  y0.light = static_cast<int>(li);
+  const std::string pair = light_letters(letter_type(l.type));
+  y0.pos_letter = pair[0];
+  y0.letter = pair[1];
+  const glm::vec2 up = rng.get2d();
+  const glm::vec2 ud = rng.get2d();
+  vec3 d{0.0f};
+  float pdf_pos = light_pdf_pos(l), pdf_dir = 0.0f;
+  vec3 beta1{0.0f};  // throughput carried by the first ray
+  switch (l.type) {
+    case EmitterKind::kArea: {
+      const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, up);
+      y0.p = ss.position;
+      y0.n = ss.normal;
+      vec3 local = sample_cosine_hemisphere(ud);
+      float sign = 1.0f;
+      if (l.two_sided && rng.get1d() < 0.5f) sign = -1.0f;
+      const Frame f = Frame::from_normal(y0.n * sign);
+      d = f.to_world(local);
+      pdf_dir = light_pdf_dir(l, y0, d);
+      beta1 = l.power * std::fabs(glm::dot(y0.n, d)) / (light_pick_ * pdf_pos * pdf_dir);
+      y0.beta = l.power / (light_pick_ * pdf_pos);
+      break;
+    }
+    case EmitterKind::kPoint: {
+      y0.p = l.position;
+      d = sample_uniform_sphere(ud);
+      pdf_dir = light_pdf_dir(l, y0, d);
+      beta1 = l.power / (light_pick_ * pdf_dir);
+      y0.beta = l.power / light_pick_;
+      break;
+    }
+    case EmitterKind::kSpot: {
+      y0.p = l.position;
+      d = Frame::from_normal(l.direction).to_world(sample_uniform_cone(ud, l.cos_cone));
+      pdf_dir = light_pdf_dir(l, y0, d);
+      beta1 = l.power / (light_pick_ * pdf_dir);
+      y0.beta = l.power / light_pick_;
+      break;
+    }
+    case EmitterKind::kDistant: {
+      y0.p = l.ap_corner + up.x * l.ap_edge1 + up.y * l.ap_edge2;
+      y0.n = l.ap_normal;
+      d = l.direction;
+      beta1 = l.power * std::fabs(glm::dot(l.ap_normal, d)) / (light_pick_ * pdf_pos);
+      y0.beta = beta1;
+      break;
+    }
+    case EmitterKind::kLaser: {
+      y0.p = l.position;
+      d = l.direction;
+      beta1 = l.power / light_pick_;
+      y0.beta = beta1;
+      break;
+    }
+  }
+  y0.ns = y0.n;
+  y0.pdf_fwd = light_pick_ * pdf_pos;  // 0 for Dirac positions
+  if (is_black(beta1)) return 1;
+  // The walk starts from y0 with the first ray's throughput.
+  Vertex saved = y0;
+  th.light[0].beta = beta1;
+  const int n = random_walk(th, rng, th.light, 1, y0.p, d, pdf_dir, max_bounces_ + 1, TransportMode::kImportance);
+  th.light[0].beta = saved.beta;
+  return n;
+}
+
+std::string Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled) const {
+  const int k = s + t - 1;
+  if (k < 1) return "";
+  std::string c(static_cast<std::size_t>(k) + 3, 'D');
+  auto vertex = [&](int i) -> const Vertex& {  // x_i in light-to-eye order
+    // A fresh sensor sample replaces z0 when t = 1; otherwise a fresh light sample replaces y0 when s = 1.
+    if (i < s) return (s == 1 && t != 1 && i == 0 && sampled) ? *sampled : th.light[static_cast<std::size_t>(i)];
+    const int j = k - i;
+    return (t == 1 && j == 0 && sampled) ? *sampled : th.eye[static_cast<std::size_t>(j)];
+  };
+  // Light end: for s = 0 the eye path hit an area light, DD.
+  if (s > 0) {
+    c[0] = vertex(0).pos_letter;
+    c[1] = vertex(0).letter;
+  }
+  for (int i = 1; i <= k - 1; ++i) c[static_cast<std::size_t>(i) + 1] = vertex(i).letter;
+  if (t > 0) {
+    c[static_cast<std::size_t>(k) + 1] = vertex(k).letter;
+    c[static_cast<std::size_t>(k) + 2] = vertex(k).pos_letter;
+  }
+  c[static_cast<std::size_t>(s)] = 'D';
+  c[static_cast<std::size_t>(s) + 1] = 'D';
+  return "L" + c + "E";
+}
+
+float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const {
+  // letters = "L c0 … E": c_i is letters[i + 1].
+  auto runs = [&](int s2, int t2) {
+    return strategies_.find(s2, t2) >= 0 && letters[static_cast<std::size_t>(s2) + 1] == 'D' &&
+           letters[static_cast<std::size_t>(s2) + 2] == 'D';
+  };
+  const auto remap = [](float f) { return f != 0.0f ? f : 1.0f; };
+  // Work on copies of the affected vertices.
+  std::array<Vertex, kMaxVertices>& L = th.light;
+  std::array<Vertex, kMaxVertices>& E = th.eye;
+  Vertex saved_qs, saved_pt, saved_qsm, saved_ptm;
+  Vertex* qs = s > 0 ? &L[static_cast<std::size_t>(s - 1)] : nullptr;
+  Vertex* pt = t > 0 ? &E[static_cast<std::size_t>(t - 1)] : nullptr;
+  Vertex* qsm = s > 1 ? &L[static_cast<std::size_t>(s - 2)] : nullptr;
+  Vertex* ptm = t > 1 ? &E[static_cast<std::size_t>(t - 2)] : nullptr;
+  if (qs) saved_qs = *qs;
+  if (pt) saved_pt = *pt;
+  if (qsm) saved_qsm = *qsm;
+  if (ptm) saved_ptm = *ptm;
+  if (t == 1 && sampled) *pt = *sampled;
+  else if (s == 1 && sampled) *qs = *sampled;
+  // --- reverse densities at the join ---
+  if (pt) {
+    if (s > 0) pt->pdf_rev = pdf(qsm, *qs, *pt);
+    else pt->pdf_rev = pdf_light_origin(*pt);
+  }
+  if (ptm) {
+    if (s > 0) ptm->pdf_rev = pdf(qs, *pt, *ptm);
+    else ptm->pdf_rev = pdf_light_dir(*pt, *ptm);
+  }
+  if (qs) {
+    if (pt) qs->pdf_rev = pdf(ptm, *pt, *qs);
+    else qs->pdf_rev = sensor_pdf_pos();  // t = 0: qs is the lens point
+  }
+  if (qsm) {
+    if (pt) qsm->pdf_rev = pdf(pt, *qs, *qsm);
+    else qsm->pdf_rev = to_area(sensor_pdf_dir(glm::normalize(qsm->p - qs->p)), *qs, *qsm);
+  }
+  // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
+  float sum = 0.0f, ri = 1.0f;
+  for (int i = t - 1; i >= 0; --i) {
+    ri *= remap(E[static_cast<std::size_t>(i)].pdf_rev) / remap(E[static_cast<std::size_t>(i)].pdf_fwd);
+    if (i == 0 && !lens_hits_) break;
+    if (runs(s + t - i, i)) sum += ri * ri;
+  }
+  ri = 1.0f;
+  for (int i = s - 1; i >= 0; --i) {
+    ri *= remap(L[static_cast<std::size_t>(i)].pdf_rev) / remap(L[static_cast<std::size_t>(i)].pdf_fwd);
+    if (runs(i, s + t - i)) sum += ri * ri;
+  }
+  if (qs) *qs = saved_qs;
+  if (pt) *pt = saved_pt;
+  if (qsm) *qsm = saved_qsm;
+  if (ptm) *ptm = saved_ptm;
+  return 1.0f / (1.0f + sum);
+}
+
+void Integrator::record(Thread& th, ClassImages& images, const std::string& path, int strategy, int batch,
+                        const vec3& c, bool splat, float rx, float ry) const {
+  const Rgb rgb{c.x, c.y, c.z};
+  const std::optional<ExactRgb> e = to_exact(rgb);
+  if (!e) {
+    th.hist.add_nonfinite();
+    return;
+  }
+  if (is_zero(*e)) return;
+  const Histogram::PathId id = th.hist.intern(path);
+  th.hist.add_exact(id, batch, strategy, *e);
+  const std::uint32_t set = th.hist.class_set(id);
+  if (splat) images.add(static_cast<int>(rx), static_cast<int>(ry), set, *e);
+  else th.pixel.add(set, *e);
+}
+
+void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int px, int py, int batch) const {
+  const int strategy = strategies_.find(s, t);
+  vec3 contrib{0.0f};
+  Vertex sampled;
+  bool splat = false;
+  float rx = 0.0f, ry = 0.0f;
+  const Vertex* qs = s > 0 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
+  const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
+  auto finite_side = [&](const Vertex& v) {  // can v be a join end (a finite BSDF part)?
+    return v.kind != Kind::kSurface || bsdf::has_finite_component(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)]);
+  };
+  if (s == 0) {
+    // --- eye path hits an area light ---
+    if (pt->kind != Kind::kSurface) return;
+    const int li = rs_.light_of_shape[static_cast<std::size_t>(pt->shape)];
+    if (li < 0) return;
+    const Vertex& prev = th.eye[static_cast<std::size_t>(t - 2)];
+    Vertex lv = *pt;
+    lv.light = li;
+    contrib = pt->beta * light_emit(rs_.lights[static_cast<std::size_t>(li)], lv, glm::normalize(prev.p - pt->p));
+  } else if (t == 0) {
+    // --- light path hits the lens ---
+    if (qs->kind != Kind::kLens) return;
+    const Vertex& prev = th.light[static_cast<std::size_t>(s - 2)];
+    const vec3 w = glm::normalize(prev.p - qs->p);
+    if (!raster_of(qs->p, w, &rx, &ry)) return;
+    contrib = qs->beta * importance(qs->p, w);
+    splat = true;
+  } else if (t == 1) {
+    // --- splat: connect qs to a fresh sensor point ---
+    if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return;
+    if (qs->kind == Kind::kLens || !finite_side(*qs)) return;
+    sampled = Vertex{};
+    sampled.kind = Kind::kCamera;
+    sampled.p = cam_.position;
+    if (cam_.type == SensorType::kLens) {
+      const glm::vec2 disk = sample_concentric_disk(rng.get2d()) * cam_.lens_radius;
+      sampled.p = cam_.position + disk.x * cam_.right + disk.y * cam_.up;
+      sampled.n = cam_.forward;
+    }
+    sampled.ns = sampled.n;
+    const std::string pair = sensor_pair();
+    sampled.letter = 'D';
+    sampled.pos_letter = pair[1];
+    const vec3 to_cam = sampled.p - qs->p;
+    const float d2 = glm::dot(to_cam, to_cam);
+    const vec3 w = to_cam / std::sqrt(d2);  // from qs to the camera
+    if (!raster_of(sampled.p, -w, &rx, &ry)) return;
+    const float we = importance(sampled.p, -w);
+    const float pdf_pos = cam_.type == SensorType::kLens ? 1.0f / lens_area() : 1.0f;
+    sampled.beta = vec3(we / pdf_pos);
+    sampled.pdf_fwd = sensor_pdf_pos();
+    vec3 fq;
+    // A light vertex's beta already holds its spatial emission; only the directional part is left.
+    if (qs->kind == Kind::kLight) fq = vec3(light_emits(rs_.lights[static_cast<std::size_t>(qs->light)], *qs, w) ? 1.0f : 0.0f);
+    else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
+                        glm::normalize(th.light[static_cast<std::size_t>(s - 2)].p - qs->p), w, qs->ns, qs->n);
+    const float g = abs_cos(*qs, w) * std::fabs(glm::dot(cam_.forward, w)) / d2;
+    contrib = qs->beta * fq * sampled.beta * g;
+    if (is_black(contrib) || !visible(th, *qs, sampled)) return;
+    splat = true;
+  } else if (s == 1) {
+    // --- next-event estimation: a fresh light sample ---
+    if (pt->kind != Kind::kSurface || !finite_side(*pt) || rs_.lights.empty()) return;
+    const float ul = rng.get1d();
+    const glm::vec2 up = rng.get2d();
+    const std::size_t li = std::min(rs_.lights.size() - 1, static_cast<std::size_t>(ul * static_cast<float>(rs_.lights.size())));
+    const RenderLight& l = rs_.lights[li];
+    if (l.type == EmitterKind::kDistant || l.type == EmitterKind::kLaser) return;  // Dirac directions: no DD join
+    sampled = Vertex{};
+    sampled.kind = Kind::kLight;
+    sampled.light = static_cast<int>(li);
+    const std::string pair = light_letters(letter_type(l.type));
+    sampled.pos_letter = pair[0];
+    sampled.letter = 'D';
+    float pdf_pos = 1.0f;
+    if (l.type == EmitterKind::kArea) {
+      const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, up);
+      sampled.p = ss.position;
+      sampled.n = ss.normal;
+      pdf_pos = light_pdf_pos(l);
+    } else {
+      sampled.p = l.position;
+    }
+    sampled.ns = sampled.n;
+    sampled.pdf_fwd = light_pick_ * light_pdf_pos(l);
+    sampled.beta = l.power / (light_pick_ * pdf_pos);
+    const vec3 to_light = sampled.p - pt->p;
+    const float d2 = glm::dot(to_light, to_light);
+    if (d2 <= 0.0f) return;
+    const vec3 w = to_light / std::sqrt(d2);
+    if (!light_emits(l, sampled, -w)) return;
+    const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
+                             glm::normalize(th.eye[static_cast<std::size_t>(t - 2)].p - pt->p), w, pt->ns, pt->n);
+    const float g = abs_cos(*pt, w) * abs_cos(sampled, w) / d2;
+    contrib = pt->beta * f * sampled.beta * g;
+    if (is_black(contrib) || !visible(th, *pt, sampled)) return;
+  } else {
+    // --- a shadow ray between y(s-1) and z(t-1) ---
+    if (qs->kind == Kind::kLens || pt->kind != Kind::kSurface || qs->kind != Kind::kSurface) return;
+    if (!finite_side(*qs) || !finite_side(*pt)) return;
+    const vec3 d = pt->p - qs->p;
+    const float d2 = glm::dot(d, d);
+    if (d2 <= 0.0f) return;
+    const vec3 w = d / std::sqrt(d2);
+    const vec3 fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
+                              glm::normalize(th.light[static_cast<std::size_t>(s - 2)].p - qs->p), w, qs->ns, qs->n);
+    const vec3 fp = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
+                              glm::normalize(th.eye[static_cast<std::size_t>(t - 2)].p - pt->p), -w, pt->ns, pt->n);
+    const float g = abs_cos(*qs, w) * abs_cos(*pt, w) / d2;
+    contrib = qs->beta * fq * fp * pt->beta * g;
+    if (is_black(contrib) || !visible(th, *qs, *pt)) return;
+  }
+  if (is_black(contrib)) return;
+  const std::string letters = full_path(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr);
+  if (letters.empty()) return;
+  const float w = mis_weight(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr, letters);
+  record(th, images, letters, strategy, batch, contrib * w, splat, rx, ry);
+  (void)px;
+  (void)py;
+}
+
+float Integrator::weight_sum(Thread& th, int s, int t) const {
+  // The full path in light-to-eye order, from the two subpaths as connected by (s, t).
+  const int k = s + t - 1;
+  std::vector<Vertex> x;
+  for (int i = 0; i < s; ++i) x.push_back(th.light[static_cast<std::size_t>(i)]);
+  for (int j = t - 1; j >= 0; --j) x.push_back(th.eye[static_cast<std::size_t>(j)]);
+  if (s == 0) {  // the eye vertex on the emitter becomes the light vertex
+    x[0].kind = Kind::kLight;
+    x[0].light = rs_.light_of_shape[static_cast<std::size_t>(x[0].shape)];
+  } else if (rs_.lights[static_cast<std::size_t>(x[0].light)].type == EmitterKind::kArea) {
+    x[0].shape = rs_.lights[static_cast<std::size_t>(x[0].light)].shape;  // so an eye path may hit it
+  }
+  const std::string letters = full_path(th, s, t, nullptr);
+  const Thread saved_light_eye = th;
+  float sum = 0.0f;
+  for (int s2 = 0; s2 <= k + 1; ++s2) {
+    const int t2 = k + 1 - s2;
+    if (strategies_.find(s2, t2) < 0 || letters[static_cast<std::size_t>(s2) + 1] != 'D' ||
+        letters[static_cast<std::size_t>(s2) + 2] != 'D')
+      continue;
+    if (t2 == 0 && !lens_hits_) continue;
+    if (s2 == 0 && x[0].kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(x[0].light)].type != EmitterKind::kArea) continue;
+    // Re-split: light subpath x0 … x(s2-1), eye subpath xk … x(s2), with forward densities as
+    // each side would have sampled them.
+    for (int i = 0; i < s2; ++i) th.light[static_cast<std::size_t>(i)] = x[static_cast<std::size_t>(i)];
+    for (int j = 0; j < t2; ++j) th.eye[static_cast<std::size_t>(j)] = x[static_cast<std::size_t>(k - j)];
+    if (s2 > 0) {
+      const RenderLight& l = rs_.lights[static_cast<std::size_t>(x[0].light)];
+      th.light[0].kind = Kind::kLight;
+      th.light[0].pdf_fwd = light_pick_ * light_pdf_pos(l);
+    }
+    if (s2 == 0) {
+      th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;
+    }
+    // The letter of x_i in this path (c_{i+1}); a Dirac there keeps both densities through it symbolic.
+    auto specular = [&](int i) { return i >= 1 && i <= k - 1 && letters[static_cast<std::size_t>(i) + 2] == 'S'; };
+    for (int i = 1; i < s2; ++i)
+      th.light[static_cast<std::size_t>(i)].pdf_fwd =
+          specular(i - 1) ? 0.0f
+                          : pdf(i > 1 ? &th.light[static_cast<std::size_t>(i - 2)] : nullptr,
+                                th.light[static_cast<std::size_t>(i - 1)], th.light[static_cast<std::size_t>(i)]);
+    for (int i = 0; i + 2 < s2; ++i)
+      th.light[static_cast<std::size_t>(i)].pdf_rev =
+          specular(i + 1) ? 0.0f
+                          : pdf(&th.light[static_cast<std::size_t>(i + 2)], th.light[static_cast<std::size_t>(i + 1)],
+                                th.light[static_cast<std::size_t>(i)]);
+    if (t2 > 0) th.eye[0].pdf_fwd = sensor_pdf_pos();
+    for (int j = 1; j < t2; ++j)
+      th.eye[static_cast<std::size_t>(j)].pdf_fwd =
+          specular(k - (j - 1)) ? 0.0f
+                                : pdf(j > 1 ? &th.eye[static_cast<std::size_t>(j - 2)] : nullptr,
+                                      th.eye[static_cast<std::size_t>(j - 1)], th.eye[static_cast<std::size_t>(j)]);
+    for (int j = 0; j + 2 < t2; ++j)
+      th.eye[static_cast<std::size_t>(j)].pdf_rev =
+          specular(k - (j + 1)) ? 0.0f
+                                : pdf(&th.eye[static_cast<std::size_t>(j + 2)], th.eye[static_cast<std::size_t>(j + 1)],
+                                      th.eye[static_cast<std::size_t>(j)]);
+    sum += mis_weight(th, s2, t2, nullptr, letters);
+  }
+  th.light = saved_light_eye.light;
+  th.eye = saved_light_eye.eye;
+  return sum;
+}
+
+void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::uint64_t pass) const {
+  const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
+  Sampler rng(o_.seed, pixel, pass);
+  const int batch = batch_of_pass(pass, o_.spp, o_.batches);
+  const int nt = eye_subpath(th, rng, px, py);
+  const int ns = light_subpath(th, rng);
+  for (int t = 0; t <= nt; ++t) {
+    for (int s = 0; s <= ns; ++s) {
+      const int k = s + t - 1;  // edges
+      if (k < 1 || k - 1 > max_bounces_) continue;
+      if (t == 0 && !(lens_hits_ && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens)) continue;
+      if (t > 0 && s > 0 && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens) continue;
+      if (s == 0 && t < 2) continue;
+      if (strategies_.find(s, t) < 0) continue;
+      connect(th, images, rng, s, t, px, py, batch);
+    }
+  }
+  th.pixel.flush(images, px, py);
+}
+
+}  // namespace
+
+Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
+                            const RenderOptions& options) {
+  Result<StrategySet> strategies = runnable_strategies(profile);
+  if (!strategies) return strategies.error();
+  Result<RenderScene> rs = make_render_scene(scene);
+  if (!rs) return rs.error();
+  RenderOptions o = options;
+  if (profile.max_bounces) o.max_bounces = std::min(o.max_bounces, *profile.max_bounces);
+  HistogramLayout layout;
+  layout.num_batches = o.batches;
+  for (const Strategy& st : strategies->strategies) layout.strategies.push_back(st.name);
+
+  RenderOutput out{Histogram(layout, classifier),
+                   ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes),
+                   layout.strategies};
+  Integrator integrator(*rs, *strategies, o, classifier);
+  const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+  tbb::enumerable_thread_specific<Integrator::Thread> locals(
+      [&] { return Integrator::Thread{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, {}, 0}; });
+  const int w = rs->camera.width, h = rs->camera.height;
+  const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+  const auto start = std::chrono::steady_clock::now();
+  std::uint64_t pass = 0;
+  for (; pass < o.spp; ++pass) {
+    if (o.cancel && o.cancel->load()) break;
+    tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& rows) {
+      Integrator::Thread& th = locals.local();
+      for (int y = rows.begin(); y < rows.end(); ++y)
+        for (int x = 0; x < w; ++x) integrator.sample(th, out.images, x, y, pass);
+    });
+    out.histogram.add_samples(batch_of_pass(pass, o.spp, o.batches), pixels);
+    if (o.progress) o.progress((pass + 1) * pixels, o.spp * pixels);
+  }
+  out.spp_done = pass;
+  out.complete = pass == o.spp;
+  for (Integrator::Thread& th : locals) {
+    Result<bool> m = out.histogram.merge(th.hist);
+    if (!m) return m.error();
+    out.rays += th.rays;
+  }
+  out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace pathex

@@ -1,0 +1,66 @@
+// The renderer: bidirectional path sampling driven by a renderer profile, with every sampled path
+// labelled by its exact full-path string (DESIGN §7).
+//
+// The profile's plain-join strategies (s, DD, t) are run as BDPT connections between a light
+// subpath of s vertices and an eye subpath of t vertices; s = 0 is an eye path hitting an area
+// light, s = 1 next-event estimation, t = 1 a light-tracing splat to the camera, t = 0 a light
+// path hitting a finite lens. Contributions are combined with the power heuristic over the
+// strategies the profile runs; for a given string exactly the strategies whose language
+// contains it have nonzero density (their join vertices are both D), so deltas are handled by
+// letters, never by huge numbers. Profiles naming a connector are refused until connectors land.
+//
+// Determinism: every random number is a function of (seed, pixel, pass, dimension), and all
+// sums are exact (classify/histogram.h), so results are bit-identical whatever the thread count.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "classify/classifier.h"
+#include "classify/histogram.h"
+#include "classify/image.h"
+#include "core/error.h"
+#include "reach/profile.h"
+#include "scene/scene.h"
+
+namespace pathex {
+
+struct RenderOptions {
+  std::uint64_t spp = 16;              // samples (passes) per pixel
+  std::uint64_t seed = 1;
+  int threads = 0;                     // 0: all cores
+  int max_bounces = 16;                // interior vertices, k - 1 (the profile's bound wins if smaller)
+  int rr_depth = 3;                    // Russian roulette after this many vertices on a subpath
+  int batches = kDefaultBatches;       // for batch-means standard errors
+  std::vector<int> layer_classes;      // classifier classes that get an image layer
+  std::function<void(std::uint64_t done, std::uint64_t total)> progress;  // called from one thread
+  const std::atomic<bool>* cancel = nullptr;  // set to stop early; the result is marked incomplete
+};
+
+struct RenderOutput {
+  Histogram histogram;
+  ClassImages images;
+  std::vector<std::string> strategy_names;
+  std::uint64_t spp_done = 0;  // passes completed (all pixels) — spp unless cancelled
+  bool complete = true;
+  double time_s = 0;
+  std::uint64_t rays = 0;      // rays cast (intersections and shadow rays)
+};
+
+// Which plain-join (s, t) pairs a profile runs, as a predicate; an error names the first
+// connector the tracer does not run.
+struct StrategySet {
+  std::vector<Strategy> strategies;
+  // Index of the profile strategy that runs (s, t), or -1.
+  int find(int s, int t) const;
+};
+Result<StrategySet> runnable_strategies(const Profile& profile);
+
+Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
+                            const RenderOptions& options);
+
+}  // namespace pathex
