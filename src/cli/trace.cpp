@@ -33,7 +33,7 @@ struct TraceArgs {
   std::uint64_t spp = 16;
   std::uint64_t seed = 1;
   int threads = 0;
-  int max_bounces = 16;
+  std::optional<int> max_bounces;
   int top_paths = 8;
   bool json = false;
   bool quiet = false;
@@ -92,7 +92,9 @@ int run(const TraceArgs& a) {
   ro.spp = a.spp;
   ro.seed = a.seed;
   ro.threads = a.threads;
-  ro.max_bounces = a.max_bounces;
+  // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
+  const int bound = a.max_bounces.value_or(profile->max_bounces.value_or(16));
+  ro.max_bounces = bound;
   for (int i = 0; i < classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
   const bool show_progress = !a.quiet && ::isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
@@ -144,11 +146,11 @@ int run(const TraceArgs& a) {
 
   // --- the table: classes with the checker's verdict, then the most important exact paths ---
   ReachCache cache(a.limits);
-  Result<const CompiledProfile*> cp = cache.compiled(a.renderer, a.max_bounces);
+  Result<const CompiledProfile*> cp = cache.compiled(a.renderer, bound);
   if (!cp) return report(cp.error());
   QueryOptions qo;
   qo.universe = scene_universe(types);
-  qo.max_bounces = a.max_bounces;
+  qo.max_bounces = bound;
   qo.witnesses = 0;
   qo.max_len = 0;
   std::cout << "scene " << scene_name << ", renderer " << profile->name << ", " << out->spp_done << " spp, "
@@ -192,7 +194,7 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--classes", args->classes_file, "Class file; default: the built-in classes");
   sub->add_option("--seed", args->seed, "Random seed")->capture_default_str();
   sub->add_option("--threads", args->threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
-  sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices (k - 1)")->capture_default_str()
+  sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices (k - 1); default: the profile's bound, else 16")
       ->check(CLI::Range(0, 1000));
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
   sub->add_option("--top", args->top_paths, "Exact paths to list")->capture_default_str()->check(CLI::Range(0, 100000));

@@ -95,7 +95,7 @@ class Integrator {
  public:
   Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl)
       : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), classifier_(cl) {
-    max_bounces_ = std::min(o.max_bounces, kMaxVertices - 3);
+    max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
     lens_hits_ = cam_.type == SensorType::kLens && cam_.lens_radius > 0.0f;
     bool any_t0 = false;
@@ -118,6 +118,24 @@ class Integrator {
   // every strategy (s', t') with s' + t' = s + t that the profile runs and whose join letters are
   // D, of the MIS weight (s', t') computes when it samples the same vertices. Must be 1.
   float weight_sum(Thread& th, int s, int t) const;
+  // weight_sum() when (s, t) joins two vertices that can be joined (s = 0: an eye vertex on an
+  // area light; t = 0: a light vertex on the lens; otherwise two surfaces with finite parts), else -1.
+  float weight_sum_if_valid(Thread& th, int s, int t) const {
+    const Vertex* qs = s > 0 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
+    const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
+    if (s == 0) {
+      if (pt->kind != Kind::kSurface || rs_.light_of_shape[static_cast<std::size_t>(pt->shape)] < 0) return -1.0f;
+    } else if (t == 0) {
+      if (qs->kind != Kind::kLens) return -1.0f;
+    } else {
+      if (qs->kind != Kind::kSurface || pt->kind != Kind::kSurface) return -1.0f;
+      if (!bsdf::has_finite_component(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)]) ||
+          !bsdf::has_finite_component(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)]))
+        return -1.0f;
+    }
+    return weight_sum(th, s, t);
+  }
+  std::string label(const Thread& th, int s, int t) const { return full_path(th, s, t, nullptr); }
   int trace_subpaths(Thread& th, Sampler& rng, int px, int py, int* ns) const {
     const int nt = eye_subpath(th, rng, px, py);
     *ns = light_subpath(th, rng);
@@ -768,6 +786,37 @@ void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::ui
 
 }  // namespace
 
+Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed,
+                                                int samples) {
+  Result<StrategySet> strategies = runnable_strategies(profile);
+  if (!strategies) return strategies.error();
+  Result<RenderScene> rs = make_render_scene(scene);
+  if (!rs) return rs.error();
+  RenderOptions o;
+  o.seed = seed;
+  o.max_bounces = std::min(8, profile.max_bounces.value_or(8));
+  HistogramLayout layout;
+  ClassImages images(1, 1, nullptr, {});
+  Integrator integrator(*rs, *strategies, o, nullptr);
+  Integrator::Thread th{Histogram(layout, nullptr), ClassImages::PixelSum(images), {}, {}, {}, 0};
+  std::vector<MisCheck> out;
+  for (int i = 0; i < samples; ++i) {
+    const int px = i % rs->camera.width, py = (i / rs->camera.width) % rs->camera.height;
+    Sampler rng(seed, static_cast<std::uint64_t>(i), 0);
+    int ns = 0;
+    const int nt = integrator.trace_subpaths(th, rng, px, py, &ns);
+    for (int t = 0; t <= nt; ++t)
+      for (int s = 0; s <= ns; ++s) {
+        if (s == 1 || t == 1 || s + t < 2 || s + t - 2 > *o.max_bounces) continue;
+        if (strategies->find(s, t) < 0) continue;
+        const float sum = integrator.weight_sum_if_valid(th, s, t);
+        if (sum < 0.0f) continue;  // not a path this connection forms
+        out.push_back({integrator.label(th, s, t), s, t, sum});
+      }
+  }
+  return out;
+}
+
 Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
                             const RenderOptions& options) {
   Result<StrategySet> strategies = runnable_strategies(profile);
@@ -775,7 +824,8 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   Result<RenderScene> rs = make_render_scene(scene);
   if (!rs) return rs.error();
   RenderOptions o = options;
-  if (profile.max_bounces) o.max_bounces = std::min(o.max_bounces, *profile.max_bounces);
+  // The same rule as the checker's: an explicit bound overrides the profile's own.
+  if (!o.max_bounces) o.max_bounces = profile.max_bounces.value_or(16);
   HistogramLayout layout;
   layout.num_batches = o.batches;
   for (const Strategy& st : strategies->strategies) layout.strategies.push_back(st.name);

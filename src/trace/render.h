@@ -33,7 +33,7 @@ struct RenderOptions {
   std::uint64_t spp = 16;              // samples (passes) per pixel
   std::uint64_t seed = 1;
   int threads = 0;                     // 0: all cores
-  int max_bounces = 16;                // interior vertices, k - 1 (the profile's bound wins if smaller)
+  std::optional<int> max_bounces;      // interior vertices, k - 1; unset: the profile's bound, else 16
   int rr_depth = 3;                    // Russian roulette after this many vertices on a subpath
   int batches = kDefaultBatches;       // for batch-means standard errors
   std::vector<int> layer_classes;      // classifier classes that get an image layer
@@ -59,6 +59,18 @@ struct StrategySet {
   int find(int s, int t) const;
 };
 Result<StrategySet> runnable_strategies(const Profile& profile);
+
+// A check of the MIS weights (for tests): trace `samples` pairs of subpaths and, for every full
+// path that a connection (s, t) with s != 1 and t != 1 of the profile forms from their vertices,
+// the sum over every strategy the profile runs for that string of the weight it computes when it
+// samples those same vertices. Each sum must be 1.
+struct MisCheck {
+  std::string path;
+  int s = 0, t = 0;
+  double weight_sum = 0.0;
+};
+Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed,
+                                                int samples);
 
 Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
                             const RenderOptions& options);

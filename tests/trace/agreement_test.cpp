@@ -1,0 +1,82 @@
+// The checker and the tracer agree (issue 4). For every sample scene and every plain-join
+// profile, rendered at low resolution with fixed seeds:
+//   - every path string with a nonzero estimate is in the profile's reachable language (the
+//     checker's R under the same bound): the tracer never samples what the checker forbids;
+//   - every string that bdpt finds carrying more than 1 % of the image, and that the profile can
+//     reach, is found by the profile with an estimate within 4 standard errors of bdpt's
+//     (the two errors combined);
+//   - no sample is non-finite.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include "io/profile_json.h"
+#include "reach/query.h"
+#include "scene/scene.h"
+#include "trace/render.h"
+
+namespace pathex {
+namespace {
+
+constexpr int kBounces = 6;
+
+HistogramReport render_scene(const Scene& scene, const Profile& profile, std::uint64_t spp) {
+  RenderOptions o;
+  o.spp = spp;
+  o.seed = 3;
+  o.max_bounces = kBounces;
+  Result<RenderOutput> out = render(scene, profile, nullptr, o);
+  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
+  RunInfo info;
+  info.spp = spp;
+  return *make_report(out->histogram, info, nullptr, {});
+}
+
+TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
+  const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes";
+  const char* const profiles[] = {"pt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer"};
+  int compared = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".json") continue;
+    Result<Scene> loaded = load_scene_file(entry.path().string());
+    ASSERT_TRUE(loaded.ok()) << loaded.error().render();
+    Scene scene = *loaded;
+    if (scene.camera.type != SensorType::kSpotmeter) scene.camera.width = scene.camera.height = 16;
+    const std::uint64_t spp = scene.camera.type == SensorType::kSpotmeter ? 4096 : 48;
+    const Profile bdpt = *resolve_profile("bdpt", Limits{});
+    const HistogramReport reference = render_scene(scene, bdpt, spp);
+    EXPECT_EQ(reference.nonfinite_samples, 0u) << entry.path().filename();
+    std::map<std::string, const PathEstimate*> by_path;
+    for (const PathEstimate& p : reference.paths) by_path[p.path] = &p;
+    for (const char* name : profiles) {
+      const Profile profile = *resolve_profile(name, Limits{});
+      const CompiledProfile checker = *compile_profile(profile, kBounces, Limits{});
+      const HistogramReport r = render_scene(scene, profile, spp);
+      const std::string where = entry.path().filename().string() + " with " + name;
+      EXPECT_EQ(r.nonfinite_samples, 0u) << where;
+      std::map<std::string, const PathEstimate*> found;
+      for (const PathEstimate& p : r.paths) {
+        found[p.path] = &p;
+        if (p.estimate.luminance != 0.0) {
+          EXPECT_TRUE(checker.reachable.accepts(p.path)) << where << ": " << p.path;
+        }
+      }
+      for (const PathEstimate& p : reference.paths) {
+        if (!(p.estimate.luminance > 0.01 * reference.total.luminance) || !checker.reachable.accepts(p.path)) continue;
+        auto it = found.find(p.path);
+        ASSERT_NE(it, found.end()) << where << ": bdpt finds " << p.path << " but the profile never samples it";
+        const double sigma = std::hypot(p.estimate.std_error, it->second->estimate.std_error);
+        EXPECT_LE(std::fabs(p.estimate.luminance - it->second->estimate.luminance), 4.0 * sigma + 1e-9)
+            << where << ": " << p.path << " bdpt " << p.estimate.luminance << " ± " << p.estimate.std_error << ", "
+            << name << " " << it->second->estimate.luminance << " ± " << it->second->estimate.std_error;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 40);
+}
+
+}  // namespace
+}  // namespace pathex

@@ -1,0 +1,149 @@
+// The tracer against closed forms (DESIGN §9), per class, with fixed seeds. Tolerances are stated
+// in standard errors (batch means over 32 batches) plus a small relative slack.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "classify/classifier.h"
+#include "classify/pathclass.h"
+#include "io/profile_json.h"
+#include "scene/scene.h"
+#include "trace/render.h"
+
+namespace pathex {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Rendered {
+  HistogramReport report;
+  RenderOutput out;
+};
+
+// Renders `scene_json` with `renderer`, classifying by `classes` (full notation).
+Rendered render_json(const std::string& scene_json, const std::string& renderer, const std::vector<std::string>& classes,
+                std::uint64_t spp, int threads = 0, std::uint64_t seed = 7) {
+  Result<Scene> scene = load_scene_json(scene_json, ".", "test");
+  EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().render());
+  Result<Profile> profile = resolve_profile(renderer, Limits{});
+  EXPECT_TRUE(profile.ok());
+  static std::vector<std::unique_ptr<PathClass>> keep;
+  std::vector<const PathClass*> pcs;
+  std::vector<ClassInfo> infos;
+  for (const std::string& c : classes) {
+    Result<PathClass> pc = compile_class(c, ClassOptions{});
+    EXPECT_TRUE(pc.ok()) << c;
+    keep.push_back(std::make_unique<PathClass>(std::move(*pc)));
+    keep.back()->name = c;
+    pcs.push_back(keep.back().get());
+    infos.push_back({c, c});
+  }
+  static std::vector<std::unique_ptr<Classifier>> keep_cl;
+  keep_cl.push_back(std::make_unique<Classifier>(*Classifier::build(pcs, Limits{})));
+  RenderOptions o;
+  o.spp = spp;
+  o.seed = seed;
+  o.threads = threads;
+  o.max_bounces = 12;
+  Result<RenderOutput> out = render(*scene, *profile, keep_cl.back().get(), o);
+  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
+  RunInfo info;
+  info.spp = spp;
+  Result<HistogramReport> rep = make_report(out->histogram, info, keep_cl.back().get(), infos);
+  EXPECT_TRUE(rep.ok());
+  return Rendered{std::move(*rep), std::move(*out)};
+}
+
+// |estimate - expected| within `sigmas` standard errors plus `rel` of expected.
+void expect_close(const Estimate& e, double expected, double sigmas, double rel, const std::string& what) {
+  EXPECT_TRUE(std::isfinite(e.std_error)) << what;
+  EXPECT_LE(std::fabs(e.luminance - expected), sigmas * e.std_error + rel * expected)
+      << what << ": estimate " << e.luminance << " ± " << e.std_error << ", expected " << expected;
+}
+
+std::string closed_sphere_point(double rho, double intensity) {
+  return R"({"camera": {"type": "pinhole", "position": [0.1, 0.05, 0], "look_at": [0.1, 0.05, 1], "up": [0, 1, 0],
+              "fov": 70, "width": 12, "height": 12},
+   "materials": {"wall": {"type": "diffuse", "albedo": [)" + std::to_string(rho) + "," + std::to_string(rho) + "," +
+         std::to_string(rho) + R"(]}},
+   "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "wall"}],
+   "lights": [{"type": "point", "position": [0, 0, 0], "intensity": [)" +
+         std::to_string(intensity) + "," + std::to_string(intensity) + "," + std::to_string(intensity) + "]}]}";
+}
+
+// DESIGN §9: inside a closed diffuse sphere of radius r and albedo rho with a point light of
+// intensity I at the centre, paths with n diffuse bounces carry rho^n I / (pi r^2) at every wall
+// point, so that is every pixel's value and the image mean. The class of those paths with a point
+// light and a pinhole is LSD D{n} DSE.
+TEST(ClosedForm, SpherePointLightPerBounce) {
+  const double rho = 0.5, intensity = 2.0;
+  std::vector<std::string> classes;
+  for (int n = 1; n <= 5; ++n) classes.push_back("LSDD{" + std::to_string(n) + "}DSE");
+  for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
+    Rendered r = render_json(closed_sphere_point(rho, intensity), renderer, classes, 256);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    for (int n = 1; n <= 5; ++n) {
+      const double expected = std::pow(rho, n) * intensity / kPi;
+      expect_close(r.report.classes[static_cast<std::size_t>(n - 1)].estimate, expected, 3.0, 0.01,
+                   std::string(renderer) + " n=" + std::to_string(n));
+    }
+  }
+}
+
+std::string closed_sphere_emitting(double rho, double le) {
+  return R"({"camera": {"type": "pinhole", "position": [0.2, 0, 0.1], "look_at": [0.2, 0.3, 1], "up": [0, 1, 0],
+              "fov": 70, "width": 12, "height": 12},
+   "materials": {"wall": {"type": "diffuse", "albedo": [)" + std::to_string(rho) + "," + std::to_string(rho) + "," +
+         std::to_string(rho) + R"(]}},
+   "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "wall",
+               "emission": [)" + std::to_string(le) + "," + std::to_string(le) + "," + std::to_string(le) +
+         R"(], "two_sided": true}]})";
+}
+
+// With the sphere itself emitting L_e: paths with n bounces carry L_e rho^n (class LDD D{n} DSE).
+TEST(ClosedForm, EmittingSpherePerBounce) {
+  const double rho = 0.5, le = 1.5;
+  std::vector<std::string> classes;
+  for (int n = 0; n <= 5; ++n) classes.push_back("LDDD{" + std::to_string(n) + "}DSE");
+  for (const char* renderer : {"pt", "pt-nee", "lt", "bdpt"}) {
+    Rendered r = render_json(closed_sphere_emitting(rho, le), renderer, classes, 128);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    for (int n = 0; n <= 5; ++n)
+      expect_close(r.report.classes[static_cast<std::size_t>(n)].estimate, le * std::pow(rho, n), 3.0, 0.01,
+                   std::string(renderer) + " n=" + std::to_string(n));
+  }
+}
+
+TEST(Determinism, SameSeedOneAndTwoThreadsIdentical) {
+  Rendered a = render_json(closed_sphere_point(0.5, 1.0), "bdpt", {"LSDDDSE"}, 16, 1);
+  Rendered b = render_json(closed_sphere_point(0.5, 1.0), "bdpt", {"LSDDDSE"}, 16, 2);
+  EXPECT_EQ(a.report.total.rgb, b.report.total.rgb);
+  EXPECT_EQ(a.report.total.std_error, b.report.total.std_error);
+  ASSERT_EQ(a.report.paths.size(), b.report.paths.size());
+  for (std::size_t i = 0; i < a.report.paths.size(); ++i) {
+    EXPECT_EQ(a.report.paths[i].path, b.report.paths[i].path);
+    EXPECT_EQ(a.report.paths[i].estimate.rgb, b.report.paths[i].estimate.rgb);
+  }
+}
+
+TEST(Labels, PointLightWithPinholeOnlyProducesSDprefixAndDSsuffix) {
+  Rendered r = render_json(closed_sphere_point(0.5, 1.0), "bdpt", {"LSD.*DSE"}, 8);
+  ASSERT_FALSE(r.report.paths.empty());
+  for (const PathEstimate& p : r.report.paths) {
+    EXPECT_EQ(p.path.substr(0, 3), "LSD") << p.path;
+    EXPECT_EQ(p.path.substr(p.path.size() - 3), "DSE") << p.path;
+  }
+  EXPECT_NEAR(r.report.classes[0].share, 1.0, 1e-12);
+}
+
+TEST(Profiles, ConnectorProfilesAreRefusedByName) {
+  Result<Profile> p = resolve_profile("bdpt+mirror", Limits{});
+  Result<StrategySet> s = runnable_strategies(*p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().message,
+            "renderer 'bdpt+mirror' uses the connector 'mirror' (strategy 'mirror'), which the tracer does not run yet; "
+            "it runs plain joins (s, DD, t) only");
+}
+
+}  // namespace
+}  // namespace pathex
