@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include <glm/glm.hpp>
+
 #include "classify/classifier.h"
 #include "classify/pathclass.h"
 #include "io/profile_json.h"
@@ -112,6 +114,78 @@ TEST(ClosedForm, EmittingSpherePerBounce) {
       expect_close(r.report.classes[static_cast<std::size_t>(n)].estimate, le * std::pow(rho, n), 3.0, 0.01,
                    std::string(renderer) + " n=" + std::to_string(n));
   }
+}
+
+// The mean over the image of radiance(p) at the point p where each pixel's ray meets the plane
+// y = 0 (0 where it misses), integrated over each pixel on a 16 x 16 grid: the reference for
+// scenes whose floor radiance is known in closed form. The camera is the pinhole of the scene
+// JSON below: position (0, 1.5, 2.5), looking at the origin, fov 50, 8 x 8 pixels.
+template <class F>
+double floor_reference(F radiance) {
+  const glm::vec3 pos(0.0f, 1.5f, 2.5f);
+  const glm::vec3 fwd = glm::normalize(-pos);
+  const glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 1, 0)));
+  const glm::vec3 up = glm::cross(right, fwd);
+  const double ty = std::tan(25.0 * kPi / 180.0), tx = ty;
+  double sum = 0;
+  const int n = 8, sub = 16;
+  for (int py = 0; py < n; ++py)
+    for (int px = 0; px < n; ++px)
+      for (int j = 0; j < sub; ++j)
+        for (int i = 0; i < sub; ++i) {
+          const double rx = px + (i + 0.5) / sub, ry = py + (j + 0.5) / sub;
+          const double sx = (2 * rx / n - 1) * tx, sy = (1 - 2 * ry / n) * ty;
+          const glm::dvec3 d = glm::dvec3(fwd) + sx * glm::dvec3(right) + sy * glm::dvec3(up);
+          if (d.y >= 0) continue;
+          const double t = -pos.y / d.y;
+          sum += radiance(glm::dvec3(pos) + t * d);
+        }
+  return sum / (n * n * sub * sub);
+}
+
+const char* kFloorCamera = R"("camera": {"type": "pinhole", "position": [0, 1.5, 2.5], "look_at": [0, 0, 0],
+                                 "up": [0, 1, 0], "fov": 50, "width": 8, "height": 8})";
+
+// DESIGN §9: a point light of intensity I at height h over a large diffuse plane of albedo rho:
+// reflected radiance rho I cos(theta) / (pi d^2). Class LSD D DSE.
+TEST(ClosedForm, PointLightOverAPlane) {
+  const double rho = 0.6, intensity = 2.0, h = 1.0;
+  const std::string scene = std::string("{") + kFloorCamera + R"(,
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+    "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"}],
+    "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [2, 2, 2]}]})";
+  const double expected = floor_reference([&](const glm::dvec3& p) {
+    const double d2 = p.x * p.x + h * h + p.z * p.z;
+    return rho * intensity * (h / std::sqrt(d2)) / (kPi * d2);
+  });
+  for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
+    Rendered r = render_json(scene, renderer, {"LSDDDSE"}, 128);
+    expect_close(r.report.classes[0].estimate, expected, 3.0, 0.005, std::string(renderer) + " point over plane");
+  }
+}
+
+// DESIGN §9: a planar mirror of reflectance R throws a caustic that is the floor lit by the
+// light's mirror image with intensity R I. Light at height 1, a large mirror facing down at
+// height 2 (image light at height 3), the camera below the mirror. Class LSD S D DSE, which
+// pt-nee cannot sample and lt and bdpt can.
+TEST(ClosedForm, MirrorCausticIsTheImageLight) {
+  const double rho = 0.6, intensity = 2.0, refl = 0.8, image_h = 3.0;
+  const std::string scene = std::string("{") + kFloorCamera + R"(,
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                  "mirror": {"type": "mirror", "reflectance": [0.8, 0.8, 0.8]}},
+    "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"},
+               {"type": "quad", "corner": [-100, 2, -100], "edge1": [200, 0, 0], "edge2": [0, 0, 200], "material": "mirror"}],
+    "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [2, 2, 2]}]})";
+  const double expected = floor_reference([&](const glm::dvec3& p) {
+    const double d2 = p.x * p.x + image_h * image_h + p.z * p.z;
+    return rho * refl * intensity * (image_h / std::sqrt(d2)) / (kPi * d2);
+  });
+  for (const char* renderer : {"lt", "bdpt"}) {
+    Rendered r = render_json(scene, renderer, {"LSDSDDSE"}, 256);
+    expect_close(r.report.classes[0].estimate, expected, 3.0, 0.005, std::string(renderer) + " mirror caustic");
+  }
+  Rendered pt = render_json(scene, "pt-nee", {"LSDSDDSE"}, 16);
+  EXPECT_EQ(pt.report.classes[0].estimate.luminance, 0.0);  // the checker says unreachable; so does the tracer
 }
 
 TEST(Determinism, SameSeedOneAndTwoThreadsIdentical) {
