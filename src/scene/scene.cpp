@@ -71,7 +71,7 @@ class Reader {
     const std::string p = ptr + "/" + key;
     if (!j.contains(key)) return fallback;
     const json& v = j.at(key);
-    if (!v.is_number_integer()) return fail(p, "expected an integer, found " + kind(v));
+    if (!v.is_number_integer()) return fail(p, "expected an integer, found " + v.dump());
     const long long x = v.get<long long>();
     if (x < lo || x > hi) return fail(p, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " + std::to_string(x));
     return static_cast<int>(x);
@@ -86,7 +86,8 @@ class Reader {
       return fail(p, "missing " + key + ", expected [x, y, z]");
     }
     const json& v = j.at(key);
-    if (!v.is_array() || v.size() != 3) return fail(p, "expected an array of 3 numbers, found " + kind(v));
+    if (!v.is_array() || v.size() != 3)
+      return fail(p, "expected an array of 3 numbers, found " + (v.is_array() ? "an array of " + std::to_string(v.size()) : kind(v)));
     vec3 out;
     for (int i = 0; i < 3; ++i) {
       const json& e = v[static_cast<std::size_t>(i)];
