@@ -1,0 +1,120 @@
+// `pathex trace` end to end: the files it writes (histogram.json with the documented keys, one
+// EXR with a layer per class and the total, a PNG per layer), the table, and refusals.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "io/image_io.h"
+
+namespace {
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+CliRun run(const std::string& args) {
+  const std::string errfile = "/tmp/pathex-trace-cli-" + std::to_string(::getpid()) + ".err";
+  const std::string cmd = std::string("cd '") + PATHEX_SOURCE_DIR + "' && '" + PATHEX_BINARY + "' " + args + " 2>" + errfile;
+  CliRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(errfile);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  r.err = ss.str();
+  std::filesystem::remove(errfile);
+  return r;
+}
+
+std::string out_dir(const std::string& name) {
+  const std::string d = (std::filesystem::temp_directory_path() / ("pathex-trace-" + std::to_string(::getpid()) + "-" + name)).string();
+  std::filesystem::remove_all(d);
+  return d;
+}
+
+TEST(TraceCli, WritesHistogramExrAndPreviews) {
+  const std::string dir = out_dir("files");
+  const CliRun r = run("trace samples/scenes/closed-sphere-point.json --renderer bdpt --spp 8 --seed 2 --threads 2 --out " + dir +
+                       " --classes samples/classes/basic.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");  // no progress bar when stderr is not a terminal
+  std::ifstream in(dir + "/histogram.json");
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(in);
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : j.items()) keys.push_back(k);
+  EXPECT_EQ(keys, std::vector<std::string>({"scene", "renderer", "spp", "seed", "threads", "time_s", "complete",
+                                            "nonfinite_samples", "total", "classes", "paths"}));
+  EXPECT_EQ(j["scene"], "samples/scenes/closed-sphere-point.json");
+  EXPECT_EQ(j["renderer"], "bdpt");
+  EXPECT_EQ(j["spp"], 8);
+  EXPECT_EQ(j["seed"], 2);
+  EXPECT_EQ(j["threads"], 2);
+  EXPECT_EQ(j["complete"], true);
+  EXPECT_EQ(j["nonfinite_samples"], 0);
+  // The sphere's wall radiance is 1/pi in every pixel (DESIGN §9), up to the bound of 16 bounces.
+  EXPECT_NEAR(j["total"]["luminance"].get<double>(), 1.0 / 3.14159265358979, 6 * j["total"]["stderr"].get<double>() + 2e-3);
+  ASSERT_EQ(j["classes"].size(), 12u);
+  for (const auto& c : j["classes"])
+    for (const char* key : {"name", "expr", "estimate", "luminance", "stderr", "samples", "share"}) EXPECT_TRUE(c.contains(key)) << key;
+  ASSERT_FALSE(j["paths"].empty());
+  EXPECT_EQ(j["paths"][0]["path"], "LSDDDSE");  // the largest: one bounce, half of the light
+  EXPECT_TRUE(j["paths"][0]["strategies"].contains("bdpt"));
+  // One EXR with the total and a layer per class; a PNG per layer.
+  pathex::Result<std::vector<pathex::ImageLayer>> layers = pathex::read_exr_layers(dir + "/classes.exr");
+  ASSERT_TRUE(layers.ok()) << layers.error().render();
+  ASSERT_EQ(layers->size(), 13u);
+  std::set<std::string> names;
+  for (const auto& l : *layers) {
+    names.insert(l.name);
+    EXPECT_EQ(l.image.width, 32);
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + l.name + ".png")) << l.name;
+  }
+  EXPECT_TRUE(names.count("total"));
+  EXPECT_TRUE(names.count("caustic-local"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(TraceCli, TableShowsSharesAndVerdicts) {
+  const std::string dir = out_dir("table");
+  const CliRun r = run("trace samples/scenes/point-mirror-caustic.json --renderer pt-nee --spp 4 --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("caustic: 0.0 % of the image, ±0.0 %; pt-nee: unreachable\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("direct: "), std::string::npos);
+  EXPECT_NE(r.out.find("most important paths\n  LSDDDSE"), std::string::npos) << r.out;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(TraceCli, JsonToStdoutMatchesTheFile) {
+  const std::string dir = out_dir("json");
+  const CliRun r = run("trace --spp 2 --json --no-images --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir + "/histogram.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(r.out, ss.str());
+  EXPECT_FALSE(std::filesystem::exists(dir + "/classes.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(TraceCli, RefusalsExitTwo) {
+  const CliRun connector = run("trace --renderer bdpt+mirror --out /tmp/pathex-never");
+  EXPECT_EQ(connector.code, 2);
+  EXPECT_EQ(connector.err,
+            "pathex: error: renderer 'bdpt+mirror' uses the connector 'mirror' (strategy 'mirror'), which the tracer does "
+            "not run yet; it runs plain joins (s, DD, t) only\n");
+  EXPECT_FALSE(std::filesystem::exists("/tmp/pathex-never"));
+  EXPECT_EQ(run("trace samples/scenes/nosuch.json").code, 2);
+  EXPECT_EQ(run("trace --spp 0").code, 2);
+}
+
+}  // namespace
