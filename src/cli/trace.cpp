@@ -44,9 +44,9 @@ struct TraceArgs {
 std::atomic<bool> g_cancel{false};
 extern "C" void on_sigint(int) { g_cancel.store(true); }
 
-std::string percent(double share) {
+std::string percent(double share, int decimals = 1) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f %%", 100.0 * share);
+  std::snprintf(buf, sizeof buf, "%.*f %%", decimals, 100.0 * share);
   return buf;
 }
 
@@ -162,7 +162,7 @@ int run(const TraceArgs& a) {
     const ClassEstimate& c = rep->classes[i];
     Result<QueryResult> q = query(*classes[i], **cp, qo);
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
-    std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0)
+    std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << profile->name << ": " << (q ? to_string(q->verdict) : "?") << "\n";
   }
   std::cout << "\nmost important paths\n";
@@ -171,7 +171,7 @@ int run(const TraceArgs& a) {
     const double share = rep->total.luminance > 0 ? p.estimate.luminance / rep->total.luminance : 0.0;
     const double err = rep->total.luminance > 0 ? p.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << "  " << std::left << std::setw(16) << p.path << std::right << std::setw(8) << percent(share) << "  ±"
-              << percent(std::isfinite(err) ? err : 0.0) << "  via";
+              << percent(std::isfinite(err) ? err : 0.0, 2) << "  via";
     for (const auto& [name, s] : p.strategies) std::cout << " " << name << " " << percent(s);
     std::cout << "\n";
   }

@@ -135,7 +135,11 @@ class Integrator {
     }
     return weight_sum(th, s, t);
   }
-  std::string label(const Thread& th, int s, int t) const { return full_path(th, s, t, nullptr); }
+  std::string label(const Thread& th, int s, int t) const {
+    std::string out;
+    full_path(th, s, t, nullptr, out);
+    return out;
+  }
   int trace_subpaths(Thread& th, Sampler& rng, int px, int py, int* ns) const {
     const int nt = eye_subpath(th, rng, px, py);
     *ns = light_subpath(th, rng);
@@ -273,7 +277,8 @@ class Integrator {
   float mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const;
   // The full-path letters of the path made by s light and t eye vertices (with `sampled`
   // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
-  std::string full_path(const Thread& th, int s, int t, const Vertex* sampled) const;
+  // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
+  void full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const;
   bool visible(Thread& th, const Vertex& a, const Vertex& b) const {
     ++th.rays;
     return rs_.geometry->visible(a.p, a.n, b.p, b.n);
@@ -480,29 +485,32 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   return n;
 }
 
-std::string Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled) const {
+void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const {
   const int k = s + t - 1;
-  if (k < 1) return "";
-  std::string c(static_cast<std::size_t>(k) + 3, 'D');
+  out.clear();
+  if (k < 1) return;
+  out.assign(static_cast<std::size_t>(k) + 5, 'D');  // L c0 … c(k+2) E: c_i is out[i + 1]
+  out.front() = 'L';
+  out.back() = 'E';
   auto vertex = [&](int i) -> const Vertex& {  // x_i in light-to-eye order
     // A fresh sensor sample replaces z0 when t = 1; otherwise a fresh light sample replaces y0 when s = 1.
     if (i < s) return (s == 1 && t != 1 && i == 0 && sampled) ? *sampled : th.light[static_cast<std::size_t>(i)];
     const int j = k - i;
     return (t == 1 && j == 0 && sampled) ? *sampled : th.eye[static_cast<std::size_t>(j)];
   };
+  auto c = [&](int i) -> char& { return out[static_cast<std::size_t>(i) + 1]; };
   // Light end: for s = 0 the eye path hit an area light, DD.
   if (s > 0) {
-    c[0] = vertex(0).pos_letter;
-    c[1] = vertex(0).letter;
+    c(0) = vertex(0).pos_letter;
+    c(1) = vertex(0).letter;
   }
-  for (int i = 1; i <= k - 1; ++i) c[static_cast<std::size_t>(i) + 1] = vertex(i).letter;
+  for (int i = 1; i <= k - 1; ++i) c(i + 1) = vertex(i).letter;
   if (t > 0) {
-    c[static_cast<std::size_t>(k) + 1] = vertex(k).letter;
-    c[static_cast<std::size_t>(k) + 2] = vertex(k).pos_letter;
+    c(k + 1) = vertex(k).letter;
+    c(k + 2) = vertex(k).pos_letter;
   }
-  c[static_cast<std::size_t>(s)] = 'D';
-  c[static_cast<std::size_t>(s) + 1] = 'D';
-  return "L" + c + "E";
+  c(s) = 'D';
+  c(s + 1) = 'D';
 }
 
 float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const {
@@ -692,7 +700,8 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
     if (is_black(contrib) || !visible(th, *qs, *pt)) return;
   }
   if (is_black(contrib)) return;
-  const std::string letters = full_path(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr);
+  std::string& letters = th.label;
+  full_path(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr, letters);
   if (letters.empty()) return;
   const float w = mis_weight(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr, letters);
   record(th, images, letters, strategy, batch, contrib * w, splat, rx, ry);
@@ -712,7 +721,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
   } else if (rs_.lights[static_cast<std::size_t>(x[0].light)].type == EmitterKind::kArea) {
     x[0].shape = rs_.lights[static_cast<std::size_t>(x[0].light)].shape;  // so an eye path may hit it
   }
-  const std::string letters = full_path(th, s, t, nullptr);
+  const std::string letters = label(th, s, t);
   const Thread saved_light_eye = th;
   float sum = 0.0f;
   for (int s2 = 0; s2 <= k + 1; ++s2) {

@@ -88,7 +88,7 @@ TEST(TraceCli, TableShowsSharesAndVerdicts) {
   const std::string dir = out_dir("table");
   const CliRun r = run("trace samples/scenes/point-mirror-caustic.json --renderer pt-nee --spp 4 --out " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("caustic: 0.0 % of the image, ±0.0 %; pt-nee: unreachable\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("caustic: 0.0 % of the image, ±0.00 %; pt-nee: unreachable\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("direct: "), std::string::npos);
   EXPECT_NE(r.out.find("most important paths\n  LSDDDSE"), std::string::npos) << r.out;
   std::filesystem::remove_all(dir);
