@@ -101,6 +101,15 @@ class Integrator {
     bool any_t0 = false;
     for (int s = 0; s < 2 * kMaxVertices; ++s) any_t0 = any_t0 || strategies.find(s, 0) >= 0;
     lens_hits_ = lens_hits_ && any_t0;
+    // Subpaths are only as long as a strategy can use: s = 1 and t = 1 take fresh samples, so a
+    // light subpath is traced only for some s >= 2 and an eye subpath beyond z0 for some t >= 2.
+    for (const Strategy& st : strategies.strategies) {
+      max_light_ = std::max(max_light_, st.s.hi == Range::kOpen ? kMaxVertices : st.s.hi);
+      max_eye_ = std::max(max_eye_, st.t.hi == Range::kOpen ? kMaxVertices : st.t.hi);
+    }
+    if (max_light_ < 2) max_light_ = 0;
+    max_light_ = std::min(max_light_, max_bounces_ + 1);
+    max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
 
   struct Thread {
@@ -292,6 +301,8 @@ class Integrator {
   const RenderOptions& o_;
   const Classifier* classifier_;
   int max_bounces_ = 16;
+  int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
+  int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;
   bool lens_hits_ = false;
 };
@@ -299,6 +310,9 @@ class Integrator {
 int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
                             float pdf_dir, int max_vertices, TransportMode mode) const {
   vec3 beta = path[static_cast<std::size_t>(count - 1)].beta;
+  // Russian roulette compares the throughput with the subpath's start, so that a light subpath
+  // (whose throughput starts at the light's power) is treated like an eye subpath.
+  const float beta_start = std::max(max_component(beta), 1e-30f);
   // `beta` passed in the first vertex already includes the first direction's weight: the caller
   // stores it in path[count - 1].beta and we continue from there.
   while (count < max_vertices) {
@@ -354,7 +368,9 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     prev.pdf_rev = to_area(pdf_rev_dir, v, prev);
     // --- Russian roulette, never mislabelling: the vertices so far stay valid prefixes ---
     if (count >= o_.rr_depth) {
-      const float q = std::max(0.05f, 1.0f - max_component(beta));
+      // Termination probability from the throughput lost so far, at most 1/2 per vertex so that a
+      // surviving path's weight grows by at most 2 each time (bounded variance).
+      const float q = std::min(0.5f, std::max(0.0f, 1.0f - max_component(beta) / beta_start));
       if (rng.get1d() < q) break;
       beta /= 1.0f - q;
     }
@@ -407,11 +423,11 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   z0.ns = z0.n;
   z0.pdf_fwd = sensor_pdf_pos();
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
-  return random_walk(th, rng, th.eye, 1, o, d, pdf_dir, max_bounces_ + 2, TransportMode::kRadiance);
+  return random_walk(th, rng, th.eye, 1, o, d, pdf_dir, max_eye_, TransportMode::kRadiance);
 }
 
 int Integrator::light_subpath(Thread& th, Sampler& rng) const {
-  if (rs_.lights.empty()) return 0;
+  if (rs_.lights.empty() || max_light_ == 0) return 0;
   const float ul = rng.get1d();
   const std::size_t li = std::min(rs_.lights.size() - 1, static_cast<std::size_t>(ul * static_cast<float>(rs_.lights.size())));
   const RenderLight& l = rs_.lights[li];
@@ -480,7 +496,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   // The walk starts from y0 with the first ray's throughput.
   Vertex saved = y0;
   th.light[0].beta = beta1;
-  const int n = random_walk(th, rng, th.light, 1, y0.p, d, pdf_dir, max_bounces_ + 1, TransportMode::kImportance);
+  const int n = random_walk(th, rng, th.light, 1, y0.p, d, pdf_dir, max_light_, TransportMode::kImportance);
   th.light[0].beta = saved.beta;
   return n;
 }
@@ -519,7 +535,7 @@ float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, co
     return strategies_.find(s2, t2) >= 0 && letters[static_cast<std::size_t>(s2) + 1] == 'D' &&
            letters[static_cast<std::size_t>(s2) + 2] == 'D';
   };
-  const auto remap = [](float f) { return f != 0.0f ? f : 1.0f; };
+  const auto remap = [](float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; };
   // Work on copies of the affected vertices.
   std::array<Vertex, kMaxVertices>& L = th.light;
   std::array<Vertex, kMaxVertices>& E = th.eye;
@@ -552,13 +568,14 @@ float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, co
     else qsm->pdf_rev = to_area(sensor_pdf_dir(glm::normalize(qsm->p - qs->p)), *qs, *qsm);
   }
   // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
-  float sum = 0.0f, ri = 1.0f;
+  // Ratios in double: long paths multiply many of them.
+  double sum = 0.0, ri = 1.0;
   for (int i = t - 1; i >= 0; --i) {
     ri *= remap(E[static_cast<std::size_t>(i)].pdf_rev) / remap(E[static_cast<std::size_t>(i)].pdf_fwd);
     if (i == 0 && !lens_hits_) break;
     if (runs(s + t - i, i)) sum += ri * ri;
   }
-  ri = 1.0f;
+  ri = 1.0;
   for (int i = s - 1; i >= 0; --i) {
     ri *= remap(L[static_cast<std::size_t>(i)].pdf_rev) / remap(L[static_cast<std::size_t>(i)].pdf_fwd);
     if (runs(i, s + t - i)) sum += ri * ri;
@@ -567,7 +584,7 @@ float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, co
   if (pt) *pt = saved_pt;
   if (qsm) *qsm = saved_qsm;
   if (ptm) *ptm = saved_ptm;
-  return 1.0f / (1.0f + sum);
+  return static_cast<float>(1.0 / (1.0 + sum));
 }
 
 void Integrator::record(Thread& th, ClassImages& images, const std::string& path, int strategy, int batch,
@@ -780,11 +797,13 @@ void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::ui
   const int nt = eye_subpath(th, rng, px, py);
   const int ns = light_subpath(th, rng);
   for (int t = 0; t <= nt; ++t) {
-    for (int s = 0; s <= ns; ++s) {
+    // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
+    const int s_max = rs_.lights.empty() ? ns : std::max(ns, 1);
+    for (int s = 0; s <= s_max; ++s) {
       const int k = s + t - 1;  // edges
       if (k < 1 || k - 1 > max_bounces_) continue;
-      if (t == 0 && !(lens_hits_ && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens)) continue;
-      if (t > 0 && s > 0 && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens) continue;
+      if (t == 0 && !(s >= 2 && lens_hits_ && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens)) continue;
+      if (t > 0 && s >= 2 && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens) continue;
       if (s == 0 && t < 2) continue;
       if (strategies_.find(s, t) < 0) continue;
       connect(th, images, rng, s, t, px, py, batch);

@@ -44,7 +44,7 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
     ASSERT_TRUE(loaded.ok()) << loaded.error().render();
     Scene scene = *loaded;
     if (scene.camera.type != SensorType::kSpotmeter) scene.camera.width = scene.camera.height = 16;
-    const std::uint64_t spp = scene.camera.type == SensorType::kSpotmeter ? 4096 : 48;
+    const std::uint64_t spp = scene.camera.type == SensorType::kSpotmeter ? 8192 : 128;
     const Profile bdpt = *resolve_profile("bdpt", Limits{});
     const HistogramReport reference = render_scene(scene, bdpt, spp);
     EXPECT_EQ(reference.nonfinite_samples, 0u) << entry.path().filename();

@@ -28,7 +28,7 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
       for (const MisCheck& c : *checks) {
         ++checked;
         ++by_length[static_cast<int>(c.path.size())];
-        EXPECT_NEAR(c.weight_sum, 1.0, 1e-3) << entry.path().filename() << " " << renderer << " " << c.path << " (s="
+        EXPECT_NEAR(c.weight_sum, 1.0, 1e-4) << entry.path().filename() << " " << renderer << " " << c.path << " (s="
                                               << c.s << ", t=" << c.t << ")";
       }
     }
