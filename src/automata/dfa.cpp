@@ -13,16 +13,10 @@
 #include <deque>
 #include <unordered_map>
 
+#include "core/hash.h"
+
 namespace pathex {
 namespace {
-
-struct VecHash {
-  std::size_t operator()(const std::vector<int>& v) const {
-    std::size_t h = 1469598103934665603ULL;
-    for (int x : v) h = (h ^ static_cast<std::size_t>(x)) * 1099511628211ULL;
-    return h;
-  }
-};
 
 struct ArrHash {
   std::size_t operator()(const std::array<int, 5>& v) const {
@@ -120,7 +114,7 @@ Result<Dfa> determinize(const Nfa& n, const Limits& limits) {
     std::sort(set.begin(), set.end());
   };
 
-  std::unordered_map<std::vector<int>, int, VecHash> ids;
+  std::unordered_map<std::vector<int>, int, IntVectorHash> ids;
   std::vector<std::vector<int>> sets;
   Dfa d;
   auto intern = [&](std::vector<int>&& set) -> int {

@@ -6,19 +6,9 @@
 #include <unordered_map>
 
 #include "automata/ops.h"
+#include "core/hash.h"
 
 namespace pathex {
-namespace {
-
-struct VecHash {
-  std::size_t operator()(const std::vector<int>& v) const {
-    std::size_t h = 1469598103934665603ULL;
-    for (int x : v) h = (h ^ static_cast<std::size_t>(x)) * 1099511628211ULL;
-    return h;
-  }
-};
-
-}  // namespace
 
 const std::uint8_t Classifier::kColumn[256] = {
 #define X4 4, 4, 4, 4
@@ -38,7 +28,7 @@ Result<Classifier::Direction> build_direction(const std::vector<Dfa>& dfas, std:
                                               std::map<std::vector<int>, std::uint32_t>& set_ids,
                                               const Limits& limits) {
   const std::size_t n = dfas.size();
-  std::unordered_map<std::vector<int>, int, VecHash> ids;
+  std::unordered_map<std::vector<int>, int, IntVectorHash> ids;
   std::vector<std::vector<int>> tuples;
   std::vector<std::int32_t> next;
   std::vector<int> labels;

@@ -2,6 +2,8 @@
 
 #include <iostream>
 
+#include "io/class_file.h"
+
 namespace pathex::cli {
 
 void add_limit_options(CLI::App* app, Limits* limits) {
@@ -50,6 +52,17 @@ Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limit
   if ((!n.lights.empty() || !n.sensors.empty()) && o.notation == Notation::kFull)
     return make_error(ErrorCode::kUsage, "--light and --sensor apply to --notation heckbert only");
   return o;
+}
+
+Result<PathClass> compile_cli_expression(const std::string& expr, const NotationOptions& n, const Limits& limits,
+                                         const std::string& classes_file, ClassTable* table) {
+  Result<ClassOptions> opts = class_options(n, limits);
+  if (!opts) return opts.error();
+  if (!classes_file.empty()) {
+    Result<bool> r = read_class_file(classes_file, *opts, table);
+    if (!r) return r.error();
+  }
+  return compile_class(expr, *opts, table);
 }
 
 int report(const Error& e) {

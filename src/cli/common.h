@@ -34,6 +34,11 @@ void add_notation_options(CLI::App* app, NotationOptions* n);
 // Turns the notation options into ClassOptions, or an error naming the bad value.
 Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limits);
 
+// The class of a command-line expression: notation options, then the optional class file's
+// names (into *table, which must outlive the result's use), then the expression itself.
+Result<PathClass> compile_cli_expression(const std::string& expr, const NotationOptions& n, const Limits& limits,
+                                         const std::string& classes_file, ClassTable* table);
+
 // Prints "pathex: error: <rendered error>" to stderr and returns kExitBadInput.
 int report(const Error& e);
 

@@ -42,14 +42,8 @@ std::string chains_text(const std::string& path) {
 }
 
 int run(const ExplainArgs& a) {
-  Result<ClassOptions> opts = class_options(a.notation, a.limits);
-  if (!opts) return report(opts.error());
   ClassTable table;
-  if (!a.classes_file.empty()) {
-    Result<bool> r = read_class_file(a.classes_file, *opts, &table);
-    if (!r) return report(r.error());
-  }
-  Result<PathClass> pc = compile_class(a.expr, *opts, &table);
+  Result<PathClass> pc = compile_cli_expression(a.expr, a.notation, a.limits, a.classes_file, &table);
   if (!pc) return report(pc.error());
   const Dfa& d = pc->dfa;
   if (a.dot) {
