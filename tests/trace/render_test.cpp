@@ -188,6 +188,53 @@ TEST(ClosedForm, MirrorCausticIsTheImageLight) {
   EXPECT_EQ(pt.report.classes[0].estimate.luminance, 0.0);  // the checker says unreachable; so does the tracer
 }
 
+// Every sensor measures radiance: inside the emitting sphere every wall point has L_e / (1 - rho),
+// so a thin lens, an orthographic camera and a spot meter all read it, from every strategy that
+// can reach them (the lens also through light paths hitting it, t = 0).
+TEST(ClosedForm, EverySensorReadsTheEmittingSphere) {
+  const std::string materials = R"("materials": {"wall": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "wall", "emission": [1, 1, 1], "two_sided": true}]})";
+  struct Case {
+    const char* camera;
+    std::vector<const char*> renderers;
+    std::uint64_t spp;
+  };
+  const Case cases[] = {
+      {R"("camera": {"type": "lens", "position": [0.1, 0, 0], "look_at": [0.1, 0, 1], "fov": 60, "aperture_radius": 0.05,
+                     "focus_distance": 0.8, "width": 6, "height": 6})", {"pt", "lt", "bdpt"}, 256},
+      {R"("camera": {"type": "orthographic", "position": [0, 0, 0], "look_at": [0, 0, 1], "film_width": 0.8,
+                     "film_height": 0.8, "width": 6, "height": 6})", {"pt", "pt-nee", "bdpt"}, 64},
+      {R"("camera": {"type": "spotmeter", "position": [0.3, 0.1, 0], "look_at": [0.5, 0.2, 1]})", {"pt", "pt-nee", "bdpt"}, 8192},
+  };
+  for (const Case& c : cases)
+    for (const char* renderer : c.renderers) {
+      Rendered r = render_json(std::string("{") + c.camera + "," + materials, renderer, {"L.*E"}, c.spp);
+      EXPECT_EQ(r.report.nonfinite_samples, 0u);
+      // Paths up to 12 bounces carry 2 (1 - 0.5^13).
+      expect_close(r.report.total, 2.0 * (1.0 - std::pow(0.5, 13)), 3.0, 0.01, std::string(renderer) + " " + c.camera);
+    }
+}
+
+// A mixture labels each vertex with the component that carried the transport (DESIGN §7). Inside
+// an emitting sphere whose material is 0.5 diffuse + 0.1 mirror, a path whose interior letters are
+// a word w carries L_e 0.5^{#D(w)} 0.1^{#S(w)}: LDD D DSE 0.5, LDD S DSE 0.1, LDD SD DSE 0.05, …
+TEST(ClosedForm, MixtureLettersCarryTheirComponentsShare) {
+  const std::string scene = R"({"camera": {"type": "pinhole", "position": [0.2, 0, 0.1], "look_at": [0.2, 0.3, 1], "fov": 70,
+                                           "width": 8, "height": 8},
+    "materials": {"mix": {"type": "mixture", "components": [{"weight": 0.5, "material": {"type": "diffuse", "albedo": [1, 1, 1]}},
+                                                            {"weight": 0.1, "material": {"type": "mirror", "reflectance": [1, 1, 1]}}]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "mix", "emission": [1, 1, 1], "two_sided": true}]})";
+  const std::vector<std::pair<std::string, double>> expected = {
+      {"LDDDSE", 1.0}, {"LDDDDSE", 0.5}, {"LDDSDSE", 0.1}, {"LDDSDDSE", 0.05}, {"LDDDSDSE", 0.05}, {"LDDSSDSE", 0.01}};
+  std::vector<std::string> classes;
+  for (const auto& [c, v] : expected) classes.push_back(c);
+  for (const char* renderer : {"pt", "bdpt"}) {
+    Rendered r = render_json(scene, renderer, classes, 512);
+    for (std::size_t i = 0; i < expected.size(); ++i)
+      expect_close(r.report.classes[i].estimate, expected[i].second, 3.0, 0.01, std::string(renderer) + " " + expected[i].first);
+  }
+}
+
 TEST(Determinism, SameSeedOneAndTwoThreadsIdentical) {
   Rendered a = render_json(closed_sphere_point(0.5, 1.0), "bdpt", {"LSDDDSE"}, 16, 1);
   Rendered b = render_json(closed_sphere_point(0.5, 1.0), "bdpt", {"LSDDDSE"}, 16, 2);
