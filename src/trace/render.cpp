@@ -56,6 +56,10 @@ namespace {
 using glm::vec3;
 constexpr int kMaxVertices = 64;  // per subpath; max_bounces is clamped so paths fit
 
+// Passes go to batches round-robin: every batch covers the whole image, passes are i.i.d., and
+// an interrupted render still spreads what it has over all batches (so its error is defined).
+int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % static_cast<std::uint64_t>(batches)); }
+
 float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
 
@@ -793,7 +797,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
 void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
   Sampler rng(o_.seed, pixel, pass);
-  const int batch = batch_of_pass(pass, o_.spp, o_.batches);
+  const int batch = batch_of(pass, o_.batches);
   const int nt = eye_subpath(th, rng, px, py);
   const int ns = light_subpath(th, rng);
   for (int t = 0; t <= nt; ++t) {
@@ -877,7 +881,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
       for (int y = rows.begin(); y < rows.end(); ++y)
         for (int x = 0; x < w; ++x) integrator.sample(th, out.images, x, y, pass);
     });
-    out.histogram.add_samples(batch_of_pass(pass, o.spp, o.batches), pixels);
+    out.histogram.add_samples(batch_of(pass, o.batches), pixels);
     if (o.progress) o.progress((pass + 1) * pixels, o.spp * pixels);
   }
   out.spp_done = pass;

@@ -247,6 +247,29 @@ TEST(Determinism, SameSeedOneAndTwoThreadsIdentical) {
   }
 }
 
+// An interrupted render keeps the passes it finished, says it is incomplete, and still has a
+// standard error (passes are spread over the batches round-robin).
+TEST(Interrupt, KeepsFinishedPassesAndMarksIncomplete) {
+  Result<Scene> scene = load_scene_json(closed_sphere_point(0.5, 1.0), ".", "test");
+  Result<Profile> profile = resolve_profile("bdpt", Limits{});
+  std::atomic<bool> cancel{false};
+  RenderOptions o;
+  o.spp = 1000;
+  o.cancel = &cancel;
+  o.progress = [&](std::uint64_t done, std::uint64_t) {
+    if (done >= 3 * 12 * 12) cancel.store(true);  // after the third pass
+  };
+  Result<RenderOutput> out = render(*scene, *profile, nullptr, o);
+  ASSERT_TRUE(out.ok());
+  EXPECT_FALSE(out->complete);
+  EXPECT_EQ(out->spp_done, 3u);
+  RunInfo info;
+  Result<HistogramReport> rep = make_report(out->histogram, info, nullptr, {});
+  ASSERT_TRUE(rep.ok());
+  EXPECT_TRUE(std::isfinite(rep->total.std_error));
+  EXPECT_EQ(out->histogram.total_samples(), 3u * 12 * 12);
+}
+
 TEST(Labels, PointLightWithPinholeOnlyProducesSDprefixAndDSsuffix) {
   Rendered r = render_json(closed_sphere_point(0.5, 1.0), "bdpt", {"LSD.*DSE"}, 8);
   ASSERT_FALSE(r.report.paths.empty());
