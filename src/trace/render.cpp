@@ -112,6 +112,10 @@ class Integrator {
       max_eye_ = std::max(max_eye_, st.t.hi == Range::kOpen ? kMaxVertices : st.t.hi);
     }
     if (max_light_ < 2) max_light_ = 0;
+    runs_.assign(kMaxRuns * kMaxRuns, 0);
+    for (std::size_t a = 0; a < kMaxRuns; ++a)
+      for (std::size_t b = 0; b < kMaxRuns; ++b)
+        runs_[a * kMaxRuns + b] = strategies.find(static_cast<int>(a), static_cast<int>(b)) >= 0 ? 1 : 0;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
@@ -305,6 +309,8 @@ class Integrator {
   const RenderOptions& o_;
   const Classifier* classifier_;
   int max_bounces_ = 16;
+  static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;
+  std::vector<std::uint8_t> runs_;  // runs_[s * kMaxRuns + t]: the profile runs (s, t)
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;
@@ -536,24 +542,27 @@ void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled
 float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const {
   // letters = "L c0 … E": c_i is letters[i + 1].
   auto runs = [&](int s2, int t2) {
-    return strategies_.find(s2, t2) >= 0 && letters[static_cast<std::size_t>(s2) + 1] == 'D' &&
-           letters[static_cast<std::size_t>(s2) + 2] == 'D';
+    return runs_[static_cast<std::size_t>(s2) * kMaxRuns + static_cast<std::size_t>(t2)] &&
+           letters[static_cast<std::size_t>(s2) + 1] == 'D' && letters[static_cast<std::size_t>(s2) + 2] == 'D';
   };
   const auto remap = [](float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; };
   // Work on copies of the affected vertices.
   std::array<Vertex, kMaxVertices>& L = th.light;
   std::array<Vertex, kMaxVertices>& E = th.eye;
-  Vertex saved_qs, saved_pt, saved_qsm, saved_ptm;
   Vertex* qs = s > 0 ? &L[static_cast<std::size_t>(s - 1)] : nullptr;
   Vertex* pt = t > 0 ? &E[static_cast<std::size_t>(t - 1)] : nullptr;
   Vertex* qsm = s > 1 ? &L[static_cast<std::size_t>(s - 2)] : nullptr;
   Vertex* ptm = t > 1 ? &E[static_cast<std::size_t>(t - 2)] : nullptr;
-  if (qs) saved_qs = *qs;
-  if (pt) saved_pt = *pt;
-  if (qsm) saved_qsm = *qsm;
-  if (ptm) saved_ptm = *ptm;
-  if (t == 1 && sampled) *pt = *sampled;
-  else if (s == 1 && sampled) *qs = *sampled;
+  // Only the four reverse densities change (and one vertex when a fresh sample replaces it):
+  // save those, restore them at the end.
+  const float rev_qs = qs ? qs->pdf_rev : 0.0f, rev_pt = pt ? pt->pdf_rev : 0.0f;
+  const float rev_qsm = qsm ? qsm->pdf_rev : 0.0f, rev_ptm = ptm ? ptm->pdf_rev : 0.0f;
+  Vertex* replaced = (t == 1 && sampled) ? pt : (s == 1 && sampled) ? qs : nullptr;
+  Vertex saved_replaced;
+  if (replaced) {
+    saved_replaced = *replaced;
+    *replaced = *sampled;
+  }
   // --- reverse densities at the join ---
   if (pt) {
     if (s > 0) pt->pdf_rev = pdf(qsm, *qs, *pt);
@@ -584,10 +593,11 @@ float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, co
     ri *= remap(L[static_cast<std::size_t>(i)].pdf_rev) / remap(L[static_cast<std::size_t>(i)].pdf_fwd);
     if (runs(i, s + t - i)) sum += ri * ri;
   }
-  if (qs) *qs = saved_qs;
-  if (pt) *pt = saved_pt;
-  if (qsm) *qsm = saved_qsm;
-  if (ptm) *ptm = saved_ptm;
+  if (replaced) *replaced = saved_replaced;
+  if (qs) qs->pdf_rev = rev_qs;
+  if (pt) pt->pdf_rev = rev_pt;
+  if (qsm) qsm->pdf_rev = rev_qsm;
+  if (ptm) ptm->pdf_rev = rev_ptm;
   return static_cast<float>(1.0 / (1.0 + sum));
 }
 
