@@ -255,7 +255,10 @@ class Integrator {
   // --- densities used by MIS ---
   // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
   float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const {
-    const vec3 wn = glm::normalize(next.p - v.p);
+    const vec3 d = next.p - v.p;
+    const float d2 = glm::dot(d, d);
+    if (d2 == 0.0f) return 0.0f;
+    const vec3 wn = d / std::sqrt(d2);
     float pdf_dir = 0.0f;
     switch (v.kind) {
       case Kind::kCamera: pdf_dir = sensor_pdf_dir(wn); break;
@@ -268,7 +271,7 @@ class Integrator {
       }
       case Kind::kLens: return 0.0f;
     }
-    return to_area(pdf_dir, v, next);
+    return pdf_dir * abs_cos(next, wn) / d2;  // solid angle at v to area at next
   }
   // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
   float pdf_light_origin(const Vertex& v) const {
