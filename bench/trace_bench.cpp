@@ -38,7 +38,8 @@ RenderOptions options(int threads, std::uint64_t spp) {
 
 // The tracer's own rate: all rays it casts (subpath extensions and shadow rays) per second.
 void BM_TracerRays(benchmark::State& state) {
-  const Profile bdpt = *resolve_profile(state.range(0) == 0 ? "bdpt" : "pt-nee", Limits{});
+  const char* const names[] = {"bdpt", "pt-nee", "pt", "lt"};
+  const Profile bdpt = *resolve_profile(names[state.range(0)], Limits{});
   std::uint64_t rays = 0;
   double seconds = 0;
   for (auto _ : state) {
@@ -49,7 +50,7 @@ void BM_TracerRays(benchmark::State& state) {
   state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays) / seconds);
   state.SetLabel(bdpt.name + ", 1 thread");
 }
-BENCHMARK(BM_TracerRays)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_TracerRays)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The baseline: a plain rtcIntersect1 loop over the same Embree scene, casting camera rays and
 // then one random bounce per hit (comparable coherence), one thread.
