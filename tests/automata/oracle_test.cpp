@@ -25,6 +25,7 @@
 #include "automata/dfa.h"
 #include "automata/ops.h"
 #include "classify/pathclass.h"
+#include "oracle/dfa_print.h"
 #include "oracle/naive_matcher.h"
 #include "oracle/random_regex.h"
 #include "regex/parser.h"
