@@ -73,6 +73,7 @@ struct Vertex {
   vec3 n{0.0f};          // geometric normal (unit); zero for points (point, spot, pinhole, laser)
   vec3 ns{0.0f};         // shading normal
   vec3 beta{1.0f};       // throughput up to and including this vertex
+  vec3 wo{0.0f};         // unit direction back to the vertex this one was sampled from
   float pdf_fwd = 0.0f;  // area density of sampling this vertex in its subpath's direction
   float pdf_rev = 0.0f;  // area density of sampling it from the other direction
   char letter = 'D';     // scattering letter: surface c_i; light c1 (direction); sensor c(k+1)
@@ -361,6 +362,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.n = hit->normal;
     v.ns = hit->shading_normal;
     v.shape = hit->shape;
+    v.wo = -d;
     v.beta = beta;
     v.pdf_fwd = to_area(pdf_dir, prev, v);
     ++count;
@@ -676,7 +678,7 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
     // A light vertex's beta already holds its spatial emission; only the directional part is left.
     if (qs->kind == Kind::kLight) fq = vec3(light_emits(rs_.lights[static_cast<std::size_t>(qs->light)], *qs, w) ? 1.0f : 0.0f);
     else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                        glm::normalize(th.light[static_cast<std::size_t>(s - 2)].p - qs->p), w, qs->ns, qs->n);
+                        qs->wo, w, qs->ns, qs->n);
     const float g = abs_cos(*qs, w) * std::fabs(glm::dot(cam_.forward, w)) / d2;
     contrib = qs->beta * fq * sampled.beta * g;
     if (is_black(contrib) || !visible(th, *qs, sampled)) return;
@@ -713,7 +715,7 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
     const vec3 w = to_light / std::sqrt(d2);
     if (!light_emits(l, sampled, -w)) return;
     const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
-                             glm::normalize(th.eye[static_cast<std::size_t>(t - 2)].p - pt->p), w, pt->ns, pt->n);
+                             pt->wo, w, pt->ns, pt->n);
     const float g = abs_cos(*pt, w) * abs_cos(sampled, w) / d2;
     contrib = pt->beta * f * sampled.beta * g;
     if (is_black(contrib) || !visible(th, *pt, sampled)) return;
@@ -726,9 +728,9 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
     if (d2 <= 0.0f) return;
     const vec3 w = d / std::sqrt(d2);
     const vec3 fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                              glm::normalize(th.light[static_cast<std::size_t>(s - 2)].p - qs->p), w, qs->ns, qs->n);
+                              qs->wo, w, qs->ns, qs->n);
     const vec3 fp = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
-                              glm::normalize(th.eye[static_cast<std::size_t>(t - 2)].p - pt->p), -w, pt->ns, pt->n);
+                              pt->wo, -w, pt->ns, pt->n);
     const float g = abs_cos(*qs, w) * abs_cos(*pt, w) / d2;
     contrib = qs->beta * fq * fp * pt->beta * g;
     if (is_black(contrib) || !visible(th, *qs, *pt)) return;
