@@ -198,11 +198,8 @@ class Integrator {
   // Directional density of the sensor (solid angle): pinhole and lens 1/(A cos^3), deltas 0.
   float sensor_pdf_dir(const vec3& dir) const {
     if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return 0.0f;
-    float rx, ry;
     const float c = glm::dot(dir, cam_.forward);
     if (c <= 0.0f) return 0.0f;
-    (void)rx;
-    (void)ry;
     return 1.0f / (cam_.image_area() * c * c * c);
   }
   float sensor_pdf_pos() const {
@@ -294,7 +291,7 @@ class Integrator {
   int light_subpath(Thread& th, Sampler& rng) const;
 
   // --- connections ---
-  void connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int px, int py, int batch) const;
+  void connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int batch) const;
   float mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const;
   // The full-path letters of the path made by s light and t eye vertices (with `sampled`
   // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
@@ -622,7 +619,7 @@ void Integrator::record(Thread& th, ClassImages& images, const std::string& path
   else th.pixel.add(set, *e);
 }
 
-void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int px, int py, int batch) const {
+void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int batch) const {
   const int strategy = strategies_.find(s, t);
   vec3 contrib{0.0f};
   Vertex sampled;
@@ -741,8 +738,6 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
   if (letters.empty()) return;
   const float w = mis_weight(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr, letters);
   record(th, images, letters, strategy, batch, contrib * w, splat, rx, ry);
-  (void)px;
-  (void)py;
 }
 
 float Integrator::weight_sum(Thread& th, int s, int t) const {
@@ -825,7 +820,7 @@ void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::ui
       if (t > 0 && s >= 2 && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens) continue;
       if (s == 0 && t < 2) continue;
       if (strategies_.find(s, t) < 0) continue;
-      connect(th, images, rng, s, t, px, py, batch);
+      connect(th, images, rng, s, t, batch);
     }
   }
   th.pixel.flush(images, px, py);
