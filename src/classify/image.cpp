@@ -116,17 +116,25 @@ ClassImages::PixelSum::PixelSum(const ClassImages& images)
       is_touched_(static_cast<std::size_t>(images.num_layers()), 0) {}
 
 void ClassImages::PixelSum::add(std::uint32_t set, const ExactRgb& c) {
-  for (int layer : images_->layers_of_set(set)) {
-    const auto l = static_cast<std::size_t>(layer);
-    add_to(sums_[l], c);
-    if (!is_touched_[l]) {
-      is_touched_[l] = 1;
-      touched_.push_back(layer);
+  for (auto& [s, sum] : by_set_)
+    if (s == set) {
+      add_to(sum, c);
+      return;
     }
-  }
+  by_set_.push_back({set, c});
 }
 
 bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {
+  for (const auto& [set, sum] : by_set_)
+    for (int layer : images_->layers_of_set(set)) {
+      const auto l = static_cast<std::size_t>(layer);
+      add_to(sums_[l], sum);
+      if (!is_touched_[l]) {
+        is_touched_[l] = 1;
+        touched_.push_back(layer);
+      }
+    }
+  by_set_.clear();
   bool ok = true;
   for (int layer : touched_) {
     const auto l = static_cast<std::size_t>(layer);

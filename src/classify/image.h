@@ -87,9 +87,12 @@ class ClassImages {
     bool flush(ClassImages& images, int x, int y);
 
    private:
+    // Contributions are summed per class set (a pixel sees few distinct sets) and expanded into
+    // layers only at flush(), so adding costs one sum whatever the number of class layers.
     const ClassImages* images_;
-    std::vector<ExactRgb> sums_;     // per layer
-    std::vector<int> touched_;       // layers with a nonzero sum since the last flush
+    std::vector<std::pair<std::uint32_t, ExactRgb>> by_set_;  // class sets touched since the last flush
+    std::vector<ExactRgb> sums_;     // per layer, used during flush()
+    std::vector<int> touched_;       // layers with a nonzero sum during flush()
     std::vector<std::uint8_t> is_touched_;
   };
 
