@@ -149,7 +149,7 @@ TrieMatcher::TrieMatcher(const Regex& r, int max_length)
       view(letter_is_, 16 + mask)[x] = static_cast<std::uint16_t>((mask >> (x % 4)) & 1);
     }
   column(0);
-  for (std::uint32_t row = 0; row < num_rows_; ++row) shared(row, 0) = Lanes{} + at(row, 0);
+  for (std::uint32_t row = 0; row < num_rows_; ++row) broadcast(shared(row, 0), at(row, 0));
 }
 
 void TrieMatcher::push(int p, Letter letter) {
@@ -187,8 +187,9 @@ void TrieMatcher::column(int j) {
 // shared column m (m ≤ q, the prefix's, broadcast to every lane) or the lanes' own column m.
 // Compiled twice, with and without AVX2 (the 16 lanes are one AVX2 register); the loader picks.
 __attribute__((target_clones("avx2", "default"))) void TrieMatcher::column16(int j, int q) {
-  const Lanes all_starts = Lanes{} + static_cast<std::uint16_t>((2u << j) - 1);
-  const Lanes bit_j = Lanes{} + static_cast<std::uint16_t>(1u << j);
+  Lanes all_starts, bit_j;
+  broadcast(all_starts, static_cast<std::uint16_t>((2u << j) - 1));
+  broadcast(bit_j, static_cast<std::uint16_t>(1u << j));
   const int which = j - 1 == q ? 0 : 1;  // the letter at j − 1 is a (x / 4) or b (x % 4)
   for (const Instr& in : ops_) {
     Lanes v{};
@@ -234,7 +235,7 @@ void TrieMatcher::select(int q, int x) {
     for (std::size_t r = 0; r < num_rows_; ++r) {
       const auto row = static_cast<std::uint32_t>(r);
       at(row, j) = lanes(row, j)[x];
-      shared(row, j) = Lanes{} + at(row, j);
+      broadcast(shared(row, j), at(row, j));
     }
 }
 

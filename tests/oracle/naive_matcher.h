@@ -89,6 +89,9 @@ class TrieMatcher {
   // Column j ≤ q of the current string, broadcast to all lanes.
   Lanes& shared(std::uint32_t row, int j) { return view(shared_, static_cast<std::size_t>(j) * num_rows_ + row); }
   static unsigned any_lane(const Lanes& x);  // bit m set if some lane has bit m
+  static void broadcast(Lanes& out, std::uint16_t v) {
+    for (int x = 0; x < 16; ++x) out[x] = v;
+  }
   void column16(int j, int q);
   // Makes P a b (lane x = 4a + b) the current string: copies lane x of columns q + 1, q + 2.
   void select(int q, int x);
