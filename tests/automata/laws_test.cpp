@@ -171,7 +171,7 @@ TEST(Laws, ConstantsAndWords) {
   for (const Dfa& d : {dfa_empty(), dfa_all(), dfa_universe(), dfa_word(""), dfa_word("LDSE"), dfa_word("SSSS")})
     EXPECT_TRUE(canonical(d));
   EXPECT_EQ(dfa_universe(), *compile(*parse("L[SD]{4,}E", kLimits), kLimits));
-  EXPECT_EQ(dfa_universe().num_states, 8) << "start, after L, 1..4 letters, 4+ letters... and dead: 0,L,1,2,3,4+,E,dead";
+  EXPECT_EQ(dfa_universe().num_states, 8) << "start; after L with 0, 1, 2, 3, 4+ letters; after E; dead";
   for (const char* w : {"", "D", "LDSE", "SSSSSSSS"}) {
     const Dfa d = dfa_word(w);
     EXPECT_EQ(enumerate_members(d, 10, 10), std::vector<std::string>{w});
