@@ -134,9 +134,21 @@ bool is_subset(const Dfa& a, const Dfa& b) { return is_empty(dfa_difference(a, b
 bool is_equivalent(const Dfa& a, const Dfa& b) { return minimize(a) == minimize(b); }
 
 bool is_finite(const Dfa& a) {
-  // Infinite iff a cycle runs through states that are both reachable (all are, after
-  // minimisation) and live. Iterative three-colour DFS over the live subgraph.
-  const std::vector<std::uint8_t> live = a.live();
+  // Infinite iff a cycle runs through states that are both reachable from the start and live.
+  // Iterative three-colour DFS over that subgraph (hand-built DFAs may have unreachable states).
+  std::vector<std::uint8_t> live = a.live();
+  std::vector<std::uint8_t> reached(static_cast<std::size_t>(a.num_states), 0);
+  std::vector<int> todo{a.start};
+  reached[static_cast<std::size_t>(a.start)] = 1;
+  while (!todo.empty()) {
+    const int s = todo.back();
+    todo.pop_back();
+    for (int l = 0; l < kNumLetters; ++l) {
+      const int t = a.step(s, l);
+      if (!reached[static_cast<std::size_t>(t)]) { reached[static_cast<std::size_t>(t)] = 1; todo.push_back(t); }
+    }
+  }
+  for (std::size_t s = 0; s < live.size(); ++s) live[s] = static_cast<std::uint8_t>(live[s] && reached[s]);
   std::vector<std::uint8_t> colour(static_cast<std::size_t>(a.num_states), 0);  // 0 new, 1 open, 2 done
   for (int root = 0; root < a.num_states; ++root) {
     if (!live[static_cast<std::size_t>(root)] || colour[static_cast<std::size_t>(root)]) continue;

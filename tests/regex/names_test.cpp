@@ -42,5 +42,17 @@ TEST(Limits, StackedStarsCostOneCopyEach) {
   EXPECT_EQ(*shortest_member(c->dfa), "LSSSSE");
 }
 
+TEST(Finiteness, UnreachableCyclesDoNotCount) {
+  // A hand-built DFA: start 0 accepts "D" then dies; state 2 loops on itself, live but unreachable.
+  Dfa d;
+  d.num_states = 4;
+  d.start = 0;
+  d.next = {1, 3, 3, 3, 3, 3, 3, 3, 2, 2, 2, 2, 3, 3, 3, 3};
+  d.accept = {0, 1, 1, 0};
+  EXPECT_TRUE(is_finite(d));
+  d.next[0] = 2;  // now "D" leads into the loop
+  EXPECT_FALSE(is_finite(d));
+}
+
 }  // namespace
 }  // namespace pathex
