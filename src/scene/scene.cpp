@@ -3,9 +3,12 @@
 // expected; unknown keys are errors, so a typo never silently does nothing.
 #include "scene/scene.h"
 
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -17,6 +20,19 @@ namespace {
 
 using nlohmann::json;
 using glm::vec3;
+
+float max_component(vec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
+
+// One reference token of a JSON pointer (RFC 6901): '~' is written "~0" and '/' is "~1".
+std::string pointer_token(std::string_view key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
 
 class Reader {
  public:
@@ -37,7 +53,7 @@ class Reader {
       if (!ok) {
         std::string list;
         for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        return fail(ptr + "/" + key, "unknown key '" + key + "', expected one of " + list);
+        return fail(ptr + "/" + pointer_token(key), "unknown key '" + key + "', expected one of " + list);
       }
     }
     return true;
@@ -123,18 +139,19 @@ class Reader {
   if (!var##_r) return var##_r.error(); \
   auto var = std::move(*var##_r)
 
-Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::string& ptr) {
+// `component`: inside a mixture, where only basic materials are allowed.
+Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::string& ptr, bool component) {
   PATHEX_TRY(type, r.string(j, "type", ptr));
   if (type == "diffuse") {
     if (auto k = r.keys(j, ptr, {"type", "albedo"}); !k) return k.error();
     PATHEX_TRY(albedo, r.vector3(j, "albedo", ptr, false, vec3(0.8f), true));
-    if (std::max(albedo.x, std::max(albedo.y, albedo.z)) > 1.0f) return r.fail(ptr + "/albedo", "expected values in [0, 1]");
+    if (const float hi = max_component(albedo); hi > 1.0f) return r.fail(ptr + "/albedo", "expected values in [0, 1], found " + Reader::fmt(hi));
     return BasicMaterial{Diffuse{albedo}};
   }
   if (type == "mirror") {
     if (auto k = r.keys(j, ptr, {"type", "reflectance"}); !k) return k.error();
     PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(1.0f), true));
-    if (std::max(refl.x, std::max(refl.y, refl.z)) > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1]");
+    if (const float hi = max_component(refl); hi > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1], found " + Reader::fmt(hi));
     return BasicMaterial{Mirror{refl}};
   }
   if (type == "dielectric") {
@@ -146,10 +163,12 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
   if (type == "glossy") {
     if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness"}); !k) return k.error();
     PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(0.8f), true));
-    if (std::max(refl.x, std::max(refl.y, refl.z)) > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1]");
+    if (const float hi = max_component(refl); hi > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1], found " + Reader::fmt(hi));
     PATHEX_TRY(rough, r.number(j, "roughness", ptr, 1e-4, 1.0, 0.2));
     return BasicMaterial{Glossy{refl, static_cast<float>(rough)}};
   }
+  if (component)
+    return r.fail(ptr + "/type", "material type '" + type + "' cannot be a mixture's component, expected diffuse, mirror, dielectric or glossy");
   return r.fail(ptr + "/type", "unknown material type '" + type + "', expected diffuse, mirror, dielectric, glossy or mixture");
 }
 
@@ -157,7 +176,7 @@ Result<Material> read_material(const Reader& r, const json& j, const std::string
   if (!j.is_object()) return r.fail(ptr, "expected a material object, found " + Reader::kind(j));
   PATHEX_TRY(type, r.string(j, "type", ptr));
   if (type != "mixture") {
-    PATHEX_TRY(basic, read_basic(r, j, ptr));
+    PATHEX_TRY(basic, read_basic(r, j, ptr, /*component=*/false));
     return std::visit([](const auto& b) { return Material{b}; }, basic);
   }
   if (auto k = r.keys(j, ptr, {"type", "components"}); !k) return k.error();
@@ -172,7 +191,7 @@ Result<Material> read_material(const Reader& r, const json& j, const std::string
     PATHEX_TRY(weight, r.number(c, "weight", cp, 0.0, 1.0));
     if (!c.contains("material")) return r.fail(cp + "/material", "missing material, expected a basic material object");
     if (!c["material"].is_object()) return r.fail(cp + "/material", "expected a basic material object");
-    PATHEX_TRY(basic, read_basic(r, c["material"], cp + "/material"));
+    PATHEX_TRY(basic, read_basic(r, c["material"], cp + "/material", /*component=*/true));
     mix.components.push_back({static_cast<float>(weight), basic});
     total += weight;
   }
@@ -215,56 +234,113 @@ Result<glm::mat4> read_transform(const Reader& r, const json& j, const std::stri
 vec3 apply_point(const glm::mat4& m, vec3 p) { return vec3(m * glm::vec4(p, 1.0f)); }
 vec3 apply_vector(const glm::mat4& m, vec3 v) { return vec3(m * glm::vec4(v, 0.0f)); }
 
-Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file) {
-  const std::string path = (std::filesystem::path(base_dir) / file).string();
-  std::ifstream in(path);
-  if (!in) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
-  // Check face indices ourselves first, so that an error names the OBJ line.
-  {
-    std::string line;
-    long long vertices = 0;
-    int line_no = 0;
-    while (std::getline(in, line)) {
-      ++line_no;
-      std::istringstream ls(line);
-      std::string tag;
-      ls >> tag;
-      if (tag == "v") {
-        ++vertices;
-      } else if (tag == "f") {
-        std::string item;
-        int n = 0;
-        while (ls >> item) {
-          ++n;
-          long long idx = 0;
-          try {
-            idx = std::stoll(item.substr(0, item.find('/')));
-          } catch (...) {
-            Error e = make_error(ErrorCode::kBadFile, "bad face index '" + item + "', expected a vertex number");
-            e.where = path + ":" + std::to_string(line_no);
-            return e;
-          }
-          const long long resolved = idx < 0 ? vertices + idx + 1 : idx;
-          if (idx == 0 || resolved < 1 || resolved > vertices) {
-            Error e = make_error(ErrorCode::kBadFile, "face index " + std::to_string(idx) + " is out of range, expected 1.." +
-                                                          std::to_string(vertices) + " (or a negative relative index)");
-            e.where = path + ":" + std::to_string(line_no);
-            return e;
-          }
-        }
-        if (n < 3) {
-          Error e = make_error(ErrorCode::kBadFile, "a face needs at least 3 vertices, found " + std::to_string(n));
-          e.where = path + ":" + std::to_string(line_no);
-          return e;
-        }
+// OBJ meshes. tinyobjloader does the loading, but it only warns about out-of-range indices and
+// reads a malformed number as 0, so a first pass over the text checks every `v` and `f` line and
+// names the offending line: "mesh.obj:LINE: what was expected".
+Error obj_error(const std::string& path, int line, std::string message) {
+  Error e = make_error(ErrorCode::kBadFile, std::move(message));
+  e.where = path + ":" + std::to_string(line);
+  return e;
+}
+
+// Parses the whole of `s` as a number; false for trailing junk.
+bool parse_double(std::string_view s, double* out) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  const char* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, *out);
+  return ec == std::errc() && p == end;
+}
+bool parse_long(std::string_view s, long long* out) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  const char* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, *out);
+  return ec == std::errc() && p == end;
+}
+
+// Splits a line into whitespace-separated words (no allocation beyond the vector).
+void split_words(std::string_view line, std::vector<std::string_view>* words) {
+  words->clear();
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+    std::size_t j = i;
+    while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
+    if (j > i) words->push_back(line.substr(i, j - i));
+    i = j;
+  }
+}
+
+// One face corner "v", "v/vt", "v//vn" or "v/vt/vn": each index 1..count, or negative (relative).
+std::optional<std::string> check_corner(std::string_view item, const long long counts[3]) {
+  static const char* const kWhat[3] = {"vertex", "texture coordinate", "normal"};
+  for (int part = 0; part < 3 && !item.empty(); ++part) {
+    const std::size_t slash = item.find('/');
+    const std::string_view field = item.substr(0, slash);
+    item = slash == std::string_view::npos ? std::string_view() : item.substr(slash + 1);
+    if (field.empty() && part > 0) continue;  // "v//vn"
+    long long idx = 0;
+    if (!parse_long(field, &idx))
+      return "bad face corner '" + std::string(field) + "', expected a " + kWhat[part] + " number";
+    const long long resolved = idx < 0 ? counts[part] + idx + 1 : idx;
+    if (idx == 0 || resolved < 1 || resolved > counts[part])
+      return std::string("face ") + kWhat[part] + " index " + std::to_string(idx) + " is out of range, expected " +
+             (counts[part] == 0 ? std::string("none: no ") + kWhat[part] + " is defined above this line"
+                                : "1.." + std::to_string(counts[part]) + " (or a negative relative index)");
+  }
+  return std::nullopt;
+}
+
+std::optional<Error> check_obj(const std::string& path, std::string_view text) {
+  long long counts[3] = {0, 0, 0};  // v, vt, vn defined so far
+  std::vector<std::string_view> words;
+  int line_no = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t eol = text.find('\n', pos);
+    if (eol == std::string_view::npos) eol = text.size();
+    std::string_view line = text.substr(pos, eol - pos);
+    pos = eol + 1;
+    ++line_no;
+    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    split_words(line, &words);
+    if (words.empty()) continue;
+    const std::string_view tag = words[0];
+    if (tag == "v") {
+      if (words.size() < 4)
+        return obj_error(path, line_no, "a vertex needs 3 coordinates, found " + std::to_string(words.size() - 1));
+      for (std::size_t i = 1; i < 4; ++i) {
+        double x = 0;
+        if (!parse_double(words[i], &x)) return obj_error(path, line_no, "bad vertex coordinate '" + std::string(words[i]) + "', expected a number");
+        if (!std::isfinite(x) || std::fabs(x) > 1e30)
+          return obj_error(path, line_no, "vertex coordinate " + std::string(words[i]) + " is not finite (or beyond 1e30)");
       }
+      ++counts[0];
+    } else if (tag == "vt") {
+      ++counts[1];
+    } else if (tag == "vn") {
+      ++counts[2];
+    } else if (tag == "f") {
+      if (words.size() < 4) return obj_error(path, line_no, "a face needs at least 3 vertices, found " + std::to_string(words.size() - 1));
+      for (std::size_t i = 1; i < words.size(); ++i)
+        if (std::optional<std::string> m = check_corner(words[i], counts)) return obj_error(path, line_no, *m);
     }
   }
+  return std::nullopt;
+}
+
+Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file) {
+  const std::string path = (std::filesystem::path(base_dir) / file).string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  const std::string text = std::move(ss).str();
+  if (std::optional<Error> e = check_obj(path, text)) return *e;
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
   tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, config)) {
+  if (!reader.ParseFromString(text, std::string(), config)) {
     Error e = make_error(ErrorCode::kBadFile, "cannot read the mesh: " + reader.Error());
     e.where = path;
     return e;
@@ -272,65 +348,136 @@ Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::s
   MeshShape mesh;
   mesh.file = file;
   const auto& v = reader.GetAttrib().vertices;
-  for (std::size_t i = 0; i + 2 < v.size(); i += 3) {
-    const vec3 p(v[i], v[i + 1], v[i + 2]);
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      Error e = make_error(ErrorCode::kBadFile, "vertex " + std::to_string(i / 3 + 1) + " is not finite");
-      e.where = path;
-      return e;
-    }
-    mesh.positions.push_back(p);
-  }
+  mesh.positions.reserve(v.size() / 3);
+  for (std::size_t i = 0; i + 2 < v.size(); i += 3) mesh.positions.emplace_back(v[i], v[i + 1], v[i + 2]);
   for (const auto& shape : reader.GetShapes())
     for (std::size_t i = 0; i + 2 < shape.mesh.indices.size(); i += 3)
-      mesh.triangles.push_back(glm::uvec3(static_cast<unsigned>(shape.mesh.indices[i].vertex_index),
-                                          static_cast<unsigned>(shape.mesh.indices[i + 1].vertex_index),
-                                          static_cast<unsigned>(shape.mesh.indices[i + 2].vertex_index)));
-  if (mesh.triangles.empty()) return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces");
+      mesh.triangles.emplace_back(static_cast<unsigned>(shape.mesh.indices[i].vertex_index),
+                                  static_cast<unsigned>(shape.mesh.indices[i + 1].vertex_index),
+                                  static_cast<unsigned>(shape.mesh.indices[i + 2].vertex_index));
+  if (mesh.triangles.empty()) return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
   return mesh;
 }
 
-// Axis-aligned bounds of a shape, for the "camera sees nothing" check.
-void extend_bounds(const Shape& s, vec3& lo, vec3& hi) {
-  auto add = [&](vec3 p) { lo = glm::min(lo, p); hi = glm::max(hi, p); };
+// --- "the camera sees no geometry" ---
+// Defined exactly: no shape's axis-aligned bounding box meets the camera's viewing region, which
+// is the field-of-view pyramid of a pinhole; for a thin lens the pyramid widened by the aperture
+// (a superset of every lens ray: slopes tan + aperture / focus distance, apex moved behind the
+// lens so the pyramid contains the lens disk); for an orthographic camera the half-infinite prism
+// over its film; for a spot meter its one ray. Each region is a convex set (base points plus a
+// cone of directions), so the separating-axis test below decides the question exactly; it errs
+// only towards "sees", so a scene is never refused for a geometry it does see.
+
+float max_abs(vec3 p) { return std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z))); }
+
+struct Box {
+  vec3 lo{std::numeric_limits<float>::max()}, hi{-std::numeric_limits<float>::max()};
+  void add(vec3 p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+};
+
+Box shape_bounds(const Shape& s) {
+  Box b;
   std::visit(
       [&](const auto& g) {
         using T = std::decay_t<decltype(g)>;
         if constexpr (std::is_same_v<T, MeshShape>) {
-          for (const vec3& p : g.positions) add(p);
+          for (const vec3& p : g.positions) b.add(p);
         } else if constexpr (std::is_same_v<T, SphereShape>) {
-          add(g.center - vec3(g.radius));
-          add(g.center + vec3(g.radius));
+          b.add(g.center - vec3(g.radius));
+          b.add(g.center + vec3(g.radius));
         } else if constexpr (std::is_same_v<T, QuadShape>) {
-          add(g.corner);
-          add(g.corner + g.edge1);
-          add(g.corner + g.edge2);
-          add(g.corner + g.edge1 + g.edge2);
-        } else {
-          add(g.center - vec3(g.radius));
-          add(g.center + vec3(g.radius));
+          b.add(g.corner);
+          b.add(g.corner + g.edge1);
+          b.add(g.corner + g.edge2);
+          b.add(g.corner + g.edge1 + g.edge2);
+        } else {  // a disk's extent along axis i is radius * sqrt(1 - n_i^2)
+          const vec3 half = g.radius * glm::sqrt(glm::max(vec3(0.0f), vec3(1.0f) - g.normal * g.normal));
+          b.add(g.center - half);
+          b.add(g.center + half);
         }
       },
       s.geometry);
+  return b;
 }
 
-bool ray_hits_box(vec3 o, vec3 d, vec3 lo, vec3 hi) {
-  float t0 = 0.0f, t1 = 1e30f;
-  for (int i = 0; i < 3; ++i) {
-    if (std::fabs(d[i]) < 1e-12f) {
-      if (o[i] < lo[i] || o[i] > hi[i]) return false;
-      continue;
+// base points + the cone of non-negative combinations of `rays`; `edges` are its edge directions.
+struct ViewRegion {
+  std::vector<vec3> base, rays, edges;
+};
+
+ViewRegion view_region(const Camera& c) {
+  const vec3 fwd = glm::normalize(c.look_at - c.position);
+  const vec3 right = glm::normalize(glm::cross(fwd, c.up));
+  const vec3 up = glm::cross(right, fwd);
+  ViewRegion v;
+  const float ty = std::tan(glm::radians(c.fov_degrees) * 0.5f);
+  const float tx = ty * static_cast<float>(c.width) / static_cast<float>(c.height);
+  auto pyramid = [&](vec3 apex, float sx, float sy) {
+    v.base = {apex};
+    for (float a : {-1.0f, 1.0f})
+      for (float b : {-1.0f, 1.0f}) v.rays.push_back(fwd + a * sx * right + b * sy * up);
+    v.edges = v.rays;
+  };
+  switch (c.type) {
+    case SensorType::kPinhole: pyramid(c.position, tx, ty); break;
+    case SensorType::kLens: {
+      const float widen = c.aperture_radius / c.focus_distance;
+      const float sx = tx + widen, sy = ty + widen;
+      pyramid(c.position - fwd * (c.aperture_radius / std::min(sx, sy)), sx, sy);
+      break;
     }
-    float a = (lo[i] - o[i]) / d[i], b = (hi[i] - o[i]) / d[i];
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a);
-    t1 = std::min(t1, b);
-    if (t0 > t1) return false;
+    case SensorType::kOrthographic:
+      for (float a : {-0.5f, 0.5f})
+        for (float b : {-0.5f, 0.5f}) v.base.push_back(c.position + a * c.film_width * right + b * c.film_height * up);
+      v.rays = {fwd};
+      v.edges = {fwd, right, up};
+      break;
+    case SensorType::kSpotmeter:
+      v.base = {c.position};
+      v.rays = {fwd};
+      v.edges = {fwd};
+      break;
+  }
+  return v;
+}
+
+// Separating-axis test between a convex view region and a box: candidate axes are the box's face
+// normals, the region's face normals (crosses of its edges) and crosses of an edge of each.
+bool region_meets_box(const ViewRegion& v, const Box& b) {
+  std::vector<vec3> axes = {vec3(1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1)};
+  for (std::size_t i = 0; i < v.edges.size(); ++i) {
+    for (std::size_t j = i + 1; j < v.edges.size(); ++j) axes.push_back(glm::cross(v.edges[i], v.edges[j]));
+    for (int k = 0; k < 3; ++k) axes.push_back(glm::cross(v.edges[i], axes[static_cast<std::size_t>(k)]));
+  }
+  const vec3 centre = 0.5f * (b.lo + b.hi), half = 0.5f * (b.hi - b.lo);
+  for (vec3 n : axes) {
+    const float len = glm::length(n);
+    if (!(len > 1e-12f)) continue;
+    n /= len;
+    const float bc = glm::dot(centre, n), br = glm::dot(half, glm::abs(n));
+    float lo = std::numeric_limits<float>::max(), hi = -lo, scale = std::fabs(bc) + br;
+    for (const vec3& p : v.base) {
+      lo = std::min(lo, glm::dot(p, n));
+      hi = std::max(hi, glm::dot(p, n));
+      scale = std::max(scale, max_abs(p));
+    }
+    const float slack = 1e-5f * scale;  // rounding only ever counts as overlap
+    // A ray along +n makes the region's interval unbounded above, one along -n below; a ray
+    // perpendicular to n (the region's own face normals; |cos| below rounding) does neither.
+    bool up = false, down = false;
+    for (const vec3& r : v.rays) {
+      const float dr = glm::dot(glm::normalize(r), n);
+      up = up || dr > 1e-6f;
+      down = down || dr < -1e-6f;
+    }
+    if (!up && hi + slack < bc - br) return false;
+    if (!down && lo - slack > bc + br) return false;
   }
   return true;
 }
 
 Result<Camera> read_camera(const Reader& r, const json& j, const std::string& ptr) {
+  if (!j.is_object()) return r.fail(ptr, "expected a camera object, found " + Reader::kind(j));
   Camera c;
   PATHEX_TRY(type, r.string(j, "type", ptr));
   if (type == "pinhole") {
@@ -452,7 +599,7 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
     if (!ok) {
       std::string list;
       for (const char* k : keys) list += std::string(list.empty() ? "" : ", ") + k;
-      return r.fail(ptr + "/" + key, "unknown key '" + key + "', expected one of " + list);
+      return r.fail(ptr + "/" + pointer_token(key), "unknown key '" + key + "', expected one of " + list);
     }
   }
   PATHEX_TRY(mat, r.string(j, "material", ptr));
@@ -507,8 +654,10 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& ex) {
-    return r.fail("", std::string("not valid JSON: ") + ex.what());
+  } catch (const json::exception& ex) {  // parse errors, and numbers beyond a double (out_of_range)
+    std::string what = ex.what();  // "[json.exception.parse_error.101] parse error at line 1, …"
+    if (const std::size_t tag = what.find("] "); what.rfind("[json.exception", 0) == 0 && tag != std::string::npos) what.erase(0, tag + 2);
+    return r.fail("", "not valid JSON: " + what);
   }
   if (auto k = r.keys(doc, "", {"camera", "materials", "shapes", "lights"}); !k) return k.error();
   Scene scene;
@@ -517,7 +666,7 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   if (!doc.contains("materials") || !doc["materials"].is_object() || doc["materials"].empty())
     return r.fail("/materials", "expected an object of named materials, e.g. {\"white\": {\"type\": \"diffuse\"}}");
   for (const auto& [mname, mj] : doc["materials"].items()) {
-    PATHEX_TRY(m, read_material(r, mj, "/materials/" + mname));
+    PATHEX_TRY(m, read_material(r, mj, "/materials/" + pointer_token(mname)));
     scene.material_names.push_back(mname);
     scene.materials.push_back(std::move(m));
   }
@@ -545,28 +694,10 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   if (!doc.contains("camera")) return r.fail("/camera", "missing camera, expected {type, position, look_at, …}");
   PATHEX_TRY(cam, read_camera(r, doc["camera"], "/camera"));
   scene.camera = cam;
-  // The camera must see some geometry: at least one of a grid of its rays reaches the bounds.
-  vec3 lo(1e30f), hi(-1e30f);
-  for (const Shape& s : scene.shapes) extend_bounds(s, lo, hi);
-  const vec3 fwd = glm::normalize(cam.look_at - cam.position);
-  const vec3 right = glm::normalize(glm::cross(fwd, cam.up));
-  const vec3 up = glm::cross(right, fwd);
-  const float ty = std::tan(glm::radians(cam.fov_degrees) * 0.5f);
-  const float tx = ty * static_cast<float>(cam.width) / static_cast<float>(cam.height);
+  const ViewRegion view = view_region(cam);
   bool sees = false;
-  for (int a = -4; a <= 4 && !sees; ++a)
-    for (int b = -4; b <= 4 && !sees; ++b) {
-      const float fa = static_cast<float>(a) / 4.0f, fb = static_cast<float>(b) / 4.0f;
-      vec3 o = cam.position, d = fwd;
-      switch (cam.type) {
-        case SensorType::kPinhole:
-        case SensorType::kLens: d = fwd + fa * tx * right + fb * ty * up; break;
-        case SensorType::kOrthographic: o = cam.position + fa * 0.5f * cam.film_width * right + fb * 0.5f * cam.film_height * up; break;
-        case SensorType::kSpotmeter: break;
-      }
-      sees = ray_hits_box(o, d, lo, hi);
-    }
-  if (!sees) return r.fail("/camera", "the camera sees no geometry: none of its rays reaches the scene's bounding box");
+  for (const Shape& s : scene.shapes) sees = sees || region_meets_box(view, shape_bounds(s));
+  if (!sees) return r.fail("/camera", "the camera sees no geometry: no shape's bounding box meets its field of view");
   return scene;
 }
 
