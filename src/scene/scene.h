@@ -4,8 +4,14 @@
 //
 // Kinds are closed sets behind one value: shapes, lights and materials are std::variants. Area
 // lights are shapes with an emission; the other lights are points, spots, distant lights
-// through an aperture and lasers. Exactly one sensor. Transforms are applied at load time, so
-// the model holds world-space geometry only.
+// through an aperture and lasers. Exactly one sensor. Transforms are applied at load time
+// (scale, then rotate, then translate), so the model holds world-space geometry only.
+//
+// Scene-level rules: at least one shape; at least one light (an entry in "lights" or a shape with
+// an emission; zero power is allowed); and the camera must see some geometry, meaning some
+// shape's axis-aligned bounding box meets the camera's viewing region (the field-of-view pyramid
+// of a pinhole, widened by the aperture for a lens, the prism over an orthographic film, or a
+// spot meter's ray). The test is exact for those boxes, so it never refuses a visible object.
 #pragma once
 
 #include <set>

@@ -13,8 +13,10 @@
 // where extent is the diagonal of the scene's bounds: proportional to the scene's size, and at
 // least about 8 float ulps of the point's own coordinates, so scenes scaled by 1e-4 or 1e+4 and
 // scenes far from the origin behave alike (tests/scene/embree_test.cpp). Hit positions are
-// projected back onto the exact surface, so the offset only needs to cover rounding. Float
-// coordinates cannot resolve a scene smaller than about 1e-6 of its distance from the origin.
+// projected back onto the exact surface, so the offset only needs to cover rounding. The price
+// of float coordinates: the offset is 1e-6 of the distance from the origin, so features (radii,
+// gaps, contacts) should be larger than about 1e-4 of that distance; a unit box 1e+5 from the
+// origin (coordinates step by 0.008 there) is beyond what float geometry can resolve.
 #pragma once
 
 #include <memory>
