@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -74,6 +75,55 @@ TEST(BadScenes, CliPrintsTheSameLineAndExits2) {
     EXPECT_EQ(out, "pathex: error: " + want.at("where").get<std::string>() + ": " + want.at("message").get<std::string>() + "\n")
         << file;
   }
+}
+
+// --- mutations of the sample scenes never crash and always name a place ---
+// Each case replaces one value anywhere in a sample scene (by a value of another kind, a
+// negative or huge number, an empty array) or deletes one key; the loader must answer with a
+// scene or an Error whose `where` is a JSON pointer into the file or an OBJ location.
+TEST(BadScenes, RandomMutationsGiveErrorsNotCrashes) {
+  std::vector<nlohmann::json> scenes;
+  for (const auto& entry : std::filesystem::directory_iterator(kDir + "/samples/scenes")) {
+    if (entry.path().extension() == ".json") scenes.push_back(nlohmann::json::parse(slurp(entry.path().string())));
+  }
+  ASSERT_FALSE(scenes.empty());
+  const nlohmann::json replacements[] = {nullptr, true, -1, 0, 1e300, -1e-300, 2.5, "text", nlohmann::json::array(),
+                                         nlohmann::json::array({1, 2}), nlohmann::json::object(), nlohmann::json{{"type", "sphere"}}};
+  std::mt19937 rng(7);
+  int errors = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    nlohmann::json doc = scenes[rng() % scenes.size()];
+    // Walk down to a random value, remembering its parent.
+    nlohmann::json* parent = nullptr;
+    nlohmann::json* node = &doc;
+    std::string key;
+    std::size_t index = 0;
+    for (int depth = 0; depth < 6 && (node->is_object() || node->is_array()) && !node->empty(); ++depth) {
+      if (depth > 0 && rng() % 3 == 0) break;
+      parent = node;
+      if (node->is_object()) {
+        auto it = node->begin();
+        std::advance(it, static_cast<long>(rng() % node->size()));
+        key = it.key();
+        node = &(*node)[key];
+      } else {
+        index = rng() % node->size();
+        node = &(*node)[index];
+      }
+    }
+    if (parent && parent->is_object() && rng() % 4 == 0) {
+      parent->erase(key);
+    } else {
+      *node = replacements[rng() % std::size(replacements)];
+    }
+    const Result<Scene> s = load_scene_json(doc.dump(), kDir + "/samples/scenes", "m.json");
+    if (s.ok()) continue;
+    ++errors;
+    const std::string& where = s.error().where;
+    EXPECT_TRUE(where.rfind("m.json:/", 0) == 0 || where.find(".obj") != std::string::npos) << where << " " << doc.dump();
+    EXPECT_FALSE(s.error().message.empty());
+  }
+  EXPECT_GT(errors, 1500);  // most mutations break something
 }
 
 // --- scenes written inline ---
