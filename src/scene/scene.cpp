@@ -332,15 +332,16 @@ Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::s
   const std::string path = (std::filesystem::path(base_dir) / file).string();
   std::ifstream in(path, std::ios::binary);
   if (!in) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const std::string text = std::move(ss).str();
-  if (std::optional<Error> e = check_obj(path, text)) return *e;
+  {  // the text is released before tinyobjloader reads the file again, to keep peak memory low
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (std::optional<Error> e = check_obj(path, std::move(ss).str())) return *e;
+  }
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
   tinyobj::ObjReader reader;
-  if (!reader.ParseFromString(text, std::string(), config)) {
+  if (!reader.ParseFromFile(path, config)) {
     Error e = make_error(ErrorCode::kBadFile, "cannot read the mesh: " + reader.Error());
     e.where = path;
     return e;
