@@ -70,13 +70,31 @@ inline constexpr int kDefaultBatches = 32;
 // Rec. 709 luminance.
 inline double luminance(const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
+// y rounded to the nearest integer (ties to even, as nearbyint in the default rounding mode) as a
+// 128-bit two's-complement value; |y| < 2^114. Adding and removing 2^52 rounds a smaller |y| in
+// one step (a larger one is already an integer), without nearbyint's library call; below 2^63
+// the integer converts directly, above it is split exactly at 2^64 (the floor of a scaled power
+// of two is exact, and so is the remainder, a multiple of y's ulp below 2^64).
+inline ExactSum round_to_fixed(double y) {
+  double x = y;
+  if (std::fabs(y) < 0x1p52) {
+    const double magic = std::copysign(0x1p52, y);
+    x = (y + magic) - magic;
+  }
+  if (std::fabs(x) < 0x1p63) return static_cast<ExactSum>(static_cast<SignedExactSum>(static_cast<std::int64_t>(x)));
+  const double hi = std::floor(x * 0x1p-64);
+  const double lo = x - hi * 0x1p64;
+  return (static_cast<ExactSum>(static_cast<SignedExactSum>(static_cast<std::int64_t>(hi))) << 64) +
+         static_cast<ExactSum>(static_cast<std::uint64_t>(lo));
+}
+
 // The contribution on the fixed-point grid (round to nearest), or nullopt if a component is not
 // finite or too large. This is the only place where a contribution is rounded.
 inline std::optional<ExactRgb> to_exact(const Rgb& c) {
   ExactRgb out;
   for (std::size_t i = 0; i < 3; ++i) {
     if (!(std::fabs(c[i]) < kMaxContribution)) return std::nullopt;  // also rejects NaN
-    out[i] = static_cast<ExactSum>(static_cast<SignedExactSum>(std::nearbyint(c[i] * 0x1p64)));
+    out[i] = round_to_fixed(c[i] * 0x1p64);
   }
   return out;
 }

@@ -166,6 +166,16 @@ bool reflection_local(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3&
   return true;
 }
 
+// Lambert needs no local frame: only the sides of the two directions (the same tests as
+// reflection_local(), on the same dot products, so the fast path agrees bit for bit), and
+// |cos θi| for its density. Diffuse is the common case of every connection and MIS density.
+bool same_side(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns, const glm::vec3& ng,
+               float* cos_i) {
+  if (!(glm::dot(wo, ng) * glm::dot(wi, ng) > 0.0f)) return false;
+  *cos_i = glm::dot(wi, ns);
+  return glm::dot(wo, ns) * *cos_i > 0.0f;
+}
+
 // --- delta components ---
 
 struct DeltaSample {
@@ -266,6 +276,30 @@ std::optional<Pick> pick(const Material& m, float u, BasicMaterial* storage) {
   return Pick{storage, 0, 1.0f, 1.0f, u};
 }
 
+// sample() for a plain Lambertian material (the common case), with the same numbers as the
+// general path: the direction drawn in ns's frame on wo's side, then f, pdf and pdf_rev exactly
+// as eval() and pdf() give them (same_side() is their test).
+std::optional<BsdfSample> sample_lambert(const Diffuse& lambert, const glm::vec3& wo, const glm::vec3& ns,
+                                         const glm::vec3& ng, float cos_o, glm::vec2 u) {
+  glm::vec3 wi_l = sample_cosine_hemisphere(u);
+  if (!(wi_l.z > 0.0f)) return std::nullopt;
+  if (cos_o < 0.0f) wi_l.z = -wi_l.z;
+  BsdfSample s;
+  s.wi = glm::normalize(Frame::from_normal(ns).to_world(wi_l));
+  float cos_i;
+  if (!same_side(wo, s.wi, ns, ng, &cos_i)) return std::nullopt;
+  s.f = lambert.albedo * kInvPi;
+  s.pdf = cosine_hemisphere_pdf(std::abs(cos_i));
+  if (!(s.pdf > 0.0f) || is_black(s.f) || !finite_vec(s.f)) return std::nullopt;
+  s.pdf_rev = cosine_hemisphere_pdf(std::abs(cos_o));
+  s.weight = s.f * (std::abs(cos_i) / s.pdf);
+  s.letter = kD;
+  s.is_delta = false;
+  s.lobe = Lobe::kDiffuseReflection;
+  if (!finite_vec(s.weight)) return std::nullopt;
+  return s;
+}
+
 }  // namespace
 
 // --- public functions ---
@@ -286,6 +320,10 @@ float fresnel_dielectric(float cos_i, float eta) {
 
 glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
                const glm::vec3& ng) {
+  if (const auto* lambert = std::get_if<Diffuse>(&m)) {
+    float cos_i;
+    return same_side(wo, wi, ns, ng, &cos_i) ? lambert->albedo * kInvPi : glm::vec3(0.0f);
+  }
   glm::vec3 wo_l, wi_l;
   if (!reflection_local(wo, wi, ns, ng, &wo_l, &wi_l)) return glm::vec3(0.0f);
   if (const auto* mix = std::get_if<Mixture>(&m)) {
@@ -309,6 +347,10 @@ glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, cons
 
 float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
           const glm::vec3& ng) {
+  if (std::holds_alternative<Diffuse>(m)) {
+    float cos_i;
+    return same_side(wo, wi, ns, ng, &cos_i) ? cosine_hemisphere_pdf(std::abs(cos_i)) : 0.0f;
+  }
   glm::vec3 wo_l, wi_l;
   if (!reflection_local(wo, wi, ns, ng, &wo_l, &wi_l)) return 0.0f;
   if (const auto* mix = std::get_if<Mixture>(&m)) {
@@ -340,6 +382,7 @@ std::optional<BsdfSample> sample(const Material& m, const glm::vec3& wo, const g
   const float cos_og = glm::dot(wo, ng);
   if (!(cos_o != 0.0f) || !(cos_og != 0.0f) || !std::isfinite(cos_o) || !std::isfinite(cos_og))
     return std::nullopt;
+  if (const auto* lambert = std::get_if<Diffuse>(&m)) return sample_lambert(*lambert, wo, ns, ng, cos_o, u);
   BasicMaterial storage;
   const std::optional<Pick> chosen = pick(m, u_component, &storage);
   if (!chosen) return std::nullopt;

@@ -192,6 +192,7 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
     hi = glm::max(hi, p);
   };
   es->areas_.assign(scene.shapes.size(), 0.0f);
+  es->quad_normals_.assign(scene.shapes.size(), vec3(0.0f));
   es->triangle_cdf_.resize(scene.shapes.size());
   for (std::size_t si = 0; si < scene.shapes.size(); ++si) {
     const Shape& shape = scene.shapes[si];
@@ -245,6 +246,7 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
         idx[i] = i;
       }
       es->areas_[si] = glm::length(glm::cross(q->edge1, q->edge2));
+      es->quad_normals_[si] = glm::normalize(glm::cross(q->edge1, q->edge2));
     } else {
       // --- sphere or disk: exact user geometry ---
       const bool sphere = std::holds_alternative<SphereShape>(shape.geometry);
@@ -290,7 +292,7 @@ vec3 EmbreeScene::offset(const vec3& p, const vec3& n, const vec3& d) const {
   return p + (glm::dot(n, d) >= 0.0f ? eps : -eps) * n;
 }
 
-std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tmin, float tmax) const {
+std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tmin, float tmax, HitDetail detail) const {
   RTCRayHit rh{};
   rh.ray = make_ray(o, d, tmin, tmax);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -309,25 +311,31 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
   if (const auto* m = std::get_if<MeshShape>(&shape.geometry)) {
     const glm::uvec3 t = m->triangles[rh.hit.primID];
     const vec3 p0 = m->positions[t.x], p1 = m->positions[t.y], p2 = m->positions[t.z];
-    h.uv = {rh.hit.u, rh.hit.v};
+    if (detail == HitDetail::kFull) h.uv = {rh.hit.u, rh.hit.v};
     h.position = (1.0f - rh.hit.u - rh.hit.v) * p0 + rh.hit.u * p1 + rh.hit.v * p2;
     const vec3 n = glm::cross(p1 - p0, p2 - p0);
     const float len = glm::length(n);
     h.normal = len > 0.0f ? n / len : -glm::normalize(d);  // degenerate triangles face the ray
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
-    h.uv = glm::clamp(quad_uv(*q, p), 0.0f, 1.0f);
-    h.position = q->corner + h.uv.x * q->edge1 + h.uv.y * q->edge2;
-    h.normal = glm::normalize(glm::cross(q->edge1, q->edge2));
+    h.normal = quad_normals_[static_cast<std::size_t>(h.shape)];
+    if (detail == HitDetail::kFull) {
+      h.uv = glm::clamp(quad_uv(*q, p), 0.0f, 1.0f);
+      h.position = q->corner + h.uv.x * q->edge1 + h.uv.y * q->edge2;
+    } else {
+      h.position = p - glm::dot(p - q->corner, h.normal) * h.normal;  // onto the plane
+    }
   } else if (const auto* s = std::get_if<SphereShape>(&shape.geometry)) {
     h.normal = glm::normalize(p - s->center);
     h.position = s->center + s->radius * h.normal;
-    h.uv = {unit_angle(h.normal.y, h.normal.x), std::acos(std::clamp(h.normal.z, -1.0f, 1.0f)) / kPi};
+    if (detail == HitDetail::kFull)
+      h.uv = {unit_angle(h.normal.y, h.normal.x), std::acos(std::clamp(h.normal.z, -1.0f, 1.0f)) / kPi};
   } else {
     const DiskShape& k = std::get<DiskShape>(shape.geometry);
     h.normal = k.normal;
     const vec3 local = Frame::from_normal(k.normal).to_local(p - k.center);
     h.position = p - local.z * k.normal;
-    h.uv = {unit_angle(local.y, local.x), std::min(std::sqrt(local.x * local.x + local.y * local.y) / k.radius, 1.0f)};
+    if (detail == HitDetail::kFull)
+      h.uv = {unit_angle(local.y, local.x), std::min(std::sqrt(local.x * local.x + local.y * local.y) / k.radius, 1.0f)};
   }
   h.shading_normal = h.normal;
   return h;
@@ -341,8 +349,8 @@ bool EmbreeScene::occluded(const vec3& o, const vec3& d, float tmin, float tmax)
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
 
-std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, const vec3& origin_normal) const {
-  return intersect(offset(o, origin_normal, d), d, 0.0f, std::numeric_limits<float>::infinity());
+std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, const vec3& origin_normal, HitDetail detail) const {
+  return intersect(offset(o, origin_normal, d), d, 0.0f, std::numeric_limits<float>::infinity(), detail);
 }
 
 bool EmbreeScene::visible(const vec3& a, const vec3& na, const vec3& b, const vec3& nb) const {

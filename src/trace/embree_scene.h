@@ -38,12 +38,16 @@ struct Hit {
   glm::vec3 shading_normal{0.0f};  // equal to `normal` (no interpolated normals yet)
   int shape = -1;                  // index into Scene::shapes
   int primitive = -1;              // triangle index for meshes, 0 otherwise
-  // Surface parameters: mesh, Embree's barycentrics (weights of the triangle's second and third
+  // Surface parameters (HitDetail::kFull only; zero otherwise): mesh, Embree's barycentrics (weights of the triangle's second and third
   // vertex); quad, position = corner + u edge1 + v edge2; sphere, u = phi / 2pi with
   // phi = atan2(y, x) about the centre in world axes, v = theta / pi with theta from +z; disk,
   // u = phi / 2pi in the disk's Frame::from_normal, v = distance from the centre / radius.
   glm::vec2 uv{0.0f};
 };
+
+// How much of a hit intersect() computes: everything, or all but the surface parameters (the
+// tracer's query: uv costs a sphere an atan2 and an acos per hit, and no BSDF reads it yet).
+enum class HitDetail : std::uint8_t { kFull, kNoUv };
 
 struct SurfaceSample {
   glm::vec3 position{0.0f};
@@ -64,13 +68,15 @@ class EmbreeScene {
   EmbreeScene& operator=(const EmbreeScene&) = delete;
 
   // --- raw queries: the ray o + t d for tmin < t < tmax, no offsets ---
-  std::optional<Hit> intersect(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) const;
+  std::optional<Hit> intersect(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax,
+                               HitDetail detail = HitDetail::kFull) const;
   bool occluded(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) const;
 
   // --- robust queries for rays that leave surfaces ---
   // The closest hit along o + t d, t > 0; `origin_normal` (zero for points in free space) offsets
   // the origin off the surface it leaves.
-  std::optional<Hit> intersect(const glm::vec3& o, const glm::vec3& d, const glm::vec3& origin_normal) const;
+  std::optional<Hit> intersect(const glm::vec3& o, const glm::vec3& d, const glm::vec3& origin_normal,
+                               HitDetail detail = HitDetail::kFull) const;
   // Whether the segment between two surface (or free-space, normal zero) points is unobstructed.
   bool visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const;
   bool visible(const glm::vec3& a, const glm::vec3& b) const { return visible(a, glm::vec3(0.0f), b, glm::vec3(0.0f)); }
@@ -111,6 +117,7 @@ class EmbreeScene {
 
   const Scene* source_ = nullptr;
   std::vector<float> areas_;
+  std::vector<glm::vec3> quad_normals_;  // unit, per shape (zero for other kinds)
   std::vector<std::vector<double>> triangle_cdf_;  // meshes: cumulative triangle areas
   std::vector<unsigned> geom_to_shape_;
   float extent_ = 1.0f;

@@ -69,30 +69,82 @@ enum class Kind : std::uint8_t { kCamera, kLight, kSurface, kLens };
 
 struct Vertex {
   Kind kind = Kind::kSurface;
+  char letter = 'D';     // scattering letter: surface c_i; light c1 (direction); sensor c(k+1)
+  char pos_letter = 'D'; // lights c0 and sensors c(k+2)
+  bool finite = true;    // can be a join end: not a surface, or a surface with a finite BSDF part
   vec3 p{0.0f};
   vec3 n{0.0f};          // geometric normal (unit); zero for points (point, spot, pinhole, laser)
   vec3 ns{0.0f};         // shading normal
   vec3 beta{1.0f};       // throughput up to and including this vertex
-  vec3 wo{0.0f};         // unit direction back to the vertex this one was sampled from
+  vec3 wo{0.0f};         // unit direction to the vertex before it on its subpath (zero for the first)
+  float d2_wo = 0.0f;    // squared distance to that vertex
   float pdf_fwd = 0.0f;  // area density of sampling this vertex in its subpath's direction
   float pdf_rev = 0.0f;  // area density of sampling it from the other direction
-  char letter = 'D';     // scattering letter: surface c_i; light c1 (direction); sensor c(k+1)
-  char pos_letter = 'D'; // lights c0 and sensors c(k+2)
   int shape = -1;        // surfaces and area-light points
   int light = -1;        // light vertices
   bool has_normal() const { return n.x != 0.0f || n.y != 0.0f || n.z != 0.0f; }
 };
 
+// Sets v.wo and v.d2_wo from its predecessor's position.
+void link(Vertex& v, const Vertex& pred) {
+  const vec3 e = pred.p - v.p;
+  v.d2_wo = glm::dot(e, e);
+  v.wo = v.d2_wo > 0.0f ? e / std::sqrt(v.d2_wo) : vec3(0.0f);
+}
+
+// A full-path string packed for hashing: bit i is set when letter c_i is S, and the string's
+// length sits in the top byte. Strings of up to kMaxPackedLetters scattering letters pack.
+__extension__ typedef unsigned __int128 PathKey;
+constexpr std::size_t kMaxPackedLetters = 120;
+
+// Per-thread map from packed strings to histogram ids, so that recording a contribution hashes
+// two words instead of a string; Histogram::intern() runs once per new path and thread.
+class PathIds {
+ public:
+  Histogram::PathId get(Histogram& hist, const std::string& letters) {
+    if (letters.size() - 2 > kMaxPackedLetters) return hist.intern(letters);
+    PathKey key = static_cast<PathKey>(letters.size()) << 120;
+    for (std::size_t i = 1; i + 1 < letters.size(); ++i)
+      if (letters[i] == 'S') key |= static_cast<PathKey>(1) << (i - 1);
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = hash(key) & mask;; i = (i + 1) & mask) {
+      Slot& slot = slots_[i];
+      if (slot.key == key) return slot.id;
+      if (slot.key == 0) {
+        const Histogram::PathId id = hist.intern(letters);
+        slot = {key, id};
+        if (2 * ++used_ > slots_.size()) grow();
+        return id;
+      }
+    }
+  }
+
+ private:
+  struct Slot {
+    PathKey key = 0;  // 0: empty (a real key has a nonzero length)
+    Histogram::PathId id = -1;
+  };
+  static std::size_t hash(PathKey key) {
+    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) ^ mix64(static_cast<std::uint64_t>(key >> 64))));
+  }
+  void grow() {
+    std::vector<Slot> old(slots_.size() * 2);
+    old.swap(slots_);
+    const std::size_t mask = slots_.size() - 1;
+    for (const Slot& slot : old) {
+      if (slot.key == 0) continue;
+      std::size_t i = hash(slot.key) & mask;
+      while (slots_[i].key != 0) i = (i + 1) & mask;
+      slots_[i] = slot;
+    }
+  }
+  std::vector<Slot> slots_ = std::vector<Slot>(256);
+  std::size_t used_ = 0;
+};
+
 // |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
 float abs_cos(const Vertex& v, const vec3& w) { return v.has_normal() ? std::fabs(glm::dot(v.n, w)) : 1.0f; }
 
-// Solid-angle density at `from` towards `to` as an area density at `to`.
-float to_area(float pdf_dir, const Vertex& from, const Vertex& to) {
-  const vec3 d = to.p - from.p;
-  const float d2 = glm::dot(d, d);
-  if (d2 == 0.0f) return 0.0f;
-  return pdf_dir * abs_cos(to, d / std::sqrt(d2)) / d2;
-}
 
 // --- the integrator ---
 
@@ -113,10 +165,13 @@ class Integrator {
       max_eye_ = std::max(max_eye_, st.t.hi == Range::kOpen ? kMaxVertices : st.t.hi);
     }
     if (max_light_ < 2) max_light_ = 0;
-    runs_.assign(kMaxRuns * kMaxRuns, 0);
+    strategy_of_.assign(kMaxRuns * kMaxRuns, -1);
     for (std::size_t a = 0; a < kMaxRuns; ++a)
       for (std::size_t b = 0; b < kMaxRuns; ++b)
-        runs_[a * kMaxRuns + b] = strategies.find(static_cast<int>(a), static_cast<int>(b)) >= 0 ? 1 : 0;
+        strategy_of_[a * kMaxRuns + b] = static_cast<std::int16_t>(strategies.find(static_cast<int>(a), static_cast<int>(b)));
+    for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
+    sensor_pair_ = sensor_letters(cam_.type);
+    for (const RenderLight& l : rs.lights) light_pairs_.push_back(light_letters(letter_type(l.type)));
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
@@ -127,7 +182,16 @@ class Integrator {
     std::array<Vertex, kMaxVertices> eye, light;
     std::string label;
     std::uint64_t rays = 0;
+    PathIds ids;
+    Vertex sampled;  // connect()'s fresh light or sensor sample
   };
+
+  // The profile's strategy that runs (s, t), or -1.
+  int strategy(int s, int t) const {
+    return static_cast<std::size_t>(s) < kMaxRuns && static_cast<std::size_t>(t) < kMaxRuns
+               ? strategy_of_[static_cast<std::size_t>(s) * kMaxRuns + static_cast<std::size_t>(t)]
+               : -1;
+  }
 
   // One sample: pixel (px, py), pass `pass`.
   void sample(Thread& th, ClassImages& images, int px, int py, std::uint64_t pass) const;
@@ -209,7 +273,6 @@ class Integrator {
       default: return 0.0f;  // a point: Dirac
     }
   }
-  std::string sensor_pair() const { return sensor_letters(cam_.type); }
 
   // --- lights ---
   float light_pdf_pos(const RenderLight& l) const {  // area density of the emitting point
@@ -251,37 +314,31 @@ class Integrator {
   }
 
   // --- densities used by MIS ---
+  // Solid-angle density at `v` of sampling the unit direction `wn`, given the unit direction
+  // `wp` to v's other neighbour (null when it has none: a surface then has no density).
+  float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
+    switch (v.kind) {
+      case Kind::kCamera: return sensor_pdf_dir(wn);
+      case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
+      case Kind::kSurface:
+        return wp ? bsdf::pdf(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)], *wp, wn, v.ns, v.n) : 0.0f;
+      case Kind::kLens: return 0.0f;
+    }
+    return 0.0f;
+  }
   // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
   float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const {
     const vec3 d = next.p - v.p;
     const float d2 = glm::dot(d, d);
     if (d2 == 0.0f) return 0.0f;
     const vec3 wn = d / std::sqrt(d2);
-    float pdf_dir = 0.0f;
-    switch (v.kind) {
-      case Kind::kCamera: pdf_dir = sensor_pdf_dir(wn); break;
-      case Kind::kLight: pdf_dir = light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn); break;
-      case Kind::kSurface: {
-        if (!prev) return 0.0f;
-        const vec3 wp = glm::normalize(prev->p - v.p);
-        pdf_dir = bsdf::pdf(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)], wp, wn, v.ns, v.n);
-        break;
-      }
-      case Kind::kLens: return 0.0f;
-    }
-    return pdf_dir * abs_cos(next, wn) / d2;  // solid angle at v to area at next
+    const vec3 wp = prev ? glm::normalize(prev->p - v.p) : vec3(0.0f);
+    return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
   }
   // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
   float pdf_light_origin(const Vertex& v) const {
     const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
     return light_pick_ * light_pdf_pos(rs_.lights[static_cast<std::size_t>(li)]);
-  }
-  // Area density at `next` of a light subpath leaving the light point `v` (an eye vertex on an
-  // area light) towards it.
-  float pdf_light_dir(const Vertex& v, const Vertex& next) const {
-    const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
-    const vec3 w = glm::normalize(next.p - v.p);
-    return to_area(light_pdf_dir(rs_.lights[static_cast<std::size_t>(li)], v, w), v, next);
   }
 
   // --- subpaths ---
@@ -311,7 +368,10 @@ class Integrator {
   const Classifier* classifier_;
   int max_bounces_ = 16;
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;
-  std::vector<std::uint8_t> runs_;  // runs_[s * kMaxRuns + t]: the profile runs (s, t)
+  std::vector<std::int16_t> strategy_of_;  // [s * kMaxRuns + t]: the profile's strategy running (s, t), or -1
+  std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
+  std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
+  std::vector<std::string> light_pairs_;  // each light's letters c0 c1
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;
@@ -329,7 +389,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   while (count < max_vertices) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.has_normal() ? prev.n : vec3(0.0f));
+    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.has_normal() ? prev.n : vec3(0.0f), HitDetail::kNoUv);
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
       const float denom = glm::dot(d, cam_.forward);
@@ -344,7 +404,8 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
           v.n = cam_.forward;
           v.ns = cam_.forward;
           v.beta = beta;
-          v.pdf_fwd = to_area(pdf_dir, prev, v);
+          link(v, prev);
+          v.pdf_fwd = v.d2_wo > 0.0f ? pdf_dir * std::fabs(glm::dot(v.n, d)) / v.d2_wo : 0.0f;
           v.letter = 'D';
           v.pos_letter = 'D';
           return count + 1;
@@ -359,9 +420,14 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.n = hit->normal;
     v.ns = hit->shading_normal;
     v.shape = hit->shape;
+    v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;
     v.wo = -d;
+    const vec3 e = v.p - prev.p;
+    v.d2_wo = glm::dot(e, e);
     v.beta = beta;
-    v.pdf_fwd = to_area(pdf_dir, prev, v);
+    // Solid angle at prev to area at v, along the unit ray direction d.
+    const float to_area_v = v.d2_wo > 0.0f ? std::fabs(glm::dot(v.n, d)) / v.d2_wo : 0.0f;
+    v.pdf_fwd = pdf_dir * to_area_v;
     ++count;
     if (count >= max_vertices) break;
     // --- scatter ---
@@ -377,7 +443,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // strategy that would join at this vertex is excluded by its letter S.
     pdf_dir = bs->is_delta ? 0.0f : bs->pdf;
     const float pdf_rev_dir = bs->is_delta ? 0.0f : bs->pdf_rev;
-    prev.pdf_rev = to_area(pdf_rev_dir, v, prev);
+    prev.pdf_rev = v.d2_wo > 0.0f ? pdf_rev_dir * abs_cos(prev, d) / v.d2_wo : 0.0f;
     // --- Russian roulette, never mislabelling: the vertices so far stay valid prefixes ---
     if (count >= o_.rr_depth) {
       // Termination probability from the throughput lost so far, at most 1/2 per vertex so that a
@@ -398,9 +464,8 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   z0 = Vertex{};
   z0.kind = Kind::kCamera;
   z0.beta = vec3(1.0f);
-  const std::string pair = sensor_pair();
-  z0.letter = pair[0];
-  z0.pos_letter = pair[1];
+  z0.letter = sensor_pair_[0];
+  z0.pos_letter = sensor_pair_[1];
   const glm::vec2 uf = rng.get2d();
   const glm::vec2 ul = rng.get2d();
   const float rx = static_cast<float>(px) + uf.x, ry = static_cast<float>(py) + uf.y;
@@ -447,9 +512,8 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   y0 = Vertex{};
   y0.kind = Kind::kLight;
   y0.light = static_cast<int>(li);
-  const std::string pair = light_letters(letter_type(l.type));
-  y0.pos_letter = pair[0];
-  y0.letter = pair[1];
+  y0.pos_letter = light_pairs_[li][0];
+  y0.letter = light_pairs_[li][1];
   const glm::vec2 up = rng.get2d();
   const glm::vec2 ud = rng.get2d();
   vec3 d{0.0f};
@@ -544,9 +608,15 @@ void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled
 float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const {
   // letters = "L c0 … E": c_i is letters[i + 1].
   auto runs = [&](int s2, int t2) {
-    return runs_[static_cast<std::size_t>(s2) * kMaxRuns + static_cast<std::size_t>(t2)] &&
+    return strategy(s2, t2) >= 0 &&
            letters[static_cast<std::size_t>(s2) + 1] == 'D' && letters[static_cast<std::size_t>(s2) + 2] == 'D';
   };
+  // When no other strategy can sample this string (pt, lt, and many strings of every profile),
+  // the weight is 1 and no density needs recomputing.
+  bool alone = true;
+  for (int s2 = 0; s2 <= s + t && alone; ++s2)
+    if (s2 != s && (s + t - s2 > 0 || lens_hits_) && runs(s2, s + t - s2)) alone = false;
+  if (alone) return 1.0f;
   const auto remap = [](float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; };
   // Work on copies of the affected vertices.
   std::array<Vertex, kMaxVertices>& L = th.light;
@@ -566,21 +636,29 @@ float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, co
     *replaced = *sampled;
   }
   // --- reverse densities at the join ---
-  if (pt) {
-    if (s > 0) pt->pdf_rev = pdf(qsm, *qs, *pt);
-    else pt->pdf_rev = pdf_light_origin(*pt);
-  }
-  if (ptm) {
-    if (s > 0) ptm->pdf_rev = pdf(qs, *pt, *ptm);
-    else ptm->pdf_rev = pdf_light_dir(*pt, *ptm);
-  }
-  if (qs) {
-    if (pt) qs->pdf_rev = pdf(ptm, *pt, *qs);
-    else qs->pdf_rev = sensor_pdf_pos();  // t = 0: qs is the lens point
-  }
-  if (qsm) {
-    if (pt) qsm->pdf_rev = pdf(pt, *qs, *qsm);
-    else qsm->pdf_rev = to_area(sensor_pdf_dir(glm::normalize(qsm->p - qs->p)), *qs, *qsm);
+  // Every direction is at hand: the join's (w, from qs to pt, at squared distance d2) and each
+  // vertex's unit direction to its predecessor (wo, at d2_wo); no normalisation is needed.
+  // Area density at `next` from solid-angle density `pdf_w` along unit `w` over squared distance `dist2`.
+  const auto area = [](float pdf_w, const Vertex& next, const vec3& w, float dist2) {
+    return dist2 > 0.0f ? pdf_w * abs_cos(next, w) / dist2 : 0.0f;
+  };
+  if (qs && pt) {
+    const vec3 e = pt->p - qs->p;
+    const float d2 = glm::dot(e, e);
+    const vec3 w = d2 > 0.0f ? e / std::sqrt(d2) : vec3(0.0f), back = -w;
+    pt->pdf_rev = area(pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
+    qs->pdf_rev = area(pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
+    if (ptm) ptm->pdf_rev = area(pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
+    if (qsm) qsm->pdf_rev = area(pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
+  } else if (pt) {  // s = 0: pt lies on an area light
+    pt->pdf_rev = pdf_light_origin(*pt);
+    if (ptm) {
+      const RenderLight& l = rs_.lights[static_cast<std::size_t>(rs_.light_of_shape[static_cast<std::size_t>(pt->shape)])];
+      ptm->pdf_rev = area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo);
+    }
+  } else if (qs) {  // t = 0: qs is the lens point
+    qs->pdf_rev = sensor_pdf_pos();
+    if (qsm) qsm->pdf_rev = area(sensor_pdf_dir(qs->wo), *qsm, qs->wo, qs->d2_wo);
   }
   // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
   // Ratios in double: long paths multiply many of them.
@@ -612,7 +690,7 @@ void Integrator::record(Thread& th, ClassImages& images, const std::string& path
     return;
   }
   if (is_zero(*e)) return;
-  const Histogram::PathId id = th.hist.intern(path);
+  const Histogram::PathId id = th.ids.get(th.hist, path);
   th.hist.add_exact(id, batch, strategy, *e);
   const std::uint32_t set = th.hist.class_set(id);
   if (splat) images.add(static_cast<int>(rx), static_cast<int>(ry), set, *e);
@@ -620,37 +698,30 @@ void Integrator::record(Thread& th, ClassImages& images, const std::string& path
 }
 
 void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int batch) const {
-  const int strategy = strategies_.find(s, t);
+  const int strategy_index = strategy(s, t);
   vec3 contrib{0.0f};
-  Vertex sampled;
+  Vertex& sampled = th.sampled;
   bool splat = false;
   float rx = 0.0f, ry = 0.0f;
   const Vertex* qs = s > 0 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
   const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
-  auto finite_side = [&](const Vertex& v) {  // can v be a join end (a finite BSDF part)?
-    return v.kind != Kind::kSurface || bsdf::has_finite_component(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)]);
-  };
   if (s == 0) {
     // --- eye path hits an area light ---
     if (pt->kind != Kind::kSurface) return;
     const int li = rs_.light_of_shape[static_cast<std::size_t>(pt->shape)];
     if (li < 0) return;
-    const Vertex& prev = th.eye[static_cast<std::size_t>(t - 2)];
-    Vertex lv = *pt;
-    lv.light = li;
-    contrib = pt->beta * light_emit(rs_.lights[static_cast<std::size_t>(li)], lv, glm::normalize(prev.p - pt->p));
+    contrib = pt->beta * light_emit(rs_.lights[static_cast<std::size_t>(li)], *pt, pt->wo);
   } else if (t == 0) {
     // --- light path hits the lens ---
     if (qs->kind != Kind::kLens) return;
-    const Vertex& prev = th.light[static_cast<std::size_t>(s - 2)];
-    const vec3 w = glm::normalize(prev.p - qs->p);
+    const vec3 w = qs->wo;
     if (!raster_of(qs->p, w, &rx, &ry)) return;
     contrib = qs->beta * importance(qs->p, w);
     splat = true;
   } else if (t == 1) {
     // --- splat: connect qs to a fresh sensor point ---
     if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return;
-    if (qs->kind == Kind::kLens || !finite_side(*qs)) return;
+    if (qs->kind == Kind::kLens || !qs->finite) return;
     sampled = Vertex{};
     sampled.kind = Kind::kCamera;
     sampled.p = cam_.position;
@@ -660,9 +731,8 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
       sampled.n = cam_.forward;
     }
     sampled.ns = sampled.n;
-    const std::string pair = sensor_pair();
     sampled.letter = 'D';
-    sampled.pos_letter = pair[1];
+    sampled.pos_letter = sensor_pair_[1];
     const vec3 to_cam = sampled.p - qs->p;
     const float d2 = glm::dot(to_cam, to_cam);
     const vec3 w = to_cam / std::sqrt(d2);  // from qs to the camera
@@ -682,7 +752,7 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
     splat = true;
   } else if (s == 1) {
     // --- next-event estimation: a fresh light sample ---
-    if (pt->kind != Kind::kSurface || !finite_side(*pt) || rs_.lights.empty()) return;
+    if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
     const float ul = rng.get1d();
     const glm::vec2 up = rng.get2d();
     const std::size_t li = std::min(rs_.lights.size() - 1, static_cast<std::size_t>(ul * static_cast<float>(rs_.lights.size())));
@@ -691,8 +761,7 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
     sampled = Vertex{};
     sampled.kind = Kind::kLight;
     sampled.light = static_cast<int>(li);
-    const std::string pair = light_letters(letter_type(l.type));
-    sampled.pos_letter = pair[0];
+    sampled.pos_letter = light_pairs_[li][0];
     sampled.letter = 'D';
     float pdf_pos = 1.0f;
     if (l.type == EmitterKind::kArea) {
@@ -719,7 +788,7 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
   } else {
     // --- a shadow ray between y(s-1) and z(t-1) ---
     if (qs->kind == Kind::kLens || pt->kind != Kind::kSurface || qs->kind != Kind::kSurface) return;
-    if (!finite_side(*qs) || !finite_side(*pt)) return;
+    if (!qs->finite || !pt->finite) return;
     const vec3 d = pt->p - qs->p;
     const float d2 = glm::dot(d, d);
     if (d2 <= 0.0f) return;
@@ -737,7 +806,7 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
   full_path(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr, letters);
   if (letters.empty()) return;
   const float w = mis_weight(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr, letters);
-  record(th, images, letters, strategy, batch, contrib * w, splat, rx, ry);
+  record(th, images, letters, strategy_index, batch, contrib * w, splat, rx, ry);
 }
 
 float Integrator::weight_sum(Thread& th, int s, int t) const {
@@ -757,7 +826,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
   float sum = 0.0f;
   for (int s2 = 0; s2 <= k + 1; ++s2) {
     const int t2 = k + 1 - s2;
-    if (strategies_.find(s2, t2) < 0 || letters[static_cast<std::size_t>(s2) + 1] != 'D' ||
+    if (strategy(s2, t2) < 0 || letters[static_cast<std::size_t>(s2) + 1] != 'D' ||
         letters[static_cast<std::size_t>(s2) + 2] != 'D')
       continue;
     if (t2 == 0 && !lens_hits_) continue;
@@ -773,6 +842,17 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
     }
     if (s2 == 0) {
       th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;
+    }
+    // Each vertex's direction to its predecessor on its new subpath.
+    for (int i = 0; i < s2; ++i) {
+      Vertex& v = th.light[static_cast<std::size_t>(i)];
+      if (i == 0) v.wo = vec3(0.0f), v.d2_wo = 0.0f;
+      else link(v, th.light[static_cast<std::size_t>(i - 1)]);
+    }
+    for (int j = 0; j < t2; ++j) {
+      Vertex& v = th.eye[static_cast<std::size_t>(j)];
+      if (j == 0) v.wo = vec3(0.0f), v.d2_wo = 0.0f;
+      else link(v, th.eye[static_cast<std::size_t>(j - 1)]);
     }
     // The letter of x_i in this path (c_{i+1}); a Dirac there keeps both densities through it symbolic.
     auto specular = [&](int i) { return i >= 1 && i <= k - 1 && letters[static_cast<std::size_t>(i) + 2] == 'S'; };
@@ -819,7 +899,7 @@ void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::ui
       if (t == 0 && !(s >= 2 && lens_hits_ && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens)) continue;
       if (t > 0 && s >= 2 && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens) continue;
       if (s == 0 && t < 2) continue;
-      if (strategies_.find(s, t) < 0) continue;
+      if (strategy(s, t) < 0) continue;
       connect(th, images, rng, s, t, batch);
     }
   }
@@ -840,7 +920,7 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
   Integrator integrator(*rs, *strategies, o, nullptr);
-  Integrator::Thread th{Histogram(layout, nullptr), ClassImages::PixelSum(images), {}, {}, {}, 0};
+  Integrator::Thread th{Histogram(layout, nullptr), ClassImages::PixelSum(images), {}, {}, {}, 0, {}, {}};
   std::vector<MisCheck> out;
   for (int i = 0; i < samples; ++i) {
     const int px = i % rs->camera.width, py = (i / rs->camera.width) % rs->camera.height;
@@ -879,7 +959,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
   tbb::enumerable_thread_specific<Integrator::Thread> locals(
-      [&] { return Integrator::Thread{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, {}, 0}; });
+      [&] { return Integrator::Thread{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, {}, 0, {}, {}}; });
   const int w = rs->camera.width, h = rs->camera.height;
   const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
   const auto start = std::chrono::steady_clock::now();

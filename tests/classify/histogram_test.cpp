@@ -46,6 +46,24 @@ TEST(ExactSum, RoundsOnceToTheGridAndConvertsBack) {
     EXPECT_FALSE(to_exact({0.0, bad, 0.0})) << bad;
 }
 
+// round_to_fixed() avoids nearbyint's library call and the 128-bit conversion's; it must agree
+// with them exactly: ties to even at every magnitude, both signs, and across the fast paths'
+// edges (2^52, 2^63, 2^64) up to the 2^114 bound.
+TEST(ExactSum, FastRoundingMatchesNearbyint) {
+  const auto reference = [](double y) { return static_cast<ExactSum>(static_cast<SignedExactSum>(std::nearbyint(y))); };
+  std::vector<double> ys = {0.0, -0.0, 0.5, 1.5, 2.5, -0.5, -1.5, -2.5, 0x1p52 - 0.5, 0x1p52 + 1, 0x1p53 + 2,
+                            0x1p63 - 1024, 0x1p63, -0x1p63, 0x1p64, -0x1p64, 0x1p64 + 0x1p12, 0x1p113, -0x1p113,
+                            std::nextafter(0x1p63, 0.0), std::nextafter(0x1p52, 0.0), 4503599627370495.5};
+  Rng rng{3};
+  for (int i = 0; i < 200000; ++i) {
+    const double magnitude = std::ldexp(1.0, static_cast<int>(rng.next() % 114));
+    const double y = (rng.uniform() * 2.0 - 1.0) * magnitude;
+    ys.push_back(y);
+    ys.push_back(std::floor(y) + 0.5);  // an exact tie, where representable
+  }
+  for (double y : ys) ASSERT_EQ(round_to_fixed(y), reference(y)) << std::hexfloat << y;
+}
+
 TEST(ExactSum, TextRoundTrip) {
   const ExactSum top = static_cast<ExactSum>(1) << 127;
   for (ExactSum v : {ExactSum{0}, ExactSum{1}, ExactSum{0} - 1, static_cast<ExactSum>(0x1f) << 70, top - 1, top})
