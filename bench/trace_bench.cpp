@@ -1,13 +1,16 @@
 // Tracer benchmarks (issue 4). Run:
-//   build/bench/trace_bench --benchmark_min_time=1
-// Each case renders the embedded Cornell box (or a generated mesh) and reports rays per second;
-// compare ratios measured in one run: the machines are shared and noisy.
+//   build/bench/trace_bench --benchmark_min_time=2
+// Each case renders the embedded Cornell box (or a generated mesh). The machines are shared and
+// noisy, so every target that is a ratio is measured interleaved: each iteration times both
+// sides back to back (in process CPU time), and the counter is the ratio of the summed times.
 #include <benchmark/benchmark.h>
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <embree3/rtcore.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -36,90 +39,124 @@ RenderOptions options(int threads, std::uint64_t spp) {
   return o;
 }
 
-// The tracer's own rate: all rays it casts (subpath extensions and shadow rays) per second.
+// Process CPU time in seconds: on a shared machine, time the host gives to others is not counted.
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The baseline: a plain rtcIntersect1 loop over the same Embree scene, one thread, casting
+// exactly `count` rays: camera rays through random pixels, each followed by up to three random
+// bounces (comparable coherence), the minimum of work around each ray. Returns the hits.
+std::uint64_t plain_embree_loop(const RenderScene& rs, std::uint64_t count, std::uint64_t seed) {
+  const RenderCamera& cam = rs.camera;
+  std::uint64_t rays = 0, hits = 0;
+  for (std::uint64_t path = 0; rays < count; ++path) {
+    Sampler rng(seed, path, 0);
+    const glm::vec2 u = rng.get2d();
+    const float sx = (2.0f * u.x - 1.0f) * cam.tan_x, sy = (1.0f - 2.0f * u.y) * cam.tan_y;
+    glm::vec3 o = cam.position, d = glm::normalize(cam.forward + sx * cam.right + sy * cam.up);
+    for (int bounce = 0; bounce < 4 && rays < count; ++bounce) {
+      RTCRayHit rh{};
+      rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
+      rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
+      rh.ray.tnear = 1e-4f;
+      rh.ray.tfar = std::numeric_limits<float>::infinity();
+      rh.ray.mask = 0xFFFFFFFFu;
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      rtcIntersect1(rs.geometry->handle(), &ctx, &rh);
+      ++rays;
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+      ++hits;
+      o = o + d * rh.ray.tfar;
+      glm::vec3 n = glm::normalize(glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+      if (glm::dot(n, d) > 0) n = -n;
+      o += n * 1e-4f;
+      d = glm::normalize(n + sample_uniform_sphere(rng.get2d()));
+    }
+  }
+  return hits;
+}
+
+// The tracer's rays per second against the plain loop's, interleaved: each iteration renders
+// (one thread, all rays it casts: subpath extensions and shadow rays), then casts the same number
+// of rays in the plain loop, so that both see the same machine; `ratio` is the tracer's rate over
+// the plain loop's, from CPU time summed over the iterations.
 void BM_TracerRays(benchmark::State& state) {
   const char* const names[] = {"bdpt", "pt-nee", "pt", "lt"};
-  const Profile bdpt = *resolve_profile(names[state.range(0)], Limits{});
+  const Profile profile = *resolve_profile(names[state.range(0)], Limits{});
+  Result<RenderScene> rs = make_render_scene(cornell());
   std::uint64_t rays = 0;
-  double seconds = 0;
+  double tracer_s = 0, plain_s = 0;
   for (auto _ : state) {
-    Result<RenderOutput> out = render(cornell(), bdpt, nullptr, options(1, 4));
+    const double t0 = cpu_seconds();
+    Result<RenderOutput> out = render(cornell(), profile, nullptr, options(1, 4));
+    const double t1 = cpu_seconds();
+    benchmark::DoNotOptimize(plain_embree_loop(*rs, out->rays, rays));
+    const double t2 = cpu_seconds();
     rays += out->rays;
-    seconds += out->time_s;
+    tracer_s += t1 - t0;
+    plain_s += t2 - t1;
   }
-  state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays) / seconds);
-  state.SetLabel(bdpt.name + ", 1 thread");
+  state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays) / tracer_s);
+  state.counters["plain_rays_per_s"] = benchmark::Counter(static_cast<double>(rays) / plain_s);
+  state.counters["ratio"] = benchmark::Counter(plain_s / tracer_s);
+  state.SetLabel(profile.name + ", 1 thread");
 }
 BENCHMARK(BM_TracerRays)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// The baseline: a plain rtcIntersect1 loop over the same Embree scene, casting camera rays and
-// then one random bounce per hit (comparable coherence), one thread.
-void BM_PlainEmbreeLoop(benchmark::State& state) {
-  Result<RenderScene> rs = make_render_scene(cornell());
-  const RenderCamera& cam = rs->camera;
-  std::uint64_t rays = 0;
-  for (auto _ : state) {
-    std::uint64_t hits = 0;
-    for (int y = 0; y < cam.height; ++y)
-      for (int x = 0; x < cam.width; ++x)
-        for (int p = 0; p < 4; ++p) {
-          Sampler rng(1, static_cast<std::uint64_t>(y * cam.width + x), static_cast<std::uint64_t>(p));
-          const float sx = (2.0f * (static_cast<float>(x) + rng.get1d()) / static_cast<float>(cam.width) - 1.0f) * cam.tan_x;
-          const float sy = (1.0f - 2.0f * (static_cast<float>(y) + rng.get1d()) / static_cast<float>(cam.height)) * cam.tan_y;
-          glm::vec3 o = cam.position, d = glm::normalize(cam.forward + sx * cam.right + sy * cam.up);
-          for (int bounce = 0; bounce < 4; ++bounce) {
-            RTCRayHit rh{};
-            rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
-            rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
-            rh.ray.tnear = 1e-4f;
-            rh.ray.tfar = std::numeric_limits<float>::infinity();
-            rh.ray.mask = 0xFFFFFFFFu;
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            RTCIntersectContext ctx;
-            rtcInitIntersectContext(&ctx);
-            rtcIntersect1(rs->geometry->handle(), &ctx, &rh);
-            ++rays;
-            if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
-            ++hits;
-            o = o + d * rh.ray.tfar;
-            glm::vec3 n = glm::normalize(glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
-            if (glm::dot(n, d) > 0) n = -n;
-            o += n * 1e-4f;
-            d = glm::normalize(n + sample_uniform_sphere(rng.get2d()));
-          }
-        }
-    benchmark::DoNotOptimize(hits);
-  }
-  state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays), benchmark::Counter::kIsRate);
-}
-BENCHMARK(BM_PlainEmbreeLoop)->Unit(benchmark::kMillisecond)->UseRealTime();
-
-// Classification overhead: the same render with no classes, with the 20-class file (labels
-// classified, an image layer per class: Arg 20), and with the 20 classes but no class layers
-// (Arg 21: the automaton's share alone).
+// Classification overhead, interleaved: each iteration renders with no classes and then with the
+// 20-class file (Arg 20: labels classified and an image layer per class; Arg 21: classified, no
+// class layers, the automaton's share alone). `overhead` is the CPU time with classes over the
+// time without, minus 1.
 void BM_RenderClasses(benchmark::State& state) {
   const Profile bdpt = *resolve_profile("bdpt", Limits{});
   ClassTable table;
   std::vector<const PathClass*> classes;
-  if (state.range(0) > 0) {
-    (void)read_class_file(std::string(PATHEX_SOURCE_DIR) + "/samples/classes/twenty.json", ClassOptions{}, &table);
-    for (const auto& c : table.user_classes()) classes.push_back(c.get());
-  }
-  const Classifier cl = *Classifier::build(classes, Limits{});
-  RenderOptions o = options(1, 4);
+  (void)read_class_file(std::string(PATHEX_SOURCE_DIR) + "/samples/classes/twenty.json", ClassOptions{}, &table);
+  for (const auto& c : table.user_classes()) classes.push_back(c.get());
+  const Classifier none = *Classifier::build({}, Limits{});
+  const Classifier twenty = *Classifier::build(classes, Limits{});
+  RenderOptions plain = options(1, 4), classified = options(1, 4);
   if (state.range(0) == 20)
-    for (int i = 0; i < cl.num_classes(); ++i) o.layer_classes.push_back(i);
-  for (auto _ : state) benchmark::DoNotOptimize(render(cornell(), bdpt, &cl, o));
-  state.SetLabel(std::to_string(classes.size()) + " classes, " + std::to_string(o.layer_classes.size()) + " class layers");
+    for (int i = 0; i < twenty.num_classes(); ++i) classified.layer_classes.push_back(i);
+  double without_s = 0, with_s = 0;
+  for (auto _ : state) {
+    const double t0 = cpu_seconds();
+    benchmark::DoNotOptimize(render(cornell(), bdpt, &none, plain));
+    const double t1 = cpu_seconds();
+    benchmark::DoNotOptimize(render(cornell(), bdpt, &twenty, classified));
+    const double t2 = cpu_seconds();
+    without_s += t1 - t0;
+    with_s += t2 - t1;
+  }
+  state.counters["overhead_pct"] = benchmark::Counter(100.0 * (with_s / without_s - 1.0));
+  state.SetLabel(std::to_string(classes.size()) + " classes, " + std::to_string(classified.layer_classes.size()) +
+                 " class layers, against none");
 }
-BENCHMARK(BM_RenderClasses)->Arg(0)->Arg(20)->Arg(21)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderClasses)->Arg(20)->Arg(21)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Thread scaling: one against two threads on the same render.
+// Thread scaling, interleaved: each iteration renders with one thread and then with two (wall
+// time); `speedup` is the summed one-thread time over the summed two-thread time.
 void BM_RenderThreads(benchmark::State& state) {
   const Profile bdpt = *resolve_profile("bdpt", Limits{});
-  for (auto _ : state) benchmark::DoNotOptimize(render(cornell(), bdpt, nullptr, options(static_cast<int>(state.range(0)), 8)));
+  double one_s = 0, two_s = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(render(cornell(), bdpt, nullptr, options(1, 8)));
+    const auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(render(cornell(), bdpt, nullptr, options(2, 8)));
+    const auto t2 = std::chrono::steady_clock::now();
+    one_s += std::chrono::duration<double>(t1 - t0).count();
+    two_s += std::chrono::duration<double>(t2 - t1).count();
+  }
+  state.counters["speedup"] = benchmark::Counter(one_s / two_s);
+  state.SetLabel("8 spp, 1 thread then 2");
 }
-BENCHMARK(BM_RenderThreads)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderThreads)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A one-million-triangle OBJ (a displaced grid) under the Cornell light: load and render, with
 // the process's peak memory.

@@ -92,26 +92,43 @@ void link(Vertex& v, const Vertex& pred) {
   v.wo = v.d2_wo > 0.0f ? e / std::sqrt(v.d2_wo) : vec3(0.0f);
 }
 
-// A full-path string packed for hashing: bit i is set when letter c_i is S, and the string's
-// length sits in the top byte. Strings of up to kMaxPackedLetters scattering letters pack.
+// A full-path string L c0 … c(k+2) E packed: bit i is set when c_i is S, and the number of
+// scattering letters (k + 3) sits in the top byte. Every string the tracer forms packs: k + 3 is
+// at most kMaxVertices + 1 letters (max_bounces is clamped so).
 __extension__ typedef unsigned __int128 PathKey;
-constexpr std::size_t kMaxPackedLetters = 120;
+constexpr int kLengthShift = 120;
+static_assert(kMaxVertices + 1 < kLengthShift);
+constexpr PathKey bit(int i) { return static_cast<PathKey>(1) << i; }
+constexpr PathKey letter_bit(char c, int i) { return c == 'S' ? bit(i) : 0; }
+int packed_length(PathKey key) { return static_cast<int>(key >> kLengthShift); }
+bool packed_is_d(PathKey key, int i) { return ((key >> i) & 1) == 0; }
+
+std::string unpack(PathKey key) {
+  const int n = packed_length(key);
+  std::string out(static_cast<std::size_t>(n) + 2, 'D');
+  out.front() = 'L';
+  out.back() = 'E';
+  for (int i = 0; i < n; ++i)
+    if (!packed_is_d(key, i)) out[static_cast<std::size_t>(i) + 1] = 'S';
+  return out;
+}
+PathKey pack(const std::string& letters) {  // "L c0 … E"
+  PathKey key = static_cast<PathKey>(letters.size() - 2) << kLengthShift;
+  for (std::size_t i = 1; i + 1 < letters.size(); ++i) key |= letter_bit(letters[i], static_cast<int>(i) - 1);
+  return key;
+}
 
 // Per-thread map from packed strings to histogram ids, so that recording a contribution hashes
 // two words instead of a string; Histogram::intern() runs once per new path and thread.
 class PathIds {
  public:
-  Histogram::PathId get(Histogram& hist, const std::string& letters) {
-    if (letters.size() - 2 > kMaxPackedLetters) return hist.intern(letters);
-    PathKey key = static_cast<PathKey>(letters.size()) << 120;
-    for (std::size_t i = 1; i + 1 < letters.size(); ++i)
-      if (letters[i] == 'S') key |= static_cast<PathKey>(1) << (i - 1);
+  Histogram::PathId get(Histogram& hist, PathKey key) {
     const std::size_t mask = slots_.size() - 1;
     for (std::size_t i = hash(key) & mask;; i = (i + 1) & mask) {
       Slot& slot = slots_[i];
       if (slot.key == key) return slot.id;
       if (slot.key == 0) {
-        const Histogram::PathId id = hist.intern(letters);
+        const Histogram::PathId id = hist.intern(unpack(key));
         slot = {key, id};
         if (2 * ++used_ > slots_.size()) grow();
         return id;
@@ -184,7 +201,33 @@ class Integrator {
     std::uint64_t rays = 0;
     PathIds ids;
     Vertex sampled;  // connect()'s fresh light or sensor sample
+    // The subpaths' letters packed (set by letter_masks()): light_mask has c0 c1 of y0, then
+    // bit i + 1 for y_i's letter; eye_masks[t] has the eye subpath's last t + 1 letters (z(t-1)
+    // … z0 and z0's spatial letter) as they sit after c(s) in any connection with t eye vertices.
+    PathKey light_mask = 0;
+    std::array<PathKey, kMaxVertices + 1> eye_masks{};
   };
+
+  void letter_masks(Thread& th, int ns, int nt) const {
+    th.light_mask = 0;
+    if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
+    for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
+    th.eye_masks[0] = letter_bit(th.eye[0].pos_letter, 0);
+    for (int t = 1; t <= nt; ++t)
+      th.eye_masks[static_cast<std::size_t>(t)] =
+          (th.eye_masks[static_cast<std::size_t>(t - 1)] << 1) | letter_bit(th.eye[static_cast<std::size_t>(t - 1)].letter, 0);
+  }
+  // The packed full-path string of connection (s, t), as full_path() spells it.
+  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
+    PathKey m = 0;
+    if (s > 0) {
+      m = th.light_mask & (bit(s + 1) - 1);
+      if (s == 1 && t != 1 && sampled) m = letter_bit(sampled->pos_letter, 0) | letter_bit(sampled->letter, 1);
+    }
+    if (t > 0) m |= th.eye_masks[static_cast<std::size_t>(t)] << (s + 1);
+    m &= ~(bit(s) | bit(s + 1));  // the join letters
+    return m | static_cast<PathKey>(s + t + 2) << kLengthShift;
+  }
 
   // The profile's strategy that runs (s, t), or -1.
   int strategy(int s, int t) const {
@@ -222,9 +265,12 @@ class Integrator {
     full_path(th, s, t, nullptr, out);
     return out;
   }
+  // The same string as the renderer records it (packed, then spelled out).
+  std::string packed_label(const Thread& th, int s, int t) const { return unpack(path_key(th, s, t, nullptr)); }
   int trace_subpaths(Thread& th, Sampler& rng, int px, int py, int* ns) const {
     const int nt = eye_subpath(th, rng, px, py);
     *ns = light_subpath(th, rng);
+    letter_masks(th, *ns, nt);
     return nt;
   }
 
@@ -349,7 +395,7 @@ class Integrator {
 
   // --- connections ---
   void connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int batch) const;
-  float mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const;
+  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key) const;
   // The full-path letters of the path made by s light and t eye vertices (with `sampled`
   // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
   // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
@@ -358,8 +404,8 @@ class Integrator {
     ++th.rays;
     return rs_.geometry->visible(a.p, a.n, b.p, b.n);
   }
-  void record(Thread& th, ClassImages& images, const std::string& path, int strategy, int batch, const vec3& c,
-              bool splat, float rx, float ry) const;
+  void record(Thread& th, ClassImages& images, PathKey path, int strategy, int batch, const vec3& c, bool splat,
+              float rx, float ry) const;
 
   const RenderScene& rs_;
   const RenderCamera& cam_;
@@ -605,84 +651,73 @@ void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled
   c(s + 1) = 'D';
 }
 
-float Integrator::mis_weight(Thread& th, int s, int t, const Vertex* sampled, const std::string& letters) const {
-  // letters = "L c0 … E": c_i is letters[i + 1].
-  auto runs = [&](int s2, int t2) {
-    return strategy(s2, t2) >= 0 &&
-           letters[static_cast<std::size_t>(s2) + 1] == 'D' && letters[static_cast<std::size_t>(s2) + 2] == 'D';
-  };
+float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key) const {
+  // Strategy (s2, t2) samples this string when the profile runs it and its join letters c(s2),
+  // c(s2+1) are both D.
+  auto runs = [&](int s2, int t2) { return strategy(s2, t2) >= 0 && ((key >> s2) & 3) == 0; };
   // When no other strategy can sample this string (pt, lt, and many strings of every profile),
   // the weight is 1 and no density needs recomputing.
   bool alone = true;
   for (int s2 = 0; s2 <= s + t && alone; ++s2)
     if (s2 != s && (s + t - s2 > 0 || lens_hits_) && runs(s2, s + t - s2)) alone = false;
   if (alone) return 1.0f;
-  const auto remap = [](float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; };
-  // Work on copies of the affected vertices.
-  std::array<Vertex, kMaxVertices>& L = th.light;
-  std::array<Vertex, kMaxVertices>& E = th.eye;
-  Vertex* qs = s > 0 ? &L[static_cast<std::size_t>(s - 1)] : nullptr;
-  Vertex* pt = t > 0 ? &E[static_cast<std::size_t>(t - 1)] : nullptr;
-  Vertex* qsm = s > 1 ? &L[static_cast<std::size_t>(s - 2)] : nullptr;
-  Vertex* ptm = t > 1 ? &E[static_cast<std::size_t>(t - 2)] : nullptr;
-  // Only the four reverse densities change (and one vertex when a fresh sample replaces it):
-  // save those, restore them at the end.
-  const float rev_qs = qs ? qs->pdf_rev : 0.0f, rev_pt = pt ? pt->pdf_rev : 0.0f;
-  const float rev_qsm = qsm ? qsm->pdf_rev : 0.0f, rev_ptm = ptm ? ptm->pdf_rev : 0.0f;
-  Vertex* replaced = (t == 1 && sampled) ? pt : (s == 1 && sampled) ? qs : nullptr;
-  Vertex saved_replaced;
-  if (replaced) {
-    saved_replaced = *replaced;
-    *replaced = *sampled;
-  }
-  // --- reverse densities at the join ---
+  const std::array<Vertex, kMaxVertices>& L = th.light;
+  const std::array<Vertex, kMaxVertices>& E = th.eye;
+  // The join's vertices; a fresh sample stands for z0 when t = 1, else for y0 when s = 1.
+  const Vertex* qs = s > 0 ? (s == 1 && t != 1 && sampled ? sampled : &L[static_cast<std::size_t>(s - 1)]) : nullptr;
+  const Vertex* pt = t > 0 ? (t == 1 && sampled ? sampled : &E[static_cast<std::size_t>(t - 1)]) : nullptr;
+  const Vertex* qsm = s > 1 ? &L[static_cast<std::size_t>(s - 2)] : nullptr;
+  const Vertex* ptm = t > 1 ? &E[static_cast<std::size_t>(t - 2)] : nullptr;
+  // --- the four reverse densities the join changes (the subpaths themselves stay untouched) ---
   // Every direction is at hand: the join's (w, from qs to pt, at squared distance d2) and each
   // vertex's unit direction to its predecessor (wo, at d2_wo); no normalisation is needed.
   // Area density at `next` from solid-angle density `pdf_w` along unit `w` over squared distance `dist2`.
   const auto area = [](float pdf_w, const Vertex& next, const vec3& w, float dist2) {
     return dist2 > 0.0f ? pdf_w * abs_cos(next, w) / dist2 : 0.0f;
   };
+  float rev_qs = 0.0f, rev_pt = 0.0f, rev_qsm = 0.0f, rev_ptm = 0.0f;
   if (qs && pt) {
     const vec3 e = pt->p - qs->p;
     const float d2 = glm::dot(e, e);
     const vec3 w = d2 > 0.0f ? e / std::sqrt(d2) : vec3(0.0f), back = -w;
-    pt->pdf_rev = area(pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
-    qs->pdf_rev = area(pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
-    if (ptm) ptm->pdf_rev = area(pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
-    if (qsm) qsm->pdf_rev = area(pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
+    rev_pt = area(pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
+    rev_qs = area(pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
+    if (ptm) rev_ptm = area(pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
+    if (qsm) rev_qsm = area(pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
   } else if (pt) {  // s = 0: pt lies on an area light
-    pt->pdf_rev = pdf_light_origin(*pt);
+    rev_pt = pdf_light_origin(*pt);
     if (ptm) {
       const RenderLight& l = rs_.lights[static_cast<std::size_t>(rs_.light_of_shape[static_cast<std::size_t>(pt->shape)])];
-      ptm->pdf_rev = area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo);
+      rev_ptm = area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo);
     }
   } else if (qs) {  // t = 0: qs is the lens point
-    qs->pdf_rev = sensor_pdf_pos();
-    if (qsm) qsm->pdf_rev = area(sensor_pdf_dir(qs->wo), *qsm, qs->wo, qs->d2_wo);
+    rev_qs = sensor_pdf_pos();
+    if (qsm) rev_qsm = area(sensor_pdf_dir(qs->wo), *qsm, qs->wo, qs->d2_wo);
   }
   // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
-  // Ratios in double: long paths multiply many of them.
+  // Ratios in double: long paths multiply many of them. Dirac densities are stored as 0 and
+  // count as 1 here; their strategies are excluded by letter.
+  const auto remap = [](float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; };
   double sum = 0.0, ri = 1.0;
   for (int i = t - 1; i >= 0; --i) {
-    ri *= remap(E[static_cast<std::size_t>(i)].pdf_rev) / remap(E[static_cast<std::size_t>(i)].pdf_fwd);
+    const float rev = i == t - 1 ? rev_pt : i == t - 2 ? rev_ptm : E[static_cast<std::size_t>(i)].pdf_rev;
+    const float fwd = i == t - 1 ? pt->pdf_fwd : E[static_cast<std::size_t>(i)].pdf_fwd;
+    ri *= remap(rev) / remap(fwd);
     if (i == 0 && !lens_hits_) break;
     if (runs(s + t - i, i)) sum += ri * ri;
   }
   ri = 1.0;
   for (int i = s - 1; i >= 0; --i) {
-    ri *= remap(L[static_cast<std::size_t>(i)].pdf_rev) / remap(L[static_cast<std::size_t>(i)].pdf_fwd);
+    const float rev = i == s - 1 ? rev_qs : i == s - 2 ? rev_qsm : L[static_cast<std::size_t>(i)].pdf_rev;
+    const float fwd = i == s - 1 ? qs->pdf_fwd : L[static_cast<std::size_t>(i)].pdf_fwd;
+    ri *= remap(rev) / remap(fwd);
     if (runs(i, s + t - i)) sum += ri * ri;
   }
-  if (replaced) *replaced = saved_replaced;
-  if (qs) qs->pdf_rev = rev_qs;
-  if (pt) pt->pdf_rev = rev_pt;
-  if (qsm) qsm->pdf_rev = rev_qsm;
-  if (ptm) ptm->pdf_rev = rev_ptm;
   return static_cast<float>(1.0 / (1.0 + sum));
 }
 
-void Integrator::record(Thread& th, ClassImages& images, const std::string& path, int strategy, int batch,
-                        const vec3& c, bool splat, float rx, float ry) const {
+void Integrator::record(Thread& th, ClassImages& images, PathKey path, int strategy, int batch, const vec3& c,
+                        bool splat, float rx, float ry) const {
   const Rgb rgb{c.x, c.y, c.z};
   const std::optional<ExactRgb> e = to_exact(rgb);
   if (!e) {
@@ -802,11 +837,9 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
     if (is_black(contrib) || !visible(th, *qs, *pt)) return;
   }
   if (is_black(contrib)) return;
-  std::string& letters = th.label;
-  full_path(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr, letters);
-  if (letters.empty()) return;
-  const float w = mis_weight(th, s, t, (s == 1 || t == 1) ? &sampled : nullptr, letters);
-  record(th, images, letters, strategy_index, batch, contrib * w, splat, rx, ry);
+  const Vertex* fresh = (s == 1 || t == 1) ? &sampled : nullptr;
+  const PathKey key = path_key(th, s, t, fresh);
+  record(th, images, key, strategy_index, batch, contrib * mis_weight(th, s, t, fresh, key), splat, rx, ry);
 }
 
 float Integrator::weight_sum(Thread& th, int s, int t) const {
@@ -877,7 +910,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
           specular(k - (j + 1)) ? 0.0f
                                 : pdf(&th.eye[static_cast<std::size_t>(j + 2)], th.eye[static_cast<std::size_t>(j + 1)],
                                       th.eye[static_cast<std::size_t>(j)]);
-    sum += mis_weight(th, s2, t2, nullptr, letters);
+    sum += mis_weight(th, s2, t2, nullptr, pack(letters));
   }
   th.light = saved_light_eye.light;
   th.eye = saved_light_eye.eye;
@@ -890,6 +923,7 @@ void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::ui
   const int batch = batch_of(pass, o_.batches);
   const int nt = eye_subpath(th, rng, px, py);
   const int ns = light_subpath(th, rng);
+  letter_masks(th, ns, nt);
   for (int t = 0; t <= nt; ++t) {
     // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
     const int s_max = rs_.lights.empty() ? ns : std::max(ns, 1);
@@ -933,7 +967,7 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
         if (strategies->find(s, t) < 0) continue;
         const float sum = integrator.weight_sum_if_valid(th, s, t);
         if (sum < 0.0f) continue;  // not a path this connection forms
-        out.push_back({integrator.label(th, s, t), s, t, sum});
+        out.push_back({integrator.label(th, s, t), s, t, sum, integrator.packed_label(th, s, t)});
       }
   }
   return out;

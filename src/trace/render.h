@@ -68,6 +68,7 @@ struct MisCheck {
   std::string path;
   int s = 0, t = 0;
   double weight_sum = 0.0;
+  std::string recorded;  // the label as the renderer packs and records it: must equal `path`
 };
 Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed,
                                                 int samples);

@@ -30,6 +30,7 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
         ++by_length[static_cast<int>(c.path.size())];
         EXPECT_NEAR(c.weight_sum, 1.0, 1e-4) << entry.path().filename() << " " << renderer << " " << c.path << " (s="
                                               << c.s << ", t=" << c.t << ")";
+        EXPECT_EQ(c.recorded, c.path) << "the packed label differs (s=" << c.s << ", t=" << c.t << ")";
       }
     }
   }
