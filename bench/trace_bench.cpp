@@ -108,7 +108,7 @@ void BM_TracerRays(benchmark::State& state) {
 }
 BENCHMARK(BM_TracerRays)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Classification overhead, interleaved: each iteration renders with no classes and then with the
+// Classification overhead, interleaved: each iteration renders with no classes and with the
 // 20-class file (Arg 20: labels classified and an image layer per class; Arg 21: classified, no
 // class layers, the automaton's share alone). `overhead` is the CPU time with classes over the
 // time without, minus 1.
@@ -120,24 +120,28 @@ void BM_RenderClasses(benchmark::State& state) {
   for (const auto& c : table.user_classes()) classes.push_back(c.get());
   const Classifier none = *Classifier::build({}, Limits{});
   const Classifier twenty = *Classifier::build(classes, Limits{});
+  const bool control = state.range(0) == 0;  // Arg 0: no classes on both sides, the method's noise floor
   RenderOptions plain = options(1, 4), classified = options(1, 4);
   if (state.range(0) == 20)
     for (int i = 0; i < twenty.num_classes(); ++i) classified.layer_classes.push_back(i);
   double without_s = 0, with_s = 0;
+  bool classes_first = false;  // alternated, so that neither side always runs on a warm cache
   for (auto _ : state) {
-    const double t0 = cpu_seconds();
-    benchmark::DoNotOptimize(render(cornell(), bdpt, &none, plain));
-    const double t1 = cpu_seconds();
-    benchmark::DoNotOptimize(render(cornell(), bdpt, &twenty, classified));
-    const double t2 = cpu_seconds();
-    without_s += t1 - t0;
-    with_s += t2 - t1;
+    for (int side = 0; side < 2; ++side) {
+      const bool with = (side == 0) == classes_first;
+      const double t0 = cpu_seconds();
+      benchmark::DoNotOptimize(with ? render(cornell(), bdpt, control ? &none : &twenty, classified)
+                                    : render(cornell(), bdpt, &none, plain));
+      (with ? with_s : without_s) += cpu_seconds() - t0;
+    }
+    classes_first = !classes_first;
   }
   state.counters["overhead_pct"] = benchmark::Counter(100.0 * (with_s / without_s - 1.0));
-  state.SetLabel(std::to_string(classes.size()) + " classes, " + std::to_string(classified.layer_classes.size()) +
-                 " class layers, against none");
+  state.SetLabel(control ? std::string("control: no classes against none")
+                         : std::to_string(classes.size()) + " classes, " + std::to_string(classified.layer_classes.size()) +
+                               " class layers, against none");
 }
-BENCHMARK(BM_RenderClasses)->Arg(20)->Arg(21)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderClasses)->Arg(0)->Arg(20)->Arg(21)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Thread scaling, interleaved: each iteration renders with one thread and then with two (wall
 // time); `speedup` is the summed one-thread time over the summed two-thread time.

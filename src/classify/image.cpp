@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <map>
 
 namespace pathex {
 namespace {
@@ -29,65 +30,119 @@ ClassImages::ClassImages(int width, int height, const Classifier* classifier, co
     : width_(std::max(width, 0)), height_(std::max(height, 0)) {
   names_.push_back("total");
   for (int k : layer_classes) names_.push_back(classifier->name(k));
+  // Sets whose classes have the same layers share a plane: without class layers every set lands
+  // in the one plane of the total. Slot 0 holds the sets with no class layer, and unknown ids.
   const int num_sets = classifier != nullptr ? classifier->num_sets() : 1;
-  layers_of_set_.resize(static_cast<std::size_t>(num_sets));
-  for (int s = 0; s < num_sets; ++s) {
-    std::vector<int>& layers = layers_of_set_[static_cast<std::size_t>(s)];
-    layers.push_back(0);
-    if (classifier == nullptr) continue;
-    for (int k : classifier->members(static_cast<std::uint32_t>(s))) {
+  std::map<std::vector<std::size_t>, std::size_t> slot_of_layers{{{}, 0}};
+  slot_of_set_.assign(static_cast<std::size_t>(num_sets), 0);
+  for (int set = 0; classifier != nullptr && set < num_sets; ++set) {
+    std::vector<std::size_t> layers;
+    for (int k : classifier->members(static_cast<std::uint32_t>(set)))
       for (std::size_t i = 0; i < layer_classes.size(); ++i)
-        if (layer_classes[i] == k) layers.push_back(static_cast<int>(i) + 1);
-    }
+        if (layer_classes[i] == k) layers.push_back(i + 1);
     std::sort(layers.begin(), layers.end());
+    const auto [it, added] = slot_of_layers.emplace(layers, slot_of_layers.size());
+    slot_of_set_[static_cast<std::size_t>(set)] = it->second;
   }
-  words_.assign(static_cast<std::size_t>(num_layers()) * static_cast<std::size_t>(width_) *
-                    static_cast<std::size_t>(height_) * 6,
-                0);
+  num_slots_ = slot_of_layers.size();
+  slots_of_layer_.resize(names_.size());
+  for (const auto& [layers, slot] : slot_of_layers) {
+    slots_of_layer_[0].push_back(slot);
+    for (std::size_t layer : layers) slots_of_layer_[layer].push_back(slot);
+  }
+  for (auto& slots : slots_of_layer_) std::sort(slots.begin(), slots.end());
+  planes_ = std::make_unique<std::atomic<std::uint64_t*>[]>(num_slots_);
+  for (std::size_t slot = 0; slot < num_slots_; ++slot) planes_[slot].store(nullptr, std::memory_order_relaxed);
 }
 
-const std::vector<int>& ClassImages::layers_of_set(std::uint32_t set) const {
-  // An unknown set id is a caller's bug; its contribution still belongs to the total.
-  return set < layers_of_set_.size() ? layers_of_set_[set] : total_only();
+ClassImages::~ClassImages() { release(); }
+
+ClassImages::ClassImages(ClassImages&& other) noexcept
+    : width_(other.width_),
+      height_(other.height_),
+      names_(std::move(other.names_)),
+      slots_of_layer_(std::move(other.slots_of_layer_)),
+      slot_of_set_(std::move(other.slot_of_set_)),
+      num_slots_(other.num_slots_),
+      planes_(std::move(other.planes_)) {
+  other.num_slots_ = 0;
 }
 
-const std::vector<int>& ClassImages::total_only() {
-  static const std::vector<int> layers = {0};
-  return layers;
+ClassImages& ClassImages::operator=(ClassImages&& other) noexcept {
+  if (this != &other) {
+    release();
+    width_ = other.width_;
+    height_ = other.height_;
+    names_ = std::move(other.names_);
+    slots_of_layer_ = std::move(other.slots_of_layer_);
+    slot_of_set_ = std::move(other.slot_of_set_);
+    num_slots_ = other.num_slots_;
+    planes_ = std::move(other.planes_);
+    other.num_slots_ = 0;
+  }
+  return *this;
+}
+
+void ClassImages::release() {
+  if (!planes_) return;
+  for (std::size_t slot = 0; slot < num_slots_; ++slot) delete[] planes_[slot].load(std::memory_order_relaxed);
+  planes_.reset();
+}
+
+std::uint64_t* ClassImages::plane(std::size_t slot) {
+  std::uint64_t* p = planes_[slot].load(std::memory_order_acquire);
+  if (p != nullptr) return p;
+  // First use: allocate zeroed; if another thread installed one meanwhile, use that one.
+  auto* fresh = new std::uint64_t[pixel_words()]();
+  if (planes_[slot].compare_exchange_strong(p, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) return fresh;
+  delete[] fresh;
+  return p;
+}
+
+const std::uint64_t* ClassImages::plane_if_any(std::size_t slot) const {
+  return planes_ ? planes_[slot].load(std::memory_order_acquire) : nullptr;
+}
+
+std::size_t ClassImages::memory_bytes() const {
+  std::size_t planes = 0;
+  for (std::size_t slot = 0; slot < num_slots_; ++slot) planes += plane_if_any(slot) != nullptr ? 1 : 0;
+  return planes * pixel_words() * sizeof(std::uint64_t);
 }
 
 bool ClassImages::add(int x, int y, std::uint32_t set, const ExactRgb& c) {
   if (!inside(x, y)) return false;
-  for (int layer : layers_of_set(set)) {
-    std::uint64_t* w = &words_[word_index(layer, x, y)];
-    for (std::size_t ch = 0; ch < 3; ++ch)
-      if (c[ch] != 0) atomic_add(w + 2 * ch, c[ch]);
-  }
-  return true;
-}
-
-bool ClassImages::add_to_layer(int layer, int x, int y, const ExactRgb& c) {
-  if (!inside(x, y) || layer < 0 || layer >= num_layers()) return false;
-  std::uint64_t* w = &words_[word_index(layer, x, y)];
+  const std::size_t slot = set < slot_of_set_.size() ? slot_of_set_[set] : 0;
+  std::uint64_t* w = plane(slot) + word_index(x, y);
   for (std::size_t ch = 0; ch < 3; ++ch)
     if (c[ch] != 0) atomic_add(w + 2 * ch, c[ch]);
   return true;
 }
 
 Result<bool> ClassImages::merge(const ClassImages& other) {
-  if (other.width_ != width_ || other.height_ != height_ || other.names_ != names_)
+  if (other.width_ != width_ || other.height_ != height_ || other.names_ != names_ || other.num_slots_ != num_slots_)
     return make_error(ErrorCode::kUsage, "cannot merge images of different sizes or layers");
-  for (std::size_t i = 0; i < words_.size(); i += 2) {
-    const ExactSum v = load(&words_[i]) + load(&other.words_[i]);
-    words_[i] = static_cast<std::uint64_t>(v);
-    words_[i + 1] = static_cast<std::uint64_t>(v >> 64);
+  for (std::size_t slot = 0; slot < num_slots_; ++slot) {
+    const std::uint64_t* src = other.plane_if_any(slot);
+    if (src == nullptr) continue;
+    std::uint64_t* dst = plane(slot);
+    for (std::size_t i = 0; i < pixel_words(); i += 2) {
+      const ExactSum v = load(&dst[i]) + load(&src[i]);
+      dst[i] = static_cast<std::uint64_t>(v);
+      dst[i + 1] = static_cast<std::uint64_t>(v >> 64);
+    }
   }
   return true;
 }
 
 ExactRgb ClassImages::sum(int layer, int x, int y) const {
-  const std::uint64_t* w = &words_[word_index(layer, x, y)];
-  return {load(w), load(w + 2), load(w + 4)};
+  ExactRgb out{};
+  for (std::size_t slot : slots_of_layer_[static_cast<std::size_t>(layer)]) {
+    const std::uint64_t* p = plane_if_any(slot);
+    if (p == nullptr) continue;
+    const std::uint64_t* w = p + word_index(x, y);
+    add_to(out, {load(w), load(w + 2), load(w + 4)});
+  }
+  return out;
 }
 
 ImageLayer ClassImages::layer(int layer, double scale) const {
@@ -96,9 +151,12 @@ ImageLayer ClassImages::layer(int layer, double scale) const {
   out.image.width = width_;
   out.image.height = height_;
   out.image.rgb.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 3);
-  const std::uint64_t* w = &words_[word_index(layer, 0, 0)];
-  for (std::size_t i = 0; i < out.image.rgb.size(); ++i)
-    out.image.rgb[i] = static_cast<float>(to_double(load(w + 2 * i)) * scale);
+  std::size_t i = 0;
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      const ExactRgb c = sum(layer, x, y);
+      for (std::size_t ch = 0; ch < 3; ++ch) out.image.rgb[i++] = static_cast<float>(to_double(c[ch]) * scale);
+    }
   return out;
 }
 
@@ -110,11 +168,6 @@ std::vector<ImageLayer> ClassImages::layers(double scale) const {
 
 // --- PixelSum ---
 
-ClassImages::PixelSum::PixelSum(const ClassImages& images)
-    : images_(&images),
-      sums_(static_cast<std::size_t>(images.num_layers()), ExactRgb{}),
-      is_touched_(static_cast<std::size_t>(images.num_layers()), 0) {}
-
 void ClassImages::PixelSum::add(std::uint32_t set, const ExactRgb& c) {
   for (auto& [s, sum] : by_set_)
     if (s == set) {
@@ -125,25 +178,12 @@ void ClassImages::PixelSum::add(std::uint32_t set, const ExactRgb& c) {
 }
 
 bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {
-  for (const auto& [set, sum] : by_set_)
-    for (int layer : images_->layers_of_set(set)) {
-      const auto l = static_cast<std::size_t>(layer);
-      add_to(sums_[l], sum);
-      if (!is_touched_[l]) {
-        is_touched_[l] = 1;
-        touched_.push_back(layer);
-      }
-    }
+  const bool inside = images.inside(x, y);
+  if (inside)
+    for (const auto& [set, sum] : by_set_)
+      if (!is_zero(sum)) images.add(x, y, set, sum);
   by_set_.clear();
-  bool ok = true;
-  for (int layer : touched_) {
-    const auto l = static_cast<std::size_t>(layer);
-    if (!images.add_to_layer(layer, x, y, sums_[l])) ok = false;
-    sums_[l] = ExactRgb{};
-    is_touched_[l] = 0;
-  }
-  touched_.clear();
-  return ok;
+  return inside;
 }
 
 }  // namespace pathex

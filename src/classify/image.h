@@ -2,25 +2,32 @@
 // with the same exact fixed-point sums as the histogram (classify/histogram.h), so that the
 // images, too, are bit-identical whatever the thread count and merge order.
 //
+// Storage is per class set, not per layer: a contribution belongs to exactly one class set (the
+// set of classes its path is in, Histogram::class_set), so it is added once, to that set's plane,
+// whatever the number of class layers; a layer is the sum of the planes of the sets that contain
+// its class (the total: of all planes), formed only when read. Sets with the same layers share a
+// plane (without class layers there is one plane, the total's), and a plane is allocated the
+// first time one of its sets is seen, so memory is 48 bytes per pixel per distinct combination of
+// layers that occurs (typically about as many as there are class layers).
+//
 // Any thread may add to any pixel at any time — camera samples to their own pixel, light-tracing
 // splats anywhere — without locks and without per-thread copies of the frame: each channel is a
 // 128-bit integer held as two 64-bit words, added with two relaxed atomic fetch-adds. The low
 // word's fetch-add returns its exact previous value in the word's modification order, so the
 // thread whose addition wraps it (and only that thread) carries 1 into the high word; when all
 // adds are done both words hold the exact sum. Integer addition commutes, so the interleaving
-// does not matter.
-//
-// Memory: 48 bytes per pixel per layer, one copy in all (a 512×512 image with the total and 7
-// classes: 96 MiB). A camera sample contributes to its own pixel several times (one contribution
+// does not matter. A camera sample contributes to its own pixel several times (one contribution
 // per bounce or strategy); PixelSum collects those with plain integer adds and reaches the shared
-// frame in one atomic add per touched layer, which keeps the atomics off the hot path.
+// frame in one atomic add per class set it touched.
 //
 // The contribution convention is the histogram's: what a sample adds to one pixel's sum before
 // the division by the pixel's sample count. layer() applies that division (scale = 1 / spp), so
 // the mean of the total layer equals the histogram's total estimate.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,20 +58,22 @@ class ClassImages {
   // Layer 0 is "total"; then one layer per entry of `layer_classes` (indices of classifier
   // classes, named after them). `classifier` may be null when `layer_classes` is empty.
   ClassImages(int width, int height, const Classifier* classifier, const std::vector<int>& layer_classes);
+  ~ClassImages();
+  ClassImages(ClassImages&& other) noexcept;
+  ClassImages& operator=(ClassImages&& other) noexcept;
+  ClassImages(const ClassImages&) = delete;
+  ClassImages& operator=(const ClassImages&) = delete;
 
   int width() const { return width_; }
   int height() const { return height_; }
   int num_layers() const { return static_cast<int>(names_.size()); }
   const std::string& layer_name(int layer) const { return names_[static_cast<std::size_t>(layer)]; }
-  // The layers a contribution of class set `set` lands in: 0 (total) first, then its classes'.
-  const std::vector<int>& layers_of_set(std::uint32_t set) const;
 
-  // Adds a contribution of a path in class set `set` (Histogram::class_set) to pixel (x, y) of
-  // the total and of the layers of its classes. Thread-safe and lock-free. Returns false, adding
-  // nothing, for a pixel outside the image.
+  // Adds a contribution of a path in class set `set` (Histogram::class_set) to pixel (x, y): it
+  // shows in the total and in the layers of its classes. Thread-safe and lock-free. Returns
+  // false, adding nothing, for a pixel outside the image. A set id the classifier does not know
+  // (a caller's bug) still counts in the total.
   bool add(int x, int y, std::uint32_t set, const ExactRgb& c);
-  // The same for one layer only.
-  bool add_to_layer(int layer, int x, int y, const ExactRgb& c);
 
   // Adds another image of the same size and layers (e.g. from another process). Exact.
   Result<bool> merge(const ClassImages& other);
@@ -74,43 +83,40 @@ class ClassImages {
   // The layer as floats, each pixel's sum times `scale` (1 / spp for the pixel's mean).
   ImageLayer layer(int layer, double scale) const;
   std::vector<ImageLayer> layers(double scale) const;
-  std::size_t memory_bytes() const { return words_.size() * sizeof(std::uint64_t); }
+  std::size_t memory_bytes() const;
 
-  // The contributions of one sample (or of all samples of one pixel) summed without atomics;
-  // flush() adds them to the shared image and clears the buffer. One per thread.
+  // The contributions of one sample (or of all samples of one pixel) summed per class set without
+  // atomics; flush() adds them to the shared image and clears the buffer. One per thread.
   class PixelSum {
    public:
-    explicit PixelSum(const ClassImages& images);
+    explicit PixelSum(const ClassImages& /*images*/) {}
     void add(std::uint32_t set, const ExactRgb& c);
     // Adds the collected sums to pixel (x, y) of `images` and clears them. Returns false (and
     // still clears) for a pixel outside the image.
     bool flush(ClassImages& images, int x, int y);
 
    private:
-    // Contributions are summed per class set (a pixel sees few distinct sets) and expanded into
-    // layers only at flush(), so adding costs one sum whatever the number of class layers.
-    const ClassImages* images_;
     std::vector<std::pair<std::uint32_t, ExactRgb>> by_set_;  // class sets touched since the last flush
-    std::vector<ExactRgb> sums_;     // per layer, used during flush()
-    std::vector<int> touched_;       // layers with a nonzero sum during flush()
-    std::vector<std::uint8_t> is_touched_;
   };
 
  private:
-  std::size_t word_index(int layer, int x, int y) const {
-    return ((static_cast<std::size_t>(layer) * static_cast<std::size_t>(height_) + static_cast<std::size_t>(y)) *
-                static_cast<std::size_t>(width_) +
-            static_cast<std::size_t>(x)) *
-           6;
+  std::size_t pixel_words() const { return static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 6; }
+  std::size_t word_index(int x, int y) const {
+    return (static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)) * 6;
   }
-  static const std::vector<int>& total_only();
   bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width_ && y < height_; }
+  // The plane of slot `slot`, allocated on first use.
+  std::uint64_t* plane(std::size_t slot);
+  const std::uint64_t* plane_if_any(std::size_t slot) const;
+  void release();
 
   int width_ = 0;
   int height_ = 0;
   std::vector<std::string> names_;
-  std::vector<std::vector<int>> layers_of_set_;  // class-set id -> layers, total first
-  std::vector<std::uint64_t> words_;             // per layer, pixel, channel: low word, high word
+  std::vector<std::vector<std::size_t>> slots_of_layer_;  // layer -> the slots whose sets it sums
+  std::vector<std::size_t> slot_of_set_;                  // class set -> its plane's slot
+  std::size_t num_slots_ = 0;                             // distinct layer lists among the sets
+  std::unique_ptr<std::atomic<std::uint64_t*>[]> planes_;  // per slot, null until first used
 };
 
 }  // namespace pathex
