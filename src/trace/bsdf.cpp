@@ -166,15 +166,7 @@ bool reflection_local(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3&
   return true;
 }
 
-// Lambert needs no local frame: only the sides of the two directions (the same tests as
-// reflection_local(), on the same dot products, so the fast path agrees bit for bit), and
-// |cos θi| for its density. Diffuse is the common case of every connection and MIS density.
-bool same_side(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns, const glm::vec3& ng,
-               float* cos_i) {
-  if (!(glm::dot(wo, ng) * glm::dot(wi, ng) > 0.0f)) return false;
-  *cos_i = glm::dot(wi, ns);
-  return glm::dot(wo, ns) * *cos_i > 0.0f;
-}
+using detail::same_side;
 
 // --- delta components ---
 
@@ -318,12 +310,8 @@ float fresnel_dielectric(float cos_i, float eta) {
   return 0.5f * (r_parl * r_parl + r_perp * r_perp);
 }
 
-glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-               const glm::vec3& ng) {
-  if (const auto* lambert = std::get_if<Diffuse>(&m)) {
-    float cos_i;
-    return same_side(wo, wi, ns, ng, &cos_i) ? lambert->albedo * kInvPi : glm::vec3(0.0f);
-  }
+glm::vec3 detail::eval_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+                               const glm::vec3& ng) {
   glm::vec3 wo_l, wi_l;
   if (!reflection_local(wo, wi, ns, ng, &wo_l, &wi_l)) return glm::vec3(0.0f);
   if (const auto* mix = std::get_if<Mixture>(&m)) {
@@ -345,12 +333,8 @@ glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, cons
       m);
 }
 
-float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-          const glm::vec3& ng) {
-  if (std::holds_alternative<Diffuse>(m)) {
-    float cos_i;
-    return same_side(wo, wi, ns, ng, &cos_i) ? cosine_hemisphere_pdf(std::abs(cos_i)) : 0.0f;
-  }
+float detail::pdf_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+                          const glm::vec3& ng) {
   glm::vec3 wo_l, wi_l;
   if (!reflection_local(wo, wi, ns, ng, &wo_l, &wi_l)) return 0.0f;
   if (const auto* mix = std::get_if<Mixture>(&m)) {

@@ -39,9 +39,13 @@
 // tangent plane (cos θ == 0 to float precision) carries nothing: sample() returns nullopt.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <optional>
+#include <variant>
 
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -88,10 +92,32 @@ std::optional<BsdfSample> sample(const Material& m, const glm::vec3& wo, const g
                                  const glm::vec3& ng, float u_component, glm::vec2 u,
                                  TransportMode mode);
 
+namespace detail {
+// Lambert needs no local frame: only the sides of the two directions (the tests reflection
+// in bsdf.cpp makes, on the same dot products, so both paths agree bit for bit) and |cos θi|.
+// Inline, because diffuse is the common case of every connection and MIS density.
+inline bool same_side(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns, const glm::vec3& ng,
+                      float* cos_i) {
+  if (!(glm::dot(wo, ng) * glm::dot(wi, ng) > 0.0f)) return false;
+  *cos_i = glm::dot(wi, ns);
+  return glm::dot(wo, ns) * *cos_i > 0.0f;
+}
+glm::vec3 eval_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+                       const glm::vec3& ng);
+float pdf_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+                  const glm::vec3& ng);
+}  // namespace detail
+
 // The BSDF summed over the finite components, weighted by the mixture weights. Reciprocal:
 // eval(wo, wi) == eval(wi, wo) bit for bit.
-glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-               const glm::vec3& ng);
+inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+                      const glm::vec3& ng) {
+  if (const auto* lambert = std::get_if<Diffuse>(&m)) {
+    float cos_i;
+    return detail::same_side(wo, wi, ns, ng, &cos_i) ? lambert->albedo * std::numbers::inv_pi_v<float> : glm::vec3(0.0f);
+  }
+  return detail::eval_general(m, wo, wi, ns, ng);
+}
 inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi,
                       const glm::vec3& n) {
   return eval(m, wo, wi, n, n);
@@ -99,8 +125,14 @@ inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& w
 
 // Solid-angle density with which sample() produces wi through a finite component, including the
 // probability of picking that component. Deltas contribute nothing here (see component_probability).
-float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-          const glm::vec3& ng);
+inline float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+                 const glm::vec3& ng) {
+  if (std::holds_alternative<Diffuse>(m)) {  // cosine-weighted: |cos θi| / π
+    float cos_i;
+    return detail::same_side(wo, wi, ns, ng, &cos_i) ? std::abs(cos_i) * std::numbers::inv_pi_v<float> : 0.0f;
+  }
+  return detail::pdf_general(m, wo, wi, ns, ng);
+}
 inline float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& n) {
   return pdf(m, wo, wi, n, n);
 }
