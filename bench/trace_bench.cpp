@@ -75,7 +75,9 @@ std::uint64_t plain_embree_loop(const RenderScene& rs, std::uint64_t count, std:
       glm::vec3 n = glm::normalize(glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
       if (glm::dot(n, d) > 0) n = -n;
       o += n * 1e-4f;
-      d = glm::normalize(n + sample_uniform_sphere(rng.get2d()));
+      const glm::vec3 nd = n + sample_uniform_sphere(rng.get2d());  // zero when the sample is exactly -n
+      const float len2 = glm::dot(nd, nd);
+      d = len2 > 1e-12f ? nd / std::sqrt(len2) : n;
     }
   }
   return hits;

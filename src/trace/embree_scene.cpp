@@ -155,6 +155,14 @@ glm::vec2 quad_uv(const QuadShape& q, const vec3& p) {
   return {(w1 * e22 - w2 * e12) / det, (w2 * e11 - w1 * e12) / det};
 }
 
+// Embree asserts that a ray's origin and direction are finite (Debian's build aborts the
+// process otherwise). A non-finite ray is a bug upstream; it is treated as hitting nothing and
+// as blocked, so that it carries no light, and never reaches Embree.
+bool finite_ray(const vec3& o, const vec3& d) {
+  return std::isfinite(o.x) && std::isfinite(o.y) && std::isfinite(o.z) && std::isfinite(d.x) && std::isfinite(d.y) &&
+         std::isfinite(d.z);
+}
+
 RTCRay make_ray(const vec3& o, const vec3& d, float tmin, float tmax) {
   RTCRay ray{};
   ray.org_x = o.x;
@@ -293,6 +301,7 @@ vec3 EmbreeScene::offset(const vec3& p, const vec3& n, const vec3& d) const {
 }
 
 std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tmin, float tmax, HitDetail detail) const {
+  if (!finite_ray(o, d)) return std::nullopt;
   RTCRayHit rh{};
   rh.ray = make_ray(o, d, tmin, tmax);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -342,6 +351,7 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
 }
 
 bool EmbreeScene::occluded(const vec3& o, const vec3& d, float tmin, float tmax) const {
+  if (!finite_ray(o, d)) return true;
   RTCRay ray = make_ray(o, d, tmin, tmax);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);

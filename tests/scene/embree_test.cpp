@@ -56,6 +56,22 @@ TEST(Embree, TwoRaySmokeTest) {
   EXPECT_FALSE((*es)->intersect({5, 5, 1}, {0, 0, -1}, 0.0f, INFINITY).has_value());
 }
 
+// Debian's Embree aborts the process on a non-finite ray (an assertion); the queries must keep
+// such a ray from it: no hit, and blocked, so it carries no light.
+TEST(Embree, NonFiniteRaysNeverReachEmbree) {
+  const Scene s = one_shape(R"({"type": "quad", "corner": [-1, -1, 0], "edge1": [2, 0, 0], "edge2": [0, 2, 0], "material": "m"})");
+  auto es = EmbreeScene::build(s);
+  ASSERT_TRUE(es.ok()) << es.error().render();
+  const float nan = std::nanf(""), inf = INFINITY;
+  for (const auto& [o, d] : std::vector<std::pair<vec3, vec3>>{
+           {{0, 0, 1}, {nan, 0, -1}}, {{nan, 0, 1}, {0, 0, -1}}, {{0, 0, 1}, {0, inf, -1}}, {{0, -inf, 1}, {0, 0, -1}}}) {
+    EXPECT_FALSE((*es)->intersect(o, d, 0.0f, INFINITY).has_value());
+    EXPECT_TRUE((*es)->occluded(o, d, 0.0f, 1.0f));
+    EXPECT_FALSE((*es)->visible(o, o + d));
+  }
+  EXPECT_TRUE((*es)->intersect({0, 0, 1}, {0, 0, -1}, 0.0f, INFINITY).has_value()) << "a finite ray still hits";
+}
+
 TEST(Embree, ExactAnalyticIntersections) {
   const Scene s = one_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "m"},
                               {"type": "disk", "center": [0, 0, -2], "normal": [0, 0, 1], "radius": 1, "material": "m"},
