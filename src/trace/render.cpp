@@ -206,9 +206,12 @@ class Integrator {
     // … z0 and z0's spatial letter) as they sit after c(s) in any connection with t eye vertices.
     PathKey light_mask = 0;
     std::array<PathKey, kMaxVertices + 1> eye_masks{};
+    int ns = 0, nt = 0;        // the current subpaths' lengths
+    bool masks_ready = false;  // the masks are built on the sample's first recorded contribution
   };
 
   void letter_masks(Thread& th, int ns, int nt) const {
+    th.masks_ready = true;
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
     for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
@@ -657,10 +660,13 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   auto runs = [&](int s2, int t2) { return strategy(s2, t2) >= 0 && ((key >> s2) & 3) == 0; };
   // When no other strategy can sample this string (pt, lt, and many strings of every profile),
   // the weight is 1 and no density needs recomputing.
-  bool alone = true;
-  for (int s2 = 0; s2 <= s + t && alone; ++s2)
-    if (s2 != s && (s + t - s2 > 0 || lens_hits_) && runs(s2, s + t - s2)) alone = false;
-  if (alone) return 1.0f;
+  // Otherwise the loops below reach only as far as the farthest strategy that can: the light
+  // side down to s2 = light_lo, the eye side up to s2 = eye_hi; densities beyond are not needed.
+  int light_lo = 0, eye_hi = s + t;
+  while (light_lo < s && !runs(light_lo, s + t - light_lo)) ++light_lo;
+  while (eye_hi > s && !((eye_hi < s + t || lens_hits_) && runs(eye_hi, s + t - eye_hi))) --eye_hi;
+  if (light_lo == s && eye_hi == s) return 1.0f;
+  const int eye_lo = s + t - eye_hi;  // the eye loop's last index: t when it does not run
   const std::array<Vertex, kMaxVertices>& L = th.light;
   const std::array<Vertex, kMaxVertices>& E = th.eye;
   // The join's vertices; a fresh sample stands for z0 when t = 1, else for y0 when s = 1.
@@ -676,30 +682,32 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
     return dist2 > 0.0f ? pdf_w * abs_cos(next, w) / dist2 : 0.0f;
   };
   float rev_qs = 0.0f, rev_pt = 0.0f, rev_qsm = 0.0f, rev_ptm = 0.0f;
+  const bool need_pt = eye_lo <= t - 1, need_ptm = ptm && eye_lo <= t - 2;
+  const bool need_qs = light_lo <= s - 1, need_qsm = qsm && light_lo <= s - 2;
   if (qs && pt) {
     const vec3 e = pt->p - qs->p;
     const float d2 = glm::dot(e, e);
     const vec3 w = d2 > 0.0f ? e / std::sqrt(d2) : vec3(0.0f), back = -w;
-    rev_pt = area(pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
-    rev_qs = area(pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
-    if (ptm) rev_ptm = area(pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
-    if (qsm) rev_qsm = area(pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
+    if (need_pt) rev_pt = area(pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
+    if (need_qs) rev_qs = area(pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
+    if (need_ptm) rev_ptm = area(pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
+    if (need_qsm) rev_qsm = area(pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
   } else if (pt) {  // s = 0: pt lies on an area light
     rev_pt = pdf_light_origin(*pt);
-    if (ptm) {
+    if (need_ptm) {
       const RenderLight& l = rs_.lights[static_cast<std::size_t>(rs_.light_of_shape[static_cast<std::size_t>(pt->shape)])];
       rev_ptm = area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo);
     }
   } else if (qs) {  // t = 0: qs is the lens point
     rev_qs = sensor_pdf_pos();
-    if (qsm) rev_qsm = area(sensor_pdf_dir(qs->wo), *qsm, qs->wo, qs->d2_wo);
+    if (need_qsm) rev_qsm = area(sensor_pdf_dir(qs->wo), *qsm, qs->wo, qs->d2_wo);
   }
   // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
   // Ratios in double: long paths multiply many of them. Dirac densities are stored as 0 and
   // count as 1 here; their strategies are excluded by letter.
   const auto remap = [](float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; };
   double sum = 0.0, ri = 1.0;
-  for (int i = t - 1; i >= 0; --i) {
+  for (int i = t - 1; i >= eye_lo; --i) {
     const float rev = i == t - 1 ? rev_pt : i == t - 2 ? rev_ptm : E[static_cast<std::size_t>(i)].pdf_rev;
     const float fwd = i == t - 1 ? pt->pdf_fwd : E[static_cast<std::size_t>(i)].pdf_fwd;
     ri *= remap(rev) / remap(fwd);
@@ -707,7 +715,7 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
     if (runs(s + t - i, i)) sum += ri * ri;
   }
   ri = 1.0;
-  for (int i = s - 1; i >= 0; --i) {
+  for (int i = s - 1; i >= light_lo; --i) {
     const float rev = i == s - 1 ? rev_qs : i == s - 2 ? rev_qsm : L[static_cast<std::size_t>(i)].pdf_rev;
     const float fwd = i == s - 1 ? qs->pdf_fwd : L[static_cast<std::size_t>(i)].pdf_fwd;
     ri *= remap(rev) / remap(fwd);
@@ -838,6 +846,7 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
   }
   if (is_black(contrib)) return;
   const Vertex* fresh = (s == 1 || t == 1) ? &sampled : nullptr;
+  if (!th.masks_ready) letter_masks(th, th.ns, th.nt);
   const PathKey key = path_key(th, s, t, fresh);
   record(th, images, key, strategy_index, batch, contrib * mis_weight(th, s, t, fresh, key), splat, rx, ry);
 }
@@ -923,7 +932,9 @@ void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::ui
   const int batch = batch_of(pass, o_.batches);
   const int nt = eye_subpath(th, rng, px, py);
   const int ns = light_subpath(th, rng);
-  letter_masks(th, ns, nt);
+  th.ns = ns;
+  th.nt = nt;
+  th.masks_ready = false;
   for (int t = 0; t <= nt; ++t) {
     // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
     const int s_max = rs_.lights.empty() ? ns : std::max(ns, 1);
