@@ -10,6 +10,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -37,6 +38,13 @@ RenderOptions options(int threads, std::uint64_t spp) {
   o.spp = spp;
   o.max_bounces = 8;
   return o;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // Process CPU time in seconds: on a shared machine, time the host gives to others is not counted.
@@ -85,14 +93,15 @@ std::uint64_t plain_embree_loop(const RenderScene& rs, std::uint64_t count, std:
 
 // The tracer's rays per second against the plain loop's, interleaved: each iteration renders
 // (one thread, all rays it casts: subpath extensions and shadow rays), then casts the same number
-// of rays in the plain loop, so that both see the same machine; `ratio` is the tracer's rate over
-// the plain loop's, from CPU time summed over the iterations.
+// of rays in the plain loop, so that both see the same machine; `ratio` is the median over
+// iterations of the tracer's rate over the plain loop's (CPU time).
 void BM_TracerRays(benchmark::State& state) {
   const char* const names[] = {"bdpt", "pt-nee", "pt", "lt"};
   const Profile profile = *resolve_profile(names[state.range(0)], Limits{});
   Result<RenderScene> rs = make_render_scene(cornell());
   std::uint64_t rays = 0;
   double tracer_s = 0, plain_s = 0;
+  std::vector<double> ratios;
   for (auto _ : state) {
     const double t0 = cpu_seconds();
     Result<RenderOutput> out = render(cornell(), profile, nullptr, options(1, 4));
@@ -102,18 +111,20 @@ void BM_TracerRays(benchmark::State& state) {
     rays += out->rays;
     tracer_s += t1 - t0;
     plain_s += t2 - t1;
+    ratios.push_back((t2 - t1) / (t1 - t0));
   }
   state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays) / tracer_s);
   state.counters["plain_rays_per_s"] = benchmark::Counter(static_cast<double>(rays) / plain_s);
-  state.counters["ratio"] = benchmark::Counter(plain_s / tracer_s);
+  state.counters["ratio"] = benchmark::Counter(median(ratios));
   state.SetLabel(profile.name + ", 1 thread");
 }
 BENCHMARK(BM_TracerRays)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Classification overhead, interleaved: each iteration renders with no classes and with the
-// 20-class file (Arg 20: labels classified and an image layer per class; Arg 21: classified, no
-// class layers, the automaton's share alone). `overhead` is the CPU time with classes over the
-// time without, minus 1.
+// Classification overhead, interleaved: each iteration renders (the CLI's default 16 spp) with no
+// classes and with the 20-class file (Arg 20: labels classified and an image layer per class;
+// Arg 21: classified, no class layers, the automaton's share alone). `overhead_pct` is the median
+// over iterations of the CPU time with classes over the time without, minus 1: the median shrugs
+// off an iteration that the shared machine slowed on one side only.
 void BM_RenderClasses(benchmark::State& state) {
   const Profile bdpt = *resolve_profile("bdpt", Limits{});
   ClassTable table;
@@ -123,12 +134,13 @@ void BM_RenderClasses(benchmark::State& state) {
   const Classifier none = *Classifier::build({}, Limits{});
   const Classifier twenty = *Classifier::build(classes, Limits{});
   const bool control = state.range(0) == 0;  // Arg 0: no classes on both sides, the method's noise floor
-  RenderOptions plain = options(1, 4), classified = options(1, 4);
+  RenderOptions plain = options(1, 16), classified = options(1, 16);
   if (state.range(0) == 20)
     for (int i = 0; i < twenty.num_classes(); ++i) classified.layer_classes.push_back(i);
-  double without_s = 0, with_s = 0;
+  std::vector<double> ratios;
   bool classes_first = false;  // alternated, so that neither side always runs on a warm cache
   for (auto _ : state) {
+    double with_s = 0, without_s = 0;
     for (int side = 0; side < 2; ++side) {
       const bool with = (side == 0) == classes_first;
       const double t0 = cpu_seconds();
@@ -136,9 +148,10 @@ void BM_RenderClasses(benchmark::State& state) {
                                     : render(cornell(), bdpt, &none, plain));
       (with ? with_s : without_s) += cpu_seconds() - t0;
     }
+    ratios.push_back(with_s / without_s);
     classes_first = !classes_first;
   }
-  state.counters["overhead_pct"] = benchmark::Counter(100.0 * (with_s / without_s - 1.0));
+  state.counters["overhead_pct"] = benchmark::Counter(100.0 * (median(ratios) - 1.0));
   state.SetLabel(control ? std::string("control: no classes against none")
                          : std::to_string(classes.size()) + " classes, " + std::to_string(classified.layer_classes.size()) +
                                " class layers, against none");

@@ -51,7 +51,7 @@ ClassImages::ClassImages(int width, int height, const Classifier* classifier, co
     for (std::size_t layer : layers) slots_of_layer_[layer].push_back(slot);
   }
   for (auto& slots : slots_of_layer_) std::sort(slots.begin(), slots.end());
-  planes_ = std::make_unique<std::atomic<std::uint64_t*>[]>(num_slots_);
+  planes_ = std::make_unique<std::atomic<TileDirectory*>[]>(num_slots_);
   for (std::size_t slot = 0; slot < num_slots_; ++slot) planes_[slot].store(nullptr, std::memory_order_relaxed);
 }
 
@@ -85,34 +85,61 @@ ClassImages& ClassImages::operator=(ClassImages&& other) noexcept {
 
 void ClassImages::release() {
   if (!planes_) return;
-  for (std::size_t slot = 0; slot < num_slots_; ++slot) delete[] planes_[slot].load(std::memory_order_relaxed);
+  for (std::size_t slot = 0; slot < num_slots_; ++slot) {
+    TileDirectory* dir = planes_[slot].load(std::memory_order_relaxed);
+    if (dir == nullptr) continue;
+    for (std::size_t t = 0; t < num_tiles(); ++t) delete[] dir[t].load(std::memory_order_relaxed);
+    delete[] dir;
+  }
   planes_.reset();
 }
 
-std::uint64_t* ClassImages::plane(std::size_t slot) {
-  std::uint64_t* p = planes_[slot].load(std::memory_order_acquire);
-  if (p != nullptr) return p;
-  // First use: allocate zeroed; if another thread installed one meanwhile, use that one.
-  auto* fresh = new std::uint64_t[pixel_words()]();
-  if (planes_[slot].compare_exchange_strong(p, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) return fresh;
-  delete[] fresh;
-  return p;
+std::uint64_t* ClassImages::words(std::size_t slot, int x, int y) {
+  // Both levels are allocated on first use; a thread that loses the race to install one frees
+  // its own and uses the winner's.
+  TileDirectory* dir = planes_[slot].load(std::memory_order_acquire);
+  if (dir == nullptr) {
+    auto* fresh = new TileDirectory[num_tiles()];
+    for (std::size_t t = 0; t < num_tiles(); ++t) fresh[t].store(nullptr, std::memory_order_relaxed);
+    if (planes_[slot].compare_exchange_strong(dir, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) {
+      dir = fresh;
+    } else {
+      delete[] fresh;
+    }
+  }
+  std::atomic<std::uint64_t*>& entry = dir[tile_index(x, y)];
+  std::uint64_t* tile = entry.load(std::memory_order_acquire);
+  if (tile == nullptr) {
+    auto* fresh = new std::uint64_t[kTileWords]();
+    if (entry.compare_exchange_strong(tile, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) {
+      tile = fresh;
+    } else {
+      delete[] fresh;
+    }
+  }
+  return tile + in_tile_index(x, y);
 }
 
-const std::uint64_t* ClassImages::plane_if_any(std::size_t slot) const {
-  return planes_ ? planes_[slot].load(std::memory_order_acquire) : nullptr;
+const std::uint64_t* ClassImages::words_if_any(std::size_t slot, int x, int y) const {
+  const TileDirectory* dir = planes_ ? planes_[slot].load(std::memory_order_acquire) : nullptr;
+  if (dir == nullptr) return nullptr;
+  const std::uint64_t* tile = dir[tile_index(x, y)].load(std::memory_order_acquire);
+  return tile != nullptr ? tile + in_tile_index(x, y) : nullptr;
 }
 
 std::size_t ClassImages::memory_bytes() const {
-  std::size_t planes = 0;
-  for (std::size_t slot = 0; slot < num_slots_; ++slot) planes += plane_if_any(slot) != nullptr ? 1 : 0;
-  return planes * pixel_words() * sizeof(std::uint64_t);
+  std::size_t tiles = 0;
+  for (std::size_t slot = 0; slot < num_slots_ && planes_; ++slot) {
+    const TileDirectory* dir = planes_[slot].load(std::memory_order_acquire);
+    for (std::size_t t = 0; dir != nullptr && t < num_tiles(); ++t) tiles += dir[t].load(std::memory_order_acquire) != nullptr ? 1 : 0;
+  }
+  return tiles * kTileWords * sizeof(std::uint64_t);
 }
 
 bool ClassImages::add(int x, int y, std::uint32_t set, const ExactRgb& c) {
   if (!inside(x, y)) return false;
   const std::size_t slot = set < slot_of_set_.size() ? slot_of_set_[set] : 0;
-  std::uint64_t* w = plane(slot) + word_index(x, y);
+  std::uint64_t* w = words(slot, x, y);
   for (std::size_t ch = 0; ch < 3; ++ch)
     if (c[ch] != 0) atomic_add(w + 2 * ch, c[ch]);
   return true;
@@ -121,25 +148,26 @@ bool ClassImages::add(int x, int y, std::uint32_t set, const ExactRgb& c) {
 Result<bool> ClassImages::merge(const ClassImages& other) {
   if (other.width_ != width_ || other.height_ != height_ || other.names_ != names_ || other.num_slots_ != num_slots_)
     return make_error(ErrorCode::kUsage, "cannot merge images of different sizes or layers");
-  for (std::size_t slot = 0; slot < num_slots_; ++slot) {
-    const std::uint64_t* src = other.plane_if_any(slot);
-    if (src == nullptr) continue;
-    std::uint64_t* dst = plane(slot);
-    for (std::size_t i = 0; i < pixel_words(); i += 2) {
-      const ExactSum v = load(&dst[i]) + load(&src[i]);
-      dst[i] = static_cast<std::uint64_t>(v);
-      dst[i + 1] = static_cast<std::uint64_t>(v >> 64);
-    }
-  }
+  for (std::size_t slot = 0; slot < num_slots_; ++slot)
+    for (int y = 0; y < height_; ++y)
+      for (int x = 0; x < width_; ++x) {
+        const std::uint64_t* src = other.words_if_any(slot, x, y);
+        if (src == nullptr) continue;
+        std::uint64_t* dst = words(slot, x, y);
+        for (std::size_t i = 0; i < 6; i += 2) {
+          const ExactSum v = load(&dst[i]) + load(&src[i]);
+          dst[i] = static_cast<std::uint64_t>(v);
+          dst[i + 1] = static_cast<std::uint64_t>(v >> 64);
+        }
+      }
   return true;
 }
 
 ExactRgb ClassImages::sum(int layer, int x, int y) const {
   ExactRgb out{};
   for (std::size_t slot : slots_of_layer_[static_cast<std::size_t>(layer)]) {
-    const std::uint64_t* p = plane_if_any(slot);
-    if (p == nullptr) continue;
-    const std::uint64_t* w = p + word_index(x, y);
+    const std::uint64_t* w = words_if_any(slot, x, y);
+    if (w == nullptr) continue;
     add_to(out, {load(w), load(w + 2), load(w + 4)});
   }
   return out;

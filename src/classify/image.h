@@ -6,9 +6,10 @@
 // set of classes its path is in, Histogram::class_set), so it is added once, to that set's plane,
 // whatever the number of class layers; a layer is the sum of the planes of the sets that contain
 // its class (the total: of all planes), formed only when read. Sets with the same layers share a
-// plane (without class layers there is one plane, the total's), and a plane is allocated the
-// first time one of its sets is seen, so memory is 48 bytes per pixel per distinct combination of
-// layers that occurs (typically about as many as there are class layers).
+// plane (without class layers there is one plane, the total's). Planes are allocated in 8 × 8-pixel
+// tiles, each the first time a contribution lands in it, so memory is 48 bytes per pixel per
+// combination of layers, counted only over the tiles where that combination occurs (rare
+// combinations, and there are hundreds with twenty overlapping classes, cost a few tiles).
 //
 // Any thread may add to any pixel at any time — camera samples to their own pixel, light-tracing
 // splats anywhere — without locks and without per-thread copies of the frame: each channel is a
@@ -100,14 +101,24 @@ class ClassImages {
   };
 
  private:
-  std::size_t pixel_words() const { return static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 6; }
-  std::size_t word_index(int x, int y) const {
-    return (static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)) * 6;
+  // A plane is a directory of 8 × 8-pixel tiles, each allocated when first touched, so that a
+  // combination of layers that only a few pixels see costs only their tiles.
+  static constexpr int kTile = 8;
+  static constexpr std::size_t kTileWords = kTile * kTile * 6;
+  using TileDirectory = std::atomic<std::uint64_t*>;  // an array of num_tiles() of these
+  std::size_t tiles_x() const { return static_cast<std::size_t>((width_ + kTile - 1) / kTile); }
+  std::size_t num_tiles() const { return tiles_x() * static_cast<std::size_t>((height_ + kTile - 1) / kTile); }
+  std::size_t tile_index(int x, int y) const {
+    return static_cast<std::size_t>(y / kTile) * tiles_x() + static_cast<std::size_t>(x / kTile);
+  }
+  static std::size_t in_tile_index(int x, int y) {
+    return static_cast<std::size_t>((y % kTile) * kTile + x % kTile) * 6;
   }
   bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width_ && y < height_; }
-  // The plane of slot `slot`, allocated on first use.
-  std::uint64_t* plane(std::size_t slot);
-  const std::uint64_t* plane_if_any(std::size_t slot) const;
+  // The six words of pixel (x, y) in the plane of `slot`, allocating on first use; or, const,
+  // null when that tile was never touched.
+  std::uint64_t* words(std::size_t slot, int x, int y);
+  const std::uint64_t* words_if_any(std::size_t slot, int x, int y) const;
   void release();
 
   int width_ = 0;
@@ -116,7 +127,7 @@ class ClassImages {
   std::vector<std::vector<std::size_t>> slots_of_layer_;  // layer -> the slots whose sets it sums
   std::vector<std::size_t> slot_of_set_;                  // class set -> its plane's slot
   std::size_t num_slots_ = 0;                             // distinct layer lists among the sets
-  std::unique_ptr<std::atomic<std::uint64_t*>[]> planes_;  // per slot, null until first used
+  std::unique_ptr<std::atomic<TileDirectory*>[]> planes_;  // per slot, null until first used
 };
 
 }  // namespace pathex
