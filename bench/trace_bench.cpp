@@ -138,20 +138,23 @@ void BM_RenderClasses(benchmark::State& state) {
   if (state.range(0) == 20)
     for (int i = 0; i < twenty.num_classes(); ++i) classified.layer_classes.push_back(i);
   std::vector<double> ratios;
+  std::size_t image_bytes = 0;
   bool classes_first = false;  // alternated, so that neither side always runs on a warm cache
   for (auto _ : state) {
     double with_s = 0, without_s = 0;
     for (int side = 0; side < 2; ++side) {
       const bool with = (side == 0) == classes_first;
       const double t0 = cpu_seconds();
-      benchmark::DoNotOptimize(with ? render(cornell(), bdpt, control ? &none : &twenty, classified)
-                                    : render(cornell(), bdpt, &none, plain));
+      Result<RenderOutput> out = with ? render(cornell(), bdpt, control ? &none : &twenty, classified)
+                                      : render(cornell(), bdpt, &none, plain);
       (with ? with_s : without_s) += cpu_seconds() - t0;
+      if (with) image_bytes = out->images.memory_bytes();
     }
     ratios.push_back(with_s / without_s);
     classes_first = !classes_first;
   }
   state.counters["overhead_pct"] = benchmark::Counter(100.0 * (median(ratios) - 1.0));
+  state.counters["image_MiB"] = benchmark::Counter(static_cast<double>(image_bytes) / (1024.0 * 1024.0));
   state.SetLabel(control ? std::string("control: no classes against none")
                          : std::to_string(classes.size()) + " classes, " + std::to_string(classified.layer_classes.size()) +
                                " class layers, against none");

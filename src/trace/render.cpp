@@ -206,6 +206,7 @@ class Integrator {
     // … z0 and z0's spatial letter) as they sit after c(s) in any connection with t eye vertices.
     PathKey light_mask = 0;
     std::array<PathKey, kMaxVertices + 1> eye_masks{};
+    ClassImages* images = nullptr;  // the shared image that splats go to
     int ns = 0, nt = 0;        // the current subpaths' lengths
     bool masks_ready = false;  // the masks are built on the sample's first recorded contribution
   };
@@ -239,8 +240,9 @@ class Integrator {
                : -1;
   }
 
-  // One sample: pixel (px, py), pass `pass`.
-  void sample(Thread& th, ClassImages& images, int px, int py, std::uint64_t pass) const;
+  // One sample: pixel (px, py), pass `pass`. Its camera contributions collect in th.pixel (the
+  // caller flushes them); light-tracing splats go straight to the shared image.
+  void sample(Thread& th, int px, int py, std::uint64_t pass) const;
 
   // For the full path x0 … xk formed by connection (s, t) of the current subpaths: the sum, over
   // every strategy (s', t') with s' + t' = s + t that the profile runs and whose join letters are
@@ -926,7 +928,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
   return sum;
 }
 
-void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::uint64_t pass) const {
+void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
   Sampler rng(o_.seed, pixel, pass);
   const int batch = batch_of(pass, o_.batches);
@@ -945,10 +947,9 @@ void Integrator::sample(Thread& th, ClassImages& images, int px, int py, std::ui
       if (t > 0 && s >= 2 && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens) continue;
       if (s == 0 && t < 2) continue;
       if (strategy(s, t) < 0) continue;
-      connect(th, images, rng, s, t, batch);
+      connect(th, *th.images, rng, s, t, batch);
     }
   }
-  th.pixel.flush(images, px, py);
 }
 
 }  // namespace
@@ -966,6 +967,7 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
   ClassImages images(1, 1, nullptr, {});
   Integrator integrator(*rs, *strategies, o, nullptr);
   Integrator::Thread th{Histogram(layout, nullptr), ClassImages::PixelSum(images), {}, {}, {}, 0, {}, {}};
+  th.images = &images;
   std::vector<MisCheck> out;
   for (int i = 0; i < samples; ++i) {
     const int px = i % rs->camera.width, py = (i / rs->camera.width) % rs->camera.height;
@@ -1004,20 +1006,32 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
   tbb::enumerable_thread_specific<Integrator::Thread> locals(
-      [&] { return Integrator::Thread{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, {}, 0, {}, {}}; });
+      [&] {
+        Integrator::Thread th{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, {}, 0, {}, {}};
+        th.images = &out.images;
+        return th;
+      });
   const int w = rs->camera.width, h = rs->camera.height;
   const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
   const auto start = std::chrono::steady_clock::now();
+  // Passes run in chunks: a pixel takes a chunk's passes back to back, so that its camera
+  // contributions reach the shared image once per chunk (and its part of the scene stays in
+  // cache); cancelling stops on a whole chunk, so every finished pass covers the whole image.
   std::uint64_t pass = 0;
-  for (; pass < o.spp; ++pass) {
+  while (pass < o.spp) {
     if (o.cancel && o.cancel->load()) break;
+    const std::uint64_t first = pass, end = std::min(o.spp, pass + kPassesPerChunk);
     tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& rows) {
       Integrator::Thread& th = locals.local();
       for (int y = rows.begin(); y < rows.end(); ++y)
-        for (int x = 0; x < w; ++x) integrator.sample(th, out.images, x, y, pass);
+        for (int x = 0; x < w; ++x) {
+          for (std::uint64_t p = first; p < end; ++p) integrator.sample(th, x, y, p);
+          th.pixel.flush(out.images, x, y);
+        }
     });
-    out.histogram.add_samples(batch_of(pass, o.batches), pixels);
-    if (o.progress) o.progress((pass + 1) * pixels, o.spp * pixels);
+    for (std::uint64_t p = first; p < end; ++p) out.histogram.add_samples(batch_of(p, o.batches), pixels);
+    pass = end;
+    if (o.progress) o.progress(pass * pixels, o.spp * pixels);
   }
   out.spp_done = pass;
   out.complete = pass == o.spp;

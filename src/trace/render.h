@@ -29,6 +29,10 @@
 
 namespace pathex {
 
+// Passes a pixel takes back to back (the last chunk may be shorter). Progress is reported, and a
+// cancelled render stops, after whole chunks, so every finished pass covers the whole image.
+inline constexpr std::uint64_t kPassesPerChunk = 4;
+
 struct RenderOptions {
   std::uint64_t spp = 16;              // samples (passes) per pixel
   std::uint64_t seed = 1;
