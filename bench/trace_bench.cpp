@@ -1,8 +1,9 @@
 // Tracer benchmarks (issue 4). Run:
-//   build/bench/trace_bench --benchmark_min_time=2
+//   build/bench/trace_bench --benchmark_min_time=4
 // Each case renders the embedded Cornell box (or a generated mesh). The machines are shared and
 // noisy, so every target that is a ratio is measured interleaved: each iteration times both
-// sides back to back (in process CPU time), and the counter is the ratio of the summed times.
+// sides back to back (in process CPU time; wall time for the thread count), and the counter is
+// the median of the per-iteration ratios (the thread speedup: the ratio of the summed times).
 #include <benchmark/benchmark.h>
 
 #include <sys/resource.h>
