@@ -207,11 +207,19 @@ class Integrator {
     PathKey light_mask = 0;
     std::array<PathKey, kMaxVertices + 1> eye_masks{};
     ClassImages* images = nullptr;  // the shared image that splats go to
+    std::array<double, kMaxVertices> light_ratio{}, eye_ratio{};  // set by letter_masks()
     int ns = 0, nt = 0;        // the current subpaths' lengths
     bool masks_ready = false;  // the masks are built on the sample's first recorded contribution
   };
 
+  // A vertex's density ratio in the MIS sums, a Dirac's densities (stored as 0) counting as 1.
+  static double remap(float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; }
+  static double ratio(const Vertex& v) { return remap(v.pdf_rev) / remap(v.pdf_fwd); }
+  // Per sample, before its first recorded contribution: the letter masks, and each vertex's
+  // ratio of reverse to forward density (a join changes only the two nearest each end).
   void letter_masks(Thread& th, int ns, int nt) const {
+    for (int i = 0; i < ns; ++i) th.light_ratio[static_cast<std::size_t>(i)] = ratio(th.light[static_cast<std::size_t>(i)]);
+    for (int i = 0; i < nt; ++i) th.eye_ratio[static_cast<std::size_t>(i)] = ratio(th.eye[static_cast<std::size_t>(i)]);
     th.masks_ready = true;
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
@@ -275,6 +283,8 @@ class Integrator {
   int trace_subpaths(Thread& th, Sampler& rng, int px, int py, int* ns) const {
     const int nt = eye_subpath(th, rng, px, py);
     *ns = light_subpath(th, rng);
+    th.ns = *ns;
+    th.nt = nt;
     letter_masks(th, *ns, nt);
     return nt;
   }
@@ -707,20 +717,19 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
   // Ratios in double: long paths multiply many of them. Dirac densities are stored as 0 and
   // count as 1 here; their strategies are excluded by letter.
-  const auto remap = [](float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; };
   double sum = 0.0, ri = 1.0;
   for (int i = t - 1; i >= eye_lo; --i) {
-    const float rev = i == t - 1 ? rev_pt : i == t - 2 ? rev_ptm : E[static_cast<std::size_t>(i)].pdf_rev;
-    const float fwd = i == t - 1 ? pt->pdf_fwd : E[static_cast<std::size_t>(i)].pdf_fwd;
-    ri *= remap(rev) / remap(fwd);
+    ri *= i == t - 1   ? remap(rev_pt) / remap(pt->pdf_fwd)
+          : i == t - 2 ? remap(rev_ptm) / remap(E[static_cast<std::size_t>(i)].pdf_fwd)
+                       : th.eye_ratio[static_cast<std::size_t>(i)];
     if (i == 0 && !lens_hits_) break;
     if (runs(s + t - i, i)) sum += ri * ri;
   }
   ri = 1.0;
   for (int i = s - 1; i >= light_lo; --i) {
-    const float rev = i == s - 1 ? rev_qs : i == s - 2 ? rev_qsm : L[static_cast<std::size_t>(i)].pdf_rev;
-    const float fwd = i == s - 1 ? qs->pdf_fwd : L[static_cast<std::size_t>(i)].pdf_fwd;
-    ri *= remap(rev) / remap(fwd);
+    ri *= i == s - 1   ? remap(rev_qs) / remap(qs->pdf_fwd)
+          : i == s - 2 ? remap(rev_qsm) / remap(L[static_cast<std::size_t>(i)].pdf_fwd)
+                       : th.light_ratio[static_cast<std::size_t>(i)];
     if (runs(i, s + t - i)) sum += ri * ri;
   }
   return static_cast<float>(1.0 / (1.0 + sum));
@@ -921,10 +930,12 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
           specular(k - (j + 1)) ? 0.0f
                                 : pdf(&th.eye[static_cast<std::size_t>(j + 2)], th.eye[static_cast<std::size_t>(j + 1)],
                                       th.eye[static_cast<std::size_t>(j)]);
+    letter_masks(th, s2, t2);  // the ratios of the re-split subpaths
     sum += mis_weight(th, s2, t2, nullptr, pack(letters));
   }
   th.light = saved_light_eye.light;
   th.eye = saved_light_eye.eye;
+  letter_masks(th, th.ns, th.nt);
   return sum;
 }
 
