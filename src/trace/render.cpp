@@ -197,19 +197,18 @@ class Integrator {
     Histogram hist;
     ClassImages::PixelSum pixel;
     std::array<Vertex, kMaxVertices> eye, light;
-    std::string label;
     std::uint64_t rays = 0;
     PathIds ids;
     Vertex sampled;  // connect()'s fresh light or sensor sample
-    // The subpaths' letters packed (set by letter_masks()): light_mask has c0 c1 of y0, then
+    // The subpaths' letters packed (set by prepare_joins()): light_mask has c0 c1 of y0, then
     // bit i + 1 for y_i's letter; eye_masks[t] has the eye subpath's last t + 1 letters (z(t-1)
     // … z0 and z0's spatial letter) as they sit after c(s) in any connection with t eye vertices.
     PathKey light_mask = 0;
     std::array<PathKey, kMaxVertices + 1> eye_masks{};
     ClassImages* images = nullptr;  // the shared image that splats go to
-    std::array<double, kMaxVertices> light_ratio{}, eye_ratio{};  // set by letter_masks()
+    std::array<double, kMaxVertices> light_ratio{}, eye_ratio{};  // set by prepare_joins()
     int ns = 0, nt = 0;        // the current subpaths' lengths
-    bool masks_ready = false;  // the masks are built on the sample's first recorded contribution
+    bool joins_ready = false;  // prepare_joins() runs on the sample's first recorded contribution
   };
 
   // A vertex's density ratio in the MIS sums, a Dirac's densities (stored as 0) counting as 1.
@@ -217,10 +216,10 @@ class Integrator {
   static double ratio(const Vertex& v) { return remap(v.pdf_rev) / remap(v.pdf_fwd); }
   // Per sample, before its first recorded contribution: the letter masks, and each vertex's
   // ratio of reverse to forward density (a join changes only the two nearest each end).
-  void letter_masks(Thread& th, int ns, int nt) const {
+  void prepare_joins(Thread& th, int ns, int nt) const {
     for (int i = 0; i < ns; ++i) th.light_ratio[static_cast<std::size_t>(i)] = ratio(th.light[static_cast<std::size_t>(i)]);
     for (int i = 0; i < nt; ++i) th.eye_ratio[static_cast<std::size_t>(i)] = ratio(th.eye[static_cast<std::size_t>(i)]);
-    th.masks_ready = true;
+    th.joins_ready = true;
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
     for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
@@ -285,7 +284,7 @@ class Integrator {
     *ns = light_subpath(th, rng);
     th.ns = *ns;
     th.nt = nt;
-    letter_masks(th, *ns, nt);
+    prepare_joins(th, *ns, nt);
     return nt;
   }
 
@@ -409,7 +408,7 @@ class Integrator {
   int light_subpath(Thread& th, Sampler& rng) const;
 
   // --- connections ---
-  void connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int batch) const;
+  void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
   float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key) const;
   // The full-path letters of the path made by s light and t eye vertices (with `sampled`
   // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
@@ -419,7 +418,7 @@ class Integrator {
     ++th.rays;
     return rs_.geometry->visible(a.p, a.n, b.p, b.n);
   }
-  void record(Thread& th, ClassImages& images, PathKey path, int strategy, int batch, const vec3& c, bool splat,
+  void record(Thread& th, PathKey path, int strategy, int batch, const vec3& c, bool splat,
               float rx, float ry) const;
 
   const RenderScene& rs_;
@@ -735,7 +734,7 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   return static_cast<float>(1.0 / (1.0 + sum));
 }
 
-void Integrator::record(Thread& th, ClassImages& images, PathKey path, int strategy, int batch, const vec3& c,
+void Integrator::record(Thread& th, PathKey path, int strategy, int batch, const vec3& c,
                         bool splat, float rx, float ry) const {
   const Rgb rgb{c.x, c.y, c.z};
   const std::optional<ExactRgb> e = to_exact(rgb);
@@ -747,11 +746,11 @@ void Integrator::record(Thread& th, ClassImages& images, PathKey path, int strat
   const Histogram::PathId id = th.ids.get(th.hist, path);
   th.hist.add_exact(id, batch, strategy, *e);
   const std::uint32_t set = th.hist.class_set(id);
-  if (splat) images.add(static_cast<int>(rx), static_cast<int>(ry), set, *e);
+  if (splat) th.images->add(static_cast<int>(rx), static_cast<int>(ry), set, *e);
   else th.pixel.add(set, *e);
 }
 
-void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, int t, int batch) const {
+void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = strategy(s, t);
   vec3 contrib{0.0f};
   Vertex& sampled = th.sampled;
@@ -857,9 +856,9 @@ void Integrator::connect(Thread& th, ClassImages& images, Sampler& rng, int s, i
   }
   if (is_black(contrib)) return;
   const Vertex* fresh = (s == 1 || t == 1) ? &sampled : nullptr;
-  if (!th.masks_ready) letter_masks(th, th.ns, th.nt);
+  if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   const PathKey key = path_key(th, s, t, fresh);
-  record(th, images, key, strategy_index, batch, contrib * mis_weight(th, s, t, fresh, key), splat, rx, ry);
+  record(th, key, strategy_index, batch, contrib * mis_weight(th, s, t, fresh, key), splat, rx, ry);
 }
 
 float Integrator::weight_sum(Thread& th, int s, int t) const {
@@ -930,12 +929,12 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
           specular(k - (j + 1)) ? 0.0f
                                 : pdf(&th.eye[static_cast<std::size_t>(j + 2)], th.eye[static_cast<std::size_t>(j + 1)],
                                       th.eye[static_cast<std::size_t>(j)]);
-    letter_masks(th, s2, t2);  // the ratios of the re-split subpaths
+    prepare_joins(th, s2, t2);  // the ratios of the re-split subpaths
     sum += mis_weight(th, s2, t2, nullptr, pack(letters));
   }
   th.light = saved_light_eye.light;
   th.eye = saved_light_eye.eye;
-  letter_masks(th, th.ns, th.nt);
+  prepare_joins(th, th.ns, th.nt);
   return sum;
 }
 
@@ -947,7 +946,7 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const int ns = light_subpath(th, rng);
   th.ns = ns;
   th.nt = nt;
-  th.masks_ready = false;
+  th.joins_ready = false;
   for (int t = 0; t <= nt; ++t) {
     // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
     const int s_max = rs_.lights.empty() ? ns : std::max(ns, 1);
@@ -958,7 +957,7 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
       if (t > 0 && s >= 2 && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens) continue;
       if (s == 0 && t < 2) continue;
       if (strategy(s, t) < 0) continue;
-      connect(th, *th.images, rng, s, t, batch);
+      connect(th, rng, s, t, batch);
     }
   }
 }
@@ -977,7 +976,7 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
   Integrator integrator(*rs, *strategies, o, nullptr);
-  Integrator::Thread th{Histogram(layout, nullptr), ClassImages::PixelSum(images), {}, {}, {}, 0, {}, {}};
+  Integrator::Thread th{Histogram(layout, nullptr), ClassImages::PixelSum(images), {}, {}, 0, {}, {}};
   th.images = &images;
   std::vector<MisCheck> out;
   for (int i = 0; i < samples; ++i) {
@@ -1018,7 +1017,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
   tbb::enumerable_thread_specific<Integrator::Thread> locals(
       [&] {
-        Integrator::Thread th{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, {}, 0, {}, {}};
+        Integrator::Thread th{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, 0, {}, {}};
         th.images = &out.images;
         return th;
       });
