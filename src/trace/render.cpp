@@ -21,6 +21,7 @@
 #include <tbb/parallel_for.h>
 
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 
@@ -186,6 +187,11 @@ class Integrator {
     for (std::size_t a = 0; a < kMaxRuns; ++a)
       for (std::size_t b = 0; b < kMaxRuns; ++b)
         strategy_of_[a * kMaxRuns + b] = static_cast<std::int16_t>(strategies.find(static_cast<int>(a), static_cast<int>(b)));
+    // runs_mask_[n] bit s2: the profile runs (s2, n - s2); t2 = 0 only when light paths can hit the lens.
+    for (std::size_t n = 0; n < runs_mask_.size(); ++n)
+      for (int s2 = 0; s2 <= static_cast<int>(n); ++s2)
+        if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
+          runs_mask_[n] |= std::uint64_t{1} << s2;
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
     sensor_pair_ = sensor_letters(cam_.type);
     for (const RenderLight& l : rs.lights) light_pairs_.push_back(light_letters(letter_type(l.type)));
@@ -429,6 +435,10 @@ class Integrator {
   int max_bounces_ = 16;
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;
   std::vector<std::int16_t> strategy_of_;  // [s * kMaxRuns + t]: the profile's strategy running (s, t), or -1
+  // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
+  // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
+  static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
+  std::array<std::uint64_t, 64> runs_mask_{};
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
   std::vector<std::string> light_pairs_;  // each light's letters c0 c1
@@ -667,17 +677,19 @@ void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled
 
 float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key) const {
   // Strategy (s2, t2) samples this string when the profile runs it and its join letters c(s2),
-  // c(s2+1) are both D.
-  auto runs = [&](int s2, int t2) { return strategy(s2, t2) >= 0 && ((key >> s2) & 3) == 0; };
+  // c(s2+1) are both D: one mask for all of them, bit s2 (runs_mask_ holds the profile's part).
   // When no other strategy can sample this string (pt, lt, and many strings of every profile),
   // the weight is 1 and no density needs recomputing.
-  // Otherwise the loops below reach only as far as the farthest strategy that can: the light
-  // side down to s2 = light_lo, the eye side up to s2 = eye_hi; densities beyond are not needed.
-  int light_lo = 0, eye_hi = s + t;
-  while (light_lo < s && !runs(light_lo, s + t - light_lo)) ++light_lo;
-  while (eye_hi > s && !((eye_hi < s + t || lens_hits_) && runs(eye_hi, s + t - eye_hi))) --eye_hi;
-  if (light_lo == s && eye_hi == s) return 1.0f;
-  const int eye_lo = s + t - eye_hi;  // the eye loop's last index: t when it does not run
+  const int n = s + t;
+  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c_(i+1) are D
+  const std::uint64_t others = runs_mask_[static_cast<std::size_t>(n)] & d_pairs & ~(std::uint64_t{1} << s);
+  if (others == 0) return 1.0f;
+  // The loops below reach only as far as the farthest strategy that can: the light side down to
+  // s2 = light_lo, the eye side up to s2 = eye_hi; densities beyond are not needed.
+  const std::uint64_t below = others & ((std::uint64_t{1} << s) - 1), above = others & ~below;
+  const int light_lo = below != 0 ? std::countr_zero(below) : s;
+  const int eye_hi = above != 0 ? 63 - std::countl_zero(above) : s;
+  const int eye_lo = n - eye_hi;  // the eye loop's last index: t when it does not run
   const std::array<Vertex, kMaxVertices>& L = th.light;
   const std::array<Vertex, kMaxVertices>& E = th.eye;
   // The join's vertices; a fresh sample stands for z0 when t = 1, else for y0 when s = 1.
@@ -721,15 +733,14 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
     ri *= i == t - 1   ? remap(rev_pt) / remap(pt->pdf_fwd)
           : i == t - 2 ? remap(rev_ptm) / remap(E[static_cast<std::size_t>(i)].pdf_fwd)
                        : th.eye_ratio[static_cast<std::size_t>(i)];
-    if (i == 0 && !lens_hits_) break;
-    if (runs(s + t - i, i)) sum += ri * ri;
+    if ((others >> (n - i)) & 1) sum += ri * ri;
   }
   ri = 1.0;
   for (int i = s - 1; i >= light_lo; --i) {
     ri *= i == s - 1   ? remap(rev_qs) / remap(qs->pdf_fwd)
           : i == s - 2 ? remap(rev_qsm) / remap(L[static_cast<std::size_t>(i)].pdf_fwd)
                        : th.light_ratio[static_cast<std::size_t>(i)];
-    if (runs(i, s + t - i)) sum += ri * ri;
+    if ((others >> i) & 1) sum += ri * ri;
   }
   return static_cast<float>(1.0 / (1.0 + sum));
 }
