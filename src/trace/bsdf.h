@@ -137,6 +137,32 @@ inline float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, co
   return pdf(m, wo, wi, n, n);
 }
 
+// Both directions' densities at a join, for BDPT's MIS: pdf(wo, wi) and pdf(wi, wo).
+struct JoinPdfs {
+  float to_wi = 0.0f;  // pdf(wo, wi): sampling wi having arrived along wo
+  float to_wo = 0.0f;  // pdf(wi, wo): sampling wo having arrived along wi
+  bool known = false;  // false: not computed here (a material other than Lambert)
+};
+// eval(), and for a Lambertian material both densities of `pdfs` from the same side test (two
+// more products), bit for bit what pdf() gives: same_side() is symmetric in wo and wi. Other
+// materials leave `pdfs` unknown, for the caller to compute only if it needs them.
+inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
+                      const glm::vec3& ng, JoinPdfs* pdfs) {
+  if (const auto* lambert = std::get_if<Diffuse>(&m)) {
+    float cos_i;
+    pdfs->known = true;
+    if (!detail::same_side(wo, wi, ns, ng, &cos_i)) {
+      pdfs->to_wi = pdfs->to_wo = 0.0f;
+      return glm::vec3(0.0f);
+    }
+    pdfs->to_wi = std::abs(cos_i) * std::numbers::inv_pi_v<float>;
+    pdfs->to_wo = std::abs(glm::dot(wo, ns)) * std::numbers::inv_pi_v<float>;
+    return lambert->albedo * std::numbers::inv_pi_v<float>;
+  }
+  pdfs->known = false;
+  return detail::eval_general(m, wo, wi, ns, ng);
+}
+
 // The discrete probability that sample() picks the delta lobe `lobe` of component `component`
 // given wo (what BsdfSample::pdf holds for that delta); 0 if that lobe is not a delta of that
 // component. For BDPT, which recomputes a specular vertex's densities in the reverse direction.

@@ -415,7 +415,16 @@ class Integrator {
 
   // --- connections ---
   void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
-  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key) const;
+  // What connect() has already computed for its join, handed to mis_weight() so that it is not
+  // computed twice: the unit direction w from the light end qs to the eye end pt, their squared
+  // distance, and the BSDF densities at each end that its BSDF evaluation gave for free.
+  struct Join {
+    vec3 w{0.0f};
+    float d2 = 0.0f;
+    bsdf::JoinPdfs at_qs;  // wo = qs->wo, wi = w
+    bsdf::JoinPdfs at_pt;  // wo = pt->wo, wi = -w
+  };
+  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join = nullptr) const;
   // The full-path letters of the path made by s light and t eye vertices (with `sampled`
   // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
   // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
@@ -675,7 +684,7 @@ void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled
   c(s + 1) = 'D';
 }
 
-float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key) const {
+float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join) const {
   // Strategy (s2, t2) samples this string when the profile runs it and its join letters c(s2),
   // c(s2+1) are both D: one mask for all of them, bit s2 (runs_mask_ holds the profile's part).
   // When no other strategy can sample this string (pt, lt, and many strings of every profile),
@@ -708,13 +717,21 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   const bool need_pt = eye_lo <= t - 1, need_ptm = ptm && eye_lo <= t - 2;
   const bool need_qs = light_lo <= s - 1, need_qsm = qsm && light_lo <= s - 2;
   if (qs && pt) {
-    const vec3 e = pt->p - qs->p;
-    const float d2 = glm::dot(e, e);
-    const vec3 w = d2 > 0.0f ? e / std::sqrt(d2) : vec3(0.0f), back = -w;
-    if (need_pt) rev_pt = area(pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
-    if (need_qs) rev_qs = area(pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
-    if (need_ptm) rev_ptm = area(pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
-    if (need_qsm) rev_qsm = area(pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
+    Join own;
+    if (join == nullptr) {
+      const vec3 e = pt->p - qs->p;
+      own.d2 = glm::dot(e, e);
+      own.w = own.d2 > 0.0f ? e / std::sqrt(own.d2) : vec3(0.0f);
+      join = &own;
+    }
+    const vec3 w = join->w, back = -w;
+    const float d2 = join->d2;
+    const bsdf::JoinPdfs& at_qs = join->at_qs;
+    const bsdf::JoinPdfs& at_pt = join->at_pt;
+    if (need_pt) rev_pt = area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
+    if (need_qs) rev_qs = area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
+    if (need_ptm) rev_ptm = area(at_pt.known ? at_pt.to_wo : pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
+    if (need_qsm) rev_qsm = area(at_qs.known ? at_qs.to_wo : pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
   } else if (pt) {  // s = 0: pt lies on an area light
     rev_pt = pdf_light_origin(*pt);
     if (need_ptm) {
@@ -769,6 +786,8 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   float rx = 0.0f, ry = 0.0f;
   const Vertex* qs = s > 0 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
   const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
+  Join join;
+  bool joined = false;  // `join` describes this connection (every case but s = 0 and t = 0)
   if (s == 0) {
     // --- eye path hits an area light ---
     if (pt->kind != Kind::kSurface) return;
@@ -809,7 +828,10 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     // A light vertex's beta already holds its spatial emission; only the directional part is left.
     if (qs->kind == Kind::kLight) fq = vec3(light_emits(rs_.lights[static_cast<std::size_t>(qs->light)], *qs, w) ? 1.0f : 0.0f);
     else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                        qs->wo, w, qs->ns, qs->n);
+                        qs->wo, w, qs->ns, qs->n, &join.at_qs);
+    join.w = w;
+    join.d2 = d2;
+    joined = true;
     const float g = abs_cos(*qs, w) * std::fabs(glm::dot(cam_.forward, w)) / d2;
     contrib = qs->beta * fq * sampled.beta * g;
     if (is_black(contrib) || !visible(th, *qs, sampled)) return;
@@ -845,7 +867,10 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     const vec3 w = to_light / std::sqrt(d2);
     if (!light_emits(l, sampled, -w)) return;
     const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
-                             pt->wo, w, pt->ns, pt->n);
+                             pt->wo, w, pt->ns, pt->n, &join.at_pt);
+    join.w = -w;  // w runs from pt to the light, the join's from the light to pt
+    join.d2 = d2;
+    joined = true;
     const float g = abs_cos(*pt, w) * abs_cos(sampled, w) / d2;
     contrib = pt->beta * f * sampled.beta * g;
     if (is_black(contrib) || !visible(th, *pt, sampled)) return;
@@ -858,9 +883,12 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     if (d2 <= 0.0f) return;
     const vec3 w = d / std::sqrt(d2);
     const vec3 fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                              qs->wo, w, qs->ns, qs->n);
+                              qs->wo, w, qs->ns, qs->n, &join.at_qs);
     const vec3 fp = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
-                              pt->wo, -w, pt->ns, pt->n);
+                              pt->wo, -w, pt->ns, pt->n, &join.at_pt);
+    join.w = w;
+    join.d2 = d2;
+    joined = true;
     const float g = abs_cos(*qs, w) * abs_cos(*pt, w) / d2;
     contrib = qs->beta * fq * fp * pt->beta * g;
     if (is_black(contrib) || !visible(th, *qs, *pt)) return;
@@ -869,7 +897,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   const Vertex* fresh = (s == 1 || t == 1) ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   const PathKey key = path_key(th, s, t, fresh);
-  record(th, key, strategy_index, batch, contrib * mis_weight(th, s, t, fresh, key), splat, rx, ry);
+  record(th, key, strategy_index, batch, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr), splat, rx, ry);
 }
 
 float Integrator::weight_sum(Thread& th, int s, int t) const {
