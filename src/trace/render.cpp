@@ -505,7 +505,9 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.d2_wo = glm::dot(e, e);
     v.beta = beta;
     // Solid angle at prev to area at v, along the unit ray direction d.
-    const float to_area_v = v.d2_wo > 0.0f ? std::fabs(glm::dot(v.n, d)) / v.d2_wo : 0.0f;
+    // 0 for coincident points (and a subnormal distance, whose inverse would overflow): no density.
+    const float inv_d2 = v.d2_wo >= std::numeric_limits<float>::min() ? 1.0f / v.d2_wo : 0.0f;
+    const float to_area_v = std::fabs(glm::dot(v.n, d)) * inv_d2;
     v.pdf_fwd = pdf_dir * to_area_v;
     ++count;
     if (count >= max_vertices) break;
@@ -522,14 +524,14 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // strategy that would join at this vertex is excluded by its letter S.
     pdf_dir = bs->is_delta ? 0.0f : bs->pdf;
     const float pdf_rev_dir = bs->is_delta ? 0.0f : bs->pdf_rev;
-    prev.pdf_rev = v.d2_wo > 0.0f ? pdf_rev_dir * abs_cos(prev, d) / v.d2_wo : 0.0f;
+    prev.pdf_rev = pdf_rev_dir * abs_cos(prev, d) * inv_d2;
     // --- Russian roulette, never mislabelling: the vertices so far stay valid prefixes ---
     if (count >= o_.rr_depth) {
       // Termination probability from the throughput lost so far, at most 1/2 per vertex so that a
       // surviving path's weight grows by at most 2 each time (bounded variance).
       const float q = std::min(0.5f, std::max(0.0f, 1.0f - max_component(beta) / beta_start));
       if (rng.get1d() < q) break;
-      beta /= 1.0f - q;
+      beta *= 1.0f / (1.0f - q);
     }
     o = v.p;
     d = bs->wi;
@@ -721,7 +723,7 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
     if (join == nullptr) {
       const vec3 e = pt->p - qs->p;
       own.d2 = glm::dot(e, e);
-      own.w = own.d2 > 0.0f ? e / std::sqrt(own.d2) : vec3(0.0f);
+      own.w = own.d2 > 0.0f ? e * (1.0f / std::sqrt(own.d2)) : vec3(0.0f);  // as connect() forms it
       join = &own;
     }
     const vec3 w = join->w, back = -w;
@@ -818,7 +820,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     sampled.pos_letter = sensor_pair_[1];
     const vec3 to_cam = sampled.p - qs->p;
     const float d2 = glm::dot(to_cam, to_cam);
-    const vec3 w = to_cam / std::sqrt(d2);  // from qs to the camera
+    const vec3 w = to_cam * (1.0f / std::sqrt(d2));  // from qs to the camera
     if (!raster_of(sampled.p, -w, &rx, &ry)) return;
     const float we = importance(sampled.p, -w);
     const float pdf_pos = cam_.type == SensorType::kLens ? 1.0f / lens_area() : 1.0f;
@@ -860,11 +862,11 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     }
     sampled.ns = sampled.n;
     sampled.pdf_fwd = light_pick_ * light_pdf_pos(l);
-    sampled.beta = l.power / (light_pick_ * pdf_pos);
+    sampled.beta = l.power * (1.0f / (light_pick_ * pdf_pos));
     const vec3 to_light = sampled.p - pt->p;
     const float d2 = glm::dot(to_light, to_light);
     if (d2 <= 0.0f) return;
-    const vec3 w = to_light / std::sqrt(d2);
+    const vec3 w = to_light * (1.0f / std::sqrt(d2));
     if (!light_emits(l, sampled, -w)) return;
     const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
                              pt->wo, w, pt->ns, pt->n, &join.at_pt);
@@ -881,7 +883,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     const vec3 d = pt->p - qs->p;
     const float d2 = glm::dot(d, d);
     if (d2 <= 0.0f) return;
-    const vec3 w = d / std::sqrt(d2);
+    const vec3 w = d * (1.0f / std::sqrt(d2));  // one division, not three
     const vec3 fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
                               qs->wo, w, qs->ns, qs->n, &join.at_qs);
     const vec3 fp = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
