@@ -295,7 +295,8 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
 float EmbreeScene::offset_epsilon(const vec3& p) const { return epsilon_ + 1e-6f * max_abs(p); }
 
 vec3 EmbreeScene::offset(const vec3& p, const vec3& n, const vec3& d) const {
-  if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f) return p;
+  // A zero normal (a point: lights, pinholes) offsets by exactly zero; no branch, whose outcome
+  // would follow which ends of a connection are points.
   const float eps = offset_epsilon(p);
   return p + (glm::dot(n, d) >= 0.0f ? eps : -eps) * n;
 }

@@ -83,7 +83,9 @@ struct Vertex {
   float pdf_rev = 0.0f;  // area density of sampling it from the other direction
   int shape = -1;        // surfaces and area-light points
   int light = -1;        // light vertices
-  bool has_normal() const { return n.x != 0.0f || n.y != 0.0f || n.z != 0.0f; }
+  // Without short-circuits: which components are zero follows the scene's orientation, which no
+  // branch predictor guesses (this test was an eighth of the tracer's mispredicted branches).
+  bool has_normal() const { return (n.x != 0.0f) | (n.y != 0.0f) | (n.z != 0.0f); }
 };
 
 // Sets v.wo and v.d2_wo from its predecessor's position.
@@ -161,7 +163,10 @@ class PathIds {
 };
 
 // |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
-float abs_cos(const Vertex& v, const vec3& w) { return v.has_normal() ? std::fabs(glm::dot(v.n, w)) : 1.0f; }
+float abs_cos(const Vertex& v, const vec3& w) {
+  const float c = std::fabs(glm::dot(v.n, w));  // computed either way, so that the choice is a select
+  return v.has_normal() ? c : 1.0f;
+}
 
 
 // --- the integrator ---
@@ -218,7 +223,8 @@ class Integrator {
   };
 
   // A vertex's density ratio in the MIS sums, a Dirac's densities (stored as 0) counting as 1.
-  static double remap(float f) { return f != 0.0f ? static_cast<double>(f) : 1.0; }
+  // Branch-free (0 + 1 is exact): Dirac vertices come and go along a path unpredictably.
+  static double remap(float f) { return static_cast<double>(f) + static_cast<double>(f == 0.0f); }
   static double ratio(const Vertex& v) { return remap(v.pdf_rev) / remap(v.pdf_fwd); }
   // Per sample, before its first recorded contribution: the letter masks, and each vertex's
   // ratio of reverse to forward density (a join changes only the two nearest each end).
@@ -468,7 +474,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   while (count < max_vertices) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.has_normal() ? prev.n : vec3(0.0f), HitDetail::kNoUv);
+    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, HitDetail::kNoUv);  // n is zero for points: no offset
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
       const float denom = glm::dot(d, cam_.forward);
@@ -988,18 +994,19 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   th.ns = ns;
   th.nt = nt;
   th.joins_ready = false;
-  for (int t = 0; t <= nt; ++t) {
-    // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
-    const int s_max = rs_.lights.empty() ? ns : std::max(ns, 1);
-    for (int s = 0; s <= s_max; ++s) {
-      const int k = s + t - 1;  // edges
-      if (k < 1 || k - 1 > max_bounces_) continue;
-      if (t == 0 && !(s >= 2 && lens_hits_ && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens)) continue;
-      if (t > 0 && s >= 2 && th.light[static_cast<std::size_t>(s - 1)].kind == Kind::kLens) continue;
-      if (s == 0 && t < 2) continue;
-      if (strategy(s, t) < 0) continue;
-      connect(th, rng, s, t, batch);
-    }
+  // The connections (s, t) in order of t, then s, over the ranges where they form a path of k =
+  // s + t - 1 >= 1 edges and at most max_bounces_ + 1 (k - 1 <= max_bounces_): loops with exact
+  // bounds rather than one loop whose tests the branch predictor keeps missing.
+  // A light subpath that reached the lens ends there (random_walk stops), so only its last vertex
+  // can be a lens vertex; it forms the t = 0 connection and no other.
+  const bool lens_end = ns >= 2 && th.light[static_cast<std::size_t>(ns - 1)].kind == Kind::kLens;
+  if (lens_end && lens_hits_ && ns - 2 <= max_bounces_ && strategy(ns, 0) >= 0) connect(th, rng, ns, 0, batch);
+  // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
+  const int s_max = (rs_.lights.empty() ? ns : std::max(ns, 1)) - (lens_end ? 1 : 0);
+  for (int t = 1; t <= nt; ++t) {
+    const int s_hi = std::min(s_max, max_bounces_ + 2 - t);
+    for (int s = std::max(0, 2 - t); s <= s_hi; ++s)
+      if (strategy(s, t) >= 0) connect(th, rng, s, t, batch);
   }
 }
 
