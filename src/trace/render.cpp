@@ -164,8 +164,9 @@ class PathIds {
 
 // |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
 float abs_cos(const Vertex& v, const vec3& w) {
-  const float c = std::fabs(glm::dot(v.n, w));  // computed either way, so that the choice is a select
-  return v.has_normal() ? c : 1.0f;
+  // Arithmetic, not a choice (which compiled to a branch that mispredicted at every point vertex):
+  // a point's n is zero, so its |cos| term is 0 and the added 1 is the whole value.
+  return std::fabs(glm::dot(v.n, w)) + static_cast<float>(!v.has_normal());
 }
 
 
@@ -414,12 +415,23 @@ class Integrator {
   }
 
   // --- subpaths ---
+  template <TransportMode mode>  // a template: the walk's tests of its direction are not branches
   int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
-                  float pdf_dir, int max_vertices, TransportMode mode) const;
+                  float pdf_dir, int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
   int light_subpath(Thread& th, Sampler& rng) const;
 
   // --- connections ---
+  // The five kinds of connection, one instantiation of connect() each, so that the kind is not a
+  // branch taken anew (and mispredicted) on every call.
+  enum class Connection {
+    kEmitter,  // s = 0: the eye subpath's last vertex lies on an area light
+    kLens,     // t = 0: the light subpath's last vertex lies on the lens
+    kSplat,    // t = 1: a light vertex joined to a fresh sensor sample
+    kNee,      // s = 1: an eye vertex joined to a fresh light sample
+    kJoin,     // s, t >= 2: a shadow ray between two subpath vertices
+  };
+  template <Connection C>
   void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
   // What connect() has already computed for its join, handed to mis_weight() so that it is not
   // computed twice: the unit direction w from the light end qs to the eye end pt, their squared
@@ -463,8 +475,9 @@ class Integrator {
   bool lens_hits_ = false;
 };
 
+template <TransportMode mode>
 int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
-                            float pdf_dir, int max_vertices, TransportMode mode) const {
+                            float pdf_dir, int max_vertices) const {
   vec3 beta = path[static_cast<std::size_t>(count - 1)].beta;
   // Russian roulette compares the throughput with the subpath's start, so that a light subpath
   // (whose throughput starts at the light's power) is treated like an eye subpath.
@@ -587,7 +600,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   z0.ns = z0.n;
   z0.pdf_fwd = sensor_pdf_pos();
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
-  return random_walk(th, rng, th.eye, 1, o, d, pdf_dir, max_eye_, TransportMode::kRadiance);
+  return random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, o, d, pdf_dir, max_eye_);
 }
 
 int Integrator::light_subpath(Thread& th, Sampler& rng) const {
@@ -659,7 +672,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   // The walk starts from y0 with the first ray's throughput.
   Vertex saved = y0;
   th.light[0].beta = beta1;
-  const int n = random_walk(th, rng, th.light, 1, y0.p, d, pdf_dir, max_light_, TransportMode::kImportance);
+  const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, d, pdf_dir, max_light_);
   th.light[0].beta = saved.beta;
   return n;
 }
@@ -786,6 +799,7 @@ void Integrator::record(Thread& th, PathKey path, int strategy, int batch, const
   else th.pixel.add(set, *e);
 }
 
+template <Integrator::Connection C>
 void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = strategy(s, t);
   vec3 contrib{0.0f};
@@ -796,20 +810,20 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
   Join join;
   bool joined = false;  // `join` describes this connection (every case but s = 0 and t = 0)
-  if (s == 0) {
+  if constexpr (C == Connection::kEmitter) {
     // --- eye path hits an area light ---
     if (pt->kind != Kind::kSurface) return;
     const int li = rs_.light_of_shape[static_cast<std::size_t>(pt->shape)];
     if (li < 0) return;
     contrib = pt->beta * light_emit(rs_.lights[static_cast<std::size_t>(li)], *pt, pt->wo);
-  } else if (t == 0) {
+  } else if constexpr (C == Connection::kLens) {
     // --- light path hits the lens ---
     if (qs->kind != Kind::kLens) return;
     const vec3 w = qs->wo;
     if (!raster_of(qs->p, w, &rx, &ry)) return;
     contrib = qs->beta * importance(qs->p, w);
     splat = true;
-  } else if (t == 1) {
+  } else if constexpr (C == Connection::kSplat) {
     // --- splat: connect qs to a fresh sensor point ---
     if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return;
     if (qs->kind == Kind::kLens || !qs->finite) return;
@@ -844,7 +858,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     contrib = qs->beta * fq * sampled.beta * g;
     if (is_black(contrib) || !visible(th, *qs, sampled)) return;
     splat = true;
-  } else if (s == 1) {
+  } else if constexpr (C == Connection::kNee) {
     // --- next-event estimation: a fresh light sample ---
     if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
     const float ul = rng.get1d();
@@ -902,7 +916,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     if (is_black(contrib) || !visible(th, *qs, *pt)) return;
   }
   if (is_black(contrib)) return;
-  const Vertex* fresh = (s == 1 || t == 1) ? &sampled : nullptr;
+  const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   const PathKey key = path_key(th, s, t, fresh);
   record(th, key, strategy_index, batch, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr), splat, rx, ry);
@@ -1000,13 +1014,19 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   // A light subpath that reached the lens ends there (random_walk stops), so only its last vertex
   // can be a lens vertex; it forms the t = 0 connection and no other.
   const bool lens_end = ns >= 2 && th.light[static_cast<std::size_t>(ns - 1)].kind == Kind::kLens;
-  if (lens_end && lens_hits_ && ns - 2 <= max_bounces_ && strategy(ns, 0) >= 0) connect(th, rng, ns, 0, batch);
+  if (lens_end && lens_hits_ && ns - 2 <= max_bounces_ && strategy(ns, 0) >= 0)
+    connect<Connection::kLens>(th, rng, ns, 0, batch);
   // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
   const int s_max = (rs_.lights.empty() ? ns : std::max(ns, 1)) - (lens_end ? 1 : 0);
-  for (int t = 1; t <= nt; ++t) {
+  if (nt >= 1)
+    for (int s = 1; s <= std::min(s_max, max_bounces_ + 1); ++s)
+      if (strategy(s, 1) >= 0) connect<Connection::kSplat>(th, rng, s, 1, batch);
+  for (int t = 2; t <= nt; ++t) {
     const int s_hi = std::min(s_max, max_bounces_ + 2 - t);
-    for (int s = std::max(0, 2 - t); s <= s_hi; ++s)
-      if (strategy(s, t) >= 0) connect(th, rng, s, t, batch);
+    if (s_hi >= 0 && strategy(0, t) >= 0) connect<Connection::kEmitter>(th, rng, 0, t, batch);
+    if (s_hi >= 1 && strategy(1, t) >= 0) connect<Connection::kNee>(th, rng, 1, t, batch);
+    for (int s = 2; s <= s_hi; ++s)
+      if (strategy(s, t) >= 0) connect<Connection::kJoin>(th, rng, s, t, batch);
   }
 }
 
