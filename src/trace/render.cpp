@@ -198,6 +198,12 @@ class Integrator {
       for (int s2 = 0; s2 <= static_cast<int>(n); ++s2)
         if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
           runs_mask_[n] |= std::uint64_t{1} << s2;
+    eye0_runs_ = (runs_mask_[1] >> 1) & 1;
+    all_runs_ = true;
+    for (std::size_t n = 1; n < runs_mask_.size(); ++n) {
+      const std::uint64_t below = (std::uint64_t{1} << n) - 1;  // s2 < n: t2 >= 1
+      all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
+    }
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
     sensor_pair_ = sensor_letters(cam_.type);
     for (const RenderLight& l : rs.lights) light_pairs_.push_back(light_letters(letter_type(l.type)));
@@ -219,6 +225,10 @@ class Integrator {
     std::array<PathKey, kMaxVertices + 1> eye_masks{};
     ClassImages* images = nullptr;  // the shared image that splats go to
     std::array<double, kMaxVertices> light_ratio{}, eye_ratio{};  // set by prepare_joins()
+    // With every strategy run (all_runs_), the MIS sums over each subpath's fixed part, from its
+    // start to vertex j (set by prepare_joins()): light_acc[j] = Σ_{i <= j, strategy (i, ·)
+    // samples the letters} Π_{m=i..j} light_ratio[m]², and eye_acc likewise.
+    std::array<double, kMaxVertices> light_acc{}, eye_acc{};
     int ns = 0, nt = 0;        // the current subpaths' lengths
     bool joins_ready = false;  // prepare_joins() runs on the sample's first recorded contribution
   };
@@ -240,6 +250,24 @@ class Integrator {
     for (int t = 1; t <= nt; ++t)
       th.eye_masks[static_cast<std::size_t>(t)] =
           (th.eye_masks[static_cast<std::size_t>(t - 1)] << 1) | letter_bit(th.eye[static_cast<std::size_t>(t - 1)].letter, 0);
+    if (!all_runs_) return;
+    // Strategy (i, ·) on the light side joins at y(i-1) and y_i: letters c_i and c_(i+1), bits i
+    // and i + 1 of light_mask. On the eye side strategy (·, j) joins at z_j and z(j-1): letters
+    // z_j's and z(j-1)'s (z0's spatial letter for j = 0, which also needs the lens).
+    double acc = 0.0;
+    for (int j = 0; j < ns; ++j) {
+      const double r = th.light_ratio[static_cast<std::size_t>(j)];
+      acc = r * r * (static_cast<double>(((th.light_mask >> j) & 3) == 0) + acc);
+      th.light_acc[static_cast<std::size_t>(j)] = acc;
+    }
+    acc = 0.0;
+    for (int j = 0; j < nt; ++j) {
+      const char before = j > 0 ? th.eye[static_cast<std::size_t>(j - 1)].letter : th.eye[0].pos_letter;
+      const bool runs = th.eye[static_cast<std::size_t>(j)].letter == 'D' && before == 'D' && (j > 0 || eye0_runs_);
+      const double r = th.eye_ratio[static_cast<std::size_t>(j)];
+      acc = r * r * (static_cast<double>(runs) + acc);
+      th.eye_acc[static_cast<std::size_t>(j)] = acc;
+    }
   }
   // The packed full-path string of connection (s, t), as full_path() spells it.
   PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
@@ -466,6 +494,11 @@ class Integrator {
   // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
   static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
   std::array<std::uint64_t, 64> runs_mask_{};
+  // The profile runs every (s, t) with t >= 1 (full BDPT), and (s, 0) for all s or none
+  // (eye0_runs_): which strategies sample a path then depends on its letters alone, so the MIS
+  // sums over each subpath's fixed part are computed once per sample (prepare_joins()).
+  bool all_runs_ = false;
+  bool eye0_runs_ = false;
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
   std::vector<std::string> light_pairs_;  // each light's letters c0 c1
@@ -766,7 +799,29 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
   // Ratios in double: long paths multiply many of them. Dirac densities are stored as 0 and
   // count as 1 here; their strategies are excluded by letter.
-  double sum = 0.0, ri = 1.0;
+  double sum = 0.0;
+  const auto runs = [&](int s2) { return static_cast<double>((others >> s2) & 1); };
+  if (all_runs_) {
+    // Each side: the join's two ratios, then the subpath's fixed part from prepare_joins().
+    if (eye_lo <= t - 1) {
+      const double a = remap(rev_pt) / remap(pt->pdf_fwd), a2 = a * a;
+      sum += a2 * runs(n - (t - 1));
+      if (need_ptm) {
+        const double b = remap(rev_ptm) / remap(E[static_cast<std::size_t>(t - 2)].pdf_fwd);
+        sum += a2 * b * b * (runs(n - (t - 2)) + (t >= 3 ? th.eye_acc[static_cast<std::size_t>(t - 3)] : 0.0));
+      }
+    }
+    if (light_lo <= s - 1) {
+      const double a = remap(rev_qs) / remap(qs->pdf_fwd), a2 = a * a;
+      sum += a2 * runs(s - 1);
+      if (need_qsm) {
+        const double b = remap(rev_qsm) / remap(L[static_cast<std::size_t>(s - 2)].pdf_fwd);
+        sum += a2 * b * b * (runs(s - 2) + (s >= 3 ? th.light_acc[static_cast<std::size_t>(s - 3)] : 0.0));
+      }
+    }
+    return static_cast<float>(1.0 / (1.0 + sum));
+  }
+  double ri = 1.0;
   for (int i = t - 1; i >= eye_lo; --i) {
     ri *= i == t - 1   ? remap(rev_pt) / remap(pt->pdf_fwd)
           : i == t - 2 ? remap(rev_ptm) / remap(E[static_cast<std::size_t>(i)].pdf_fwd)
