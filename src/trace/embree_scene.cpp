@@ -159,8 +159,10 @@ glm::vec2 quad_uv(const QuadShape& q, const vec3& p) {
 // process otherwise). A non-finite ray is a bug upstream; it is treated as hitting nothing and
 // as blocked, so that it carries no light, and never reaches Embree.
 bool finite_ray(const vec3& o, const vec3& d) {
-  return std::isfinite(o.x) && std::isfinite(o.y) && std::isfinite(o.z) && std::isfinite(d.x) && std::isfinite(d.y) &&
-         std::isfinite(d.z);
+  // One test of the sum of products by zero: 0 * x is 0 for finite x and NaN for an infinity or
+  // NaN, so the sum is 0 exactly when all six are finite (no short-circuit branches per component).
+  const vec3 z = o * 0.0f + d * 0.0f;
+  return z.x + z.y + z.z == 0.0f;
 }
 
 RTCRay make_ray(const vec3& o, const vec3& d, float tmin, float tmax) {
