@@ -268,30 +268,6 @@ std::optional<Pick> pick(const Material& m, float u, BasicMaterial* storage) {
   return Pick{storage, 0, 1.0f, 1.0f, u};
 }
 
-// sample() for a plain Lambertian material (the common case), with the same numbers as the
-// general path: the direction drawn in ns's frame on wo's side, then f, pdf and pdf_rev exactly
-// as eval() and pdf() give them (same_side() is their test).
-std::optional<BsdfSample> sample_lambert(const Diffuse& lambert, const glm::vec3& wo, const glm::vec3& ns,
-                                         const glm::vec3& ng, float cos_o, glm::vec2 u) {
-  glm::vec3 wi_l = sample_cosine_hemisphere(u);
-  if (!(wi_l.z > 0.0f)) return std::nullopt;
-  if (cos_o < 0.0f) wi_l.z = -wi_l.z;
-  BsdfSample s;
-  s.wi = glm::normalize(Frame::from_normal(ns).to_world(wi_l));
-  float cos_i;
-  if (!same_side(wo, s.wi, ns, ng, &cos_i)) return std::nullopt;
-  s.f = lambert.albedo * kInvPi;
-  s.pdf = cosine_hemisphere_pdf(std::abs(cos_i));
-  if (!(s.pdf > 0.0f) || is_black(s.f) || !finite_vec(s.f)) return std::nullopt;
-  s.pdf_rev = cosine_hemisphere_pdf(std::abs(cos_o));
-  s.weight = s.f * (std::abs(cos_i) / s.pdf);
-  s.letter = kD;
-  s.is_delta = false;
-  s.lobe = Lobe::kDiffuseReflection;
-  if (!finite_vec(s.weight)) return std::nullopt;
-  return s;
-}
-
 }  // namespace
 
 // --- public functions ---
@@ -359,14 +335,14 @@ float detail::pdf_general(const Material& m, const glm::vec3& wo, const glm::vec
       m);
 }
 
-std::optional<BsdfSample> sample(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
-                                 const glm::vec3& ng, float u_component, glm::vec2 u,
-                                 TransportMode mode) {
+std::optional<BsdfSample> detail::sample_general(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
+                                                const glm::vec3& ng, float u_component, glm::vec2 u,
+                                                TransportMode mode) {
   const float cos_o = glm::dot(wo, ns);
   const float cos_og = glm::dot(wo, ng);
   if (!(cos_o != 0.0f) || !(cos_og != 0.0f) || !std::isfinite(cos_o) || !std::isfinite(cos_og))
     return std::nullopt;
-  if (const auto* lambert = std::get_if<Diffuse>(&m)) return sample_lambert(*lambert, wo, ns, ng, cos_o, u);
+  // Lambert never gets here: sample() (bsdf.h) takes it inline.
   BasicMaterial storage;
   const std::optional<Pick> chosen = pick(m, u_component, &storage);
   if (!chosen) return std::nullopt;

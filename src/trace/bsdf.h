@@ -51,6 +51,8 @@
 
 #include "alphabet/alphabet.h"
 #include "scene/material.h"
+#include "trace/frame.h"
+#include "trace/rng.h"
 
 namespace pathex {
 
@@ -88,9 +90,9 @@ namespace bsdf {
 // reflection/refraction choice of a dielectric); `u` drives the direction within the lobe.
 // nullopt when the sampled direction carries nothing (below the surface, leaking through ng,
 // grazing exactly, zero-weight material).
-std::optional<BsdfSample> sample(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
-                                 const glm::vec3& ng, float u_component, glm::vec2 u,
-                                 TransportMode mode);
+inline std::optional<BsdfSample> sample(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
+                                        const glm::vec3& ng, float u_component, glm::vec2 u,
+                                        TransportMode mode);
 
 namespace detail {
 // Lambert needs no local frame: only the sides of the two directions (the tests reflection
@@ -135,6 +137,50 @@ inline float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, co
 }
 inline float pdf(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& n) {
   return pdf(m, wo, wi, n, n);
+}
+
+namespace detail {
+std::optional<BsdfSample> sample_general(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
+                                         const glm::vec3& ng, float u_component, glm::vec2 u, TransportMode mode);
+inline bool all_finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+// sample() for a plain Lambertian material (the common case), with the same numbers as the
+// general path: the direction drawn in ns's frame on wo's side, then f, pdf and pdf_rev exactly
+// as eval() and pdf() give them (same_side() is their test). Inline, like eval(): it is the step
+// of almost every bounce.
+inline std::optional<BsdfSample> sample_lambert(const Diffuse& lambert, const glm::vec3& wo, const glm::vec3& ns,
+                                                const glm::vec3& ng, float cos_o, glm::vec2 u) {
+  glm::vec3 wi_l = sample_cosine_hemisphere(u);
+  if (!(wi_l.z > 0.0f)) return std::nullopt;
+  if (cos_o < 0.0f) wi_l.z = -wi_l.z;
+  BsdfSample s;
+  s.wi = glm::normalize(Frame::from_normal(ns).to_world(wi_l));
+  float cos_i;
+  if (!same_side(wo, s.wi, ns, ng, &cos_i)) return std::nullopt;
+  s.f = lambert.albedo * kInvPi;
+  s.pdf = cosine_hemisphere_pdf(std::abs(cos_i));
+  if (!(s.pdf > 0.0f) || (s.f.x == 0.0f && s.f.y == 0.0f && s.f.z == 0.0f) || !all_finite(s.f)) return std::nullopt;
+  s.pdf_rev = cosine_hemisphere_pdf(std::abs(cos_o));
+  s.weight = s.f * (std::abs(cos_i) / s.pdf);
+  s.letter = kD;
+  s.is_delta = false;
+  s.lobe = Lobe::kDiffuseReflection;
+  if (!all_finite(s.weight)) return std::nullopt;
+  return s;
+}
+}  // namespace detail
+
+inline std::optional<BsdfSample> sample(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
+                                        const glm::vec3& ng, float u_component, glm::vec2 u,
+                                        TransportMode mode) {
+  if (const auto* lambert = std::get_if<Diffuse>(&m)) {
+    // The same entry tests as the general path's.
+    const float cos_o = glm::dot(wo, ns);
+    const float cos_og = glm::dot(wo, ng);
+    if (!(cos_o != 0.0f) || !(cos_og != 0.0f) || !std::isfinite(cos_o) || !std::isfinite(cos_og))
+      return std::nullopt;
+    return detail::sample_lambert(*lambert, wo, ns, ng, cos_o, u);
+  }
+  return detail::sample_general(m, wo, ns, ng, u_component, u, mode);
 }
 
 // Both directions' densities at a join, for BDPT's MIS: pdf(wo, wi) and pdf(wi, wo).
