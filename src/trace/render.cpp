@@ -229,6 +229,9 @@ class Integrator {
     // start to vertex j (set by prepare_joins()): light_acc[j] = Σ_{i <= j, strategy (i, ·)
     // samples the letters} Π_{m=i..j} light_ratio[m]², and eye_acc likewise.
     std::array<double, kMaxVertices> light_acc{}, eye_acc{};
+    // 1 / (remapped forward density) of each vertex (set by prepare_joins()): a weight multiplies
+    // by it rather than dividing on its critical path.
+    std::array<double, kMaxVertices> light_inv_fwd{}, eye_inv_fwd{};
     int ns = 0, nt = 0;        // the current subpaths' lengths
     bool joins_ready = false;  // prepare_joins() runs on the sample's first recorded contribution
   };
@@ -237,11 +240,18 @@ class Integrator {
   // Branch-free (0 + 1 is exact): Dirac vertices come and go along a path unpredictably.
   static double remap(float f) { return static_cast<double>(f) + static_cast<double>(f == 0.0f); }
   static double ratio(const Vertex& v) { return remap(v.pdf_rev) / remap(v.pdf_fwd); }
+  static double inv_fwd(const Vertex& v) { return 1.0 / remap(v.pdf_fwd); }
   // Per sample, before its first recorded contribution: the letter masks, and each vertex's
   // ratio of reverse to forward density (a join changes only the two nearest each end).
   void prepare_joins(Thread& th, int ns, int nt) const {
-    for (int i = 0; i < ns; ++i) th.light_ratio[static_cast<std::size_t>(i)] = ratio(th.light[static_cast<std::size_t>(i)]);
-    for (int i = 0; i < nt; ++i) th.eye_ratio[static_cast<std::size_t>(i)] = ratio(th.eye[static_cast<std::size_t>(i)]);
+    for (int i = 0; i < ns; ++i) {
+      th.light_ratio[static_cast<std::size_t>(i)] = ratio(th.light[static_cast<std::size_t>(i)]);
+      th.light_inv_fwd[static_cast<std::size_t>(i)] = inv_fwd(th.light[static_cast<std::size_t>(i)]);
+    }
+    for (int i = 0; i < nt; ++i) {
+      th.eye_ratio[static_cast<std::size_t>(i)] = ratio(th.eye[static_cast<std::size_t>(i)]);
+      th.eye_inv_fwd[static_cast<std::size_t>(i)] = inv_fwd(th.eye[static_cast<std::size_t>(i)]);
+    }
     th.joins_ready = true;
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
@@ -804,18 +814,20 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   if (all_runs_) {
     // Each side: the join's two ratios, then the subpath's fixed part from prepare_joins().
     if (eye_lo <= t - 1) {
-      const double a = remap(rev_pt) / remap(pt->pdf_fwd), a2 = a * a;
+      const double a = remap(rev_pt) * (t == 1 && sampled ? inv_fwd(*pt) : th.eye_inv_fwd[static_cast<std::size_t>(t - 1)]);
+      const double a2 = a * a;
       sum += a2 * runs(n - (t - 1));
       if (need_ptm) {
-        const double b = remap(rev_ptm) / remap(E[static_cast<std::size_t>(t - 2)].pdf_fwd);
+        const double b = remap(rev_ptm) * th.eye_inv_fwd[static_cast<std::size_t>(t - 2)];
         sum += a2 * b * b * (runs(n - (t - 2)) + (t >= 3 ? th.eye_acc[static_cast<std::size_t>(t - 3)] : 0.0));
       }
     }
     if (light_lo <= s - 1) {
-      const double a = remap(rev_qs) / remap(qs->pdf_fwd), a2 = a * a;
+      const double a = remap(rev_qs) * (qs != &L[static_cast<std::size_t>(s - 1)] ? inv_fwd(*qs) : th.light_inv_fwd[static_cast<std::size_t>(s - 1)]);
+      const double a2 = a * a;
       sum += a2 * runs(s - 1);
       if (need_qsm) {
-        const double b = remap(rev_qsm) / remap(L[static_cast<std::size_t>(s - 2)].pdf_fwd);
+        const double b = remap(rev_qsm) * th.light_inv_fwd[static_cast<std::size_t>(s - 2)];
         sum += a2 * b * b * (runs(s - 2) + (s >= 3 ? th.light_acc[static_cast<std::size_t>(s - 3)] : 0.0));
       }
     }
