@@ -138,11 +138,14 @@ std::size_t ClassImages::memory_bytes() const {
 
 bool ClassImages::add(int x, int y, std::uint32_t set, const ExactRgb& c) {
   if (!inside(x, y)) return false;
-  const std::size_t slot = set < slot_of_set_.size() ? slot_of_set_[set] : 0;
+  add_to_slot(set < slot_of_set_.size() ? slot_of_set_[set] : 0, x, y, c);
+  return true;
+}
+
+void ClassImages::add_to_slot(std::size_t slot, int x, int y, const ExactRgb& c) {
   std::uint64_t* w = words(slot, x, y);
   for (std::size_t ch = 0; ch < 3; ++ch)
     if (c[ch] != 0) atomic_add(w + 2 * ch, c[ch]);
-  return true;
 }
 
 Result<bool> ClassImages::merge(const ClassImages& other) {
@@ -197,20 +200,21 @@ std::vector<ImageLayer> ClassImages::layers(double scale) const {
 // --- PixelSum ---
 
 void ClassImages::PixelSum::add(std::uint32_t set, const ExactRgb& c) {
-  for (auto& [s, sum] : by_set_)
-    if (s == set) {
+  const std::size_t slot = set < slot_of_set_->size() ? (*slot_of_set_)[set] : 0;  // as ClassImages::add
+  for (auto& [s, sum] : by_slot_)
+    if (s == slot) {
       add_to(sum, c);
       return;
     }
-  by_set_.push_back({set, c});
+  by_slot_.push_back({slot, c});
 }
 
 bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {
   const bool inside = images.inside(x, y);
   if (inside)
-    for (const auto& [set, sum] : by_set_)
-      if (!is_zero(sum)) images.add(x, y, set, sum);
-  by_set_.clear();
+    for (const auto& [slot, sum] : by_slot_)
+      if (!is_zero(sum)) images.add_to_slot(slot, x, y, sum);
+  by_slot_.clear();
   return inside;
 }
 

@@ -86,18 +86,20 @@ class ClassImages {
   std::vector<ImageLayer> layers(double scale) const;
   std::size_t memory_bytes() const;
 
-  // The contributions of one sample (or of all samples of one pixel) summed per class set without
-  // atomics; flush() adds them to the shared image and clears the buffer. One per thread.
+  // The contributions of one sample (or of all samples of one pixel) summed per plane (the class
+  // sets whose classes have the same layers share one) without atomics; flush() adds them to
+  // `images`, which must be the image it was made for, and clears the buffer. One per thread.
   class PixelSum {
    public:
-    explicit PixelSum(const ClassImages& /*images*/) {}
+    explicit PixelSum(const ClassImages& images) : slot_of_set_(&images.slot_of_set_) {}
     void add(std::uint32_t set, const ExactRgb& c);
     // Adds the collected sums to pixel (x, y) of `images` and clears them. Returns false (and
     // still clears) for a pixel outside the image.
     bool flush(ClassImages& images, int x, int y);
 
    private:
-    std::vector<std::pair<std::uint32_t, ExactRgb>> by_set_;  // class sets touched since the last flush
+    const std::vector<std::size_t>* slot_of_set_;               // the image's, read only
+    std::vector<std::pair<std::size_t, ExactRgb>> by_slot_;  // planes touched since the last flush
   };
 
  private:
@@ -118,6 +120,7 @@ class ClassImages {
   // The six words of pixel (x, y) in the plane of `slot`, allocating on first use; or, const,
   // null when that tile was never touched.
   std::uint64_t* words(std::size_t slot, int x, int y);
+  void add_to_slot(std::size_t slot, int x, int y, const ExactRgb& c);  // (x, y) inside
   const std::uint64_t* words_if_any(std::size_t slot, int x, int y) const;
   void release();
 
