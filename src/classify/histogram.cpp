@@ -47,6 +47,7 @@ std::optional<ExactSum> exact_from_string(std::string_view s) {
 Histogram::Histogram(HistogramLayout layout, const Classifier* classifier)
     : layout_(std::move(layout)),
       classifier_(classifier),
+      cells_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
       batch_samples_(static_cast<std::size_t>(std::max(layout_.num_batches, 0)), 0) {}
 
 Histogram::PathId Histogram::intern(std::string_view path) {
@@ -56,7 +57,7 @@ Histogram::PathId Histogram::intern(std::string_view path) {
   paths_.emplace_back(path);
   ids_.emplace(paths_.back(), id);
   sets_.push_back(classifier_ != nullptr ? classifier_->classify(path) : 0);
-  cells_.resize(cells_.size() + static_cast<std::size_t>(layout_.num_batches));
+  for (std::vector<Cell>& row : cells_) row.emplace_back();
   strategy_sums_.resize(strategy_sums_.size() + layout_.strategies.size(), ExactRgb{});
   return id;
 }
@@ -79,7 +80,7 @@ ExactSum add_saturating(ExactSum a, ExactSum b, ExactSum cap) { return b >= cap 
 
 void Histogram::add_exact(PathId id, int batch, int strategy, const ExactRgb& c) {
   if (is_zero(c)) return;
-  Cell& cell = cells_[cell_index(id, batch)];
+  Cell& cell = cell_of(id, batch);
   add_to(cell.sum, c);
   ++cell.contributions;
   if (strategy != kNoStrategy)
@@ -91,7 +92,7 @@ void Histogram::add_exact(PathId id, int batch, int strategy, const ExactRgb& c)
 }
 
 void Histogram::add_cell(PathId id, int batch, const ExactRgb& sum, std::uint64_t contributions) {
-  Cell& cell = cells_[cell_index(id, batch)];
+  Cell& cell = cell_of(id, batch);
   add_to(cell.sum, sum);
   cell.contributions += contributions;
 }

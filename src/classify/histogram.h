@@ -178,7 +178,9 @@ class Histogram {
   Result<bool> merge(const Histogram& other);
 
   // --- the exact state (for reports and serialisation) ---
-  const Cell& cell(PathId id, int batch) const { return cells_[cell_index(id, batch)]; }
+  const Cell& cell(PathId id, int batch) const {
+    return cells_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(id)];
+  }
   const ExactRgb& strategy_sum(PathId id, int strategy) const {
     return strategy_sums_[static_cast<std::size_t>(id) * layout_.strategies.size() +
                           static_cast<std::size_t>(strategy)];
@@ -203,9 +205,8 @@ class Histogram {
     using is_transparent = void;
     std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
   };
-  std::size_t cell_index(PathId id, int batch) const {
-    return static_cast<std::size_t>(id) * static_cast<std::size_t>(layout_.num_batches) +
-           static_cast<std::size_t>(batch);
+  Cell& cell_of(PathId id, int batch) {
+    return cells_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(id)];
   }
 
   HistogramLayout layout_;
@@ -213,7 +214,9 @@ class Histogram {
   std::unordered_map<std::string, PathId, StringHash, std::equal_to<>> ids_;
   std::vector<std::string> paths_;
   std::vector<std::uint32_t> sets_;
-  std::vector<Cell> cells_;             // path-major: id * B + batch
+  // Batch-major, [batch][id]: a render's passes go to batches round-robin, so the cells it adds
+  // to at a time are a few batches' rows, not a line of every path's B cells.
+  std::vector<std::vector<Cell>> cells_;
   std::vector<ExactRgb> strategy_sums_;  // id * S + strategy
   std::vector<std::uint64_t> batch_samples_;
   std::uint64_t nonfinite_ = 0;
