@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <map>
 
 namespace pathex {
@@ -216,6 +217,35 @@ bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {
       if (!is_zero(sum)) images.add_to_slot(slot, x, y, sum);
   by_slot_.clear();
   return inside;
+}
+
+ClassImages::SplatBuffer::SplatBuffer(std::size_t entries) : entries_(std::bit_ceil(std::max<std::size_t>(entries, 1))) {}
+
+bool ClassImages::SplatBuffer::add(ClassImages& images, int x, int y, std::uint32_t set, const ExactRgb& c) {
+  if (!images.inside(x, y)) return false;
+  const std::uint64_t slot = set < images.slot_of_set_.size() ? images.slot_of_set_[set] : 0;  // as add()
+  const std::uint64_t pixel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(images.width_) + static_cast<std::uint64_t>(x);
+  const std::uint64_t key = slot * images.num_pixels() + pixel;
+  Entry& e = entries_[(pixel + slot * 0x9E3779B97F4A7C15ULL) & (entries_.size() - 1)];
+  if (e.key == key) {
+    add_to(e.sum, c);
+    return true;
+  }
+  spill(images, e);
+  e.key = key;
+  e.sum = c;
+  return true;
+}
+
+void ClassImages::SplatBuffer::spill(ClassImages& images, Entry& e) {
+  if (e.key == kEmpty) return;
+  const std::uint64_t pixel = e.key % images.num_pixels(), width = static_cast<std::uint64_t>(images.width_);
+  images.add_to_slot(e.key / images.num_pixels(), static_cast<int>(pixel % width), static_cast<int>(pixel / width), e.sum);
+  e.key = kEmpty;
+}
+
+void ClassImages::SplatBuffer::flush(ClassImages& images) {
+  for (Entry& e : entries_) spill(images, e);
 }
 
 }  // namespace pathex

@@ -102,6 +102,30 @@ class ClassImages {
     std::vector<std::pair<std::size_t, ExactRgb>> by_slot_;  // planes touched since the last flush
   };
 
+  // Contributions to arbitrary pixels (light tracing's splats) summed without atomics in a
+  // direct-mapped table of (plane, pixel) entries: a pixel splatted again while its entry is held
+  // costs an integer add, and the shared image gets one atomic add per channel when the entry is
+  // evicted or flushed. The sums are exact, so the result does not depend on when that happens.
+  // One per thread; flush() before the image is read.
+  class SplatBuffer {
+   public:
+    static constexpr std::size_t kDefaultEntries = 4096;  // 256 KiB
+    SplatBuffer() : SplatBuffer(kDefaultEntries) {}
+    explicit SplatBuffer(std::size_t entries);
+    // As ClassImages::add (false, adding nothing, outside the image).
+    bool add(ClassImages& images, int x, int y, std::uint32_t set, const ExactRgb& c);
+    void flush(ClassImages& images);
+
+   private:
+    struct Entry {
+      std::uint64_t key = kEmpty;  // slot * pixels + pixel
+      ExactRgb sum{};
+    };
+    static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+    static void spill(ClassImages& images, Entry& e);  // adds an entry to the image and empties it
+    std::vector<Entry> entries_;  // a power of two
+  };
+
  private:
   // A plane is a directory of 8 × 8-pixel tiles, each allocated when first touched, so that a
   // combination of layers that only a few pixels see costs only their tiles.
@@ -117,6 +141,7 @@ class ClassImages {
     return static_cast<std::size_t>((y % kTile) * kTile + x % kTile) * 6;
   }
   bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width_ && y < height_; }
+  std::uint64_t num_pixels() const { return static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_); }
   // The six words of pixel (x, y) in the plane of `slot`, allocating on first use; or, const,
   // null when that tile was never touched.
   std::uint64_t* words(std::size_t slot, int x, int y);

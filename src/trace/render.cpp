@@ -224,6 +224,7 @@ class Integrator {
     PathKey light_mask = 0;
     std::array<PathKey, kMaxVertices + 1> eye_masks{};
     ClassImages* images = nullptr;  // the shared image that splats go to
+    ClassImages::SplatBuffer splats = ClassImages::SplatBuffer();  // they go through this; render() flushes it at the end
     std::array<double, kMaxVertices> light_ratio{}, eye_ratio{};  // set by prepare_joins()
     // With every strategy run (all_runs_), the MIS sums over each subpath's fixed part, from its
     // start to vertex j (set by prepare_joins()): light_acc[j] = Σ_{i <= j, strategy (i, ·)
@@ -862,7 +863,7 @@ void Integrator::record(Thread& th, PathKey path, int strategy, int batch, const
   const Histogram::PathId id = th.ids.get(th.hist, path);
   th.hist.add_exact(id, batch, strategy, *e);
   const std::uint32_t set = th.hist.class_set(id);
-  if (splat) th.images->add(static_cast<int>(rx), static_cast<int>(ry), set, *e);
+  if (splat) th.splats.add(*th.images, static_cast<int>(rx), static_cast<int>(ry), set, *e);
   else th.pixel.add(set, *e);
 }
 
@@ -1181,6 +1182,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   out.spp_done = pass;
   out.complete = pass == o.spp;
   for (Integrator::Thread& th : locals) {
+    th.splats.flush(out.images);
     Result<bool> m = out.histogram.merge(th.hist);
     if (!m) return m.error();
     out.rays += th.rays;

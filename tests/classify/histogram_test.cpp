@@ -546,5 +546,31 @@ TEST(ClassImages, PixelSumFlushEqualsDirectAddsAndTheTotalMatchesTheHistogram) {
   EXPECT_FALSE(direct.merge(other));
 }
 
+TEST(ClassImages, SplatBufferEqualsDirectAddsThroughEvictionsAndIgnoresPixelsOutside) {
+  Classes classes({{"point", "LS.*E"}, {"area", "LD.*E"}});
+  ClassImages direct(5, 3, &*classes.classifier, {0, 1}), buffered(5, 3, &*classes.classifier, {0, 1});
+  Histogram h(HistogramLayout{4, {}}, &*classes.classifier);
+  ClassImages::SplatBuffer splats(4);  // 4 entries for 15 pixels in 3 planes: most adds evict
+  const std::vector<Sample> stream = sample_stream(3000, 4);
+  for (std::size_t i = 0; i < stream.size(); ++i) {
+    const Sample& s = stream[i];
+    // Scattered pixels, revisited now and then (i / 3), as light tracing's splats are.
+    const int x = static_cast<int>((i / 3 * 7) % 5), y = static_cast<int>((i / 3 * 11) % 3);
+    const ExactRgb c = *to_exact(s.value);
+    const std::uint32_t set = h.class_set(h.intern(s.path));
+    EXPECT_TRUE(direct.add(x, y, set, c));
+    EXPECT_TRUE(splats.add(buffered, x, y, set, c));
+  }
+  EXPECT_FALSE(splats.add(buffered, 5, 0, 0, *to_exact(Rgb{1.0, 1.0, 1.0})));
+  EXPECT_FALSE(splats.add(buffered, 0, -1, 0, *to_exact(Rgb{1.0, 1.0, 1.0})));
+  splats.flush(buffered);
+  for (int l = 0; l < 3; ++l)
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 5; ++x) EXPECT_TRUE(direct.sum(l, x, y) == buffered.sum(l, x, y)) << l << " " << x << " " << y;
+  EXPECT_FALSE(is_zero(buffered.sum(1, 0, 0)) && is_zero(buffered.sum(2, 0, 0))) << "both planes were reached";
+  splats.flush(buffered);  // empty now: nothing is added twice
+  EXPECT_TRUE(direct.sum(0, 2, 1) == buffered.sum(0, 2, 1));
+}
+
 }  // namespace
 }  // namespace pathex
