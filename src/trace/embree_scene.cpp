@@ -412,7 +412,7 @@ SurfaceSample EmbreeScene::sample_shape(int shape_index, glm::vec2 u) const {
     s.normal = glm::length(n) > 0.0f ? glm::normalize(n) : vec3(0.0f, 0.0f, 1.0f);
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
     s.position = q->corner + u.x * q->edge1 + u.y * q->edge2;
-    s.normal = glm::normalize(glm::cross(q->edge1, q->edge2));
+    s.normal = quad_normals_[static_cast<std::size_t>(shape_index)];  // normalize(e1 × e2), once per scene
   } else if (const auto* sp = std::get_if<SphereShape>(&shape.geometry)) {
     s.normal = sample_uniform_sphere(u);
     s.position = sp->center + sp->radius * s.normal;
