@@ -219,6 +219,11 @@ bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {
   return inside;
 }
 
+std::size_t ClassImages::splat_entries() const {
+  const std::uint64_t keys = num_pixels() * std::max<std::uint64_t>(num_slots_, 1);
+  return static_cast<std::size_t>(std::min<std::uint64_t>(keys, SplatBuffer::kMaxEntries));
+}
+
 ClassImages::SplatBuffer::SplatBuffer(std::size_t entries) : entries_(std::bit_ceil(std::max<std::size_t>(entries, 1))) {}
 
 bool ClassImages::SplatBuffer::add(ClassImages& images, int x, int y, std::uint32_t set, const ExactRgb& c) {
@@ -226,7 +231,7 @@ bool ClassImages::SplatBuffer::add(ClassImages& images, int x, int y, std::uint3
   const std::uint64_t slot = set < images.slot_of_set_.size() ? images.slot_of_set_[set] : 0;  // as add()
   const std::uint64_t pixel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(images.width_) + static_cast<std::uint64_t>(x);
   const std::uint64_t key = slot * images.num_pixels() + pixel;
-  Entry& e = entries_[(pixel + slot * 0x9E3779B97F4A7C15ULL) & (entries_.size() - 1)];
+  Entry& e = entries_[key & (entries_.size() - 1)];
   if (e.key == key) {
     add_to(e.sum, c);
     return true;

@@ -75,6 +75,9 @@ class ClassImages {
   // false, adding nothing, for a pixel outside the image. A set id the classifier does not know
   // (a caller's bug) still counts in the total.
   bool add(int x, int y, std::uint32_t set, const ExactRgb& c);
+  // The SplatBuffer size that holds every (plane, pixel) of this image without evicting, at most
+  // SplatBuffer::kMaxEntries.
+  std::size_t splat_entries() const;
 
   // Adds another image of the same size and layers (e.g. from another process). Exact.
   Result<bool> merge(const ClassImages& other);
@@ -103,15 +106,16 @@ class ClassImages {
   };
 
   // Contributions to arbitrary pixels (light tracing's splats) summed without atomics in a
-  // direct-mapped table of (plane, pixel) entries: a pixel splatted again while its entry is held
-  // costs an integer add, and the shared image gets one atomic add per channel when the entry is
-  // evicted or flushed. The sums are exact, so the result does not depend on when that happens.
-  // One per thread; flush() before the image is read.
+  // direct-mapped table of (plane, pixel) entries, entry (plane × pixels + pixel) modulo the
+  // table's size: a pixel splatted again while its entry is held costs an integer add, and the
+  // shared image gets one atomic add per channel when the entry is evicted or flushed. The sums
+  // are exact, so the result does not depend on when that happens. One per thread; flush()
+  // before the image is read.
   class SplatBuffer {
    public:
-    static constexpr std::size_t kDefaultEntries = 4096;  // 256 KiB
-    SplatBuffer() : SplatBuffer(kDefaultEntries) {}
-    explicit SplatBuffer(std::size_t entries);
+    static constexpr std::size_t kMaxEntries = 16384;  // 64 bytes each: 1 MiB
+    SplatBuffer() : SplatBuffer(1) {}
+    explicit SplatBuffer(std::size_t entries);  // rounded up to a power of two
     // As ClassImages::add (false, adding nothing, outside the image).
     bool add(ClassImages& images, int x, int y, std::uint32_t set, const ExactRgb& c);
     void flush(ClassImages& images);

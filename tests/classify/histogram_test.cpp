@@ -570,6 +570,9 @@ TEST(ClassImages, SplatBufferEqualsDirectAddsThroughEvictionsAndIgnoresPixelsOut
   EXPECT_FALSE(is_zero(buffered.sum(1, 0, 0)) && is_zero(buffered.sum(2, 0, 0))) << "both planes were reached";
   splats.flush(buffered);  // empty now: nothing is added twice
   EXPECT_TRUE(direct.sum(0, 2, 1) == buffered.sum(0, 2, 1));
+  // Sized to hold every (plane, pixel): one plane of 64 × 64 pixels; capped for large images.
+  EXPECT_EQ(ClassImages(64, 64, nullptr, {}).splat_entries(), 4096u);
+  EXPECT_EQ(ClassImages(1000, 1000, nullptr, {}).splat_entries(), ClassImages::SplatBuffer::kMaxEntries);
 }
 
 }  // namespace
