@@ -22,6 +22,7 @@
 #include "io/profile_json.h"
 #include "scene/scene.h"
 #include "trace/render.h"
+#include "trace/embree_scene.h"
 #include "trace/render_scene.h"
 #include "trace/rng.h"
 
@@ -161,6 +162,50 @@ void BM_RenderClasses(benchmark::State& state) {
                                " class layers, against none");
 }
 BENCHMARK(BM_RenderClasses)->Arg(0)->Arg(20)->Arg(21)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Shadow rays alone, interleaved: the same 64 Ki segments between points on the Cornell box's
+// surfaces (sampled by area, so about a quarter are blocked) tested one by one with
+// EmbreeScene::visible() and in full OcclusionBatch packets of 16; `speedup` is the median of
+// the per-iteration ratios of single-ray time over batched time.
+void BM_ShadowRays(benchmark::State& state) {
+  Result<RenderScene> rs = make_render_scene(cornell());
+  const EmbreeScene& es = *rs->geometry;
+  struct Segment {
+    glm::vec3 a, na, b, nb;
+  };
+  std::vector<Segment> segments;
+  std::mt19937 pick(3);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  const auto shapes = static_cast<unsigned>(cornell().shapes.size());
+  for (int i = 0; i < 65536; ++i) {
+    const SurfaceSample a = es.sample_shape(static_cast<int>(pick() % shapes), {u01(pick), u01(pick)});
+    const SurfaceSample b = es.sample_shape(static_cast<int>(pick() % shapes), {u01(pick), u01(pick)});
+    segments.push_back({a.position, a.normal, b.position, b.normal});
+  }
+  std::vector<double> ratios;
+  std::uint64_t visible_single = 0, visible_batched = 0;
+  OcclusionBatch batch;
+  for (auto _ : state) {
+    const double t0 = cpu_seconds();
+    for (const Segment& g : segments) visible_single += es.visible(g.a, g.na, g.b, g.nb);
+    const double t1 = cpu_seconds();
+    for (const Segment& g : segments) {
+      batch.add(es, g.a, g.na, g.b, g.nb);
+      if (!batch.full()) continue;
+      batch.trace(es);
+      for (int lane = 0; lane < batch.size(); ++lane) visible_batched += batch.visible(lane);
+      batch.clear();
+    }
+    const double t2 = cpu_seconds();
+    ratios.push_back((t1 - t0) / (t2 - t1));
+  }
+  if (visible_single != visible_batched) state.SkipWithError("batched and single answers differ");
+  state.counters["speedup"] = benchmark::Counter(median(ratios));
+  state.counters["visible"] = benchmark::Counter(static_cast<double>(visible_single) /
+                                                 (static_cast<double>(state.iterations()) * static_cast<double>(segments.size())));
+  state.SetLabel("64 Ki segments, one by one against packets of 16");
+}
+BENCHMARK(BM_ShadowRays)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Thread scaling, interleaved: each iteration renders with one thread and then with two (wall
 // time); `speedup` is the summed one-thread time over the summed two-thread time.

@@ -365,6 +365,47 @@ bool EmbreeScene::occluded(const vec3& o, const vec3& d, float tmin, float tmax)
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
 
+int OcclusionBatch::add(const EmbreeScene& scene, const vec3& a, const vec3& na, const vec3& b, const vec3& nb) {
+  const int lane = size_++;
+  // The ray of EmbreeScene::visible(): from a, moved off its surface, to b, moved off its own.
+  const vec3 o = scene.offset(a, na, b - a);
+  const vec3 d = scene.offset(b, nb, a - b) - o;
+  rays_.org_x[lane] = o.x;
+  rays_.org_y[lane] = o.y;
+  rays_.org_z[lane] = o.z;
+  rays_.tnear[lane] = 0.0f;
+  rays_.dir_x[lane] = d.x;
+  rays_.dir_y[lane] = d.y;
+  rays_.dir_z[lane] = d.z;
+  rays_.time[lane] = 0.0f;
+  rays_.mask[lane] = 0xFFFFFFFFu;
+  rays_.id[lane] = 0;
+  rays_.flags[lane] = 0;
+  // A non-finite ray never reaches Embree and counts as blocked, as in occluded().
+  const bool finite = finite_ray(o, d);
+  rays_.tfar[lane] = finite ? 1.0f : -std::numeric_limits<float>::infinity();
+  valid_[lane] = finite ? -1 : 0;
+  return lane;
+}
+
+void OcclusionBatch::trace(const EmbreeScene& scene) {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  if (size_ >= kMinPacket) {
+    for (int lane = size_; lane < kCapacity; ++lane) valid_[lane] = 0;
+    rtcOccluded16(valid_, scene.handle(), &ctx, &rays_);
+    return;
+  }
+  for (int lane = 0; lane < size_; ++lane) {
+    if (valid_[lane] == 0) continue;
+    RTCRay ray;
+    set_ray(ray, vec3(rays_.org_x[lane], rays_.org_y[lane], rays_.org_z[lane]),
+            vec3(rays_.dir_x[lane], rays_.dir_y[lane], rays_.dir_z[lane]), 0.0f, 1.0f);
+    rtcOccluded1(scene.handle(), &ctx, &ray);
+    rays_.tfar[lane] = ray.tfar;
+  }
+}
+
 std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, const vec3& origin_normal, HitDetail detail) const {
   return intersect(offset(o, origin_normal, d), d, 0.0f, std::numeric_limits<float>::infinity(), detail);
 }

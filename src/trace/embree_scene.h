@@ -54,6 +54,36 @@ struct SurfaceSample {
   glm::vec3 normal{0.0f};  // geometric, unit, outward
 };
 
+class EmbreeScene;
+
+// Shadow rays tested together. A renderer's connections are independent of each other, so a
+// thread queues their segments here and has Embree trace them as one 16-wide ray packet
+// (rtcOccluded16), which costs markedly less per ray than single rays (bench/trace_bench
+// BM_ShadowRays). A batch with too few segments to fill much of a packet is traced ray by ray:
+// a mostly empty packet costs more than its rays would alone. Same answers as
+// EmbreeScene::visible() (tests/scene/embree_test.cpp): the same offsets, the same non-finite
+// guard. One writer; the rays live in the batch (no allocation).
+class OcclusionBatch {
+ public:
+  static constexpr int kCapacity = 16;
+  static constexpr int kMinPacket = 9;  // fewer segments than this are traced one by one
+
+  int size() const { return size_; }
+  bool full() const { return size_ == kCapacity; }
+  // Queues the segment between a and b (normals as for EmbreeScene::visible(); zero for points
+  // in free space) and returns its lane. The batch must not be full.
+  int add(const EmbreeScene& scene, const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb);
+  // Tests every queued segment; visible(lane) then holds until clear().
+  void trace(const EmbreeScene& scene);
+  bool visible(int lane) const { return rays_.tfar[lane] >= 0.0f; }
+  void clear() { size_ = 0; }
+
+ private:
+  alignas(64) RTCRay16 rays_;
+  alignas(64) int valid_[kCapacity];
+  int size_ = 0;
+};
+
 class EmbreeScene {
   struct Key {
     explicit Key() = default;

@@ -211,6 +211,15 @@ class Integrator {
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
 
+  // A weighted contribution on its way to record(): with its shadow ray pending, or none needed.
+  struct Pending {
+    PathKey key = 0;
+    vec3 c{0.0f};
+    int strategy = 0, batch = 0;
+    bool splat = false;  // to raster point (rx, ry); else to the sample's own pixel
+    float rx = 0.0f, ry = 0.0f;
+  };
+
   struct Thread {
     Histogram hist;
     ClassImages::PixelSum pixel;
@@ -235,6 +244,10 @@ class Integrator {
     std::array<double, kMaxVertices> light_inv_fwd{}, eye_inv_fwd{};
     int ns = 0, nt = 0;        // the current subpaths' lengths
     bool joins_ready = false;  // prepare_joins() runs on the sample's first recorded contribution
+    // Shadow rays queued by connect(), traced when the batch is full and when a pixel's chunk of
+    // samples ends (finish_pixel()); pending[lane] is what lane's ray decides on.
+    OcclusionBatch shadow = OcclusionBatch();
+    std::array<Pending, OcclusionBatch::kCapacity> pending{};
   };
 
   // A vertex's density ratio in the MIS sums, a Dirac's densities (stored as 0) counting as 1.
@@ -302,6 +315,9 @@ class Integrator {
   // One sample: pixel (px, py), pass `pass`. Its camera contributions collect in th.pixel (the
   // caller flushes them); light-tracing splats go straight to the shared image.
   void sample(Thread& th, int px, int py, std::uint64_t pass) const;
+  // After a pixel's samples, before its camera contributions (th.pixel) are flushed: traces the
+  // shadow rays still queued and records what they let through.
+  void finish_pixel(Thread& th) const { trace_shadows(th); }
 
   // For the full path x0 … xk formed by connection (s, t) of the current subpaths: the sum, over
   // every strategy (s', t') with s' + t' = s + t that the profile runs and whose join letters are
@@ -486,12 +502,8 @@ class Integrator {
   // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
   // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
   void full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const;
-  bool visible(Thread& th, const Vertex& a, const Vertex& b) const {
-    ++th.rays;
-    return rs_.geometry->visible(a.p, a.n, b.p, b.n);
-  }
-  void record(Thread& th, PathKey path, int strategy, int batch, const vec3& c, bool splat,
-              float rx, float ry) const;
+  void record(Thread& th, const Pending& r) const;
+  void trace_shadows(Thread& th) const;
 
   const RenderScene& rs_;
   const RenderCamera& cam_;
@@ -851,19 +863,18 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   return static_cast<float>(1.0 / (1.0 + sum));
 }
 
-void Integrator::record(Thread& th, PathKey path, int strategy, int batch, const vec3& c,
-                        bool splat, float rx, float ry) const {
-  const Rgb rgb{c.x, c.y, c.z};
+void Integrator::record(Thread& th, const Pending& r) const {
+  const Rgb rgb{r.c.x, r.c.y, r.c.z};
   const std::optional<ExactRgb> e = to_exact(rgb);
   if (!e) {
     th.hist.add_nonfinite();
     return;
   }
   if (is_zero(*e)) return;
-  const Histogram::PathId id = th.ids.get(th.hist, path);
-  th.hist.add_exact(id, batch, strategy, *e);
+  const Histogram::PathId id = th.ids.get(th.hist, r.key);
+  th.hist.add_exact(id, r.batch, r.strategy, *e);
   const std::uint32_t set = th.hist.class_set(id);
-  if (splat) th.splats.add(*th.images, static_cast<int>(rx), static_cast<int>(ry), set, *e);
+  if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, *e);
   else th.pixel.add(set, *e);
 }
 
@@ -878,6 +889,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
   Join join;
   bool joined = false;  // `join` describes this connection (every case but s = 0 and t = 0)
+  std::array<const Vertex*, 2> ends{};  // the shadow ray's ends, in the order visible() takes them
   if constexpr (C == Connection::kEmitter) {
     // --- eye path hits an area light ---
     if (pt->kind != Kind::kSurface) return;
@@ -924,7 +936,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     joined = true;
     const float g = abs_cos(*qs, w) * std::fabs(glm::dot(cam_.forward, w)) / d2;
     contrib = qs->beta * fq * sampled.beta * g;
-    if (is_black(contrib) || !visible(th, *qs, sampled)) return;
+    ends = {qs, &sampled};
     splat = true;
   } else if constexpr (C == Connection::kNee) {
     // --- next-event estimation: a fresh light sample ---
@@ -963,7 +975,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     joined = true;
     const float g = abs_cos(*pt, w) * abs_cos(sampled, w) / d2;
     contrib = pt->beta * f * sampled.beta * g;
-    if (is_black(contrib) || !visible(th, *pt, sampled)) return;
+    ends = {pt, &sampled};
   } else {
     // --- a shadow ray between y(s-1) and z(t-1) ---
     if (qs->kind == Kind::kLens || pt->kind != Kind::kSurface || qs->kind != Kind::kSurface) return;
@@ -981,13 +993,29 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     joined = true;
     const float g = abs_cos(*qs, w) * abs_cos(*pt, w) / d2;
     contrib = qs->beta * fq * fp * pt->beta * g;
-    if (is_black(contrib) || !visible(th, *qs, *pt)) return;
+    ends = {qs, pt};
   }
   if (is_black(contrib)) return;
   const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   const PathKey key = path_key(th, s, t, fresh);
-  record(th, key, strategy_index, batch, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr), splat, rx, ry);
+  const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr), strategy_index, batch, splat, rx, ry};
+  if constexpr (C == Connection::kEmitter || C == Connection::kLens) {
+    record(th, r);  // no shadow ray: the path's last edge was traced
+  } else {
+    // The weight is known before the shadow ray is: the ray joins the thread's batch, and the
+    // contribution is recorded if the batch finds the segment unobstructed.
+    ++th.rays;
+    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, ends[0]->p, ends[0]->n, ends[1]->p, ends[1]->n))] = r;
+    if (th.shadow.full()) trace_shadows(th);
+  }
+}
+
+void Integrator::trace_shadows(Thread& th) const {
+  th.shadow.trace(*rs_.geometry);
+  for (int lane = 0; lane < th.shadow.size(); ++lane)
+    if (th.shadow.visible(lane)) record(th, th.pending[static_cast<std::size_t>(lane)]);
+  th.shadow.clear();
 }
 
 float Integrator::weight_sum(Thread& th, int s, int t) const {
@@ -1173,6 +1201,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
       for (int y = rows.begin(); y < rows.end(); ++y)
         for (int x = 0; x < w; ++x) {
           for (std::uint64_t p = first; p < end; ++p) integrator.sample(th, x, y, p);
+          integrator.finish_pixel(th);
           th.pixel.flush(out.images, x, y);
         }
     });

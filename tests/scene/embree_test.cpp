@@ -380,5 +380,56 @@ TEST(Embree, ConcurrentQueriesAgreeWithSerialOnes) {
   EXPECT_EQ(std::count(serial.begin(), serial.end(), -1.0f), 0);  // the box is closed
 }
 
+// Shadow rays traced together (an Embree packet, or one by one for a small batch) give the
+// answers visible() gives for each alone: segments between points sampled on the Cornell box's
+// quads and spheres (user geometry), points in free space, coincident points and non-finite ones,
+// at every batch size from 1 to full.
+TEST(Embree, OcclusionBatchAgreesWithVisibleAtEveryBatchSize) {
+  Result<Scene> scene = load_scene_json(default_scene_json(), ".", "default");
+  ASSERT_TRUE(scene.ok());
+  auto es = EmbreeScene::build(*scene);
+  ASSERT_TRUE(es.ok());
+  struct Point {
+    vec3 p, n;
+  };
+  std::vector<Point> points;
+  Uniform u;
+  for (int i = 0; i < 400; ++i) {
+    const int shape = i % static_cast<int>(scene->shapes.size());
+    const SurfaceSample ss = (*es)->sample_shape(shape, u.next2());
+    points.push_back({ss.position, ss.normal});
+  }
+  for (int i = 0; i < 20; ++i) points.push_back({vec3(u.next(), u.next(), u.next()) * 2.0f - 1.0f, vec3(0.0f)});
+  points.push_back({vec3(std::nanf(""), 0, 0), vec3(0.0f)});
+  points.push_back({vec3(0, INFINITY, 0), vec3(0, 1, 0)});
+  std::mt19937 pick(7);
+  int agree = 0, blocked = 0, open = 0;
+  OcclusionBatch batch;
+  for (int round = 0; round < 400; ++round) {
+    const int size = 1 + round % OcclusionBatch::kCapacity;
+    std::vector<std::pair<Point, Point>> segments;
+    for (int i = 0; i < size; ++i) {
+      const Point& a = points[pick() % points.size()];
+      const Point& b = i == 0 && round % 7 == 0 ? a : points[pick() % points.size()];  // sometimes coincident
+      segments.push_back({a, b});
+      EXPECT_EQ(batch.add(**es, a.p, a.n, b.p, b.n), i);
+    }
+    EXPECT_EQ(batch.full(), size == OcclusionBatch::kCapacity);
+    batch.trace(**es);
+    for (int i = 0; i < size; ++i) {
+      const auto& [a, b] = segments[static_cast<std::size_t>(i)];
+      const bool alone = (*es)->visible(a.p, a.n, b.p, b.n);
+      EXPECT_EQ(batch.visible(i), alone) << "round " << round << " lane " << i;
+      agree += batch.visible(i) == alone;
+      (alone ? open : blocked) += 1;
+    }
+    batch.clear();
+    EXPECT_EQ(batch.size(), 0);
+  }
+  EXPECT_EQ(agree, open + blocked);
+  EXPECT_GT(blocked, 500) << "the test needs segments that something blocks";
+  EXPECT_GT(open, 500) << "and segments that nothing blocks";
+}
+
 }  // namespace
 }  // namespace pathex
