@@ -149,23 +149,31 @@ inline bool all_finite(const glm::vec3& v) { return std::isfinite(v.x) && std::i
 // of almost every bounce.
 inline std::optional<BsdfSample> sample_lambert(const Diffuse& lambert, const glm::vec3& wo, const glm::vec3& ns,
                                                 const glm::vec3& ng, float cos_o, glm::vec2 u) {
+  // The sample is built in the returned object itself (every return names `out`, so it is
+  // elided): returning a local BsdfSample made GCC copy it into the optional with a `rep movs`,
+  // whose start-up cost showed in the tracer's random walks.
+  std::optional<BsdfSample> out(std::in_place);
+  BsdfSample& s = *out;
   glm::vec3 wi_l = sample_cosine_hemisphere(u);
-  if (!(wi_l.z > 0.0f)) return std::nullopt;
-  if (cos_o < 0.0f) wi_l.z = -wi_l.z;
-  BsdfSample s;
-  s.wi = glm::normalize(Frame::from_normal(ns).to_world(wi_l));
-  float cos_i;
-  if (!same_side(wo, s.wi, ns, ng, &cos_i)) return std::nullopt;
-  s.f = lambert.albedo * kInvPi;
-  s.pdf = cosine_hemisphere_pdf(std::abs(cos_i));
-  if (!(s.pdf > 0.0f) || (s.f.x == 0.0f && s.f.y == 0.0f && s.f.z == 0.0f) || !all_finite(s.f)) return std::nullopt;
-  s.pdf_rev = cosine_hemisphere_pdf(std::abs(cos_o));
-  s.weight = s.f * (std::abs(cos_i) / s.pdf);
-  s.letter = kD;
-  s.is_delta = false;
-  s.lobe = Lobe::kDiffuseReflection;
-  if (!all_finite(s.weight)) return std::nullopt;
-  return s;
+  float cos_i = 0.0f;
+  if (wi_l.z > 0.0f) {
+    if (cos_o < 0.0f) wi_l.z = -wi_l.z;
+    s.wi = glm::normalize(Frame::from_normal(ns).to_world(wi_l));
+    if (same_side(wo, s.wi, ns, ng, &cos_i)) {
+      s.f = lambert.albedo * kInvPi;
+      s.pdf = cosine_hemisphere_pdf(std::abs(cos_i));
+      if (s.pdf > 0.0f && !(s.f.x == 0.0f && s.f.y == 0.0f && s.f.z == 0.0f) && all_finite(s.f)) {
+        s.pdf_rev = cosine_hemisphere_pdf(std::abs(cos_o));
+        s.weight = s.f * (std::abs(cos_i) / s.pdf);
+        s.letter = kD;
+        s.is_delta = false;
+        s.lobe = Lobe::kDiffuseReflection;
+        if (all_finite(s.weight)) return out;
+      }
+    }
+  }
+  out.reset();
+  return out;
 }
 }  // namespace detail
 
