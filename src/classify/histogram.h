@@ -98,6 +98,15 @@ inline std::optional<ExactRgb> to_exact(const Rgb& c) {
   }
   return out;
 }
+// The same into `out` (unchanged when false), for hot callers: the value is written where it is
+// used, never copied into an optional, which GCC does with 16-byte loads of words just stored as
+// 8-byte halves (a store-forwarding stall per channel).
+inline bool to_exact(const Rgb& c, ExactRgb* out) {
+  for (std::size_t i = 0; i < 3; ++i)
+    if (!(std::fabs(c[i]) < kMaxContribution)) return false;
+  for (std::size_t i = 0; i < 3; ++i) (*out)[i] = round_to_fixed(c[i] * 0x1p64);
+  return true;
+}
 inline double to_double(ExactSum s) { return static_cast<double>(static_cast<SignedExactSum>(s)) * 0x1p-64; }
 inline Rgb to_double(const ExactRgb& s) { return {to_double(s[0]), to_double(s[1]), to_double(s[2])}; }
 inline void add_to(ExactRgb& acc, const ExactRgb& c) {

@@ -865,17 +865,17 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
 
 void Integrator::record(Thread& th, const Pending& r) const {
   const Rgb rgb{r.c.x, r.c.y, r.c.z};
-  const std::optional<ExactRgb> e = to_exact(rgb);
-  if (!e) {
+  ExactRgb e;
+  if (!to_exact(rgb, &e)) {
     th.hist.add_nonfinite();
     return;
   }
-  if (is_zero(*e)) return;
+  if (is_zero(e)) return;
   const Histogram::PathId id = th.ids.get(th.hist, r.key);
-  th.hist.add_exact(id, r.batch, r.strategy, *e);
+  th.hist.add_exact(id, r.batch, r.strategy, e);
   const std::uint32_t set = th.hist.class_set(id);
-  if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, *e);
-  else th.pixel.add(set, *e);
+  if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, e);
+  else th.pixel.add(set, e);
 }
 
 template <Integrator::Connection C>
