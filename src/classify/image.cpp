@@ -219,23 +219,26 @@ bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {
   return inside;
 }
 
+std::uint64_t ClassImages::splat_keys() const { return num_pixels() * std::max<std::uint64_t>(num_slots_, 1); }
+
 std::size_t ClassImages::splat_entries() const {
-  const std::uint64_t keys = num_pixels() * std::max<std::uint64_t>(num_slots_, 1);
-  return static_cast<std::size_t>(std::min<std::uint64_t>(keys, SplatBuffer::kMaxEntries));
+  return static_cast<std::size_t>(std::min<std::uint64_t>(splat_keys(), SplatBuffer::kMaxEntries));
 }
 
-ClassImages::SplatBuffer::SplatBuffer(std::size_t entries) : entries_(std::bit_ceil(std::max<std::size_t>(entries, 1))) {}
+ClassImages::SplatBuffer::SplatBuffer(std::size_t entries, std::uint64_t keys)
+    : entries_(std::bit_ceil(std::max<std::size_t>(entries, 1))), hashed_(keys > entries_.size()) {}
 
 bool ClassImages::SplatBuffer::add(ClassImages& images, int x, int y, std::uint32_t set, const ExactRgb& c) {
   if (!images.inside(x, y)) return false;
   const std::uint64_t slot = set < images.slot_of_set_.size() ? images.slot_of_set_[set] : 0;  // as add()
   const std::uint64_t pixel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(images.width_) + static_cast<std::uint64_t>(x);
   const std::uint64_t key = slot * images.num_pixels() + pixel;
-  Entry& e = entries_[key & (entries_.size() - 1)];
+  Entry& e = entries_[index(key)];
   if (e.key == key) {
     add_to(e.sum, c);
     return true;
   }
+  evictions_ += e.key != kEmpty;
   spill(images, e);
   e.key = key;
   e.sum = c;

@@ -1183,7 +1183,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
       [&] {
         Integrator::Thread th{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, 0, {}, {}};
         th.images = &out.images;
-        th.splats = ClassImages::SplatBuffer(out.images.splat_entries());
+        th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
         return th;
       });
   const int w = rs->camera.width, h = rs->camera.height;

@@ -573,6 +573,20 @@ TEST(ClassImages, SplatBufferEqualsDirectAddsThroughEvictionsAndIgnoresPixelsOut
   // Sized to hold every (plane, pixel): one plane of 64 × 64 pixels; capped for large images.
   EXPECT_EQ(ClassImages(64, 64, nullptr, {}).splat_entries(), 4096u);
   EXPECT_EQ(ClassImages(1000, 1000, nullptr, {}).splat_entries(), ClassImages::SplatBuffer::kMaxEntries);
+  EXPECT_GT(splats.evictions(), 1000u) << "4 entries for 45 keys";
+  // A buffer that holds every key (15 pixels x 3 planes) never evicts, and still sums exactly.
+  ClassImages roomy(5, 3, &*classes.classifier, {0, 1});
+  ASSERT_EQ(roomy.splat_keys(), 45u);
+  ClassImages::SplatBuffer all(roomy.splat_entries(), roomy.splat_keys());
+  for (std::size_t i = 0; i < stream.size(); ++i) {
+    const int x = static_cast<int>((i / 3 * 7) % 5), y = static_cast<int>((i / 3 * 11) % 3);
+    all.add(roomy, x, y, h.class_set(h.intern(stream[i].path)), *to_exact(stream[i].value));
+  }
+  EXPECT_EQ(all.evictions(), 0u);
+  all.flush(roomy);
+  for (int l = 0; l < 3; ++l)
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 5; ++x) EXPECT_TRUE(direct.sum(l, x, y) == roomy.sum(l, x, y)) << l << " " << x << " " << y;
 }
 
 }  // namespace
