@@ -139,7 +139,6 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
   }
 }
 
-float max_abs(const vec3& p) { return std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z))); }
 
 float unit_angle(float y, float x) {  // atan2 mapped to [0, 1)
   const float u = std::atan2(y, x) / (2.0f * kPi);
@@ -294,15 +293,6 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
   es->extent_ = scene.shapes.empty() ? 1.0f : std::max(glm::length(hi - lo), std::numeric_limits<float>::min());
   es->epsilon_ = 1e-5f * es->extent_;
   return es;
-}
-
-float EmbreeScene::offset_epsilon(const vec3& p) const { return epsilon_ + 1e-6f * max_abs(p); }
-
-vec3 EmbreeScene::offset(const vec3& p, const vec3& n, const vec3& d) const {
-  // A zero normal (a point: lights, pinholes) offsets by exactly zero; no branch, whose outcome
-  // would follow which ends of a connection are points.
-  const float eps = offset_epsilon(p);
-  return p + (glm::dot(n, d) >= 0.0f ? eps : -eps) * n;
 }
 
 std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tmin, float tmax, HitDetail detail) const {

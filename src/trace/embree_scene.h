@@ -19,6 +19,8 @@
 // origin (coordinates step by 0.008 there) is beyond what float geometry can resolve.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -111,8 +113,16 @@ class EmbreeScene {
   bool visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const;
   bool visible(const glm::vec3& a, const glm::vec3& b) const { return visible(a, glm::vec3(0.0f), b, glm::vec3(0.0f)); }
   // p moved off its surface (normal n) towards the side of direction d; p itself when n is zero.
-  glm::vec3 offset(const glm::vec3& p, const glm::vec3& n, const glm::vec3& d) const;
-  float offset_epsilon(const glm::vec3& p) const;
+  // Inline: every ray the tracer casts takes one or two.
+  glm::vec3 offset(const glm::vec3& p, const glm::vec3& n, const glm::vec3& d) const {
+    // A zero normal (a point: lights, pinholes) offsets by exactly zero; no branch, whose outcome
+    // would follow which ends of a connection are points.
+    const float eps = offset_epsilon(p);
+    return p + (glm::dot(n, d) >= 0.0f ? eps : -eps) * n;
+  }
+  float offset_epsilon(const glm::vec3& p) const {
+    return epsilon_ + 1e-6f * std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z)));
+  }
 
   // --- shapes ---
   float shape_area(int shape) const { return areas_[static_cast<std::size_t>(shape)]; }

@@ -8,6 +8,8 @@
 // strategies the profile runs; for a given string exactly the strategies whose language
 // contains it have nonzero density (their join vertices are both D), so deltas are handled by
 // letters, never by huge numbers. Profiles naming a connector are refused until connectors land.
+// Shadow rays are queued per thread and traced sixteen at a time as one Embree packet
+// (OcclusionBatch); a contribution is recorded once its segment is found clear.
 //
 // Determinism: every random number is a function of (seed, pixel, pass, dimension), and all
 // sums are exact (classify/histogram.h), so results are bit-identical whatever the thread count.
