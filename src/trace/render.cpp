@@ -216,13 +216,16 @@ class Integrator {
     PathKey key = 0;
     vec3 c{0.0f};
     int strategy = 0, batch = 0;
-    bool splat = false;  // to raster point (rx, ry); else to the sample's own pixel
+    bool splat = false;  // to raster point (rx, ry); else to the sample's own pixel, column px
     float rx = 0.0f, ry = 0.0f;
+    int px = 0;
   };
 
   struct Thread {
     Histogram hist;
-    ClassImages::PixelSum pixel;
+    // The current row's camera contributions, pixel by pixel; flushed to the image at the row's
+    // end (finish_row()), after the row's last shadow rays.
+    std::vector<ClassImages::PixelSum> row;
     std::array<Vertex, kMaxVertices> eye, light;
     std::uint64_t rays = 0;
     PathIds ids;
@@ -243,9 +246,11 @@ class Integrator {
     // by it rather than dividing on its critical path.
     std::array<double, kMaxVertices> light_inv_fwd{}, eye_inv_fwd{};
     int ns = 0, nt = 0;        // the current subpaths' lengths
+    int px = 0;                // the current sample's column
     bool joins_ready = false;  // prepare_joins() runs on the sample's first recorded contribution
-    // Shadow rays queued by connect(), traced when the batch is full and when a pixel's chunk of
-    // samples ends (finish_pixel()); pending[lane] is what lane's ray decides on.
+    // Shadow rays queued by connect(), traced when the batch is full and when a row ends
+    // (finish_row()); pending[lane] is what lane's ray decides on. A row is one thread's work
+    // from start to end, so which rays share a packet does not depend on the thread count.
     OcclusionBatch shadow = OcclusionBatch();
     std::array<Pending, OcclusionBatch::kCapacity> pending{};
   };
@@ -312,12 +317,15 @@ class Integrator {
                : -1;
   }
 
-  // One sample: pixel (px, py), pass `pass`. Its camera contributions collect in th.pixel (the
-  // caller flushes them); light-tracing splats go straight to the shared image.
+  // One sample: pixel (px, py), pass `pass`. Its camera contributions collect in th.row (the
+  // caller flushes them with finish_row()); light-tracing splats go through th.splats.
   void sample(Thread& th, int px, int py, std::uint64_t pass) const;
-  // After a pixel's samples, before its camera contributions (th.pixel) are flushed: traces the
-  // shadow rays still queued and records what they let through.
-  void finish_pixel(Thread& th) const { trace_shadows(th); }
+  // After a row's samples: traces the shadow rays still queued, records what they let through,
+  // and adds the row's camera contributions to row y of the image.
+  void finish_row(Thread& th, ClassImages& images, int y) const {
+    trace_shadows(th);
+    for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].flush(images, static_cast<int>(x), y);
+  }
 
   // For the full path x0 … xk formed by connection (s, t) of the current subpaths: the sum, over
   // every strategy (s', t') with s' + t' = s + t that the profile runs and whose join letters are
@@ -875,7 +883,7 @@ void Integrator::record(Thread& th, const Pending& r) const {
   th.hist.add_exact(id, r.batch, r.strategy, e);
   const std::uint32_t set = th.hist.class_set(id);
   if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, e);
-  else th.pixel.add(set, e);
+  else th.row[static_cast<std::size_t>(r.px)].add(set, e);
 }
 
 template <Integrator::Connection C>
@@ -999,7 +1007,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   const PathKey key = path_key(th, s, t, fresh);
-  const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr), strategy_index, batch, splat, rx, ry};
+  const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr), strategy_index, batch, splat, rx, ry, th.px};
   if constexpr (C == Connection::kEmitter || C == Connection::kLens) {
     record(th, r);  // no shadow ray: the path's last edge was traced
   } else {
@@ -1099,6 +1107,7 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
   Sampler rng(o_.seed, pixel, pass);
   const int batch = batch_of(pass, o_.batches);
+  th.px = px;
   const int nt = eye_subpath(th, rng, px, py);
   const int ns = light_subpath(th, rng);
   th.ns = ns;
@@ -1140,7 +1149,7 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
   Integrator integrator(*rs, *strategies, o, nullptr);
-  Integrator::Thread th{Histogram(layout, nullptr), ClassImages::PixelSum(images), {}, {}, 0, {}, {}};
+  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}};
   th.images = &images;
   std::vector<MisCheck> out;
   for (int i = 0; i < samples; ++i) {
@@ -1181,7 +1190,9 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
   tbb::enumerable_thread_specific<Integrator::Thread> locals(
       [&] {
-        Integrator::Thread th{Histogram(layout, classifier), ClassImages::PixelSum(out.images), {}, {}, 0, {}, {}};
+        Integrator::Thread th{Histogram(layout, classifier),
+                              std::vector<ClassImages::PixelSum>(static_cast<std::size_t>(rs->camera.width), ClassImages::PixelSum(out.images)),
+                              {}, {}, 0, {}, {}};
         th.images = &out.images;
         th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
         return th;
@@ -1198,12 +1209,11 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
     const std::uint64_t first = pass, end = std::min(o.spp, pass + kPassesPerChunk);
     tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& rows) {
       Integrator::Thread& th = locals.local();
-      for (int y = rows.begin(); y < rows.end(); ++y)
-        for (int x = 0; x < w; ++x) {
+      for (int y = rows.begin(); y < rows.end(); ++y) {
+        for (int x = 0; x < w; ++x)
           for (std::uint64_t p = first; p < end; ++p) integrator.sample(th, x, y, p);
-          integrator.finish_pixel(th);
-          th.pixel.flush(out.images, x, y);
-        }
+        integrator.finish_row(th, out.images, y);
+      }
     });
     for (std::uint64_t p = first; p < end; ++p) out.histogram.add_samples(batch_of(p, o.batches), pixels);
     pass = end;
