@@ -17,66 +17,21 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/cli_run.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code = -1;
-  std::string out;
-  std::string err;
-  double seconds = 0;
-};
+using pathex::test::CliRun;
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-// One scratch directory per test process (ctest runs tests in parallel), removed at exit.
-fs::path temp_dir() {
-  struct Dir {
-    fs::path path = fs::temp_directory_path() / ("pathex-cli-test-" + std::to_string(::getpid()));
-    Dir() { fs::create_directories(path); }
-    ~Dir() {
-      std::error_code ec;
-      fs::remove_all(path, ec);
-    }
-  };
-  static const Dir dir;
-  return dir.path;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
+fs::path temp_dir() { return pathex::test::scratch_dir(); }
 void write(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+std::string slurp(const fs::path& p) { return pathex::test::read_file(p); }
 
 // Runs pathex with `args` (each passed as one argument) and `input` on stdin.
 CliRun pathex(const std::vector<std::string>& args, const std::string& input = "") {
-  const fs::path in = temp_dir() / "stdin.txt";
-  const fs::path err = temp_dir() / "stderr.txt";
-  write(in, input);
-  std::string cmd = "cd " + quote(PATHEX_SOURCE_DIR) + " && " + quote(PATHEX_BINARY);
-  for (const std::string& a : args) cmd += " " + quote(a);
-  cmd += " < " + quote(in.string()) + " 2> " + quote(err.string());
-  CliRun r;
-  const auto start = std::chrono::steady_clock::now();
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.err = slurp(err);
-  return r;
+  return pathex::test::run_pathex_args(args, input);
 }
 
 nlohmann::json load_json(const std::string& relative) {

@@ -10,22 +10,16 @@
 #include <nlohmann/json.hpp>
 #include <pugixml.hpp>
 
+#include "support/cli_run.h"
+
 namespace {
 
-struct CliRun {
-  int code = -1;
-  std::string out;
-};
+using pathex::test::CliRun;
 
+// Standard output, then standard error, as one text.
 CliRun run(const std::string& args) {
-  const std::string cmd = std::string("cd '") + PATHEX_SOURCE_DIR + "' && '" + PATHEX_BINARY + "' " + args + " 2>&1";
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  CliRun r = pathex::test::run_pathex(args);
+  r.out += r.err;
   return r;
 }
 

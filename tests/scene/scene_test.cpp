@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "automata/ops.h"
+#include "support/cli_run.h"
 #include "classify/pathclass.h"
 #include "scene/scene.h"
 #include "scene/universe.h"
@@ -62,17 +63,10 @@ TEST(BadScenes, LibraryNamesWhereAndWhat) {
 TEST(BadScenes, CliPrintsTheSameLineAndExits2) {
   const nlohmann::json table = expected_table();
   for (const auto& [file, want] : table.items()) {
-    const std::string cmd = "cd '" + kDir + "' && '" + PATHEX_BINARY + "' trace tests/scene/bad/" + file +
-                            " --quiet --out /tmp/pathex-bad-scene-out 2>&1 >/dev/null";
-    FILE* p = popen(cmd.c_str(), "r");
-    ASSERT_NE(p, nullptr);
-    std::string out;
-    char buf[4096];
-    std::size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-    const int status = pclose(p);
-    EXPECT_EQ(WEXITSTATUS(status), 2) << file;
-    EXPECT_EQ(out, "pathex: error: " + want.at("where").get<std::string>() + ": " + want.at("message").get<std::string>() + "\n")
+    const pathex::test::CliRun r =
+        pathex::test::run_pathex("trace tests/scene/bad/" + file + " --quiet --out /tmp/pathex-bad-scene-out");
+    EXPECT_EQ(r.code, 2) << file;
+    EXPECT_EQ(r.err, "pathex: error: " + want.at("where").get<std::string>() + ": " + want.at("message").get<std::string>() + "\n")
         << file;
   }
 }

@@ -2,6 +2,8 @@
 // EXR with a layer per class and the total, a PNG per layer), the table, and refusals.
 #include <gtest/gtest.h>
 
+#include "support/cli_run.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -13,28 +15,9 @@
 
 namespace {
 
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
+using pathex::test::CliRun;
 
-CliRun run(const std::string& args) {
-  const std::string errfile = "/tmp/pathex-trace-cli-" + std::to_string(::getpid()) + ".err";
-  const std::string cmd = std::string("cd '") + PATHEX_SOURCE_DIR + "' && '" + PATHEX_BINARY + "' " + args + " 2>" + errfile;
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(errfile);
-  std::stringstream ss;
-  ss << e.rdbuf();
-  r.err = ss.str();
-  std::filesystem::remove(errfile);
-  return r;
-}
+CliRun run(const std::string& args) { return pathex::test::run_pathex(args); }
 
 std::string out_dir(const std::string& name) {
   const std::string d = (std::filesystem::temp_directory_path() / ("pathex-trace-" + std::to_string(::getpid()) + "-" + name)).string();

@@ -1,0 +1,83 @@
+// Runs the pathex binary the way the README's user does (from the source tree, through the
+// shell), for the tests of the command line. Header-only: PATHEX_SOURCE_DIR and PATHEX_BINARY are
+// compile definitions of each test executable (tests/CMakeLists.txt).
+#pragma once
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <vector>
+
+namespace pathex::test {
+
+struct CliRun {
+  int code = -1;       // the exit code; -1 when the process did not exit normally
+  std::string out;     // standard output
+  std::string err;     // standard error
+  double seconds = 0;  // wall time, process start included
+};
+
+// `s` single-quoted for the shell.
+inline std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// The test process's scratch directory (ctest runs test processes in parallel), removed at exit.
+inline std::filesystem::path scratch_dir() {
+  struct Dir {
+    std::filesystem::path path = std::filesystem::temp_directory_path() / ("pathex-test-" + std::to_string(::getpid()));
+    Dir() { std::filesystem::create_directories(path); }
+    ~Dir() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
+}
+
+inline std::string read_file(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// `pathex ARGS` in the source directory, ARGS being shell text (the caller quotes what needs
+// it), with `input` on standard input.
+inline CliRun run_pathex(const std::string& args, const std::string& input = "") {
+  const std::filesystem::path in = scratch_dir() / "stdin.txt", err = scratch_dir() / "stderr.txt";
+  std::ofstream(in, std::ios::binary) << input;
+  const std::string cmd = "cd " + shell_quote(PATHEX_SOURCE_DIR) + " && " + shell_quote(PATHEX_BINARY) + " " + args +
+                          " < " + shell_quote(in.string()) + " 2> " + shell_quote(err.string());
+  CliRun r;
+  const auto start = std::chrono::steady_clock::now();
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = read_file(err);
+  return r;
+}
+
+// The same with each argument quoted.
+inline CliRun run_pathex_args(const std::vector<std::string>& args, const std::string& input = "") {
+  std::string text;
+  for (const std::string& a : args) text += (text.empty() ? "" : " ") + shell_quote(a);
+  return run_pathex(text, input);
+}
+
+}  // namespace pathex::test
