@@ -357,9 +357,8 @@ bool EmbreeScene::occluded(const vec3& o, const vec3& d, float tmin, float tmax)
 
 int OcclusionBatch::add(const EmbreeScene& scene, const vec3& a, const vec3& na, const vec3& b, const vec3& nb) {
   const int lane = size_++;
-  // The ray of EmbreeScene::visible(): from a, moved off its surface, to b, moved off its own.
-  const vec3 o = scene.offset(a, na, b - a);
-  const vec3 d = scene.offset(b, nb, a - b) - o;
+  vec3 o, d;
+  scene.shadow_ray(a, na, b, nb, &o, &d);
   rays_.org_x[lane] = o.x;
   rays_.org_y[lane] = o.y;
   rays_.org_z[lane] = o.z;
@@ -401,9 +400,9 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, const ve
 }
 
 bool EmbreeScene::visible(const vec3& a, const vec3& na, const vec3& b, const vec3& nb) const {
-  const vec3 o = offset(a, na, b - a);
-  const vec3 e = offset(b, nb, a - b);
-  return !occluded(o, e - o, 0.0f, 1.0f);
+  vec3 o, d;
+  shadow_ray(a, na, b, nb, &o, &d);
+  return !occluded(o, d, 0.0f, 1.0f);
 }
 
 float EmbreeScene::area_pdf(int shape) const {

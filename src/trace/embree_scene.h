@@ -120,6 +120,13 @@ class EmbreeScene {
     const float eps = offset_epsilon(p);
     return p + (glm::dot(n, d) >= 0.0f ? eps : -eps) * n;
   }
+  // The shadow ray between a and b as visible() casts it (o + t d, 0 < t < 1): from a moved off
+  // its surface to b moved off its own. OcclusionBatch casts the same ray.
+  void shadow_ray(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb, glm::vec3* o,
+                  glm::vec3* d) const {
+    *o = offset(a, na, b - a);
+    *d = offset(b, nb, a - b) - *o;
+  }
   float offset_epsilon(const glm::vec3& p) const {
     return epsilon_ + 1e-6f * std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z)));
   }
