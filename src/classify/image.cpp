@@ -201,21 +201,36 @@ std::vector<ImageLayer> ClassImages::layers(double scale) const {
 // --- PixelSum ---
 
 void ClassImages::PixelSum::add(std::uint32_t set, const ExactRgb& c) {
-  const std::size_t slot = set < slot_of_set_->size() ? (*slot_of_set_)[set] : 0;  // as ClassImages::add
-  for (auto& [s, sum] : by_slot_)
-    if (s == slot) {
-      add_to(sum, c);
-      return;
-    }
-  by_slot_.push_back({slot, c});
+  const auto slot = static_cast<std::uint32_t>(set < slot_of_set_->size() ? (*slot_of_set_)[set] : 0);  // as ClassImages::add
+  // Without an early exit: the plane's position among a pixel's planes is unpredictable, and a
+  // search that stops at it mispredicted about once per contribution.
+  const std::size_t n = slots_.size();
+  std::size_t at = n;
+  for (std::size_t i = 0; i < n; ++i) at = slots_[i] == slot ? i : at;
+  if (at < n) {
+    add_to(sums_[at], c);
+    return;
+  }
+  slots_.push_back(slot);
+  sums_.push_back(c);
+}
+
+void ClassImages::PixelSum::prefetch(ClassImages& images, int x, int y) const {
+  if (!images.inside(x, y)) return;
+  for (std::uint32_t slot : slots_) {
+    const std::uint64_t* w = images.words(slot, x, y);
+    __builtin_prefetch(w, 1);
+    __builtin_prefetch(w + 5, 1);
+  }
 }
 
 bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {
   const bool inside = images.inside(x, y);
   if (inside)
-    for (const auto& [slot, sum] : by_slot_)
-      if (!is_zero(sum)) images.add_to_slot(slot, x, y, sum);
-  by_slot_.clear();
+    for (std::size_t i = 0; i < slots_.size(); ++i)
+      if (!is_zero(sums_[i])) images.add_to_slot(slots_[i], x, y, sums_[i]);
+  slots_.clear();
+  sums_.clear();
   return inside;
 }
 

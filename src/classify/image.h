@@ -100,10 +100,16 @@ class ClassImages {
     // Adds the collected sums to pixel (x, y) of `images` and clears them. Returns false (and
     // still clears) for a pixel outside the image.
     bool flush(ClassImages& images, int x, int y);
+    // Starts loading the pixel's words in the planes that flush() will add to.
+    void prefetch(ClassImages& images, int x, int y) const;
 
    private:
-    const std::vector<std::size_t>* slot_of_set_;               // the image's, read only
-    std::vector<std::pair<std::size_t, ExactRgb>> by_slot_;  // planes touched since the last flush
+    const std::vector<std::size_t>* slot_of_set_;  // the image's, read only
+    // The planes touched since the last flush and their sums, in parallel: the search for a
+    // plane reads one short array (one cache line for up to 16 planes) instead of striding over
+    // the 48-byte sums.
+    std::vector<std::uint32_t> slots_;
+    std::vector<ExactRgb> sums_;
   };
 
   // Contributions to arbitrary pixels (light tracing's splats) summed without atomics in a
