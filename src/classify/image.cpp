@@ -263,12 +263,26 @@ bool ClassImages::SplatBuffer::add(ClassImages& images, int x, int y, std::uint3
 void ClassImages::SplatBuffer::spill(ClassImages& images, Entry& e) {
   if (e.key == kEmpty) return;
   const std::uint64_t pixel = e.key % images.num_pixels(), width = static_cast<std::uint64_t>(images.width_);
-  images.add_to_slot(e.key / images.num_pixels(), static_cast<int>(pixel % width), static_cast<int>(pixel / width), e.sum);
+  std::uint64_t* w = images.words(e.key / images.num_pixels(), static_cast<int>(pixel % width), static_cast<int>(pixel / width));
+  __builtin_prefetch(w, 1);
+  __builtin_prefetch(w + 5, 1);
+  queue_[static_cast<std::size_t>(queued_++)] = {w, e.sum};
   e.key = kEmpty;
+  if (queued_ == kSpillQueue) drain();
+}
+
+void ClassImages::SplatBuffer::drain() {
+  for (int i = 0; i < queued_; ++i) {
+    const Spilled& q = queue_[static_cast<std::size_t>(i)];
+    for (std::size_t ch = 0; ch < 3; ++ch)
+      if (q.sum[ch] != 0) atomic_add(q.words + 2 * ch, q.sum[ch]);
+  }
+  queued_ = 0;
 }
 
 void ClassImages::SplatBuffer::flush(ClassImages& images) {
   for (Entry& e : entries_) spill(images, e);
+  drain();
 }
 
 }  // namespace pathex

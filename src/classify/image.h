@@ -26,6 +26,7 @@
 // the mean of the total layer equals the histogram's total estimate.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -138,7 +139,18 @@ class ClassImages {
       ExactRgb sum{};
     };
     static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
-    static void spill(ClassImages& images, Entry& e);  // adds an entry to the image and empties it
+    // Moves an entry to the spill queue and empties it. The queue starts loading each spilled
+    // entry's words in the image and adds them all when it is full (drain()): an evicted entry's
+    // pixel is anywhere in the image, rarely in cache, and its atomic adds waited for it one by one.
+    void spill(ClassImages& images, Entry& e);
+    void drain();
+    struct Spilled {
+      std::uint64_t* words;  // the pixel's words in the entry's plane
+      ExactRgb sum;
+    };
+    static constexpr int kSpillQueue = 16;
+    std::array<Spilled, kSpillQueue> queue_{};
+    int queued_ = 0;
     std::size_t index(std::uint64_t key) const {
       const std::uint64_t h = hashed_ ? (key * 0x9E3779B97F4A7C15ull) >> 32 : key;
       return static_cast<std::size_t>(h & (entries_.size() - 1));
