@@ -122,23 +122,35 @@ void BM_TracerRays(benchmark::State& state) {
 }
 BENCHMARK(BM_TracerRays)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Classification overhead, interleaved: each iteration renders (the CLI's default 16 spp) with no
-// classes and with the 20-class file (Arg 20: labels classified and an image layer per class;
-// Arg 21: classified, no class layers, the automaton's share alone). `overhead_pct` is the median
-// over iterations of the CPU time with classes over the time without, minus 1: the median shrugs
-// off an iteration that the shared machine slowed on one side only.
+// Classification overhead, interleaved: each iteration renders (the CLI's default 16 spp) the
+// same scene both ways. Arg 20: the 20-class file with an image layer per class against no
+// classifier and no layers at all (the strictest baseline: no path is classified, the image is
+// the total alone). Arg 21: the 20 classes classified, no class layers, against the same (the
+// automaton's share alone). Arg 5: what a user of the CLI sees, `pathex trace --classes
+// samples/classes/twenty.json` against `pathex trace` with no class file, which classifies by
+// the five built-in classes and writes their layers. Arg 0: a control, no classes on both
+// sides. `overhead_pct` is the median over iterations of the CPU time of the first side over
+// the second, minus 1: the median shrugs off an iteration that the shared machine slowed on one
+// side only.
 void BM_RenderClasses(benchmark::State& state) {
   const Profile bdpt = *resolve_profile("bdpt", Limits{});
   ClassTable table;
-  std::vector<const PathClass*> classes;
+  std::vector<const PathClass*> classes, builtin_classes;
   (void)read_class_file(std::string(PATHEX_SOURCE_DIR) + "/samples/classes/twenty.json", ClassOptions{}, &table);
   for (const auto& c : table.user_classes()) classes.push_back(c.get());
+  for (const auto& c : ClassTable::builtins().builtin_classes())  // as src/cli/trace.cpp
+    if (c->name != "all") builtin_classes.push_back(c.get());
   const Classifier none = *Classifier::build({}, Limits{});
   const Classifier twenty = *Classifier::build(classes, Limits{});
-  const bool control = state.range(0) == 0;  // Arg 0: no classes on both sides, the method's noise floor
+  const Classifier builtin = *Classifier::build(builtin_classes, Limits{});
+  const int arg = static_cast<int>(state.range(0));
+  const bool control = arg == 0;
   RenderOptions plain = options(1, 16), classified = options(1, 16);
-  if (state.range(0) == 20)
+  if (arg == 20 || arg == 5)
     for (int i = 0; i < twenty.num_classes(); ++i) classified.layer_classes.push_back(i);
+  if (arg == 5)
+    for (int i = 0; i < builtin.num_classes(); ++i) plain.layer_classes.push_back(i);
+  const Classifier* const base = arg == 5 ? &builtin : &none;
   std::vector<double> ratios;
   std::size_t image_bytes = 0;
   bool classes_first = false;  // alternated, so that neither side always runs on a warm cache
@@ -148,7 +160,7 @@ void BM_RenderClasses(benchmark::State& state) {
       const bool with = (side == 0) == classes_first;
       const double t0 = cpu_seconds();
       Result<RenderOutput> out = with ? render(cornell(), bdpt, control ? &none : &twenty, classified)
-                                      : render(cornell(), bdpt, &none, plain);
+                                      : render(cornell(), bdpt, base, plain);
       (with ? with_s : without_s) += cpu_seconds() - t0;
       if (with) image_bytes = out->images.memory_bytes();
     }
@@ -157,11 +169,12 @@ void BM_RenderClasses(benchmark::State& state) {
   }
   state.counters["overhead_pct"] = benchmark::Counter(100.0 * (median(ratios) - 1.0));
   state.counters["image_MiB"] = benchmark::Counter(static_cast<double>(image_bytes) / (1024.0 * 1024.0));
-  state.SetLabel(control ? std::string("control: no classes against none")
-                         : std::to_string(classes.size()) + " classes, " + std::to_string(classified.layer_classes.size()) +
-                               " class layers, against none");
+  const std::string label = std::to_string(classes.size()) + " classes, " + std::to_string(classified.layer_classes.size()) + " class layers";
+  state.SetLabel(control     ? std::string("control: no classes against none")
+                 : arg == 5 ? label + ", against the CLI's default (" + std::to_string(builtin_classes.size()) + " built-in classes and layers)"
+                            : label + ", against no classes");
 }
-BENCHMARK(BM_RenderClasses)->Arg(0)->Arg(20)->Arg(21)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderClasses)->Arg(0)->Arg(20)->Arg(21)->Arg(5)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Shadow rays alone, interleaved: the same 64 Ki segments between points on the Cornell box's
 // surfaces (sampled by area, so about a quarter are blocked) tested one by one with

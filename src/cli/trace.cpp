@@ -95,7 +95,10 @@ int run(const TraceArgs& a) {
   // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
   const int bound = a.max_bounces.value_or(profile->max_bounces.value_or(16));
   ro.max_bounces = bound;
-  for (int i = 0; i < classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
+  // Without image outputs the render keeps the histogram alone (the same histogram).
+  ro.images = !a.no_images;
+  if (ro.images)
+    for (int i = 0; i < classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
   const bool show_progress = !a.quiet && ::isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
   if (show_progress) {
@@ -200,7 +203,7 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--top", args->top_paths, "Exact paths to list")->capture_default_str()->check(CLI::Range(0, 100000));
   sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
-  sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs");
+  sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs and the per-pixel sums behind them (the histogram is the same)");
   add_limit_options(sub, &args->limits);
   return {sub, [args] { return run(*args); }};
 }

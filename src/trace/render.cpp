@@ -884,6 +884,7 @@ void Integrator::record(Thread& th, const Pending& r) const {
   if (is_zero(e)) return;
   const Histogram::PathId id = th.ids.get(th.hist, r.key);
   th.hist.add_exact(id, r.batch, r.strategy, e);
+  if (!o_.images) return;
   const std::uint32_t set = th.hist.class_set(id);
   if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, e);
   else th.row[static_cast<std::size_t>(r.px)].add(set, e);
@@ -1186,7 +1187,8 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   for (const Strategy& st : strategies->strategies) layout.strategies.push_back(st.name);
 
   RenderOutput out{Histogram(layout, classifier),
-                   ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes),
+                   o.images ? ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes)
+                            : ClassImages(0, 0, nullptr, {}),
                    layout.strategies};
   Integrator integrator(*rs, *strategies, o, classifier);
   const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
@@ -1194,7 +1196,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   tbb::enumerable_thread_specific<Integrator::Thread> locals(
       [&] {
         Integrator::Thread th{Histogram(layout, classifier),
-                              std::vector<ClassImages::PixelSum>(static_cast<std::size_t>(rs->camera.width), ClassImages::PixelSum(out.images)),
+                              std::vector<ClassImages::PixelSum>(static_cast<std::size_t>(out.images.width()), ClassImages::PixelSum(out.images)),
                               {}, {}, 0, {}, {}};
         th.images = &out.images;
         th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());

@@ -43,6 +43,10 @@ struct RenderOptions {
   int rr_depth = 3;                    // Russian roulette after this many vertices on a subpath
   int batches = kDefaultBatches;       // for batch-means standard errors
   std::vector<int> layer_classes;      // classifier classes that get an image layer
+  // Accumulate the images at all. Off (`pathex trace --no-images`), the render keeps only the
+  // histogram, which is the same either way, and RenderOutput::images is empty (0 × 0): no
+  // per-pixel sums, no splat buffers, none of the image's memory traffic.
+  bool images = true;
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;  // called from one thread
   const std::atomic<bool>* cancel = nullptr;  // set to stop early; the result is marked incomplete
 };

@@ -247,6 +247,43 @@ TEST(Determinism, SameSeedOneAndTwoThreadsIdentical) {
   }
 }
 
+// Without images (pathex trace --no-images) the render keeps no per-pixel sums at all, and the
+// histogram is exactly the one the render with images keeps: the images never feed it.
+TEST(Images, OffLeavesTheHistogramExactlyTheSameAndTheImageEmpty) {
+  Result<Scene> scene = load_scene_json(default_scene_json(), ".", "default");
+  ASSERT_TRUE(scene.ok());
+  Result<Profile> profile = resolve_profile("bdpt", Limits{});
+  RenderOptions with;
+  with.spp = 2;
+  with.threads = 2;
+  RenderOptions without = with;
+  without.images = false;
+  Result<RenderOutput> a = render(*scene, *profile, nullptr, with);
+  Result<RenderOutput> b = render(*scene, *profile, nullptr, without);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->images.width(), 64);
+  EXPECT_GT(a->images.memory_bytes(), 0u);
+  EXPECT_EQ(b->images.width(), 0);
+  EXPECT_EQ(b->images.num_layers(), 1);
+  EXPECT_EQ(b->images.memory_bytes(), 0u);
+  EXPECT_EQ(a->rays, b->rays);
+  const Histogram& ha = a->histogram;
+  const Histogram& hb = b->histogram;
+  ASSERT_EQ(ha.num_paths(), hb.num_paths());
+  ASSERT_GT(ha.num_paths(), 100);
+  for (int id = 0; id < ha.num_paths(); ++id) {
+    const std::optional<Histogram::PathId> other = hb.find(ha.path(id));
+    ASSERT_TRUE(other.has_value()) << ha.path(id);
+    for (int batch = 0; batch < ha.num_batches(); ++batch) {
+      EXPECT_TRUE(ha.cell(id, batch).sum == hb.cell(*other, batch).sum) << ha.path(id) << " batch " << batch;
+      EXPECT_EQ(ha.cell(id, batch).contributions, hb.cell(*other, batch).contributions) << ha.path(id);
+    }
+  }
+  EXPECT_EQ(ha.total_samples(), hb.total_samples());
+  EXPECT_EQ(ha.nonfinite(), 0u);
+  EXPECT_EQ(hb.nonfinite(), 0u);
+}
+
 // An interrupted render keeps the passes it finished, says it is incomplete, and still has a
 // standard error (passes are spread over the batches round-robin).
 TEST(Interrupt, KeepsFinishedPassesAndMarksIncomplete) {
