@@ -21,6 +21,13 @@ void atomic_add(std::uint64_t* words, ExactSum v) {
   if (high != 0) std::atomic_ref<std::uint64_t>(words[1]).fetch_add(high, std::memory_order_relaxed);
 }
 
+// Asks for the cache lines of a pixel's six words (48 bytes may straddle two lines) ahead of the
+// atomic adds to them.
+void request(const std::uint64_t* words) {
+  __builtin_prefetch(words, 1);
+  __builtin_prefetch(words + 5, 1);
+}
+
 ExactSum load(const std::uint64_t* words) {
   return (static_cast<ExactSum>(words[1]) << 64) | static_cast<ExactSum>(words[0]);
 }
@@ -217,11 +224,7 @@ void ClassImages::PixelSum::add(std::uint32_t set, const ExactRgb& c) {
 
 void ClassImages::PixelSum::prefetch(ClassImages& images, int x, int y) const {
   if (!images.inside(x, y)) return;
-  for (std::uint32_t slot : slots_) {
-    const std::uint64_t* w = images.words(slot, x, y);
-    __builtin_prefetch(w, 1);
-    __builtin_prefetch(w + 5, 1);
-  }
+  for (std::uint32_t slot : slots_) request(images.words(slot, x, y));
 }
 
 bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {
@@ -264,8 +267,7 @@ void ClassImages::SplatBuffer::spill(ClassImages& images, Entry& e) {
   if (e.key == kEmpty) return;
   const std::uint64_t pixel = e.key % images.num_pixels(), width = static_cast<std::uint64_t>(images.width_);
   std::uint64_t* w = images.words(e.key / images.num_pixels(), static_cast<int>(pixel % width), static_cast<int>(pixel / width));
-  __builtin_prefetch(w, 1);
-  __builtin_prefetch(w + 5, 1);
+  request(w);
   queue_[static_cast<std::size_t>(queued_++)] = {w, e.sum};
   e.key = kEmpty;
   if (queued_ == kSpillQueue) drain();
