@@ -40,6 +40,35 @@ Expr e_opt(const Expr& a) {
   return node(Kind::kOpt, {a});
 }
 
+// The items of a concatenation, as a list.
+std::vector<Expr> items(const Expr& e) {
+  if (e.kind == Kind::kCat) return e.kids;
+  return {e};
+}
+
+Expr from_items(std::vector<Expr> v) {
+  if (v.empty()) return e_eps();
+  if (v.size() == 1) return v[0];
+  return node(Kind::kCat, std::move(v));
+}
+
+// Does v[at, at + n) equal `want`?
+bool run_equals(const std::vector<Expr>& v, std::size_t at, const std::vector<Expr>& want) {
+  if (at + want.size() > v.size()) return false;
+  for (std::size_t i = 0; i < want.size(); ++i)
+    if (!(v[at + i] == want[i])) return false;
+  return true;
+}
+
+Expr e_alt(const Expr& a, const Expr& b);
+
+// The union of a list of expressions.
+Expr from_list(const std::vector<Expr>& v) {
+  Expr u = leaf(Kind::kEmpty);
+  for (const Expr& x : v) u = e_alt(u, x);
+  return u;
+}
+
 Expr e_alt(const Expr& a, const Expr& b) {
   if (a.kind == Kind::kEmpty) return b;
   if (b.kind == Kind::kEmpty) return a;
@@ -61,6 +90,28 @@ Expr e_alt(const Expr& a, const Expr& b) {
   take(a, take);
   take(b, take);
   if (letters) parts.insert(parts.begin(), e_set(letters));
+  // y | x+ y -> x* y, and y | y x+ -> y x*.
+  for (std::size_t i = 0; i < parts.size(); ++i)
+    for (std::size_t j = 0; j < parts.size(); ++j) {
+      if (i == j || parts[j].kind != Kind::kCat) continue;
+      const std::vector<Expr> y = items(parts[i]);
+      const std::vector<Expr>& v = parts[j].kids;
+      if (v.size() != y.size() + 1) continue;
+      if (v.front().kind == Kind::kPlus && run_equals(v, 1, y)) {
+        std::vector<Expr> w = v;
+        w.front() = node(Kind::kStar, {v.front().kids[0]});
+        parts[i] = from_items(std::move(w));
+        parts.erase(parts.begin() + static_cast<long>(j));
+        return e_alt(from_list(parts), leaf(eps ? Kind::kEps : Kind::kEmpty));
+      }
+      if (v.back().kind == Kind::kPlus && run_equals(v, 0, y)) {
+        std::vector<Expr> w = v;
+        w.back() = node(Kind::kStar, {v.back().kids[0]});
+        parts[i] = from_items(std::move(w));
+        parts.erase(parts.begin() + static_cast<long>(j));
+        return e_alt(from_list(parts), leaf(eps ? Kind::kEps : Kind::kEmpty));
+      }
+    }
   // x* absorbs x, x+ and x? beside it; x+ absorbs x.
   std::vector<Expr> kept;
   for (std::size_t i = 0; i < parts.size(); ++i) {
@@ -75,26 +126,6 @@ Expr e_alt(const Expr& a, const Expr& b) {
   }
   Expr u = kept.size() == 1 ? kept[0] : node(Kind::kAlt, std::move(kept));
   return eps ? e_opt(u) : u;
-}
-
-// The items of a concatenation, as a list.
-std::vector<Expr> items(const Expr& e) {
-  if (e.kind == Kind::kCat) return e.kids;
-  return {e};
-}
-
-Expr from_items(std::vector<Expr> v) {
-  if (v.empty()) return e_eps();
-  if (v.size() == 1) return v[0];
-  return node(Kind::kCat, std::move(v));
-}
-
-// Does v[at, at + n) equal `want`?
-bool run_equals(const std::vector<Expr>& v, std::size_t at, const std::vector<Expr>& want) {
-  if (at + want.size() > v.size()) return false;
-  for (std::size_t i = 0; i < want.size(); ++i)
-    if (!(v[at + i] == want[i])) return false;
-  return true;
 }
 
 Expr e_cat(const Expr& a, const Expr& b) {

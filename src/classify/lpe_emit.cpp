@@ -1,5 +1,7 @@
 #include "classify/lpe_emit.h"
 
+#include <algorithm>
+
 #include "automata/nfa.h"
 #include "automata/ops.h"
 #include "automata/to_regex.h"
@@ -20,37 +22,65 @@ std::string lpe_atom(LetterMask m) {
   return "";  // the interior language has no other letters
 }
 
-// The interiors the class allows with some light and sensor pair, read camera first: an NFA on the
-// class's DFA with its D and S edges reversed, entered at the states from which a sensor pair and
-// E accept, and left at the states a light pair leads to.
-Nfa camera_first_interiors(const Dfa& d) {
+// The interiors w that the class allows between one of `lights` and one of `sensors` (the paths
+// L l0 l1 w s0 s1 E), as an NFA on the class's DFA: light first, or camera first with its D and S
+// edges reversed.
+Nfa interiors(const Dfa& d, const std::vector<LightType>& lights, const std::vector<SensorType>& sensors,
+              bool camera_first) {
   Nfa n;
   const int states = d.num_states;
   n.states.resize(static_cast<std::size_t>(states + 2));
-  n.start = states;
-  n.accept = states + 1;
+  const int light_side = states, sensor_side = states + 1;
   for (int q = 0; q < states; ++q)
-    for (Letter l : {kD, kS}) n.states[static_cast<std::size_t>(d.step(q, l))].edges.push_back({static_cast<LetterMask>(1u << l), q});
+    for (Letter l : {kD, kS}) {
+      const int r = d.step(q, l);
+      if (camera_first) n.states[static_cast<std::size_t>(r)].edges.push_back({static_cast<LetterMask>(1u << l), q});
+      else n.states[static_cast<std::size_t>(q)].edges.push_back({static_cast<LetterMask>(1u << l), r});
+    }
+  auto eps = [&](int from, int to) { n.states[static_cast<std::size_t>(from)].eps.push_back(to); };
   for (int p = 0; p < states; ++p) {
     bool sensor_end = false;
-    for (SensorType t : kAllSensorTypes) {
+    for (SensorType t : sensors) {
       const std::string s = sensor_letters(t);
       const int e = d.step(d.step(d.step(p, *letter_from_char(s[0])), *letter_from_char(s[1])), kE);
       sensor_end = sensor_end || d.accept[static_cast<std::size_t>(e)];
     }
-    if (sensor_end) n.states[static_cast<std::size_t>(n.start)].eps.push_back(p);
+    if (sensor_end) camera_first ? eps(sensor_side, p) : eps(p, sensor_side);
   }
-  for (LightType t : kAllLightTypes) {
+  for (LightType t : lights) {
     const std::string s = light_letters(t);
     const int e = d.step(d.step(d.step(d.start, kL), *letter_from_char(s[0])), *letter_from_char(s[1]));
-    n.states[static_cast<std::size_t>(e)].eps.push_back(n.accept);
+    camera_first ? eps(e, light_side) : eps(light_side, e);
   }
+  n.start = camera_first ? sensor_side : light_side;
+  n.accept = camera_first ? light_side : sensor_side;
   return n;
 }
 
 Dfa full_class(const std::string& expr) {
   Result<PathClass> c = compile_class(expr, ClassOptions{});
   return c ? c->dfa : dfa_empty();  // the expressions are constants of this file
+}
+
+// Two-letter words as an expression: a product of letter sets as two sets (`..`, `S.`), else an
+// alternation in parentheses.
+std::string pairs_text(const std::vector<std::string>& words) {
+  LetterMask first = 0, second = 0;
+  for (const std::string& w : words) {
+    first |= static_cast<LetterMask>(1u << *letter_from_char(w[0]));
+    second |= static_cast<LetterMask>(1u << *letter_from_char(w[1]));
+  }
+  auto set = [](LetterMask m) {
+    Expr e;
+    e.kind = Expr::Kind::kSet;
+    e.mask = m;
+    return to_full_notation(e);
+  };
+  if (static_cast<std::size_t>(__builtin_popcount(first) * __builtin_popcount(second)) == words.size())
+    return set(first) + set(second);
+  std::string s = "(";
+  for (std::size_t i = 0; i < words.size(); ++i) s += (i ? "|" : "") + words[i];
+  return s + ")";
 }
 
 std::string join(const std::vector<std::string>& words) {
@@ -84,9 +114,12 @@ Result<LpeEmission> emit_lpe(const Dfa& cls, const Limits& limits) {
     }
 
   // --- the LPE: C, the interiors camera first, the light ---
-  Result<Dfa> interiors = determinize(camera_first_interiors(cls), limits);
-  if (!interiors) return interiors.error();
-  Result<Expr> x = dfa_to_expr(minimize(*interiors), kMaxEmitStates, kMaxEmitNodes);
+  Result<Dfa> inner = determinize(
+      interiors(cls, {kAllLightTypes.begin(), kAllLightTypes.end()}, {kAllSensorTypes.begin(), kAllSensorTypes.end()},
+                /*camera_first=*/true),
+      limits);
+  if (!inner) return inner.error();
+  Result<Expr> x = dfa_to_expr(minimize(*inner), kMaxEmitStates, kMaxEmitNodes);
   if (!x) return x.error();
   ExprStyle style;
   style.atom = lpe_atom;
@@ -114,6 +147,50 @@ Result<LpeEmission> emit_lpe(const Dfa& cls, const Limits& limits) {
     out.losses.push_back("sensor types: the class has only " + join(sensor_names) + " sensors; an LPE's C is every sensor");
   if (dfa_intersect(t->dfa, ends_universe(used)) != cls)
     out.losses.push_back("the class ties its interior letters to particular light or sensor types; an LPE cannot");
+  return out;
+}
+
+Result<std::string> full_path_expression(const Dfa& cls, const Limits& limits) {
+  // The interior language of each (light, sensor) pair; pairs with the same language share a term.
+  struct Term {
+    Dfa interior;
+    std::vector<std::pair<LightType, SensorType>> ends;
+  };
+  std::vector<Term> terms;
+  for (LightType l : kAllLightTypes)
+    for (SensorType s : kAllSensorTypes) {
+      Result<Dfa> inner = determinize(interiors(cls, {l}, {s}, /*camera_first=*/false), limits);
+      if (!inner) return inner.error();
+      Dfa w = minimize(*inner);
+      if (is_empty(w)) continue;
+      auto it = std::find_if(terms.begin(), terms.end(), [&](const Term& t) { return t.interior == w; });
+      if (it == terms.end()) terms.push_back({std::move(w), {}}), it = terms.end() - 1;
+      it->ends.push_back({l, s});
+    }
+  std::string out;
+  for (const Term& t : terms) {
+    Result<Expr> x = dfa_to_expr(t.interior, kMaxEmitStates, kMaxEmitNodes);
+    if (!x) return x.error();
+    const std::string middle = to_full_notation(*x);
+    // Each light with the sensors it goes with; lights with the same sensors share a rectangle.
+    std::vector<std::pair<std::vector<LightType>, std::vector<SensorType>>> rects;
+    for (LightType l : kAllLightTypes) {
+      std::vector<SensorType> with;
+      for (const auto& [el, es] : t.ends)
+        if (el == l) with.push_back(es);
+      if (with.empty()) continue;
+      auto it = std::find_if(rects.begin(), rects.end(), [&](const auto& r) { return r.second == with; });
+      if (it == rects.end()) rects.push_back({{l}, with});
+      else it->first.push_back(l);
+    }
+    for (const auto& [ls, ss] : rects) {
+      std::vector<std::string> lw, sw;
+      for (LightType l : ls) lw.push_back(light_letters(l));
+      for (SensorType s : ss) sw.push_back(sensor_letters(s));
+      if (!out.empty()) out += '|';
+      out += "L" + pairs_text(lw) + middle + pairs_text(sw) + "E";
+    }
+  }
   return out;
 }
 

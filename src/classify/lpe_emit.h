@@ -1,4 +1,5 @@
-// The way back from a path class to a light path expression, for an Arnold, RenderMan or Karma AOV.
+// The way back from a path class to a light path expression, for an Arnold, RenderMan or Karma AOV,
+// and to a readable full-path expression.
 //
 // An LPE's C and L stand for every sensor and light type, so what an LPE can say about a full path
 // L c0 c1 w c(k+1) c(k+2) E is its interior w alone. The closest LPE to a class is therefore the
@@ -36,5 +37,10 @@ struct LpeEmission {
 // Limits bound the automata built; the expression is refused past 2000 live states or 100000
 // nodes (errors say so).
 Result<LpeEmission> emit_lpe(const Dfa& cls, const Limits& limits);
+
+// The class as a full-path expression written from its DFA, with the light and sensor letter
+// pairs factored out of the interior: `L..S+D.*..E` rather than an automaton's tangle of the
+// last two letters. What `explain --notation lpe` shows as an LPE's translation. "" when empty.
+Result<std::string> full_path_expression(const Dfa& cls, const Limits& limits);
 
 }  // namespace pathex

@@ -2,6 +2,7 @@
 
 #include <iostream>
 
+#include "classify/notation_hint.h"
 #include "io/class_file.h"
 
 namespace pathex::cli {
@@ -64,7 +65,14 @@ Result<PathClass> compile_cli_expression(const std::string& expr, const Notation
     Result<bool> r = read_class_file(classes_file, *opts, table);
     if (!r) return r.error();
   }
-  return compile_class(expr, *opts, table);
+  Result<PathClass> pc = compile_class(expr, *opts, table);
+  if (pc) print_notation_hint(expr, *pc, *opts, table);
+  return pc;
+}
+
+void print_notation_hint(const std::string& expr, const PathClass& pc, const ClassOptions& options,
+                         const ClassTable* table) {
+  if (std::optional<std::string> h = heckbert_hint(expr, pc, options, table)) std::cerr << "pathex: hint: " << *h << "\n";
 }
 
 int report(const Error& e) {

@@ -4,7 +4,6 @@
 #include <nlohmann/json.hpp>
 
 #include "automata/ops.h"
-#include "automata/to_regex.h"
 #include "classify/lpe_emit.h"
 #include "cli/common.h"
 #include "io/class_file.h"
@@ -96,8 +95,8 @@ int run(const ExplainArgs& a) {
   // expression it became, written from the class's automaton.
   std::string normal = to_string(pc->ast);
   if (pc->notation == Notation::kLpe) {
-    Result<Expr> x = dfa_to_expr(d, 2000, 100000);
-    normal = x ? to_full_notation(*x) : "(too large to print: " + x.error().message + ")";
+    Result<std::string> x = full_path_expression(d, a.limits);
+    normal = x ? *x : "(too large to print: " + x.error().message + ")";
   }
 
   if (a.json) {

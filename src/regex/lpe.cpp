@@ -585,7 +585,7 @@ class LpeParser {
       if (!at_end() && peek() != '>') {
         if (!parse_component(2, &scatters)) return -1;
         skip_space();
-        if (!at_end() && peek() == '\'') {
+        if (!at_end() && (peek() == '\'' || peek() == '[')) {  // a third component: custom labels
           refuse_label(col());
           return -1;
         }
