@@ -10,14 +10,16 @@
 #include <set>
 #include <string>
 
+#include "regex/repeat.h"
+
 namespace pathex {
 namespace {
 
 // Event types and scattering types as bits. An event set is (types, scatters): the events whose
 // type is in `types` and whose scattering label is in `scatters`. Camera, light, emissive-object
 // and background events carry the label "none".
-enum : std::uint8_t { kTC = 1, kTR = 2, kTT = 4, kTV = 8, kTL = 16, kTO = 32, kTB = 64, kAllTypes = 127 };
-enum : std::uint8_t { kSD = 1, kSG = 2, kSS = 4, kSStraight = 8, kSNone = 16, kAllScatters = 31 };
+constexpr std::uint8_t kTC = 1, kTR = 2, kTT = 4, kTV = 8, kTL = 16, kTO = 32, kTB = 64, kAllTypes = 127;
+constexpr std::uint8_t kSD = 1, kSG = 2, kSS = 4, kSStraight = 8, kSNone = 16, kAllScatters = 31;
 
 std::uint8_t type_bit(char c) {
   switch (c) {
@@ -283,68 +285,21 @@ class LpeParser {
     return failed_ ? -1 : cur;
   }
 
-  bool parse_number(int* out) {
-    const int column = col();
-    long long v = 0;
-    while (!at_end() && std::isdigit(static_cast<unsigned char>(peek()))) {
-      v = v * 10 + (peek() - '0');
-      if (v > limits_.max_repeat) {
-        fail(column, limit_message("repetition count", static_cast<std::size_t>(limits_.max_repeat), "repetitions", "--max-repeat"),
-             ErrorCode::kLimit);
-        return false;
-      }
-      ++pos_;
-    }
-    *out = static_cast<int>(v);
-    return true;
-  }
-
-  bool is_digit() const { return !at_end() && std::isdigit(static_cast<unsigned char>(peek())); }
-
-  // '{' n '}' | '{' n ',' '}' | '{' n ',' m '}'
+  // '{' n '}' | '{' n ',' '}' | '{' n ',' m '}' (regex/repeat.h).
   bool parse_braces(int* min, int* max) {
-    const int open = col();
-    auto unclosed = [&] {
-      fail(open, "missing '}' to close this '{'");
-      return false;
-    };
-    ++pos_;
-    skip_space();
-    if (at_end()) return unclosed();
-    if (!is_digit()) {
-      fail(col(), "expected a number after '{', found " + found());
-      return false;
-    }
-    if (!parse_number(min)) return false;
-    skip_space();
-    if (at_end()) return unclosed();
-    if (peek() == '}') { ++pos_; *max = *min; return true; }
-    if (peek() != ',') {
-      fail(col(), "expected ',' or '}' in repetition, found " + found());
+    Result<RepeatCounts> c = read_repeat(text_, &pos_, limits_, [this](std::size_t at) {
+      const std::size_t here = pos_;
+      pos_ = at;
+      std::string f = found();
+      pos_ = here;
+      return f;
+    });
+    if (!c) {
+      fail(c.error().column, c.error().message, c.error().code);
       return false;
     }
-    ++pos_;
-    skip_space();
-    if (at_end()) return unclosed();
-    if (peek() == '}') { ++pos_; *max = kUnbounded; return true; }
-    if (!is_digit()) {
-      fail(col(), "expected a number or '}' after ',', found " + found());
-      return false;
-    }
-    const int max_col = col();
-    if (!parse_number(max)) return false;
-    skip_space();
-    if (at_end()) return unclosed();
-    if (peek() != '}') {
-      fail(col(), "expected '}' in repetition, found " + found());
-      return false;
-    }
-    ++pos_;
-    if (*min > *max) {
-      fail(max_col, "repetition {" + std::to_string(*min) + "," + std::to_string(*max) +
-                        "}: the maximum is smaller than the minimum");
-      return false;
-    }
+    *min = c->min;
+    *max = c->max;
     return true;
   }
 
