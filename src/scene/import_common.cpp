@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <utility>
 
 #include <assimp/Importer.hpp>
@@ -22,6 +25,27 @@ Error located(const Location& at, std::string message) {
   Error e = make_error(ErrorCode::kBadFile, std::move(message));
   e.where = at.str();
   return e;
+}
+
+// --- files ---
+
+SceneFiles::SceneFiles(const std::string& main_file) {
+  const std::string dir = std::filesystem::path(main_file).parent_path().string();
+  base_dir_ = dir.empty() ? "." : dir;
+}
+
+std::string SceneFiles::resolve(const std::string& file) const {
+  const std::filesystem::path p(file);
+  return p.is_absolute() ? file : (std::filesystem::path(base_dir_) / p).string();
+}
+
+Result<std::string> SceneFiles::read(const std::string& path, const Location& from, int depth, const std::string& directive) const {
+  if (depth > 32) return located(from, directive + " nested more than 32 deep (a file including itself?)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return located(from, depth == 0 ? "cannot open the scene file" : "cannot open the included file '" + path + "'");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return std::move(ss).str();
 }
 
 // --- materials ---
@@ -240,6 +264,36 @@ Result<Scene> SceneBuilder::finish(const std::string& file) {
   auto fail = [&](const std::string& message) { return located(Location{file}, message); };
   if (!has_camera_) return fail("the scene has no camera");
   if (s.shapes.empty()) return fail("the scene is empty: expected at least one shape");
+  // --- every coordinate finite and within 1e30, as the JSON loader requires ---
+  auto bad = [](glm::vec3 v) { return !(std::fabs(v.x) <= 1e30f && std::fabs(v.y) <= 1e30f && std::fabs(v.z) <= 1e30f); };
+  for (const Shape& shape : s.shapes) {
+    bool out_of_range = false;
+    std::visit(
+        [&](const auto& g) {
+          using T = std::decay_t<decltype(g)>;
+          if constexpr (std::is_same_v<T, MeshShape>) {
+            for (const glm::vec3& p : g.positions) out_of_range = out_of_range || bad(p);
+          } else if constexpr (std::is_same_v<T, QuadShape>) {
+            out_of_range = bad(g.corner) || bad(g.edge1) || bad(g.edge2);
+          } else if constexpr (std::is_same_v<T, SphereShape>) {
+            out_of_range = bad(g.center) || bad(glm::vec3(g.radius));
+          } else {
+            out_of_range = bad(g.center) || bad(g.normal) || bad(glm::vec3(g.radius));
+          }
+        },
+        shape.geometry);
+    if (out_of_range) return located(Location{shape.pointer}, "the shape's transformed coordinates are not finite (or beyond 1e30)");
+  }
+  for (const Light& light : s.lights) {
+    const bool out_of_range = std::visit([&](const auto& l) {
+      using T = std::decay_t<decltype(l)>;
+      if constexpr (std::is_same_v<T, DistantLight>) return bad(l.direction) || bad(l.irradiance);
+      else if constexpr (std::is_same_v<T, PointLight>) return bad(l.position) || bad(l.intensity);
+      else if constexpr (std::is_same_v<T, SpotLight>) return bad(l.position) || bad(l.direction) || bad(l.intensity);
+      else return bad(l.position) || bad(l.direction) || bad(l.power);
+    }, light);
+    if (out_of_range) return fail("a light's transformed position, direction or emission is not finite (or beyond 1e30)");
+  }
   // --- distant lights: an aperture upstream of the bounding sphere, covering it ---
   if (!distant_.empty()) {
     const auto [centre, radius] = bounding_sphere(s);

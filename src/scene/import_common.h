@@ -37,6 +37,20 @@ struct Location {
 // A kBadFile error whose `where` is the location.
 Error located(const Location& at, std::string message);
 
+// The files of one scene: relative names (includes, meshes) resolve against the main file's folder,
+// as pbrt-v4 and Mitsuba 3 resolve them, and includes nest at most 32 deep.
+class SceneFiles {
+ public:
+  explicit SceneFiles(const std::string& main_file);
+  std::string resolve(const std::string& file) const;
+  // The text of `path`, included from `from` at nesting `depth` (0: the main file); `directive`
+  // names the including directive in messages.
+  Result<std::string> read(const std::string& path, const Location& from, int depth, const std::string& directive) const;
+
+ private:
+  std::string base_dir_;
+};
+
 // A mixture of `a` (weight 1 - w) and `b` (weight w), flattened: mixtures of mixtures become one
 // mixture whose weights are the products along the way (both formats' mix and blend choose one
 // material per shading point with these probabilities, which is the same linear combination).

@@ -107,10 +107,7 @@ class Props {
 
 class Importer {
  public:
-  explicit Importer(std::string path) : main_(std::move(path)) {
-    const std::string dir = std::filesystem::path(main_).parent_path().string();
-    base_dir_ = dir.empty() ? "." : dir;
-  }
+  explicit Importer(std::string path) : main_(std::move(path)), files_(main_) {}
 
   Result<Scene> run() {
     if (auto e = read_file(main_, Location{main_}, 0)) return *e;
@@ -246,7 +243,8 @@ class Importer {
 
  private:
   friend class Props;
-  std::string main_, base_dir_;
+  std::string main_;
+  import::SceneFiles files_;
   std::deque<Doc> docs_;
   std::map<std::string, std::string> defaults_;
   std::map<std::string, pugi::xml_node> bsdfs_;  // top-level <bsdf id>
@@ -254,20 +252,12 @@ class Importer {
   int default_material_ = -1;
   import::SceneBuilder builder_;
 
-  std::string resolve(const std::string& file) const {
-    const std::filesystem::path p(file);
-    return p.is_absolute() ? file : (std::filesystem::path(base_dir_) / p).string();
-  }
-
   std::optional<Error> read_file(const std::string& path, const Location& from, int depth) {
-    if (depth > 32) return located(from, "<include> nested more than 32 deep (a file including itself?)");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return located(from, depth == 0 ? "cannot open the scene file" : "cannot open the included file '" + path + "'");
-    std::ostringstream ss;
-    ss << in.rdbuf();
+    Result<std::string> text = files_.read(path, from, depth, "<include>");
+    if (!text) return text.error();
     Doc& d = docs_.emplace_back();
     d.path = path;
-    d.text = ss.str();
+    d.text = std::move(*text);
     const pugi::xml_parse_result res = d.xml.load_buffer(d.text.data(), d.text.size());
     if (!res) {
       Location at{path, 1, 1};
@@ -301,7 +291,7 @@ class Importer {
     if (tag == "include") {
       Result<std::string> file = attr(n, "filename");
       if (!file) return file.error();
-      return read_file(resolve(*file), where(n), depth + 1);
+      return read_file(files_.resolve(*file), where(n), depth + 1);
     }
     if (tag == "bsdf") {
       const std::string id = n.attribute("id").value();
@@ -451,11 +441,11 @@ class Importer {
         return located(where(n), "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face normals (add <boolean name=\"face_normals\" value=\"true\"/>)");
       MeshShape mesh;
       if (type == "obj") {
-        MI_TRY(obj, load_obj_mesh(resolve(file)));
-        if (obj.triangles.empty()) return located(where(n), "the mesh '" + resolve(file) + "' has no faces");
+        MI_TRY(obj, load_obj_mesh(files_.resolve(file)));
+        if (obj.triangles.empty()) return located(where(n), "the mesh '" + files_.resolve(file) + "' has no faces");
         mesh = std::move(obj);
       } else {
-        MI_TRY(ply, import::load_ply_mesh(resolve(file), where(n), /*discard_normals=*/true));
+        MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), /*discard_normals=*/true));
         mesh = std::move(ply);
       }
       mesh.file = file;

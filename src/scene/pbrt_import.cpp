@@ -206,10 +206,7 @@ struct GraphicsState {
 
 class Importer {
  public:
-  explicit Importer(std::string main_file) : main_file_(std::move(main_file)) {
-    const std::string dir = std::filesystem::path(main_file_).parent_path().string();
-    base_dir_ = dir.empty() ? "." : dir;
-  }
+  explicit Importer(std::string main_file) : main_file_(std::move(main_file)), files_(main_file_) {}
 
   Result<Scene> run() {
     if (auto e = parse_file(main_file_, Location{main_file_}, 0)) return *e;
@@ -218,7 +215,8 @@ class Importer {
   }
 
  private:
-  std::string main_file_, base_dir_;
+  std::string main_file_;
+  import::SceneFiles files_;
   import::SceneBuilder builder_;
   GraphicsState gs_;
   std::vector<GraphicsState> stack_;
@@ -314,12 +312,9 @@ class Importer {
 
   // --- files ---
   std::optional<Error> parse_file(const std::string& path, const Location& from, int depth) {
-    if (depth > 32) return located(from, "Include/Import nested more than 32 deep (a file including itself?)");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return located(from, depth == 0 ? "cannot open the scene file" : "cannot open the included file '" + path + "'");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    Result<std::vector<Token>> tokens = tokenize(ss.str(), path);
+    Result<std::string> text = files_.read(path, from, depth, "Include/Import");
+    if (!text) return text.error();
+    Result<std::vector<Token>> tokens = tokenize(*text, path);
     if (!tokens) return tokens.error();
     Stream s{&*tokens, 0, Location{path}};
     while (!s.done()) {
@@ -331,11 +326,6 @@ class Importer {
     if (depth == 0 && !stack_.empty())
       return located(stack_at_.back(), std::string(stack_is_attribute_.back() ? "AttributeBegin" : "TransformBegin") + " has no matching End");
     return std::nullopt;
-  }
-
-  std::string resolve(const std::string& file) const {
-    const std::filesystem::path p(file);
-    return p.is_absolute() ? file : (std::filesystem::path(base_dir_) / p).string();
   }
 
   // --- directives ---
@@ -419,7 +409,7 @@ class Importer {
     }
     if (name == "Include" || name == "Import") {
       PBRT_TRY(file, quoted(s, at, name));
-      return parse_file(resolve(file), at, depth + 1);
+      return parse_file(files_.resolve(file), at, depth + 1);
     }
     if (name == "WorldBegin") {
       if (in_world_) return located(at, "a second WorldBegin");
@@ -676,7 +666,7 @@ class Importer {
         ps.ignore({"edgelength"});
         PBRT_TRY(file, ps.string("filename", ""));
         if (file.empty()) return located(at, "plymesh needs a \"string filename\"");
-        PBRT_TRY(ply, import::load_ply_mesh(resolve(file), at, /*discard_normals=*/false));
+        PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, /*discard_normals=*/false));
         mesh = std::move(ply);
         mesh.file = file;
       } else {
@@ -685,7 +675,10 @@ class Importer {
         std::vector<long long> idx;
         if (Param* ip = ps.find("indices")) {
           if (ip->type != "integer") return located(ip->at, "indices must be integers");
-          for (double x : ip->numbers) idx.push_back(static_cast<long long>(x));
+          for (double x : ip->numbers) {
+            if (x != std::floor(x) || std::fabs(x) > 1e15) return located(ip->at, "indices must be integers");
+            idx.push_back(static_cast<long long>(x));
+          }
         } else if (p.size() == corners) {
           for (std::size_t i = 0; i < corners; ++i) idx.push_back(static_cast<long long>(i));
         }
