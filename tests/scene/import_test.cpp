@@ -381,6 +381,8 @@ std::vector<Refusal> refusals() {
        "shape \"cube\" is not supported, expected obj, ply, sphere, rectangle or disk"},
       {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",
        "emitter \"envmap\" is not supported, expected point, spot, directional, or area inside a shape"},
+      {"plastic.xml", "  <bsdf type=\"plastic\" id=\"unused\"/>\n</scene>\n", "plastic.xml:2:3",
+       "bsdf \"plastic\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, blendbsdf or twosided"},
       {"medium.xml", "  <medium type=\"homogeneous\"/>\n</scene>\n", "medium.xml:2:3",
        "<medium> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)"},
       {"rough-glass.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"roughdielectric\"/>\n  </shape>\n</scene>\n", "rough-glass.xml:3:5",
