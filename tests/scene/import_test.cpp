@@ -493,6 +493,9 @@ TEST(ImportRefusals, PlyMeshesWithNormalsOrCurvedQuads) {
   EXPECT_EQ(relative(b.error().message),
             "the PLY mesh 'curved.ply' has a non-planar quad (face 0), which pbrt renders as a curved bilinear patch; pathex supports planar "
             "quads only");
+  const Result<Scene> c = load_scene_file(write("ply-obj.pbrt", kPbrtHead + "Shape \"plymesh\" \"string filename\" \"mesh.obj\"\n"));
+  ASSERT_FALSE(c.ok());
+  EXPECT_EQ(relative(c.error().message), "the mesh 'mesh.obj' is not a .ply file");
 }
 
 }  // namespace
