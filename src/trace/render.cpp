@@ -178,7 +178,7 @@ class Integrator {
       : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), classifier_(cl) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
-    lens_hits_ = cam_.type == SensorType::kLens && cam_.lens_radius > 0.0f;
+    lens_hits_ = cam_.type == SensorType::kLens;
     bool any_t0 = false;
     for (int s = 0; s < 2 * kMaxVertices; ++s) any_t0 = any_t0 || strategies.find(s, 0) >= 0;
     lens_hits_ = lens_hits_ && any_t0;
@@ -205,8 +205,8 @@ class Integrator {
       all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
     }
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
-    sensor_pair_ = sensor_letters(cam_.type);
-    for (const RenderLight& l : rs.lights) light_pairs_.push_back(light_letters(letter_type(l.type)));
+    sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
+    for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
@@ -368,88 +368,34 @@ class Integrator {
   }
 
  private:
-  // --- sensors ---
-  vec3 raster_dir(float rx, float ry) const {  // direction through raster point, z = 1 image plane
-    const float sx = (2.0f * rx / static_cast<float>(cam_.width) - 1.0f) * cam_.tan_x;
-    const float sy = (1.0f - 2.0f * ry / static_cast<float>(cam_.height)) * cam_.tan_y;
-    return cam_.forward + sx * cam_.right + sy * cam_.up;
+  // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
+  // Densities as the MIS ratios keep them: a Dirac part's is stored as 0.
+  static float finite_part(float pdf, bool delta) { return delta ? 0.0f : pdf; }
+  // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w.
+  float sensor_pdf_dir(const Vertex& v, const vec3& w) const {
+    const RayPdf p = pdf_ray(cam_.params, v.p, w);
+    return finite_part(p.dir, p.delta_dir);
   }
-  // Raster position of a direction leaving the camera centre (pinhole) or, for a lens, of the
-  // focus-plane point the ray from `lens_point` reaches. False when outside the image.
-  bool raster_of(const vec3& lens_point, const vec3& dir, float* rx, float* ry) const {
-    const float c = glm::dot(dir, cam_.forward);
-    if (c <= 0.0f) return false;
-    vec3 q = dir / c;  // on the z = 1 plane, relative to lens_point
-    if (cam_.type == SensorType::kLens) {
-      const vec3 focus = lens_point + dir * (cam_.focus_distance / c);
-      q = (focus - cam_.position) / cam_.focus_distance;
-    }
-    const float sx = glm::dot(q, cam_.right) / cam_.tan_x, sy = glm::dot(q, cam_.up) / cam_.tan_y;
-    *rx = (sx + 1.0f) * 0.5f * static_cast<float>(cam_.width);
-    *ry = (1.0f - sy) * 0.5f * static_cast<float>(cam_.height);
-    return *rx >= 0.0f && *ry >= 0.0f && *rx < static_cast<float>(cam_.width) && *ry < static_cast<float>(cam_.height);
-  }
-  float lens_area() const { return kPi * cam_.lens_radius * cam_.lens_radius; }
-  // Importance per unit projected solid angle and lens area (pinhole, lens), 0 outside the image.
-  float importance(const vec3& lens_point, const vec3& dir) const {
-    float rx, ry;
-    if (!raster_of(lens_point, dir, &rx, &ry)) return 0.0f;
-    const float c = glm::dot(dir, cam_.forward);
-    const float w = 1.0f / (cam_.image_area() * c * c * c * c);
-    return cam_.type == SensorType::kLens ? w / lens_area() : w;
-  }
-  // Directional density of the sensor (solid angle): pinhole and lens 1/(A cos^3), deltas 0.
-  float sensor_pdf_dir(const vec3& dir) const {
-    if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return 0.0f;
-    const float c = glm::dot(dir, cam_.forward);
-    if (c <= 0.0f) return 0.0f;
-    return 1.0f / (cam_.image_area() * c * c * c);
-  }
-  float sensor_pdf_pos() const {
-    switch (cam_.type) {
-      case SensorType::kLens: return 1.0f / lens_area();
-      case SensorType::kOrthographic: return 1.0f / (cam_.film_width * cam_.film_height);
-      default: return 0.0f;  // a point: Dirac
-    }
-  }
-
-  // --- lights ---
-  float light_pdf_pos(const RenderLight& l) const {  // area density of the emitting point
-    switch (l.type) {
-      case EmitterKind::kArea: return 1.0f / rs_.geometry->shape_area(l.shape);
-      case EmitterKind::kDistant: return 1.0f / l.ap_area;
-      default: return 0.0f;  // Dirac
-    }
-  }
-  // Whether a light vertex emits towards `w` through its finite directional part: the emitting
-  // side of an area light, anywhere for a point light, inside a spot's cone. Dirac directions
-  // (distant, laser) have no finite part.
-  bool light_emits(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    switch (l.type) {
-      case EmitterKind::kArea: {
-        const float c = glm::dot(v.n, w);
-        return c > 0.0f || (l.two_sided && c < 0.0f);
-      }
-      case EmitterKind::kPoint: return true;
-      case EmitterKind::kSpot: return glm::dot(w, l.direction) >= l.cos_cone;
-      default: return false;
-    }
-  }
-  // Emitted radiance (area) or intensity (point, spot) towards `w`.
-  vec3 light_emit(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    return light_emits(l, v, w) ? l.power : vec3(0.0f);
-  }
+  // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
   float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    switch (l.type) {
-      case EmitterKind::kArea: {
-        const float c = glm::dot(v.n, w);
-        if (l.two_sided) return std::fabs(c) / (2.0f * kPi);
-        return c > 0.0f ? c / kPi : 0.0f;
-      }
-      case EmitterKind::kPoint: return 1.0f / (4.0f * kPi);
-      case EmitterKind::kSpot: return glm::dot(w, l.direction) >= l.cos_cone ? 1.0f / (2.0f * kPi * (1.0f - l.cos_cone)) : 0.0f;
-      default: return 0.0f;
-    }
+    const RayPdf p = pdf_ray(l.params, SurfacePoint{v.p, v.n, l.pdf_pos}, w);
+    return finite_part(p.dir, p.delta_dir);
+  }
+  // A light chosen uniformly by u, and a point on it drawn from u2 (area lights; the others
+  // ignore the point).
+  std::size_t pick_light(float u) const {
+    return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(u * static_cast<float>(rs_.lights.size())));
+  }
+  SurfacePoint sample_point(const RenderLight& l, glm::vec2 u2) const {
+    if (!l.is_area()) return {};
+    const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, u2);
+    return {ss.position, ss.normal, l.pdf_pos};
+  }
+  // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
+  void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
+    const float w = static_cast<float>(cam_.width), h = static_cast<float>(cam_.height);
+    *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
+    *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
   }
 
   // --- densities used by MIS ---
@@ -457,7 +403,7 @@ class Integrator {
   // `wp` to v's other neighbour (null when it has none: a surface then has no density).
   float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
     switch (v.kind) {
-      case Kind::kCamera: return sensor_pdf_dir(wn);
+      case Kind::kCamera: return sensor_pdf_dir(v, wn);
       case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
       case Kind::kSurface:
         return wp ? bsdf::pdf(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)], *wp, wn, v.ns, v.n) : 0.0f;
@@ -477,7 +423,7 @@ class Integrator {
   // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
   float pdf_light_origin(const Vertex& v) const {
     const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
-    return light_pick_ * light_pdf_pos(rs_.lights[static_cast<std::size_t>(li)]);
+    return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
   }
 
   // --- subpaths ---
@@ -517,7 +463,7 @@ class Integrator {
   void trace_shadows(Thread& th) const;
 
   const RenderScene& rs_;
-  const RenderCamera& cam_;
+  const RenderSensor& cam_;
   const StrategySet& strategies_;
   const RenderOptions& o_;
   const Classifier* classifier_;
@@ -557,24 +503,20 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, HitDetail::kNoUv);  // n is zero for points: no offset
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
-      const float denom = glm::dot(d, cam_.forward);
-      if (denom < 0.0f) {
-        const float tl = glm::dot(cam_.position - o, cam_.forward) / denom;
-        const vec3 q = o + tl * d;
-        if (tl > 0.0f && (!hit || tl < hit->t) && glm::length(q - cam_.position) <= cam_.lens_radius) {
-          Vertex& v = path[static_cast<std::size_t>(count)];
-          v = Vertex{};
-          v.kind = Kind::kLens;
-          v.p = q;
-          v.n = cam_.forward;
-          v.ns = cam_.forward;
-          v.beta = beta;
-          link(v, prev);
-          v.pdf_fwd = v.d2_wo > 0.0f ? pdf_dir * std::fabs(glm::dot(v.n, d)) / v.d2_wo : 0.0f;
-          v.letter = 'D';
-          v.pos_letter = 'D';
-          return count + 1;
-        }
+      const std::optional<EndpointConnection> lens = hit_lens(cam_.params, o, d);
+      if (lens && (!hit || lens->distance < hit->t)) {
+        Vertex& v = path[static_cast<std::size_t>(count)];
+        v = Vertex{};
+        v.kind = Kind::kLens;
+        v.p = lens->position;
+        v.n = lens->normal;
+        v.ns = lens->normal;
+        v.beta = beta;
+        link(v, prev);
+        v.pdf_fwd = v.d2_wo > 0.0f ? pdf_dir * std::fabs(glm::dot(v.n, d)) / v.d2_wo : 0.0f;
+        v.letter = 'D';
+        v.pos_letter = 'D';
+        return count + 1;
       }
     }
     if (!hit) break;
@@ -635,45 +577,22 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   z0.pos_letter = sensor_pair_[1];
   const glm::vec2 uf = rng.get2d();
   const glm::vec2 ul = rng.get2d();
-  const float rx = static_cast<float>(px) + uf.x, ry = static_cast<float>(py) + uf.y;
-  vec3 o = cam_.position, d = cam_.forward;
-  float pdf_dir = 0.0f;
-  switch (cam_.type) {
-    case SensorType::kPinhole: {
-      d = glm::normalize(raster_dir(rx, ry));
-      pdf_dir = sensor_pdf_dir(d);
-      break;
-    }
-    case SensorType::kLens: {
-      const vec3 target = cam_.position + raster_dir(rx, ry) * cam_.focus_distance;
-      const glm::vec2 disk = sample_concentric_disk(ul) * cam_.lens_radius;
-      o = cam_.position + disk.x * cam_.right + disk.y * cam_.up;
-      d = glm::normalize(target - o);
-      z0.n = cam_.forward;
-      pdf_dir = sensor_pdf_dir(d);
-      break;
-    }
-    case SensorType::kOrthographic: {
-      const float sx = (2.0f * rx / static_cast<float>(cam_.width) - 1.0f) * 0.5f * cam_.film_width;
-      const float sy = (1.0f - 2.0f * ry / static_cast<float>(cam_.height)) * 0.5f * cam_.film_height;
-      o = cam_.position + sx * cam_.right + sy * cam_.up;
-      z0.n = cam_.forward;
-      pdf_dir = 0.0f;  // Dirac direction
-      break;
-    }
-    case SensorType::kSpotmeter: pdf_dir = 0.0f; break;
-  }
-  z0.p = o;
+  const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(cam_.width),
+                         (static_cast<float>(py) + uf.y) / static_cast<float>(cam_.height)};
+  const std::optional<EndpointRay> r = sample_ray(cam_.params, raster, ul);
+  z0.pdf_fwd = cam_.pdf_pos;
+  if (!r) return 1;
+  z0.p = r->origin;
+  z0.n = r->pdf.delta_pos ? vec3(0.0f) : r->normal;  // a point sensor has no surface
   z0.ns = z0.n;
-  z0.pdf_fwd = sensor_pdf_pos();
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
-  return random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, o, d, pdf_dir, max_eye_);
+  return random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
+                                               finite_part(r->pdf.dir, r->pdf.delta_dir), max_eye_);
 }
 
 int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
-  const float ul = rng.get1d();
-  const std::size_t li = std::min(rs_.lights.size() - 1, static_cast<std::size_t>(ul * static_cast<float>(rs_.lights.size())));
+  const std::size_t li = pick_light(rng.get1d());
   const RenderLight& l = rs_.lights[li];
   Vertex& y0 = th.light[0];
   y0 = Vertex{};
@@ -681,66 +600,27 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   y0.light = static_cast<int>(li);
   y0.pos_letter = light_pairs_[li][0];
   y0.letter = light_pairs_[li][1];
-  const glm::vec2 up = rng.get2d();
-  const glm::vec2 ud = rng.get2d();
-  vec3 d{0.0f};
-  float pdf_pos = light_pdf_pos(l), pdf_dir = 0.0f;
-  vec3 beta1{0.0f};  // throughput carried by the first ray
-  switch (l.type) {
-    case EmitterKind::kArea: {
-      const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, up);
-      y0.p = ss.position;
-      y0.n = ss.normal;
-      vec3 local = sample_cosine_hemisphere(ud);
-      float sign = 1.0f;
-      if (l.two_sided && rng.get1d() < 0.5f) sign = -1.0f;
-      const Frame f = Frame::from_normal(y0.n * sign);
-      d = f.to_world(local);
-      pdf_dir = light_pdf_dir(l, y0, d);
-      beta1 = l.power * std::fabs(glm::dot(y0.n, d)) / (light_pick_ * pdf_pos * pdf_dir);
-      y0.beta = l.power / (light_pick_ * pdf_pos);
-      break;
-    }
-    case EmitterKind::kPoint: {
-      y0.p = l.position;
-      d = sample_uniform_sphere(ud);
-      pdf_dir = light_pdf_dir(l, y0, d);
-      beta1 = l.power / (light_pick_ * pdf_dir);
-      y0.beta = l.power / light_pick_;
-      break;
-    }
-    case EmitterKind::kSpot: {
-      y0.p = l.position;
-      d = Frame::from_normal(l.direction).to_world(sample_uniform_cone(ud, l.cos_cone));
-      pdf_dir = light_pdf_dir(l, y0, d);
-      beta1 = l.power / (light_pick_ * pdf_dir);
-      y0.beta = l.power / light_pick_;
-      break;
-    }
-    case EmitterKind::kDistant: {
-      y0.p = l.ap_corner + up.x * l.ap_edge1 + up.y * l.ap_edge2;
-      y0.n = l.ap_normal;
-      d = l.direction;
-      beta1 = l.power * std::fabs(glm::dot(l.ap_normal, d)) / (light_pick_ * pdf_pos);
-      y0.beta = beta1;
-      break;
-    }
-    case EmitterKind::kLaser: {
-      y0.p = l.position;
-      d = l.direction;
-      beta1 = l.power / light_pick_;
-      y0.beta = beta1;
-      break;
-    }
+  const SurfacePoint x = sample_point(l, rng.get2d());
+  const std::optional<EndpointRay> r = sample_ray(l.params, x, rng.get2d());
+  y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
+  if (!r) {  // no emission from this sample: y0 alone, carrying nothing
+    y0.p = x.position;
+    y0.beta = vec3(0.0f);
+    return 1;
   }
+  y0.p = r->origin;
+  y0.n = r->normal;
   y0.ns = y0.n;
-  y0.pdf_fwd = light_pick_ * pdf_pos;  // 0 for Dirac positions
+  // y0 keeps the spatial part of the emission, L_e⁽⁰⁾ / p (a join at y0 evaluates the directional
+  // part); the walk continues with the first ray's whole throughput.
+  y0.beta = spatial_emission(l.params) / (light_pick_ * (r->pdf.delta_pos ? 1.0f : r->pdf.pos));
+  const vec3 beta1 = r->weight / light_pick_;
   if (is_black(beta1)) return 1;
-  // The walk starts from y0 with the first ray's throughput.
-  Vertex saved = y0;
+  const vec3 saved = y0.beta;
   th.light[0].beta = beta1;
-  const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, d, pdf_dir, max_light_);
-  th.light[0].beta = saved.beta;
+  const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, r->direction,
+                                                        finite_part(r->pdf.dir, r->pdf.delta_dir), max_light_);
+  th.light[0].beta = saved;
   return n;
 }
 
@@ -827,8 +707,8 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
       rev_ptm = area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo);
     }
   } else if (qs) {  // t = 0: qs is the lens point
-    rev_qs = sensor_pdf_pos();
-    if (need_qsm) rev_qsm = area(sensor_pdf_dir(qs->wo), *qsm, qs->wo, qs->d2_wo);
+    rev_qs = cam_.pdf_pos;
+    if (need_qsm) rev_qsm = area(sensor_pdf_dir(*qs, qs->wo), *qsm, qs->wo, qs->d2_wo);
   }
   // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
   // Ratios in double: long paths multiply many of them. Dirac densities are stored as 0 and
@@ -907,86 +787,69 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     if (pt->kind != Kind::kSurface) return;
     const int li = rs_.light_of_shape[static_cast<std::size_t>(pt->shape)];
     if (li < 0) return;
-    contrib = pt->beta * light_emit(rs_.lights[static_cast<std::size_t>(li)], *pt, pt->wo);
+    const LightParams& l = rs_.lights[static_cast<std::size_t>(li)].params;
+    contrib = pt->beta * spatial_emission(l) * directional_emission(l, pt->n, pt->wo);
   } else if constexpr (C == Connection::kLens) {
     // --- light path hits the lens ---
     if (qs->kind != Kind::kLens) return;
-    const vec3 w = qs->wo;
-    if (!raster_of(qs->p, w, &rx, &ry)) return;
-    contrib = qs->beta * importance(qs->p, w);
+    glm::vec2 raster;
+    const vec3 we = importance(cam_.params, qs->p, qs->wo, &raster);
+    if (is_black(we)) return;
+    to_pixels(raster, &rx, &ry);
+    contrib = qs->beta * we;
     splat = true;
   } else if constexpr (C == Connection::kSplat) {
     // --- splat: connect qs to a fresh sensor point ---
-    if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return;
+    if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no DD join
     if (qs->kind == Kind::kLens || !qs->finite) return;
+    const std::optional<EndpointConnection> c = connect_finite(cam_.params, rng.get2d(), qs->p);
+    if (!c) return;
     sampled = Vertex{};
     sampled.kind = Kind::kCamera;
-    sampled.p = cam_.position;
-    if (cam_.type == SensorType::kLens) {
-      const glm::vec2 disk = sample_concentric_disk(rng.get2d()) * cam_.lens_radius;
-      sampled.p = cam_.position + disk.x * cam_.right + disk.y * cam_.up;
-      sampled.n = cam_.forward;
-    }
+    sampled.p = c->position;
+    sampled.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c->normal;  // a pinhole is a point
     sampled.ns = sampled.n;
     sampled.letter = 'D';
     sampled.pos_letter = sensor_pair_[1];
-    const vec3 to_cam = sampled.p - qs->p;
-    const float d2 = glm::dot(to_cam, to_cam);
-    const vec3 w = to_cam * (1.0f / std::sqrt(d2));  // from qs to the camera
-    if (!raster_of(sampled.p, -w, &rx, &ry)) return;
-    const float we = importance(sampled.p, -w);
-    const float pdf_pos = cam_.type == SensorType::kLens ? 1.0f / lens_area() : 1.0f;
-    sampled.beta = vec3(we / pdf_pos);
-    sampled.pdf_fwd = sensor_pdf_pos();
+    sampled.pdf_fwd = cam_.pdf_pos;
+    const vec3 w = c->wi;  // from qs to the sensor
+    to_pixels(c->raster, &rx, &ry);
     vec3 fq;
     // A light vertex's beta already holds its spatial emission; only the directional part is left.
-    if (qs->kind == Kind::kLight) fq = vec3(light_emits(rs_.lights[static_cast<std::size_t>(qs->light)], *qs, w) ? 1.0f : 0.0f);
+    if (qs->kind == Kind::kLight) fq = vec3(directional_emission(rs_.lights[static_cast<std::size_t>(qs->light)].params, qs->n, w));
     else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
                         qs->wo, w, qs->ns, qs->n, &join.at_qs);
     join.w = w;
-    join.d2 = d2;
+    join.d2 = c->distance * c->distance;
     joined = true;
-    const float g = abs_cos(*qs, w) * std::fabs(glm::dot(cam_.forward, w)) / d2;
-    contrib = qs->beta * fq * sampled.beta * g;
+    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);
     ends = {qs, &sampled};
     splat = true;
   } else if constexpr (C == Connection::kNee) {
     // --- next-event estimation: a fresh light sample ---
     if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
-    const float ul = rng.get1d();
+    const std::size_t li = pick_light(rng.get1d());
     const glm::vec2 up = rng.get2d();
-    const std::size_t li = std::min(rs_.lights.size() - 1, static_cast<std::size_t>(ul * static_cast<float>(rs_.lights.size())));
     const RenderLight& l = rs_.lights[li];
-    if (l.type == EmitterKind::kDistant || l.type == EmitterKind::kLaser) return;  // Dirac directions: no DD join
+    if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
+    const std::optional<EndpointConnection> c = pathex::connect(l.params, sample_point(l, up), pt->p);
+    if (!c) return;
     sampled = Vertex{};
     sampled.kind = Kind::kLight;
     sampled.light = static_cast<int>(li);
     sampled.pos_letter = light_pairs_[li][0];
     sampled.letter = 'D';
-    float pdf_pos = 1.0f;
-    if (l.type == EmitterKind::kArea) {
-      const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, up);
-      sampled.p = ss.position;
-      sampled.n = ss.normal;
-      pdf_pos = light_pdf_pos(l);
-    } else {
-      sampled.p = l.position;
-    }
+    sampled.p = c->position;
+    sampled.n = c->normal;
     sampled.ns = sampled.n;
-    sampled.pdf_fwd = light_pick_ * light_pdf_pos(l);
-    sampled.beta = l.power * (1.0f / (light_pick_ * pdf_pos));
-    const vec3 to_light = sampled.p - pt->p;
-    const float d2 = glm::dot(to_light, to_light);
-    if (d2 <= 0.0f) return;
-    const vec3 w = to_light * (1.0f / std::sqrt(d2));
-    if (!light_emits(l, sampled, -w)) return;
+    sampled.pdf_fwd = light_pick_ * l.pdf_pos;
+    const vec3 w = c->wi;  // from pt to the light
     const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
                              pt->wo, w, pt->ns, pt->n, &join.at_pt);
     join.w = -w;  // w runs from pt to the light, the join's from the light to pt
-    join.d2 = d2;
+    join.d2 = c->distance * c->distance;
     joined = true;
-    const float g = abs_cos(*pt, w) * abs_cos(sampled, w) / d2;
-    contrib = pt->beta * f * sampled.beta * g;
+    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;
     ends = {pt, &sampled};
   } else {
     // --- a shadow ray between y(s-1) and z(t-1) ---
@@ -1039,7 +902,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
   if (s == 0) {  // the eye vertex on the emitter becomes the light vertex
     x[0].kind = Kind::kLight;
     x[0].light = rs_.light_of_shape[static_cast<std::size_t>(x[0].shape)];
-  } else if (rs_.lights[static_cast<std::size_t>(x[0].light)].type == EmitterKind::kArea) {
+  } else if (rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) {
     x[0].shape = rs_.lights[static_cast<std::size_t>(x[0].light)].shape;  // so an eye path may hit it
   }
   const std::string letters = label(th, s, t);
@@ -1051,15 +914,14 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
         letters[static_cast<std::size_t>(s2) + 2] != 'D')
       continue;
     if (t2 == 0 && !lens_hits_) continue;
-    if (s2 == 0 && x[0].kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(x[0].light)].type != EmitterKind::kArea) continue;
+    if (s2 == 0 && x[0].kind == Kind::kLight && !rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) continue;
     // Re-split: light subpath x0 … x(s2-1), eye subpath xk … x(s2), with forward densities as
     // each side would have sampled them.
     for (int i = 0; i < s2; ++i) th.light[static_cast<std::size_t>(i)] = x[static_cast<std::size_t>(i)];
     for (int j = 0; j < t2; ++j) th.eye[static_cast<std::size_t>(j)] = x[static_cast<std::size_t>(k - j)];
     if (s2 > 0) {
-      const RenderLight& l = rs_.lights[static_cast<std::size_t>(x[0].light)];
       th.light[0].kind = Kind::kLight;
-      th.light[0].pdf_fwd = light_pick_ * light_pdf_pos(l);
+      th.light[0].pdf_fwd = light_pick_ * rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
     }
     if (s2 == 0) {
       th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;
@@ -1087,7 +949,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
           specular(i + 1) ? 0.0f
                           : pdf(&th.light[static_cast<std::size_t>(i + 2)], th.light[static_cast<std::size_t>(i + 1)],
                                 th.light[static_cast<std::size_t>(i)]);
-    if (t2 > 0) th.eye[0].pdf_fwd = sensor_pdf_pos();
+    if (t2 > 0) th.eye[0].pdf_fwd = cam_.pdf_pos;
     for (int j = 1; j < t2; ++j)
       th.eye[static_cast<std::size_t>(j)].pdf_fwd =
           specular(k - (j - 1)) ? 0.0f

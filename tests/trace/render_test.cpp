@@ -164,6 +164,30 @@ TEST(ClosedForm, PointLightOverAPlane) {
   }
 }
 
+// A spot light (hard edge, half angle 30°) at height h over the plane, pointing straight down:
+// inside its cone the floor's radiance is the point light's, rho I cos(theta) / (pi d^2), and
+// outside it is 0. The edge is decided once, in trace/emitters.h (the cone's boundary itself emits
+// nothing), and every strategy reads it there: next-event estimation, light tracing and bdpt agree
+// with the closed form. Class LSD D DSE.
+TEST(ClosedForm, SpotLightOverAPlaneIsThePointLightInsideItsCone) {
+  const double rho = 0.6, intensity = 2.0, h = 1.0, cos_cone = std::cos(30.0 * kPi / 180.0);
+  const std::string scene = std::string("{") + kFloorCamera + R"(,
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+    "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"}],
+    "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], "cone": 30, "intensity": [2, 2, 2]}]})";
+  const double expected = floor_reference([&](const glm::dvec3& p) {
+    const double d2 = p.x * p.x + h * h + p.z * p.z;
+    const double cos_theta = h / std::sqrt(d2);
+    return cos_theta > cos_cone ? rho * intensity * cos_theta / (kPi * d2) : 0.0;
+  });
+  ASSERT_GT(expected, 0.0);
+  for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
+    Rendered r = render_json(scene, renderer, {"LSDDDSE"}, 256);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    expect_close(r.report.classes[0].estimate, expected, 3.0, 0.005, std::string(renderer) + " spot over plane");
+  }
+}
+
 // DESIGN §9: a planar mirror of reflectance R throws a caustic that is the floor lit by the
 // light's mirror image with intensity R I. Light at height 1, a large mirror facing down at
 // height 2 (image light at height 3), the camera below the mirror. Class LSD S D DSE, which
