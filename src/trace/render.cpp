@@ -34,19 +34,22 @@ namespace pathex {
 
 // --- strategies the tracer runs ---
 
-int StrategySet::find(int s, int t) const {
+int StrategySet::find(int s, int t) const { return find_connector(ConnectorKind::kNone, s, t); }
+
+int StrategySet::find_connector(ConnectorKind k, int s, int t) const {
   for (std::size_t i = 0; i < strategies.size(); ++i)
-    if (strategies[i].s.contains(s) && strategies[i].t.contains(t)) return static_cast<int>(i);
+    if (strategies[i].connector == k && strategies[i].s.contains(s) && strategies[i].t.contains(t)) return static_cast<int>(i);
   return -1;
 }
 
 Result<StrategySet> runnable_strategies(const Profile& profile) {
   StrategySet set;
   for (const Strategy& st : profile.strategies) {
-    if (st.connector != ConnectorKind::kNone)
+    if (st.connector == ConnectorKind::kMirror || st.connector == ConnectorKind::kManifold)
       return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' uses the connector '" + to_string(st.connector) +
                                                "' (strategy '" + st.name +
-                                               "'), which the tracer does not run yet; it runs plain joins (s, DD, t) only");
+                                               "'), which the tracer does not run yet; it runs plain joins (s, DD, t) and the "
+                                               "distant-projection and ortho-projection connectors");
     set.strategies.push_back(st);
   }
   return set;
@@ -60,6 +63,15 @@ constexpr int kMaxVertices = 64;  // per subpath; max_bounces is clamped so path
 // Passes go to batches round-robin: every batch covers the whole image, passes are i.i.d., and
 // an interrupted render still spreads what it has over all batches (so its error is defined).
 int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % static_cast<std::uint64_t>(batches)); }
+
+// Random-number dimensions (trace/rng.h): each stage of a sample draws from its own block, so that
+// adding a strategy leaves every other strategy's numbers unchanged. The eye and the light subpath
+// draw at most 4 + 4 per vertex; each connection (kind, subpath length) then draws at most 4.
+constexpr std::uint64_t kEyeDims = 0;
+constexpr std::uint64_t kLightDims = 1024;
+constexpr std::uint64_t kJoinDims = 2048;
+constexpr std::uint64_t kDimsPerJoin = 4;
+static_assert(4 + 4 * 64 <= kLightDims - kEyeDims, "a subpath's numbers fit its block");
 
 float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
@@ -198,8 +210,13 @@ class Integrator {
       for (int s2 = 0; s2 <= static_cast<int>(n); ++s2)
         if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
           runs_mask_[n] |= std::uint64_t{1} << s2;
+    for (std::size_t i = 0; i < kMaxRuns; ++i) {
+      distant_of_[i] = static_cast<std::int16_t>(strategies.find_connector(ConnectorKind::kDistantProjection, 0, static_cast<int>(i)));
+      ortho_of_[i] = static_cast<std::int16_t>(strategies.find_connector(ConnectorKind::kOrthoProjection, static_cast<int>(i), 0));
+      has_connectors_ = has_connectors_ || distant_of_[i] >= 0 || ortho_of_[i] >= 0;
+    }
     eye0_runs_ = (runs_mask_[1] >> 1) & 1;
-    all_runs_ = true;
+    all_runs_ = !has_connectors_;  // the per-sample sums below know plain joins only
     for (std::size_t n = 1; n < runs_mask_.size(); ++n) {
       const std::uint64_t below = (std::uint64_t{1} << n) - 1;  // s2 < n: t2 >= 1
       all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
@@ -216,7 +233,8 @@ class Integrator {
     PathKey key = 0;
     vec3 c{0.0f};
     int strategy = 0, batch = 0;
-    bool splat = false;  // to raster point (rx, ry); else to the sample's own pixel, column px
+    bool splat = false;
+    bool connector = false;  // counted in the connector's statistics  // to raster point (rx, ry); else to the sample's own pixel, column px
     float rx = 0.0f, ry = 0.0f;
     int px = 0;
   };
@@ -228,6 +246,7 @@ class Integrator {
     std::vector<ClassImages::PixelSum> row;
     std::array<Vertex, kMaxVertices> eye, light;
     std::uint64_t rays = 0;
+    std::vector<ConnectorStats> connectors;  // indexed by profile strategy (only connectors' are used)
     PathIds ids;
     Vertex sampled;  // connect()'s fresh light or sensor sample
     // The subpaths' letters packed (set by prepare_joins()): light_mask has c0 c1 of y0, then
@@ -299,7 +318,8 @@ class Integrator {
     }
   }
   // The packed full-path string of connection (s, t), as full_path() spells it.
-  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
+  // A projection connector's chain keeps its S letter (`chain_s`, the bit of the Dirac direction).
+  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled, PathKey chain_s = 0) const {
     PathKey m = 0;
     if (s > 0) {
       m = th.light_mask & (bit(s + 1) - 1);
@@ -307,7 +327,7 @@ class Integrator {
     }
     if (t > 0) m |= th.eye_masks[static_cast<std::size_t>(t)] << (s + 1);
     m &= ~(bit(s) | bit(s + 1));  // the join letters
-    return m | static_cast<PathKey>(s + t + 2) << kLengthShift;
+    return m | chain_s | static_cast<PathKey>(s + t + 2) << kLengthShift;
   }
 
   // The profile's strategy that runs (s, t), or -1.
@@ -442,7 +462,22 @@ class Integrator {
     kSplat,    // t = 1: a light vertex joined to a fresh sensor sample
     kNee,      // s = 1: an eye vertex joined to a fresh light sample
     kJoin,     // s, t >= 2: a shadow ray between two subpath vertices
+    kDistant,  // distant-projection (0, DSD, t): an eye vertex joined to a distant light's aperture
+    kOrtho,    // ortho-projection (s, DSD, 0): a light vertex joined to an orthographic film
   };
+  // How a contribution's two subpaths are joined, as MIS must know it: a plain join (both join
+  // letters D) or a projection connector, which builds the endpoint on its Dirac side.
+  enum class JoinKind : std::uint8_t { kPlain, kDistant, kOrtho };
+  // The profile's strategy running a connector at this subpath length, or -1.
+  int distant_of(int t) const { return static_cast<std::size_t>(t) < kMaxRuns ? distant_of_[static_cast<std::size_t>(t)] : -1; }
+  int ortho_of(int s) const { return static_cast<std::size_t>(s) < kMaxRuns ? ortho_of_[static_cast<std::size_t>(s)] : -1; }
+  // Density of the far end of a parallel beam per unit area there, relative to the near end's:
+  // points x and y on one line along w, with unit normals (zero: no surface), map areas as
+  // dA_x |cos θ_x| = dA_y |cos θ_y|.
+  static float parallel_jacobian(const Vertex& far, const Vertex& near, const vec3& w) {
+    const float c = abs_cos(near, w);
+    return c > 0.0f ? abs_cos(far, w) / c : 0.0f;
+  }
   template <Connection C>
   void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
   // What connect() has already computed for its join, handed to mis_weight() so that it is not
@@ -454,7 +489,8 @@ class Integrator {
     bsdf::JoinPdfs at_qs;  // wo = qs->wo, wi = w
     bsdf::JoinPdfs at_pt;  // wo = pt->wo, wi = -w
   };
-  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join = nullptr) const;
+  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join = nullptr,
+                   JoinKind self = JoinKind::kPlain) const;
   // The full-path letters of the path made by s light and t eye vertices (with `sampled`
   // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
   // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
@@ -470,6 +506,8 @@ class Integrator {
   int max_bounces_ = 16;
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;
   std::vector<std::int16_t> strategy_of_;  // [s * kMaxRuns + t]: the profile's strategy running (s, t), or -1
+  std::array<std::int16_t, kMaxRuns> distant_of_{}, ortho_of_{};  // see distant_of(), ortho_of()
+  bool has_connectors_ = false;
   // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
   // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
   static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
@@ -586,8 +624,11 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   z0.n = r->pdf.delta_pos ? vec3(0.0f) : r->normal;  // a point sensor has no surface
   z0.ns = z0.n;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
-  return random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
-                                               finite_part(r->pdf.dir, r->pdf.delta_dir), max_eye_);
+  const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
+                                                      finite_part(r->pdf.dir, r->pdf.delta_dir), max_eye_);
+  // An orthographic sensor's rays are a parallel beam (see light_subpath()).
+  if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.eye[1].pdf_fwd = parallel_jacobian(th.eye[1], z0, r->direction);
+  return n;
 }
 
 int Integrator::light_subpath(Thread& th, Sampler& rng) const {
@@ -621,6 +662,10 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, r->direction,
                                                         finite_part(r->pdf.dir, r->pdf.delta_dir), max_light_);
   th.light[0].beta = saved;
+  // A Dirac direction from a finite-area origin (a distant light's aperture) is a parallel beam:
+  // its first vertex has a finite density per area, which the distant-projection connector's
+  // MIS weight compares with the eye's.
+  if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.light[1].pdf_fwd = parallel_jacobian(th.light[1], y0, r->direction);
   return n;
 }
 
@@ -652,14 +697,39 @@ void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled
   c(s + 1) = 'D';
 }
 
-float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join) const {
+float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join,
+                             JoinKind self) const {
   // Strategy (s2, t2) samples this string when the profile runs it and its join letters c(s2),
   // c(s2+1) are both D: one mask for all of them, bit s2 (runs_mask_ holds the profile's part).
   // When no other strategy can sample this string (pt, lt, and many strings of every profile),
   // the weight is 1 and no density needs recomputing.
   const int n = s + t;
   const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c_(i+1) are D
-  const std::uint64_t others = runs_mask_[static_cast<std::size_t>(n)] & d_pairs & ~(std::uint64_t{1} << s);
+  std::uint64_t others = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
+  if (self == JoinKind::kPlain) others &= ~(std::uint64_t{1} << s);
+  // The projection connectors sample the split (1, n - 1) of strings beginning DSD (a distant
+  // light) and the split (n - 1, 1) of strings ending DSD (an orthographic sensor). Their density
+  // is the plain split's with the projected endpoint's area density (light choice aside) replaced
+  // by 1, so their ratios to the plain recurrence's carry a factor 1 / pdf_pos (`conn_w2`, squared).
+  double conn_w2_first = 0.0, conn_w2_last = 0.0, self_w2 = 1.0;
+  if (has_connectors_) {
+    const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };  // c_i c_(i+1) c_(i+2) = DSD
+    if (n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && !(self == JoinKind::kDistant)) {
+      const Vertex& x0 = s == 1 && t != 1 && sampled ? *sampled : th.light[0];
+      const double pos = rs_.lights[static_cast<std::size_t>(x0.light)].pdf_pos;
+      conn_w2_first = 1.0 / (pos * pos);
+      others |= std::uint64_t{1} << 1;
+    }
+    if (n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && !(self == JoinKind::kOrtho)) {
+      conn_w2_last = 1.0 / (static_cast<double>(cam_.pdf_pos) * cam_.pdf_pos);
+      others |= std::uint64_t{1} << (n - 1);
+    }
+    if (self == JoinKind::kDistant) {
+      const double pos = rs_.lights[static_cast<std::size_t>((sampled ? *sampled : th.light[0]).light)].pdf_pos;
+      self_w2 = pos * pos;
+    }
+    if (self == JoinKind::kOrtho) self_w2 = static_cast<double>(cam_.pdf_pos) * cam_.pdf_pos;
+  }
   if (others == 0) return 1.0f;
   // The loops below reach only as far as the farthest strategy that can: the light side down to
   // s2 = light_lo, the eye side up to s2 = eye_hi; densities beyond are not needed.
@@ -698,6 +768,9 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
     const bsdf::JoinPdfs& at_pt = join->at_pt;
     if (need_pt) rev_pt = area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
     if (need_qs) rev_qs = area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
+    // A connector's endpoint sends a parallel beam: the density at the other end is per area.
+    if (self == JoinKind::kDistant) rev_pt = parallel_jacobian(*pt, *qs, w);
+    if (self == JoinKind::kOrtho) rev_qs = parallel_jacobian(*qs, *pt, w);
     if (need_ptm) rev_ptm = area(at_pt.known ? at_pt.to_wo : pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
     if (need_qsm) rev_qsm = area(at_qs.known ? at_qs.to_wo : pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
   } else if (pt) {  // s = 0: pt lies on an area light
@@ -715,6 +788,11 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   // count as 1 here; their strategies are excluded by letter.
   double sum = 0.0;
   const auto runs = [&](int s2) { return static_cast<double>((others >> s2) & 1); };
+  // The term of strategy s2 for density ratio ri (a connector's carries its factor).
+  const auto term = [&](int s2, double ri) {
+    const double w2 = s2 == 1 && conn_w2_first != 0.0 ? conn_w2_first : s2 == n - 1 && conn_w2_last != 0.0 ? conn_w2_last : 1.0;
+    return ri * ri * w2;
+  };
   if (all_runs_) {
     // Each side: the join's two ratios, then the subpath's fixed part from prepare_joins().
     if (eye_lo <= t - 1) {
@@ -742,16 +820,16 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
     ri *= i == t - 1   ? remap(rev_pt) / remap(pt->pdf_fwd)
           : i == t - 2 ? remap(rev_ptm) / remap(E[static_cast<std::size_t>(i)].pdf_fwd)
                        : th.eye_ratio[static_cast<std::size_t>(i)];
-    if ((others >> (n - i)) & 1) sum += ri * ri;
+    if ((others >> (n - i)) & 1) sum += term(n - i, ri);
   }
   ri = 1.0;
   for (int i = s - 1; i >= light_lo; --i) {
     ri *= i == s - 1   ? remap(rev_qs) / remap(qs->pdf_fwd)
           : i == s - 2 ? remap(rev_qsm) / remap(L[static_cast<std::size_t>(i)].pdf_fwd)
                        : th.light_ratio[static_cast<std::size_t>(i)];
-    if ((others >> i) & 1) sum += ri * ri;
+    if ((others >> i) & 1) sum += term(i, ri);
   }
-  return static_cast<float>(1.0 / (1.0 + sum));
+  return static_cast<float>(1.0 / (1.0 + sum * self_w2));
 }
 
 void Integrator::record(Thread& th, const Pending& r) const {
@@ -772,7 +850,12 @@ void Integrator::record(Thread& th, const Pending& r) const {
 
 template <Integrator::Connection C>
 void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) const {
-  const int strategy_index = strategy(s, t);
+  constexpr bool by_light = C == Connection::kSplat || C == Connection::kOrtho || C == Connection::kLens;
+  rng.set_dimension(kJoinDims + (static_cast<std::uint64_t>(C) * kMaxRuns + static_cast<std::uint64_t>(by_light ? s : t)) * kDimsPerJoin);
+  constexpr JoinKind kind = C == Connection::kDistant ? JoinKind::kDistant : C == Connection::kOrtho ? JoinKind::kOrtho : JoinKind::kPlain;
+  const int strategy_index = C == Connection::kDistant ? distant_of(t) : C == Connection::kOrtho ? ortho_of(s) : strategy(s, t);
+  ConnectorStats* stats = kind != JoinKind::kPlain ? &th.connectors[static_cast<std::size_t>(strategy_index)] : nullptr;
+  PathKey chain_s = 0;  // a connector's S letter
   vec3 contrib{0.0f};
   Vertex& sampled = th.sampled;
   bool splat = false;
@@ -851,6 +934,68 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     joined = true;
     contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;
     ends = {pt, &sampled};
+  } else if constexpr (C == Connection::kDistant) {
+    // --- distant-projection: the aperture point on the line through pt against the light ---
+    if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
+    const std::size_t li = pick_light(rng.get1d());
+    const RenderLight& l = rs_.lights[li];
+    if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
+    ++stats->attempts;
+    const std::optional<EndpointConnection> c = pathex::connect(l.params, SurfacePoint{}, pt->p);
+    if (!c) {
+      ++stats->outside;
+      return;
+    }
+    sampled = Vertex{};
+    sampled.kind = Kind::kLight;
+    sampled.light = static_cast<int>(li);
+    sampled.pos_letter = light_pairs_[li][0];
+    sampled.letter = light_pairs_[li][1];
+    sampled.p = c->position;
+    sampled.n = c->normal;
+    sampled.ns = sampled.n;
+    sampled.pdf_fwd = light_pick_ * l.pdf_pos;
+    const vec3 w = c->wi;  // from pt towards the light
+    const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
+                             pt->wo, w, pt->ns, pt->n, &join.at_pt);
+    join.w = -w;
+    join.d2 = c->distance * c->distance;
+    joined = true;
+    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;  // weight: E
+    ends = {pt, &sampled};
+    chain_s = bit(1);  // c1, the light's direction
+  } else if constexpr (C == Connection::kOrtho) {
+    // --- ortho-projection: the film point on the line of sight through qs ---
+    if (qs->kind == Kind::kLens || !qs->finite) return;
+    const auto* film = std::get_if<OrthographicParams>(&cam_.params);
+    if (film == nullptr) return;
+    ++stats->attempts;
+    const std::optional<EndpointConnection> c = pathex::connect(*film, qs->p);
+    if (!c) {
+      ++stats->outside;
+      return;
+    }
+    sampled = Vertex{};
+    sampled.kind = Kind::kCamera;
+    sampled.p = c->position;
+    sampled.n = c->normal;
+    sampled.ns = sampled.n;
+    sampled.letter = sensor_pair_[0];
+    sampled.pos_letter = sensor_pair_[1];
+    sampled.pdf_fwd = cam_.pdf_pos;
+    const vec3 w = c->wi;  // from qs towards the film
+    to_pixels(c->raster, &rx, &ry);
+    vec3 fq;
+    if (qs->kind == Kind::kLight) fq = vec3(directional_emission(rs_.lights[static_cast<std::size_t>(qs->light)].params, qs->n, w));
+    else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
+                        qs->wo, w, qs->ns, qs->n, &join.at_qs);
+    join.w = w;
+    join.d2 = c->distance * c->distance;
+    joined = true;
+    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);  // weight: We = 1 / film area
+    ends = {qs, &sampled};
+    splat = true;
+    chain_s = bit(s + 1);  // c(k+1), the sensor's direction
   } else {
     // --- a shadow ray between y(s-1) and z(t-1) ---
     if (qs->kind == Kind::kLens || pt->kind != Kind::kSurface || qs->kind != Kind::kSurface) return;
@@ -870,11 +1015,15 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     contrib = qs->beta * fq * fp * pt->beta * g;
     ends = {qs, pt};
   }
-  if (is_black(contrib)) return;
-  const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee ? &sampled : nullptr;
+  if (is_black(contrib)) {
+    if (stats) ++stats->no_transport;
+    return;
+  }
+  const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee || kind != JoinKind::kPlain ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
-  const PathKey key = path_key(th, s, t, fresh);
-  const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr), strategy_index, batch, splat, rx, ry, th.px};
+  const PathKey key = path_key(th, s, t, fresh, chain_s);
+  const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr, kind), strategy_index, batch, splat,
+                  stats != nullptr, rx, ry, th.px};
   if constexpr (C == Connection::kEmitter || C == Connection::kLens) {
     record(th, r);  // no shadow ray: the path's last edge was traced
   } else {
@@ -888,8 +1037,13 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
 
 void Integrator::trace_shadows(Thread& th) const {
   th.shadow.trace(*rs_.geometry);
-  for (int lane = 0; lane < th.shadow.size(); ++lane)
-    if (th.shadow.visible(lane)) record(th, th.pending[static_cast<std::size_t>(lane)]);
+  for (int lane = 0; lane < th.shadow.size(); ++lane) {
+    const Pending& r = th.pending[static_cast<std::size_t>(lane)];
+    const bool visible = th.shadow.visible(lane);
+    if (r.connector) ++(visible ? th.connectors[static_cast<std::size_t>(r.strategy)].successes
+                                : th.connectors[static_cast<std::size_t>(r.strategy)].occluded);
+    if (visible) record(th, r);
+  }
   th.shadow.clear();
 }
 
@@ -910,11 +1064,14 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
   float sum = 0.0f;
   for (int s2 = 0; s2 <= k + 1; ++s2) {
     const int t2 = k + 1 - s2;
-    if (strategy(s2, t2) < 0 || letters[static_cast<std::size_t>(s2) + 1] != 'D' ||
-        letters[static_cast<std::size_t>(s2) + 2] != 'D')
-      continue;
-    if (t2 == 0 && !lens_hits_) continue;
-    if (s2 == 0 && x[0].kind == Kind::kLight && !rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) continue;
+    const auto letters_at = [&](int i, int count) { return letters.substr(static_cast<std::size_t>(i) + 1, static_cast<std::size_t>(count)); };
+    bool plain = strategy(s2, t2) >= 0 && letters_at(s2, 2) == "DD";
+    if (t2 == 0 && !lens_hits_) plain = false;
+    if (s2 == 0 && x[0].kind == Kind::kLight && !rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) plain = false;
+    const bool distant = s2 == 1 && distant_of(t2) >= 0 && letters_at(0, 3) == "DSD";
+    const bool ortho = t2 == 1 && ortho_of(s2) >= 0 && letters_at(k, 3) == "DSD";
+    if (!plain && !distant && !ortho) continue;
+    const JoinKind kind = distant ? JoinKind::kDistant : ortho ? JoinKind::kOrtho : JoinKind::kPlain;
     // Re-split: light subpath x0 … x(s2-1), eye subpath xk … x(s2), with forward densities as
     // each side would have sampled them.
     for (int i = 0; i < s2; ++i) th.light[static_cast<std::size_t>(i)] = x[static_cast<std::size_t>(i)];
@@ -960,8 +1117,14 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
           specular(k - (j + 1)) ? 0.0f
                                 : pdf(&th.eye[static_cast<std::size_t>(j + 2)], th.eye[static_cast<std::size_t>(j + 1)],
                                       th.eye[static_cast<std::size_t>(j)]);
+    // Parallel beams (a distant light's, an orthographic sensor's) give their first vertex a
+    // density per area, as light_subpath() and eye_subpath() set it.
+    if (s2 >= 2 && th.light[0].pdf_fwd > 0.0f && light_pairs_[static_cast<std::size_t>(th.light[0].light)][1] == 'S')
+      th.light[1].pdf_fwd = parallel_jacobian(th.light[1], th.light[0], glm::normalize(th.light[1].p - th.light[0].p));
+    if (t2 >= 2 && cam_.pdf_pos > 0.0f && sensor_pair_[0] == 'S')
+      th.eye[1].pdf_fwd = parallel_jacobian(th.eye[1], th.eye[0], glm::normalize(th.eye[1].p - th.eye[0].p));
     prepare_joins(th, s2, t2);  // the ratios of the re-split subpaths
-    sum += mis_weight(th, s2, t2, nullptr, pack(letters));
+    sum += mis_weight(th, s2, t2, nullptr, pack(letters), nullptr, kind);
   }
   th.light = saved_light_eye.light;
   th.eye = saved_light_eye.eye;
@@ -972,9 +1135,11 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
   Sampler rng(o_.seed, pixel, pass);
+  rng.set_dimension(kEyeDims);
   const int batch = batch_of(pass, o_.batches);
   th.px = px;
   const int nt = eye_subpath(th, rng, px, py);
+  rng.set_dimension(kLightDims);
   const int ns = light_subpath(th, rng);
   th.ns = ns;
   th.nt = nt;
@@ -996,9 +1161,13 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
     const int s_hi = std::min(s_max, max_bounces_ + 2 - t);
     if (s_hi >= 0 && strategy(0, t) >= 0) connect<Connection::kEmitter>(th, rng, 0, t, batch);
     if (s_hi >= 1 && strategy(1, t) >= 0) connect<Connection::kNee>(th, rng, 1, t, batch);
+    if (s_hi >= 1 && distant_of(t) >= 0) connect<Connection::kDistant>(th, rng, 1, t, batch);
     for (int s = 2; s <= s_hi; ++s)
       if (strategy(s, t) >= 0) connect<Connection::kJoin>(th, rng, s, t, batch);
   }
+  if (has_connectors_ && nt >= 1)
+    for (int s = 1; s <= std::min(ns - (lens_end ? 1 : 0), max_bounces_ + 1); ++s)
+      if (ortho_of(s) >= 0) connect<Connection::kOrtho>(th, rng, s, 1, batch);
 }
 
 }  // namespace
@@ -1015,8 +1184,9 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
   Integrator integrator(*rs, *strategies, o, nullptr);
-  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}};
+  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
   th.images = &images;
+  th.connectors.resize(strategies->strategies.size());
   std::vector<MisCheck> out;
   for (int i = 0; i < samples; ++i) {
     const int px = i % rs->camera.width, py = (i / rs->camera.width) % rs->camera.height;
@@ -1059,9 +1229,10 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
       [&] {
         Integrator::Thread th{Histogram(layout, classifier),
                               std::vector<ClassImages::PixelSum>(static_cast<std::size_t>(out.images.width()), ClassImages::PixelSum(out.images)),
-                              {}, {}, 0, {}, {}};
+                              {}, {}, 0, {}, {}, {}};
         th.images = &out.images;
         th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
+        th.connectors.resize(strategies->strategies.size());
         return th;
       });
   const int w = rs->camera.width, h = rs->camera.height;
@@ -1093,6 +1264,21 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
     Result<bool> m = out.histogram.merge(th.hist);
     if (!m) return m.error();
     out.rays += th.rays;
+  }
+  // Connector statistics, in the profile's order (integer sums: the same for every thread count).
+  for (std::size_t i = 0; i < strategies->strategies.size(); ++i) {
+    const Strategy& st = strategies->strategies[i];
+    if (st.connector == ConnectorKind::kNone) continue;
+    ConnectorStats total{st.name, to_string(st.connector)};
+    for (const Integrator::Thread& th : locals) {
+      const ConnectorStats& c = th.connectors[i];
+      total.attempts += c.attempts;
+      total.successes += c.successes;
+      total.outside += c.outside;
+      total.occluded += c.occluded;
+      total.no_transport += c.no_transport;
+    }
+    out.connectors.push_back(total);
   }
   out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
