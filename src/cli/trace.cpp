@@ -14,6 +14,8 @@
 
 #include "cli/common.h"
 #include "cli/reach_common.h"
+#include <nlohmann/json.hpp>
+
 #include "io/atomic_file.h"
 #include "io/class_file.h"
 #include "io/histogram_json.h"
@@ -135,7 +137,21 @@ int run(const TraceArgs& a) {
   std::error_code ec;
   std::filesystem::create_directories(a.out, ec);
   if (ec) return report(make_error(ErrorCode::kBadFile, "cannot create the output folder " + a.out + ": " + ec.message()));
-  const std::string json_text = histogram_json_text(*rep);
+  // histogram.json, plus what each connector did ("connectors": [{strategy, connector, attempts,
+  // successes, failures {outside, occluded, no_transport}}] in the profile's order; absent when the
+  // profile has none).
+  nlohmann::ordered_json doc = to_json(*rep);
+  if (!out->connectors.empty()) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const ConnectorStats& c : out->connectors)
+      list.push_back({{"strategy", c.strategy},
+                      {"connector", c.connector},
+                      {"attempts", c.attempts},
+                      {"successes", c.successes},
+                      {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
+    doc["connectors"] = std::move(list);
+  }
+  const std::string json_text = doc.dump(2) + "\n";
   if (Result<bool> w = write_file_atomic(a.out + "/histogram.json", json_text); !w) return report(w.error());
   if (!a.no_images) {
     const std::vector<ImageLayer> layers = out->images.layers(out->spp_done ? 1.0 / static_cast<double>(out->spp_done) : 0.0);
@@ -167,6 +183,16 @@ int run(const TraceArgs& a) {
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << profile->name << ": " << (q ? to_string(q->verdict) : "?") << "\n";
+  }
+  if (!out->connectors.empty()) {
+    int width = 10;
+    for (const ConnectorStats& c : out->connectors) width = std::max(width, static_cast<int>(c.strategy.size()));
+    std::cout << "\n" << std::left << std::setw(width + 2) << "connectors" << std::right
+              << "  attempts  successes   outside  occluded  no transport\n";
+    for (const ConnectorStats& c : out->connectors)
+      std::cout << "  " << std::left << std::setw(width) << c.strategy << std::right << std::setw(10) << c.attempts
+                << std::setw(11) << c.successes << std::setw(10) << c.outside << std::setw(10) << c.occluded
+                << std::setw(14) << c.no_transport << "   (" << c.connector << ")\n";
   }
   std::cout << "\nmost important paths\n";
   for (std::size_t i = 0; i < rep->paths.size() && static_cast<int>(i) < a.top_paths; ++i) {
