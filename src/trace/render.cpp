@@ -25,6 +25,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/frame.h"
 #include "trace/render_scene.h"
@@ -107,72 +108,8 @@ void link(Vertex& v, const Vertex& pred) {
   v.wo = v.d2_wo > 0.0f ? e / std::sqrt(v.d2_wo) : vec3(0.0f);
 }
 
-// A full-path string L c0 … c(k+2) E packed: bit i is set when c_i is S, and the number of
-// scattering letters (k + 3) sits in the top byte. Every string the tracer forms packs: k + 3 is
-// at most kMaxVertices + 1 letters (max_bounces is clamped so).
-__extension__ typedef unsigned __int128 PathKey;
-constexpr int kLengthShift = 120;
-static_assert(kMaxVertices + 1 < kLengthShift);
-constexpr PathKey bit(int i) { return static_cast<PathKey>(1) << i; }
-constexpr PathKey letter_bit(char c, int i) { return c == 'S' ? bit(i) : 0; }
-int packed_length(PathKey key) { return static_cast<int>(key >> kLengthShift); }
-bool packed_is_d(PathKey key, int i) { return ((key >> i) & 1) == 0; }
-
-std::string unpack(PathKey key) {
-  const int n = packed_length(key);
-  std::string out(static_cast<std::size_t>(n) + 2, 'D');
-  out.front() = 'L';
-  out.back() = 'E';
-  for (int i = 0; i < n; ++i)
-    if (!packed_is_d(key, i)) out[static_cast<std::size_t>(i) + 1] = 'S';
-  return out;
-}
-PathKey pack(const std::string& letters) {  // "L c0 … E"
-  PathKey key = static_cast<PathKey>(letters.size() - 2) << kLengthShift;
-  for (std::size_t i = 1; i + 1 < letters.size(); ++i) key |= letter_bit(letters[i], static_cast<int>(i) - 1);
-  return key;
-}
-
-// Per-thread map from packed strings to histogram ids, so that recording a contribution hashes
-// two words instead of a string; Histogram::intern() runs once per new path and thread.
-class PathIds {
- public:
-  Histogram::PathId get(Histogram& hist, PathKey key) {
-    const std::size_t mask = slots_.size() - 1;
-    for (std::size_t i = hash(key) & mask;; i = (i + 1) & mask) {
-      Slot& slot = slots_[i];
-      if (slot.key == key) return slot.id;
-      if (slot.key == 0) {
-        const Histogram::PathId id = hist.intern(unpack(key));
-        slot = {key, id};
-        if (2 * ++used_ > slots_.size()) grow();
-        return id;
-      }
-    }
-  }
-
- private:
-  struct Slot {
-    PathKey key = 0;  // 0: empty (a real key has a nonzero length)
-    Histogram::PathId id = -1;
-  };
-  static std::size_t hash(PathKey key) {
-    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) ^ mix64(static_cast<std::uint64_t>(key >> 64))));
-  }
-  void grow() {
-    std::vector<Slot> old(slots_.size() * 2);
-    old.swap(slots_);
-    const std::size_t mask = slots_.size() - 1;
-    for (const Slot& slot : old) {
-      if (slot.key == 0) continue;
-      std::size_t i = hash(slot.key) & mask;
-      while (slots_[i].key != 0) i = (i + 1) & mask;
-      slots_[i] = slot;
-    }
-  }
-  std::vector<Slot> slots_ = std::vector<Slot>(256);
-  std::size_t used_ = 0;
-};
+using namespace accel;  // PathKey, PathIds
+static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
 
 // |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
 float abs_cos(const Vertex& v, const vec3& w) {
@@ -186,7 +123,9 @@ float abs_cos(const Vertex& v, const vec3& w) {
 
 class Integrator {
  public:
-  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl)
+  // `general_mis` (for tests) turns off the per-sample MIS sums, leaving the general recurrence.
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl,
+             bool general_mis = false)
       : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), classifier_(cl) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
@@ -216,7 +155,7 @@ class Integrator {
       has_connectors_ = has_connectors_ || distant_of_[i] >= 0 || ortho_of_[i] >= 0;
     }
     eye0_runs_ = (runs_mask_[1] >> 1) & 1;
-    all_runs_ = !has_connectors_;  // the per-sample sums below know plain joins only
+    all_runs_ = !has_connectors_ && !general_mis;  // the per-sample sums below know plain joins only
     for (std::size_t n = 1; n < runs_mask_.size(); ++n) {
       const std::uint64_t below = (std::uint64_t{1} << n) - 1;  // s2 < n: t2 >= 1
       all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
@@ -375,6 +314,11 @@ class Integrator {
     std::string out;
     full_path(th, s, t, nullptr, out);
     return out;
+  }
+  // The weight of connection (s, t) of the current subpaths, as the renderer computes it.
+  float own_weight(Thread& th, int s, int t) const {
+    prepare_joins(th, th.ns, th.nt);
+    return mis_weight(th, s, t, nullptr, path_key(th, s, t, nullptr));
   }
   // The same string as the renderer records it (packed, then spelled out).
   std::string packed_label(const Thread& th, int s, int t) const { return unpack(path_key(th, s, t, nullptr)); }
@@ -1184,6 +1128,7 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
   Integrator integrator(*rs, *strategies, o, nullptr);
+  const Integrator general(*rs, *strategies, o, nullptr, /*general_mis=*/true);
   Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
   th.images = &images;
   th.connectors.resize(strategies->strategies.size());
@@ -1199,7 +1144,9 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
         if (strategies->find(s, t) < 0) continue;
         const float sum = integrator.weight_sum_if_valid(th, s, t);
         if (sum < 0.0f) continue;  // not a path this connection forms
-        out.push_back({integrator.label(th, s, t), s, t, sum, integrator.packed_label(th, s, t)});
+        const float weight = integrator.own_weight(th, s, t);
+        const float weight_general = general.own_weight(th, s, t);
+        out.push_back({integrator.label(th, s, t), s, t, sum, weight, weight_general, integrator.packed_label(th, s, t)});
       }
   }
   return out;
