@@ -825,18 +825,32 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     to_pixels(raster, &rx, &ry);
     contrib = qs->beta * we;
     splat = true;
-  } else if constexpr (C == Connection::kSplat) {
-    // --- splat: connect qs to a fresh sensor point ---
-    if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no DD join
+  } else if constexpr (C == Connection::kSplat || C == Connection::kOrtho) {
+    // --- a light vertex joined to a sensor point: a fresh one (the splat, t = 1) or, for
+    //     ortho-projection, the film point on the line of sight through qs ---
     if (qs->kind == Kind::kLens || !qs->finite) return;
-    const std::optional<EndpointConnection> c = connect_finite(cam_.params, rng.get2d(), qs->p);
-    if (!c) return;
+    std::optional<EndpointConnection> c;
+    if constexpr (C == Connection::kSplat) {
+      if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no DD join
+      c = connect_finite(cam_.params, rng.get2d(), qs->p);
+      if (!c) return;
+    } else {
+      const auto* film = std::get_if<OrthographicParams>(&cam_.params);
+      if (film == nullptr) return;
+      ++stats->attempts;
+      c = pathex::connect(*film, qs->p);
+      if (!c) {
+        ++stats->outside;
+        return;
+      }
+      chain_s = bit(s + 1);  // c(k+1), the sensor's direction
+    }
     sampled = Vertex{};
     sampled.kind = Kind::kCamera;
     sampled.p = c->position;
     sampled.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c->normal;  // a pinhole is a point
     sampled.ns = sampled.n;
-    sampled.letter = 'D';
+    sampled.letter = C == Connection::kSplat ? 'D' : sensor_pair_[0];
     sampled.pos_letter = sensor_pair_[1];
     sampled.pdf_fwd = cam_.pdf_pos;
     const vec3 w = c->wi;  // from qs to the sensor
@@ -849,23 +863,36 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     join.w = w;
     join.d2 = c->distance * c->distance;
     joined = true;
-    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);
+    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);  // weight: We cos / d² (splat), We (film)
     ends = {qs, &sampled};
     splat = true;
-  } else if constexpr (C == Connection::kNee) {
-    // --- next-event estimation: a fresh light sample ---
+  } else if constexpr (C == Connection::kNee || C == Connection::kDistant) {
+    // --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
+    //     for distant-projection, the aperture point on the line through pt against the light ---
     if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
     const std::size_t li = pick_light(rng.get1d());
-    const glm::vec2 up = rng.get2d();
     const RenderLight& l = rs_.lights[li];
-    if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
-    const std::optional<EndpointConnection> c = pathex::connect(l.params, sample_point(l, up), pt->p);
-    if (!c) return;
+    std::optional<EndpointConnection> c;
+    if constexpr (C == Connection::kNee) {
+      const glm::vec2 up = rng.get2d();
+      if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
+      c = pathex::connect(l.params, sample_point(l, up), pt->p);
+      if (!c) return;
+    } else {
+      if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
+      ++stats->attempts;
+      c = pathex::connect(l.params, SurfacePoint{}, pt->p);
+      if (!c) {
+        ++stats->outside;
+        return;
+      }
+      chain_s = bit(1);  // c1, the light's direction
+    }
     sampled = Vertex{};
     sampled.kind = Kind::kLight;
     sampled.light = static_cast<int>(li);
     sampled.pos_letter = light_pairs_[li][0];
-    sampled.letter = 'D';
+    sampled.letter = C == Connection::kNee ? 'D' : light_pairs_[li][1];
     sampled.p = c->position;
     sampled.n = c->normal;
     sampled.ns = sampled.n;
@@ -876,70 +903,8 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     join.w = -w;  // w runs from pt to the light, the join's from the light to pt
     join.d2 = c->distance * c->distance;
     joined = true;
-    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;
+    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;  // weight: Le cos / (p d²), I / d², E
     ends = {pt, &sampled};
-  } else if constexpr (C == Connection::kDistant) {
-    // --- distant-projection: the aperture point on the line through pt against the light ---
-    if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
-    const std::size_t li = pick_light(rng.get1d());
-    const RenderLight& l = rs_.lights[li];
-    if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
-    ++stats->attempts;
-    const std::optional<EndpointConnection> c = pathex::connect(l.params, SurfacePoint{}, pt->p);
-    if (!c) {
-      ++stats->outside;
-      return;
-    }
-    sampled = Vertex{};
-    sampled.kind = Kind::kLight;
-    sampled.light = static_cast<int>(li);
-    sampled.pos_letter = light_pairs_[li][0];
-    sampled.letter = light_pairs_[li][1];
-    sampled.p = c->position;
-    sampled.n = c->normal;
-    sampled.ns = sampled.n;
-    sampled.pdf_fwd = light_pick_ * l.pdf_pos;
-    const vec3 w = c->wi;  // from pt towards the light
-    const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
-                             pt->wo, w, pt->ns, pt->n, &join.at_pt);
-    join.w = -w;
-    join.d2 = c->distance * c->distance;
-    joined = true;
-    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;  // weight: E
-    ends = {pt, &sampled};
-    chain_s = bit(1);  // c1, the light's direction
-  } else if constexpr (C == Connection::kOrtho) {
-    // --- ortho-projection: the film point on the line of sight through qs ---
-    if (qs->kind == Kind::kLens || !qs->finite) return;
-    const auto* film = std::get_if<OrthographicParams>(&cam_.params);
-    if (film == nullptr) return;
-    ++stats->attempts;
-    const std::optional<EndpointConnection> c = pathex::connect(*film, qs->p);
-    if (!c) {
-      ++stats->outside;
-      return;
-    }
-    sampled = Vertex{};
-    sampled.kind = Kind::kCamera;
-    sampled.p = c->position;
-    sampled.n = c->normal;
-    sampled.ns = sampled.n;
-    sampled.letter = sensor_pair_[0];
-    sampled.pos_letter = sensor_pair_[1];
-    sampled.pdf_fwd = cam_.pdf_pos;
-    const vec3 w = c->wi;  // from qs towards the film
-    to_pixels(c->raster, &rx, &ry);
-    vec3 fq;
-    if (qs->kind == Kind::kLight) fq = vec3(directional_emission(rs_.lights[static_cast<std::size_t>(qs->light)].params, qs->n, w));
-    else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                        qs->wo, w, qs->ns, qs->n, &join.at_qs);
-    join.w = w;
-    join.d2 = c->distance * c->distance;
-    joined = true;
-    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);  // weight: We = 1 / film area
-    ends = {qs, &sampled};
-    splat = true;
-    chain_s = bit(s + 1);  // c(k+1), the sensor's direction
   } else {
     // --- a shadow ray between y(s-1) and z(t-1) ---
     if (qs->kind == Kind::kLens || pt->kind != Kind::kSurface || qs->kind != Kind::kSurface) return;
