@@ -257,8 +257,8 @@ class Integrator {
     }
   }
   // The packed full-path string of connection (s, t), as full_path() spells it.
-  // A projection connector's chain keeps its S letter (`chain_s`, the bit of the Dirac direction).
-  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled, PathKey chain_s = 0) const {
+  // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
+  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
     PathKey m = 0;
     if (s > 0) {
       m = th.light_mask & (bit(s + 1) - 1);
@@ -266,7 +266,7 @@ class Integrator {
     }
     if (t > 0) m |= th.eye_masks[static_cast<std::size_t>(t)] << (s + 1);
     m &= ~(bit(s) | bit(s + 1));  // the join letters
-    return m | chain_s | static_cast<PathKey>(s + t + 2) << kLengthShift;
+    return m | static_cast<PathKey>(s + t + 2) << kLengthShift;
   }
 
   // The profile's strategy that runs (s, t), or -1.
@@ -732,10 +732,13 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   // count as 1 here; their strategies are excluded by letter.
   double sum = 0.0;
   const auto runs = [&](int s2) { return static_cast<double>((others >> s2) & 1); };
-  // The term of strategy s2 for density ratio ri (a connector's carries its factor).
+  // The term of strategy s2 for density ratio ri (a connector's carries its factor; profiles
+  // without connectors never take the branch).
   const auto term = [&](int s2, double ri) {
-    const double w2 = s2 == 1 && conn_w2_first != 0.0 ? conn_w2_first : s2 == n - 1 && conn_w2_last != 0.0 ? conn_w2_last : 1.0;
-    return ri * ri * w2;
+    double r2 = ri * ri;
+    if (has_connectors_) [[unlikely]]
+      r2 *= s2 == 1 && conn_w2_first != 0.0 ? conn_w2_first : s2 == n - 1 && conn_w2_last != 0.0 ? conn_w2_last : 1.0;
+    return r2;
   };
   if (all_runs_) {
     // Each side: the join's two ratios, then the subpath's fixed part from prepare_joins().
@@ -930,7 +933,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   }
   const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee || kind != JoinKind::kPlain ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
-  const PathKey key = path_key(th, s, t, fresh, chain_s);
+  const PathKey key = path_key(th, s, t, fresh) | chain_s;
   const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr, kind), strategy_index, batch, splat,
                   stats != nullptr, rx, ry, th.px};
   if constexpr (C == Connection::kEmitter || C == Connection::kLens) {
