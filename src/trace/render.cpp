@@ -75,6 +75,7 @@ struct Vertex {
   bool finite = true;    // can be a join end: not a surface, or a surface with a finite BSDF part
   vec3 p{0.0f};
   vec3 n{0.0f};          // geometric normal (unit); zero for points (point, spot, pinhole, laser)
+  vec3 err{0.0f};        // bound on p's rounding error (Hit::error): how far a ray leaving p is offset
   vec3 ns{0.0f};         // shading normal
   vec3 beta{1.0f};       // throughput up to and including this vertex
   vec3 wo{0.0f};         // unit direction to the vertex before it on its subpath (zero for the first)
@@ -554,7 +555,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   while (count < max_vertices) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, HitDetail::kNoUv);  // n is zero for points: no offset
+    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, HitDetail::kNoUv);  // zero for points: no offset
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
       const float denom = glm::dot(d, cam_.forward);
@@ -583,6 +584,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.kind = Kind::kSurface;
     v.p = hit->position;
     v.n = hit->normal;
+    v.err = hit->error;
     v.ns = hit->shading_normal;
     v.shape = hit->shape;
     v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;
@@ -691,6 +693,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
       const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, up);
       y0.p = ss.position;
       y0.n = ss.normal;
+      y0.err = ss.error;
       vec3 local = sample_cosine_hemisphere(ud);
       float sign = 1.0f;
       if (l.two_sided && rng.get1d() < 0.5f) sign = -1.0f;
@@ -720,6 +723,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
     case EmitterKind::kDistant: {
       y0.p = l.ap_corner + up.x * l.ap_edge1 + up.y * l.ap_edge2;
       y0.n = l.ap_normal;
+      y0.err = parallelogram_error(l.ap_corner, l.ap_edge1, l.ap_edge2);
       d = l.direction;
       beta1 = l.power * std::fabs(glm::dot(l.ap_normal, d)) / (light_pick_ * pdf_pos);
       y0.beta = beta1;
@@ -968,6 +972,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
       const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, up);
       sampled.p = ss.position;
       sampled.n = ss.normal;
+      sampled.err = ss.error;
       pdf_pos = light_pdf_pos(l);
     } else {
       sampled.p = l.position;
@@ -1018,7 +1023,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     // The weight is known before the shadow ray is: the ray joins the thread's batch, and the
     // contribution is recorded if the batch finds the segment unobstructed.
     ++th.rays;
-    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, ends[0]->p, ends[0]->n, ends[1]->p, ends[1]->n))] = r;
+    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, ends[0]->p, ends[0]->n, ends[0]->err, ends[1]->p, ends[1]->n, ends[1]->err))] = r;
     if (th.shadow.full()) trace_shadows(th);
   }
 }

@@ -59,7 +59,6 @@ struct RenderScene {
   std::vector<int> light_of_shape;           // index into lights, -1 for non-emitters
   std::vector<RenderLight> lights;
   RenderCamera camera;
-  float scene_extent = 1.0f;
 };
 
 Result<RenderScene> make_render_scene(const Scene& scene);
