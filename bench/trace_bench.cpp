@@ -60,12 +60,12 @@ double cpu_seconds() {
 // exactly `count` rays: camera rays through random pixels, each followed by up to three random
 // bounces (comparable coherence), the minimum of work around each ray. Returns the hits.
 std::uint64_t plain_embree_loop(const RenderScene& rs, std::uint64_t count, std::uint64_t seed) {
-  const RenderCamera& cam = rs.camera;
+  const PinholeParams& cam = std::get<PinholeParams>(rs.camera.params);  // the Cornell box's
   std::uint64_t rays = 0, hits = 0;
   for (std::uint64_t path = 0; rays < count; ++path) {
     Sampler rng(seed, path, 0);
     const glm::vec2 u = rng.get2d();
-    const float sx = (2.0f * u.x - 1.0f) * cam.tan_x, sy = (1.0f - 2.0f * u.y) * cam.tan_y;
+    const float sx = (2.0f * u.x - 1.0f) * cam.tan_half_x, sy = (1.0f - 2.0f * u.y) * cam.tan_half_y;
     glm::vec3 o = cam.position, d = glm::normalize(cam.forward + sx * cam.right + sy * cam.up);
     for (int bounce = 0; bounce < 4 && rays < count; ++bounce) {
       RTCRayHit rh{};

@@ -14,6 +14,8 @@
 
 #include "cli/common.h"
 #include "cli/reach_common.h"
+#include <nlohmann/json.hpp>
+
 #include "io/atomic_file.h"
 #include "io/class_file.h"
 #include "io/histogram_json.h"
@@ -159,7 +161,21 @@ int run(const TraceArgs& a) {
   if (!rep) return report(rep.error());
 
   // --- outputs: one set, whole or not at all, shielded from signals (io/output_set.h) ---
-  const std::string json_text = histogram_json_text(*rep);
+  // histogram.json, plus what each connector did ("connectors": [{strategy, connector, attempts,
+  // successes, failures {outside, occluded, no_transport}}] in the profile's order; absent when the
+  // profile has none).
+  nlohmann::ordered_json doc = to_json(*rep);
+  if (!out->connectors.empty()) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const ConnectorStats& c : out->connectors)
+      list.push_back({{"strategy", c.strategy},
+                      {"connector", c.connector},
+                      {"attempts", c.attempts},
+                      {"successes", c.successes},
+                      {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
+    doc["connectors"] = std::move(list);
+  }
+  const std::string json_text = doc.dump(2) + "\n";
   {
     const SignalShield shield;
     Result<bool> written = out_set->write([&](const std::string& dir) -> Result<bool> {
@@ -196,6 +212,16 @@ int run(const TraceArgs& a) {
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << profile->name << ": " << (q ? to_string(q->verdict) : "?") << "\n";
+  }
+  if (!out->connectors.empty()) {
+    int width = 10;
+    for (const ConnectorStats& c : out->connectors) width = std::max(width, static_cast<int>(c.strategy.size()));
+    std::cout << "\n" << std::left << std::setw(width + 2) << "connectors" << std::right
+              << "  attempts  successes   outside  occluded  no transport\n";
+    for (const ConnectorStats& c : out->connectors)
+      std::cout << "  " << std::left << std::setw(width) << c.strategy << std::right << std::setw(10) << c.attempts
+                << std::setw(11) << c.successes << std::setw(10) << c.outside << std::setw(10) << c.occluded
+                << std::setw(14) << c.no_transport << "   (" << c.connector << ")\n";
   }
   std::cout << "\nmost important paths\n";
   for (std::size_t i = 0; i < rep->paths.size() && static_cast<int>(i) < a.top_paths; ++i) {
