@@ -88,6 +88,7 @@ struct Vertex {
   bool finite = true;    // can be a join end: not a surface, or a surface with a finite BSDF part
   vec3 p{0.0f};
   vec3 n{0.0f};          // geometric normal (unit); zero for points (point, spot, pinhole, laser)
+  vec3 err{0.0f};        // bound on p's rounding error (Hit::error): how far a ray leaving p is offset
   vec3 ns{0.0f};         // shading normal
   vec3 beta{1.0f};       // throughput up to and including this vertex
   vec3 wo{0.0f};         // unit direction to the vertex before it on its subpath (zero for the first)
@@ -350,10 +351,19 @@ class Integrator {
   std::size_t pick_light(float u) const {
     return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(u * static_cast<float>(rs_.lights.size())));
   }
-  SurfacePoint sample_point(const RenderLight& l, glm::vec2 u2) const {
+  // *error: the point's rounding-error bound (SurfaceSample::error), which offsets rays leaving it.
+  SurfacePoint sample_point(const RenderLight& l, glm::vec2 u2, vec3* error) const {
+    *error = aperture_error(l);
     if (!l.is_area()) return {};
     const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, u2);
+    *error = ss.error;
     return {ss.position, ss.normal, l.pdf_pos};
+  }
+  // The error bound of a distant light's aperture points (zero for other lights): the aperture is
+  // no shape, but it may coincide with one (a window pane).
+  static vec3 aperture_error(const RenderLight& l) {
+    const auto* d = std::get_if<DistantLightParams>(&l.params);
+    return d ? parallelogram_error(d->corner, d->edge1, d->edge2) : vec3(0.0f);
   }
   // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
   void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
@@ -482,7 +492,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   while (count < max_vertices) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, HitDetail::kNoUv);  // n is zero for points: no offset
+    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, HitDetail::kNoUv);  // zero for points: no offset
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
       const std::optional<EndpointConnection> lens = hit_lens(cam_.params, o, d);
@@ -507,6 +517,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.kind = Kind::kSurface;
     v.p = hit->position;
     v.n = hit->normal;
+    v.err = hit->error;
     v.ns = hit->shading_normal;
     v.shape = hit->shape;
     v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;
@@ -585,7 +596,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   y0.light = static_cast<int>(li);
   y0.pos_letter = light_pairs_[li][0];
   y0.letter = light_pairs_[li][1];
-  const SurfacePoint x = sample_point(l, rng.get2d());
+  const SurfacePoint x = sample_point(l, rng.get2d(), &y0.err);
   const std::optional<EndpointRay> r = sample_ray(l.params, x, rng.get2d());
   y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
@@ -876,10 +887,11 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     const std::size_t li = pick_light(rng.get1d());
     const RenderLight& l = rs_.lights[li];
     std::optional<EndpointConnection> c;
+    vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
     if constexpr (C == Connection::kNee) {
       const glm::vec2 up = rng.get2d();
       if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
-      c = pathex::connect(l.params, sample_point(l, up), pt->p);
+      c = pathex::connect(l.params, sample_point(l, up, &err), pt->p);
       if (!c) return;
     } else {
       if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
@@ -889,6 +901,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
         ++stats->outside;
         return;
       }
+      err = aperture_error(l);
       chain_s = bit(1);  // c1, the light's direction
     }
     sampled = Vertex{};
@@ -898,6 +911,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     sampled.letter = C == Connection::kNee ? 'D' : light_pairs_[li][1];
     sampled.p = c->position;
     sampled.n = c->normal;
+    sampled.err = err;
     sampled.ns = sampled.n;
     sampled.pdf_fwd = light_pick_ * l.pdf_pos;
     const vec3 w = c->wi;  // from pt to the light
@@ -942,7 +956,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     // The weight is known before the shadow ray is: the ray joins the thread's batch, and the
     // contribution is recorded if the batch finds the segment unobstructed.
     ++th.rays;
-    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, ends[0]->p, ends[0]->n, ends[1]->p, ends[1]->n))] = r;
+    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, ends[0]->p, ends[0]->n, ends[0]->err, ends[1]->p, ends[1]->n, ends[1]->err))] = r;
     if (th.shadow.full()) trace_shadows(th);
   }
 }
