@@ -184,7 +184,7 @@ void BM_ShadowRays(benchmark::State& state) {
   Result<RenderScene> rs = make_render_scene(cornell());
   const EmbreeScene& es = *rs->geometry;
   struct Segment {
-    glm::vec3 a, na, b, nb;
+    glm::vec3 a, na, ea, b, nb, eb;
   };
   std::vector<Segment> segments;
   std::mt19937 pick(3);
@@ -193,17 +193,17 @@ void BM_ShadowRays(benchmark::State& state) {
   for (int i = 0; i < 65536; ++i) {
     const SurfaceSample a = es.sample_shape(static_cast<int>(pick() % shapes), {u01(pick), u01(pick)});
     const SurfaceSample b = es.sample_shape(static_cast<int>(pick() % shapes), {u01(pick), u01(pick)});
-    segments.push_back({a.position, a.normal, b.position, b.normal});
+    segments.push_back({a.position, a.normal, a.error, b.position, b.normal, b.error});
   }
   std::vector<double> ratios;
   std::uint64_t visible_single = 0, visible_batched = 0;
   OcclusionBatch batch;
   for (auto _ : state) {
     const double t0 = cpu_seconds();
-    for (const Segment& g : segments) visible_single += es.visible(g.a, g.na, g.b, g.nb);
+    for (const Segment& g : segments) visible_single += es.visible(g.a, g.na, g.ea, g.b, g.nb, g.eb);
     const double t1 = cpu_seconds();
     for (const Segment& g : segments) {
-      batch.add(es, g.a, g.na, g.b, g.nb);
+      batch.add(es, g.a, g.na, g.ea, g.b, g.nb, g.eb);
       if (!batch.full()) continue;
       batch.trace(es);
       for (int lane = 0; lane < batch.size(); ++lane) visible_batched += batch.visible(lane);

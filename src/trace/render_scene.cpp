@@ -11,7 +11,6 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
   Result<std::unique_ptr<EmbreeScene>> geometry = EmbreeScene::build(scene);
   if (!geometry) return geometry.error();
   rs.geometry = std::move(*geometry);
-  rs.scene_extent = rs.geometry->extent();
   rs.light_of_shape.assign(scene.shapes.size(), -1);
   for (std::size_t i = 0; i < scene.shapes.size(); ++i) {
     const Shape& s = scene.shapes[i];

@@ -53,7 +53,6 @@ struct RenderScene {
   std::vector<int> light_of_shape;           // index into lights, -1 for non-emitters
   std::vector<RenderLight> lights;
   RenderSensor camera;
-  float scene_extent = 1.0f;
 };
 
 Result<RenderScene> make_render_scene(const Scene& scene);
