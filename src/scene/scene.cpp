@@ -387,6 +387,15 @@ Result<MeshShape> load_obj_mesh(const std::string& path) {
       mesh.triangles.emplace_back(static_cast<unsigned>(shape.mesh.indices[i].vertex_index),
                                   static_cast<unsigned>(shape.mesh.indices[i + 1].vertex_index),
                                   static_cast<unsigned>(shape.mesh.indices[i + 2].vertex_index));
+  // check_obj and tinyobjloader split some bytes differently (a NUL, a lone carriage return): a
+  // face tinyobjloader kept may then name a vertex it did not read (found by fuzz/obj_fuzz.cpp).
+  for (const glm::uvec3& t : mesh.triangles)
+    if (std::max(t.x, std::max(t.y, t.z)) >= mesh.positions.size()) {
+      Error e = make_error(ErrorCode::kBadFile, "a face refers to a vertex that was not read; expected plain text lines "
+                                                "(no NUL bytes or lone carriage returns)");
+      e.where = path;
+      return e;
+    }
   return mesh;
 }
 
