@@ -6,25 +6,53 @@
 
 namespace pathex::cli {
 
+const CLI::Validator& non_negative() {
+  static const CLI::Validator v(
+      [](std::string& value) -> std::string {
+        const std::size_t first = value.find_first_not_of(" \t");
+        if (first != std::string::npos && value[first] == '-')
+          return "expected a non-negative integer, got '" + value + "'";
+        return "";
+      },
+      /*validator_desc=*/"", /*validator_name=*/"non-negative");
+  return v;
+}
+
 void add_limit_options(CLI::App* app, Limits* limits) {
   app->add_option("--max-states", limits->max_states, "Largest automaton (NFA or DFA states) to build")
-      ->capture_default_str()->group("Limits");
+      ->capture_default_str()->group("Limits")->check(non_negative());
   app->add_option("--max-depth", limits->max_depth, "Deepest nesting of groups and operators")
       ->capture_default_str()->group("Limits");
   app->add_option("--max-repeat", limits->max_repeat, "Largest count in {n}, {n,} and {n,m}")
       ->capture_default_str()->group("Limits");
   app->add_option("--max-length", limits->max_length, "Longest full-path string accepted as input")
-      ->capture_default_str()->group("Limits");
+      ->capture_default_str()->group("Limits")->check(non_negative());
 }
 
 void add_notation_options(CLI::App* app, NotationOptions* n) {
   app->add_option("--notation", n->notation, "full (L c0 c1 … E) or heckbert (L w E, one letter per interior vertex)")
       ->check(CLI::IsMember({"full", "heckbert"}))->capture_default_str();
-  app->add_option("--light", n->lights, "Light types for Heckbert notation: area, distant, point, laser (default all)")
-      ->delimiter(',')->allow_extra_args(false);
-  app->add_option("--sensor", n->sensors,
-                  "Sensor types for Heckbert notation: lens, pinhole, orthographic, spotmeter (default all)")
-      ->delimiter(',')->allow_extra_args(false);
+  // The type names list the choices ("LIST:{area,distant,point,laser}"): --help shows them and
+  // the generated bash completion offers them.
+  std::string lights, sensors;
+  for (LightType t : kAllLightTypes) lights += (lights.empty() ? "" : ",") + to_string(t);
+  for (SensorType t : kAllSensorTypes) sensors += (sensors.empty() ? "" : ",") + to_string(t);
+  app->add_option("--light", n->lights, "Light types for Heckbert notation, one comma-separated list (default all)")
+      ->delimiter(',')->allow_extra_args(false)->type_name("LIST:{" + lights + "}");
+  app->add_option("--sensor", n->sensors, "Sensor types for Heckbert notation, one comma-separated list (default all)")
+      ->delimiter(',')->allow_extra_args(false)->type_name("LIST:{" + sensors + "}");
+}
+
+std::optional<std::string> misused_list_option(int argc, char** argv) {
+  for (int i = 1; i + 2 < argc; ++i) {
+    const std::string option = argv[i], next = argv[i + 2];
+    const bool light = option == "--light" && light_type_from_string(next);
+    const bool sensor = option == "--sensor" && sensor_type_from_string(next);
+    if (light || sensor)
+      return option + " takes one comma-separated list, such as " + option + " " + argv[i + 1] + "," + next +
+             "; '" + next + "' after it would be read as an expression";
+  }
+  return std::nullopt;
 }
 
 Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limits) {

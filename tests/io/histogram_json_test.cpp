@@ -67,8 +67,9 @@ void expect_same_estimate(const Estimate& a, const Estimate& b) {
 TEST(HistogramJson, HasTheDocumentedKeysInOrder) {
   Fixture f;
   const json doc = to_json(f.report(shard(0, 40)));
-  EXPECT_EQ(keys(doc), (std::vector<std::string>{"scene", "renderer", "spp", "seed", "threads", "time_s", "complete",
-                                                  "nonfinite_samples", "total", "classes", "paths"}));
+  EXPECT_EQ(keys(doc), (std::vector<std::string>{"scene", "renderer", "spp", "spp_requested", "seed", "threads",
+                                                  "time_s", "complete", "nonfinite_samples", "distinct_paths",
+                                                  "max_paths", "total", "classes", "paths"}));
   EXPECT_EQ(doc["scene"], "scenes/cornell.json");
   EXPECT_EQ(doc["renderer"], "bdpt");
   EXPECT_EQ(doc["spp"], 64);
