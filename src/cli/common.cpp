@@ -2,6 +2,7 @@
 
 #include <iostream>
 
+#include "classify/notation_hint.h"
 #include "io/class_file.h"
 
 namespace pathex::cli {
@@ -30,16 +31,18 @@ void add_limit_options(CLI::App* app, Limits* limits) {
 }
 
 void add_notation_options(CLI::App* app, NotationOptions* n) {
-  app->add_option("--notation", n->notation, "full (L c0 c1 … E) or heckbert (L w E, one letter per interior vertex)")
-      ->check(CLI::IsMember({"full", "heckbert"}))->capture_default_str();
+  app->add_option("--notation", n->notation,
+                  "full (L c0 c1 … E), heckbert (L w E, one letter per interior vertex) or lpe (OSL light path "
+                  "expression, camera first: C<RD>L)")
+      ->check(CLI::IsMember({"full", "heckbert", "lpe"}))->capture_default_str();
   // The type names list the choices ("LIST:{area,distant,point,laser}"): --help shows them and
   // the generated bash completion offers them.
   std::string lights, sensors;
   for (LightType t : kAllLightTypes) lights += (lights.empty() ? "" : ",") + to_string(t);
   for (SensorType t : kAllSensorTypes) sensors += (sensors.empty() ? "" : ",") + to_string(t);
-  app->add_option("--light", n->lights, "Light types for Heckbert notation, one comma-separated list (default all)")
+  app->add_option("--light", n->lights, "Light types for Heckbert and LPE notation, one comma-separated list (default all)")
       ->delimiter(',')->allow_extra_args(false)->type_name("LIST:{" + lights + "}");
-  app->add_option("--sensor", n->sensors, "Sensor types for Heckbert notation, one comma-separated list (default all)")
+  app->add_option("--sensor", n->sensors, "Sensor types for Heckbert and LPE notation, one comma-separated list (default all)")
       ->delimiter(',')->allow_extra_args(false)->type_name("LIST:{" + sensors + "}");
 }
 
@@ -58,7 +61,7 @@ std::optional<std::string> misused_list_option(int argc, char** argv) {
 Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limits) {
   ClassOptions o;
   o.limits = limits;
-  o.notation = n.notation == "heckbert" ? Notation::kHeckbert : Notation::kFull;
+  o.notation = notation_from_string(n.notation).value_or(Notation::kFull);
   if (!n.lights.empty()) {
     o.ends.lights.clear();
     for (const std::string& s : n.lights) {
@@ -78,7 +81,7 @@ Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limit
     }
   }
   if ((!n.lights.empty() || !n.sensors.empty()) && o.notation == Notation::kFull)
-    return make_error(ErrorCode::kUsage, "--light and --sensor apply to --notation heckbert only");
+    return make_error(ErrorCode::kUsage, "--light and --sensor apply to --notation heckbert and lpe only");
   return o;
 }
 
@@ -90,7 +93,14 @@ Result<PathClass> compile_cli_expression(const std::string& expr, const Notation
     Result<bool> r = read_class_file(classes_file, *opts, table);
     if (!r) return r.error();
   }
-  return compile_class(expr, *opts, table);
+  Result<PathClass> pc = compile_class(expr, *opts, table);
+  if (pc) print_notation_hint(expr, *pc, *opts, table);
+  return pc;
+}
+
+void print_notation_hint(const std::string& expr, const PathClass& pc, const ClassOptions& options,
+                         const ClassTable* table) {
+  if (std::optional<std::string> h = heckbert_hint(expr, pc, options, table)) std::cerr << "pathex: hint: " << *h << "\n";
 }
 
 int report(const Error& e) {

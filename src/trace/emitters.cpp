@@ -221,12 +221,12 @@ glm::vec3 power(const SpotLightParams& p) {
 
 // --- distant light through an aperture ---
 
+float aperture_area(const DistantLightParams& p) { return glm::length(glm::cross(p.edge1, p.edge2)); }
+
 namespace {
 glm::vec3 aperture_normal(const DistantLightParams& p) {
   return glm::normalize(glm::cross(p.edge1, p.edge2));
 }
-float aperture_area(const DistantLightParams& p) { return glm::length(glm::cross(p.edge1, p.edge2)); }
-
 // Parallelogram coordinates (a, b) of a point in the aperture's plane.
 glm::vec2 aperture_coords(const DistantLightParams& p, const glm::vec3& x) {
   const glm::vec3 d = x - p.corner;
@@ -537,6 +537,109 @@ std::optional<EndpointRay> sample_ray(const SpotMeterParams& p) {
 RayPdf pdf_ray(const SpotMeterParams&) { return {1.0f, 1.0f, true, true}; }
 
 std::optional<EndpointConnection> connect(const SpotMeterParams&, const glm::vec3&) {
+  return std::nullopt;
+}
+
+// --- the handles ---
+
+namespace {
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+}  // namespace
+
+Letter pos_letter(const LightParams& l) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kPosLetter; }, l);
+}
+Letter dir_letter(const LightParams& l) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kDirLetter; }, l);
+}
+Letter pos_letter(const SensorParams& s) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kPosLetter; }, s);
+}
+Letter dir_letter(const SensorParams& s) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kDirLetter; }, s);
+}
+
+std::optional<EndpointRay> sample_ray(const LightParams& l, const SurfacePoint& x, glm::vec2 u) {
+  return std::visit(Overloaded{[&](const AreaLightParams& p) { return sample_ray(p, x, u); },
+                               [&](const LaserParams& p) { return sample_ray(p); },
+                               [&](const auto& p) { return sample_ray(p, u); }},
+                    l);
+}
+
+RayPdf pdf_ray(const LightParams& l, const SurfacePoint& x, const glm::vec3& direction) {
+  return std::visit(Overloaded{[&](const AreaLightParams& p) { return pdf_ray(p, x, direction); },
+                               [&](const DistantLightParams& p) { return pdf_ray(p, x.position); },
+                               [&](const LaserParams& p) { return pdf_ray(p); },
+                               [&](const auto& p) { return pdf_ray(p, direction); }},
+                    l);
+}
+
+std::optional<EndpointConnection> connect(const LightParams& l, const SurfacePoint& x,
+                                          const glm::vec3& ref) {
+  return std::visit(Overloaded{[&](const AreaLightParams& p) { return connect(p, x, ref); },
+                               [&](const auto& p) { return connect(p, ref); }},
+                    l);
+}
+
+glm::vec3 spatial_emission(const LightParams& l) {
+  return std::visit(Overloaded{[](const AreaLightParams& p) { return p.radiance; },
+                               [](const PointLightParams& p) { return p.intensity; },
+                               [](const SpotLightParams& p) { return p.intensity; },
+                               [](const DistantLightParams& p) { return p.irradiance; },
+                               [](const LaserParams& p) { return p.power; }},
+                    l);
+}
+
+float directional_emission(const LightParams& l, const glm::vec3& n, const glm::vec3& w) {
+  return std::visit(
+      Overloaded{[&](const AreaLightParams& p) { return is_black(emitted_radiance(p, n, w)) ? 0.0f : 1.0f; },
+                 [](const PointLightParams&) { return 1.0f; },
+                 [&](const SpotLightParams& p) { return spot_falloff(p, glm::dot(w, p.axis)); },
+                 [](const auto&) { return 0.0f; }},
+      l);
+}
+
+std::optional<EndpointRay> sample_ray(const SensorParams& s, glm::vec2 raster, glm::vec2 u_lens) {
+  return std::visit(Overloaded{[&](const ThinLensParams& p) { return sample_ray(p, raster, u_lens); },
+                               [&](const SpotMeterParams& p) { return sample_ray(p); },
+                               [&](const auto& p) { return sample_ray(p, raster); }},
+                    s);
+}
+
+RayPdf pdf_ray(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction) {
+  return std::visit(Overloaded{[&](const PinholeParams& p) { return pdf_ray(p, direction); },
+                               [&](const ThinLensParams& p) { return pdf_ray(p, origin, direction); },
+                               [&](const OrthographicParams& p) { return pdf_ray(p, origin); },
+                               [&](const SpotMeterParams& p) { return pdf_ray(p); }},
+                    s);
+}
+
+std::optional<EndpointConnection> connect_finite(const SensorParams& s, glm::vec2 u_lens,
+                                                 const glm::vec3& ref) {
+  return std::visit(
+      Overloaded{[&](const PinholeParams& p) { return connect(p, ref); },
+                 [&](const ThinLensParams& p) { return connect(p, u_lens, ref); },
+                 [](const auto&) { return std::optional<EndpointConnection>(); }},
+      s);
+}
+
+glm::vec3 importance(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction,
+                     glm::vec2* raster) {
+  return std::visit(
+      Overloaded{[&](const PinholeParams& p) { return importance(p, direction, raster); },
+                 [&](const ThinLensParams& p) { return importance(p, origin, direction, raster); },
+                 [](const auto&) { return glm::vec3(0.0f); }},
+      s);
+}
+
+std::optional<EndpointConnection> hit_lens(const SensorParams& s, const glm::vec3& origin,
+                                           const glm::vec3& direction) {
+  if (const auto* p = std::get_if<ThinLensParams>(&s)) return hit_lens(*p, origin, direction);
   return std::nullopt;
 }
 

@@ -36,7 +36,8 @@ HistogramReport render_scene(const Scene& scene, const Profile& profile, std::ui
 
 TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
   const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes";
-  const char* const profiles[] = {"pt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer"};
+  const char* const profiles[] = {"pt",           "pt-nee",       "lt",           "pbrt-v4-lightpath", "mitsuba3-ptracer",
+                                  "pt-nee+distant", "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path",     "bdpt+ortho"};
   int compared = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".json") continue;

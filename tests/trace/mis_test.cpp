@@ -21,7 +21,8 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
     if (entry.path().extension() != ".json") continue;
     Result<Scene> scene = load_scene_file(entry.path().string());
     ASSERT_TRUE(scene.ok()) << scene.error().render();
-    for (const char* renderer : {"bdpt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer"}) {
+    for (const char* renderer : {"bdpt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer", "pt-nee+distant",
+                                 "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path", "bdpt+ortho"}) {
       Result<Profile> profile = resolve_profile(renderer, Limits{});
       Result<std::vector<MisCheck>> checks = check_mis_weights(*scene, *profile, 11, 300);
       ASSERT_TRUE(checks.ok()) << checks.error().render();
