@@ -86,7 +86,6 @@ struct EndpointConnection {
   glm::vec3 weight{0.0f};
   float pdf_dir = 0.0f;       // solid-angle density of wi at ref for this join; 0 when `delta`
   bool delta = false;         // wi was fixed (point-like position or single direction), not sampled
-  RayPdf ray_pdf;             // sample_ray's densities for the ray position → −wi
   glm::vec2 raster{0.0f};     // sensors: where the join lands on the film
 };
 

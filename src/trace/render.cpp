@@ -25,6 +25,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/frame.h"
 #include "trace/render_scene.h"
@@ -108,72 +109,8 @@ void link(Vertex& v, const Vertex& pred) {
   v.wo = v.d2_wo > 0.0f ? e / std::sqrt(v.d2_wo) : vec3(0.0f);
 }
 
-// A full-path string L c0 … c(k+2) E packed: bit i is set when c_i is S, and the number of
-// scattering letters (k + 3) sits in the top byte. Every string the tracer forms packs: k + 3 is
-// at most kMaxVertices + 1 letters (max_bounces is clamped so).
-__extension__ typedef unsigned __int128 PathKey;
-constexpr int kLengthShift = 120;
-static_assert(kMaxVertices + 1 < kLengthShift);
-constexpr PathKey bit(int i) { return static_cast<PathKey>(1) << i; }
-constexpr PathKey letter_bit(char c, int i) { return c == 'S' ? bit(i) : 0; }
-int packed_length(PathKey key) { return static_cast<int>(key >> kLengthShift); }
-bool packed_is_d(PathKey key, int i) { return ((key >> i) & 1) == 0; }
-
-std::string unpack(PathKey key) {
-  const int n = packed_length(key);
-  std::string out(static_cast<std::size_t>(n) + 2, 'D');
-  out.front() = 'L';
-  out.back() = 'E';
-  for (int i = 0; i < n; ++i)
-    if (!packed_is_d(key, i)) out[static_cast<std::size_t>(i) + 1] = 'S';
-  return out;
-}
-PathKey pack(const std::string& letters) {  // "L c0 … E"
-  PathKey key = static_cast<PathKey>(letters.size() - 2) << kLengthShift;
-  for (std::size_t i = 1; i + 1 < letters.size(); ++i) key |= letter_bit(letters[i], static_cast<int>(i) - 1);
-  return key;
-}
-
-// Per-thread map from packed strings to histogram ids, so that recording a contribution hashes
-// two words instead of a string; Histogram::intern() runs once per new path and thread.
-class PathIds {
- public:
-  Histogram::PathId get(Histogram& hist, PathKey key) {
-    const std::size_t mask = slots_.size() - 1;
-    for (std::size_t i = hash(key) & mask;; i = (i + 1) & mask) {
-      Slot& slot = slots_[i];
-      if (slot.key == key) return slot.id;
-      if (slot.key == 0) {
-        const Histogram::PathId id = hist.intern(unpack(key));
-        slot = {key, id};
-        if (2 * ++used_ > slots_.size()) grow();
-        return id;
-      }
-    }
-  }
-
- private:
-  struct Slot {
-    PathKey key = 0;  // 0: empty (a real key has a nonzero length)
-    Histogram::PathId id = -1;
-  };
-  static std::size_t hash(PathKey key) {
-    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) ^ mix64(static_cast<std::uint64_t>(key >> 64))));
-  }
-  void grow() {
-    std::vector<Slot> old(slots_.size() * 2);
-    old.swap(slots_);
-    const std::size_t mask = slots_.size() - 1;
-    for (const Slot& slot : old) {
-      if (slot.key == 0) continue;
-      std::size_t i = hash(slot.key) & mask;
-      while (slots_[i].key != 0) i = (i + 1) & mask;
-      slots_[i] = slot;
-    }
-  }
-  std::vector<Slot> slots_ = std::vector<Slot>(256);
-  std::size_t used_ = 0;
-};
+using namespace accel;  // PathKey, PathIds
+static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
 
 // |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
 float abs_cos(const Vertex& v, const vec3& w) {
@@ -187,7 +124,9 @@ float abs_cos(const Vertex& v, const vec3& w) {
 
 class Integrator {
  public:
-  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl)
+  // `general_mis` (for tests) turns off the per-sample MIS sums, leaving the general recurrence.
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl,
+             bool general_mis = false)
       : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), classifier_(cl) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
@@ -217,7 +156,7 @@ class Integrator {
       has_connectors_ = has_connectors_ || distant_of_[i] >= 0 || ortho_of_[i] >= 0;
     }
     eye0_runs_ = (runs_mask_[1] >> 1) & 1;
-    all_runs_ = !has_connectors_;  // the per-sample sums below know plain joins only
+    all_runs_ = !has_connectors_ && !general_mis;  // the per-sample sums below know plain joins only
     for (std::size_t n = 1; n < runs_mask_.size(); ++n) {
       const std::uint64_t below = (std::uint64_t{1} << n) - 1;  // s2 < n: t2 >= 1
       all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
@@ -319,8 +258,8 @@ class Integrator {
     }
   }
   // The packed full-path string of connection (s, t), as full_path() spells it.
-  // A projection connector's chain keeps its S letter (`chain_s`, the bit of the Dirac direction).
-  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled, PathKey chain_s = 0) const {
+  // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
+  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
     PathKey m = 0;
     if (s > 0) {
       m = th.light_mask & (bit(s + 1) - 1);
@@ -328,7 +267,7 @@ class Integrator {
     }
     if (t > 0) m |= th.eye_masks[static_cast<std::size_t>(t)] << (s + 1);
     m &= ~(bit(s) | bit(s + 1));  // the join letters
-    return m | chain_s | static_cast<PathKey>(s + t + 2) << kLengthShift;
+    return m | static_cast<PathKey>(s + t + 2) << kLengthShift;
   }
 
   // The profile's strategy that runs (s, t), or -1.
@@ -376,6 +315,11 @@ class Integrator {
     std::string out;
     full_path(th, s, t, nullptr, out);
     return out;
+  }
+  // The weight of connection (s, t) of the current subpaths, as the renderer computes it.
+  float own_weight(Thread& th, int s, int t) const {
+    prepare_joins(th, th.ns, th.nt);
+    return mis_weight(th, s, t, nullptr, path_key(th, s, t, nullptr));
   }
   // The same string as the renderer records it (packed, then spelled out).
   std::string packed_label(const Thread& th, int s, int t) const { return unpack(path_key(th, s, t, nullptr)); }
@@ -799,10 +743,13 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
   // count as 1 here; their strategies are excluded by letter.
   double sum = 0.0;
   const auto runs = [&](int s2) { return static_cast<double>((others >> s2) & 1); };
-  // The term of strategy s2 for density ratio ri (a connector's carries its factor).
+  // The term of strategy s2 for density ratio ri (a connector's carries its factor; profiles
+  // without connectors never take the branch).
   const auto term = [&](int s2, double ri) {
-    const double w2 = s2 == 1 && conn_w2_first != 0.0 ? conn_w2_first : s2 == n - 1 && conn_w2_last != 0.0 ? conn_w2_last : 1.0;
-    return ri * ri * w2;
+    double r2 = ri * ri;
+    if (has_connectors_) [[unlikely]]
+      r2 *= s2 == 1 && conn_w2_first != 0.0 ? conn_w2_first : s2 == n - 1 && conn_w2_last != 0.0 ? conn_w2_last : 1.0;
+    return r2;
   };
   if (all_runs_) {
     // Each side: the join's two ratios, then the subpath's fixed part from prepare_joins().
@@ -892,18 +839,32 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     to_pixels(raster, &rx, &ry);
     contrib = qs->beta * we;
     splat = true;
-  } else if constexpr (C == Connection::kSplat) {
-    // --- splat: connect qs to a fresh sensor point ---
-    if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no DD join
+  } else if constexpr (C == Connection::kSplat || C == Connection::kOrtho) {
+    // --- a light vertex joined to a sensor point: a fresh one (the splat, t = 1) or, for
+    //     ortho-projection, the film point on the line of sight through qs ---
     if (qs->kind == Kind::kLens || !qs->finite) return;
-    const std::optional<EndpointConnection> c = connect_finite(cam_.params, rng.get2d(), qs->p);
-    if (!c) return;
+    std::optional<EndpointConnection> c;
+    if constexpr (C == Connection::kSplat) {
+      if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no DD join
+      c = connect_finite(cam_.params, rng.get2d(), qs->p);
+      if (!c) return;
+    } else {
+      const auto* film = std::get_if<OrthographicParams>(&cam_.params);
+      if (film == nullptr) return;
+      ++stats->attempts;
+      c = pathex::connect(*film, qs->p);
+      if (!c) {
+        ++stats->outside;
+        return;
+      }
+      chain_s = bit(s + 1);  // c(k+1), the sensor's direction
+    }
     sampled = Vertex{};
     sampled.kind = Kind::kCamera;
     sampled.p = c->position;
     sampled.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c->normal;  // a pinhole is a point
     sampled.ns = sampled.n;
-    sampled.letter = 'D';
+    sampled.letter = C == Connection::kSplat ? 'D' : sensor_pair_[0];
     sampled.pos_letter = sensor_pair_[1];
     sampled.pdf_fwd = cam_.pdf_pos;
     const vec3 w = c->wi;  // from qs to the sensor
@@ -916,24 +877,38 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     join.w = w;
     join.d2 = c->distance * c->distance;
     joined = true;
-    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);
+    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);  // weight: We cos / d² (splat), We (film)
     ends = {qs, &sampled};
     splat = true;
-  } else if constexpr (C == Connection::kNee) {
-    // --- next-event estimation: a fresh light sample ---
+  } else if constexpr (C == Connection::kNee || C == Connection::kDistant) {
+    // --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
+    //     for distant-projection, the aperture point on the line through pt against the light ---
     if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
     const std::size_t li = pick_light(rng.get1d());
-    const glm::vec2 up = rng.get2d();
     const RenderLight& l = rs_.lights[li];
-    if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
-    vec3 err;
-    const std::optional<EndpointConnection> c = pathex::connect(l.params, sample_point(l, up, &err), pt->p);
-    if (!c) return;
+    std::optional<EndpointConnection> c;
+    vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
+    if constexpr (C == Connection::kNee) {
+      const glm::vec2 up = rng.get2d();
+      if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
+      c = pathex::connect(l.params, sample_point(l, up, &err), pt->p);
+      if (!c) return;
+    } else {
+      if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
+      ++stats->attempts;
+      c = pathex::connect(l.params, SurfacePoint{}, pt->p);
+      if (!c) {
+        ++stats->outside;
+        return;
+      }
+      err = aperture_error(l);
+      chain_s = bit(1);  // c1, the light's direction
+    }
     sampled = Vertex{};
     sampled.kind = Kind::kLight;
     sampled.light = static_cast<int>(li);
     sampled.pos_letter = light_pairs_[li][0];
-    sampled.letter = 'D';
+    sampled.letter = C == Connection::kNee ? 'D' : light_pairs_[li][1];
     sampled.p = c->position;
     sampled.n = c->normal;
     sampled.err = err;
@@ -945,71 +920,8 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     join.w = -w;  // w runs from pt to the light, the join's from the light to pt
     join.d2 = c->distance * c->distance;
     joined = true;
-    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;
+    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;  // weight: Le cos / (p d²), I / d², E
     ends = {pt, &sampled};
-  } else if constexpr (C == Connection::kDistant) {
-    // --- distant-projection: the aperture point on the line through pt against the light ---
-    if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
-    const std::size_t li = pick_light(rng.get1d());
-    const RenderLight& l = rs_.lights[li];
-    if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
-    ++stats->attempts;
-    const std::optional<EndpointConnection> c = pathex::connect(l.params, SurfacePoint{}, pt->p);
-    if (!c) {
-      ++stats->outside;
-      return;
-    }
-    sampled = Vertex{};
-    sampled.kind = Kind::kLight;
-    sampled.light = static_cast<int>(li);
-    sampled.pos_letter = light_pairs_[li][0];
-    sampled.letter = light_pairs_[li][1];
-    sampled.p = c->position;
-    sampled.n = c->normal;
-    sampled.err = aperture_error(l);
-    sampled.ns = sampled.n;
-    sampled.pdf_fwd = light_pick_ * l.pdf_pos;
-    const vec3 w = c->wi;  // from pt towards the light
-    const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
-                             pt->wo, w, pt->ns, pt->n, &join.at_pt);
-    join.w = -w;
-    join.d2 = c->distance * c->distance;
-    joined = true;
-    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;  // weight: E
-    ends = {pt, &sampled};
-    chain_s = bit(1);  // c1, the light's direction
-  } else if constexpr (C == Connection::kOrtho) {
-    // --- ortho-projection: the film point on the line of sight through qs ---
-    if (qs->kind == Kind::kLens || !qs->finite) return;
-    const auto* film = std::get_if<OrthographicParams>(&cam_.params);
-    if (film == nullptr) return;
-    ++stats->attempts;
-    const std::optional<EndpointConnection> c = pathex::connect(*film, qs->p);
-    if (!c) {
-      ++stats->outside;
-      return;
-    }
-    sampled = Vertex{};
-    sampled.kind = Kind::kCamera;
-    sampled.p = c->position;
-    sampled.n = c->normal;
-    sampled.ns = sampled.n;
-    sampled.letter = sensor_pair_[0];
-    sampled.pos_letter = sensor_pair_[1];
-    sampled.pdf_fwd = cam_.pdf_pos;
-    const vec3 w = c->wi;  // from qs towards the film
-    to_pixels(c->raster, &rx, &ry);
-    vec3 fq;
-    if (qs->kind == Kind::kLight) fq = vec3(directional_emission(rs_.lights[static_cast<std::size_t>(qs->light)].params, qs->n, w));
-    else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                        qs->wo, w, qs->ns, qs->n, &join.at_qs);
-    join.w = w;
-    join.d2 = c->distance * c->distance;
-    joined = true;
-    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);  // weight: We = 1 / film area
-    ends = {qs, &sampled};
-    splat = true;
-    chain_s = bit(s + 1);  // c(k+1), the sensor's direction
   } else {
     // --- a shadow ray between y(s-1) and z(t-1) ---
     if (qs->kind == Kind::kLens || pt->kind != Kind::kSurface || qs->kind != Kind::kSurface) return;
@@ -1035,7 +947,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   }
   const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee || kind != JoinKind::kPlain ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
-  const PathKey key = path_key(th, s, t, fresh, chain_s);
+  const PathKey key = path_key(th, s, t, fresh) | chain_s;
   const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr, kind), strategy_index, batch, splat,
                   stats != nullptr, rx, ry, th.px};
   if constexpr (C == Connection::kEmitter || C == Connection::kLens) {
@@ -1198,6 +1110,7 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
   Integrator integrator(*rs, *strategies, o, nullptr);
+  const Integrator general(*rs, *strategies, o, nullptr, /*general_mis=*/true);
   Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
   th.images = &images;
   th.connectors.resize(strategies->strategies.size());
@@ -1213,7 +1126,9 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
         if (strategies->find(s, t) < 0) continue;
         const float sum = integrator.weight_sum_if_valid(th, s, t);
         if (sum < 0.0f) continue;  // not a path this connection forms
-        out.push_back({integrator.label(th, s, t), s, t, sum, integrator.packed_label(th, s, t)});
+        const float weight = integrator.own_weight(th, s, t);
+        const float weight_general = general.own_weight(th, s, t);
+        out.push_back({integrator.label(th, s, t), s, t, sum, weight, weight_general, integrator.packed_label(th, s, t)});
       }
   }
   return out;

@@ -160,6 +160,7 @@ TEST(LpeEmit, BuiltinsAndKnownAnswers) {
   for (const auto& c : ClassTable::builtins().builtin_classes()) expect_round_trip(c->dfa, "$" + c->name);
   Result<LpeEmission> caustic = emit_lpe(full("$caustic"), Limits{});
   ASSERT_TRUE(caustic.ok());
+  EXPECT_EQ(caustic->lpe, "C[DGS]*[DG]S+[LO]");  // (S*[DG])+ is written [DGS]*[DG]
   EXPECT_TRUE(caustic->exact);
   Result<LpeEmission> direct = emit_lpe(full("$direct"), Limits{});
   EXPECT_EQ(direct->lpe, "C[DGS][LO]");
@@ -216,6 +217,7 @@ TEST(LpeFullPathForm, IsTheClassAndFactorsTheEnds) {
   EXPECT_EQ(*full_path_expression(lpe("C<RD>S+L"), Limits{}), "L..S+D..E");
   EXPECT_EQ(*full_path_expression(lpe("C.*DS+L"), Limits{}), "L..S+D.*..E");
   EXPECT_EQ(*full_path_expression(lpe("CO"), Limits{}), "LDD..E");
+  EXPECT_EQ(*full_path_expression(lpe("C<RD>.*"), Limits{}), "L...*D..E");
 }
 
 // State elimination alone, on random DFAs of random expressions, printed in full notation.
