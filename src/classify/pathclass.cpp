@@ -3,6 +3,7 @@
 #include <cctype>
 
 #include "automata/ops.h"
+#include "core/budget.h"
 #include "regex/parser.h"
 
 namespace pathex {
@@ -34,6 +35,7 @@ Error with_source(Error e, std::string_view text) {
 // E then anything: the shape of every member of an eye-first expression.
 const Dfa& starts_with_e() {
   static const Dfa d = [] {
+    ExemptFromBudget exempt;
     Dfa x;
     x.num_states = 3;  // 0 start, 1 after E (accepting, absorbing), 2 dead
     x.next = {2, 1, 2, 2, 1, 1, 1, 1, 2, 2, 2, 2};
@@ -46,6 +48,7 @@ const Dfa& starts_with_e() {
 // Classic L[SD]*E.
 const Dfa& classic_universe() {
   static const Dfa d = [] {
+    ExemptFromBudget exempt;
     Dfa x;
     x.num_states = 4;  // 0 start, 1 after L (loops on S D), 2 accept, 3 dead
     x.next.assign(16, 3);
@@ -74,9 +77,24 @@ Result<Dfa> expand_ends(const Dfa& classic, const EndTypes& ends, const Limits& 
 
 }  // namespace
 
-Dfa ends_universe(const EndTypes& ends) { return *expand_ends(classic_universe(), ends, Limits{}); }
+Dfa ends_universe(const EndTypes& ends) {
+  ExemptFromBudget exempt;
+  return expand_ends(classic_universe(), ends, Limits{}).expect("L[SD]*E expands under the default limits");
+}
+
+Result<PathClass> compile_class_unbudgeted(std::string_view text, const ClassOptions& options, const ClassTable* names);
 
 Result<PathClass> compile_class(std::string_view text, const ClassOptions& options, const ClassTable* names) {
+  Result<PathClass> c = within_budget(options.limits, [&] { return compile_class_unbudgeted(text, options, names); });
+  if (!c && c.error().source.empty()) {
+    Error e = with_source(c.error(), text);
+    e.column = 1;
+    return e;
+  }
+  return c;
+}
+
+Result<PathClass> compile_class_unbudgeted(std::string_view text, const ClassOptions& options, const ClassTable* names) {
   const ClassTable& table = names ? *names : ClassTable::builtins();
   Error notation_error;
   bool notation_mismatch = false;
@@ -140,11 +158,11 @@ Result<PathClass> compile_class(std::string_view text, const ClassOptions& optio
 ClassTable::ClassTable() = default;
 
 ClassTable::ClassTable(BuiltinTag) : is_builtin_table_(true) {
+  ExemptFromBudget exempt;  // built on first use, by whichever operation comes first
   ClassOptions options;
   for (const BuiltinDef& b : kBuiltins) {
-    Result<PathClass> c = compile_class(b.expr, options, this);
     // The built-in expressions are constants of this file; tests compile each of them.
-    auto pc = std::make_unique<PathClass>(std::move(*c));
+    auto pc = std::make_unique<PathClass>(compile_class(b.expr, options, this).expect("a built-in class compiles"));
     pc->name = b.name;
     pc->description = b.description;
     builtin_.push_back(std::move(pc));

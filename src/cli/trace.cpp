@@ -60,7 +60,7 @@ std::string format_seconds(double s) {
 int run(const TraceArgs& a) {
   // --- scene, profile, classes ---
   Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
-                                        : load_scene_file(a.scene);
+                                        : load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
   if (!scene) return report(scene.error());
   const std::string scene_name = a.scene.empty() ? "default (embedded cornell)" : a.scene;
   Result<Profile> profile = resolve_profile(a.renderer, a.limits);

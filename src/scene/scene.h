@@ -24,6 +24,7 @@
 
 #include "alphabet/alphabet.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "scene/material.h"
 
 namespace pathex {
@@ -90,9 +91,21 @@ struct Scene {
   Camera camera;
 };
 
+// How much of a scene to load.
+struct SceneLoadOptions {
+  std::size_t max_file_bytes = Limits{}.max_file_bytes;  // the scene file and each mesh (--max-file-size)
+  // false: meshes keep their vertex positions but are not triangulated (enough for the scene's
+  // universe and the camera check; what `query --scene` and `check` need).
+  bool triangles = true;
+};
+// An OBJ face may have at most this many corners (tinyobjloader's triangulation of one polygon
+// is quadratic in its corners; a modeller's n-gons are far smaller).
+inline constexpr std::size_t kMaxFaceCorners = 1024;
+
 // `base_dir` resolves relative mesh paths; `name` prefixes error locations.
-Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name);
-Result<Scene> load_scene_file(const std::string& path);
+Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
+                              const SceneLoadOptions& options = {});
+Result<Scene> load_scene_file(const std::string& path, const SceneLoadOptions& options = {});
 
 // The scene embedded in the binary: a Cornell box with an area light, a mirror and a glass sphere.
 const char* default_scene_json();

@@ -23,6 +23,7 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
     ASSERT_TRUE(scene.ok()) << scene.error().render();
     for (const char* renderer : {"bdpt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer"}) {
       Result<Profile> profile = resolve_profile(renderer, Limits{});
+      ASSERT_TRUE(profile.ok());
       Result<std::vector<MisCheck>> checks = check_mis_weights(*scene, *profile, 11, 300);
       ASSERT_TRUE(checks.ok()) << checks.error().render();
       for (const MisCheck& c : *checks) {

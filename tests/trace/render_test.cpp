@@ -41,7 +41,7 @@ Rendered render_json(const std::string& scene_json, const std::string& renderer,
     infos.push_back({c, c});
   }
   static std::vector<std::unique_ptr<Classifier>> keep_cl;
-  keep_cl.push_back(std::make_unique<Classifier>(*Classifier::build(pcs, Limits{})));
+  keep_cl.push_back(std::make_unique<Classifier>(Classifier::build(pcs, Limits{}).expect("a test input")));
   RenderOptions o;
   o.spp = spp;
   o.seed = seed;
@@ -258,6 +258,7 @@ TEST(Images, OffLeavesTheHistogramExactlyTheSameAndTheImageEmpty) {
   with.threads = 2;
   RenderOptions without = with;
   without.images = false;
+  ASSERT_TRUE(profile.ok());
   Result<RenderOutput> a = render(*scene, *profile, nullptr, with);
   Result<RenderOutput> b = render(*scene, *profile, nullptr, without);
   ASSERT_TRUE(a.ok() && b.ok());
@@ -296,6 +297,8 @@ TEST(Interrupt, KeepsFinishedPassesAndMarksIncomplete) {
   o.progress = [&](std::uint64_t done, std::uint64_t) {
     if (done >= 3 * 12 * 12) cancel.store(true);  // once the third pass is done
   };
+  ASSERT_TRUE(scene.ok());
+  ASSERT_TRUE(profile.ok());
   Result<RenderOutput> out = render(*scene, *profile, nullptr, o);
   ASSERT_TRUE(out.ok());
   EXPECT_FALSE(out->complete);
@@ -321,6 +324,7 @@ TEST(Labels, PointLightWithPinholeOnlyProducesSDprefixAndDSsuffix) {
 
 TEST(Profiles, ConnectorProfilesAreRefusedByName) {
   Result<Profile> p = resolve_profile("bdpt+mirror", Limits{});
+  ASSERT_TRUE(p.ok());
   Result<StrategySet> s = runnable_strategies(*p);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().message,
