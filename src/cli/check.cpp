@@ -113,9 +113,9 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
       c.max_bounces = static_cast<int>(*m);
     }
     if (jc.contains("notation")) {
-      if (jc.at("notation") == "full") c.notation = Notation::kFull;
-      else if (jc.at("notation") == "heckbert") c.notation = Notation::kHeckbert;
-      else return bad(file, ptr + "/notation", "expected \"full\" or \"heckbert\"");
+      const auto n = jc.at("notation").is_string() ? notation_from_string(jc.at("notation").get<std::string>()) : std::nullopt;
+      if (!n) return bad(file, ptr + "/notation", "expected \"full\", \"heckbert\" or \"lpe\"");
+      c.notation = *n;
     }
     if (!jc.contains("require") || !jc.at("require").is_array() || jc.at("require").empty())
       return bad(file, ptr + "/require", "expected a non-empty array of requirements");

@@ -14,16 +14,23 @@
 
 #include "cli/common.h"
 #include "cli/reach_common.h"
+#include <nlohmann/json.hpp>
+
 #include "io/atomic_file.h"
 #include "io/class_file.h"
 #include "io/histogram_json.h"
 #include "io/image_io.h"
+#include "io/output_set.h"
 #include "io/profile_json.h"
 #include "scene/universe.h"
 #include "trace/render.h"
 
 namespace pathex::cli {
 namespace {
+
+// --max-memory's default: what the render's images and their writing may take, estimated before
+// rendering (render_memory_estimate()).
+constexpr std::uint64_t kDefaultMaxMemory = std::uint64_t{4} << 30;
 
 struct TraceArgs {
   std::string scene;
@@ -38,6 +45,7 @@ struct TraceArgs {
   bool json = false;
   bool quiet = false;
   bool no_images = false;
+  std::uint64_t max_memory = kDefaultMaxMemory;
   Limits limits;
 };
 
@@ -57,11 +65,20 @@ std::string format_seconds(double s) {
   return buf;
 }
 
+std::string gib(std::uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(bytes) / static_cast<double>(std::uint64_t{1} << 30));
+  return buf;
+}
+
 int run(const TraceArgs& a) {
   // --- scene, profile, classes ---
   Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
                                         : load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
   if (!scene) return report(scene.error());
+  // The output folder is checked before the render, not after it.
+  Result<OutputSet> out_set = OutputSet::prepare(a.out);
+  if (!out_set) return report(out_set.error());
   const std::string scene_name = a.scene.empty() ? "default (embedded cornell)" : a.scene;
   Result<Profile> profile = resolve_profile(a.renderer, a.limits);
   if (!profile) return report(profile.error());
@@ -99,6 +116,18 @@ int run(const TraceArgs& a) {
   ro.images = !a.no_images;
   if (ro.images)
     for (int i = 0; i < classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
+  // --- memory: the images and their writing, estimated before the render ---
+  const int num_layers = 1 + static_cast<int>(ro.layer_classes.size());
+  const std::uint64_t need = ro.images ? render_memory_estimate(scene->camera.width, scene->camera.height, num_layers) : 0;
+  if (need > a.max_memory) {
+    Error e = make_error(ErrorCode::kLimit,
+                         "the images would take about " + gib(need) + " (" + std::to_string(scene->camera.width) + " x " +
+                             std::to_string(scene->camera.height) + " pixels, " + std::to_string(num_layers) +
+                             " layers), more than --max-memory " + gib(a.max_memory) +
+                             "; pass --no-images for the histogram alone, render fewer pixels or classes, or raise --max-memory");
+    e.where = scene_name + ":/camera";
+    return report(e);
+  }
   const bool show_progress = !a.quiet && ::isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
   if (show_progress) {
@@ -131,16 +160,32 @@ int run(const TraceArgs& a) {
   Result<HistogramReport> rep = make_report(out->histogram, info, &*classifier, infos);
   if (!rep) return report(rep.error());
 
-  // --- outputs, each written whole or not at all ---
-  std::error_code ec;
-  std::filesystem::create_directories(a.out, ec);
-  if (ec) return report(make_error(ErrorCode::kBadFile, "cannot create the output folder " + a.out + ": " + ec.message()));
-  const std::string json_text = histogram_json_text(*rep);
-  if (Result<bool> w = write_file_atomic(a.out + "/histogram.json", json_text); !w) return report(w.error());
-  if (!a.no_images) {
-    const std::vector<ImageLayer> layers = out->images.layers(out->spp_done ? 1.0 / static_cast<double>(out->spp_done) : 0.0);
-    if (Result<bool> w = write_exr(a.out + "/classes.exr", layers); !w) return report(w.error());
-    if (Result<bool> w = write_previews(a.out, layers); !w) return report(w.error());
+  // --- outputs: one set, whole or not at all, shielded from signals (io/output_set.h) ---
+  // histogram.json, plus what each connector did ("connectors": [{strategy, connector, attempts,
+  // successes, failures {outside, occluded, no_transport}}] in the profile's order; absent when the
+  // profile has none).
+  nlohmann::ordered_json doc = to_json(*rep);
+  if (!out->connectors.empty()) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const ConnectorStats& c : out->connectors)
+      list.push_back({{"strategy", c.strategy},
+                      {"connector", c.connector},
+                      {"attempts", c.attempts},
+                      {"successes", c.successes},
+                      {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
+    doc["connectors"] = std::move(list);
+  }
+  const std::string json_text = doc.dump(2) + "\n";
+  {
+    const SignalShield shield;
+    Result<bool> written = out_set->write([&](const std::string& dir) -> Result<bool> {
+      if (Result<bool> w = write_file_atomic(dir + "/histogram.json", json_text); !w) return w;
+      if (a.no_images) return true;
+      const std::vector<ImageLayer> layers = out->images.layers(out->spp_done ? 1.0 / static_cast<double>(out->spp_done) : 0.0);
+      if (Result<bool> w = write_exr(dir + "/classes.exr", layers); !w) return w;
+      return write_previews(dir, layers);
+    });
+    if (!written) return report(written.error());
   }
   if (a.json) {
     std::cout << json_text;
@@ -168,6 +213,16 @@ int run(const TraceArgs& a) {
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << profile->name << ": " << (q ? to_string(q->verdict) : "?") << "\n";
   }
+  if (!out->connectors.empty()) {
+    int width = 10;
+    for (const ConnectorStats& c : out->connectors) width = std::max(width, static_cast<int>(c.strategy.size()));
+    std::cout << "\n" << std::left << std::setw(width + 2) << "connectors" << std::right
+              << "  attempts  successes   outside  occluded  no transport\n";
+    for (const ConnectorStats& c : out->connectors)
+      std::cout << "  " << std::left << std::setw(width) << c.strategy << std::right << std::setw(10) << c.attempts
+                << std::setw(11) << c.successes << std::setw(10) << c.outside << std::setw(10) << c.occluded
+                << std::setw(14) << c.no_transport << "   (" << c.connector << ")\n";
+  }
   std::cout << "\nmost important paths\n";
   for (std::size_t i = 0; i < rep->paths.size() && static_cast<int>(i) < a.top_paths; ++i) {
     const PathEstimate& p = rep->paths[i];
@@ -189,7 +244,8 @@ Command add_trace(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("trace", "Render a scene, label every path, write path-class histograms and images");
   sub->footer("Example:\n  pathex trace                         # the embedded Cornell box\n"
               "  pathex trace samples/scenes/point-mirror-caustic.json --renderer pt-nee --spp 64 --out out/\n"
-              "Writes DIR/histogram.json, DIR/classes.exr (a layer per class and the total) and DIR/<layer>.png.\n"
+              "Writes DIR/histogram.json, DIR/classes.exr (a layer per class and the total) and DIR/<layer>.png,\n"
+              "as one set that replaces the previous one whole (DIR must hold only what pathex wrote there).\n"
               "Ctrl-C stops early and writes what was rendered, marked \"complete\": false (exit 1).");
   sub->add_option("SCENE", args->scene, "Scene file (grammar/scene.schema.json); default: the embedded Cornell box");
   sub->add_option("--renderer", args->renderer, "Renderer profile: built-in name or file")->capture_default_str();
@@ -204,6 +260,10 @@ Command add_trace(CLI::App& app) {
   sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs and the per-pixel sums behind them (the histogram is the same)");
+  sub->add_option("--max-memory", args->max_memory,
+                  "Refuse a render whose images (and their writing) would take more, estimated before rendering; e.g. 512M, 16G")
+      ->transform(CLI::AsSizeValue(false))
+      ->default_str("4G");
   add_limit_options(sub, &args->limits);
   return {sub, [args] { return run(*args); }};
 }

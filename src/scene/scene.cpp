@@ -3,6 +3,9 @@
 // expected; unknown keys are errors, so a typo never silently does nothing.
 #include "scene/scene.h"
 
+#include "scene/mitsuba_import.h"
+#include "scene/pbrt_import.h"
+
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -53,6 +56,19 @@ class Reader : public JsonReader {
     }
     if (nonzero && glm::dot(out, out) == 0.0f) return fail(p, "expected a non-zero vector");
     return out;
+  }
+
+  // An emission, intensity, irradiance or power: a non-negative 3-vector of at most kMaxLightValue.
+  Result<vec3> light_value(const json& j, const std::string& key, const std::string& ptr, bool required) const {
+    Result<vec3> v = vector3(j, key, ptr, required, vec3(0.0f), /*nonneg=*/true);
+    if (!v) return v;
+    for (int i = 0; i < 3; ++i)
+      if ((*v)[i] > kMaxLightValue)
+        return fail(ptr + "/" + key + "/" + std::to_string(i),
+                    "expected at most 1e9, found " + fmt((*v)[i]) +
+                        ": the tracer sums contributions exactly below 2^50 (about 1.1e15) and drops larger ones, so "
+                        "brighter lights would lose samples; scale the scene's lights down (the image scales with them)");
+    return v;
   }
 
 };
@@ -261,21 +277,20 @@ std::optional<Error> scan_obj(const std::string& path, std::string_view text, st
   return std::nullopt;
 }
 
-Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file,
-                           const SceneLoadOptions& options) {
-  const std::string path = (std::filesystem::path(base_dir) / file).string();
+// The OBJ at `path`: checked and scanned for its vertices and faces, then (if asked) triangulated.
+Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& options, std::size_t* faces) {
   MeshShape mesh;
-  mesh.file = file;
-  std::size_t faces = 0;
+  mesh.file = path;
   {  // the text is released before tinyobjloader reads the file again, to keep peak memory low
     Result<std::string> text = read_input_file(path, options.max_file_bytes);
     if (!text) {
       if (text.error().code == ErrorCode::kLimit) return text.error();
-      return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+      Error e = make_error(ErrorCode::kBadFile, "cannot open the mesh");
+      e.where = path;
+      return e;
     }
-    if (std::optional<Error> e = scan_obj(path, *text, &mesh.positions, &faces)) return *e;
+    if (std::optional<Error> e = scan_obj(path, *text, &mesh.positions, faces)) return *e;
   }
-  if (faces == 0) return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
   if (!options.triangles) return mesh;  // the positions alone: bounds and types, no triangulation
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
@@ -295,9 +310,30 @@ Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::s
       mesh.triangles.emplace_back(static_cast<unsigned>(shape.mesh.indices[i].vertex_index),
                                   static_cast<unsigned>(shape.mesh.indices[i + 1].vertex_index),
                                   static_cast<unsigned>(shape.mesh.indices[i + 2].vertex_index));
-  if (mesh.triangles.empty()) return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
   return mesh;
 }
+
+Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file,
+                           const SceneLoadOptions& options) {
+  const std::string path = (std::filesystem::path(base_dir) / file).string();
+  if (!std::ifstream(path, std::ios::binary)) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+  std::size_t faces = 0;
+  Result<MeshShape> mesh = read_obj(path, options, &faces);
+  if (!mesh) return mesh.error();
+  if (faces == 0 || (options.triangles && mesh->triangles.empty()))
+    return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
+  mesh->file = file;
+  return mesh;
+}
+
+}  // namespace
+
+Result<MeshShape> load_obj_mesh(const std::string& path, const SceneLoadOptions& options) {
+  std::size_t faces = 0;
+  return read_obj(path, options, &faces);
+}
+
+namespace {
 
 // --- "the camera sees no geometry" ---
 // Defined exactly: no shape's axis-aligned bounding box meets the camera's viewing region, which
@@ -416,6 +452,23 @@ bool region_meets_box(const ViewRegion& v, const Box& b) {
   return true;
 }
 
+// --- the scene-level rules every loader checks (check_scene_rules) ---
+constexpr const char* kNoLight = "the scene has no light: expected an entry in /lights or a shape with an emission";
+constexpr const char* kSeesNothing = "the camera sees no geometry: no shape's bounding box meets its field of view";
+
+bool has_light(const Scene& scene) {
+  bool any = !scene.lights.empty();
+  for (const Shape& s : scene.shapes) any = any || s.emissive();
+  return any;
+}
+
+bool camera_sees_geometry(const Scene& scene) {
+  const ViewRegion view = view_region(scene.camera);
+  for (const Shape& s : scene.shapes)
+    if (region_meets_box(view, shape_bounds(s))) return true;
+  return false;
+}
+
 Result<Camera> read_camera(const Reader& r, const json& j, const std::string& ptr) {
   if (!j.is_object()) return r.fail(ptr, "expected a camera object, found " + Reader::kind(j));
   Camera c;
@@ -479,21 +532,21 @@ Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr)
   if (type == "point") {
     if (auto k = r.keys(j, ptr, {"type", "position", "intensity"}); !k) return k.error();
     PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
-    PATHEX_TRY(i, r.vector3(j, "intensity", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(i, r.light_value(j, "intensity", ptr, true));
     return Light{PointLight{p, i}};
   }
   if (type == "spot") {
     if (auto k = r.keys(j, ptr, {"type", "position", "direction", "intensity", "cone"}); !k) return k.error();
     PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
     PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
-    PATHEX_TRY(i, r.vector3(j, "intensity", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(i, r.light_value(j, "intensity", ptr, true));
     PATHEX_TRY(cone, r.number(j, "cone", ptr, 1e-3, 180.0, 30.0));
     return Light{SpotLight{p, glm::normalize(d), i, static_cast<float>(cone)}};
   }
   if (type == "distant") {
     if (auto k = r.keys(j, ptr, {"type", "direction", "irradiance", "aperture"}); !k) return k.error();
     PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
-    PATHEX_TRY(e, r.vector3(j, "irradiance", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(e, r.light_value(j, "irradiance", ptr, true));
     if (!j.contains("aperture")) return r.fail(ptr + "/aperture", "missing aperture, expected {corner, edge1, edge2}: the window the light enters through");
     const std::string ap = ptr + "/aperture";
     if (auto k = r.keys(j["aperture"], ap, {"corner", "edge1", "edge2"}); !k) return k.error();
@@ -509,7 +562,7 @@ Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr)
     if (auto k = r.keys(j, ptr, {"type", "position", "direction", "power"}); !k) return k.error();
     PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
     PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
-    PATHEX_TRY(pw, r.vector3(j, "power", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(pw, r.light_value(j, "power", ptr, true));
     return Light{LaserLight{p, glm::normalize(d), pw}};
   }
   return r.fail(ptr + "/type", "unknown light type '" + type + "', expected point, spot, distant or laser (area lights are shapes with an emission)");
@@ -547,7 +600,7 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
   for (std::size_t i = 0; i < scene.material_names.size(); ++i)
     if (scene.material_names[i] == mat) s.material = static_cast<int>(i);
   if (s.material < 0) return r.fail(ptr + "/material", "unknown material '" + mat + "', expected a name defined in /materials");
-  PATHEX_TRY(em, r.vector3(j, "emission", ptr, false, vec3(0.0f), true));
+  PATHEX_TRY(em, r.light_value(j, "emission", ptr, false));
   s.emission = em;
   if (j.contains("two_sided")) {
     if (!j["two_sided"].is_boolean()) return r.fail(ptr + "/two_sided", "expected true or false");
@@ -621,21 +674,26 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
       scene.lights.push_back(std::move(l));
     }
   }
-  bool any_light = !scene.lights.empty();
-  for (const Shape& s : scene.shapes) any_light = any_light || s.emissive();
-  if (!any_light) return r.fail("/lights", "the scene has no light: expected an entry in /lights or a shape with an emission");
+  if (!has_light(scene)) return r.fail("/lights", kNoLight);
   // --- camera ---
   if (!doc.contains("camera")) return r.fail("/camera", "missing camera, expected {type, position, look_at, …}");
   PATHEX_TRY(cam, read_camera(r, doc["camera"], "/camera"));
   scene.camera = cam;
-  const ViewRegion view = view_region(cam);
-  bool sees = false;
-  for (const Shape& s : scene.shapes) sees = sees || region_meets_box(view, shape_bounds(s));
-  if (!sees) return r.fail("/camera", "the camera sees no geometry: no shape's bounding box meets its field of view");
+  if (!camera_sees_geometry(scene)) return r.fail("/camera", kSeesNothing);
   return scene;
 }
 
+std::optional<SceneRuleViolation> check_scene_rules(const Scene& scene) {
+  if (scene.shapes.empty()) return SceneRuleViolation{"/shapes", "the scene is empty: expected at least one shape"};
+  if (!has_light(scene)) return SceneRuleViolation{"/lights", kNoLight};
+  if (!camera_sees_geometry(scene)) return SceneRuleViolation{"/camera", kSeesNothing};
+  return std::nullopt;
+}
+
 Result<Scene> load_scene_file(const std::string& path, const SceneLoadOptions& options) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".pbrt") return load_scene_pbrt(path);
+  if (ext == ".xml") return load_scene_mitsuba(path);
   Result<std::string> text = read_input_file(path, options.max_file_bytes);
   if (!text) {
     if (text.error().code == ErrorCode::kLimit) return text.error();

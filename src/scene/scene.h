@@ -14,6 +14,7 @@
 // spot meter's ray). The test is exact for those boxes, so it never refuses a visible object.
 #pragma once
 
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -102,10 +103,30 @@ struct SceneLoadOptions {
 // is quadratic in its corners; a modeller's n-gons are far smaller).
 inline constexpr std::size_t kMaxFaceCorners = 1024;
 
+// The largest emission, intensity, irradiance or power component a scene may give. The tracer sums
+// contributions exactly in fixed point and counts one of 2^50 (about 1.1e15) or more as non-finite
+// (classify/histogram.h); 1e9 leaves a factor of 1e6 for what geometry and sampling multiply a
+// light's value by. Physical values stay far below it (the sun's radiance is about 2e7 W/(m^2 sr)).
+inline constexpr float kMaxLightValue = 1e9f;
+
 // `base_dir` resolves relative mesh paths; `name` prefixes error locations.
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
                               const SceneLoadOptions& options = {});
+// The entry point of every command: dispatches on the extension. `.pbrt` is a pbrt-v4 scene
+// (scene/pbrt_import.h), `.xml` a Mitsuba 3 scene (scene/mitsuba_import.h), anything else JSON.
 Result<Scene> load_scene_file(const std::string& path, const SceneLoadOptions& options = {});
+
+// An OBJ file's triangles (polygons fan-triangulated); errors name the OBJ file and line. The
+// result may have no triangles: callers say where the mesh was asked for.
+Result<MeshShape> load_obj_mesh(const std::string& path, const SceneLoadOptions& options = {});
+
+// The scene-level rules above (a shape, a light, a camera that sees a shape), which every loader
+// checks once the scene is complete: the first one violated, with the JSON pointer it concerns.
+struct SceneRuleViolation {
+  std::string pointer;
+  std::string message;
+};
+std::optional<SceneRuleViolation> check_scene_rules(const Scene& scene);
 
 // The scene embedded in the binary: a Cornell box with an area light, a mirror and a glass sphere.
 const char* default_scene_json();
