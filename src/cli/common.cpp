@@ -20,14 +20,21 @@ const CLI::Validator& non_negative() {
 }
 
 void add_limit_options(CLI::App* app, Limits* limits) {
+  // Each limit has a floor of 1 (0 for none would refuse everything) and the ceiling the engine
+  // provably survives (core/limits.h); a negative value is refused, never wrapped around.
   app->add_option("--max-states", limits->max_states, "Largest automaton (NFA or DFA states) to build")
-      ->capture_default_str()->group("Limits")->check(non_negative());
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxStatesCeiling))->group("Limits");
   app->add_option("--max-depth", limits->max_depth, "Deepest nesting of groups and operators")
-      ->capture_default_str()->group("Limits");
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(1, kMaxDepthCeiling))->group("Limits");
   app->add_option("--max-repeat", limits->max_repeat, "Largest count in {n}, {n,} and {n,m}")
-      ->capture_default_str()->group("Limits");
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(1, kMaxRepeatCeiling))->group("Limits");
   app->add_option("--max-length", limits->max_length, "Longest full-path string accepted as input")
-      ->capture_default_str()->group("Limits")->check(non_negative());
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxLengthCeiling))->group("Limits");
+  app->add_option("--max-work", limits->max_work,
+                  "Work budget of one operation: automaton states built, subset elements, counting cells")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxWorkCeiling))->group("Limits");
+  app->add_option("--max-file-size", limits->max_file_bytes, "Largest input file read (class, profile, check, scene, mesh), bytes")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxFileBytesCeiling))->group("Limits");
 }
 
 void add_notation_options(CLI::App* app, NotationOptions* n) {

@@ -87,7 +87,7 @@ std::string gib(std::uint64_t bytes) {
 int run(const TraceArgs& a) {
   // --- scene, profile, classes ---
   Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
-                                        : load_scene_file(a.scene);
+                                        : load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
   if (!scene) return report(scene.error());
   if (!a.resolution.empty())
     if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return report(r.error());

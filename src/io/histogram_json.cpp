@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/json_reader.h"
+
 namespace pathex {
 namespace {
 
@@ -347,15 +349,9 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
 }
 
 Result<HistogramFile> parse_histogram_json(const std::string& text, const std::string& filename) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& ex) {
-    Error e = make_error(ErrorCode::kBadFile, std::string("not valid JSON: ") + ex.what());
-    e.where = filename;
-    return e;
-  }
-  return histogram_from_json(doc, filename);
+  Result<json> doc = parse_ordered_json(text, filename);
+  if (!doc) return doc.error();
+  return histogram_from_json(*doc, filename);
 }
 
 }  // namespace pathex

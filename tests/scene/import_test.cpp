@@ -93,7 +93,7 @@ Rendered render_small(Scene scene, std::uint64_t seed, std::uint64_t spp) {
   o.seed = seed;
   o.threads = 2;
   o.max_bounces = 6;
-  const Profile profile = *resolve_profile("pt-nee", Limits{});
+  const Profile profile = resolve_profile("pt-nee", Limits{}).expect("a test input");
   Result<RenderOutput> out = render(scene, profile, nullptr, o);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
   RunInfo info;

@@ -38,6 +38,7 @@ Mean render_mean(const std::string& scene_json) {
   RenderOptions o;
   o.spp = 16;
   o.seed = 11;
+  ASSERT_TRUE(profile.ok());
   Result<RenderOutput> out = render(*scene, *profile, nullptr, o);
   EXPECT_TRUE(out.ok());
   if (!out) return {};
