@@ -158,8 +158,8 @@ TEST(Issue17Hangs, ProfilesThatTookSeconds) {
   EXPECT_EQ(m.out.substr(0, m.out.find('\n', m.out.find('\n') + 1)), "class     many         \nL.*DD.*E  partial      ");
   // A 5,000-letter chain: its shortest witness is 5,004 letters, and listing witnesses needs a
   // table of (length x states) cells past the budget: the query stops naming --max-work.
-  write(scratch("chain.json"), R"({"name": "long", "strategies": [{"s": 0, "chain": "D)" + std::string(4998, 'S') +
-                                    R"(D", "t": "0..", "connector": "manifold"}]})");
+  write(scratch("chain.json"), R"({"name": "long", "strategies": [{"s": 1, "chain": "D)" + std::string(4998, 'S') +
+                                    R"(D", "t": "1..", "connector": "manifold"}]})");
   const CliRun c = pathex({"query", "--renderer", scratch("chain.json").string(), "L.*E"});
   EXPECT_EQ(c.code, 2);
   EXPECT_EQ(c.err,
