@@ -216,11 +216,11 @@ TEST(LpeFullPathForm, IsTheClassAndFactorsTheEnds) {
     }
     EXPECT_EQ(full(*f), cls) << e["full"].get<std::string>() << " printed as " << *f;
   }
-  EXPECT_EQ(*full_path_expression(lpe("C<RD>L"), Limits{}), "L..D..E");
-  EXPECT_EQ(*full_path_expression(lpe("C<RD>S+L"), Limits{}), "L..S+D..E");
-  EXPECT_EQ(*full_path_expression(lpe("C.*DS+L"), Limits{}), "L..S+D.*..E");
-  EXPECT_EQ(*full_path_expression(lpe("CO"), Limits{}), "LDD..E");
-  EXPECT_EQ(*full_path_expression(lpe("C<RD>.*"), Limits{}), "L...*D..E");
+  EXPECT_EQ(full_path_expression(lpe("C<RD>L"), Limits{}).expect("a test input"), "L..D..E");
+  EXPECT_EQ(full_path_expression(lpe("C<RD>S+L"), Limits{}).expect("a test input"), "L..S+D..E");
+  EXPECT_EQ(full_path_expression(lpe("C.*DS+L"), Limits{}).expect("a test input"), "L..S+D.*..E");
+  EXPECT_EQ(full_path_expression(lpe("CO"), Limits{}).expect("a test input"), "LDD..E");
+  EXPECT_EQ(full_path_expression(lpe("C<RD>.*"), Limits{}).expect("a test input"), "L...*D..E");
 }
 
 // State elimination alone, on random DFAs of random expressions, printed in full notation.
