@@ -83,8 +83,12 @@ void warn_unreachable_lights(const Scene& scene, const Profile& profile, const C
         alternatives[type] = "";
         continue;
       }
+      // The built-in profiles are embedded texts; if the limits in force refuse one, the warning
+      // names no alternative rather than failing the render it only advises on.
+      Result<std::vector<Profile>> builtins = builtin_profiles(limits);
+      if (!builtins) continue;
       std::string others;
-      for (const Profile& other : builtin_profiles(limits)) {
+      for (const Profile& other : *builtins) {
         if (other.name == profile.name || !runnable_strategies(other)) continue;
         Result<CompiledProfile> oc = compile_profile(other, bound, limits);
         if (!oc) continue;

@@ -51,8 +51,8 @@ Result<bool> load_class_file(const std::string& text, const std::string& filenam
     // `pathex trace` writes a layer per class beside the image's own "total" layer (classes.exr,
     // total.png): a class of that name would collide with it only after the whole render.
     if (name == "total")
-      return file_error(filename, ptr + "/name",
-                        "the class name 'total' is reserved for the image's total layer, expected another name");
+      return reader.fail(ptr + "/name",
+                         "the class name 'total' is reserved for the image's total layer, expected another name");
     // Entries are full notation unless they say otherwise, whatever --notation says for the
     // command line's own expressions: a class file means the same thing in every command.
     ClassOptions opts = options;
