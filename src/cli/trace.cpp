@@ -1,6 +1,7 @@
 // pathex trace: render a scene, label every sampled path, write the path-class histogram, the
 // per-class EXR and PNG previews, and print where the light went, class by class, next to what the
 // checker says the renderer can reach.
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -12,16 +13,18 @@
 #include <sstream>
 #include <thread>
 
-#include "cli/common.h"
-#include "cli/reach_common.h"
 #include <nlohmann/json.hpp>
 
+#include "cli/common.h"
+#include "cli/reach_common.h"
+#include "cli/trace_checks.h"
 #include "io/atomic_file.h"
 #include "io/class_file.h"
 #include "io/histogram_json.h"
 #include "io/image_io.h"
 #include "io/output_set.h"
 #include "io/profile_json.h"
+#include "io/progress.h"
 #include "scene/universe.h"
 #include "trace/render.h"
 
@@ -41,6 +44,8 @@ struct TraceArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   std::optional<int> max_bounces;
+  std::string resolution;  // "WxH"; empty: the scene's
+  std::uint64_t max_paths = 1000;
   int top_paths = 8;
   bool json = false;
   bool quiet = false;
@@ -58,11 +63,19 @@ std::string percent(double share, int decimals = 1) {
   return buf;
 }
 
-std::string format_seconds(double s) {
-  char buf[32];
-  if (s < 60) std::snprintf(buf, sizeof buf, "%.0f s", s);
-  else std::snprintf(buf, sizeof buf, "%.0f min %02.0f s", std::floor(s / 60), std::fmod(s, 60));
+// An absolute estimate: the mean pixel luminance and its standard error, "0.01234 ± 0.00012".
+std::string absolute(const Estimate& e) {
+  char buf[64];
+  if (std::isfinite(e.std_error)) std::snprintf(buf, sizeof buf, "%.5f ± %.5f", e.luminance, e.std_error);
+  else std::snprintf(buf, sizeof buf, "%.5f (too few batches for an error)", e.luminance);
   return buf;
+}
+
+// The terminal's width in columns (stderr's), or 80 when it does not say.
+int terminal_columns() {
+  winsize w{};
+  if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &w) == 0 && w.ws_col > 0) return w.ws_col;
+  return 80;
 }
 
 std::string gib(std::uint64_t bytes) {
@@ -74,8 +87,10 @@ std::string gib(std::uint64_t bytes) {
 int run(const TraceArgs& a) {
   // --- scene, profile, classes ---
   Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
-                                        : load_scene_file(a.scene);
+                                        : load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
   if (!scene) return report(scene.error());
+  if (!a.resolution.empty())
+    if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return report(r.error());
   // The output folder is checked before the render, not after it.
   Result<OutputSet> out_set = OutputSet::prepare(a.out);
   if (!out_set) return report(out_set.error());
@@ -104,13 +119,19 @@ int run(const TraceArgs& a) {
   std::vector<ClassInfo> infos;
   for (const PathClass* c : classes) infos.push_back({c->name, c->text});
 
+  // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
+  const int bound = a.max_bounces.value_or(profile->max_bounces.value_or(16));
+  ReachCache cache(a.limits);
+  Result<const CompiledProfile*> cp = cache.compiled(a.renderer, bound);
+  if (!cp) return report(cp.error());
+  const Dfa universe = scene_universe(types);
+  warn_unreachable_lights(*scene, *profile, **cp, universe, bound, a.limits);
+
   // --- render ---
   RenderOptions ro;
   ro.spp = a.spp;
   ro.seed = a.seed;
   ro.threads = a.threads;
-  // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
-  const int bound = a.max_bounces.value_or(profile->max_bounces.value_or(16));
   ro.max_bounces = bound;
   // Without image outputs the render keeps the histogram alone (the same histogram).
   ro.images = !a.no_images;
@@ -132,12 +153,14 @@ int run(const TraceArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   if (show_progress) {
     ro.progress = [start](std::uint64_t done, std::uint64_t total) {
-      const double f = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
+      Progress p;
+      p.fraction = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
       const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const int bar = static_cast<int>(f * 30);
-      std::fprintf(stderr, "\r[%.*s%*s] %5.1f%%  %.2f M samples/s  %s left   ", bar, "##############################",
-                   30 - bar, "", 100 * f, el > 0 ? static_cast<double>(done) / el * 1e-6 : 0.0,
-                   format_seconds(f > 0 ? el / f - el : 0).c_str());
+      p.samples_per_s = el > 0 ? static_cast<double>(done) / el : 0.0;
+      p.seconds_left = p.fraction > 0 ? el / p.fraction - el : 0;
+      // Padded to the width it was fitted to, so a shorter line covers a longer one.
+      const int columns = terminal_columns();
+      std::fprintf(stderr, "\r%-*s", std::max(columns - 1, 0), progress_line(p, columns).c_str());
       std::fflush(stderr);
     };
   }
@@ -146,18 +169,19 @@ int run(const TraceArgs& a) {
   std::signal(SIGINT, on_sigint);
   Result<RenderOutput> out = render(*scene, *profile, &*classifier, ro);
   std::signal(SIGINT, SIG_DFL);
-  if (show_progress) std::fprintf(stderr, "\r%70s\r", "");
+  if (show_progress) std::fprintf(stderr, "\r%*s\r", std::max(terminal_columns() - 1, 0), "");
   if (!out) return report(out.error());
 
   RunInfo info;
   info.scene = scene_name;
   info.renderer = profile->name;
   info.spp = out->spp_done;
+  info.spp_requested = a.spp;
   info.seed = a.seed;
   info.threads = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
   info.time_s = out->time_s;
   info.complete = out->complete;
-  Result<HistogramReport> rep = make_report(out->histogram, info, &*classifier, infos);
+  Result<HistogramReport> rep = make_report(out->histogram, info, &*classifier, infos, a.max_paths);
   if (!rep) return report(rep.error());
 
   // --- outputs: one set, whole or not at all, shielded from signals (io/output_set.h) ---
@@ -193,25 +217,23 @@ int run(const TraceArgs& a) {
   }
 
   // --- the table: classes with the checker's verdict, then the most important exact paths ---
-  ReachCache cache(a.limits);
-  Result<const CompiledProfile*> cp = cache.compiled(a.renderer, bound);
-  if (!cp) return report(cp.error());
   QueryOptions qo;
-  qo.universe = scene_universe(types);
+  qo.universe = universe;
   qo.max_bounces = bound;
   qo.witnesses = 0;
   qo.max_len = 0;
   std::cout << "scene " << scene_name << ", renderer " << profile->name << ", " << out->spp_done << " spp, "
             << std::fixed << std::setprecision(2) << out->time_s << " s" << (out->complete ? "" : " (interrupted)")
             << ", non-finite samples " << rep->nonfinite_samples << "\n";
-  std::cout << "image mean luminance " << std::setprecision(5) << rep->total.luminance << " ± " << rep->total.std_error
-            << "\n\n";
+  std::cout << "image mean luminance " << absolute(rep->total) << "\n"
+            << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n\n";
   for (std::size_t i = 0; i < rep->classes.size(); ++i) {
     const ClassEstimate& c = rep->classes[i];
     Result<QueryResult> q = query(*classes[i], **cp, qo);
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
-              << "; " << profile->name << ": " << (q ? to_string(q->verdict) : "?") << "\n";
+              << "; " << profile->name << ": " << (q ? to_string(q->verdict) : "?") << "; luminance "
+              << absolute(c.estimate) << "\n";
   }
   if (!out->connectors.empty()) {
     int width = 10;
@@ -229,7 +251,7 @@ int run(const TraceArgs& a) {
     const double share = rep->total.luminance > 0 ? p.estimate.luminance / rep->total.luminance : 0.0;
     const double err = rep->total.luminance > 0 ? p.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << "  " << std::left << std::setw(16) << p.path << std::right << std::setw(8) << percent(share) << "  ±"
-              << percent(std::isfinite(err) ? err : 0.0, 2) << "  via";
+              << percent(std::isfinite(err) ? err : 0.0, 2) << "  luminance " << absolute(p.estimate) << "  via";
     for (const auto& [name, s] : p.strategies) std::cout << " " << name << " " << percent(s);
     std::cout << "\n";
   }
@@ -251,11 +273,16 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--renderer", args->renderer, "Renderer profile: built-in name or file")->capture_default_str();
   sub->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 24));
   sub->add_option("--classes", args->classes_file, "Class file; default: the built-in classes");
-  sub->add_option("--seed", args->seed, "Random seed")->capture_default_str();
+  sub->add_option("--seed", args->seed, "Random seed (0 to 2^64 - 1)")->capture_default_str()->check(non_negative());
   sub->add_option("--threads", args->threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
   sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices (k - 1); default: the profile's bound, else 16")
       ->check(CLI::Range(0, 1000));
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
+  sub->add_option("--resolution", args->resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
+      ->type_name("WxH");
+  sub->add_option("--max-paths", args->max_paths,
+                  "Rows of histogram.json's path table; the rest are summed into one \"other\" row")
+      ->capture_default_str()->check(non_negative());
   sub->add_option("--top", args->top_paths, "Exact paths to list")->capture_default_str()->check(CLI::Range(0, 100000));
   sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");

@@ -93,12 +93,12 @@ Rendered render_small(Scene scene, std::uint64_t seed, std::uint64_t spp) {
   o.seed = seed;
   o.threads = 2;
   o.max_bounces = 6;
-  const Profile profile = *resolve_profile("pt-nee", Limits{});
+  const Profile profile = resolve_profile("pt-nee", Limits{}).expect("a test input");
   Result<RenderOutput> out = render(scene, profile, nullptr, o);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
   RunInfo info;
   info.spp = spp;
-  Rendered r{*make_report(out->histogram, info, nullptr, {}), {}};
+  Rendered r{make_report(out->histogram, info, nullptr, {}).expect("a test input"), {}};
   const ImageLayer total = out->images.layer(0, 1.0 / static_cast<double>(spp));
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x)
