@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/common.h"
+#include "cli/estimate_text.h"
 #include "cli/reach_common.h"
 #include "cli/trace_checks.h"
 #include "io/atomic_file.h"
@@ -56,20 +57,6 @@ struct TraceArgs {
 
 std::atomic<bool> g_cancel{false};
 extern "C" void on_sigint(int) { g_cancel.store(true); }
-
-std::string percent(double share, int decimals = 1) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*f %%", decimals, 100.0 * share);
-  return buf;
-}
-
-// An absolute estimate: the mean pixel luminance and its standard error, "0.01234 ± 0.00012".
-std::string absolute(const Estimate& e) {
-  char buf[64];
-  if (std::isfinite(e.std_error)) std::snprintf(buf, sizeof buf, "%.5f ± %.5f", e.luminance, e.std_error);
-  else std::snprintf(buf, sizeof buf, "%.5f (too few batches for an error)", e.luminance);
-  return buf;
-}
 
 // The terminal's width in columns (stderr's), or 80 when it does not say.
 int terminal_columns() {
