@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/bias_common.h"
 #include "cli/common.h"
 #include "cli/estimate_text.h"
 #include "cli/reach_common.h"
@@ -51,6 +52,8 @@ struct TraceArgs {
   bool json = false;
   bool quiet = false;
   bool no_images = false;
+  bool missed = false;       // also measure what the renderer misses (pathex bias)
+  std::string reference;     // the reference for --missed; empty: bias's default
   std::uint64_t max_memory = kDefaultMaxMemory;
   Limits limits;
 };
@@ -171,6 +174,21 @@ int run(const TraceArgs& a) {
   Result<HistogramReport> rep = make_report(out->histogram, info, &*classifier, infos, a.max_paths);
   if (!rep) return report(rep.error());
 
+  // --- --missed: a reference render of the same scene, spp and seed measures what this one misses ---
+  std::optional<BiasReport> missed;
+  if (a.missed) {
+    BiasOptions bo;
+    bo.spp = a.spp;
+    bo.seed = a.seed;
+    bo.threads = a.threads;
+    bo.renderer_bounces = bound;  // what this render could sample: its own bound
+    bo.images = false;
+    bo.limits = a.limits;
+    Result<BiasRun> b = measure_missed(*scene, scene_name, *profile, a.reference, {}, bo);
+    if (!b) return report(b.error());
+    missed = std::move(b->report);
+  }
+
   // --- outputs: one set, whole or not at all, shielded from signals (io/output_set.h) ---
   // histogram.json, plus what each connector did ("connectors": [{strategy, connector, attempts,
   // successes, failures {outside, occluded, no_transport}}] in the profile's order; absent when the
@@ -186,6 +204,14 @@ int run(const TraceArgs& a) {
                       {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
     doc["connectors"] = std::move(list);
   }
+  if (missed)
+    doc["missed"] = {{"reference", missed->reference},
+                     {"reference_max_bounces", missed->reference_bounces},
+                     {"luminance", missed->missed.luminance},
+                     {"stderr", std::isfinite(missed->missed.std_error) ? nlohmann::ordered_json(missed->missed.std_error) : nlohmann::ordered_json(nullptr)},
+                     {"share", missed->share},
+                     {"share_stderr", missed->share_std_error},
+                     {"exact", missed->covered}};
   const std::string json_text = doc.dump(2) + "\n";
   {
     const SignalShield shield;
@@ -213,7 +239,9 @@ int run(const TraceArgs& a) {
             << std::fixed << std::setprecision(2) << out->time_s << " s" << (out->complete ? "" : " (interrupted)")
             << ", non-finite samples " << rep->nonfinite_samples << "\n";
   std::cout << "image mean luminance " << absolute(rep->total) << "\n"
-            << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n\n";
+            << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n";
+  if (missed) std::cout << "this renderer " << missed_line(*missed).substr(missed->renderer.size() + 1) << "\n";
+  std::cout << "\n";
   for (std::size_t i = 0; i < rep->classes.size(); ++i) {
     const ClassEstimate& c = rep->classes[i];
     Result<QueryResult> q = query(*classes[i], **cp, qo);
@@ -273,6 +301,10 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--top", args->top_paths, "Exact paths to list")->capture_default_str()->check(CLI::Range(0, 100000));
   sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
+  sub->add_flag("--missed", args->missed,
+                "Also render the reference (pathex bias) and print what share of its light this renderer cannot sample");
+  sub->add_option("--reference", args->reference, "The reference of --missed; default: bdpt plus the connectors the scene needs")
+      ->needs("--missed");
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs and the per-pixel sums behind them (the histogram is the same)");
   sub->add_option("--max-memory", args->max_memory,
                   "Refuse a render whose images (and their writing) would take more, estimated before rendering; e.g. 512M, 16G")
