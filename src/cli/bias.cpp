@@ -12,6 +12,7 @@
 #include "cli/bias_common.h"
 #include "cli/common.h"
 #include "cli/estimate_text.h"
+#include "cli/render_watch.h"
 #include "cli/trace_checks.h"
 #include "cli/witness_text.h"
 #include "io/atomic_file.h"
@@ -34,6 +35,7 @@ struct BiasArgs {
   int top_paths = 8;
   bool json = false;
   bool no_images = false;
+  bool quiet = false;
 };
 
 void print_text(const BiasReport& r, int top, const std::string& out_dir, bool images) {
@@ -109,7 +111,12 @@ int run(BiasArgs a) {
 
   // --- the reference render and what the renderer misses ---
   a.options.images = !a.no_images;
-  Result<BiasRun> run = measure_missed(*scene, a.scene, *renderer, a.reference, *classes, a.options);
+  Result<BiasRun> run = [&] {
+    const RenderWatch watch(!a.quiet);
+    a.options.progress = watch.progress();
+    a.options.cancel = watch.cancel();
+    return measure_missed(*scene, a.scene, *renderer, a.reference, *classes, a.options);
+  }();
   if (!run) return report(run.error());
   run->histogram.run.threads = a.options.threads > 0 ? a.options.threads : static_cast<int>(std::thread::hardware_concurrency());
   const nlohmann::ordered_json doc = to_json(run->report);
@@ -146,7 +153,7 @@ Command add_bias(CLI::App& app) {
               "Renders the scene once with the reference (default: bdpt plus every connector the scene's universe\n"
               "needs) and reports the light the renderer cannot sample, with the checker's reasons. Writes\n"
               "DIR/bias.json, DIR/histogram.json, DIR/classes.exr, DIR/missed.exr and DIR/<layer>.png (missed.png\n"
-              "on the total's exposure).");
+              "on the total's exposure). Ctrl-C stops early and writes what was rendered (exit 1).");
   sub->add_option("SCENE", args->scene, "Scene file (grammar/scene.schema.json)")->required();
   sub->add_option("--renderer", args->renderer, "The renderer profile to measure: built-in name or file")->required();
   sub->add_option("--reference", args->reference,
@@ -166,6 +173,7 @@ Command add_bias(CLI::App& app) {
   sub->add_option("--top", args->top_paths, "Missed exact paths to list (bias.json has all)")->capture_default_str()->check(CLI::Range(0, 100000));
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
   sub->add_flag("--json", args->json, "Print bias.json to stdout instead of the table");
+  sub->add_flag("--quiet", args->quiet, "No progress bar");
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs (the numbers are the same)");
   add_limit_options(sub, &args->options.limits);
   return {sub, [args] { return run(*args); }};

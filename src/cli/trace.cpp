@@ -1,11 +1,7 @@
 // pathex trace: render a scene, label every sampled path, write the path-class histogram, the
 // per-class EXR and PNG previews, and print where the light went, class by class, next to what the
 // checker says the renderer can reach.
-#include <sys/ioctl.h>
-#include <unistd.h>
-
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
@@ -18,6 +14,7 @@
 #include "cli/bias_common.h"
 #include "cli/common.h"
 #include "cli/estimate_text.h"
+#include "cli/render_watch.h"
 #include "cli/reach_common.h"
 #include "cli/trace_checks.h"
 #include "io/atomic_file.h"
@@ -26,7 +23,6 @@
 #include "io/image_io.h"
 #include "io/output_set.h"
 #include "io/profile_json.h"
-#include "io/progress.h"
 #include "scene/universe.h"
 #include "trace/render.h"
 
@@ -58,16 +54,6 @@ struct TraceArgs {
   Limits limits;
 };
 
-std::atomic<bool> g_cancel{false};
-extern "C" void on_sigint(int) { g_cancel.store(true); }
-
-// The terminal's width in columns (stderr's), or 80 when it does not say.
-int terminal_columns() {
-  winsize w{};
-  if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &w) == 0 && w.ws_col > 0) return w.ws_col;
-  return 80;
-}
-
 std::string gib(std::uint64_t bytes) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(bytes) / static_cast<double>(std::uint64_t{1} << 30));
@@ -89,21 +75,11 @@ int run(const TraceArgs& a) {
   if (!profile) return report(profile.error());
   if (Result<StrategySet> runnable = runnable_strategies(*profile); !runnable) return report(runnable.error());
 
-  ClassOptions copts;
-  copts.limits = a.limits;
   const SceneTypes types = scene_types(*scene);
-  copts.ends.lights.assign(types.lights.begin(), types.lights.end());
-  copts.ends.sensors = {types.sensor};
   ClassTable table;
-  std::vector<const PathClass*> classes;
-  if (!a.classes_file.empty()) {
-    Result<bool> r = read_class_file(a.classes_file, copts, &table);
-    if (!r) return report(r.error());
-    for (const auto& c : table.user_classes()) classes.push_back(c.get());
-  } else {
-    for (const auto& c : ClassTable::builtins().builtin_classes())
-      if (c->name != "all") classes.push_back(c.get());
-  }
+  Result<std::vector<const PathClass*>> listed = render_classes(a.classes_file, *scene, a.limits, &table);
+  if (!listed) return report(listed.error());
+  const std::vector<const PathClass*>& classes = *listed;
   Result<Classifier> classifier = Classifier::build(classes, a.limits);
   if (!classifier) return report(classifier.error());
   std::vector<ClassInfo> infos;
@@ -139,27 +115,12 @@ int run(const TraceArgs& a) {
     e.where = scene_name + ":/camera";
     return report(e);
   }
-  const bool show_progress = !a.quiet && ::isatty(STDERR_FILENO);
-  const auto start = std::chrono::steady_clock::now();
-  if (show_progress) {
-    ro.progress = [start](std::uint64_t done, std::uint64_t total) {
-      Progress p;
-      p.fraction = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
-      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      p.samples_per_s = el > 0 ? static_cast<double>(done) / el : 0.0;
-      p.seconds_left = p.fraction > 0 ? el / p.fraction - el : 0;
-      // Padded to the width it was fitted to, so a shorter line covers a longer one.
-      const int columns = terminal_columns();
-      std::fprintf(stderr, "\r%-*s", std::max(columns - 1, 0), progress_line(p, columns).c_str());
-      std::fflush(stderr);
-    };
-  }
-  g_cancel.store(false);
-  ro.cancel = &g_cancel;
-  std::signal(SIGINT, on_sigint);
-  Result<RenderOutput> out = render(*scene, *profile, &*classifier, ro);
-  std::signal(SIGINT, SIG_DFL);
-  if (show_progress) std::fprintf(stderr, "\r%*s\r", std::max(terminal_columns() - 1, 0), "");
+  Result<RenderOutput> out = [&] {
+    const RenderWatch watch(!a.quiet);
+    ro.progress = watch.progress();
+    ro.cancel = watch.cancel();
+    return render(*scene, *profile, &*classifier, ro);
+  }();
   if (!out) return report(out.error());
 
   RunInfo info;
@@ -184,6 +145,9 @@ int run(const TraceArgs& a) {
     bo.renderer_bounces = bound;  // what this render could sample: its own bound
     bo.images = false;
     bo.limits = a.limits;
+    const RenderWatch watch(!a.quiet);
+    bo.progress = watch.progress();
+    bo.cancel = watch.cancel();
     Result<BiasRun> b = measure_missed(*scene, scene_name, *profile, a.reference, {}, bo);
     if (!b) return report(b.error());
     missed = std::move(b->report);
