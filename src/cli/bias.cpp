@@ -50,7 +50,7 @@ void print_text(const BiasReport& r, int top, const std::string& out_dir, bool i
               << r.reference_bounces << " interior vertices (the checker proves it), so the missed light is 0 exactly\n";
   else
     std::cout << r.renderer << " misses " << absolute(r.missed) << ", " << percent(r.share) << " ± "
-              << percent(r.share_std_error, 2) << " of the image (missed.exr, missed.png)\n";
+              << percent(r.share_std_error, 2) << " of the image" << (images ? " (missed.exr, missed.png)" : "") << "\n";
   if (r.shortest) std::cout << "shortest path it cannot sample: " << witness_line(*r.shortest) << "\n";
 
   int width = 8;
