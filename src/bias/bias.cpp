@@ -198,6 +198,10 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
   // Missed paths: R's verdict once per distinct path of the histogram (its rows), never per sample.
   for (const PathEstimate& p : hist->paths) {
     if (r->reachable.accepts(p.path)) continue;
+    if (rep.paths.size() >= o.max_paths) {
+      ++rep.other_missed_paths;
+      continue;
+    }
     MissedPath mp;
     mp.estimate = p;
     mp.share = rep.total.luminance > 0 ? p.estimate.luminance / rep.total.luminance : 0.0;
@@ -213,7 +217,12 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
     rep.neither_finite = is_finite(neither);
   }
 
-  // histogram.json keeps the user's classes and "missed"; the per-class parts are in the report.
+  // histogram.json keeps the user's classes and "missed" (the per-class parts are in the report)
+  // and, like trace's, max_paths rows and one "other" row summing the rest exactly.
+  if (hist->paths.size() > o.max_paths) {
+    hist = make_report(out->histogram, info, &*classifier, infos, o.max_paths);
+    if (!hist) return hist.error();
+  }
   hist->classes.resize(static_cast<std::size_t>(n + 1));
   return BiasRun{std::move(rep), std::move(*out), std::move(*hist)};
 }

@@ -76,8 +76,8 @@ void print_text(const BiasReport& r, int top, const std::string& out_dir, bool i
               << "  " << absolute(p.estimate.estimate) << "  chains " << chains_text(p.chains) << "; " << p.reason
               << "\n";
   }
-  if (static_cast<int>(r.paths.size()) > top)
-    std::cout << "  … " << r.paths.size() - static_cast<std::size_t>(top) << " more in bias.json (--top)\n";
+  const std::uint64_t more = r.paths.size() - std::min(r.paths.size(), static_cast<std::size_t>(top)) + r.other_missed_paths;
+  if (more > 0) std::cout << "  … " << more << " more (bias.json lists " << r.paths.size() << "; --top, --max-paths)\n";
 
   std::cout << "\nnot counted\n";
   if (r.neither.empty()) {
@@ -170,6 +170,9 @@ Command add_bias(CLI::App& app) {
       ->check(CLI::Range(0, kMaxReferenceBounces));
   sub->add_option("--resolution", args->resolution, "Image size WIDTHxHEIGHT, such as 64x64; default: the scene's")->type_name("WxH");
   sub->add_option("--witnesses", args->options.witnesses, "Paths neither renderer samples to show")->capture_default_str()->check(CLI::Range(1, 100));
+  sub->add_option("--max-paths", args->options.max_paths,
+                  "Rows of the path tables of histogram.json and bias.json; the rest are summed (histogram.json) or counted (bias.json)")
+      ->capture_default_str()->check(non_negative());
   sub->add_option("--top", args->top_paths, "Missed exact paths to list (bias.json has all)")->capture_default_str()->check(CLI::Range(0, 100000));
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
   sub->add_flag("--json", args->json, "Print bias.json to stdout instead of the table");

@@ -111,6 +111,7 @@ nlohmann::ordered_json to_json(const BiasReport& r) {
     paths.push_back(jp);
   }
   j["paths"] = paths;
+  j["other_missed_paths"] = r.other_missed_paths;
   J neither = J::array();
   for (const Witness& w : r.neither) neither.push_back(J(to_json(w)));
   j["not_counted"] = {
