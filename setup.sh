@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 packages=(build-essential cmake pkg-config
   libembree-dev libtbb-dev libglm-dev libcli11-dev nlohmann-json3-dev
-  libtinyobjloader-dev libopenexr-dev libpng-dev
+  libtinyobjloader-dev libopenexr-dev libpng-dev zlib1g-dev libopenmpi-dev openmpi-bin
   libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev libpugixml-dev)
 missing=()
 for p in "${packages[@]}"; do

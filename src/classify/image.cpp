@@ -102,7 +102,7 @@ void ClassImages::release() {
   planes_.reset();
 }
 
-std::uint64_t* ClassImages::words(std::size_t slot, int x, int y) {
+std::uint64_t* ClassImages::tile(std::size_t slot, std::size_t tile) {
   // Both levels are allocated on first use; a thread that loses the race to install one frees
   // its own and uses the winner's.
   TileDirectory* dir = planes_[slot].load(std::memory_order_acquire);
@@ -115,17 +115,31 @@ std::uint64_t* ClassImages::words(std::size_t slot, int x, int y) {
       delete[] fresh;
     }
   }
-  std::atomic<std::uint64_t*>& entry = dir[tile_index(x, y)];
-  std::uint64_t* tile = entry.load(std::memory_order_acquire);
-  if (tile == nullptr) {
+  std::atomic<std::uint64_t*>& entry = dir[tile];
+  std::uint64_t* words = entry.load(std::memory_order_acquire);
+  if (words == nullptr) {
     auto* fresh = new std::uint64_t[kTileWords]();
-    if (entry.compare_exchange_strong(tile, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) {
-      tile = fresh;
+    if (entry.compare_exchange_strong(words, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) {
+      words = fresh;
     } else {
       delete[] fresh;
     }
   }
-  return tile + in_tile_index(x, y);
+  return words;
+}
+
+const std::uint64_t* ClassImages::tile_words(std::size_t plane, std::size_t tile) const {
+  const TileDirectory* dir = planes_ ? planes_[plane].load(std::memory_order_acquire) : nullptr;
+  return dir != nullptr ? dir[tile].load(std::memory_order_acquire) : nullptr;
+}
+
+void ClassImages::add_tile(std::size_t plane, std::size_t tile_id, const std::uint64_t* src) {
+  std::uint64_t* dst = tile(plane, tile_id);
+  for (std::size_t i = 0; i < kTileWords; i += 2) {
+    const ExactSum v = load(&dst[i]) + load(&src[i]);
+    dst[i] = static_cast<std::uint64_t>(v);
+    dst[i + 1] = static_cast<std::uint64_t>(v >> 64);
+  }
 }
 
 const std::uint64_t* ClassImages::words_if_any(std::size_t slot, int x, int y) const {
@@ -160,17 +174,8 @@ Result<bool> ClassImages::merge(const ClassImages& other) {
   if (other.width_ != width_ || other.height_ != height_ || other.names_ != names_ || other.num_slots_ != num_slots_)
     return make_error(ErrorCode::kUsage, "cannot merge images of different sizes or layers");
   for (std::size_t slot = 0; slot < num_slots_; ++slot)
-    for (int y = 0; y < height_; ++y)
-      for (int x = 0; x < width_; ++x) {
-        const std::uint64_t* src = other.words_if_any(slot, x, y);
-        if (src == nullptr) continue;
-        std::uint64_t* dst = words(slot, x, y);
-        for (std::size_t i = 0; i < 6; i += 2) {
-          const ExactSum v = load(&dst[i]) + load(&src[i]);
-          dst[i] = static_cast<std::uint64_t>(v);
-          dst[i + 1] = static_cast<std::uint64_t>(v >> 64);
-        }
-      }
+    for (std::size_t t = 0; t < num_tiles(); ++t)
+      if (const std::uint64_t* src = other.tile_words(slot, t)) add_tile(slot, t, src);
   return true;
 }
 

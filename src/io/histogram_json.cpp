@@ -145,8 +145,6 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
   doc["renderer"] = r.run.renderer;
   doc["spp"] = r.run.spp;
   doc["seed"] = r.run.seed;
-  doc["threads"] = r.run.threads;
-  doc["time_s"] = r.run.time_s;
   doc["complete"] = r.run.complete;
   doc["nonfinite_samples"] = r.nonfinite_samples;
   json total = json::object();
@@ -281,13 +279,6 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
   r.run.renderer = rd.str(doc, "", "renderer");
   r.run.spp = rd.uint(doc, "", "spp");
   r.run.seed = rd.uint(doc, "", "seed");
-  if (const json* t = rd.field(doc, "", "threads")) {
-    if (!t->is_number_integer() || t->get<std::int64_t>() < 0 || t->get<std::int64_t>() > 1 << 20)
-      rd.fail("/threads", "expected a thread count");
-    else
-      r.run.threads = t->get<int>();
-  }
-  r.run.time_s = rd.number(doc, "", "time_s");
   r.run.complete = rd.boolean(doc, "", "complete");
   r.nonfinite_samples = rd.uint(doc, "", "nonfinite_samples");
   if (const json* t = rd.field(doc, "", "total")) r.total = rd.estimate(*t, "/total", /*samples_required=*/false);

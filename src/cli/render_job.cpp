@@ -1,0 +1,170 @@
+#include "cli/render_job.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "io/atomic_file.h"
+#include "io/class_file.h"
+#include "io/histogram_json.h"
+#include "io/image_io.h"
+
+namespace pathex::cli {
+
+Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string& text, const std::string& filename,
+                                                              const RenderIdentity& identity, const Limits& limits) {
+  ClassOptions copts;
+  copts.limits = limits;
+  for (const std::string& l : identity.lights) {
+    const std::optional<LightType> t = light_type_from_string(l);
+    if (!t) return make_error(ErrorCode::kBadValue, "unknown light type \"" + l + "\"");
+    copts.ends.lights.push_back(*t);
+  }
+  const std::optional<SensorType> sensor = sensor_type_from_string(identity.sensor);
+  if (!sensor) return make_error(ErrorCode::kBadValue, "unknown sensor type \"" + identity.sensor + "\"");
+  copts.ends.sensors = {*sensor};
+  auto out = std::make_unique<RenderClasses>();
+  if (!filename.empty()) {
+    Result<bool> r = load_class_file(text, filename, copts, &out->table);
+    if (!r) return r.error();
+    for (const auto& c : out->table.user_classes()) out->classes.push_back(c.get());
+  } else {
+    for (const auto& c : ClassTable::builtins().builtin_classes())
+      if (c->name != "all") out->classes.push_back(c.get());
+  }
+  Result<Classifier> classifier = Classifier::build(out->classes, limits);
+  if (!classifier) return classifier.error();
+  out->classifier = std::make_unique<Classifier>(std::move(*classifier));
+  for (const PathClass* c : out->classes) out->infos.push_back({c->name, c->text});
+  return out;
+}
+
+RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& classes) {
+  HistogramLayout layout;
+  layout.num_batches = identity.batches;
+  layout.strategies = identity.strategies;
+  std::vector<int> layers;
+  if (identity.images)
+    for (int i = 0; i < classes.classifier->num_classes(); ++i) layers.push_back(i);
+  return {Histogram(layout, classes.classifier.get()),
+          identity.images ? ClassImages(identity.width, identity.height, classes.classifier.get(), layers)
+                          : ClassImages(0, 0, nullptr, {})};
+}
+
+Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
+                                           const RenderClasses& classes) {
+  const RenderIdentity& id = header.identity;
+  RunInfo info;
+  info.scene = id.scene;
+  info.renderer = id.renderer;
+  info.spp = header.passes.count();
+  info.seed = id.seed;
+  info.complete = header.passes == header.share;
+  Result<HistogramReport> rep = make_report(sums.histogram, info, classes.classifier.get(), classes.infos);
+  if (!rep) return rep.error();
+
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return make_error(ErrorCode::kBadFile, "cannot create the output folder " + dir + ": " + ec.message());
+  WrittenReport out{std::move(*rep), {}};
+  out.json_text = histogram_json_text(out.report);
+  if (Result<bool> w = write_file_atomic(dir + "/histogram.json", out.json_text); !w) return w.error();
+  if (id.images) {
+    const std::uint64_t spp = header.passes.count();
+    const std::vector<ImageLayer> layers = sums.images.layers(spp ? 1.0 / static_cast<double>(spp) : 0.0);
+    if (Result<bool> w = write_exr(dir + "/classes.exr", layers); !w) return w.error();
+    if (Result<bool> w = write_previews(dir, layers); !w) return w.error();
+  }
+  if (Result<bool> w = write_file_atomic(dir + "/" + kRenderShardName, encode_shard(header, sums.histogram, sums.images)); !w)
+    return w.error();
+  nlohmann::ordered_json run = nlohmann::ordered_json::object();
+  run["time_s"] = header.run.time_s;
+  run["threads"] = header.run.threads;
+  run["rays"] = header.run.rays;
+  run["passes"] = header.passes.to_string();
+  if (Result<bool> w = write_file_atomic(dir + "/run.json", run.dump(2) + "\n"); !w) return w.error();
+  return out;
+}
+
+Result<std::vector<ShardFile>> read_render_folder(const std::string& dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    Error e = make_error(ErrorCode::kBadFile, "not a render folder (no such directory)");
+    e.where = dir;
+    return e;
+  }
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
+    if (entry.path().extension() == kShardExtension) names.push_back(entry.path().string());
+  if (ec) {
+    Error e = make_error(ErrorCode::kBadFile, "cannot list the folder: " + ec.message());
+    e.where = dir;
+    return e;
+  }
+  if (names.empty()) {
+    Error e = make_error(ErrorCode::kBadFile,
+                         std::string("no shard file (*") + kShardExtension + ") in the folder: is it a pathex trace output folder?");
+    e.where = dir;
+    return e;
+  }
+  std::sort(names.begin(), names.end());
+  std::vector<ShardFile> out;
+  for (const std::string& n : names) {
+    Result<ShardFile> f = read_shard(n);
+    if (!f) return f.error();
+    out.push_back(std::move(*f));
+  }
+  return out;
+}
+
+Result<CombinedRender> combine_shards(const std::vector<ShardFile>& files, const Limits& limits) {
+  const ShardFile& first = files.front();
+  ShardHeader header;
+  header.identity = first.header.identity;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const ShardHeader& h = files[i].header;
+    if (i > 0) {
+      if (std::optional<std::string> d = identity_difference(h.identity, first.header.identity))
+        return make_error(ErrorCode::kUsage, files[i].path + " and " + first.path + " are not of one render: " + *d);
+      const PassSet both = header.passes.intersect(h.passes);
+      if (!both.empty()) {
+        std::size_t j = 0;
+        while (files[j].header.passes.intersect(h.passes).empty()) ++j;
+        const PassSet overlap = files[j].header.passes.intersect(h.passes);
+        return make_error(ErrorCode::kUsage, "passes " + overlap.to_string() + " are in both " + files[j].path + " and " +
+                                                 files[i].path + ": the renders to merge must hold disjoint passes");
+      }
+    }
+    header.spp = std::max(header.spp, h.spp);
+    header.share.add(h.share);
+    header.passes.add(h.passes);
+    header.run.time_s += h.run.time_s;
+    header.run.threads = std::max(header.run.threads, h.run.threads);
+    header.run.rays += h.run.rays;
+  }
+  const RenderIdentity& id = header.identity;
+  Result<std::unique_ptr<RenderClasses>> classes = compile_render_classes(id.classes_text, id.classes_file, id, limits);
+  if (!classes) {
+    Error e = classes.error();
+    e.message = "the class file recorded in " + first.path + " does not compile: " + e.message;
+    return e;
+  }
+  RenderSums sums = empty_sums(id, **classes);
+  CombinedRender out{std::move(header), std::move(*classes), std::move(sums)};
+  for (const ShardFile& f : files)
+    if (Result<bool> r = add_shard_sums(f, &out.sums.histogram, &out.sums.images); !r) return r.error();
+  return out;
+}
+
+}  // namespace pathex::cli
+
+namespace pathex::cli {
+namespace {
+Cluster* g_cluster = nullptr;
+}  // namespace
+
+Cluster* current_cluster() { return g_cluster; }
+void set_cluster(Cluster* cluster) { g_cluster = cluster; }
+
+}  // namespace pathex::cli
