@@ -6,7 +6,7 @@ cd "$(dirname "$0")"
 packages=(build-essential cmake pkg-config
   libembree-dev libtbb-dev libglm-dev libcli11-dev nlohmann-json3-dev
   libtinyobjloader-dev libopenexr-dev libpng-dev zlib1g-dev libopenmpi-dev openmpi-bin
-  libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev libpugixml-dev)
+  libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev libpugixml-dev libassimp-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Scale-out figures (issue 16), from the build in ./build:
 #   merge    `pathex merge` of 16 shards of a 512 x 512 render with the twenty classes
-#            (samples/classes/twenty.json), median wall time of 3 merges (target < 2 s);
+#            (samples/classes/twenty.json), median wall and CPU time of 3 merges (target < 2 s);
 #   size     the shard files against the outputs of the same render (target <= 2x): the
 #            single render's render.shard against its histogram.json + classes.exr + PNGs, and
 #            the 16 shards' files against theirs;
@@ -32,16 +32,15 @@ if [ "$what" = merge ] || [ "$what" = size ] || [ "$what" = all ]; then
     done
   fi
   if [ "$what" != size ]; then
-    times=()
+    times=(); cpus=()
     for r in 1 2 3; do
       rm -rf "$work/merged"
-      t0=$(now)
-      "$P" merge "$work"/s{0..15} --quiet --out "$work/merged"
-      t1=$(now)
-      times+=("$(echo "$t1 - $t0" | bc -l)")
+      /usr/bin/time -f '%e %U %S' -o "$work/time.txt" "$P" merge "$work"/s{0..15} --quiet --out "$work/merged"
+      read -r wall user sys < "$work/time.txt"
+      times+=("$wall"); cpus+=("$(echo "$user + $sys" | bc -l)")
     done
-    printf 'merge of 16 shards (512x512, 20 classes, 16 spp): %s s (median of %s)\n' \
-      "$(printf '%s\n' "${times[@]}" | median)" "$(printf '%.3f ' "${times[@]}")"
+    printf 'merge of 16 shards (512x512, 20 classes, 16 spp): wall %s s, CPU (user + sys) %s s (medians of 3; load average %s)\n' \
+      "$(printf '%s\n' "${times[@]}" | median)" "$(printf '%s\n' "${cpus[@]}" | median)" "$(cut -d' ' -f1-3 /proc/loadavg)"
   fi
   if [ "$what" != merge ]; then
     [ -f "$work/merged/render.shard" ] || "$P" merge "$work"/s{0..15} --quiet --out "$work/merged"

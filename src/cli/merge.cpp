@@ -6,7 +6,6 @@
 
 #include "cli/common.h"
 #include "cli/render_job.h"
-#include "core/version.h"
 
 namespace pathex::cli {
 namespace {
@@ -20,16 +19,12 @@ struct MergeArgs {
 };
 
 int run(const MergeArgs& a) {
-  std::vector<ShardFile> files;
+  std::vector<std::string> files;
   for (const std::string& dir : a.dirs) {
-    Result<std::vector<ShardFile>> f = read_render_folder(dir);
+    Result<std::vector<std::string>> f = render_folder_shards(dir);
     if (!f) return report(f.error());
-    for (ShardFile& file : *f) files.push_back(std::move(file));
+    files.insert(files.end(), f->begin(), f->end());
   }
-  for (const ShardFile& f : files)
-    if (f.header.identity.pathex != pathex_version())
-      return report(make_error(ErrorCode::kUsage, f.path + " was rendered by another pathex version (" + f.header.identity.pathex +
-                                                      " against " + pathex_version() + ")"));
   Result<CombinedRender> combined = combine_shards(files, a.limits);
   if (!combined) return report(combined.error());
   ShardHeader& header = combined->header;

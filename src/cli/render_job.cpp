@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
+#include "core/version.h"
 #include "io/atomic_file.h"
 #include "io/class_file.h"
 #include "io/histogram_json.h"
@@ -87,7 +89,7 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
   return out;
 }
 
-Result<std::vector<ShardFile>> read_render_folder(const std::string& dir) {
+Result<std::vector<std::string>> render_folder_shards(const std::string& dir) {
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) {
     Error e = make_error(ErrorCode::kBadFile, "not a render folder (no such directory)");
@@ -109,52 +111,52 @@ Result<std::vector<ShardFile>> read_render_folder(const std::string& dir) {
     return e;
   }
   std::sort(names.begin(), names.end());
-  std::vector<ShardFile> out;
-  for (const std::string& n : names) {
-    Result<ShardFile> f = read_shard(n);
-    if (!f) return f.error();
-    out.push_back(std::move(*f));
-  }
-  return out;
+  return names;
 }
 
-Result<CombinedRender> combine_shards(const std::vector<ShardFile>& files, const Limits& limits) {
-  const ShardFile& first = files.front();
-  ShardHeader header;
-  header.identity = first.header.identity;
-  for (std::size_t i = 0; i < files.size(); ++i) {
-    const ShardHeader& h = files[i].header;
-    if (i > 0) {
-      if (std::optional<std::string> d = identity_difference(h.identity, first.header.identity))
-        return make_error(ErrorCode::kUsage, files[i].path + " and " + first.path + " are not of one render: " + *d);
-      const PassSet both = header.passes.intersect(h.passes);
-      if (!both.empty()) {
-        std::size_t j = 0;
-        while (files[j].header.passes.intersect(h.passes).empty()) ++j;
-        const PassSet overlap = files[j].header.passes.intersect(h.passes);
-        return make_error(ErrorCode::kUsage, "passes " + overlap.to_string() + " are in both " + files[j].path + " and " +
-                                                 files[i].path + ": the renders to merge must hold disjoint passes");
+Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits) {
+  std::optional<CombinedRender> out;
+  std::vector<std::pair<std::string, PassSet>> seen;  // each file's passes, for naming an overlap
+  for (const std::string& path : paths) {
+    Result<ShardFile> file = read_shard(path);
+    if (!file) return file.error();
+    const ShardHeader& h = file->header;
+    if (h.identity.pathex != pathex_version())
+      return make_error(ErrorCode::kUsage, path + " was rendered by another pathex version (" + h.identity.pathex + " against " +
+                                               pathex_version() + ")");
+    if (!out) {
+      // The first file fixes the render: its classes are compiled and its layout laid out.
+      Result<std::unique_ptr<RenderClasses>> classes =
+          compile_render_classes(h.identity.classes_text, h.identity.classes_file, h.identity, limits);
+      if (!classes) {
+        Error e = classes.error();
+        e.message = "the class file recorded in " + path + " does not compile: " + e.message;
+        return e;
       }
+      RenderSums sums = empty_sums(h.identity, **classes);
+      ShardHeader header;
+      header.identity = h.identity;
+      out.emplace(CombinedRender{std::move(header), std::move(*classes), std::move(sums)});
+    } else {
+      if (std::optional<std::string> d = identity_difference(h.identity, out->header.identity))
+        return make_error(ErrorCode::kUsage, path + " and " + seen.front().first + " are not of one render: " + *d);
+      for (const auto& [other, passes] : seen)
+        if (const PassSet both = passes.intersect(h.passes); !both.empty())
+          return make_error(ErrorCode::kUsage, "passes " + both.to_string() + " are in both " + other + " and " + path +
+                                                   ": the renders to merge must hold disjoint passes");
     }
+    if (Result<bool> r = add_shard_sums(*file, &out->sums.histogram, &out->sums.images); !r) return r.error();
+    ShardHeader& header = out->header;
     header.spp = std::max(header.spp, h.spp);
     header.share.add(h.share);
     header.passes.add(h.passes);
     header.run.time_s += h.run.time_s;
     header.run.threads = std::max(header.run.threads, h.run.threads);
     header.run.rays += h.run.rays;
+    seen.emplace_back(path, h.passes);
   }
-  const RenderIdentity& id = header.identity;
-  Result<std::unique_ptr<RenderClasses>> classes = compile_render_classes(id.classes_text, id.classes_file, id, limits);
-  if (!classes) {
-    Error e = classes.error();
-    e.message = "the class file recorded in " + first.path + " does not compile: " + e.message;
-    return e;
-  }
-  RenderSums sums = empty_sums(id, **classes);
-  CombinedRender out{std::move(header), std::move(*classes), std::move(sums)};
-  for (const ShardFile& f : files)
-    if (Result<bool> r = add_shard_sums(f, &out.sums.histogram, &out.sums.images); !r) return r.error();
-  return out;
+  if (!out) return make_error(ErrorCode::kUsage, "no shard files to combine");
+  return std::move(*out);
 }
 
 }  // namespace pathex::cli

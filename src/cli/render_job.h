@@ -51,8 +51,8 @@ struct WrittenReport {
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
                                            const RenderClasses& classes);
 
-// The shard files of a render folder (every *.shard in it, by name), read and checked.
-Result<std::vector<ShardFile>> read_render_folder(const std::string& dir);
+// The shard files of a render folder: every *.shard in it, by name; an error if there is none.
+Result<std::vector<std::string>> render_folder_shards(const std::string& dir);
 
 inline constexpr const char* kRenderShardName = "render.shard";
 
@@ -63,9 +63,10 @@ struct CombinedRender {
   std::unique_ptr<RenderClasses> classes;
   RenderSums sums;
 };
-// Refuses (kUsage), naming both files, files of different renders (identity_difference) and
-// files holding the same pass twice (naming the passes).
-Result<CombinedRender> combine_shards(const std::vector<ShardFile>& files, const Limits& limits);
+// Reads the files one at a time (one file's bytes in memory at once). Refuses damaged files
+// (kBadFile), files of another pathex build than this one, and (kUsage, naming both files) files
+// of different renders (identity_difference) or holding the same pass twice (naming the passes).
+Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits);
 
 }  // namespace pathex::cli
 

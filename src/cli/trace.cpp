@@ -111,7 +111,6 @@ struct Job {
   std::unique_ptr<RenderClasses> classes;
   ShardHeader header;  // identity, spp, share; passes: those already held
   std::optional<CombinedRender> resumed;
-  std::vector<std::string> resumed_files;
   std::string out;
 };
 
@@ -179,14 +178,11 @@ Result<bool> load_resumed(const TraceArgs& a, Job* job) {
   if (!a.settings_given.empty())
     return make_error(ErrorCode::kUsage, "--resume takes the render's settings from " + a.resume + "; " +
                                              a.settings_given.front() + " cannot be given with it");
-  Result<std::vector<ShardFile>> files = read_render_folder(a.resume);
+  Result<std::vector<std::string>> files = render_folder_shards(a.resume);
   if (!files) return files.error();
   Result<CombinedRender> combined = combine_shards(*files, a.limits);
   if (!combined) return combined.error();
   const RenderIdentity& id = combined->header.identity;
-  if (id.pathex != pathex_version())
-    return make_error(ErrorCode::kUsage, a.resume + " was rendered by pathex " + id.pathex + "; this is pathex " +
-                                             pathex_version() + ", whose passes would not match");
   Result<Scene> scene = id.scene_file.empty() ? load_scene_json(default_scene_json(), ".", id.scene) : load_scene_file(id.scene_file);
   if (!scene) return scene.error();
   if (scene_content_hash(*scene) != id.scene_hash)
@@ -197,7 +193,6 @@ Result<bool> load_resumed(const TraceArgs& a, Job* job) {
   if (profile_hash(*profile) != id.renderer_hash)
     return make_error(ErrorCode::kUsage, "the renderer profile " + id.renderer_source + " changed since " + a.resume +
                                              " was rendered");
-  for (const ShardFile& f : *files) job->resumed_files.push_back(f.path);
   job->header.identity = id;
   job->header.spp = combined->header.spp;
   job->header.share = combined->header.share;

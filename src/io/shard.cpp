@@ -8,7 +8,6 @@
 #include <array>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -403,12 +402,13 @@ Result<ShardFile> parse_shard(std::string bytes, const std::string& path) {
 }
 
 Result<ShardFile> read_shard(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return file_error(path, "cannot open the shard file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) return file_error(path, "cannot read the shard file");
-  return parse_shard(std::move(ss).str(), path);
+  const std::streamoff size = in.tellg();
+  std::string bytes(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)), '\0');
+  in.seekg(0);
+  if (size < 0 || !in.read(bytes.data(), size)) return file_error(path, "cannot read the shard file");
+  return parse_shard(std::move(bytes), path);
 }
 
 Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* images) {

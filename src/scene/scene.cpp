@@ -3,6 +3,9 @@
 // expected; unknown keys are errors, so a typo never silently does nothing.
 #include "scene/scene.h"
 
+#include "scene/mitsuba_import.h"
+#include "scene/pbrt_import.h"
+
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -330,8 +333,23 @@ std::optional<Error> check_obj(const std::string& path, std::string_view text) {
 
 Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file) {
   const std::string path = (std::filesystem::path(base_dir) / file).string();
+  if (!std::ifstream(path, std::ios::binary)) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+  Result<MeshShape> mesh = load_obj_mesh(path);
+  if (!mesh) return mesh.error();
+  if (mesh->triangles.empty()) return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
+  mesh->file = file;
+  return mesh;
+}
+
+}  // namespace
+
+Result<MeshShape> load_obj_mesh(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+  if (!in) {
+    Error e = make_error(ErrorCode::kBadFile, "cannot open the mesh");
+    e.where = path;
+    return e;
+  }
   {  // the text is released before tinyobjloader reads the file again, to keep peak memory low
     std::ostringstream ss;
     ss << in.rdbuf();
@@ -347,7 +365,7 @@ Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::s
     return e;
   }
   MeshShape mesh;
-  mesh.file = file;
+  mesh.file = path;
   const auto& v = reader.GetAttrib().vertices;
   mesh.positions.reserve(v.size() / 3);
   for (std::size_t i = 0; i + 2 < v.size(); i += 3) mesh.positions.emplace_back(v[i], v[i + 1], v[i + 2]);
@@ -356,9 +374,10 @@ Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::s
       mesh.triangles.emplace_back(static_cast<unsigned>(shape.mesh.indices[i].vertex_index),
                                   static_cast<unsigned>(shape.mesh.indices[i + 1].vertex_index),
                                   static_cast<unsigned>(shape.mesh.indices[i + 2].vertex_index));
-  if (mesh.triangles.empty()) return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
   return mesh;
 }
+
+namespace {
 
 // --- "the camera sees no geometry" ---
 // Defined exactly: no shape's axis-aligned bounding box meets the camera's viewing region, which
@@ -475,6 +494,23 @@ bool region_meets_box(const ViewRegion& v, const Box& b) {
     if (!down && lo - slack > bc + br) return false;
   }
   return true;
+}
+
+// --- the scene-level rules every loader checks (check_scene_rules) ---
+constexpr const char* kNoLight = "the scene has no light: expected an entry in /lights or a shape with an emission";
+constexpr const char* kSeesNothing = "the camera sees no geometry: no shape's bounding box meets its field of view";
+
+bool has_light(const Scene& scene) {
+  bool any = !scene.lights.empty();
+  for (const Shape& s : scene.shapes) any = any || s.emissive();
+  return any;
+}
+
+bool camera_sees_geometry(const Scene& scene) {
+  const ViewRegion view = view_region(scene.camera);
+  for (const Shape& s : scene.shapes)
+    if (region_meets_box(view, shape_bounds(s))) return true;
+  return false;
 }
 
 Result<Camera> read_camera(const Reader& r, const json& j, const std::string& ptr) {
@@ -688,21 +724,26 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
       scene.lights.push_back(std::move(l));
     }
   }
-  bool any_light = !scene.lights.empty();
-  for (const Shape& s : scene.shapes) any_light = any_light || s.emissive();
-  if (!any_light) return r.fail("/lights", "the scene has no light: expected an entry in /lights or a shape with an emission");
+  if (!has_light(scene)) return r.fail("/lights", kNoLight);
   // --- camera ---
   if (!doc.contains("camera")) return r.fail("/camera", "missing camera, expected {type, position, look_at, …}");
   PATHEX_TRY(cam, read_camera(r, doc["camera"], "/camera"));
   scene.camera = cam;
-  const ViewRegion view = view_region(cam);
-  bool sees = false;
-  for (const Shape& s : scene.shapes) sees = sees || region_meets_box(view, shape_bounds(s));
-  if (!sees) return r.fail("/camera", "the camera sees no geometry: no shape's bounding box meets its field of view");
+  if (!camera_sees_geometry(scene)) return r.fail("/camera", kSeesNothing);
   return scene;
 }
 
+std::optional<SceneRuleViolation> check_scene_rules(const Scene& scene) {
+  if (scene.shapes.empty()) return SceneRuleViolation{"/shapes", "the scene is empty: expected at least one shape"};
+  if (!has_light(scene)) return SceneRuleViolation{"/lights", kNoLight};
+  if (!camera_sees_geometry(scene)) return SceneRuleViolation{"/camera", kSeesNothing};
+  return std::nullopt;
+}
+
 Result<Scene> load_scene_file(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".pbrt") return load_scene_pbrt(path);
+  if (ext == ".xml") return load_scene_mitsuba(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     Error e = make_error(ErrorCode::kBadFile, "cannot open the scene file");

@@ -14,6 +14,7 @@
 // spot meter's ray). The test is exact for those boxes, so it never refuses a visible object.
 #pragma once
 
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -92,7 +93,21 @@ struct Scene {
 
 // `base_dir` resolves relative mesh paths; `name` prefixes error locations.
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name);
+// The entry point of every command: dispatches on the extension. `.pbrt` is a pbrt-v4 scene
+// (scene/pbrt_import.h), `.xml` a Mitsuba 3 scene (scene/mitsuba_import.h), anything else JSON.
 Result<Scene> load_scene_file(const std::string& path);
+
+// An OBJ file's triangles (polygons fan-triangulated); errors name the OBJ file and line. The
+// result may have no triangles: callers say where the mesh was asked for.
+Result<MeshShape> load_obj_mesh(const std::string& path);
+
+// The scene-level rules above (a shape, a light, a camera that sees a shape), which every loader
+// checks once the scene is complete: the first one violated, with the JSON pointer it concerns.
+struct SceneRuleViolation {
+  std::string pointer;
+  std::string message;
+};
+std::optional<SceneRuleViolation> check_scene_rules(const Scene& scene);
 
 // The scene embedded in the binary: a Cornell box with an area light, a mirror and a glass sphere.
 const char* default_scene_json();

@@ -1,0 +1,678 @@
+// Mitsuba 3 scene import. pugixml parses the XML (kept as text, so that every element's offset
+// becomes a line and column); the importer walks <scene>, resolving <default> parameters ($name),
+// <include> files and <ref> ids, and turns each plugin of the subset into the scene model.
+//
+// Each plugin reads its properties through a Props object that marks them used; a property left
+// unused, an unknown plugin type or tag is refused with its location.
+#include "scene/mitsuba_import.h"
+
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <pugixml.hpp>
+
+#include "scene/import_common.h"
+
+namespace pathex {
+namespace {
+
+using import::Location;
+using import::located;
+using glm::vec3;
+
+#define MI_TRY(var, expr)          \
+  auto var##_r = (expr);           \
+  if (!var##_r) return var##_r.error(); \
+  auto var = std::move(*var##_r)
+
+// Mitsuba's named indices of refraction (its documentation's table).
+std::optional<double> named_ior(const std::string& name) {
+  static const std::map<std::string, double> table = {
+      {"vacuum", 1.0},       {"helium", 1.000036},  {"hydrogen", 1.000132}, {"air", 1.000277},
+      {"carbon dioxide", 1.00045}, {"water", 1.3330}, {"acetone", 1.36},    {"ethanol", 1.361},
+      {"carbon tetrachloride", 1.461}, {"glycerol", 1.4729}, {"benzene", 1.501}, {"silicone oil", 1.52045},
+      {"bromine", 1.661},    {"water ice", 1.31},   {"fused quartz", 1.458}, {"pyrex", 1.470},
+      {"acrylic glass", 1.49}, {"polypropylene", 1.49}, {"bk7", 1.5046},   {"sodium chloride", 1.544},
+      {"amber", 1.55},       {"pet", 1.5750},       {"diamond", 2.419}};
+  auto it = table.find(name);
+  if (it == table.end()) return std::nullopt;
+  return it->second;
+}
+
+struct Doc {
+  std::string path, text;
+  pugi::xml_document xml;
+};
+
+class Importer;
+
+// The properties and nested objects of one plugin element.
+class Props {
+ public:
+  Props(Importer* im, pugi::xml_node node, std::string what) : im_(im), node_(node), what_(std::move(what)) {
+    for (pugi::xml_node c : node.children()) {
+      if (c.type() != pugi::node_element) continue;
+      children_.push_back({c, false});
+    }
+  }
+  const std::string& what() const { return what_; }
+  pugi::xml_node find(const std::string& name) {
+    for (Child& c : children_)
+      if (c.node.attribute("name").value() == name) {
+        c.used = true;
+        return c.node;
+      }
+    return {};
+  }
+  // Nested objects with this tag (bsdf, emitter, film, ...), including <ref>s to them.
+  std::vector<pugi::xml_node> nested(const std::string& tag) {
+    std::vector<pugi::xml_node> out;
+    for (Child& c : children_)
+      if (c.node.name() == tag || (std::string(c.node.name()) == "ref" && tag == "bsdf")) {
+        c.used = true;
+        out.push_back(c.node);
+      }
+    return out;
+  }
+  void ignore(std::initializer_list<const char*> names) {
+    for (Child& c : children_)
+      for (const char* n : names) c.used = c.used || c.node.attribute("name").value() == std::string(n) || c.node.name() == std::string(n);
+  }
+  std::optional<Error> unused() const;
+
+  Result<double> number(const std::string& name, double fallback);
+  Result<bool> boolean(const std::string& name, bool fallback);
+  Result<std::string> string(const std::string& name, const std::string& fallback);
+  Result<vec3> color(const std::string& name, vec3 fallback);
+  Result<vec3> point(const std::string& name, vec3 fallback);
+  Result<glm::mat4> transform(const std::string& name);
+
+ private:
+  struct Child {
+    pugi::xml_node node;
+    bool used;
+  };
+  Importer* im_;
+  pugi::xml_node node_;
+  std::string what_;
+  std::vector<Child> children_;
+};
+
+class Importer {
+ public:
+  explicit Importer(std::string path) : main_(std::move(path)), files_(main_) {}
+
+  Result<Scene> run() {
+    if (auto e = read_file(main_, Location{main_}, 0)) return *e;
+    return builder_.finish(main_);
+  }
+
+  // --- locations and attributes ---
+  Location where(pugi::xml_node n) const {
+    for (const Doc& d : docs_) {
+      if (n.root() != d.xml.root()) continue;
+      const std::ptrdiff_t off = n.offset_debug();
+      Location at{d.path};
+      if (off < 0) return at;
+      at.line = 1;
+      std::size_t line_start = 0;
+      for (std::size_t i = 0; i < static_cast<std::size_t>(off) && i < d.text.size(); ++i)
+        if (d.text[i] == '\n') {
+          ++at.line;
+          line_start = i + 1;
+        }
+      // offset_debug points at the element's name; the column names its '<'.
+      at.column = static_cast<int>(static_cast<std::size_t>(off) - line_start);
+      return at;
+    }
+    return Location{main_};
+  }
+
+  // An attribute's value with $name parameters replaced by their <default>s.
+  Result<std::string> attr(pugi::xml_node n, const char* name) const {
+    std::string v = n.attribute(name).value();
+    std::string out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (v[i] != '$') {
+        out += v[i];
+        continue;
+      }
+      std::size_t j = i + 1;
+      while (j < v.size() && (std::isalnum(static_cast<unsigned char>(v[j])) || v[j] == '_')) ++j;
+      const std::string key = v.substr(i + 1, j - i - 1);
+      auto it = defaults_.find(key);
+      if (it == defaults_.end()) return located(where(n), "unknown parameter $" + key + " (no <default name=\"" + key + "\">)");
+      out += it->second;
+      i = j - 1;
+    }
+    return out;
+  }
+
+  Result<std::vector<double>> numbers(pugi::xml_node n, const char* name) const {
+    MI_TRY(text, attr(n, name));
+    for (char& c : text)
+      if (c == ',') c = ' ';
+    std::istringstream in(text);
+    std::vector<double> out;
+    std::string word;
+    while (in >> word) {
+      char* end = nullptr;
+      const double x = std::strtod(word.c_str(), &end);
+      if (end == word.c_str() || *end != '\0' || !std::isfinite(x))
+        return located(where(n), "bad number '" + word + "' in attribute " + name);
+      out.push_back(x);
+    }
+    return out;
+  }
+
+  Result<vec3> vector3(pugi::xml_node n, vec3 fallback) const {
+    if (n.attribute("value")) {
+      MI_TRY(v, numbers(n, "value"));
+      if (v.size() == 1) return vec3(static_cast<float>(v[0]));
+      if (v.size() != 3) return located(where(n), "expected 3 numbers in value");
+      return vec3(v[0], v[1], v[2]);
+    }
+    vec3 out = fallback;
+    const char* axes[3] = {"x", "y", "z"};
+    for (int i = 0; i < 3; ++i) {
+      if (!n.attribute(axes[i])) continue;
+      MI_TRY(v, numbers(n, axes[i]));
+      if (v.size() != 1) return located(where(n), std::string("expected one number in ") + axes[i]);
+      out[i] = static_cast<float>(v[0]);
+    }
+    return out;
+  }
+
+  Result<glm::mat4> transform(pugi::xml_node t) const {
+    glm::mat4 m(1.0f);
+    for (pugi::xml_node op : t.children()) {
+      if (op.type() != pugi::node_element) continue;
+      const std::string tag = op.name();
+      glm::mat4 step(1.0f);
+      if (tag == "translate") {
+        MI_TRY(v, vector3(op, vec3(0.0f)));
+        step = glm::translate(glm::mat4(1.0f), v);
+      } else if (tag == "scale") {
+        MI_TRY(v, vector3(op, vec3(1.0f)));
+        step = glm::scale(glm::mat4(1.0f), v);
+      } else if (tag == "rotate") {
+        MI_TRY(axis, vector3(op, vec3(0.0f)));
+        MI_TRY(angle, numbers(op, "angle"));
+        if (angle.size() != 1 || glm::length(axis) == 0.0f) return located(where(op), "rotate needs an axis (x, y, z or value) and an angle");
+        step = glm::rotate(glm::mat4(1.0f), glm::radians(static_cast<float>(angle[0])), glm::normalize(axis));
+      } else if (tag == "matrix") {
+        MI_TRY(v, numbers(op, "value"));
+        if (v.size() != 16 && v.size() != 9) return located(where(op), "matrix needs 16 (or 9) numbers, row by row");
+        if (v.size() == 9) {
+          for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) step[c][r] = static_cast<float>(v[static_cast<std::size_t>(3 * r + c)]);
+        } else {
+          for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c) step[c][r] = static_cast<float>(v[static_cast<std::size_t>(4 * r + c)]);
+        }
+      } else if (tag == "lookat") {
+        MI_TRY(origin, numbers(op, "origin"));
+        MI_TRY(target, numbers(op, "target"));
+        std::vector<double> up = {0, 1, 0};
+        if (op.attribute("up")) {
+          MI_TRY(u, numbers(op, "up"));
+          up = u;
+        }
+        if (origin.size() != 3 || target.size() != 3 || up.size() != 3) return located(where(op), "lookat needs origin, target and up as 3 numbers each");
+        const vec3 o(origin[0], origin[1], origin[2]), tg(target[0], target[1], target[2]), u(up[0], up[1], up[2]);
+        if (glm::length(tg - o) == 0.0f) return located(where(op), "lookat's origin and target coincide");
+        const vec3 dir = glm::normalize(tg - o);
+        if (glm::length(glm::cross(glm::normalize(u), dir)) < 1e-6f) return located(where(op), "lookat's up is parallel to the viewing direction");
+        // Mitsuba's look_at: columns left = up × dir, up' = dir × left, dir, origin.
+        const vec3 left = glm::normalize(glm::cross(glm::normalize(u), dir));
+        step = glm::mat4(glm::vec4(left, 0), glm::vec4(glm::cross(dir, left), 0), glm::vec4(dir, 0), glm::vec4(o, 1));
+      } else {
+        return located(where(op), "transform operation <" + tag + "> is not supported, expected translate, rotate, scale, matrix or lookat");
+      }
+      m = step * m;  // each operation applies after the ones before it
+    }
+    return m;
+  }
+
+ private:
+  friend class Props;
+  std::string main_;
+  import::SceneFiles files_;
+  std::deque<Doc> docs_;
+  std::map<std::string, std::string> defaults_;
+  std::map<std::string, pugi::xml_node> bsdfs_;  // top-level <bsdf id>
+  std::map<std::string, int> bsdf_index_;
+  int default_material_ = -1;
+  import::SceneBuilder builder_;
+
+  std::optional<Error> read_file(const std::string& path, const Location& from, int depth) {
+    Result<std::string> text = files_.read(path, from, depth, "<include>");
+    if (!text) return text.error();
+    Doc& d = docs_.emplace_back();
+    d.path = path;
+    d.text = std::move(*text);
+    const pugi::xml_parse_result res = d.xml.load_buffer(d.text.data(), d.text.size());
+    if (!res) {
+      Location at{path, 1, 1};
+      for (std::size_t i = 0; i < static_cast<std::size_t>(std::max<std::ptrdiff_t>(res.offset, 0)) && i < d.text.size(); ++i) {
+        if (d.text[i] == '\n') {
+          ++at.line;
+          at.column = 1;
+        } else {
+          ++at.column;
+        }
+      }
+      return located(at, std::string("not valid XML: ") + res.description());
+    }
+    const pugi::xml_node scene = d.xml.child("scene");
+    if (!scene) return located(Location{path}, "expected a <scene> root element");
+    for (pugi::xml_node n : scene.children()) {
+      if (n.type() != pugi::node_element) continue;
+      if (auto e = top_level(n, depth)) return e;
+    }
+    return std::nullopt;
+  }
+
+  std::optional<Error> top_level(pugi::xml_node n, int depth) {
+    const std::string tag = n.name();
+    if (tag == "default") {
+      const std::string name = n.attribute("name").value();
+      if (name.empty() || !n.attribute("value")) return located(where(n), "<default> needs name and value");
+      defaults_.emplace(name, n.attribute("value").value());  // the first definition wins
+      return std::nullopt;
+    }
+    if (tag == "include") {
+      Result<std::string> file = attr(n, "filename");
+      if (!file) return file.error();
+      return read_file(files_.resolve(*file), where(n), depth + 1);
+    }
+    if (tag == "bsdf") {
+      const std::string id = n.attribute("id").value();
+      if (id.empty()) return located(where(n), "a top-level <bsdf> needs an id");
+      bsdfs_[id] = n;
+      return std::nullopt;
+    }
+    if (tag == "shape") return shape(n);
+    if (tag == "emitter") return emitter(n);
+    if (tag == "sensor") return sensor(n);
+    if (tag == "integrator") return std::nullopt;  // how to estimate is pathex's choice (see the README)
+    return located(where(n), "<" + tag + "> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)");
+  }
+
+  // --- materials ---
+  Result<Material> bsdf(pugi::xml_node n) {
+    if (std::string(n.name()) == "ref") {
+      MI_TRY(id, attr(n, "id"));
+      auto it = bsdfs_.find(id);
+      if (it == bsdfs_.end()) return located(where(n), "unknown bsdf id \"" + id + "\"");
+      return bsdf(it->second);
+    }
+    MI_TRY(type, attr(n, "type"));
+    Props p(this, n, "<bsdf type=\"" + type + "\">");
+    p.ignore({"id"});
+    Material m;
+    if (type == "twosided") {
+      // pathex's reflective materials are two-sided already.
+      const std::vector<pugi::xml_node> inner = p.nested("bsdf");
+      if (inner.size() != 1) return located(where(n), "twosided with " + std::to_string(inner.size()) + " nested BSDFs is not supported, expected one");
+      MI_TRY(x, bsdf(inner[0]));
+      if (std::holds_alternative<Dielectric>(x)) return located(where(n), "a twosided dielectric is not supported");
+      m = x;
+    } else if (type == "diffuse") {
+      MI_TRY(r, p.color("reflectance", vec3(0.5f)));
+      if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
+        return located(where(n), "diffuse reflectance must be within [0, 1]");
+      m = Diffuse{r};
+    } else if (type == "conductor" || type == "roughconductor") {
+      MI_TRY(material, p.string("material", "none"));
+      vec3 r0(1.0f);
+      if (p.find("eta") || p.find("k")) {
+        MI_TRY(eta, p.color("eta", vec3(0.0f)));
+        MI_TRY(k, p.color("k", vec3(1.0f)));
+        r0 = import::conductor_reflectance(eta, k);
+      } else if (material != "none") {
+        return located(where(n), "conductor material \"" + material + "\" is a measured spectrum, which pathex cannot import: give eta and k as rgb, or material none with specular_reflectance");
+      }
+      MI_TRY(spec, p.color("specular_reflectance", vec3(1.0f)));
+      r0 *= spec;
+      if (glm::any(glm::lessThan(r0, vec3(0.0f))) || glm::any(glm::greaterThan(r0, vec3(1.0f))))
+        return located(where(n), "conductor reflectance must be within [0, 1]");
+      if (type == "conductor") {
+        m = Mirror{r0};
+      } else {
+        MI_TRY(dist, p.string("distribution", "beckmann"));
+        if (dist != "ggx") return located(where(n), "microfacet distribution \"" + dist + "\" is not supported: pathex's glossy lobe is GGX, set <string name=\"distribution\" value=\"ggx\"/>");
+        if (p.find("alpha_u") || p.find("alpha_v")) return located(where(n), "anisotropic roughness (alpha_u, alpha_v) is not supported");
+        MI_TRY(alpha, p.number("alpha", 0.1));
+        p.ignore({"sample_visible"});
+        if (!(alpha >= 1e-4) || alpha > 1.0) return located(where(n), "alpha must be within [1e-4, 1]");
+        m = Glossy{r0, static_cast<float>(alpha)};
+      }
+    } else if (type == "dielectric") {
+      double ior[2] = {1.5046, 1.000277};
+      const char* names[2] = {"int_ior", "ext_ior"};
+      for (int i = 0; i < 2; ++i) {
+        pugi::xml_node q = p.find(names[i]);
+        if (!q) continue;
+        if (std::string(q.name()) == "string") {
+          MI_TRY(s, attr(q, "value"));
+          std::optional<double> v = named_ior(s);
+          if (!v) return located(where(q), "unknown index of refraction \"" + s + "\"");
+          ior[i] = *v;
+        } else {
+          MI_TRY(v, p.number(names[i], ior[i]));
+          ior[i] = v;
+        }
+      }
+      MI_TRY(refl, p.color("specular_reflectance", vec3(1.0f)));
+      MI_TRY(trans, p.color("specular_transmittance", vec3(1.0f)));
+      if (refl != trans) return located(where(n), "different specular_reflectance and specular_transmittance are not supported: pathex's dielectric has one tint");
+      const double eta = ior[0] / ior[1];
+      if (!(eta > 1.0001) || eta > 10.0) return located(where(n), "int_ior / ext_ior must be within (1, 10], found " + std::to_string(eta));
+      m = Dielectric{static_cast<float>(eta), refl};
+    } else if (type == "roughdielectric") {
+      return located(where(n), "roughdielectric is not supported: pathex has no rough transmission");
+    } else if (type == "blendbsdf") {
+      MI_TRY(w, p.number("weight", 0.5));
+      if (w < 0 || w > 1) return located(where(n), "weight must be within [0, 1]");
+      const std::vector<pugi::xml_node> inner = p.nested("bsdf");
+      if (inner.size() != 2) return located(where(n), "blendbsdf needs two nested BSDFs, found " + std::to_string(inner.size()));
+      MI_TRY(a, bsdf(inner[0]));
+      MI_TRY(b, bsdf(inner[1]));
+      m = import::blend(a, b, static_cast<float>(w));
+    } else {
+      return located(where(n), "bsdf \"" + type + "\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, blendbsdf or twosided");
+    }
+    if (auto e = p.unused()) return *e;
+    return m;
+  }
+
+  Result<int> material_of(Props& p, pugi::xml_node shape_node) {
+    const std::vector<pugi::xml_node> b = p.nested("bsdf");
+    if (b.size() > 1) return located(where(shape_node), "a shape with more than one BSDF");
+    if (b.empty()) {
+      if (default_material_ < 0) default_material_ = builder_.add_material("mitsuba default diffuse", Material{Diffuse{vec3(0.5f)}});
+      return default_material_;
+    }
+    if (std::string(b[0].name()) == "ref") {
+      MI_TRY(id, attr(b[0], "id"));
+      if (auto it = bsdf_index_.find(id); it != bsdf_index_.end()) return it->second;
+      MI_TRY(m, bsdf(b[0]));
+      return bsdf_index_[id] = builder_.add_material(id, m);
+    }
+    MI_TRY(m, bsdf(b[0]));
+    return builder_.add_material(where(b[0]).str(), m);
+  }
+
+  // --- shapes ---
+  std::optional<Error> shape(pugi::xml_node n) {
+    MI_TRY(type, attr(n, "type"));
+    Props p(this, n, "<shape type=\"" + type + "\">");
+    p.ignore({"id"});
+    Shape s;
+    s.pointer = where(n).str();
+    MI_TRY(mat, material_of(p, n));
+    s.material = mat;
+    const std::vector<pugi::xml_node> emitters = p.nested("emitter");
+    if (emitters.size() > 1) return located(where(n), "a shape with more than one emitter");
+    if (emitters.size() == 1) {
+      MI_TRY(etype, attr(emitters[0], "type"));
+      if (etype != "area") return located(where(emitters[0]), "emitter \"" + etype + "\" inside a shape is not supported, expected area");
+      Props e(this, emitters[0], "<emitter type=\"area\">");
+      MI_TRY(radiance, e.color("radiance", vec3(1.0f)));
+      if (auto u = e.unused()) return u;
+      if (glm::any(glm::lessThan(radiance, vec3(0.0f)))) return located(where(emitters[0]), "radiance must be non-negative");
+      s.emission = radiance;
+    }
+    MI_TRY(m, p.transform("to_world"));
+    MI_TRY(flip, p.boolean("flip_normals", false));
+    if (type == "obj" || type == "ply") {
+      MI_TRY(file, p.string("filename", ""));
+      if (file.empty()) return located(where(n), "<shape type=\"" + type + "\"> needs a filename");
+      MI_TRY(face_normals, p.boolean("face_normals", false));
+      if (!face_normals)
+        return located(where(n), "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face normals (add <boolean name=\"face_normals\" value=\"true\"/>)");
+      MeshShape mesh;
+      if (type == "obj") {
+        MI_TRY(obj, load_obj_mesh(files_.resolve(file)));
+        if (obj.triangles.empty()) return located(where(n), "the mesh '" + files_.resolve(file) + "' has no faces");
+        mesh = std::move(obj);
+      } else {
+        MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), /*discard_normals=*/true));
+        mesh = std::move(ply);
+      }
+      mesh.file = file;
+      for (vec3& q : mesh.positions) q = import::apply_point(m, q);
+      if (flip)
+        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      s.geometry = std::move(mesh);
+    } else if (type == "sphere") {
+      MI_TRY(centre, p.point("center", vec3(0.0f)));
+      MI_TRY(radius, p.number("radius", 1.0));
+      float scale = 1.0f;
+      if (!import::is_similarity(m, &scale)) return located(where(n), "a sphere under a non-uniform scale is not supported");
+      if (!(radius > 0)) return located(where(n), "radius must be positive");
+      if (flip && s.emissive()) return located(where(n), "a sphere emitting inwards (flip_normals) is not supported");
+      s.geometry = SphereShape{import::apply_point(m, centre), static_cast<float>(radius) * scale};
+    } else if (type == "rectangle") {
+      const vec3 e1 = import::apply_vector(m, vec3(2, 0, 0)), e2 = import::apply_vector(m, vec3(0, 2, 0));
+      if (!(glm::length(glm::cross(e1, e2)) > 0.0f)) return located(where(n), "the rectangle's area is zero");
+      const bool front = (glm::dot(glm::cross(e1, e2), import::apply_normal(m, vec3(0, 0, 1))) > 0.0f) != flip;
+      const vec3 corner = import::apply_point(m, vec3(-1, -1, 0));
+      s.geometry = front ? QuadShape{corner, e1, e2} : QuadShape{corner, e2, e1};
+    } else if (type == "disk") {
+      const vec3 ex = import::apply_vector(m, vec3(1, 0, 0)), ey = import::apply_vector(m, vec3(0, 1, 0));
+      const float r = glm::length(ex);
+      if (!(r > 0.0f) || std::fabs(glm::length(ey) - r) > 1e-4f * r || std::fabs(glm::dot(ex, ey)) > 1e-4f * r * r)
+        return located(where(n), "an elliptical disk (to_world scales x and y differently) is not supported");
+      const vec3 normal = import::apply_normal(m, vec3(0, 0, 1));
+      s.geometry = DiskShape{import::apply_point(m, vec3(0.0f)), flip ? -normal : normal, r};
+    } else {
+      return located(where(n), "shape \"" + type + "\" is not supported, expected obj, ply, sphere, rectangle or disk");
+    }
+    if (auto e = p.unused()) return e;
+    builder_.add_shape(std::move(s));
+    return std::nullopt;
+  }
+
+  // --- emitters ---
+  std::optional<Error> emitter(pugi::xml_node n) {
+    MI_TRY(type, attr(n, "type"));
+    Props p(this, n, "<emitter type=\"" + type + "\">");
+    p.ignore({"id"});
+    if (type == "area") return located(where(n), "an area emitter must be inside a <shape>");
+    if (type != "point" && type != "spot" && type != "directional")
+      return located(where(n), "emitter \"" + type + "\" is not supported, expected point, spot, directional, or area inside a shape");
+    const bool has_to_world = static_cast<bool>(p.find("to_world"));
+    MI_TRY(m, p.transform("to_world"));
+    if (type == "directional") {
+      MI_TRY(e, p.color("irradiance", vec3(1.0f)));
+      vec3 d = import::apply_vector(m, vec3(0, 0, 1));
+      if (pugi::xml_node dn = p.find("direction")) {
+        if (has_to_world) return located(where(dn), "give direction or to_world, not both");
+        MI_TRY(v, vector3(dn, vec3(0.0f)));
+        d = v;
+      }
+      if (!(glm::length(d) > 0.0f)) return located(where(n), "the direction is zero");
+      if (glm::any(glm::lessThan(e, vec3(0.0f)))) return located(where(n), "irradiance must be non-negative");
+      if (auto u = p.unused()) return u;
+      builder_.add_distant(d, e);
+      return std::nullopt;
+    }
+    MI_TRY(intensity, p.color("intensity", vec3(1.0f)));
+    if (glm::any(glm::lessThan(intensity, vec3(0.0f)))) return located(where(n), "intensity must be non-negative");
+    vec3 position = import::apply_point(m, vec3(0.0f));
+    if (pugi::xml_node pn = p.find("position")) {
+      if (has_to_world) return located(where(pn), "give position or to_world, not both");
+      MI_TRY(v, vector3(pn, vec3(0.0f)));
+      position = v;
+    }
+    if (type == "point") {
+      if (auto u = p.unused()) return u;
+      builder_.add_light(PointLight{position, intensity});
+      return std::nullopt;
+    }
+    MI_TRY(cutoff, p.number("cutoff_angle", 20.0));
+    MI_TRY(beam, p.number("beam_width", cutoff * 0.75));
+    if (beam != cutoff)
+      return located(where(n), "a spot light with a soft edge (beam_width < cutoff_angle) is not supported: pathex's spot has a hard edge, set beam_width equal to cutoff_angle");
+    if (!(cutoff > 0.0) || cutoff > 180.0) return located(where(n), "cutoff_angle must be within (0, 180]");
+    float s = 1.0f;
+    if (!import::is_similarity(m, &s)) return located(where(n), "a spot light under a non-uniform scale is not supported");
+    if (auto u = p.unused()) return u;
+    builder_.add_light(SpotLight{position, glm::normalize(import::apply_vector(m, vec3(0, 0, 1))), intensity, static_cast<float>(cutoff)});
+    return std::nullopt;
+  }
+
+  // --- the sensor ---
+  std::optional<Error> sensor(pugi::xml_node n) {
+    if (builder_.has_camera()) return located(where(n), "a second <sensor> (pathex renders one camera)");
+    MI_TRY(type, attr(n, "type"));
+    if (type != "perspective" && type != "thinlens" && type != "orthographic")
+      return located(where(n), "sensor \"" + type + "\" is not supported, expected perspective, thinlens or orthographic");
+    Props p(this, n, "<sensor type=\"" + type + "\">");
+    p.ignore({"id", "near_clip", "far_clip", "shutter_open", "shutter_close", "sampler"});
+    Camera c;
+    c.width = 768;
+    c.height = 576;
+    const std::vector<pugi::xml_node> films = p.nested("film");
+    if (films.size() > 1) return located(where(n), "a sensor with more than one film");
+    if (films.size() == 1) {
+      MI_TRY(ftype, attr(films[0], "type"));
+      if (ftype != "hdrfilm") return located(where(films[0]), "film \"" + ftype + "\" is not supported, expected hdrfilm");
+      Props f(this, films[0], "<film type=\"hdrfilm\">");
+      MI_TRY(w, f.number("width", 768));
+      MI_TRY(h, f.number("height", 576));
+      if (w != std::floor(w) || h != std::floor(h) || w < 1 || h < 1 || w > 16384 || h > 16384)
+        return located(where(films[0]), "width and height must be integers within 1..16384");
+      c.width = static_cast<int>(w);
+      c.height = static_cast<int>(h);
+      f.ignore({"rfilter", "pixel_format", "component_format", "file_format", "sample_border", "banner", "id"});
+      if (auto u = f.unused()) return u;
+    }
+    MI_TRY(m, p.transform("to_world"));
+    const vec3 ex = import::apply_vector(m, vec3(1, 0, 0)), ey = import::apply_vector(m, vec3(0, 1, 0));
+    const vec3 ez = import::apply_vector(m, vec3(0, 0, 1));
+    if (!(glm::length(ex) > 0.0f && glm::length(ey) > 0.0f && glm::length(ez) > 0.0f) ||
+        std::fabs(glm::dot(glm::normalize(ex), glm::normalize(ey))) > 1e-4f || std::fabs(glm::dot(glm::normalize(ex), glm::normalize(ez))) > 1e-4f ||
+        std::fabs(glm::dot(glm::normalize(ey), glm::normalize(ez))) > 1e-4f)
+      return located(where(n), "the sensor's to_world must not shear");
+    c.position = import::apply_point(m, vec3(0.0f));
+    c.look_at = c.position + glm::normalize(ez);
+    c.up = glm::normalize(ey);
+    const vec3 image_right = -glm::normalize(ex);  // Mitsuba's image x runs along camera -x
+    const float aspect = static_cast<float>(c.width) / static_cast<float>(c.height);
+    if (type == "orthographic") {
+      // The film spans [-1, 1] x [-1/aspect, 1/aspect] in camera space, scaled by to_world.
+      c.type = SensorType::kOrthographic;
+      c.film_width = 2.0f * glm::length(ex);
+      c.film_height = 2.0f / aspect * glm::length(ey);
+    } else {
+      float scale = 1.0f;
+      if (!import::is_similarity(m, &scale) || std::fabs(scale - 1.0f) > 1e-3f)
+        return located(where(n), "a perspective sensor's to_world must be rigid (no scale)");
+      if (p.find("focal_length")) return located(where(n), "focal_length is not supported, give fov");
+      pugi::xml_node fov_node = p.find("fov");
+      if (!fov_node) return located(where(n), "the sensor needs a fov");
+      MI_TRY(fov, p.number("fov", 0.0));
+      MI_TRY(axis, p.string("fov_axis", "x"));
+      if (!(fov > 0 && fov < 180)) return located(where(fov_node), "fov must be within (0, 180)");
+      const float t = std::tan(glm::radians(static_cast<float>(fov)) * 0.5f);
+      float tan_y = 0.0f;
+      if (axis == "x" || (axis == "smaller" && aspect <= 1.0f) || (axis == "larger" && aspect > 1.0f)) tan_y = t / aspect;
+      else if (axis == "y" || axis == "smaller" || axis == "larger") tan_y = t;
+      else if (axis == "diagonal") tan_y = t / std::sqrt(1.0f + aspect * aspect);
+      else return located(where(n), "fov_axis \"" + axis + "\" is not supported, expected x, y, diagonal, smaller or larger");
+      c.fov_degrees = glm::degrees(2.0f * std::atan(tan_y));
+      if (type == "thinlens") {
+        c.type = SensorType::kLens;
+        MI_TRY(ar, p.number("aperture_radius", 0.0));
+        MI_TRY(fd, p.number("focus_distance", 0.0));
+        if (!(ar > 0) || !(fd > 0)) return located(where(n), "thinlens needs a positive aperture_radius and focus_distance");
+        c.aperture_radius = static_cast<float>(ar);
+        c.focus_distance = static_cast<float>(fd);
+      }
+    }
+    if (auto u = p.unused()) return u;
+    builder_.set_camera(c, image_right);
+    return std::nullopt;
+  }
+};
+
+// --- Props ---
+
+std::optional<Error> Props::unused() const {
+  for (const Child& c : children_) {
+    if (c.used) continue;
+    const std::string name = c.node.attribute("name").value();
+    return located(im_->where(c.node), "<" + std::string(c.node.name()) + (name.empty() ? "" : " name=\"" + name + "\"") + "> in " + what_ +
+                                           " is not supported");
+  }
+  return std::nullopt;
+}
+
+Result<double> Props::number(const std::string& name, double fallback) {
+  pugi::xml_node n = find(name);
+  if (!n) return fallback;
+  const std::string tag = n.name();
+  if (tag != "float" && tag != "integer") return located(im_->where(n), "'" + name + "' must be a <float>");
+  MI_TRY(v, im_->numbers(n, "value"));
+  if (v.size() != 1) return located(im_->where(n), "'" + name + "' expects one number");
+  return v[0];
+}
+
+Result<bool> Props::boolean(const std::string& name, bool fallback) {
+  pugi::xml_node n = find(name);
+  if (!n) return fallback;
+  MI_TRY(v, im_->attr(n, "value"));
+  if (std::string(n.name()) != "boolean" || (v != "true" && v != "false")) return located(im_->where(n), "'" + name + "' must be a <boolean> true or false");
+  return v == "true";
+}
+
+Result<std::string> Props::string(const std::string& name, const std::string& fallback) {
+  pugi::xml_node n = find(name);
+  if (!n) return fallback;
+  if (std::string(n.name()) != "string") return located(im_->where(n), "'" + name + "' must be a <string>");
+  return im_->attr(n, "value");
+}
+
+Result<vec3> Props::color(const std::string& name, vec3 fallback) {
+  pugi::xml_node n = find(name);
+  if (!n) return fallback;
+  const std::string tag = n.name();
+  if (tag == "texture") return located(im_->where(n), "textures are not supported ('" + name + "'), give an <rgb>");
+  if (tag != "rgb" && tag != "float" && tag != "spectrum") return located(im_->where(n), "'" + name + "' must be an <rgb>");
+  MI_TRY(v, im_->numbers(n, "value"));
+  if (tag == "spectrum" && v.size() != 1)
+    return located(im_->where(n), "a sampled <spectrum> is not supported: pathex renders in RGB, give an <rgb>");
+  if (v.size() == 1) return vec3(static_cast<float>(v[0]));
+  if (tag != "rgb" || v.size() != 3) return located(im_->where(n), "'" + name + "' expects 3 numbers");
+  return vec3(v[0], v[1], v[2]);
+}
+
+Result<vec3> Props::point(const std::string& name, vec3 fallback) {
+  pugi::xml_node n = find(name);
+  if (!n) return fallback;
+  if (std::string(n.name()) != "point" && std::string(n.name()) != "vector") return located(im_->where(n), "'" + name + "' must be a <point>");
+  return im_->vector3(n, fallback);
+}
+
+Result<glm::mat4> Props::transform(const std::string& name) {
+  pugi::xml_node n = find(name);
+  if (!n) return glm::mat4(1.0f);
+  if (std::string(n.name()) != "transform") return located(im_->where(n), "'" + name + "' must be a <transform>");
+  return im_->transform(n);
+}
+
+}  // namespace
+
+Result<Scene> load_scene_mitsuba(const std::string& path) { return Importer(path).run(); }
+
+}  // namespace pathex

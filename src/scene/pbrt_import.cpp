@@ -1,0 +1,782 @@
+// pbrt-v4 scene import: a tokenizer that keeps line and column, and an interpreter of the
+// directives in the subset (README "Importing pbrt-v4 and Mitsuba 3 scenes"). The interpreter
+// keeps pbrt's graphics state (current transform, material, area light, ReverseOrientation) on an
+// attribute stack and turns each Shape and LightSource into the scene model at once; the camera
+// waits for the end, when the film's resolution is known.
+//
+// Every parameter a directive reads is marked used; one left unused is refused with its location,
+// as is every directive, shape, material or light type outside the subset.
+#include "scene/pbrt_import.h"
+
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "scene/import_common.h"
+
+namespace pathex {
+namespace {
+
+using import::Location;
+using import::located;
+using glm::vec3;
+
+// --- tokens ---
+
+struct Token {
+  enum Kind { kWord, kString, kNumber, kOpen, kClose } kind = kWord;
+  std::string text;  // a string's contents without quotes
+  Location at;
+};
+
+Result<std::vector<Token>> tokenize(const std::string& text, const std::string& file) {
+  std::vector<Token> out;
+  int line = 1;
+  std::size_t line_start = 0;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+      line_start = ++i;
+      continue;
+    }
+    if (c == ' ' || c == '\t' || c == '\r') {
+      ++i;
+      continue;
+    }
+    if (c == '#') {
+      while (i < text.size() && text[i] != '\n') ++i;
+      continue;
+    }
+    Token t;
+    t.at = Location{file, line, static_cast<int>(i - line_start) + 1};
+    if (c == '[' || c == ']') {
+      t.kind = c == '[' ? Token::kOpen : Token::kClose;
+      ++i;
+    } else if (c == '"') {
+      std::size_t j = i + 1;
+      while (j < text.size() && text[j] != '"' && text[j] != '\n') ++j;
+      if (j >= text.size() || text[j] != '"') return located(t.at, "unterminated string, expected a closing '\"' on the same line");
+      t.kind = Token::kString;
+      t.text = text.substr(i + 1, j - i - 1);
+      i = j + 1;
+    } else {
+      std::size_t j = i;
+      while (j < text.size() && std::string_view(" \t\r\n[]\"#").find(text[j]) == std::string_view::npos) ++j;
+      t.text = text.substr(i, j - i);
+      const char f = t.text[0];
+      t.kind = (std::isdigit(static_cast<unsigned char>(f)) || f == '-' || f == '+' || f == '.') ? Token::kNumber : Token::kWord;
+      i = j;
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+// --- parameters: "type name" value or [values] ---
+
+struct Param {
+  std::string type, name;
+  std::vector<double> numbers;
+  std::vector<std::string> strings;
+  std::vector<bool> bools;
+  Location at;
+  bool used = false;
+};
+
+class Params {
+ public:
+  std::vector<Param> list;
+
+  Param* find(const std::string& name) {
+    for (Param& p : list)
+      if (p.name == name) {
+        p.used = true;
+        return &p;
+      }
+    return nullptr;
+  }
+  // Marks every parameter with one of these names used (render settings pathex does not need).
+  void ignore(std::initializer_list<const char*> names) {
+    for (Param& p : list)
+      for (const char* n : names) p.used = p.used || p.name == n;
+  }
+  void ignore_all() {
+    for (Param& p : list) p.used = true;
+  }
+  std::optional<Error> unused(const std::string& what) const {
+    for (const Param& p : list)
+      if (!p.used) return located(p.at, "parameter \"" + p.type + " " + p.name + "\" of " + what + " is not supported");
+    return std::nullopt;
+  }
+
+  Result<double> number(const std::string& name, double fallback, std::initializer_list<const char*> types = {"float"}) {
+    Param* p = find(name);
+    if (!p) return fallback;
+    bool ok = false;
+    for (const char* t : types) ok = ok || p->type == t;
+    if (!ok || p->numbers.size() != 1) return located(p->at, "parameter '" + name + "' expects one " + *types.begin() + " value");
+    return p->numbers[0];
+  }
+  Result<int> integer(const std::string& name, int fallback) {
+    Result<double> x = number(name, fallback, {"integer"});
+    if (!x) return x.error();
+    if (*x != std::floor(*x) || std::fabs(*x) > 1e9) return located(find(name)->at, "parameter '" + name + "' expects an integer");
+    return static_cast<int>(*x);
+  }
+  Result<bool> boolean(const std::string& name, bool fallback) {
+    Param* p = find(name);
+    if (!p) return fallback;
+    if (p->type != "bool" || p->bools.size() != 1) return located(p->at, "parameter '" + name + "' expects one bool value (true or false)");
+    return static_cast<bool>(p->bools[0]);
+  }
+  Result<std::string> string(const std::string& name, const std::string& fallback) {
+    Param* p = find(name);
+    if (!p) return fallback;
+    if (p->type != "string" || p->strings.size() != 1) return located(p->at, "parameter '" + name + "' expects one string");
+    return p->strings[0];
+  }
+  Result<vec3> point(const std::string& name, vec3 fallback) {
+    Param* p = find(name);
+    if (!p) return fallback;
+    if ((p->type != "point3" && p->type != "point" && p->type != "vector3" && p->type != "vector") || p->numbers.size() != 3)
+      return located(p->at, "parameter '" + name + "' expects one point3 (3 numbers)");
+    return vec3(p->numbers[0], p->numbers[1], p->numbers[2]);
+  }
+  // A colour: "rgb" (or "color") with 3 values, or a "float" for a grey. Spectra are refused:
+  // pathex transports RGB, and pbrt's RGB illuminants and reflectances render as their RGB.
+  Result<vec3> rgb(const std::string& name, vec3 fallback, bool allow_float) {
+    Param* p = find(name);
+    if (!p) return fallback;
+    if ((p->type == "rgb" || p->type == "color") && p->numbers.size() == 3) return vec3(p->numbers[0], p->numbers[1], p->numbers[2]);
+    if (allow_float && p->type == "float" && p->numbers.size() == 1) return vec3(static_cast<float>(p->numbers[0]));
+    if (p->type == "spectrum" || p->type == "blackbody")
+      return located(p->at, "parameter \"" + p->type + " " + name + "\" is not supported: pathex renders in RGB, give \"rgb " + name + "\" [r g b]");
+    if (p->type == "texture") return located(p->at, "textures are not supported (parameter \"texture " + name + "\"), give \"rgb " + name + "\" [r g b]");
+    return located(p->at, "parameter '" + name + "' expects \"rgb " + name + "\" [r g b]");
+  }
+  Result<std::vector<vec3>> points(const std::string& name) {
+    Param* p = find(name);
+    if (!p) return std::vector<vec3>{};
+    if ((p->type != "point3" && p->type != "point") || p->numbers.size() % 3 != 0)
+      return located(p->at, "parameter '" + name + "' expects point3 values (a multiple of 3 numbers)");
+    std::vector<vec3> out;
+    for (std::size_t i = 0; i < p->numbers.size(); i += 3) {
+      const vec3 v(p->numbers[i], p->numbers[i + 1], p->numbers[i + 2]);
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return located(p->at, "parameter '" + name + "' has a value that is not finite");
+      out.push_back(v);
+    }
+    return out;
+  }
+};
+
+#define PBRT_TRY(var, expr)        \
+  auto var##_r = (expr);           \
+  if (!var##_r) return var##_r.error(); \
+  auto var = std::move(*var##_r)
+
+bool parse_number(const std::string& s, double* out) {
+  std::string_view v = s;
+  if (!v.empty() && v.front() == '+') v.remove_prefix(1);
+  auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), *out);
+  return ec == std::errc() && p == v.data() + v.size() && std::isfinite(*out);
+}
+
+// --- the interpreter ---
+
+struct AreaLight {
+  vec3 radiance{0.0f};
+  bool two_sided = false;
+};
+
+struct GraphicsState {
+  glm::mat4 ctm{1.0f};
+  int material = -1;  // builder index; -1: pbrt's default (diffuse, reflectance 0.5)
+  std::optional<AreaLight> area;
+  bool reverse = false;
+};
+
+class Importer {
+ public:
+  explicit Importer(std::string main_file) : main_file_(std::move(main_file)), files_(main_file_) {}
+
+  Result<Scene> run() {
+    if (auto e = parse_file(main_file_, Location{main_file_}, 0)) return *e;
+    if (auto e = make_camera()) return *e;
+    return builder_.finish(main_file_);
+  }
+
+ private:
+  std::string main_file_;
+  import::SceneFiles files_;
+  import::SceneBuilder builder_;
+  GraphicsState gs_;
+  std::vector<GraphicsState> stack_;
+  std::vector<Location> stack_at_;
+  std::vector<bool> stack_is_attribute_;
+  bool in_world_ = false;
+  std::map<std::string, glm::mat4> coordinate_systems_;
+  std::map<std::string, Material> named_materials_;
+  std::map<std::string, int> named_material_index_;
+  int default_material_ = -1;
+  // The camera and film, combined once the file is read.
+  std::string camera_type_ = "perspective";
+  Params camera_params_;
+  glm::mat4 camera_from_world_{1.0f};
+  Location camera_at_;
+  int width_ = 1280, height_ = 720;
+
+  // --- token stream helpers ---
+  struct Stream {
+    const std::vector<Token>* tokens;
+    std::size_t pos = 0;
+    Location end;
+    bool done() const { return pos >= tokens->size(); }
+    const Token& peek() const { return (*tokens)[pos]; }
+  };
+
+  Result<std::vector<double>> numbers(Stream& s, int count, const Location& at, const std::string& directive) {
+    std::vector<double> out;
+    const bool bracket = !s.done() && s.peek().kind == Token::kOpen;
+    if (bracket) ++s.pos;
+    while (static_cast<int>(out.size()) < count) {
+      if (s.done() || s.peek().kind != Token::kNumber)
+        return located(s.done() ? at : s.peek().at, directive + " expects " + std::to_string(count) + " numbers");
+      double x = 0;
+      if (!parse_number(s.peek().text, &x)) return located(s.peek().at, "bad number '" + s.peek().text + "'");
+      out.push_back(x);
+      ++s.pos;
+    }
+    if (bracket) {
+      if (s.done() || s.peek().kind != Token::kClose) return located(s.done() ? at : s.peek().at, directive + " expects ']' after " + std::to_string(count) + " numbers");
+      ++s.pos;
+    }
+    return out;
+  }
+
+  Result<std::string> quoted(Stream& s, const Location& at, const std::string& directive) {
+    if (s.done() || s.peek().kind != Token::kString) return located(s.done() ? at : s.peek().at, directive + " expects a quoted name");
+    return (*s.tokens)[s.pos++].text;
+  }
+
+  Result<Params> params(Stream& s) {
+    Params out;
+    while (!s.done() && s.peek().kind == Token::kString) {
+      Param p;
+      p.at = s.peek().at;
+      std::istringstream decl(s.peek().text);
+      std::string extra;
+      if (!(decl >> p.type >> p.name) || (decl >> extra)) return located(p.at, "bad parameter declaration \"" + s.peek().text + "\", expected \"type name\"");
+      ++s.pos;
+      if (p.type == "normal3") p.type = "normal";
+      if (p.type == "point3") p.type = "point3";
+      const bool bracket = !s.done() && s.peek().kind == Token::kOpen;
+      if (bracket) ++s.pos;
+      int count = 0;
+      while (!s.done() && s.peek().kind != Token::kClose && (bracket || count == 0)) {
+        const Token& t = s.peek();
+        if (t.kind == Token::kNumber) {
+          double x = 0;
+          if (!parse_number(t.text, &x)) return located(t.at, "bad number '" + t.text + "'");
+          p.numbers.push_back(x);
+        } else if (t.kind == Token::kString && (p.type == "string" || p.type == "texture" || p.type == "spectrum")) {
+          p.strings.push_back(t.text);
+        } else if ((t.kind == Token::kString || t.kind == Token::kWord) && (t.text == "true" || t.text == "false")) {
+          p.bools.push_back(t.text == "true");
+        } else if (!bracket) {
+          break;
+        } else {
+          return located(t.at, "unexpected '" + t.text + "' in the values of parameter \"" + p.type + " " + p.name + "\"");
+        }
+        ++s.pos;
+        ++count;
+      }
+      if (bracket) {
+        if (s.done()) return located(p.at, "parameter \"" + p.type + " " + p.name + "\" expects ']'");
+        ++s.pos;
+      }
+      if (count == 0) return located(p.at, "parameter \"" + p.type + " " + p.name + "\" has no value");
+      if (p.type == "bool" && p.bools.size() != static_cast<std::size_t>(count)) return located(p.at, "parameter \"bool " + p.name + "\" expects true or false");
+      out.list.push_back(std::move(p));
+    }
+    return out;
+  }
+
+  // --- files ---
+  std::optional<Error> parse_file(const std::string& path, const Location& from, int depth) {
+    Result<std::string> text = files_.read(path, from, depth, "Include/Import");
+    if (!text) return text.error();
+    Result<std::vector<Token>> tokens = tokenize(*text, path);
+    if (!tokens) return tokens.error();
+    Stream s{&*tokens, 0, Location{path}};
+    while (!s.done()) {
+      const Token& t = s.peek();
+      if (t.kind != Token::kWord) return located(t.at, "expected a directive, found '" + t.text + "'");
+      ++s.pos;
+      if (auto e = directive(t.text, t.at, s, depth)) return e;
+    }
+    if (depth == 0 && !stack_.empty())
+      return located(stack_at_.back(), std::string(stack_is_attribute_.back() ? "AttributeBegin" : "TransformBegin") + " has no matching End");
+    return std::nullopt;
+  }
+
+  // --- directives ---
+  std::optional<Error> directive(const std::string& name, const Location& at, Stream& s, int depth) {
+    auto transform_op = [&](int count, auto apply) -> std::optional<Error> {
+      Result<std::vector<double>> v = numbers(s, count, at, name);
+      if (!v) return v.error();
+      apply(*v);
+      return std::nullopt;
+    };
+    if (name == "Translate")
+      return transform_op(3, [&](const std::vector<double>& v) { gs_.ctm = glm::translate(gs_.ctm, vec3(v[0], v[1], v[2])); });
+    if (name == "Scale")
+      return transform_op(3, [&](const std::vector<double>& v) { gs_.ctm = glm::scale(gs_.ctm, vec3(v[0], v[1], v[2])); });
+    if (name == "Rotate") {
+      Result<std::vector<double>> v = numbers(s, 4, at, name);
+      if (!v) return v.error();
+      const vec3 axis((*v)[1], (*v)[2], (*v)[3]);
+      if (glm::length(axis) == 0.0f) return located(at, "Rotate's axis is zero");
+      gs_.ctm = glm::rotate(gs_.ctm, glm::radians(static_cast<float>((*v)[0])), glm::normalize(axis));
+      return std::nullopt;
+    }
+    if (name == "LookAt") {
+      Result<std::vector<double>> v = numbers(s, 9, at, name);
+      if (!v) return v.error();
+      const vec3 eye((*v)[0], (*v)[1], (*v)[2]), look((*v)[3], (*v)[4], (*v)[5]), up((*v)[6], (*v)[7], (*v)[8]);
+      if (glm::length(look - eye) == 0.0f) return located(at, "LookAt's eye and look-at points coincide");
+      const vec3 dir = glm::normalize(look - eye);
+      if (glm::length(glm::cross(glm::normalize(up), dir)) < 1e-6f) return located(at, "LookAt's up vector is parallel to the viewing direction");
+      // pbrt's LookAt: camera +x is up × dir, +y the new up, +z dir (a left-handed camera space).
+      const vec3 right = glm::normalize(glm::cross(glm::normalize(up), dir));
+      const vec3 new_up = glm::cross(dir, right);
+      glm::mat4 world_from_camera(glm::vec4(right, 0), glm::vec4(new_up, 0), glm::vec4(dir, 0), glm::vec4(eye, 1));
+      gs_.ctm = gs_.ctm * glm::inverse(world_from_camera);
+      return std::nullopt;
+    }
+    if (name == "Transform" || name == "ConcatTransform") {
+      Result<std::vector<double>> v = numbers(s, 16, at, name);
+      if (!v) return v.error();
+      float m[16];
+      for (int i = 0; i < 16; ++i) m[i] = static_cast<float>((*v)[static_cast<std::size_t>(i)]);
+      const glm::mat4 t = glm::make_mat4(m);  // pbrt lists the matrix column by column, as glm stores it
+      gs_.ctm = name == "Transform" ? t : gs_.ctm * t;
+      return std::nullopt;
+    }
+    if (name == "Identity") {
+      gs_.ctm = glm::mat4(1.0f);
+      return std::nullopt;
+    }
+    if (name == "CoordinateSystem" || name == "CoordSysTransform") {
+      PBRT_TRY(n, quoted(s, at, name));
+      if (name == "CoordinateSystem") {
+        coordinate_systems_[n] = gs_.ctm;
+        return std::nullopt;
+      }
+      auto it = coordinate_systems_.find(n);
+      if (it == coordinate_systems_.end()) return located(at, "unknown coordinate system \"" + n + "\"");
+      gs_.ctm = it->second;
+      return std::nullopt;
+    }
+    if (name == "ReverseOrientation") {
+      gs_.reverse = !gs_.reverse;
+      return std::nullopt;
+    }
+    if (name == "AttributeBegin" || name == "TransformBegin") {
+      stack_.push_back(gs_);
+      stack_at_.push_back(at);
+      stack_is_attribute_.push_back(name == "AttributeBegin");
+      return std::nullopt;
+    }
+    if (name == "AttributeEnd" || name == "TransformEnd") {
+      const bool attribute = name == "AttributeEnd";
+      if (stack_.empty() || stack_is_attribute_.back() != attribute)
+        return located(at, name + " has no matching " + (attribute ? "AttributeBegin" : "TransformBegin"));
+      if (attribute) gs_ = stack_.back();
+      else gs_.ctm = stack_.back().ctm;
+      stack_.pop_back();
+      stack_at_.pop_back();
+      stack_is_attribute_.pop_back();
+      return std::nullopt;
+    }
+    if (name == "Include" || name == "Import") {
+      PBRT_TRY(file, quoted(s, at, name));
+      return parse_file(files_.resolve(file), at, depth + 1);
+    }
+    if (name == "WorldBegin") {
+      if (in_world_) return located(at, "a second WorldBegin");
+      in_world_ = true;
+      gs_.ctm = glm::mat4(1.0f);
+      coordinate_systems_["world"] = gs_.ctm;
+      return std::nullopt;
+    }
+    // --- directives with a type and parameters ---
+    static const char* const kTyped[] = {"Camera", "Film", "Sampler", "Integrator", "PixelFilter", "ColorSpace", "Shape",
+                                         "LightSource", "AreaLightSource", "Material", "MakeNamedMaterial", "NamedMaterial"};
+    bool typed = false;
+    for (const char* k : kTyped) typed = typed || name == k;
+    if (!typed)
+      return located(at, "directive '" + name + "' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)");
+    PBRT_TRY(type, quoted(s, at, name));
+    PBRT_TRY(ps, params(s));
+    const bool scene_wide = name == "Camera" || name == "Film" || name == "Sampler" || name == "Integrator" ||
+                            name == "PixelFilter" || name == "ColorSpace";
+    if (scene_wide && in_world_) return located(at, name + " must come before WorldBegin");
+    if (!scene_wide && !in_world_) return located(at, name + " must come after WorldBegin");
+    const std::string what = name + " \"" + type + "\"";
+    if (name == "Sampler" || name == "Integrator" || name == "PixelFilter") {
+      ps.ignore_all();  // how to estimate is pathex's choice (--renderer, --spp); see the README
+      return std::nullopt;
+    }
+    if (name == "ColorSpace") {
+      if (type != "srgb") return located(at, "color space \"" + type + "\" is not supported, expected \"srgb\"");
+      return std::nullopt;
+    }
+    if (name == "Film") {
+      if (type != "rgb") return located(at, "film \"" + type + "\" is not supported, expected \"rgb\"");
+      PBRT_TRY(w, ps.integer("xresolution", 1280));
+      PBRT_TRY(h, ps.integer("yresolution", 720));
+      if (w < 1 || h < 1 || w > 16384 || h > 16384) return located(at, "the film resolution must be within 1..16384");
+      width_ = w;
+      height_ = h;
+      ps.ignore({"filename", "savefp16"});
+      return ps.unused(what);
+    }
+    if (name == "Camera") {
+      if (type != "perspective" && type != "orthographic")
+        return located(at, "camera \"" + type + "\" is not supported, expected \"perspective\" or \"orthographic\"");
+      camera_type_ = type;
+      camera_params_ = std::move(ps);
+      camera_from_world_ = gs_.ctm;
+      camera_at_ = at;
+      coordinate_systems_["camera"] = glm::inverse(gs_.ctm);
+      return std::nullopt;  // made at the end, with the film
+    }
+    if (name == "MakeNamedMaterial") {
+      PBRT_TRY(mtype, ps.string("type", ""));
+      if (mtype.empty()) return located(at, "MakeNamedMaterial \"" + type + "\" needs a \"string type\" parameter");
+      PBRT_TRY(m, material(mtype, ps, at));
+      if (auto e = ps.unused("material \"" + mtype + "\"")) return e;
+      named_materials_[type] = m;
+      named_material_index_.erase(type);
+      return std::nullopt;
+    }
+    if (name == "NamedMaterial") {
+      PBRT_TRY(index, named_index(type, at));
+      gs_.material = index;
+      return ps.unused(what);
+    }
+    if (name == "Material") {
+      PBRT_TRY(m, material(type, ps, at));
+      if (auto e = ps.unused(what)) return e;
+      gs_.material = builder_.add_material(at.str(), m);
+      return std::nullopt;
+    }
+    if (name == "AreaLightSource") {
+      if (type != "diffuse") return located(at, "area light \"" + type + "\" is not supported, expected \"diffuse\"");
+      PBRT_TRY(l, ps.rgb("L", vec3(1.0f), false));
+      PBRT_TRY(scale, ps.number("scale", 1.0));
+      PBRT_TRY(two, ps.boolean("twosided", false));
+      if (ps.find("power")) return located(ps.find("power")->at, "parameter 'power' is not supported: give L and scale");
+      if (auto e = ps.unused(what)) return e;
+      if (l.x < 0 || l.y < 0 || l.z < 0 || scale < 0) return located(at, "an area light's radiance must be non-negative");
+      gs_.area = AreaLight{l * static_cast<float>(scale), two};
+      return std::nullopt;
+    }
+    if (name == "LightSource") {
+      if (auto e = light(type, ps, at)) return e;
+      return ps.unused(what);
+    }
+    // Shape
+    if (auto e = shape(type, ps, at)) return e;
+    return ps.unused(what);
+  }
+
+  // --- materials ---
+  Result<int> named_index(const std::string& n, const Location& at) {
+    if (auto it = named_material_index_.find(n); it != named_material_index_.end()) return it->second;
+    auto it = named_materials_.find(n);
+    if (it == named_materials_.end()) return located(at, "unknown named material \"" + n + "\"");
+    const int index = builder_.add_material(n, it->second);
+    named_material_index_[n] = index;
+    return index;
+  }
+
+  // GGX alpha from pbrt's roughness parameters (remapped by sqrt unless remaproughness is false).
+  Result<float> alpha(Params& ps, const Location& at) {
+    PBRT_TRY(r, ps.number("roughness", 0.0));
+    PBRT_TRY(u, ps.number("uroughness", r));
+    PBRT_TRY(v, ps.number("vroughness", r));
+    PBRT_TRY(remap, ps.boolean("remaproughness", true));
+    if (u != v) return located(at, "anisotropic roughness (uroughness != vroughness) is not supported");
+    if (u < 0) return located(at, "roughness must be non-negative");
+    return static_cast<float>(remap ? std::sqrt(u) : u);
+  }
+
+  Result<Material> material(const std::string& type, Params& ps, const Location& at) {
+    if (type == "diffuse") {
+      PBRT_TRY(r, ps.rgb("reflectance", vec3(0.5f), true));
+      if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
+        return located(at, "diffuse reflectance must be within [0, 1]");
+      return Material{Diffuse{r}};
+    }
+    if (type == "conductor") {
+      vec3 r0;
+      if (ps.find("reflectance")) {
+        PBRT_TRY(r, ps.rgb("reflectance", vec3(1.0f), true));
+        r0 = r;
+      } else if (ps.find("eta") || ps.find("k")) {
+        PBRT_TRY(eta, ps.rgb("eta", vec3(1.0f), true));
+        PBRT_TRY(k, ps.rgb("k", vec3(0.0f), true));
+        r0 = import::conductor_reflectance(eta, k);
+      } else {
+        return located(at, "conductor needs \"rgb reflectance\" or rgb \"eta\" and \"k\" (pbrt's default copper is a spectrum, which pathex cannot import)");
+      }
+      if (glm::any(glm::lessThan(r0, vec3(0.0f))) || glm::any(glm::greaterThan(r0, vec3(1.0f))))
+        return located(at, "conductor reflectance must be within [0, 1]");
+      PBRT_TRY(a, alpha(ps, at));
+      if (a < 1e-3f) return Material{Mirror{r0}};  // pbrt treats alpha < 1e-3 as smooth
+      if (a > 1.0f) return located(at, "conductor roughness gives GGX alpha " + std::to_string(a) + ", pathex's glossy accepts at most 1");
+      return Material{Glossy{r0, a}};
+    }
+    if (type == "dielectric") {
+      Param* eta_p = ps.find("eta");
+      if (eta_p && eta_p->type != "float")
+        return located(eta_p->at, "parameter \"" + eta_p->type + " eta\" is not supported: give \"float eta\" (pathex's dielectric has one index)");
+      PBRT_TRY(eta, ps.number("eta", 1.5));
+      PBRT_TRY(a, alpha(ps, at));
+      if (a >= 1e-3f) return located(at, "a rough dielectric is not supported: pathex has no rough transmission (set roughness 0)");
+      if (!(eta > 1.0001) || eta > 10.0) return located(at, "dielectric eta must be within (1, 10], found " + std::to_string(eta));
+      return Material{Dielectric{static_cast<float>(eta), vec3(1.0f)}};
+    }
+    if (type == "mix") {
+      Param* m = ps.find("materials");
+      if (!m || m->type != "string" || m->strings.size() != 2) return located(m ? m->at : at, "mix needs \"string materials\" [\"a\" \"b\"]");
+      PBRT_TRY(amount, ps.number("amount", 0.5));
+      if (amount < 0 || amount > 1) return located(at, "mix amount must be within [0, 1]");
+      Material parts[2];
+      for (int i = 0; i < 2; ++i) {
+        auto it = named_materials_.find(m->strings[static_cast<std::size_t>(i)]);
+        if (it == named_materials_.end()) return located(m->at, "unknown named material \"" + m->strings[static_cast<std::size_t>(i)] + "\"");
+        parts[i] = it->second;
+      }
+      return import::blend(parts[0], parts[1], static_cast<float>(amount));
+    }
+    return located(at, "material \"" + type + "\" is not supported, expected diffuse, conductor, dielectric or mix");
+  }
+
+  int current_material() {
+    if (gs_.material >= 0) return gs_.material;
+    if (default_material_ < 0) default_material_ = builder_.add_material("pbrt default diffuse", Material{Diffuse{vec3(0.5f)}});
+    return default_material_;
+  }
+
+  // --- lights ---
+  std::optional<Error> light(const std::string& type, Params& ps, const Location& at) {
+    for (const char* p : {"power", "illuminance"})
+      if (Param* q = ps.find(p)) return located(q->at, "parameter '" + std::string(p) + "' is not supported: give the light's I or L and scale");
+    const bool point = type == "point", spot = type == "spot", distant = type == "distant";
+    if (!point && !spot && !distant) return located(at, "light \"" + type + "\" is not supported, expected point, spot, distant or an AreaLightSource");
+    PBRT_TRY(value, ps.rgb(distant ? "L" : "I", vec3(1.0f), false));
+    PBRT_TRY(scale, ps.number("scale", 1.0));
+    if (value.x < 0 || value.y < 0 || value.z < 0 || scale < 0) return located(at, "a light's emission must be non-negative");
+    const vec3 emitted = value * static_cast<float>(scale);
+    PBRT_TRY(from, ps.point("from", vec3(0.0f)));
+    if (point) {
+      builder_.add_light(PointLight{import::apply_point(gs_.ctm, from), emitted});
+      return std::nullopt;
+    }
+    PBRT_TRY(to, ps.point("to", vec3(0.0f, 0.0f, 1.0f)));
+    const vec3 dir = import::apply_vector(gs_.ctm, to - from);
+    if (!(glm::length(dir) > 0.0f)) return located(at, "the light's from and to coincide");
+    if (distant) {
+      builder_.add_distant(dir, emitted);  // pbrt's "L" of a distant light is its irradiance
+      return std::nullopt;
+    }
+    PBRT_TRY(cone, ps.number("coneangle", 30.0));
+    PBRT_TRY(delta, ps.number("conedeltaangle", 5.0));
+    if (delta != 0.0)
+      return located(at, "a spot light with a soft edge (conedeltaangle " + Reader_fmt(delta) + ") is not supported: pathex's spot has a hard edge, set conedeltaangle 0");
+    float s = 1.0f;
+    if (!import::is_similarity(gs_.ctm, &s)) return located(at, "a spot light under a non-uniform scale is not supported");
+    if (!(cone > 0.0) || cone > 180.0) return located(at, "coneangle must be within (0, 180]");
+    builder_.add_light(SpotLight{import::apply_point(gs_.ctm, from), glm::normalize(dir), emitted, static_cast<float>(cone)});
+    return std::nullopt;
+  }
+
+  static std::string Reader_fmt(double x) {
+    std::ostringstream s;
+    s << x;
+    return s.str();
+  }
+
+  // --- shapes ---
+  std::optional<Error> shape(const std::string& type, Params& ps, const Location& at) {
+    if (Param* p = ps.find("alpha")) return located(p->at, "alpha cut-outs are not supported");
+    Shape s;
+    s.pointer = at.str();
+    s.material = current_material();
+    if (gs_.area) {
+      s.emission = gs_.area->radiance;
+      s.two_sided = gs_.area->two_sided;
+    }
+    // pbrt's front side: the parametric normal, flipped by ReverseOrientation and by a transform
+    // that swaps handedness (shapes.cpp: flipNormal = reverseOrientation ^ transformSwapsHandedness).
+    const bool flip = gs_.reverse != import::swaps_handedness(gs_.ctm);
+    const glm::mat4& m = gs_.ctm;
+    if (type == "sphere" || type == "disk") {
+      if (Param* p = ps.find("phimax"); p && !(p->numbers.size() == 1 && p->numbers[0] >= 360.0))
+        return located(p->at, "partial " + type + "s (phimax) are not supported");
+      float scale = 1.0f;
+      if (!import::is_similarity(m, &scale)) return located(at, "a " + type + " under a non-uniform scale is not supported");
+      PBRT_TRY(radius, ps.number("radius", 1.0));
+      if (!(radius > 0)) return located(at, "radius must be positive");
+      if (type == "sphere") {
+        for (const char* z : {"zmin", "zmax"})
+          if (Param* p = ps.find(z)) return located(p->at, "partial spheres (" + std::string(z) + ") are not supported");
+        if (flip && s.emissive() && !s.two_sided)
+          return located(at, "a sphere emitting inwards (ReverseOrientation or a mirroring transform) is not supported");
+        s.geometry = SphereShape{import::apply_point(m, vec3(0.0f)), static_cast<float>(radius) * scale};
+      } else {
+        PBRT_TRY(height, ps.number("height", 0.0));
+        PBRT_TRY(inner, ps.number("innerradius", 0.0));
+        if (inner != 0.0) return located(ps.find("innerradius")->at, "disks with a hole (innerradius) are not supported");
+        const vec3 n = import::apply_normal(m, vec3(0, 0, 1));
+        s.geometry = DiskShape{import::apply_point(m, vec3(0, 0, static_cast<float>(height))), flip ? -n : n,
+                               static_cast<float>(radius) * scale};
+      }
+      builder_.add_shape(std::move(s));
+      return std::nullopt;
+    }
+    if (type == "trianglemesh" || type == "bilinearmesh" || type == "plymesh") {
+      for (const char* n : {"N", "S"})
+        if (Param* p = ps.find(n)) return located(p->at, "per-vertex normals and tangents (" + std::string(n) + ") are not supported: pathex shades meshes with their face normals");
+      ps.ignore({"uv", "faceIndices"});
+      MeshShape mesh;
+      if (type == "plymesh") {
+        if (Param* p = ps.find("displacement")) return located(p->at, "displacement is not supported");
+        ps.ignore({"edgelength"});
+        PBRT_TRY(file, ps.string("filename", ""));
+        if (file.empty()) return located(at, "plymesh needs a \"string filename\"");
+        PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, /*discard_normals=*/false));
+        mesh = std::move(ply);
+        mesh.file = file;
+      } else {
+        PBRT_TRY(p, ps.points("P"));
+        const std::size_t corners = type == "trianglemesh" ? 3 : 4;
+        std::vector<long long> idx;
+        if (Param* ip = ps.find("indices")) {
+          if (ip->type != "integer") return located(ip->at, "indices must be integers");
+          for (double x : ip->numbers) {
+            if (x != std::floor(x) || std::fabs(x) > 1e15) return located(ip->at, "indices must be integers");
+            idx.push_back(static_cast<long long>(x));
+          }
+        } else if (p.size() == corners) {
+          for (std::size_t i = 0; i < corners; ++i) idx.push_back(static_cast<long long>(i));
+        }
+        if (p.empty() || idx.empty() || idx.size() % corners != 0)
+          return located(at, type + " needs \"point3 P\" and \"integer indices\" (" + std::to_string(corners) + " per " +
+                                 (corners == 3 ? "triangle" : "patch") + ")");
+        for (long long i : idx)
+          if (i < 0 || i >= static_cast<long long>(p.size())) return located(ps.find("indices")->at, "index " + std::to_string(i) + " is out of range, expected 0.." + std::to_string(p.size() - 1));
+        mesh.positions = p;
+        if (corners == 3) {
+          for (std::size_t i = 0; i < idx.size(); i += 3) mesh.triangles.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
+        } else {
+          // A bilinear patch p00 p10 p01 p11 that is a planar parallelogram is a quad; planar
+          // otherwise it is two triangles; a curved patch is refused.
+          for (std::size_t i = 0; i < idx.size(); i += 4) {
+            const vec3 p00 = import::apply_point(m, p[idx[i]]), p10 = import::apply_point(m, p[idx[i + 1]]);
+            const vec3 p01 = import::apply_point(m, p[idx[i + 2]]), p11 = import::apply_point(m, p[idx[i + 3]]);
+            const vec3 n = glm::cross(p10 - p00, p01 - p00);
+            const float size = std::max(glm::length(p10 - p00), glm::length(p01 - p00));
+            if (!(glm::length(n) > 0.0f)) return located(at, "a degenerate bilinear patch (zero area)");
+            if (std::fabs(glm::dot(p11 - p00, glm::normalize(n))) > 1e-5f * size)
+              return located(at, "a curved (non-planar) bilinear patch is not supported");
+            Shape q = s;
+            if (glm::length(p11 - (p10 + p01 - p00)) <= 1e-5f * size) {
+              q.geometry = flip ? QuadShape{p00, p01 - p00, p10 - p00} : QuadShape{p00, p10 - p00, p01 - p00};
+            } else {
+              MeshShape tri;
+              tri.positions = {p00, p10, p11, p01};
+              tri.triangles = {glm::uvec3(0, 1, 2), glm::uvec3(0, 2, 3)};
+              if (flip)
+                for (glm::uvec3& t : tri.triangles) std::swap(t.y, t.z);
+              q.geometry = std::move(tri);
+            }
+            builder_.add_shape(std::move(q));
+          }
+          return std::nullopt;
+        }
+      }
+      for (vec3& p : mesh.positions) p = import::apply_point(m, p);
+      if (flip)
+        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      s.geometry = std::move(mesh);
+      builder_.add_shape(std::move(s));
+      return std::nullopt;
+    }
+    return located(at, "shape \"" + type + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere or disk");
+  }
+
+  // --- the camera, once the film is known ---
+  std::optional<Error> make_camera() {
+    Params& ps = camera_params_;
+    const Location at = camera_at_.file.empty() ? Location{main_file_} : camera_at_;
+    const std::string what = "Camera \"" + camera_type_ + "\"";
+    for (const char* p : {"screenwindow", "frameaspectratio"})
+      if (Param* q = ps.find(p)) return located(q->at, "parameter '" + std::string(p) + "' is not supported");
+    ps.ignore({"shutteropen", "shutterclose"});
+    const glm::mat4 world_from_camera = glm::inverse(camera_from_world_);
+    float scale = 1.0f;
+    if (!import::is_similarity(world_from_camera, &scale) || std::fabs(scale - 1.0f) > 1e-3f)
+      return located(at, "the camera's transform must be rigid (rotations, translations and mirroring only)");
+    Camera c;
+    c.width = width_;
+    c.height = height_;
+    c.position = import::apply_point(world_from_camera, vec3(0.0f));
+    const vec3 forward = glm::normalize(import::apply_vector(world_from_camera, vec3(0, 0, 1)));
+    c.look_at = c.position + forward;
+    c.up = glm::normalize(import::apply_vector(world_from_camera, vec3(0, 1, 0)));
+    const vec3 right = glm::normalize(import::apply_vector(world_from_camera, vec3(1, 0, 0)));
+    // pbrt's screen window spans [-1, 1] on the shorter image axis.
+    const float aspect = static_cast<float>(width_) / static_cast<float>(height_);
+    const float y_extent = aspect >= 1.0f ? 1.0f : 1.0f / aspect;
+    PBRT_TRY(lens, ps.number("lensradius", 0.0));
+    PBRT_TRY(focus, ps.number("focaldistance", 1e6));
+    if (lens < 0 || !(focus > 0)) return located(at, "lensradius must be non-negative and focaldistance positive");
+    if (camera_type_ == "perspective") {
+      PBRT_TRY(fov, ps.number("fov", 90.0));
+      if (!(fov > 0 && fov < 180)) return located(at, "fov must be within (0, 180)");
+      const float tan_y = std::tan(glm::radians(static_cast<float>(fov)) * 0.5f) * y_extent;
+      c.fov_degrees = glm::degrees(2.0f * std::atan(tan_y));
+      if (lens > 0) {
+        c.type = SensorType::kLens;
+        c.aperture_radius = static_cast<float>(lens);
+        c.focus_distance = static_cast<float>(focus);
+      }
+    } else {
+      if (lens > 0) return located(at, "an orthographic camera with a lens is not supported");
+      c.type = SensorType::kOrthographic;
+      c.film_height = 2.0f * y_extent;
+      c.film_width = c.film_height * aspect;
+    }
+    if (auto e = ps.unused(what)) return e;
+    builder_.set_camera(c, right);
+    return std::nullopt;
+  }
+};
+
+}  // namespace
+
+Result<Scene> load_scene_pbrt(const std::string& path) { return Importer(path).run(); }
+
+}  // namespace pathex

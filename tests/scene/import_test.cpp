@@ -1,0 +1,452 @@
+// Scene import (pbrt-v4 .pbrt, Mitsuba 3 .xml): the exported Cornell boxes give the JSON scene's
+// model and image (per path string within 3 standard errors, per pixel within 3 standard errors
+// of the run-to-run spread), each format's conventions (handedness, field of view, light units)
+// give exact values, and everything outside the subset is refused with its file, line, column
+// and an exact message, by the library and by the CLI (exit 2).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "classify/histogram.h"
+#include "io/profile_json.h"
+#include "scene/scene.h"
+#include "support/cli_run.h"
+#include "trace/render.h"
+
+namespace pathex {
+namespace {
+
+const std::string kDir = PATHEX_SOURCE_DIR;
+const std::string kScenes = kDir + "/samples/scenes/";
+
+// Inline scenes go to the test process's scratch folder; locations in errors are shown relative to it.
+const std::string& scratch() {
+  static const std::string dir = pathex::test::scratch_dir().string();
+  return dir;
+}
+
+std::string write(const std::string& name, const std::string& text) {
+  const std::string path = scratch() + "/" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+std::string relative(std::string s) {
+  for (const std::string& prefix : {scratch() + "/", kDir + "/"})
+    for (std::size_t at; (at = s.find(prefix)) != std::string::npos;) s.erase(at, prefix.size());
+  return s;
+}
+
+Scene load(const std::string& path) {
+  Result<Scene> s = load_scene_file(path);
+  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().render());
+  return s.ok() ? *s : Scene{};
+}
+
+void expect_near(glm::vec3 a, glm::vec3 b, const std::string& what) {
+  EXPECT_LT(glm::length(a - b), 1e-5f) << what << ": (" << a.x << ", " << a.y << ", " << a.z << ") vs (" << b.x << ", " << b.y
+                                        << ", " << b.z << ")";
+}
+
+// --- the exported Cornell boxes: the same model ---
+
+TEST(ImportCornell, SameCameraLightsAndTypesAsTheJsonScene) {
+  const Scene json = load(kScenes + "cornell.json");
+  for (const char* file : {"cornell.pbrt", "cornell.xml"}) {
+    const Scene s = load(kScenes + file);
+    SCOPED_TRACE(file);
+    EXPECT_EQ(describe(scene_types(s)), describe(scene_types(json)));
+    expect_near(s.camera.position, json.camera.position, "position");
+    expect_near(glm::normalize(s.camera.look_at - s.camera.position), glm::normalize(json.camera.look_at - json.camera.position), "forward");
+    expect_near(s.camera.up, json.camera.up, "up");
+    EXPECT_NEAR(s.camera.fov_degrees, json.camera.fov_degrees, 1e-4);
+    EXPECT_EQ(s.camera.width, 64);
+    EXPECT_EQ(s.camera.height, 64);
+    int emitters = 0;
+    for (const Shape& shape : s.shapes) {
+      if (!shape.emissive()) continue;
+      ++emitters;
+      expect_near(shape.emission, glm::vec3(17, 15, 12), "emission");
+      EXPECT_FALSE(shape.two_sided);
+      const QuadShape* q = std::get_if<QuadShape>(&shape.geometry);
+      ASSERT_NE(q, nullptr);
+      expect_near(glm::normalize(glm::cross(q->edge1, q->edge2)), glm::vec3(0, -1, 0), "the lamp faces down");
+      expect_near(q->corner + 0.5f * (q->edge1 + q->edge2), glm::vec3(0, 1.98f, 0), "the lamp's centre");
+    }
+    EXPECT_EQ(emitters, 1);
+    EXPECT_EQ(s.shapes.size(), json.shapes.size());
+  }
+}
+
+// Renders `scene` at 16 x 16 with `seed`; returns the report and the total image's luminance.
+struct Rendered {
+  HistogramReport report;
+  std::vector<double> luminance;
+};
+Rendered render_small(Scene scene, std::uint64_t seed, std::uint64_t spp) {
+  scene.camera.width = scene.camera.height = 16;
+  RenderOptions o;
+  o.spp = spp;
+  o.seed = seed;
+  o.threads = 2;
+  o.max_bounces = 6;
+  const Profile profile = *resolve_profile("pt-nee", Limits{});
+  Result<RenderOutput> out = render(scene, profile, nullptr, o);
+  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
+  RunInfo info;
+  info.spp = spp;
+  Rendered r{*make_report(out->histogram, info, nullptr, {}), {}};
+  const ImageLayer total = out->images.layer(0, 1.0 / static_cast<double>(spp));
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x)
+      r.luminance.push_back(0.2126 * total.image.at(x, y, 0) + 0.7152 * total.image.at(x, y, 1) + 0.0722 * total.image.at(x, y, 2));
+  return r;
+}
+
+// The two-sided probability that Student's t with `dof` degrees of freedom exceeds |t| = 3
+// (numerical integration of its density; dof >= 2).
+double t_tail_beyond_3(double dof) {
+  const double c = std::exp(std::lgamma((dof + 1) / 2) - std::lgamma(dof / 2)) / std::sqrt(dof * M_PI);
+  double inside = 0;
+  const int n = 6000;
+  for (int i = 0; i < n; ++i) {
+    const double t = 3.0 * (i + 0.5) / n;
+    inside += c * std::pow(1 + t * t / dof, -(dof + 1) / 2) * (3.0 / n);
+  }
+  return 1.0 - 2.0 * inside;
+}
+
+// Per-pixel luminance over kRuns independent renders (seeds first_seed, first_seed + 1, ...).
+constexpr int kRuns = 8;
+constexpr std::uint64_t kSpp = 16;
+struct PixelStats {
+  std::vector<double> mean, var;
+};
+PixelStats pixel_stats(const Scene& s, std::uint64_t first_seed) {
+  std::vector<std::vector<double>> runs;
+  for (int i = 0; i < kRuns; ++i) {
+    Rendered r = render_small(s, first_seed + static_cast<std::uint64_t>(i), kSpp);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    runs.push_back(std::move(r.luminance));
+  }
+  PixelStats st{std::vector<double>(runs[0].size(), 0.0), std::vector<double>(runs[0].size(), 0.0)};
+  for (const auto& run : runs)
+    for (std::size_t p = 0; p < run.size(); ++p) st.mean[p] += run[p] / kRuns;
+  for (const auto& run : runs)
+    for (std::size_t p = 0; p < run.size(); ++p) st.var[p] += (run[p] - st.mean[p]) * (run[p] - st.mean[p]) / (kRuns - 1);
+  return st;
+}
+
+// Welch's t per pixel; the images agree when |t| > 3 happens no more often than chance allows
+// for that many pixels, plus 3 standard deviations of that count (binomial). Pixels that are
+// exactly constant in both (they see only the lamp) must be equal.
+struct PixelVerdict {
+  int beyond = 0, lit = 0, unequal_constant = 0;
+  double bound = 0;
+  bool agree() const { return unequal_constant == 0 && beyond <= bound; }
+};
+PixelVerdict compare_pixels(const PixelStats& a, const PixelStats& b) {
+  PixelVerdict v;
+  for (std::size_t p = 0; p < a.mean.size(); ++p) {
+    const double se = std::sqrt(a.var[p] / kRuns + b.var[p] / kRuns);
+    if (!(se > 0)) {
+      v.unequal_constant += a.mean[p] != b.mean[p] ? 1 : 0;
+      continue;
+    }
+    ++v.lit;
+    v.beyond += std::fabs(a.mean[p] - b.mean[p]) / se > 3.0 ? 1 : 0;
+  }
+  const double p = t_tail_beyond_3(kRuns - 1);  // the fewest degrees of freedom Welch's t can have: conservative
+  v.bound = v.lit * p + 3 * std::sqrt(v.lit * p * (1 - p));
+  return v;
+}
+
+TEST(ImportCornell, ImagesMatchTheJsonSceneWithin3Sigma) {
+  const Scene json = load(kScenes + "cornell.json");
+  const PixelStats ref = pixel_stats(json, 1);
+  const HistogramReport ref_report = render_small(json, 1000, kSpp * kRuns).report;
+  std::uint64_t seed = 100;
+  for (const char* file : {"cornell.pbrt", "cornell.xml"}) {
+    SCOPED_TRACE(file);
+    const Scene scene = load(kScenes + file);
+    const PixelStats got = pixel_stats(scene, seed);
+    const HistogramReport report = render_small(scene, seed + 1000, kSpp * kRuns).report;
+    seed += 100;
+    // --- per path string: every string carrying more than 0.5 % of the JSON image (batch-means
+    // standard errors; a string the import's run did not sample counts as 0 ± 0) ---
+    std::map<std::string, const PathEstimate*> by_path;
+    for (const PathEstimate& p : report.paths) by_path[p.path] = &p;
+    int compared = 0;
+    for (const PathEstimate& want : ref_report.paths) {
+      if (want.estimate.luminance < 0.005 * ref_report.total.luminance) continue;
+      const Estimate est = by_path.count(want.path) ? by_path[want.path]->estimate : Estimate{{}, 0.0, 0.0, 0};
+      const double sigma = std::hypot(want.estimate.std_error, est.std_error);
+      EXPECT_LE(std::fabs(est.luminance - want.estimate.luminance), 3 * sigma) << want.path;
+      ++compared;
+    }
+    EXPECT_GE(compared, 5);
+    EXPECT_LE(std::fabs(report.total.luminance - ref_report.total.luminance), 3 * std::hypot(report.total.std_error, ref_report.total.std_error));
+    // --- per pixel ---
+    const PixelVerdict v = compare_pixels(got, ref);
+    EXPECT_TRUE(v.agree()) << v.beyond << " of " << v.lit << " pixels beyond 3 sigma (at most " << v.bound << " by chance), "
+                           << v.unequal_constant << " constant pixels differ";
+    EXPECT_GE(v.lit, 200);
+  }
+}
+
+// The per-pixel statistic can fail: the box mirrored left-right (the red wall on the right, as
+// pbrt shows cornell.pbrt without its Scale -1 1 1) is told apart from the JSON scene.
+TEST(ImportCornell, AMirroredBoxFailsThePixelTest) {
+  const Scene json = load(kScenes + "cornell.json");
+  Scene mirrored = json;
+  for (Shape& s : mirrored.shapes) {
+    if (auto* q = std::get_if<QuadShape>(&s.geometry)) {
+      q->corner.x = -q->corner.x;
+      q->edge1.x = -q->edge1.x;
+      q->edge2.x = -q->edge2.x;
+      std::swap(q->edge1, q->edge2);
+    } else if (auto* sp = std::get_if<SphereShape>(&s.geometry)) {
+      sp->center.x = -sp->center.x;
+    }
+  }
+  const PixelVerdict v = compare_pixels(pixel_stats(mirrored, 1), pixel_stats(json, 100));
+  EXPECT_FALSE(v.agree());
+  EXPECT_GT(v.beyond, 2 * v.bound);
+}
+
+// --- each format's conventions ---
+
+TEST(ImportPbrt, LookAtWithoutAMirroringScaleShowsTheWorldMirrored) {
+  // pbrt's image right is up x forward: looking down -z with y up, world +x is on the image's left.
+  const std::string head = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\n"
+                           "Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 32\nWorldBegin\n"
+                           "LightSource \"point\" \"point3 from\" [1 0 0] \"rgb I\" [1 2 3] \"float scale\" 2\n"
+                           "Shape \"sphere\" \"float radius\" 0.5\n";
+  const Scene plain = load(write("lookat.pbrt", head));
+  ASSERT_EQ(plain.lights.size(), 1u);
+  const auto& p = std::get<PointLight>(plain.lights[0]);
+  expect_near(p.position, glm::vec3(-1, 0, 0), "mirrored through the camera's vertical plane");
+  expect_near(p.intensity, glm::vec3(2, 4, 6), "I times scale");
+  const Scene flipped = load(write("lookat-scale.pbrt", "Scale -1 1 1\n" + head));
+  expect_near(std::get<PointLight>(flipped.lights[0]).position, glm::vec3(1, 0, 0), "with Scale -1 1 1 nothing is mirrored");
+  expect_near(flipped.camera.position, glm::vec3(0, 0, 5), "camera");
+}
+
+TEST(ImportPbrt, FovIsTheShorterImageAxis) {
+  auto fov = [](int w, int h) {
+    const std::string text = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nFilm \"rgb\" \"integer xresolution\" " +
+                             std::to_string(w) + " \"integer yresolution\" " + std::to_string(h) +
+                             "\nWorldBegin\nLightSource \"point\"\nShape \"sphere\"\n";
+    return load(write("fov.pbrt", text)).camera.fov_degrees;
+  };
+  EXPECT_NEAR(fov(128, 64), 40.0, 1e-4);  // landscape: the vertical axis is the shorter
+  EXPECT_NEAR(fov(64, 128), glm::degrees(2 * std::atan(2 * std::tan(glm::radians(20.0)))), 1e-3);
+}
+
+TEST(ImportPbrt, DistantLightCoversTheSceneWithItsIrradiance) {
+  const Scene s = load(write("distant.pbrt",
+                             "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n"
+                             "LightSource \"distant\" \"point3 from\" [0 10 0] \"point3 to\" [0 0 0] \"rgb L\" [3 3 3] \"float scale\" 0.5\n"
+                             "Translate 2 0 0\nShape \"sphere\"\n"));
+  ASSERT_EQ(s.lights.size(), 1u);
+  const auto& d = std::get<DistantLight>(s.lights[0]);
+  expect_near(d.direction, glm::vec3(0, -1, 0), "travels from 'from' to 'to'");
+  expect_near(d.irradiance, glm::vec3(1.5f), "L times scale is the irradiance");
+  // The aperture lies above the sphere (centre (2, 0, 0), radius 1) and covers its shadow.
+  const glm::vec3 lo = glm::min(d.aperture_corner, d.aperture_corner + d.aperture_edge1 + d.aperture_edge2);
+  const glm::vec3 hi = glm::max(d.aperture_corner, d.aperture_corner + d.aperture_edge1 + d.aperture_edge2);
+  EXPECT_GT(lo.y, 1.0f);
+  EXPECT_LT(lo.x, 1.0f);
+  EXPECT_GT(hi.x, 3.0f);
+  EXPECT_LT(lo.z, -1.0f);
+  EXPECT_GT(hi.z, 1.0f);
+}
+
+TEST(ImportPbrt, MaterialsMapOntoPathexKinds) {
+  const Scene s = load(write("materials.pbrt",
+                             "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nLightSource \"point\"\n"
+                             "MakeNamedMaterial \"d\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.2 0.4 0.6]\n"
+                             "MakeNamedMaterial \"g\" \"string type\" \"conductor\" \"rgb reflectance\" [0.9 0.9 0.9] \"float roughness\" 0.04\n"
+                             "MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"d\" \"g\"] \"float amount\" 0.25\n"
+                             "NamedMaterial \"m\"\nShape \"sphere\"\n"
+                             "Material \"conductor\" \"rgb eta\" [2 2 2] \"rgb k\" [0 0 0]\nShape \"disk\" \"float height\" -1\n"));
+  ASSERT_EQ(s.shapes.size(), 2u);
+  const auto& mix = std::get<Mixture>(s.materials[static_cast<std::size_t>(s.shapes[0].material)]);
+  ASSERT_EQ(mix.components.size(), 2u);
+  EXPECT_FLOAT_EQ(mix.components[0].weight, 0.75f);
+  expect_near(std::get<Diffuse>(mix.components[0].material).albedo, glm::vec3(0.2f, 0.4f, 0.6f), "diffuse");
+  EXPECT_FLOAT_EQ(mix.components[1].weight, 0.25f);
+  EXPECT_FLOAT_EQ(std::get<Glossy>(mix.components[1].material).roughness, 0.2f);  // alpha = sqrt(roughness)
+  const auto& mirror = std::get<Mirror>(s.materials[static_cast<std::size_t>(s.shapes[1].material)]);
+  expect_near(mirror.reflectance, glm::vec3(1.0f / 9.0f), "((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2)");
+}
+
+TEST(ImportMitsuba, FovAxisAndOrthographicFilm) {
+  auto camera = [](const std::string& sensor) {
+    return load(write("sensor.xml", "<scene version=\"3.0.0\">" + sensor +
+                                        "<emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"3\" z=\"0\"/></emitter>"
+                                        "<shape type=\"sphere\"/></scene>"))
+        .camera;
+  };
+  const std::string film = "<film type=\"hdrfilm\"><integer name=\"width\" value=\"128\"/><integer name=\"height\" value=\"64\"/></film>";
+  const std::string look = "<transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform>";
+  const double t = std::tan(glm::radians(20.0));
+  EXPECT_NEAR(camera("<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/>" + look + film + "</sensor>").fov_degrees,
+              glm::degrees(2 * std::atan(t / 2)), 1e-3);  // fov_axis x by default
+  EXPECT_NEAR(camera("<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><string name=\"fov_axis\" value=\"y\"/>" + look + film +
+                     "</sensor>")
+                  .fov_degrees,
+              40.0, 1e-4);
+  EXPECT_NEAR(camera("<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><string name=\"fov_axis\" value=\"diagonal\"/>" + look +
+                     film + "</sensor>")
+                  .fov_degrees,
+              glm::degrees(2 * std::atan(t / std::sqrt(5.0))), 1e-3);
+  const Camera ortho = camera("<sensor type=\"orthographic\"><transform name=\"to_world\"><scale value=\"3\"/>"
+                              "<lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform>" +
+                              film + "</sensor>");
+  EXPECT_EQ(ortho.type, SensorType::kOrthographic);
+  EXPECT_NEAR(ortho.film_width, 6.0, 1e-5);   // [-1, 1] scaled by 3
+  EXPECT_NEAR(ortho.film_height, 3.0, 1e-5);  // [-1/aspect, 1/aspect] scaled by 3
+  expect_near(ortho.position, glm::vec3(0, 0, 5), "position");
+}
+
+TEST(ImportMitsuba, LightsKeepTheirUnitsAndPlaces) {
+  const Scene s = load(write("lights.xml",
+                             "<scene version=\"3.0.0\"><sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/>"
+                             "<transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>"
+                             "<emitter type=\"point\"><rgb name=\"intensity\" value=\"1, 2, 3\"/><point name=\"position\" x=\"1\" y=\"0\" z=\"0\"/></emitter>"
+                             "<emitter type=\"spot\"><rgb name=\"intensity\" value=\"4\"/><float name=\"cutoff_angle\" value=\"25\"/>"
+                             "<float name=\"beam_width\" value=\"25\"/><transform name=\"to_world\"><lookat origin=\"0, 2, 0\" target=\"0, 0, 0\" up=\"0, 0, 1\"/></transform></emitter>"
+                             "<emitter type=\"directional\"><vector name=\"direction\" x=\"0\" y=\"-1\" z=\"0\"/><rgb name=\"irradiance\" value=\"5\"/></emitter>"
+                             "<shape type=\"sphere\"/></scene>"));
+  ASSERT_EQ(s.lights.size(), 3u);
+  const auto& p = std::get<PointLight>(s.lights[0]);
+  expect_near(p.position, glm::vec3(1, 0, 0), "Mitsuba is right-handed: nothing is mirrored");
+  expect_near(p.intensity, glm::vec3(1, 2, 3), "intensity in W/sr");
+  const auto& spot = std::get<SpotLight>(s.lights[1]);
+  expect_near(spot.position, glm::vec3(0, 2, 0), "spot position");
+  expect_near(spot.direction, glm::vec3(0, -1, 0), "spot emits along to_world's +z");
+  EXPECT_FLOAT_EQ(spot.cone_degrees, 25.0f);
+  const auto& d = std::get<DistantLight>(s.lights[2]);
+  expect_near(d.direction, glm::vec3(0, -1, 0), "direction of travel");
+  expect_near(d.irradiance, glm::vec3(5), "irradiance");
+}
+
+// --- refusals: located, exact ---
+
+struct Refusal {
+  const char* file;
+  const char* text;
+  const char* where;  // relative to the scratch folder
+  const char* message;
+};
+
+const std::string kPbrtHead = "LookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n";
+const std::string kXmlHead = "<scene version=\"3.0.0\">\n";
+
+std::vector<Refusal> refusals() {
+  return {
+      // pbrt-v4
+      {"object.pbrt", "ObjectBegin \"thing\"\n", "object.pbrt:4:1",
+       "directive 'ObjectBegin' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
+      {"medium.pbrt", "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n", "medium.pbrt:4:1",
+       "directive 'MakeNamedMedium' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
+      {"cylinder.pbrt", "Shape \"cylinder\"\n", "cylinder.pbrt:4:1",
+       "shape \"cylinder\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere or disk"},
+      {"coated.pbrt", "Material \"coateddiffuse\"\n", "coated.pbrt:4:1",
+       "material \"coateddiffuse\" is not supported, expected diffuse, conductor, dielectric or mix"},
+      {"infinite.pbrt", "LightSource \"infinite\" \"rgb L\" [1 1 1]\n", "infinite.pbrt:4:1",
+       "light \"infinite\" is not supported, expected point, spot, distant or an AreaLightSource"},
+      {"zmin.pbrt", "Shape \"sphere\" \"float zmin\" -0.5\n", "zmin.pbrt:4:16", "partial spheres (zmin) are not supported"},
+      {"typo.pbrt", "Shape \"sphere\" \"float radiu\" 2\n", "typo.pbrt:4:16", "parameter \"float radiu\" of Shape \"sphere\" is not supported"},
+      {"rough-glass.pbrt", "Material \"dielectric\" \"float roughness\" 0.1\n", "rough-glass.pbrt:4:1",
+       "a rough dielectric is not supported: pathex has no rough transmission (set roughness 0)"},
+      {"blackbody.pbrt", "LightSource \"point\" \"blackbody I\" 3000\n", "blackbody.pbrt:4:21",
+       "parameter \"blackbody I\" is not supported: pathex renders in RGB, give \"rgb I\" [r g b]"},
+      {"texture.pbrt", "Material \"diffuse\" \"texture reflectance\" \"checks\"\n", "texture.pbrt:4:20",
+       "textures are not supported (parameter \"texture reflectance\"), give \"rgb reflectance\" [r g b]"},
+      {"soft-spot.pbrt", "LightSource \"spot\" \"rgb I\" [1 1 1]\n", "soft-spot.pbrt:4:1",
+       "a spot light with a soft edge (conedeltaangle 5) is not supported: pathex's spot has a hard edge, set conedeltaangle 0"},
+      {"normals.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1 0 0 1 0 0 1]\n", "normals.pbrt:4:53",
+       "per-vertex normals and tangents (N) are not supported: pathex shades meshes with their face normals"},
+      {"include.pbrt", "Include \"missing.pbrt\"\n", "include.pbrt:4:1", "cannot open the included file 'missing.pbrt'"},
+      {"end.pbrt", "AttributeEnd\n", "end.pbrt:4:1", "AttributeEnd has no matching AttributeBegin"},
+      {"string.pbrt", "Shape \"sphere\n", "string.pbrt:4:7", "unterminated string, expected a closing '\"' on the same line"},
+      {"nolight.pbrt", "Shape \"sphere\"\n", "nolight.pbrt", "the scene has no light: expected a light source or an emitting shape"},
+      // Mitsuba 3
+      {"cube.xml", "  <shape type=\"cube\"/>\n</scene>\n", "cube.xml:2:3",
+       "shape \"cube\" is not supported, expected obj, ply, sphere, rectangle or disk"},
+      {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",
+       "emitter \"envmap\" is not supported, expected point, spot, directional, or area inside a shape"},
+      {"medium.xml", "  <medium type=\"homogeneous\"/>\n</scene>\n", "medium.xml:2:3",
+       "<medium> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)"},
+      {"rough-glass.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"roughdielectric\"/>\n  </shape>\n</scene>\n", "rough-glass.xml:3:5",
+       "roughdielectric is not supported: pathex has no rough transmission"},
+      {"beckmann.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"roughconductor\"/>\n  </shape>\n</scene>\n", "beckmann.xml:3:5",
+       "microfacet distribution \"beckmann\" is not supported: pathex's glossy lobe is GGX, set <string name=\"distribution\" value=\"ggx\"/>"},
+      {"bitmap.xml",
+       "  <shape type=\"sphere\">\n    <bsdf type=\"diffuse\">\n      <texture type=\"bitmap\" name=\"reflectance\"/>\n    </bsdf>\n  </shape>\n</scene>\n",
+       "bitmap.xml:4:7", "textures are not supported ('reflectance'), give an <rgb>"},
+      {"typo.xml", "  <shape type=\"sphere\">\n    <float name=\"radiuss\" value=\"1\"/>\n  </shape>\n</scene>\n", "typo.xml:3:5",
+       "<float name=\"radiuss\"> in <shape type=\"sphere\"> is not supported"},
+      {"smooth.xml", "  <shape type=\"obj\">\n    <string name=\"filename\" value=\"x.obj\"/>\n  </shape>\n</scene>\n", "smooth.xml:2:3",
+       "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face "
+       "normals (add <boolean name=\"face_normals\" value=\"true\"/>)"},
+      {"soft-spot.xml", "  <emitter type=\"spot\"/>\n</scene>\n", "soft-spot.xml:2:3",
+       "a spot light with a soft edge (beam_width < cutoff_angle) is not supported: pathex's spot has a hard edge, set beam_width equal to "
+       "cutoff_angle"},
+      {"param.xml", "  <shape type=\"sphere\">\n    <float name=\"radius\" value=\"$r\"/>\n  </shape>\n</scene>\n", "param.xml:3:5",
+       "unknown parameter $r (no <default name=\"r\">)"},
+      {"broken.xml", "  <shape type=\"sphere\">\n</scene>\n", "broken.xml:3:3", "not valid XML: Start-end tags mismatch"},
+  };
+}
+
+std::string full_text(const Refusal& r) {
+  const std::string f = r.file;
+  return (f.size() > 5 && f.substr(f.size() - 5) == ".pbrt" ? kPbrtHead : kXmlHead) + r.text;
+}
+
+TEST(ImportRefusals, LibraryNamesFileLineColumnAndWhat) {
+  for (const Refusal& r : refusals()) {
+    const Result<Scene> s = load_scene_file(write(r.file, full_text(r)));
+    ASSERT_FALSE(s.ok()) << r.file;
+    EXPECT_EQ(relative(s.error().where), r.where) << r.file;
+    EXPECT_EQ(relative(s.error().message), r.message) << r.file;
+  }
+}
+
+TEST(ImportRefusals, CliPrintsTheSameLineAndExits2) {
+  for (const Refusal& r : refusals()) {
+    const std::string path = write(r.file, full_text(r));
+    const pathex::test::CliRun run = pathex::test::run_pathex("trace " + path + " --quiet --out " + scratch() + "/out");
+    EXPECT_EQ(run.code, 2) << r.file;
+    EXPECT_EQ(relative(run.err), std::string("pathex: error: ") + r.where + ": " + r.message + "\n") << r.file;
+  }
+  // query --scene and check read scenes through the same entry point.
+  const pathex::test::CliRun q = pathex::test::run_pathex("query --scene " + write("object.pbrt", kPbrtHead + "ObjectBegin \"thing\"\n") + " 'L.*E'");
+  EXPECT_EQ(q.code, 2);
+  EXPECT_NE(q.err.find("object.pbrt:4:1: directive 'ObjectBegin' is not supported"), std::string::npos) << q.err;
+}
+
+TEST(ImportRefusals, PlyMeshesWithNormalsOrCurvedQuads) {
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n";
+  write("normals.ply", header + "property float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n");
+  write("curved.ply", header + "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 1\n0 1 0\n4 0 1 2 3\n");
+  const Result<Scene> a = load_scene_file(write("ply-normals.pbrt", kPbrtHead + "Shape \"plymesh\" \"string filename\" \"normals.ply\"\n"));
+  ASSERT_FALSE(a.ok());
+  EXPECT_EQ(relative(a.error().where), "ply-normals.pbrt:4:1");
+  EXPECT_EQ(relative(a.error().message),
+            "the PLY mesh 'normals.ply' has per-vertex normals, which are not supported: pathex shades meshes with their face normals");
+  const Result<Scene> b = load_scene_file(write("ply-curved.pbrt", kPbrtHead + "Shape \"plymesh\" \"string filename\" \"curved.ply\"\n"));
+  ASSERT_FALSE(b.ok());
+  EXPECT_EQ(relative(b.error().message),
+            "the PLY mesh 'curved.ply' has a non-planar quad (face 0), which pbrt renders as a curved bilinear patch; pathex supports planar "
+            "quads only");
+}
+
+}  // namespace
+}  // namespace pathex
