@@ -60,12 +60,12 @@ double cpu_seconds() {
 // exactly `count` rays: camera rays through random pixels, each followed by up to three random
 // bounces (comparable coherence), the minimum of work around each ray. Returns the hits.
 std::uint64_t plain_embree_loop(const RenderScene& rs, std::uint64_t count, std::uint64_t seed) {
-  const RenderCamera& cam = rs.camera;
+  const PinholeParams& cam = std::get<PinholeParams>(rs.camera.params);  // the Cornell box's
   std::uint64_t rays = 0, hits = 0;
   for (std::uint64_t path = 0; rays < count; ++path) {
     Sampler rng(seed, path, 0);
     const glm::vec2 u = rng.get2d();
-    const float sx = (2.0f * u.x - 1.0f) * cam.tan_x, sy = (1.0f - 2.0f * u.y) * cam.tan_y;
+    const float sx = (2.0f * u.x - 1.0f) * cam.tan_half_x, sy = (1.0f - 2.0f * u.y) * cam.tan_half_y;
     glm::vec3 o = cam.position, d = glm::normalize(cam.forward + sx * cam.right + sy * cam.up);
     for (int bounce = 0; bounce < 4 && rays < count; ++bounce) {
       RTCRayHit rh{};
@@ -184,7 +184,7 @@ void BM_ShadowRays(benchmark::State& state) {
   Result<RenderScene> rs = make_render_scene(cornell());
   const EmbreeScene& es = *rs->geometry;
   struct Segment {
-    glm::vec3 a, na, b, nb;
+    glm::vec3 a, na, ea, b, nb, eb;
   };
   std::vector<Segment> segments;
   std::mt19937 pick(3);
@@ -193,17 +193,17 @@ void BM_ShadowRays(benchmark::State& state) {
   for (int i = 0; i < 65536; ++i) {
     const SurfaceSample a = es.sample_shape(static_cast<int>(pick() % shapes), {u01(pick), u01(pick)});
     const SurfaceSample b = es.sample_shape(static_cast<int>(pick() % shapes), {u01(pick), u01(pick)});
-    segments.push_back({a.position, a.normal, b.position, b.normal});
+    segments.push_back({a.position, a.normal, a.error, b.position, b.normal, b.error});
   }
   std::vector<double> ratios;
   std::uint64_t visible_single = 0, visible_batched = 0;
   OcclusionBatch batch;
   for (auto _ : state) {
     const double t0 = cpu_seconds();
-    for (const Segment& g : segments) visible_single += es.visible(g.a, g.na, g.b, g.nb);
+    for (const Segment& g : segments) visible_single += es.visible(g.a, g.na, g.ea, g.b, g.nb, g.eb);
     const double t1 = cpu_seconds();
     for (const Segment& g : segments) {
-      batch.add(es, g.a, g.na, g.b, g.nb);
+      batch.add(es, g.a, g.na, g.ea, g.b, g.nb, g.eb);
       if (!batch.full()) continue;
       batch.trace(es);
       for (int lane = 0; lane < batch.size(); ++lane) visible_batched += batch.visible(lane);

@@ -5,8 +5,8 @@
 // per letter — and the final state names every class the path belongs to. It is built twice,
 // once for each reading direction: forward (L to E, as light subpaths grow) and backward (E to L,
 // as eye subpaths grow; the product of the reversed languages). In either direction a state can
-// be asked whether any class is still reachable, which is what lets a tracer stop a subpath that
-// can no longer complete to a requested class.
+// be asked whether any class is still reachable (the tracer does not prune subpaths with it yet;
+// it classifies each path string once, when the histogram first meets it).
 //
 // States are row offsets into the table (state index × 8), so stepping is a single load:
 // `s = table[s + column(c)]`. Columns 0–3 are the letters D E L S; any other character goes to

@@ -20,10 +20,12 @@
 // sane radiance) is counted in nonfinite() and never added; the magnitude guard then proves that
 // no sum can leave the representable range (see Histogram::magnitude()).
 //
-// Batch means. Samples are grouped into B batches (default 32) by *pass* — contiguous ranges of
-// the per-pixel sample index, see batch_of_pass() — so that every batch covers the whole image
-// and the batch estimates X_b = S_b / n_b are independent and identically distributed, whatever
-// the strategy (splats from light tracing land anywhere, which rules out a per-pixel variance).
+// Batch means. Samples are grouped into B batches (default 32) by *pass*, the per-pixel sample
+// index — the renderer deals passes to batches round-robin (pass mod B, trace/render.cpp), so
+// that an interrupted render still spreads what it has over every batch — so that every batch
+// covers the whole image and the batch estimates X_b = S_b / n_b are independent and identically
+// distributed, whatever the strategy (splats from light tracing land anywhere, which rules out a
+// per-pixel variance). batch_of_pass() below is the other possible dealing, contiguous ranges.
 // With N = Σ n_b and X̄ = Σ S_b / N, the standard error of X̄ is estimated by
 //
 //     stderr² = Σ_b (S_b − n_b X̄)² / (N² − Σ_b n_b²),

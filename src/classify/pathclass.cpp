@@ -3,6 +3,7 @@
 #include <cctype>
 
 #include "automata/ops.h"
+#include "regex/lpe.h"
 #include "regex/parser.h"
 
 namespace pathex {
@@ -74,9 +75,50 @@ Result<Dfa> expand_ends(const Dfa& classic, const EndTypes& ends, const Limits& 
 
 }  // namespace
 
+std::optional<Notation> notation_from_string(std::string_view s) {
+  if (s == "full") return Notation::kFull;
+  if (s == "heckbert") return Notation::kHeckbert;
+  if (s == "lpe") return Notation::kLpe;
+  return std::nullopt;
+}
+
+std::string to_string(Notation n) {
+  switch (n) {
+    case Notation::kFull: return "full";
+    case Notation::kHeckbert: return "heckbert";
+    case Notation::kLpe: return "lpe";
+  }
+  return "full";
+}
+
 Dfa ends_universe(const EndTypes& ends) { return *expand_ends(classic_universe(), ends, Limits{}); }
 
+namespace {
+
+// An LPE is read into an eye-first full-notation tree whose C and L already stand for the sensor
+// and light types: compile it, reverse it, intersect with the universe. No names, no guessing of
+// the direction (an LPE that starts with '.' is still camera-first).
+Result<PathClass> compile_lpe(std::string_view text, const ClassOptions& options) {
+  Result<Regex> ast = parse_lpe(text, options.ends.lights, options.ends.sensors, options.limits);
+  if (!ast) return ast.error();
+  Result<Dfa> raw = compile(*ast, options.limits);
+  if (!raw) return with_source(raw.error(), text);
+  Result<Dfa> rev = dfa_reverse(*raw, options.limits);
+  if (!rev) return with_source(rev.error(), text);
+  PathClass pc;
+  pc.text = std::string(text);
+  pc.notation = Notation::kLpe;
+  pc.eye_first = true;
+  pc.dfa = dfa_intersect(*rev, dfa_universe());
+  pc.light_ast = reversed(*ast);
+  pc.ast = std::move(*ast);
+  return pc;
+}
+
+}  // namespace
+
 Result<PathClass> compile_class(std::string_view text, const ClassOptions& options, const ClassTable* names) {
+  if (options.notation == Notation::kLpe) return compile_lpe(text, options);
   const ClassTable& table = names ? *names : ClassTable::builtins();
   Error notation_error;
   bool notation_mismatch = false;
@@ -84,11 +126,13 @@ Result<PathClass> compile_class(std::string_view text, const ClassOptions& optio
   NameLookup lookup = [&](std::string_view name) -> const Regex* {
     const PathClass* c = table.find(name);
     if (!c) return nullptr;
-    if (c->notation != options.notation && !notation_mismatch) {
+    // An LPE class's tree is full notation (its ends are expanded already).
+    const Notation tree = c->notation == Notation::kHeckbert ? Notation::kHeckbert : Notation::kFull;
+    if (tree != options.notation && !notation_mismatch) {
       notation_mismatch = true;
       mismatched_name = "$" + std::string(name);
       notation_error.message = "'$" + std::string(name) + "' is written in " +
-                               (c->notation == Notation::kFull ? "full" : "Heckbert") +
+                               (tree == Notation::kFull ? "full" : "Heckbert") +
                                " notation and cannot be used in a " +
                                (options.notation == Notation::kFull ? "full" : "Heckbert") + "-notation expression";
     }

@@ -1,13 +1,15 @@
 // Path classes: expressions turned into sets of valid full paths.
 //
-// compile_class() is the one road from text to language: parse (full or Heckbert notation),
-// compile to a minimal DFA, reverse if the expression is written eye-first, expand Heckbert's
-// L and E into the light and sensor letter pairs, and intersect with the universe
+// compile_class() is the one road from text to language: parse (full, Heckbert or LPE notation),
+// compile to a minimal DFA, reverse if the expression is written eye-first (LPEs always are),
+// expand Heckbert's L and E (an LPE's C and L) into the light and sensor letter pairs, and
+// intersect with the universe
 // U = L[SD]{4,}E. Named classes ($name) come from a ClassTable: the built-ins plus, in order,
 // the entries of a class file, each of which may refer to the ones before it.
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -20,9 +22,14 @@
 
 namespace pathex {
 
-enum class Notation { kFull, kHeckbert };
+// kLpe: OSL light path expressions, camera first (regex/lpe.h); their classes' trees are full
+// notation, so full-notation expressions may name them.
+enum class Notation { kFull, kHeckbert, kLpe };
+// "full", "heckbert", "lpe"; nullopt for anything else.
+std::optional<Notation> notation_from_string(std::string_view s);
+std::string to_string(Notation n);
 
-// Which lights and sensors Heckbert notation (and a scene) may put at the ends. Default: all.
+// Which lights and sensors Heckbert and LPE notation (and a scene) may put at the ends. Default: all.
 struct EndTypes {
   std::vector<LightType> lights{kAllLightTypes.begin(), kAllLightTypes.end()};
   std::vector<SensorType> sensors{kAllSensorTypes.begin(), kAllSensorTypes.end()};

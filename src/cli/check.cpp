@@ -117,9 +117,9 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
       c.max_bounces = m.get<int>();
     }
     if (jc.contains("notation")) {
-      if (jc["notation"] == "full") c.notation = Notation::kFull;
-      else if (jc["notation"] == "heckbert") c.notation = Notation::kHeckbert;
-      else return bad(file, ptr + "/notation", "expected \"full\" or \"heckbert\"");
+      const auto n = jc["notation"].is_string() ? notation_from_string(jc["notation"].get<std::string>()) : std::nullopt;
+      if (!n) return bad(file, ptr + "/notation", "expected \"full\", \"heckbert\" or \"lpe\"");
+      c.notation = *n;
     }
     if (!jc.contains("require") || !jc["require"].is_array() || jc["require"].empty())
       return bad(file, ptr + "/require", "expected a non-empty array of requirements");

@@ -2,6 +2,7 @@
 
 #include <iostream>
 
+#include "classify/notation_hint.h"
 #include "io/class_file.h"
 
 namespace pathex::cli {
@@ -18,19 +19,21 @@ void add_limit_options(CLI::App* app, Limits* limits) {
 }
 
 void add_notation_options(CLI::App* app, NotationOptions* n) {
-  app->add_option("--notation", n->notation, "full (L c0 c1 … E) or heckbert (L w E, one letter per interior vertex)")
-      ->check(CLI::IsMember({"full", "heckbert"}))->capture_default_str();
-  app->add_option("--light", n->lights, "Light types for Heckbert notation: area, distant, point, laser (default all)")
+  app->add_option("--notation", n->notation,
+                  "full (L c0 c1 … E), heckbert (L w E, one letter per interior vertex) or lpe (OSL light path "
+                  "expression, camera first: C<RD>L)")
+      ->check(CLI::IsMember({"full", "heckbert", "lpe"}))->capture_default_str();
+  app->add_option("--light", n->lights, "Light types for Heckbert and LPE notation: area, distant, point, laser (default all)")
       ->delimiter(',')->allow_extra_args(false);
   app->add_option("--sensor", n->sensors,
-                  "Sensor types for Heckbert notation: lens, pinhole, orthographic, spotmeter (default all)")
+                  "Sensor types for Heckbert and LPE notation: lens, pinhole, orthographic, spotmeter (default all)")
       ->delimiter(',')->allow_extra_args(false);
 }
 
 Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limits) {
   ClassOptions o;
   o.limits = limits;
-  o.notation = n.notation == "heckbert" ? Notation::kHeckbert : Notation::kFull;
+  o.notation = notation_from_string(n.notation).value_or(Notation::kFull);
   if (!n.lights.empty()) {
     o.ends.lights.clear();
     for (const std::string& s : n.lights) {
@@ -50,7 +53,7 @@ Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limit
     }
   }
   if ((!n.lights.empty() || !n.sensors.empty()) && o.notation == Notation::kFull)
-    return make_error(ErrorCode::kUsage, "--light and --sensor apply to --notation heckbert only");
+    return make_error(ErrorCode::kUsage, "--light and --sensor apply to --notation heckbert and lpe only");
   return o;
 }
 
@@ -62,7 +65,14 @@ Result<PathClass> compile_cli_expression(const std::string& expr, const Notation
     Result<bool> r = read_class_file(classes_file, *opts, table);
     if (!r) return r.error();
   }
-  return compile_class(expr, *opts, table);
+  Result<PathClass> pc = compile_class(expr, *opts, table);
+  if (pc) print_notation_hint(expr, *pc, *opts, table);
+  return pc;
+}
+
+void print_notation_hint(const std::string& expr, const PathClass& pc, const ClassOptions& options,
+                         const ClassTable* table) {
+  if (std::optional<std::string> h = heckbert_hint(expr, pc, options, table)) std::cerr << "pathex: hint: " << *h << "\n";
 }
 
 int report(const Error& e) {

@@ -39,6 +39,11 @@ Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limit
 Result<PathClass> compile_cli_expression(const std::string& expr, const NotationOptions& n, const Limits& limits,
                                          const std::string& classes_file, ClassTable* table);
 
+// Prints "pathex: hint: …" on stderr when a full-notation expression reads like a Heckbert string
+// (classify/notation_hint.h). compile_cli_expression() calls it.
+void print_notation_hint(const std::string& expr, const PathClass& pc, const ClassOptions& options,
+                         const ClassTable* table);
+
 // Prints "pathex: error: <rendered error>" to stderr and returns kExitBadInput.
 int report(const Error& e);
 

@@ -6,6 +6,7 @@
 
 #include "cli/common.h"
 #include "cli/render_job.h"
+#include "io/output_set.h"
 
 namespace pathex::cli {
 namespace {
@@ -34,8 +35,17 @@ int run(const MergeArgs& a) {
     return report(make_error(ErrorCode::kUsage, "passes " + missing.to_string() + " of 0-" + std::to_string(header.spp - 1) +
                                                     " are in no shard; give --partial to merge what there is (marked \"complete\": false)"));
   header.share = whole;  // the merge is of the whole render: complete when no pass is missing
-  Result<WrittenReport> w = write_render_outputs(a.out, header, combined->sums, *combined->classes);
-  if (!w) return report(w.error());
+  Result<OutputSet> out_set = OutputSet::prepare(a.out);
+  if (!out_set) return report(out_set.error());
+  {
+    const SignalShield shield;
+    Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
+      Result<WrittenReport> r = write_render_outputs(dir, header, combined->sums, *combined->classes);
+      if (!r) return r.error();
+      return true;
+    });
+    if (!w) return report(w.error());
+  }
   if (!a.quiet) {
     std::cout << "merged " << files.size() << " shard file" << (files.size() == 1 ? "" : "s") << ": " << header.passes.count()
               << " of " << header.spp << " spp";

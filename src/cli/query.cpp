@@ -92,6 +92,7 @@ int run(const QueryArgs& a) {
   for (const std::string& e : a.exprs) {
     Result<PathClass> pc = compile_class(e, copts, &table);
     if (!pc) return report(pc.error());
+    print_notation_hint(e, *pc, copts, &table);
     pc->text = e;
     std::vector<QueryResult> row;
     for (const CompiledProfile& cp : setup.compiled) {

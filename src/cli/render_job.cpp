@@ -55,7 +55,7 @@ RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& class
 }
 
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                           const RenderClasses& classes) {
+                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors) {
   const RenderIdentity& id = header.identity;
   RunInfo info;
   info.scene = id.scene;
@@ -66,11 +66,19 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
   Result<HistogramReport> rep = make_report(sums.histogram, info, classes.classifier.get(), classes.infos);
   if (!rep) return rep.error();
 
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return make_error(ErrorCode::kBadFile, "cannot create the output folder " + dir + ": " + ec.message());
   WrittenReport out{std::move(*rep), {}};
-  out.json_text = histogram_json_text(out.report);
+  nlohmann::ordered_json doc = to_json(out.report);
+  if (!connectors.empty()) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const ConnectorStats& c : connectors)
+      list.push_back({{"strategy", c.strategy},
+                      {"connector", c.connector},
+                      {"attempts", c.attempts},
+                      {"successes", c.successes},
+                      {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
+    doc["connectors"] = std::move(list);
+  }
+  out.json_text = doc.dump(2) + "\n";
   if (Result<bool> w = write_file_atomic(dir + "/histogram.json", out.json_text); !w) return w.error();
   if (id.images) {
     const std::uint64_t spp = header.passes.count();
@@ -89,28 +97,37 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
   return out;
 }
 
+std::string ranks_folder(const std::string& dir) {
+  std::string d = dir;
+  while (d.size() > 1 && d.back() == '/') d.pop_back();
+  return d + ".ranks";
+}
+
 Result<std::vector<std::string>> render_folder_shards(const std::string& dir) {
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) {
-    Error e = make_error(ErrorCode::kBadFile, "not a render folder (no such directory)");
-    e.where = dir;
-    return e;
-  }
   std::vector<std::string> names;
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
-    if (entry.path().extension() == kShardExtension) names.push_back(entry.path().string());
-  if (ec) {
-    Error e = make_error(ErrorCode::kBadFile, "cannot list the folder: " + ec.message());
-    e.where = dir;
-    return e;
+  std::error_code ec;
+  bool any_folder = false;
+  for (const std::string& d : {dir, ranks_folder(dir)}) {
+    if (!std::filesystem::is_directory(d, ec)) continue;
+    any_folder = true;
+    std::vector<std::string> here;
+    for (const auto& entry : std::filesystem::directory_iterator(d, ec))
+      if (entry.path().extension() == kShardExtension) here.push_back(entry.path().string());
+    if (ec) {
+      Error e = make_error(ErrorCode::kBadFile, "cannot list the folder: " + ec.message());
+      e.where = d;
+      return e;
+    }
+    std::sort(here.begin(), here.end());
+    names.insert(names.end(), here.begin(), here.end());
   }
   if (names.empty()) {
-    Error e = make_error(ErrorCode::kBadFile,
-                         std::string("no shard file (*") + kShardExtension + ") in the folder: is it a pathex trace output folder?");
+    Error e = make_error(ErrorCode::kBadFile, any_folder ? std::string("no shard file (*") + kShardExtension +
+                                                               ") in the folder: is it a pathex trace output folder?"
+                                                         : std::string("not a render folder (no such directory)"));
     e.where = dir;
     return e;
   }
-  std::sort(names.begin(), names.end());
   return names;
 }
 

@@ -17,6 +17,7 @@
 #include "core/limits.h"
 #include "core/pass_set.h"
 #include "io/shard.h"
+#include "trace/render.h"
 
 namespace pathex::cli {
 
@@ -48,10 +49,18 @@ struct WrittenReport {
   HistogramReport report;
   std::string json_text;
 };
+// histogram.json also lists what each connector did ("connectors": [{strategy, connector,
+// attempts, successes, failures {outside, occluded, no_transport}}] in the profile's order;
+// absent when the profile has none).
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                           const RenderClasses& classes);
+                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors = {});
 
-// The shard files of a render folder: every *.shard in it, by name; an error if there is none.
+// Where the MPI ranks of a render into `dir` keep their own shard files until rank 0 has written
+// the outputs: the folder "<dir>.ranks" beside it (the output folder holds only its set).
+std::string ranks_folder(const std::string& dir);
+
+// The shard files of a render folder: every *.shard in it and in its ranks folder, by name; an
+// error if there is none.
 Result<std::vector<std::string>> render_folder_shards(const std::string& dir);
 
 inline constexpr const char* kRenderShardName = "render.shard";

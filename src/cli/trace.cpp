@@ -21,6 +21,7 @@
 #include "io/class_file.h"
 #include "io/histogram_json.h"
 #include "io/image_io.h"
+#include "io/output_set.h"
 #include "io/profile_json.h"
 #include "scene/scene_hash.h"
 #include "scene/universe.h"
@@ -28,6 +29,10 @@
 
 namespace pathex::cli {
 namespace {
+
+// --max-memory's default: what the render's images and their writing may take, estimated before
+// rendering (render_memory_estimate()).
+constexpr std::uint64_t kDefaultMaxMemory = std::uint64_t{4} << 30;
 
 struct TraceArgs {
   std::string scene;
@@ -45,6 +50,7 @@ struct TraceArgs {
   std::string shard;       // "i/n"
   std::string resume;      // a render folder
   double time_limit = 0;   // seconds; 0: none
+  std::uint64_t max_memory = kDefaultMaxMemory;
   std::vector<std::string> settings_given;  // render settings named on the command line (refused with --resume)
   Limits limits;
 };
@@ -57,6 +63,12 @@ extern "C" void on_stop(int) { g_cancel.store(true); }
 std::string percent(double share, int decimals = 1) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.*f %%", decimals, 100.0 * share);
+  return buf;
+}
+
+std::string gib(std::uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(bytes) / static_cast<double>(std::uint64_t{1} << 30));
   return buf;
 }
 
@@ -205,17 +217,8 @@ Result<bool> load_resumed(const TraceArgs& a, Job* job) {
   return true;
 }
 
-// Removes the shard files of `dir` other than render.shard: older renders' or the ranks' of a run
-// whose sums render.shard now holds.
-void remove_other_shards(const std::string& dir) {
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
-    if (entry.path().extension() == kShardExtension && entry.path().filename() != kRenderShardName)
-      std::filesystem::remove(entry.path(), ec);
-}
-
 std::string rank_shard_path(const std::string& dir, int rank) {
-  return dir + "/rank-" + std::to_string(rank) + kShardExtension;
+  return ranks_folder(dir) + "/rank-" + std::to_string(rank) + kShardExtension;
 }
 
 int run(const TraceArgs& a) {
@@ -225,6 +228,19 @@ int run(const TraceArgs& a) {
   Cluster* cluster = current_cluster();
   const int rank = cluster != nullptr ? cluster->rank() : 0;
   const int ranks = cluster != nullptr ? cluster->size() : 1;
+  // Connector statistics (histogram.json "connectors") are per process and not yet kept in shard
+  // files, so a render that is split or resumed must not use a connector.
+  for (const Strategy& st : job.profile->strategies)
+    if (st.connector != ConnectorKind::kNone && (!a.shard.empty() || !a.resume.empty() || ranks > 1))
+      return report(make_error(ErrorCode::kUsage, "the " + job.profile->name + " profile uses the " + to_string(st.connector) +
+                                                      " connector, whose statistics are not merged yet: --shard, --resume and MPI runs need a profile without connectors"));
+  // The output folder is checked before the render, not after it.
+  std::optional<OutputSet> out_set;
+  if (rank == 0) {
+    Result<OutputSet> prepared = OutputSet::prepare(job.out);
+    if (!prepared) return report(prepared.error());
+    out_set.emplace(std::move(*prepared));
+  }
 
   // --- render this process's part of the passes still missing ---
   const PassSet todo = job.header.share.minus(job.header.passes);
@@ -240,6 +256,18 @@ int run(const TraceArgs& a) {
   ro.images = id.images;
   if (ro.images)
     for (int i = 0; i < job.classes->classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
+  // --- memory: the images and their writing, estimated before the render ---
+  const int num_layers = 1 + static_cast<int>(ro.layer_classes.size());
+  const std::uint64_t need = ro.images ? render_memory_estimate(id.width, id.height, num_layers) : 0;
+  if (need > a.max_memory) {
+    Error e = make_error(ErrorCode::kLimit,
+                         "the images would take about " + gib(need) + " (" + std::to_string(id.width) + " x " +
+                             std::to_string(id.height) + " pixels, " + std::to_string(num_layers) +
+                             " layers), more than --max-memory " + gib(a.max_memory) +
+                             "; pass --no-images for the histogram alone, render fewer pixels or classes, or raise --max-memory");
+    e.where = id.scene + ":/camera";
+    return report(e);
+  }
   const bool show_progress = rank == 0 && !a.quiet && ::isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
   ro.progress = [&](std::uint64_t done, std::uint64_t total) {
@@ -272,7 +300,7 @@ int run(const TraceArgs& a) {
   if (cluster != nullptr) {
     const std::string mine = rank_shard_path(job.out, rank);
     std::error_code ec;
-    std::filesystem::create_directories(job.out, ec);
+    std::filesystem::create_directories(ranks_folder(job.out), ec);
     if (Result<bool> w = write_file_atomic(mine, encode_shard(header, sums.histogram, sums.images)); !w) return report(w.error());
     if (g_cancel.load())
       std::fprintf(stderr, "pathex: rank %d stopped after %s of its passes; they are kept in %s ('pathex trace --resume %s' finishes the render)\n",
@@ -287,13 +315,18 @@ int run(const TraceArgs& a) {
     header.run.rays += job.resumed->header.run.rays;
   }
 
-  // --- outputs (rank 0), each written whole or not at all ---
+  // --- outputs (rank 0): one set, whole or not at all, shielded from signals (io/output_set.h) ---
   std::optional<WrittenReport> written;
   std::optional<Error> failure;
   if (rank == 0) {
-    Result<WrittenReport> w = write_render_outputs(job.out, header, sums, *job.classes);
-    if (w) written = std::move(*w);
-    else failure = w.error();
+    const SignalShield shield;
+    Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
+      Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, out->connectors);
+      if (!r) return r.error();
+      written = std::move(*r);
+      return true;
+    });
+    if (!w) failure = w.error();
   }
   if (cluster != nullptr) {
     // Every rank's work is in render.shard once rank 0 has written it: the ranks' files go.
@@ -304,7 +337,10 @@ int run(const TraceArgs& a) {
     if (rank != 0) return kExitOk;
   }
   if (failure) return report(*failure);
-  remove_other_shards(job.out);
+  {  // the ranks' files of a failed MPI run, now held by render.shard
+    std::error_code ec;
+    std::filesystem::remove_all(ranks_folder(job.out), ec);
+  }
   const HistogramReport* rep = &written->report;
   const bool complete = rep->run.complete;
   if (a.json) {
@@ -336,6 +372,16 @@ int run(const TraceArgs& a) {
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << id.renderer << ": " << (q ? to_string(q->verdict) : "?") << "\n";
   }
+  if (!out->connectors.empty()) {
+    int width = 10;
+    for (const ConnectorStats& c : out->connectors) width = std::max(width, static_cast<int>(c.strategy.size()));
+    std::cout << "\n" << std::left << std::setw(width + 2) << "connectors" << std::right
+              << "  attempts  successes   outside  occluded  no transport\n";
+    for (const ConnectorStats& c : out->connectors)
+      std::cout << "  " << std::left << std::setw(width) << c.strategy << std::right << std::setw(10) << c.attempts
+                << std::setw(11) << c.successes << std::setw(10) << c.outside << std::setw(10) << c.occluded
+                << std::setw(14) << c.no_transport << "   (" << c.connector << ")\n";
+  }
   std::cout << "\nmost important paths\n";
   for (std::size_t i = 0; i < rep->paths.size() && static_cast<int>(i) < a.top_paths; ++i) {
     const PathEstimate& p = rep->paths[i];
@@ -361,7 +407,8 @@ Command add_trace(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("trace", "Render a scene, label every path, write path-class histograms and images");
   sub->footer("Example:\n  pathex trace                         # the embedded Cornell box\n"
               "  pathex trace samples/scenes/point-mirror-caustic.json --renderer pt-nee --spp 64 --out out/\n"
-              "Writes DIR/histogram.json, DIR/classes.exr (a layer per class and the total) and DIR/<layer>.png.\n"
+              "Writes DIR/histogram.json, DIR/classes.exr (a layer per class and the total) and DIR/<layer>.png,\n"
+              "as one set that replaces the previous one whole (DIR must hold only what pathex wrote there).\n"
               "Also DIR/render.shard (the exact sums, for merge and --resume) and DIR/run.json (time, threads).\n"
               "Ctrl-C, SIGTERM or --time stop early and write what was rendered, marked \"complete\": false (exit 1);\n"
               "'pathex trace --resume DIR' renders the rest. Split a render: --shard 0/4 … 3/4, then pathex merge.");
@@ -378,6 +425,10 @@ Command add_trace(CLI::App& app) {
   sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs and the per-pixel sums behind them (the histogram is the same)");
+  sub->add_option("--max-memory", args->max_memory,
+                  "Refuse a render whose images (and their writing) would take more, estimated before rendering; e.g. 512M, 16G")
+      ->transform(CLI::AsSizeValue(false))
+      ->default_str("4G");
   sub->add_option("--shard", args->shard, "Render shard i of n of the passes (i/n, 0 <= i < n); merge the shards with pathex merge");
   sub->add_option("--resume", args->resume, "Continue the interrupted render in this folder to its requested spp (settings come from the folder)");
   sub->add_option("--time", args->time_limit, "Stop after this many seconds (at the end of a chunk of passes); --resume continues")

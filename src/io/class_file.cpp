@@ -71,9 +71,9 @@ Result<bool> load_class_file(const std::string& text, const std::string& filenam
     opts.notation = Notation::kFull;
     if (entry.contains("notation")) {
       const auto& n = entry["notation"];
-      if (n == "full") opts.notation = Notation::kFull;
-      else if (n == "heckbert") opts.notation = Notation::kHeckbert;
-      else return file_error(filename, ptr + "/notation", "expected \"full\" or \"heckbert\"");
+      const auto parsed = n.is_string() ? notation_from_string(n.get<std::string>()) : std::nullopt;
+      if (!parsed) return file_error(filename, ptr + "/notation", "expected \"full\", \"heckbert\" or \"lpe\"");
+      opts.notation = *parsed;
     }
     std::string description;
     if (entry.contains("description")) {

@@ -67,6 +67,14 @@ double srgb_encode(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::
 
 }  // namespace
 
+// --- memory ---
+
+std::uint64_t render_memory_estimate(int width, int height, int layers) {
+  constexpr std::uint64_t kBytesPerPixelLayer = 48 + 12 + 2 * 12;
+  return static_cast<std::uint64_t>(std::max(width, 0)) * static_cast<std::uint64_t>(std::max(height, 0)) *
+         static_cast<std::uint64_t>(std::max(layers, 1)) * kBytesPerPixelLayer;
+}
+
 // --- OpenEXR ---
 
 Result<std::string> encode_exr(const std::vector<ImageLayer>& layers, const ExrOptions& options) {

@@ -149,6 +149,17 @@ Result<bool> check_strategy(Strategy* st, const Limits& limits, const std::strin
     return pointer_error(pointer + "/s", "the distant-projection connector joins at c0..c2, so s must be 0");
   if (st->connector == ConnectorKind::kOrthoProjection && !(st->t.lo == 0 && st->t.hi == 0))
     return pointer_error(pointer + "/t", "the ortho-projection connector joins at ck..c(k+2), so t must be 0");
+  // Where a connector may stand is stated by the strategy's s and t (DESIGN §4); the checker's
+  // languages and the tracer's strategy table both read them. Mirror and manifold construct
+  // interior vertices only (every S they join is one of x1 … x(k-1)), so s ≥ 1 and t ≥ 1.
+  if (st->connector == ConnectorKind::kMirror || st->connector == ConnectorKind::kManifold) {
+    const bool s_ok = st->s.lo >= 1;
+    if (!s_ok || st->t.lo < 1)
+      return pointer_error(pointer + (s_ok ? "/t" : "/s"),
+                           "the " + to_string(st->connector) +
+                               " connector constructs interior vertices only, so s and t must be at least 1 (found s " +
+                               st->s.to_string() + ", t " + st->t.to_string() + ")");
+  }
   st->chain_dfa = std::move(*chain);
   return true;
 }

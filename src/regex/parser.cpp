@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <string>
 
+#include "regex/repeat.h"
+
 namespace pathex {
 namespace {
 
@@ -233,70 +235,21 @@ class Parser {
     return failed_ ? -1 : cur;
   }
 
-  // The cursor is on a digit. Reads the number, failing as soon as it exceeds max_repeat.
-  bool parse_number(int* out) {
-    const int column = col();
-    long long v = 0;
-    while (!at_end() && std::isdigit(static_cast<unsigned char>(peek()))) {
-      v = v * 10 + (peek() - '0');
-      if (v > limits_.max_repeat) {
-        fail(column, limit_message("repetition count", static_cast<std::size_t>(limits_.max_repeat), "repetitions", "--max-repeat"),
-             ErrorCode::kLimit);
-        return false;
-      }
-      ++pos_;
-    }
-    *out = static_cast<int>(v);
-    return true;
-  }
-
-  bool is_digit() const { return !at_end() && std::isdigit(static_cast<unsigned char>(peek())); }
-
-  // '{' n '}' | '{' n ',' '}' | '{' n ',' m '}'. Running out of text anywhere inside is an
-  // unclosed '{', reported at the '{' like an unclosed '(' or '['.
+  // '{' n '}' | '{' n ',' '}' | '{' n ',' m '}' (regex/repeat.h).
   bool parse_braces(int* min, int* max) {
-    const int open = col();
-    auto unclosed = [&] {
-      fail(open, "missing '}' to close this '{'");
-      return false;
-    };
-    ++pos_;  // '{'
-    skip_space();
-    if (at_end()) return unclosed();
-    if (!is_digit()) {
-      fail(col(), "expected a number after '{', found " + found());
-      return false;
-    }
-    if (!parse_number(min)) return false;
-    skip_space();
-    if (at_end()) return unclosed();
-    if (peek() == '}') { ++pos_; *max = *min; return true; }
-    if (peek() != ',') {
-      fail(col(), "expected ',' or '}' in repetition, found " + found());
+    Result<RepeatCounts> c = read_repeat(text_, &pos_, limits_, [this](std::size_t at) {
+      const std::size_t here = pos_;
+      pos_ = at;
+      std::string f = found();
+      pos_ = here;
+      return f;
+    });
+    if (!c) {
+      fail(c.error().column, c.error().message, c.error().code);
       return false;
     }
-    ++pos_;  // ','
-    skip_space();
-    if (at_end()) return unclosed();
-    if (peek() == '}') { ++pos_; *max = kUnbounded; return true; }
-    if (!is_digit()) {
-      fail(col(), "expected a number or '}' after ',', found " + found());
-      return false;
-    }
-    const int max_col = col();
-    if (!parse_number(max)) return false;
-    skip_space();
-    if (at_end()) return unclosed();
-    if (peek() != '}') {
-      fail(col(), "expected '}' in repetition, found " + found());
-      return false;
-    }
-    ++pos_;
-    if (*min > *max) {
-      fail(max_col, "repetition {" + std::to_string(*min) + "," + std::to_string(*max) +
-                        "}: the maximum is smaller than the minimum");
-      return false;
-    }
+    *min = c->min;
+    *max = c->max;
     return true;
   }
 

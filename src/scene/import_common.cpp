@@ -1,6 +1,7 @@
 #include "scene/import_common.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -104,6 +105,9 @@ bool is_similarity(const glm::mat4& m, float* scale) {
 // --- PLY meshes through assimp ---
 
 Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".ply") return located(at, "the mesh '" + path + "' is not a .ply file");
   Assimp::Importer importer;
   // No post-processing: the faces arrive as written, so quads can be checked before splitting.
   const aiScene* scene = importer.ReadFile(path, 0);

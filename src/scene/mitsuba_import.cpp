@@ -297,6 +297,9 @@ class Importer {
       const std::string id = n.attribute("id").value();
       if (id.empty()) return located(where(n), "a top-level <bsdf> needs an id");
       bsdfs_[id] = n;
+      // Checked now, used or not: an unsupported BSDF is refused even before a shape refers to it.
+      Result<Material> m = bsdf(n);
+      if (!m) return m.error();
       return std::nullopt;
     }
     if (tag == "shape") return shape(n);

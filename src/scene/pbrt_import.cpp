@@ -276,8 +276,6 @@ class Importer {
       std::string extra;
       if (!(decl >> p.type >> p.name) || (decl >> extra)) return located(p.at, "bad parameter declaration \"" + s.peek().text + "\", expected \"type name\"");
       ++s.pos;
-      if (p.type == "normal3") p.type = "normal";
-      if (p.type == "point3") p.type = "point3";
       const bool bracket = !s.done() && s.peek().kind == Token::kOpen;
       if (bracket) ++s.pos;
       int count = 0;
@@ -604,7 +602,7 @@ class Importer {
     PBRT_TRY(cone, ps.number("coneangle", 30.0));
     PBRT_TRY(delta, ps.number("conedeltaangle", 5.0));
     if (delta != 0.0)
-      return located(at, "a spot light with a soft edge (conedeltaangle " + Reader_fmt(delta) + ") is not supported: pathex's spot has a hard edge, set conedeltaangle 0");
+      return located(at, "a spot light with a soft edge (conedeltaangle " + fmt_number(delta) + ") is not supported: pathex's spot has a hard edge, set conedeltaangle 0");
     float s = 1.0f;
     if (!import::is_similarity(gs_.ctm, &s)) return located(at, "a spot light under a non-uniform scale is not supported");
     if (!(cone > 0.0) || cone > 180.0) return located(at, "coneangle must be within (0, 180]");
@@ -612,7 +610,7 @@ class Importer {
     return std::nullopt;
   }
 
-  static std::string Reader_fmt(double x) {
+  static std::string fmt_number(double x) {
     std::ostringstream s;
     s << x;
     return s.str();

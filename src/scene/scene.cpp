@@ -120,6 +120,19 @@ class Reader {
     return out;
   }
 
+  // An emission, intensity, irradiance or power: a non-negative 3-vector of at most kMaxLightValue.
+  Result<vec3> light_value(const json& j, const std::string& key, const std::string& ptr, bool required) const {
+    Result<vec3> v = vector3(j, key, ptr, required, vec3(0.0f), /*nonneg=*/true);
+    if (!v) return v;
+    for (int i = 0; i < 3; ++i)
+      if ((*v)[i] > kMaxLightValue)
+        return fail(ptr + "/" + key + "/" + std::to_string(i),
+                    "expected at most 1e9, found " + fmt((*v)[i]) +
+                        ": the tracer sums contributions exactly below 2^50 (about 1.1e15) and drops larger ones, so "
+                        "brighter lights would lose samples; scale the scene's lights down (the image scales with them)");
+    return v;
+  }
+
   Result<std::string> string(const json& j, const std::string& key, const std::string& ptr) const {
     const std::string p = ptr + "/" + key;
     if (!j.contains(key)) return fail(p, "missing " + key + ", expected a string");
@@ -576,21 +589,21 @@ Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr)
   if (type == "point") {
     if (auto k = r.keys(j, ptr, {"type", "position", "intensity"}); !k) return k.error();
     PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
-    PATHEX_TRY(i, r.vector3(j, "intensity", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(i, r.light_value(j, "intensity", ptr, true));
     return Light{PointLight{p, i}};
   }
   if (type == "spot") {
     if (auto k = r.keys(j, ptr, {"type", "position", "direction", "intensity", "cone"}); !k) return k.error();
     PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
     PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
-    PATHEX_TRY(i, r.vector3(j, "intensity", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(i, r.light_value(j, "intensity", ptr, true));
     PATHEX_TRY(cone, r.number(j, "cone", ptr, 1e-3, 180.0, 30.0));
     return Light{SpotLight{p, glm::normalize(d), i, static_cast<float>(cone)}};
   }
   if (type == "distant") {
     if (auto k = r.keys(j, ptr, {"type", "direction", "irradiance", "aperture"}); !k) return k.error();
     PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
-    PATHEX_TRY(e, r.vector3(j, "irradiance", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(e, r.light_value(j, "irradiance", ptr, true));
     if (!j.contains("aperture")) return r.fail(ptr + "/aperture", "missing aperture, expected {corner, edge1, edge2}: the window the light enters through");
     const std::string ap = ptr + "/aperture";
     if (auto k = r.keys(j["aperture"], ap, {"corner", "edge1", "edge2"}); !k) return k.error();
@@ -606,7 +619,7 @@ Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr)
     if (auto k = r.keys(j, ptr, {"type", "position", "direction", "power"}); !k) return k.error();
     PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
     PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
-    PATHEX_TRY(pw, r.vector3(j, "power", ptr, true, vec3(0.0f), true));
+    PATHEX_TRY(pw, r.light_value(j, "power", ptr, true));
     return Light{LaserLight{p, glm::normalize(d), pw}};
   }
   return r.fail(ptr + "/type", "unknown light type '" + type + "', expected point, spot, distant or laser (area lights are shapes with an emission)");
@@ -644,7 +657,7 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
   for (std::size_t i = 0; i < scene.material_names.size(); ++i)
     if (scene.material_names[i] == mat) s.material = static_cast<int>(i);
   if (s.material < 0) return r.fail(ptr + "/material", "unknown material '" + mat + "', expected a name defined in /materials");
-  PATHEX_TRY(em, r.vector3(j, "emission", ptr, false, vec3(0.0f), true));
+  PATHEX_TRY(em, r.light_value(j, "emission", ptr, false));
   s.emission = em;
   if (j.contains("two_sided")) {
     if (!j["two_sided"].is_boolean()) return r.fail(ptr + "/two_sided", "expected true or false");

@@ -91,6 +91,12 @@ struct Scene {
   Camera camera;
 };
 
+// The largest emission, intensity, irradiance or power component a scene may give. The tracer sums
+// contributions exactly in fixed point and counts one of 2^50 (about 1.1e15) or more as non-finite
+// (classify/histogram.h); 1e9 leaves a factor of 1e6 for what geometry and sampling multiply a
+// light's value by. Physical values stay far below it (the sun's radiance is about 2e7 W/(m^2 sr)).
+inline constexpr float kMaxLightValue = 1e9f;
+
 // `base_dir` resolves relative mesh paths; `name` prefixes error locations.
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name);
 // The entry point of every command: dispatches on the extension. `.pbrt` is a pbrt-v4 scene

@@ -1,6 +1,8 @@
 // Embree geometry for a Scene (see embree_scene.h for the conventions): building the Embree
 // scene, the user-geometry callbacks of the exact spheres and disks, ray queries with the
-// self-intersection offset, and uniform area sampling of shapes.
+// self-intersection offset, and uniform area sampling of shapes. Every position computed here
+// comes with its error bound (Hit::error, SurfaceSample::error), from the magnitudes it was
+// computed from; the gamma(n) of each is the number of roundings on its way, rounded up.
 #include "trace/embree_scene.h"
 
 #include <algorithm>
@@ -154,6 +156,26 @@ glm::vec2 quad_uv(const QuadShape& q, const vec3& p) {
   return {(w1 * e22 - w2 * e12) / det, (w2 * e11 - w1 * e12) / det};
 }
 
+// --- positions and their error bounds ---
+
+// b0 p0 + b1 p1 + b2 p2: three products and two sums per component, and barycentrics whose sum
+// is 1 only up to rounding (pbrt-v4 bounds the same interpolation by gamma(7)); and Embree's test.
+vec3 triangle_point(const vec3& p0, const vec3& p1, const vec3& p2, float b0, float b1, float b2, vec3* error) {
+  const vec3 span = glm::abs(p1 - p0) + glm::abs(p2 - p0);
+  *error = error_gamma(7) * (glm::abs(b0 * p0) + glm::abs(b1 * p1) + glm::abs(b2 * p2)) +
+           primitive_test_error(std::max(span.x, std::max(span.y, span.z)));
+  return b0 * p0 + b1 * p1 + b2 * p2;
+}
+
+// centre + radius n with n unit up to rounding: the reprojection and the sum (pbrt-v4: gamma(5)
+// for the reprojection in object space, plus the move to world space).
+vec3 sphere_error(const SphereShape& s, const vec3& n) {
+  return error_gamma(8) * (glm::abs(s.center) + s.radius * glm::abs(n));
+}
+
+// A point of the disk's plane within the radius: a projection or a frame's rotation, and a sum.
+vec3 disk_error(const DiskShape& d) { return error_gamma(8) * (glm::abs(d.center) + vec3(d.radius)); }
+
 // Embree asserts that a ray's origin and direction are finite (Debian's build aborts the
 // process otherwise). A non-finite ray is a bug upstream; it is treated as hitting nothing and
 // as blocked, so that it carries no light, and never reaches Embree.
@@ -197,11 +219,6 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
   rtcSetSceneFlags(es->scene_.get(), RTC_SCENE_FLAG_ROBUST);
   RTCDevice device = es->device_.get();
 
-  vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-  auto grow = [&](const vec3& p) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  };
   es->areas_.assign(scene.shapes.size(), 0.0f);
   es->quad_normals_.assign(scene.shapes.size(), vec3(0.0f));
   es->triangle_cdf_.resize(scene.shapes.size());
@@ -223,7 +240,6 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
         v[3 * i] = m->positions[i].x;
         v[3 * i + 1] = m->positions[i].y;
         v[3 * i + 2] = m->positions[i].z;
-        grow(m->positions[i]);
       }
       std::vector<double>& cdf = es->triangle_cdf_[si];
       cdf.reserve(m->triangles.size());
@@ -253,7 +269,6 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
         v[3 * i] = corners[i].x;
         v[3 * i + 1] = corners[i].y;
         v[3 * i + 2] = corners[i].z;
-        grow(corners[i]);
         idx[i] = i;
       }
       es->areas_[si] = glm::length(glm::cross(q->edge1, q->edge2));
@@ -271,13 +286,9 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
       if (sphere) {
         const SphereShape& s = std::get<SphereShape>(shape.geometry);
         es->areas_[si] = 4.0f * kPi * s.radius * s.radius;
-        grow(s.center - vec3(s.radius));
-        grow(s.center + vec3(s.radius));
       } else {
         const DiskShape& s = std::get<DiskShape>(shape.geometry);
         es->areas_[si] = kPi * s.radius * s.radius;
-        grow(s.center - vec3(s.radius));
-        grow(s.center + vec3(s.radius));
       }
     }
     rtcCommitGeometry(g);
@@ -290,8 +301,6 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
   if (es->errors_->first.empty()) rtcCommitScene(es->scene_.get());
   if (!es->errors_->first.empty())
     return make_error(ErrorCode::kBadValue, "Embree could not build the scene: " + es->errors_->first);
-  es->extent_ = scene.shapes.empty() ? 1.0f : std::max(glm::length(hi - lo), std::numeric_limits<float>::min());
-  es->epsilon_ = 1e-5f * es->extent_;
   return es;
 }
 
@@ -316,12 +325,13 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
     const glm::uvec3 t = m->triangles[rh.hit.primID];
     const vec3 p0 = m->positions[t.x], p1 = m->positions[t.y], p2 = m->positions[t.z];
     if (detail == HitDetail::kFull) h.uv = {rh.hit.u, rh.hit.v};
-    h.position = (1.0f - rh.hit.u - rh.hit.v) * p0 + rh.hit.u * p1 + rh.hit.v * p2;
+    h.position = triangle_point(p0, p1, p2, 1.0f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v, &h.error);
     const vec3 n = glm::cross(p1 - p0, p2 - p0);
     const float len = glm::length(n);
     h.normal = len > 0.0f ? n / len : -glm::normalize(d);  // degenerate triangles face the ray
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
     h.normal = quad_normals_[static_cast<std::size_t>(h.shape)];
+    h.error = parallelogram_error(q->corner, q->edge1, q->edge2);  // the projection too: p lies within the quad
     if (detail == HitDetail::kFull) {
       h.uv = glm::clamp(quad_uv(*q, p), 0.0f, 1.0f);
       h.position = q->corner + h.uv.x * q->edge1 + h.uv.y * q->edge2;
@@ -331,6 +341,7 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
   } else if (const auto* s = std::get_if<SphereShape>(&shape.geometry)) {
     h.normal = glm::normalize(p - s->center);
     h.position = s->center + s->radius * h.normal;
+    h.error = sphere_error(*s, h.normal);
     if (detail == HitDetail::kFull)
       h.uv = {unit_angle(h.normal.y, h.normal.x), std::acos(std::clamp(h.normal.z, -1.0f, 1.0f)) / kPi};
   } else {
@@ -338,6 +349,7 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
     h.normal = k.normal;
     const vec3 local = Frame::from_normal(k.normal).to_local(p - k.center);
     h.position = p - local.z * k.normal;
+    h.error = disk_error(k);
     if (detail == HitDetail::kFull)
       h.uv = {unit_angle(local.y, local.x), std::min(std::sqrt(local.x * local.x + local.y * local.y) / k.radius, 1.0f)};
   }
@@ -355,10 +367,11 @@ bool EmbreeScene::occluded(const vec3& o, const vec3& d, float tmin, float tmax)
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
 
-int OcclusionBatch::add(const EmbreeScene& scene, const vec3& a, const vec3& na, const vec3& b, const vec3& nb) {
+int OcclusionBatch::add(const EmbreeScene&, const vec3& a, const vec3& na, const vec3& ea, const vec3& b, const vec3& nb,
+                        const vec3& eb) {
   const int lane = size_++;
   vec3 o, d;
-  scene.shadow_ray(a, na, b, nb, &o, &d);
+  EmbreeScene::shadow_ray(a, na, ea, b, nb, eb, &o, &d);
   rays_.org_x[lane] = o.x;
   rays_.org_y[lane] = o.y;
   rays_.org_z[lane] = o.z;
@@ -395,13 +408,15 @@ void OcclusionBatch::trace(const EmbreeScene& scene) {
   }
 }
 
-std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, const vec3& origin_normal, HitDetail detail) const {
-  return intersect(offset(o, origin_normal, d), d, 0.0f, std::numeric_limits<float>::infinity(), detail);
+std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, const vec3& origin_normal, const vec3& origin_error,
+                                          HitDetail detail) const {
+  return intersect(offset(o, origin_normal, origin_error, d), d, 0.0f, std::numeric_limits<float>::infinity(), detail);
 }
 
-bool EmbreeScene::visible(const vec3& a, const vec3& na, const vec3& b, const vec3& nb) const {
+bool EmbreeScene::visible(const vec3& a, const vec3& na, const vec3& ea, const vec3& b, const vec3& nb,
+                          const vec3& eb) const {
   vec3 o, d;
-  shadow_ray(a, na, b, nb, &o, &d);
+  shadow_ray(a, na, ea, b, nb, eb, &o, &d);
   return !occluded(o, d, 0.0f, 1.0f);
 }
 
@@ -437,20 +452,23 @@ SurfaceSample EmbreeScene::sample_shape(int shape_index, glm::vec2 u) const {
     const glm::uvec3 t = m->triangles[i];
     const glm::vec2 b = sample_uniform_triangle(glm::vec2(ux, u.y));
     const vec3 p0 = m->positions[t.x], p1 = m->positions[t.y], p2 = m->positions[t.z];
-    s.position = b.x * p0 + b.y * p1 + (1.0f - b.x - b.y) * p2;
+    s.position = triangle_point(p0, p1, p2, b.x, b.y, 1.0f - b.x - b.y, &s.error);
     const vec3 n = glm::cross(p1 - p0, p2 - p0);
     s.normal = glm::length(n) > 0.0f ? glm::normalize(n) : vec3(0.0f, 0.0f, 1.0f);
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
     s.position = q->corner + u.x * q->edge1 + u.y * q->edge2;
+    s.error = parallelogram_error(q->corner, q->edge1, q->edge2);
     s.normal = quad_normals_[static_cast<std::size_t>(shape_index)];  // normalize(e1 × e2), once per scene
   } else if (const auto* sp = std::get_if<SphereShape>(&shape.geometry)) {
     s.normal = sample_uniform_sphere(u);
     s.position = sp->center + sp->radius * s.normal;
+    s.error = sphere_error(*sp, s.normal);
   } else {
     const DiskShape& d = std::get<DiskShape>(shape.geometry);
     const glm::vec2 p = sample_concentric_disk(u) * d.radius;
     const Frame f = Frame::from_normal(d.normal);
     s.position = d.center + f.to_world(vec3(p.x, p.y, 0.0f));
+    s.error = disk_error(d);
     s.normal = d.normal;
   }
   return s;

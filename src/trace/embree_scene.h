@@ -6,21 +6,29 @@
 // error callback collects Embree's own errors, which build() returns as an Error value. All
 // queries are const and thread-safe (TBB calls them concurrently).
 //
-// Self-intersection: the raw queries (intersect/occluded with tmin, tmax) take the ray as given.
-// The robust ones (intersect with an origin normal, visible) move a ray's origin off the surface
-// it leaves, along the geometric normal to the side the ray goes, by
-//     offset_epsilon(p) = 1e-5 * extent + 1e-6 * max(|p.x|, |p.y|, |p.z|),
-// where extent is the diagonal of the scene's bounds: proportional to the scene's size, and at
-// least about 8 float ulps of the point's own coordinates, so scenes scaled by 1e-4 or 1e+4 and
-// scenes far from the origin behave alike (tests/scene/embree_test.cpp). Hit positions are
-// projected back onto the exact surface, so the offset only needs to cover rounding. The price
-// of float coordinates: the offset is 1e-6 of the distance from the origin, so features (radii,
-// gaps, contacts) should be larger than about 1e-4 of that distance; a unit box 1e+5 from the
-// origin (coordinates step by 0.008 there) is beyond what float geometry can resolve.
+// Self-intersection (pbrt-v4's method, Pharr, Jakob and Humphreys, "Physically Based Rendering",
+// 4th ed., sec. 6.8; Wächter and Binder, Ray Tracing Gems ch. 6): every hit and every sampled
+// surface point carries `error`, a per-component bound on the rounding error of its position
+// relative to the surface as Embree and the analytic tests see it (from the magnitudes that went
+// into computing it: gamma(n) * (|b0 p0| + |b1 p1| + |b2 p2|) for a triangle, and so on). A ray
+// leaving the surface starts at the point moved along the geometric normal, to the side the ray
+// goes, by the error bound's extent along the normal, dot(|n|, error), and then rounded one float
+// further away: the new origin is provably on the ray's side of the surface. The offset depends
+// on the point and its own primitive only, never on the scene's size: a ground plane 1e6 away, or
+// a far sphere, leaves the rest of the scene untouched (tests/scene/embree_test.cpp,
+// tests/trace/render_test.cpp). The raw queries (intersect/occluded with tmin, tmax) take the ray
+// as given; the robust ones (intersect with an origin normal and error, visible, OcclusionBatch)
+// offset. Points in free space (lights, pinholes: normal zero) are not moved. Hit positions are
+// put back onto the exact surface, so the bounds only cover rounding. The price of float
+// coordinates stays: the error (and so the offset) is about 1e-6 of the magnitudes involved, so
+// features (radii, gaps, contacts) should be larger than that.
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -38,6 +46,7 @@ struct Hit {
   glm::vec3 position{0.0f};        // on the surface
   glm::vec3 normal{0.0f};          // geometric, unit, the shape's outward side (whichever side was hit)
   glm::vec3 shading_normal{0.0f};  // equal to `normal` (no interpolated normals yet)
+  glm::vec3 error{0.0f};           // bound on |position - the exact surface point|, per component
   int shape = -1;                  // index into Scene::shapes
   int primitive = -1;              // triangle index for meshes, 0 otherwise
   // Surface parameters (HitDetail::kFull only; zero otherwise): mesh, Embree's barycentrics (weights of the triangle's second and third
@@ -54,7 +63,29 @@ enum class HitDetail : std::uint8_t { kFull, kNoUv };
 struct SurfaceSample {
   glm::vec3 position{0.0f};
   glm::vec3 normal{0.0f};  // geometric, unit, outward
+  glm::vec3 error{0.0f};   // as Hit::error
 };
+
+// gamma(n) = n u / (1 - n u) with u = 2^-24, the unit roundoff of float: the bound on the
+// relative error of n successive float operations (pbrt-v4's gamma()).
+constexpr float error_gamma(int n) {
+  constexpr float u = 0x1p-24f;
+  return static_cast<float>(n) * u / (1.0f - static_cast<float>(n) * u);
+}
+
+// A ray that leaves a triangle or quad is tested against it again by Embree, whose rounding in
+// that test grows with the distance from the ray's origin to the primitive's vertices: the
+// primitive's size `extent`, in every direction (an exact point on the plane y = 0 has no error
+// of its own, yet a ray leaving it exactly there can hit the plane again at a tiny t). Bounds of
+// points on triangles and quads include this term.
+inline glm::vec3 primitive_test_error(float extent) { return glm::vec3(error_gamma(12) * extent); }
+
+// The error bound of a point corner + u edge1 + v edge2 (u, v in [0, 1]) on a parallelogram whose
+// corners are float: a quad shape's hits and samples, a distant light's aperture points.
+inline glm::vec3 parallelogram_error(const glm::vec3& corner, const glm::vec3& edge1, const glm::vec3& edge2) {
+  const glm::vec3 span = glm::abs(edge1) + glm::abs(edge2);
+  return error_gamma(8) * (glm::abs(corner) + span) + primitive_test_error(std::max(span.x, std::max(span.y, span.z)));
+}
 
 class EmbreeScene;
 
@@ -72,9 +103,10 @@ class OcclusionBatch {
 
   int size() const { return size_; }
   bool full() const { return size_ == kCapacity; }
-  // Queues the segment between a and b (normals as for EmbreeScene::visible(); zero for points
-  // in free space) and returns its lane. The batch must not be full.
-  int add(const EmbreeScene& scene, const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb);
+  // Queues the segment between a and b (normals and error bounds as for EmbreeScene::visible();
+  // zero for points in free space) and returns its lane. The batch must not be full.
+  int add(const EmbreeScene& scene, const glm::vec3& a, const glm::vec3& na, const glm::vec3& ea, const glm::vec3& b,
+          const glm::vec3& nb, const glm::vec3& eb);
   // Tests every queued segment; visible(lane) then holds until clear().
   void trace(const EmbreeScene& scene);
   bool visible(int lane) const { return rays_.tfar[lane] >= 0.0f; }
@@ -105,30 +137,35 @@ class EmbreeScene {
   bool occluded(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) const;
 
   // --- robust queries for rays that leave surfaces ---
-  // The closest hit along o + t d, t > 0; `origin_normal` (zero for points in free space) offsets
-  // the origin off the surface it leaves.
+  // The closest hit along o + t d, t > 0, from a point with normal `origin_normal` and error bound
+  // `origin_error` (both zero for points in free space), moved off its surface first.
   std::optional<Hit> intersect(const glm::vec3& o, const glm::vec3& d, const glm::vec3& origin_normal,
-                               HitDetail detail = HitDetail::kFull) const;
-  // Whether the segment between two surface (or free-space, normal zero) points is unobstructed.
-  bool visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const;
-  bool visible(const glm::vec3& a, const glm::vec3& b) const { return visible(a, glm::vec3(0.0f), b, glm::vec3(0.0f)); }
-  // p moved off its surface (normal n) towards the side of direction d; p itself when n is zero.
-  // Inline: every ray the tracer casts takes one or two.
-  glm::vec3 offset(const glm::vec3& p, const glm::vec3& n, const glm::vec3& d) const {
-    // A zero normal (a point: lights, pinholes) offsets by exactly zero; no branch, whose outcome
-    // would follow which ends of a connection are points.
-    const float eps = offset_epsilon(p);
-    return p + (glm::dot(n, d) >= 0.0f ? eps : -eps) * n;
+                               const glm::vec3& origin_error, HitDetail detail = HitDetail::kFull) const;
+  // Whether the segment between two surface points (normal n, error bound e; both zero for a
+  // point in free space) is unobstructed.
+  bool visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& ea, const glm::vec3& b, const glm::vec3& nb,
+               const glm::vec3& eb) const;
+  bool visible(const glm::vec3& a, const glm::vec3& b) const {
+    const glm::vec3 zero(0.0f);
+    return visible(a, zero, zero, b, zero, zero);
+  }
+  // p (normal n, error bound e) moved off its surface towards the side of direction d: by
+  // dot(|n|, e) along n, then one float further in each component that moved. Inline: every ray
+  // the tracer casts takes one or two.
+  static glm::vec3 offset(const glm::vec3& p, const glm::vec3& n, const glm::vec3& e, const glm::vec3& d) {
+    // A zero normal or error (a point: lights, pinholes) offsets by exactly zero, without a branch
+    // whose outcome would follow which ends of a connection are points.
+    const float dist = glm::dot(glm::abs(n), e);
+    const glm::vec3 off = (glm::dot(n, d) >= 0.0f ? dist : -dist) * n;
+    const glm::vec3 q = p + off;
+    return {away(q.x, off.x), away(q.y, off.y), away(q.z, off.z)};
   }
   // The shadow ray between a and b as visible() casts it (o + t d, 0 < t < 1): from a moved off
   // its surface to b moved off its own. OcclusionBatch casts the same ray.
-  void shadow_ray(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb, glm::vec3* o,
-                  glm::vec3* d) const {
-    *o = offset(a, na, b - a);
-    *d = offset(b, nb, a - b) - *o;
-  }
-  float offset_epsilon(const glm::vec3& p) const {
-    return epsilon_ + 1e-6f * std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z)));
+  static void shadow_ray(const glm::vec3& a, const glm::vec3& na, const glm::vec3& ea, const glm::vec3& b,
+                         const glm::vec3& nb, const glm::vec3& eb, glm::vec3* o, glm::vec3* d) {
+    *o = offset(a, na, ea, b - a);
+    *d = offset(b, nb, eb, a - b) - *o;
   }
 
   // --- shapes ---
@@ -141,7 +178,6 @@ class EmbreeScene {
   glm::vec3 normal_at(int shape, int primitive, const glm::vec3& p) const;
 
   RTCScene handle() const { return scene_.get(); }
-  float extent() const { return extent_; }  // diagonal of the scene's bounding box
   std::size_t triangle_count() const { return triangles_; }
 
   struct AnalyticRecord;  // a sphere or disk as Embree user geometry
@@ -154,6 +190,15 @@ class EmbreeScene {
   struct SceneRelease {
     void operator()(RTCScene s) const { rtcReleaseScene(s); }
   };
+  // x moved to the next float in the direction of dir's sign (x itself when dir is zero or x is not
+  // finite), on the bits: adding one to a float's bits moves it one float away from zero.
+  static float away(float x, float dir) {
+    std::uint32_t b = std::bit_cast<std::uint32_t>(x);
+    if (x == 0.0f) b = dir < 0.0f ? 0x80000000u : 0u;  // either zero: step to dir's side
+    const bool outwards = (b >> 31) == static_cast<std::uint32_t>(dir < 0.0f);
+    b = outwards ? b + 1 : b - 1;
+    return dir == 0.0f || !std::isfinite(x) ? x : std::bit_cast<float>(b);  // an infinity stays one (never FLT_MAX)
+  }
 
   // Declaration order is destruction order reversed: the scene goes first, then the records
   // its user geometry points to, then the device, then the error sink the device reports to.
@@ -167,8 +212,6 @@ class EmbreeScene {
   std::vector<glm::vec3> quad_normals_;  // unit, per shape (zero for other kinds)
   std::vector<std::vector<double>> triangle_cdf_;  // meshes: cumulative triangle areas
   std::vector<unsigned> geom_to_shape_;
-  float extent_ = 1.0f;
-  float epsilon_ = 1e-5f;
   std::size_t triangles_ = 0;
 };
 

@@ -25,7 +25,7 @@ bool in_unit_square(glm::vec2 r) { return r.x >= 0.0f && r.x < 1.0f && r.y >= 0.
 bool unit_and_length(const glm::vec3& v, glm::vec3* dir, float* length) {
   const float len = glm::length(v);
   if (!(len > 0.0f) || !std::isfinite(len)) return false;
-  *dir = v / len;
+  *dir = v * (1.0f / len);
   *length = len;
   return true;
 }
@@ -120,15 +120,16 @@ std::optional<EndpointConnection> connect(const AreaLightParams& p, const Surfac
                                           const glm::vec3& ref) {
   EndpointConnection c;
   if (!unit_and_length(x.position - ref, &c.wi, &c.distance)) return std::nullopt;
-  const float cos_l = std::abs(glm::dot(x.normal, c.wi));
-  c.value = emitted_radiance(p, x.normal, -c.wi);
-  if (!(cos_l > 0.0f) || is_black(c.value) || !(x.pdf_area > 0.0f)) return std::nullopt;
+  const float cos_signed = -glm::dot(x.normal, c.wi);  // at the light, towards ref
+  const float cos_l = std::abs(cos_signed);
+  const bool emits = cos_signed > 0.0f || (p.two_sided && cos_signed < 0.0f);  // as emitted_radiance()
+  if (!emits || !(x.pdf_area > 0.0f)) return std::nullopt;
+  c.value = p.radiance;
   c.position = x.position;
   c.normal = x.normal;
   c.pdf_dir = area_to_solid_angle(x.pdf_area, c.distance, cos_l);
   c.weight = c.value * (cos_l / (c.distance * c.distance * x.pdf_area));
   c.delta = false;
-  c.ray_pdf = pdf_ray(p, x, -c.wi);
   if (!finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
   return c;
 }
@@ -162,7 +163,6 @@ std::optional<EndpointConnection> connect(const PointLightParams& p, const glm::
   c.value = p.intensity;
   c.weight = p.intensity / (c.distance * c.distance);
   c.delta = true;
-  c.ray_pdf = pdf_ray(p, -c.wi);
   if (!finite_vec(c.weight)) return std::nullopt;
   return c;
 }
@@ -210,7 +210,6 @@ std::optional<EndpointConnection> connect(const SpotLightParams& p, const glm::v
   c.position = p.position;
   c.weight = c.value / (c.distance * c.distance);
   c.delta = true;
-  c.ray_pdf = pdf_ray(p, -c.wi);
   if (!finite_vec(c.weight)) return std::nullopt;
   return c;
 }
@@ -221,12 +220,12 @@ glm::vec3 power(const SpotLightParams& p) {
 
 // --- distant light through an aperture ---
 
+float aperture_area(const DistantLightParams& p) { return glm::length(glm::cross(p.edge1, p.edge2)); }
+
 namespace {
 glm::vec3 aperture_normal(const DistantLightParams& p) {
   return glm::normalize(glm::cross(p.edge1, p.edge2));
 }
-float aperture_area(const DistantLightParams& p) { return glm::length(glm::cross(p.edge1, p.edge2)); }
-
 // Parallelogram coordinates (a, b) of a point in the aperture's plane.
 glm::vec2 aperture_coords(const DistantLightParams& p, const glm::vec3& x) {
   const glm::vec3 d = x - p.corner;
@@ -281,7 +280,6 @@ std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm
   c.value = p.irradiance;
   c.weight = p.irradiance;  // E: the irradiance on a surface facing the light
   c.delta = true;
-  c.ray_pdf = {1.0f / area, 1.0f, false, true};
   return c;
 }
 
@@ -322,9 +320,9 @@ std::optional<EndpointRay> sample_ray(const PinholeParams& p, glm::vec2 raster) 
   r.normal = p.forward;
   const float cos_theta = glm::dot(r.direction, p.forward);
   if (!(cos_theta > 0.0f)) return std::nullopt;
-  const float area = cam.image_area();
-  r.value = glm::vec3(perspective_we(area, cos_theta));
-  r.pdf = {1.0f, perspective_pdf_dir(area, cos_theta), true, false};
+  const float pdf_dir = perspective_pdf_dir(cam.image_area(), cos_theta);
+  r.value = glm::vec3(pdf_dir / cos_theta);  // We = 1 / (A cos⁴θ)
+  r.pdf = {1.0f, pdf_dir, true, false};
   r.weight = glm::vec3(1.0f);  // We cos / p_dir = 1 exactly
   r.pos_letter = PinholeParams::kPosLetter;
   r.dir_letter = PinholeParams::kDirLetter;
@@ -343,10 +341,12 @@ glm::vec3 importance(const PinholeParams& p, const glm::vec3& direction, glm::ve
 }
 
 RayPdf pdf_ray(const PinholeParams& p, const glm::vec3& direction) {
-  glm::vec2 raster;
-  if (is_black(importance(p, direction, &raster))) return {1.0f, 0.0f, true, false};
+  // importance()'s test of the image, without its value (MIS asks for this density often).
   const float cos_theta = glm::dot(direction, p.forward);
-  return {1.0f, perspective_pdf_dir(perspective(p).image_area(), cos_theta), true, false};
+  if (!(cos_theta > 0.0f)) return {1.0f, 0.0f, true, false};
+  const Perspective cam = perspective(p);
+  if (!in_unit_square(cam.raster(direction, cos_theta))) return {1.0f, 0.0f, true, false};
+  return {1.0f, perspective_pdf_dir(cam.image_area(), cos_theta), true, false};
 }
 
 std::optional<EndpointConnection> connect(const PinholeParams& p, const glm::vec3& ref) {
@@ -359,7 +359,6 @@ std::optional<EndpointConnection> connect(const PinholeParams& p, const glm::vec
   c.normal = p.forward;
   c.weight = c.value * (cos_theta / (c.distance * c.distance));
   c.delta = true;
-  c.ray_pdf = pdf_ray(p, -c.wi);
   if (!finite_vec(c.weight)) return std::nullopt;
   return c;
 }
@@ -440,7 +439,6 @@ std::optional<EndpointConnection> connect_lens_point(const ThinLensParams& p, co
   c.pdf_dir = area_to_solid_angle(1.0f / a_lens, c.distance, cos_lens);
   c.weight = c.value * (cos_lens * a_lens / (c.distance * c.distance));
   c.delta = false;
-  c.ray_pdf = pdf_ray(p, x, -c.wi);
   if (!finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
   return c;
 }
@@ -515,7 +513,6 @@ std::optional<EndpointConnection> connect(const OrthographicParams& p, const glm
   c.value = glm::vec3(1.0f / area);
   c.weight = c.value;  // We: the film point's share of the image mean
   c.delta = true;
-  c.ray_pdf = {1.0f / area, 1.0f, false, true};
   return c;
 }
 
@@ -537,6 +534,109 @@ std::optional<EndpointRay> sample_ray(const SpotMeterParams& p) {
 RayPdf pdf_ray(const SpotMeterParams&) { return {1.0f, 1.0f, true, true}; }
 
 std::optional<EndpointConnection> connect(const SpotMeterParams&, const glm::vec3&) {
+  return std::nullopt;
+}
+
+// --- the handles ---
+
+namespace {
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+}  // namespace
+
+Letter pos_letter(const LightParams& l) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kPosLetter; }, l);
+}
+Letter dir_letter(const LightParams& l) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kDirLetter; }, l);
+}
+Letter pos_letter(const SensorParams& s) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kPosLetter; }, s);
+}
+Letter dir_letter(const SensorParams& s) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kDirLetter; }, s);
+}
+
+std::optional<EndpointRay> sample_ray(const LightParams& l, const SurfacePoint& x, glm::vec2 u) {
+  return std::visit(Overloaded{[&](const AreaLightParams& p) { return sample_ray(p, x, u); },
+                               [&](const LaserParams& p) { return sample_ray(p); },
+                               [&](const auto& p) { return sample_ray(p, u); }},
+                    l);
+}
+
+RayPdf pdf_ray(const LightParams& l, const SurfacePoint& x, const glm::vec3& direction) {
+  return std::visit(Overloaded{[&](const AreaLightParams& p) { return pdf_ray(p, x, direction); },
+                               [&](const DistantLightParams& p) { return pdf_ray(p, x.position); },
+                               [&](const LaserParams& p) { return pdf_ray(p); },
+                               [&](const auto& p) { return pdf_ray(p, direction); }},
+                    l);
+}
+
+std::optional<EndpointConnection> connect(const LightParams& l, const SurfacePoint& x,
+                                          const glm::vec3& ref) {
+  return std::visit(Overloaded{[&](const AreaLightParams& p) { return connect(p, x, ref); },
+                               [&](const auto& p) { return connect(p, ref); }},
+                    l);
+}
+
+glm::vec3 spatial_emission(const LightParams& l) {
+  return std::visit(Overloaded{[](const AreaLightParams& p) { return p.radiance; },
+                               [](const PointLightParams& p) { return p.intensity; },
+                               [](const SpotLightParams& p) { return p.intensity; },
+                               [](const DistantLightParams& p) { return p.irradiance; },
+                               [](const LaserParams& p) { return p.power; }},
+                    l);
+}
+
+float directional_emission(const LightParams& l, const glm::vec3& n, const glm::vec3& w) {
+  return std::visit(
+      Overloaded{[&](const AreaLightParams& p) { return is_black(emitted_radiance(p, n, w)) ? 0.0f : 1.0f; },
+                 [](const PointLightParams&) { return 1.0f; },
+                 [&](const SpotLightParams& p) { return spot_falloff(p, glm::dot(w, p.axis)); },
+                 [](const auto&) { return 0.0f; }},
+      l);
+}
+
+std::optional<EndpointRay> sample_ray(const SensorParams& s, glm::vec2 raster, glm::vec2 u_lens) {
+  return std::visit(Overloaded{[&](const ThinLensParams& p) { return sample_ray(p, raster, u_lens); },
+                               [&](const SpotMeterParams& p) { return sample_ray(p); },
+                               [&](const auto& p) { return sample_ray(p, raster); }},
+                    s);
+}
+
+RayPdf pdf_ray(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction) {
+  return std::visit(Overloaded{[&](const PinholeParams& p) { return pdf_ray(p, direction); },
+                               [&](const ThinLensParams& p) { return pdf_ray(p, origin, direction); },
+                               [&](const OrthographicParams& p) { return pdf_ray(p, origin); },
+                               [&](const SpotMeterParams& p) { return pdf_ray(p); }},
+                    s);
+}
+
+std::optional<EndpointConnection> connect_finite(const SensorParams& s, glm::vec2 u_lens,
+                                                 const glm::vec3& ref) {
+  return std::visit(
+      Overloaded{[&](const PinholeParams& p) { return connect(p, ref); },
+                 [&](const ThinLensParams& p) { return connect(p, u_lens, ref); },
+                 [](const auto&) { return std::optional<EndpointConnection>(); }},
+      s);
+}
+
+glm::vec3 importance(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction,
+                     glm::vec2* raster) {
+  return std::visit(
+      Overloaded{[&](const PinholeParams& p) { return importance(p, direction, raster); },
+                 [&](const ThinLensParams& p) { return importance(p, origin, direction, raster); },
+                 [](const auto&) { return glm::vec3(0.0f); }},
+      s);
+}
+
+std::optional<EndpointConnection> hit_lens(const SensorParams& s, const glm::vec3& origin,
+                                           const glm::vec3& direction) {
+  if (const auto* p = std::get_if<ThinLensParams>(&s)) return hit_lens(*p, origin, direction);
   return std::nullopt;
 }
 

@@ -1,5 +1,7 @@
-// Emission (lights) and importance (sensors) as plain functions over plain parameter structs: the
-// integrator maps scene objects to these structs, so this file depends on no scene type.
+// The one light and sensor model of the tracer: emission (lights) and importance (sensors) as plain
+// functions over plain parameter structs, and the handles LightParams / SensorParams (a variant of
+// those structs) that every strategy of the integrator calls. render_scene.cpp maps scene objects
+// to these structs, so this file depends on no scene type.
 //
 // Every endpoint has a spatial and a directional part (Veach §8.3.2: L_e = L_e⁽⁰⁾ L_e⁽¹⁾,
 // W_e = W_e⁽⁰⁾ W_e⁽¹⁾), each either a finite density (letter D) or a Dirac delta (letter S); the
@@ -42,6 +44,7 @@
 #pragma once
 
 #include <optional>
+#include <variant>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -83,7 +86,6 @@ struct EndpointConnection {
   glm::vec3 weight{0.0f};
   float pdf_dir = 0.0f;       // solid-angle density of wi at ref for this join; 0 when `delta`
   bool delta = false;         // wi was fixed (point-like position or single direction), not sampled
-  RayPdf ray_pdf;             // sample_ray's densities for the ray position → −wi
   glm::vec2 raster{0.0f};     // sensors: where the join lands on the film
 };
 
@@ -135,7 +137,9 @@ glm::vec3 power(const PointLightParams& p);  // 4π I
 
 // Spot light, LSD: I(w) = intensity · falloff(cos θ), θ from the axis. falloff is 1 inside
 // cos_falloff_start, 0 outside cos_total, and smoothstep in between (pbrt-v4's SpotLight); with
-// cos_falloff_start == cos_total the edge is hard. Directions are sampled uniformly in the cone.
+// cos_falloff_start == cos_total the edge is hard. The edge itself (cos θ == cos_total) emits
+// nothing. Scene spot lights have a hard edge (cone_degrees is the half angle). Directions are
+// sampled uniformly in the cone.
 struct SpotLightParams {
   glm::vec3 position{0.0f};
   glm::vec3 axis{0.0f, 0.0f, -1.0f};  // unit
@@ -170,7 +174,8 @@ RayPdf pdf_ray(const DistantLightParams& p, const glm::vec3& origin);  // 0 outs
 // aperture point on the line through ref; nullopt when that line misses the aperture or the
 // aperture is behind ref.
 std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm::vec3& ref);
-glm::vec3 power(const DistantLightParams& p);  // E · A · |cos(direction, aperture normal)|
+glm::vec3 power(const DistantLightParams& p);
+float aperture_area(const DistantLightParams& p);  // |edge1 × edge2|  // E · A · |cos(direction, aperture normal)|
 
 // Laser, LSS: power Φ along one ray. Nothing can be joined to it (connect() is always nullopt).
 struct LaserParams {
@@ -266,5 +271,49 @@ struct SpotMeterParams {
 std::optional<EndpointRay> sample_ray(const SpotMeterParams& p);
 RayPdf pdf_ray(const SpotMeterParams& p);
 std::optional<EndpointConnection> connect(const SpotMeterParams& p, const glm::vec3& ref);
+
+// ---------------------------------------------------------------------------------------------
+// The handles: a light or a sensor of a render as one value over the closed set of kinds above.
+// Each operation dispatches to the kind's function; kinds without the operation (a join to a
+// laser, the importance of a Dirac direction) answer nullopt or zero.
+// ---------------------------------------------------------------------------------------------
+
+using LightParams =
+    std::variant<AreaLightParams, PointLightParams, SpotLightParams, DistantLightParams, LaserParams>;
+using SensorParams = std::variant<PinholeParams, ThinLensParams, OrthographicParams, SpotMeterParams>;
+
+Letter pos_letter(const LightParams& l);   // c0
+Letter dir_letter(const LightParams& l);   // c1
+Letter pos_letter(const SensorParams& s);  // c(k+2)
+Letter dir_letter(const SensorParams& s);  // c(k+1)
+
+// Lights. `x` is the point the integrator chose on an area light's surface (with its density);
+// the other kinds ignore it, except pdf_ray of a distant light, which reads x.position as the
+// ray's origin.
+std::optional<EndpointRay> sample_ray(const LightParams& l, const SurfacePoint& x, glm::vec2 u);
+RayPdf pdf_ray(const LightParams& l, const SurfacePoint& x, const glm::vec3& direction);
+std::optional<EndpointConnection> connect(const LightParams& l, const SurfacePoint& x,
+                                          const glm::vec3& ref);
+// Veach's split L_e = L_e⁽⁰⁾ L_e⁽¹⁾ for the finite directional part: the spatial factor (Le for an
+// area light, I for point and spot lights, E, Φ) and the directional factor towards w from a
+// point with normal n (area: 1 on an emitting side, else 0; point: 1; spot: the falloff). A Dirac
+// direction (distant, laser) has no finite directional part: 0.
+glm::vec3 spatial_emission(const LightParams& l);
+float directional_emission(const LightParams& l, const glm::vec3& n, const glm::vec3& w);
+
+// Sensors. `raster` ∈ [0,1)² as above; u_lens is read by the thin lens only.
+std::optional<EndpointRay> sample_ray(const SensorParams& s, glm::vec2 raster, glm::vec2 u_lens);
+// Densities of the ray leaving `origin` (a point of the sensor) in `direction`.
+RayPdf pdf_ray(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction);
+// The t = 1 join of a finite direction (pinhole, thin lens); nullopt for the others.
+std::optional<EndpointConnection> connect_finite(const SensorParams& s, glm::vec2 u_lens,
+                                                 const glm::vec3& ref);
+// We of the ray leaving `origin` in `direction` with its raster position (pinhole, thin lens);
+// 0 for Dirac directions and outside the image.
+glm::vec3 importance(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction,
+                     glm::vec2* raster);
+// A ray crossing a thin lens (strategy t = 0); nullopt for every other sensor.
+std::optional<EndpointConnection> hit_lens(const SensorParams& s, const glm::vec3& origin,
+                                           const glm::vec3& direction);
 
 }  // namespace pathex

@@ -25,6 +25,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/frame.h"
 #include "trace/render_scene.h"
@@ -34,19 +35,22 @@ namespace pathex {
 
 // --- strategies the tracer runs ---
 
-int StrategySet::find(int s, int t) const {
+int StrategySet::find(int s, int t) const { return find_connector(ConnectorKind::kNone, s, t); }
+
+int StrategySet::find_connector(ConnectorKind k, int s, int t) const {
   for (std::size_t i = 0; i < strategies.size(); ++i)
-    if (strategies[i].s.contains(s) && strategies[i].t.contains(t)) return static_cast<int>(i);
+    if (strategies[i].connector == k && strategies[i].s.contains(s) && strategies[i].t.contains(t)) return static_cast<int>(i);
   return -1;
 }
 
 Result<StrategySet> runnable_strategies(const Profile& profile) {
   StrategySet set;
   for (const Strategy& st : profile.strategies) {
-    if (st.connector != ConnectorKind::kNone)
+    if (st.connector == ConnectorKind::kMirror || st.connector == ConnectorKind::kManifold)
       return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' uses the connector '" + to_string(st.connector) +
                                                "' (strategy '" + st.name +
-                                               "'), which the tracer does not run yet; it runs plain joins (s, DD, t) only");
+                                               "'), which the tracer does not run yet; it runs plain joins (s, DD, t) and the "
+                                               "distant-projection and ortho-projection connectors");
     set.strategies.push_back(st);
   }
   return set;
@@ -60,6 +64,15 @@ constexpr int kMaxVertices = 64;  // per subpath; max_bounces is clamped so path
 // Passes go to batches round-robin: every batch covers the whole image, passes are i.i.d., and
 // an interrupted render still spreads what it has over all batches (so its error is defined).
 int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % static_cast<std::uint64_t>(batches)); }
+
+// Random-number dimensions (trace/rng.h): each stage of a sample draws from its own block, so that
+// adding a strategy leaves every other strategy's numbers unchanged. The eye and the light subpath
+// draw at most 4 + 4 per vertex; each connection (kind, subpath length) then draws at most 4.
+constexpr std::uint64_t kEyeDims = 0;
+constexpr std::uint64_t kLightDims = 1024;
+constexpr std::uint64_t kJoinDims = 2048;
+constexpr std::uint64_t kDimsPerJoin = 4;
+static_assert(4 + 4 * 64 <= kLightDims - kEyeDims, "a subpath's numbers fit its block");
 
 float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
@@ -75,6 +88,7 @@ struct Vertex {
   bool finite = true;    // can be a join end: not a surface, or a surface with a finite BSDF part
   vec3 p{0.0f};
   vec3 n{0.0f};          // geometric normal (unit); zero for points (point, spot, pinhole, laser)
+  vec3 err{0.0f};        // bound on p's rounding error (Hit::error): how far a ray leaving p is offset
   vec3 ns{0.0f};         // shading normal
   vec3 beta{1.0f};       // throughput up to and including this vertex
   vec3 wo{0.0f};         // unit direction to the vertex before it on its subpath (zero for the first)
@@ -95,72 +109,8 @@ void link(Vertex& v, const Vertex& pred) {
   v.wo = v.d2_wo > 0.0f ? e / std::sqrt(v.d2_wo) : vec3(0.0f);
 }
 
-// A full-path string L c0 … c(k+2) E packed: bit i is set when c_i is S, and the number of
-// scattering letters (k + 3) sits in the top byte. Every string the tracer forms packs: k + 3 is
-// at most kMaxVertices + 1 letters (max_bounces is clamped so).
-__extension__ typedef unsigned __int128 PathKey;
-constexpr int kLengthShift = 120;
-static_assert(kMaxVertices + 1 < kLengthShift);
-constexpr PathKey bit(int i) { return static_cast<PathKey>(1) << i; }
-constexpr PathKey letter_bit(char c, int i) { return c == 'S' ? bit(i) : 0; }
-int packed_length(PathKey key) { return static_cast<int>(key >> kLengthShift); }
-bool packed_is_d(PathKey key, int i) { return ((key >> i) & 1) == 0; }
-
-std::string unpack(PathKey key) {
-  const int n = packed_length(key);
-  std::string out(static_cast<std::size_t>(n) + 2, 'D');
-  out.front() = 'L';
-  out.back() = 'E';
-  for (int i = 0; i < n; ++i)
-    if (!packed_is_d(key, i)) out[static_cast<std::size_t>(i) + 1] = 'S';
-  return out;
-}
-PathKey pack(const std::string& letters) {  // "L c0 … E"
-  PathKey key = static_cast<PathKey>(letters.size() - 2) << kLengthShift;
-  for (std::size_t i = 1; i + 1 < letters.size(); ++i) key |= letter_bit(letters[i], static_cast<int>(i) - 1);
-  return key;
-}
-
-// Per-thread map from packed strings to histogram ids, so that recording a contribution hashes
-// two words instead of a string; Histogram::intern() runs once per new path and thread.
-class PathIds {
- public:
-  Histogram::PathId get(Histogram& hist, PathKey key) {
-    const std::size_t mask = slots_.size() - 1;
-    for (std::size_t i = hash(key) & mask;; i = (i + 1) & mask) {
-      Slot& slot = slots_[i];
-      if (slot.key == key) return slot.id;
-      if (slot.key == 0) {
-        const Histogram::PathId id = hist.intern(unpack(key));
-        slot = {key, id};
-        if (2 * ++used_ > slots_.size()) grow();
-        return id;
-      }
-    }
-  }
-
- private:
-  struct Slot {
-    PathKey key = 0;  // 0: empty (a real key has a nonzero length)
-    Histogram::PathId id = -1;
-  };
-  static std::size_t hash(PathKey key) {
-    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) ^ mix64(static_cast<std::uint64_t>(key >> 64))));
-  }
-  void grow() {
-    std::vector<Slot> old(slots_.size() * 2);
-    old.swap(slots_);
-    const std::size_t mask = slots_.size() - 1;
-    for (const Slot& slot : old) {
-      if (slot.key == 0) continue;
-      std::size_t i = hash(slot.key) & mask;
-      while (slots_[i].key != 0) i = (i + 1) & mask;
-      slots_[i] = slot;
-    }
-  }
-  std::vector<Slot> slots_ = std::vector<Slot>(256);
-  std::size_t used_ = 0;
-};
+using namespace accel;  // PathKey, PathIds
+static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
 
 // |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
 float abs_cos(const Vertex& v, const vec3& w) {
@@ -174,11 +124,13 @@ float abs_cos(const Vertex& v, const vec3& w) {
 
 class Integrator {
  public:
-  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl)
+  // `general_mis` (for tests) turns off the per-sample MIS sums, leaving the general recurrence.
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl,
+             bool general_mis = false)
       : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), classifier_(cl) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
-    lens_hits_ = cam_.type == SensorType::kLens && cam_.lens_radius > 0.0f;
+    lens_hits_ = cam_.type == SensorType::kLens;
     bool any_t0 = false;
     for (int s = 0; s < 2 * kMaxVertices; ++s) any_t0 = any_t0 || strategies.find(s, 0) >= 0;
     lens_hits_ = lens_hits_ && any_t0;
@@ -198,15 +150,20 @@ class Integrator {
       for (int s2 = 0; s2 <= static_cast<int>(n); ++s2)
         if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
           runs_mask_[n] |= std::uint64_t{1} << s2;
+    for (std::size_t i = 0; i < kMaxRuns; ++i) {
+      distant_of_[i] = static_cast<std::int16_t>(strategies.find_connector(ConnectorKind::kDistantProjection, 0, static_cast<int>(i)));
+      ortho_of_[i] = static_cast<std::int16_t>(strategies.find_connector(ConnectorKind::kOrthoProjection, static_cast<int>(i), 0));
+      has_connectors_ = has_connectors_ || distant_of_[i] >= 0 || ortho_of_[i] >= 0;
+    }
     eye0_runs_ = (runs_mask_[1] >> 1) & 1;
-    all_runs_ = true;
+    all_runs_ = !has_connectors_ && !general_mis;  // the per-sample sums below know plain joins only
     for (std::size_t n = 1; n < runs_mask_.size(); ++n) {
       const std::uint64_t below = (std::uint64_t{1} << n) - 1;  // s2 < n: t2 >= 1
       all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
     }
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
-    sensor_pair_ = sensor_letters(cam_.type);
-    for (const RenderLight& l : rs.lights) light_pairs_.push_back(light_letters(letter_type(l.type)));
+    sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
+    for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
@@ -216,7 +173,8 @@ class Integrator {
     PathKey key = 0;
     vec3 c{0.0f};
     int strategy = 0, batch = 0;
-    bool splat = false;  // to raster point (rx, ry); else to the sample's own pixel, column px
+    bool splat = false;
+    bool connector = false;  // counted in the connector's statistics  // to raster point (rx, ry); else to the sample's own pixel, column px
     float rx = 0.0f, ry = 0.0f;
     int px = 0;
   };
@@ -228,6 +186,7 @@ class Integrator {
     std::vector<ClassImages::PixelSum> row;
     std::array<Vertex, kMaxVertices> eye, light;
     std::uint64_t rays = 0;
+    std::vector<ConnectorStats> connectors;  // indexed by profile strategy (only connectors' are used)
     PathIds ids;
     Vertex sampled;  // connect()'s fresh light or sensor sample
     // The subpaths' letters packed (set by prepare_joins()): light_mask has c0 c1 of y0, then
@@ -299,6 +258,7 @@ class Integrator {
     }
   }
   // The packed full-path string of connection (s, t), as full_path() spells it.
+  // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
   PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
     PathKey m = 0;
     if (s > 0) {
@@ -356,6 +316,11 @@ class Integrator {
     full_path(th, s, t, nullptr, out);
     return out;
   }
+  // The weight of connection (s, t) of the current subpaths, as the renderer computes it.
+  float own_weight(Thread& th, int s, int t) const {
+    prepare_joins(th, th.ns, th.nt);
+    return mis_weight(th, s, t, nullptr, path_key(th, s, t, nullptr));
+  }
   // The same string as the renderer records it (packed, then spelled out).
   std::string packed_label(const Thread& th, int s, int t) const { return unpack(path_key(th, s, t, nullptr)); }
   int trace_subpaths(Thread& th, Sampler& rng, int px, int py, int* ns) const {
@@ -368,88 +333,43 @@ class Integrator {
   }
 
  private:
-  // --- sensors ---
-  vec3 raster_dir(float rx, float ry) const {  // direction through raster point, z = 1 image plane
-    const float sx = (2.0f * rx / static_cast<float>(cam_.width) - 1.0f) * cam_.tan_x;
-    const float sy = (1.0f - 2.0f * ry / static_cast<float>(cam_.height)) * cam_.tan_y;
-    return cam_.forward + sx * cam_.right + sy * cam_.up;
+  // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
+  // Densities as the MIS ratios keep them: a Dirac part's is stored as 0.
+  static float finite_part(float pdf, bool delta) { return delta ? 0.0f : pdf; }
+  // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w.
+  float sensor_pdf_dir(const Vertex& v, const vec3& w) const {
+    const RayPdf p = pdf_ray(cam_.params, v.p, w);
+    return finite_part(p.dir, p.delta_dir);
   }
-  // Raster position of a direction leaving the camera centre (pinhole) or, for a lens, of the
-  // focus-plane point the ray from `lens_point` reaches. False when outside the image.
-  bool raster_of(const vec3& lens_point, const vec3& dir, float* rx, float* ry) const {
-    const float c = glm::dot(dir, cam_.forward);
-    if (c <= 0.0f) return false;
-    vec3 q = dir / c;  // on the z = 1 plane, relative to lens_point
-    if (cam_.type == SensorType::kLens) {
-      const vec3 focus = lens_point + dir * (cam_.focus_distance / c);
-      q = (focus - cam_.position) / cam_.focus_distance;
-    }
-    const float sx = glm::dot(q, cam_.right) / cam_.tan_x, sy = glm::dot(q, cam_.up) / cam_.tan_y;
-    *rx = (sx + 1.0f) * 0.5f * static_cast<float>(cam_.width);
-    *ry = (1.0f - sy) * 0.5f * static_cast<float>(cam_.height);
-    return *rx >= 0.0f && *ry >= 0.0f && *rx < static_cast<float>(cam_.width) && *ry < static_cast<float>(cam_.height);
-  }
-  float lens_area() const { return kPi * cam_.lens_radius * cam_.lens_radius; }
-  // Importance per unit projected solid angle and lens area (pinhole, lens), 0 outside the image.
-  float importance(const vec3& lens_point, const vec3& dir) const {
-    float rx, ry;
-    if (!raster_of(lens_point, dir, &rx, &ry)) return 0.0f;
-    const float c = glm::dot(dir, cam_.forward);
-    const float w = 1.0f / (cam_.image_area() * c * c * c * c);
-    return cam_.type == SensorType::kLens ? w / lens_area() : w;
-  }
-  // Directional density of the sensor (solid angle): pinhole and lens 1/(A cos^3), deltas 0.
-  float sensor_pdf_dir(const vec3& dir) const {
-    if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return 0.0f;
-    const float c = glm::dot(dir, cam_.forward);
-    if (c <= 0.0f) return 0.0f;
-    return 1.0f / (cam_.image_area() * c * c * c);
-  }
-  float sensor_pdf_pos() const {
-    switch (cam_.type) {
-      case SensorType::kLens: return 1.0f / lens_area();
-      case SensorType::kOrthographic: return 1.0f / (cam_.film_width * cam_.film_height);
-      default: return 0.0f;  // a point: Dirac
-    }
-  }
-
-  // --- lights ---
-  float light_pdf_pos(const RenderLight& l) const {  // area density of the emitting point
-    switch (l.type) {
-      case EmitterKind::kArea: return 1.0f / rs_.geometry->shape_area(l.shape);
-      case EmitterKind::kDistant: return 1.0f / l.ap_area;
-      default: return 0.0f;  // Dirac
-    }
-  }
-  // Whether a light vertex emits towards `w` through its finite directional part: the emitting
-  // side of an area light, anywhere for a point light, inside a spot's cone. Dirac directions
-  // (distant, laser) have no finite part.
-  bool light_emits(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    switch (l.type) {
-      case EmitterKind::kArea: {
-        const float c = glm::dot(v.n, w);
-        return c > 0.0f || (l.two_sided && c < 0.0f);
-      }
-      case EmitterKind::kPoint: return true;
-      case EmitterKind::kSpot: return glm::dot(w, l.direction) >= l.cos_cone;
-      default: return false;
-    }
-  }
-  // Emitted radiance (area) or intensity (point, spot) towards `w`.
-  vec3 light_emit(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    return light_emits(l, v, w) ? l.power : vec3(0.0f);
-  }
+  // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
   float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    switch (l.type) {
-      case EmitterKind::kArea: {
-        const float c = glm::dot(v.n, w);
-        if (l.two_sided) return std::fabs(c) / (2.0f * kPi);
-        return c > 0.0f ? c / kPi : 0.0f;
-      }
-      case EmitterKind::kPoint: return 1.0f / (4.0f * kPi);
-      case EmitterKind::kSpot: return glm::dot(w, l.direction) >= l.cos_cone ? 1.0f / (2.0f * kPi * (1.0f - l.cos_cone)) : 0.0f;
-      default: return 0.0f;
-    }
+    const RayPdf p = pdf_ray(l.params, SurfacePoint{v.p, v.n, l.pdf_pos}, w);
+    return finite_part(p.dir, p.delta_dir);
+  }
+  // A light chosen uniformly by u, and a point on it drawn from u2 (area lights; the others
+  // ignore the point).
+  std::size_t pick_light(float u) const {
+    return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(u * static_cast<float>(rs_.lights.size())));
+  }
+  // *error: the point's rounding-error bound (SurfaceSample::error), which offsets rays leaving it.
+  SurfacePoint sample_point(const RenderLight& l, glm::vec2 u2, vec3* error) const {
+    *error = aperture_error(l);
+    if (!l.is_area()) return {};
+    const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, u2);
+    *error = ss.error;
+    return {ss.position, ss.normal, l.pdf_pos};
+  }
+  // The error bound of a distant light's aperture points (zero for other lights): the aperture is
+  // no shape, but it may coincide with one (a window pane).
+  static vec3 aperture_error(const RenderLight& l) {
+    const auto* d = std::get_if<DistantLightParams>(&l.params);
+    return d ? parallelogram_error(d->corner, d->edge1, d->edge2) : vec3(0.0f);
+  }
+  // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
+  void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
+    const float w = static_cast<float>(cam_.width), h = static_cast<float>(cam_.height);
+    *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
+    *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
   }
 
   // --- densities used by MIS ---
@@ -457,7 +377,7 @@ class Integrator {
   // `wp` to v's other neighbour (null when it has none: a surface then has no density).
   float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
     switch (v.kind) {
-      case Kind::kCamera: return sensor_pdf_dir(wn);
+      case Kind::kCamera: return sensor_pdf_dir(v, wn);
       case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
       case Kind::kSurface:
         return wp ? bsdf::pdf(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)], *wp, wn, v.ns, v.n) : 0.0f;
@@ -477,7 +397,7 @@ class Integrator {
   // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
   float pdf_light_origin(const Vertex& v) const {
     const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
-    return light_pick_ * light_pdf_pos(rs_.lights[static_cast<std::size_t>(li)]);
+    return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
   }
 
   // --- subpaths ---
@@ -496,7 +416,22 @@ class Integrator {
     kSplat,    // t = 1: a light vertex joined to a fresh sensor sample
     kNee,      // s = 1: an eye vertex joined to a fresh light sample
     kJoin,     // s, t >= 2: a shadow ray between two subpath vertices
+    kDistant,  // distant-projection (0, DSD, t): an eye vertex joined to a distant light's aperture
+    kOrtho,    // ortho-projection (s, DSD, 0): a light vertex joined to an orthographic film
   };
+  // How a contribution's two subpaths are joined, as MIS must know it: a plain join (both join
+  // letters D) or a projection connector, which builds the endpoint on its Dirac side.
+  enum class JoinKind : std::uint8_t { kPlain, kDistant, kOrtho };
+  // The profile's strategy running a connector at this subpath length, or -1.
+  int distant_of(int t) const { return static_cast<std::size_t>(t) < kMaxRuns ? distant_of_[static_cast<std::size_t>(t)] : -1; }
+  int ortho_of(int s) const { return static_cast<std::size_t>(s) < kMaxRuns ? ortho_of_[static_cast<std::size_t>(s)] : -1; }
+  // Density of the far end of a parallel beam per unit area there, relative to the near end's:
+  // points x and y on one line along w, with unit normals (zero: no surface), map areas as
+  // dA_x |cos θ_x| = dA_y |cos θ_y|.
+  static float parallel_jacobian(const Vertex& far, const Vertex& near, const vec3& w) {
+    const float c = abs_cos(near, w);
+    return c > 0.0f ? abs_cos(far, w) / c : 0.0f;
+  }
   template <Connection C>
   void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
   // What connect() has already computed for its join, handed to mis_weight() so that it is not
@@ -508,7 +443,8 @@ class Integrator {
     bsdf::JoinPdfs at_qs;  // wo = qs->wo, wi = w
     bsdf::JoinPdfs at_pt;  // wo = pt->wo, wi = -w
   };
-  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join = nullptr) const;
+  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join = nullptr,
+                   JoinKind self = JoinKind::kPlain) const;
   // The full-path letters of the path made by s light and t eye vertices (with `sampled`
   // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
   // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
@@ -517,13 +453,15 @@ class Integrator {
   void trace_shadows(Thread& th) const;
 
   const RenderScene& rs_;
-  const RenderCamera& cam_;
+  const RenderSensor& cam_;
   const StrategySet& strategies_;
   const RenderOptions& o_;
   const Classifier* classifier_;
   int max_bounces_ = 16;
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;
   std::vector<std::int16_t> strategy_of_;  // [s * kMaxRuns + t]: the profile's strategy running (s, t), or -1
+  std::array<std::int16_t, kMaxRuns> distant_of_{}, ortho_of_{};  // see distant_of(), ortho_of()
+  bool has_connectors_ = false;
   // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
   // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
   static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
@@ -554,27 +492,23 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   while (count < max_vertices) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, HitDetail::kNoUv);  // n is zero for points: no offset
+    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, HitDetail::kNoUv);  // zero for points: no offset
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
-      const float denom = glm::dot(d, cam_.forward);
-      if (denom < 0.0f) {
-        const float tl = glm::dot(cam_.position - o, cam_.forward) / denom;
-        const vec3 q = o + tl * d;
-        if (tl > 0.0f && (!hit || tl < hit->t) && glm::length(q - cam_.position) <= cam_.lens_radius) {
-          Vertex& v = path[static_cast<std::size_t>(count)];
-          v = Vertex{};
-          v.kind = Kind::kLens;
-          v.p = q;
-          v.n = cam_.forward;
-          v.ns = cam_.forward;
-          v.beta = beta;
-          link(v, prev);
-          v.pdf_fwd = v.d2_wo > 0.0f ? pdf_dir * std::fabs(glm::dot(v.n, d)) / v.d2_wo : 0.0f;
-          v.letter = 'D';
-          v.pos_letter = 'D';
-          return count + 1;
-        }
+      const std::optional<EndpointConnection> lens = hit_lens(cam_.params, o, d);
+      if (lens && (!hit || lens->distance < hit->t)) {
+        Vertex& v = path[static_cast<std::size_t>(count)];
+        v = Vertex{};
+        v.kind = Kind::kLens;
+        v.p = lens->position;
+        v.n = lens->normal;
+        v.ns = lens->normal;
+        v.beta = beta;
+        link(v, prev);
+        v.pdf_fwd = v.d2_wo > 0.0f ? pdf_dir * std::fabs(glm::dot(v.n, d)) / v.d2_wo : 0.0f;
+        v.letter = 'D';
+        v.pos_letter = 'D';
+        return count + 1;
       }
     }
     if (!hit) break;
@@ -583,6 +517,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.kind = Kind::kSurface;
     v.p = hit->position;
     v.n = hit->normal;
+    v.err = hit->error;
     v.ns = hit->shading_normal;
     v.shape = hit->shape;
     v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;
@@ -635,45 +570,25 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   z0.pos_letter = sensor_pair_[1];
   const glm::vec2 uf = rng.get2d();
   const glm::vec2 ul = rng.get2d();
-  const float rx = static_cast<float>(px) + uf.x, ry = static_cast<float>(py) + uf.y;
-  vec3 o = cam_.position, d = cam_.forward;
-  float pdf_dir = 0.0f;
-  switch (cam_.type) {
-    case SensorType::kPinhole: {
-      d = glm::normalize(raster_dir(rx, ry));
-      pdf_dir = sensor_pdf_dir(d);
-      break;
-    }
-    case SensorType::kLens: {
-      const vec3 target = cam_.position + raster_dir(rx, ry) * cam_.focus_distance;
-      const glm::vec2 disk = sample_concentric_disk(ul) * cam_.lens_radius;
-      o = cam_.position + disk.x * cam_.right + disk.y * cam_.up;
-      d = glm::normalize(target - o);
-      z0.n = cam_.forward;
-      pdf_dir = sensor_pdf_dir(d);
-      break;
-    }
-    case SensorType::kOrthographic: {
-      const float sx = (2.0f * rx / static_cast<float>(cam_.width) - 1.0f) * 0.5f * cam_.film_width;
-      const float sy = (1.0f - 2.0f * ry / static_cast<float>(cam_.height)) * 0.5f * cam_.film_height;
-      o = cam_.position + sx * cam_.right + sy * cam_.up;
-      z0.n = cam_.forward;
-      pdf_dir = 0.0f;  // Dirac direction
-      break;
-    }
-    case SensorType::kSpotmeter: pdf_dir = 0.0f; break;
-  }
-  z0.p = o;
+  const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(cam_.width),
+                         (static_cast<float>(py) + uf.y) / static_cast<float>(cam_.height)};
+  const std::optional<EndpointRay> r = sample_ray(cam_.params, raster, ul);
+  z0.pdf_fwd = cam_.pdf_pos;
+  if (!r) return 1;
+  z0.p = r->origin;
+  z0.n = r->pdf.delta_pos ? vec3(0.0f) : r->normal;  // a point sensor has no surface
   z0.ns = z0.n;
-  z0.pdf_fwd = sensor_pdf_pos();
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
-  return random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, o, d, pdf_dir, max_eye_);
+  const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
+                                                      finite_part(r->pdf.dir, r->pdf.delta_dir), max_eye_);
+  // An orthographic sensor's rays are a parallel beam (see light_subpath()).
+  if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.eye[1].pdf_fwd = parallel_jacobian(th.eye[1], z0, r->direction);
+  return n;
 }
 
 int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
-  const float ul = rng.get1d();
-  const std::size_t li = std::min(rs_.lights.size() - 1, static_cast<std::size_t>(ul * static_cast<float>(rs_.lights.size())));
+  const std::size_t li = pick_light(rng.get1d());
   const RenderLight& l = rs_.lights[li];
   Vertex& y0 = th.light[0];
   y0 = Vertex{};
@@ -681,66 +596,31 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   y0.light = static_cast<int>(li);
   y0.pos_letter = light_pairs_[li][0];
   y0.letter = light_pairs_[li][1];
-  const glm::vec2 up = rng.get2d();
-  const glm::vec2 ud = rng.get2d();
-  vec3 d{0.0f};
-  float pdf_pos = light_pdf_pos(l), pdf_dir = 0.0f;
-  vec3 beta1{0.0f};  // throughput carried by the first ray
-  switch (l.type) {
-    case EmitterKind::kArea: {
-      const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, up);
-      y0.p = ss.position;
-      y0.n = ss.normal;
-      vec3 local = sample_cosine_hemisphere(ud);
-      float sign = 1.0f;
-      if (l.two_sided && rng.get1d() < 0.5f) sign = -1.0f;
-      const Frame f = Frame::from_normal(y0.n * sign);
-      d = f.to_world(local);
-      pdf_dir = light_pdf_dir(l, y0, d);
-      beta1 = l.power * std::fabs(glm::dot(y0.n, d)) / (light_pick_ * pdf_pos * pdf_dir);
-      y0.beta = l.power / (light_pick_ * pdf_pos);
-      break;
-    }
-    case EmitterKind::kPoint: {
-      y0.p = l.position;
-      d = sample_uniform_sphere(ud);
-      pdf_dir = light_pdf_dir(l, y0, d);
-      beta1 = l.power / (light_pick_ * pdf_dir);
-      y0.beta = l.power / light_pick_;
-      break;
-    }
-    case EmitterKind::kSpot: {
-      y0.p = l.position;
-      d = Frame::from_normal(l.direction).to_world(sample_uniform_cone(ud, l.cos_cone));
-      pdf_dir = light_pdf_dir(l, y0, d);
-      beta1 = l.power / (light_pick_ * pdf_dir);
-      y0.beta = l.power / light_pick_;
-      break;
-    }
-    case EmitterKind::kDistant: {
-      y0.p = l.ap_corner + up.x * l.ap_edge1 + up.y * l.ap_edge2;
-      y0.n = l.ap_normal;
-      d = l.direction;
-      beta1 = l.power * std::fabs(glm::dot(l.ap_normal, d)) / (light_pick_ * pdf_pos);
-      y0.beta = beta1;
-      break;
-    }
-    case EmitterKind::kLaser: {
-      y0.p = l.position;
-      d = l.direction;
-      beta1 = l.power / light_pick_;
-      y0.beta = beta1;
-      break;
-    }
+  const SurfacePoint x = sample_point(l, rng.get2d(), &y0.err);
+  const std::optional<EndpointRay> r = sample_ray(l.params, x, rng.get2d());
+  y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
+  if (!r) {  // no emission from this sample: y0 alone, carrying nothing
+    y0.p = x.position;
+    y0.beta = vec3(0.0f);
+    return 1;
   }
+  y0.p = r->origin;
+  y0.n = r->normal;
   y0.ns = y0.n;
-  y0.pdf_fwd = light_pick_ * pdf_pos;  // 0 for Dirac positions
+  // y0 keeps the spatial part of the emission, L_e⁽⁰⁾ / p (a join at y0 evaluates the directional
+  // part); the walk continues with the first ray's whole throughput.
+  y0.beta = spatial_emission(l.params) / (light_pick_ * (r->pdf.delta_pos ? 1.0f : r->pdf.pos));
+  const vec3 beta1 = r->weight / light_pick_;
   if (is_black(beta1)) return 1;
-  // The walk starts from y0 with the first ray's throughput.
-  Vertex saved = y0;
+  const vec3 saved = y0.beta;
   th.light[0].beta = beta1;
-  const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, d, pdf_dir, max_light_);
-  th.light[0].beta = saved.beta;
+  const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, r->direction,
+                                                        finite_part(r->pdf.dir, r->pdf.delta_dir), max_light_);
+  th.light[0].beta = saved;
+  // A Dirac direction from a finite-area origin (a distant light's aperture) is a parallel beam:
+  // its first vertex has a finite density per area, which the distant-projection connector's
+  // MIS weight compares with the eye's.
+  if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.light[1].pdf_fwd = parallel_jacobian(th.light[1], y0, r->direction);
   return n;
 }
 
@@ -772,14 +652,39 @@ void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled
   c(s + 1) = 'D';
 }
 
-float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join) const {
+float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const Join* join,
+                             JoinKind self) const {
   // Strategy (s2, t2) samples this string when the profile runs it and its join letters c(s2),
   // c(s2+1) are both D: one mask for all of them, bit s2 (runs_mask_ holds the profile's part).
   // When no other strategy can sample this string (pt, lt, and many strings of every profile),
   // the weight is 1 and no density needs recomputing.
   const int n = s + t;
   const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c_(i+1) are D
-  const std::uint64_t others = runs_mask_[static_cast<std::size_t>(n)] & d_pairs & ~(std::uint64_t{1} << s);
+  std::uint64_t others = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
+  if (self == JoinKind::kPlain) others &= ~(std::uint64_t{1} << s);
+  // The projection connectors sample the split (1, n - 1) of strings beginning DSD (a distant
+  // light) and the split (n - 1, 1) of strings ending DSD (an orthographic sensor). Their density
+  // is the plain split's with the projected endpoint's area density (light choice aside) replaced
+  // by 1, so their ratios to the plain recurrence's carry a factor 1 / pdf_pos (`conn_w2`, squared).
+  double conn_w2_first = 0.0, conn_w2_last = 0.0, self_w2 = 1.0;
+  if (has_connectors_) {
+    const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };  // c_i c_(i+1) c_(i+2) = DSD
+    if (n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && !(self == JoinKind::kDistant)) {
+      const Vertex& x0 = s == 1 && t != 1 && sampled ? *sampled : th.light[0];
+      const double pos = rs_.lights[static_cast<std::size_t>(x0.light)].pdf_pos;
+      conn_w2_first = 1.0 / (pos * pos);
+      others |= std::uint64_t{1} << 1;
+    }
+    if (n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && !(self == JoinKind::kOrtho)) {
+      conn_w2_last = 1.0 / (static_cast<double>(cam_.pdf_pos) * cam_.pdf_pos);
+      others |= std::uint64_t{1} << (n - 1);
+    }
+    if (self == JoinKind::kDistant) {
+      const double pos = rs_.lights[static_cast<std::size_t>((sampled ? *sampled : th.light[0]).light)].pdf_pos;
+      self_w2 = pos * pos;
+    }
+    if (self == JoinKind::kOrtho) self_w2 = static_cast<double>(cam_.pdf_pos) * cam_.pdf_pos;
+  }
   if (others == 0) return 1.0f;
   // The loops below reach only as far as the farthest strategy that can: the light side down to
   // s2 = light_lo, the eye side up to s2 = eye_hi; densities beyond are not needed.
@@ -818,6 +723,9 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
     const bsdf::JoinPdfs& at_pt = join->at_pt;
     if (need_pt) rev_pt = area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
     if (need_qs) rev_qs = area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
+    // A connector's endpoint sends a parallel beam: the density at the other end is per area.
+    if (self == JoinKind::kDistant) rev_pt = parallel_jacobian(*pt, *qs, w);
+    if (self == JoinKind::kOrtho) rev_qs = parallel_jacobian(*qs, *pt, w);
     if (need_ptm) rev_ptm = area(at_pt.known ? at_pt.to_wo : pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
     if (need_qsm) rev_qsm = area(at_qs.known ? at_qs.to_wo : pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
   } else if (pt) {  // s = 0: pt lies on an area light
@@ -827,14 +735,22 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
       rev_ptm = area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo);
     }
   } else if (qs) {  // t = 0: qs is the lens point
-    rev_qs = sensor_pdf_pos();
-    if (need_qsm) rev_qsm = area(sensor_pdf_dir(qs->wo), *qsm, qs->wo, qs->d2_wo);
+    rev_qs = cam_.pdf_pos;
+    if (need_qsm) rev_qsm = area(sensor_pdf_dir(*qs, qs->wo), *qsm, qs->wo, qs->d2_wo);
   }
   // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
   // Ratios in double: long paths multiply many of them. Dirac densities are stored as 0 and
   // count as 1 here; their strategies are excluded by letter.
   double sum = 0.0;
   const auto runs = [&](int s2) { return static_cast<double>((others >> s2) & 1); };
+  // The term of strategy s2 for density ratio ri (a connector's carries its factor; profiles
+  // without connectors never take the branch).
+  const auto term = [&](int s2, double ri) {
+    double r2 = ri * ri;
+    if (has_connectors_) [[unlikely]]
+      r2 *= s2 == 1 && conn_w2_first != 0.0 ? conn_w2_first : s2 == n - 1 && conn_w2_last != 0.0 ? conn_w2_last : 1.0;
+    return r2;
+  };
   if (all_runs_) {
     // Each side: the join's two ratios, then the subpath's fixed part from prepare_joins().
     if (eye_lo <= t - 1) {
@@ -862,16 +778,16 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
     ri *= i == t - 1   ? remap(rev_pt) / remap(pt->pdf_fwd)
           : i == t - 2 ? remap(rev_ptm) / remap(E[static_cast<std::size_t>(i)].pdf_fwd)
                        : th.eye_ratio[static_cast<std::size_t>(i)];
-    if ((others >> (n - i)) & 1) sum += ri * ri;
+    if ((others >> (n - i)) & 1) sum += term(n - i, ri);
   }
   ri = 1.0;
   for (int i = s - 1; i >= light_lo; --i) {
     ri *= i == s - 1   ? remap(rev_qs) / remap(qs->pdf_fwd)
           : i == s - 2 ? remap(rev_qsm) / remap(L[static_cast<std::size_t>(i)].pdf_fwd)
                        : th.light_ratio[static_cast<std::size_t>(i)];
-    if ((others >> i) & 1) sum += ri * ri;
+    if ((others >> i) & 1) sum += term(i, ri);
   }
-  return static_cast<float>(1.0 / (1.0 + sum));
+  return static_cast<float>(1.0 / (1.0 + sum * self_w2));
 }
 
 void Integrator::record(Thread& th, const Pending& r) const {
@@ -892,7 +808,12 @@ void Integrator::record(Thread& th, const Pending& r) const {
 
 template <Integrator::Connection C>
 void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) const {
-  const int strategy_index = strategy(s, t);
+  constexpr bool by_light = C == Connection::kSplat || C == Connection::kOrtho || C == Connection::kLens;
+  rng.set_dimension(kJoinDims + (static_cast<std::uint64_t>(C) * kMaxRuns + static_cast<std::uint64_t>(by_light ? s : t)) * kDimsPerJoin);
+  constexpr JoinKind kind = C == Connection::kDistant ? JoinKind::kDistant : C == Connection::kOrtho ? JoinKind::kOrtho : JoinKind::kPlain;
+  const int strategy_index = C == Connection::kDistant ? distant_of(t) : C == Connection::kOrtho ? ortho_of(s) : strategy(s, t);
+  ConnectorStats* stats = kind != JoinKind::kPlain ? &th.connectors[static_cast<std::size_t>(strategy_index)] : nullptr;
+  PathKey chain_s = 0;  // a connector's S letter
   vec3 contrib{0.0f};
   Vertex& sampled = th.sampled;
   bool splat = false;
@@ -907,86 +828,99 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     if (pt->kind != Kind::kSurface) return;
     const int li = rs_.light_of_shape[static_cast<std::size_t>(pt->shape)];
     if (li < 0) return;
-    contrib = pt->beta * light_emit(rs_.lights[static_cast<std::size_t>(li)], *pt, pt->wo);
+    const LightParams& l = rs_.lights[static_cast<std::size_t>(li)].params;
+    contrib = pt->beta * spatial_emission(l) * directional_emission(l, pt->n, pt->wo);
   } else if constexpr (C == Connection::kLens) {
     // --- light path hits the lens ---
     if (qs->kind != Kind::kLens) return;
-    const vec3 w = qs->wo;
-    if (!raster_of(qs->p, w, &rx, &ry)) return;
-    contrib = qs->beta * importance(qs->p, w);
+    glm::vec2 raster;
+    const vec3 we = importance(cam_.params, qs->p, qs->wo, &raster);
+    if (is_black(we)) return;
+    to_pixels(raster, &rx, &ry);
+    contrib = qs->beta * we;
     splat = true;
-  } else if constexpr (C == Connection::kSplat) {
-    // --- splat: connect qs to a fresh sensor point ---
-    if (cam_.type != SensorType::kPinhole && cam_.type != SensorType::kLens) return;
+  } else if constexpr (C == Connection::kSplat || C == Connection::kOrtho) {
+    // --- a light vertex joined to a sensor point: a fresh one (the splat, t = 1) or, for
+    //     ortho-projection, the film point on the line of sight through qs ---
     if (qs->kind == Kind::kLens || !qs->finite) return;
+    std::optional<EndpointConnection> c;
+    if constexpr (C == Connection::kSplat) {
+      if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no DD join
+      c = connect_finite(cam_.params, rng.get2d(), qs->p);
+      if (!c) return;
+    } else {
+      const auto* film = std::get_if<OrthographicParams>(&cam_.params);
+      if (film == nullptr) return;
+      ++stats->attempts;
+      c = pathex::connect(*film, qs->p);
+      if (!c) {
+        ++stats->outside;
+        return;
+      }
+      chain_s = bit(s + 1);  // c(k+1), the sensor's direction
+    }
     sampled = Vertex{};
     sampled.kind = Kind::kCamera;
-    sampled.p = cam_.position;
-    if (cam_.type == SensorType::kLens) {
-      const glm::vec2 disk = sample_concentric_disk(rng.get2d()) * cam_.lens_radius;
-      sampled.p = cam_.position + disk.x * cam_.right + disk.y * cam_.up;
-      sampled.n = cam_.forward;
-    }
+    sampled.p = c->position;
+    sampled.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c->normal;  // a pinhole is a point
     sampled.ns = sampled.n;
-    sampled.letter = 'D';
+    sampled.letter = C == Connection::kSplat ? 'D' : sensor_pair_[0];
     sampled.pos_letter = sensor_pair_[1];
-    const vec3 to_cam = sampled.p - qs->p;
-    const float d2 = glm::dot(to_cam, to_cam);
-    const vec3 w = to_cam * (1.0f / std::sqrt(d2));  // from qs to the camera
-    if (!raster_of(sampled.p, -w, &rx, &ry)) return;
-    const float we = importance(sampled.p, -w);
-    const float pdf_pos = cam_.type == SensorType::kLens ? 1.0f / lens_area() : 1.0f;
-    sampled.beta = vec3(we / pdf_pos);
-    sampled.pdf_fwd = sensor_pdf_pos();
+    sampled.pdf_fwd = cam_.pdf_pos;
+    const vec3 w = c->wi;  // from qs to the sensor
+    to_pixels(c->raster, &rx, &ry);
     vec3 fq;
     // A light vertex's beta already holds its spatial emission; only the directional part is left.
-    if (qs->kind == Kind::kLight) fq = vec3(light_emits(rs_.lights[static_cast<std::size_t>(qs->light)], *qs, w) ? 1.0f : 0.0f);
+    if (qs->kind == Kind::kLight) fq = vec3(directional_emission(rs_.lights[static_cast<std::size_t>(qs->light)].params, qs->n, w));
     else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
                         qs->wo, w, qs->ns, qs->n, &join.at_qs);
     join.w = w;
-    join.d2 = d2;
+    join.d2 = c->distance * c->distance;
     joined = true;
-    const float g = abs_cos(*qs, w) * std::fabs(glm::dot(cam_.forward, w)) / d2;
-    contrib = qs->beta * fq * sampled.beta * g;
+    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);  // weight: We cos / d² (splat), We (film)
     ends = {qs, &sampled};
     splat = true;
-  } else if constexpr (C == Connection::kNee) {
-    // --- next-event estimation: a fresh light sample ---
+  } else if constexpr (C == Connection::kNee || C == Connection::kDistant) {
+    // --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
+    //     for distant-projection, the aperture point on the line through pt against the light ---
     if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
-    const float ul = rng.get1d();
-    const glm::vec2 up = rng.get2d();
-    const std::size_t li = std::min(rs_.lights.size() - 1, static_cast<std::size_t>(ul * static_cast<float>(rs_.lights.size())));
+    const std::size_t li = pick_light(rng.get1d());
     const RenderLight& l = rs_.lights[li];
-    if (l.type == EmitterKind::kDistant || l.type == EmitterKind::kLaser) return;  // Dirac directions: no DD join
+    std::optional<EndpointConnection> c;
+    vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
+    if constexpr (C == Connection::kNee) {
+      const glm::vec2 up = rng.get2d();
+      if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
+      c = pathex::connect(l.params, sample_point(l, up, &err), pt->p);
+      if (!c) return;
+    } else {
+      if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
+      ++stats->attempts;
+      c = pathex::connect(l.params, SurfacePoint{}, pt->p);
+      if (!c) {
+        ++stats->outside;
+        return;
+      }
+      err = aperture_error(l);
+      chain_s = bit(1);  // c1, the light's direction
+    }
     sampled = Vertex{};
     sampled.kind = Kind::kLight;
     sampled.light = static_cast<int>(li);
     sampled.pos_letter = light_pairs_[li][0];
-    sampled.letter = 'D';
-    float pdf_pos = 1.0f;
-    if (l.type == EmitterKind::kArea) {
-      const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, up);
-      sampled.p = ss.position;
-      sampled.n = ss.normal;
-      pdf_pos = light_pdf_pos(l);
-    } else {
-      sampled.p = l.position;
-    }
+    sampled.letter = C == Connection::kNee ? 'D' : light_pairs_[li][1];
+    sampled.p = c->position;
+    sampled.n = c->normal;
+    sampled.err = err;
     sampled.ns = sampled.n;
-    sampled.pdf_fwd = light_pick_ * light_pdf_pos(l);
-    sampled.beta = l.power * (1.0f / (light_pick_ * pdf_pos));
-    const vec3 to_light = sampled.p - pt->p;
-    const float d2 = glm::dot(to_light, to_light);
-    if (d2 <= 0.0f) return;
-    const vec3 w = to_light * (1.0f / std::sqrt(d2));
-    if (!light_emits(l, sampled, -w)) return;
+    sampled.pdf_fwd = light_pick_ * l.pdf_pos;
+    const vec3 w = c->wi;  // from pt to the light
     const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
                              pt->wo, w, pt->ns, pt->n, &join.at_pt);
     join.w = -w;  // w runs from pt to the light, the join's from the light to pt
-    join.d2 = d2;
+    join.d2 = c->distance * c->distance;
     joined = true;
-    const float g = abs_cos(*pt, w) * abs_cos(sampled, w) / d2;
-    contrib = pt->beta * f * sampled.beta * g;
+    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;  // weight: Le cos / (p d²), I / d², E
     ends = {pt, &sampled};
   } else {
     // --- a shadow ray between y(s-1) and z(t-1) ---
@@ -1007,26 +941,35 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     contrib = qs->beta * fq * fp * pt->beta * g;
     ends = {qs, pt};
   }
-  if (is_black(contrib)) return;
-  const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee ? &sampled : nullptr;
+  if (is_black(contrib)) {
+    if (stats) ++stats->no_transport;
+    return;
+  }
+  const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee || kind != JoinKind::kPlain ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
-  const PathKey key = path_key(th, s, t, fresh);
-  const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr), strategy_index, batch, splat, rx, ry, th.px};
+  const PathKey key = path_key(th, s, t, fresh) | chain_s;
+  const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr, kind), strategy_index, batch, splat,
+                  stats != nullptr, rx, ry, th.px};
   if constexpr (C == Connection::kEmitter || C == Connection::kLens) {
     record(th, r);  // no shadow ray: the path's last edge was traced
   } else {
     // The weight is known before the shadow ray is: the ray joins the thread's batch, and the
     // contribution is recorded if the batch finds the segment unobstructed.
     ++th.rays;
-    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, ends[0]->p, ends[0]->n, ends[1]->p, ends[1]->n))] = r;
+    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, ends[0]->p, ends[0]->n, ends[0]->err, ends[1]->p, ends[1]->n, ends[1]->err))] = r;
     if (th.shadow.full()) trace_shadows(th);
   }
 }
 
 void Integrator::trace_shadows(Thread& th) const {
   th.shadow.trace(*rs_.geometry);
-  for (int lane = 0; lane < th.shadow.size(); ++lane)
-    if (th.shadow.visible(lane)) record(th, th.pending[static_cast<std::size_t>(lane)]);
+  for (int lane = 0; lane < th.shadow.size(); ++lane) {
+    const Pending& r = th.pending[static_cast<std::size_t>(lane)];
+    const bool visible = th.shadow.visible(lane);
+    if (r.connector) ++(visible ? th.connectors[static_cast<std::size_t>(r.strategy)].successes
+                                : th.connectors[static_cast<std::size_t>(r.strategy)].occluded);
+    if (visible) record(th, r);
+  }
   th.shadow.clear();
 }
 
@@ -1039,7 +982,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
   if (s == 0) {  // the eye vertex on the emitter becomes the light vertex
     x[0].kind = Kind::kLight;
     x[0].light = rs_.light_of_shape[static_cast<std::size_t>(x[0].shape)];
-  } else if (rs_.lights[static_cast<std::size_t>(x[0].light)].type == EmitterKind::kArea) {
+  } else if (rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) {
     x[0].shape = rs_.lights[static_cast<std::size_t>(x[0].light)].shape;  // so an eye path may hit it
   }
   const std::string letters = label(th, s, t);
@@ -1047,19 +990,21 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
   float sum = 0.0f;
   for (int s2 = 0; s2 <= k + 1; ++s2) {
     const int t2 = k + 1 - s2;
-    if (strategy(s2, t2) < 0 || letters[static_cast<std::size_t>(s2) + 1] != 'D' ||
-        letters[static_cast<std::size_t>(s2) + 2] != 'D')
-      continue;
-    if (t2 == 0 && !lens_hits_) continue;
-    if (s2 == 0 && x[0].kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(x[0].light)].type != EmitterKind::kArea) continue;
+    const auto letters_at = [&](int i, int count) { return letters.substr(static_cast<std::size_t>(i) + 1, static_cast<std::size_t>(count)); };
+    bool plain = strategy(s2, t2) >= 0 && letters_at(s2, 2) == "DD";
+    if (t2 == 0 && !lens_hits_) plain = false;
+    if (s2 == 0 && x[0].kind == Kind::kLight && !rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) plain = false;
+    const bool distant = s2 == 1 && distant_of(t2) >= 0 && letters_at(0, 3) == "DSD";
+    const bool ortho = t2 == 1 && ortho_of(s2) >= 0 && letters_at(k, 3) == "DSD";
+    if (!plain && !distant && !ortho) continue;
+    const JoinKind kind = distant ? JoinKind::kDistant : ortho ? JoinKind::kOrtho : JoinKind::kPlain;
     // Re-split: light subpath x0 … x(s2-1), eye subpath xk … x(s2), with forward densities as
     // each side would have sampled them.
     for (int i = 0; i < s2; ++i) th.light[static_cast<std::size_t>(i)] = x[static_cast<std::size_t>(i)];
     for (int j = 0; j < t2; ++j) th.eye[static_cast<std::size_t>(j)] = x[static_cast<std::size_t>(k - j)];
     if (s2 > 0) {
-      const RenderLight& l = rs_.lights[static_cast<std::size_t>(x[0].light)];
       th.light[0].kind = Kind::kLight;
-      th.light[0].pdf_fwd = light_pick_ * light_pdf_pos(l);
+      th.light[0].pdf_fwd = light_pick_ * rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
     }
     if (s2 == 0) {
       th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;
@@ -1087,7 +1032,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
           specular(i + 1) ? 0.0f
                           : pdf(&th.light[static_cast<std::size_t>(i + 2)], th.light[static_cast<std::size_t>(i + 1)],
                                 th.light[static_cast<std::size_t>(i)]);
-    if (t2 > 0) th.eye[0].pdf_fwd = sensor_pdf_pos();
+    if (t2 > 0) th.eye[0].pdf_fwd = cam_.pdf_pos;
     for (int j = 1; j < t2; ++j)
       th.eye[static_cast<std::size_t>(j)].pdf_fwd =
           specular(k - (j - 1)) ? 0.0f
@@ -1098,8 +1043,14 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
           specular(k - (j + 1)) ? 0.0f
                                 : pdf(&th.eye[static_cast<std::size_t>(j + 2)], th.eye[static_cast<std::size_t>(j + 1)],
                                       th.eye[static_cast<std::size_t>(j)]);
+    // Parallel beams (a distant light's, an orthographic sensor's) give their first vertex a
+    // density per area, as light_subpath() and eye_subpath() set it.
+    if (s2 >= 2 && th.light[0].pdf_fwd > 0.0f && light_pairs_[static_cast<std::size_t>(th.light[0].light)][1] == 'S')
+      th.light[1].pdf_fwd = parallel_jacobian(th.light[1], th.light[0], glm::normalize(th.light[1].p - th.light[0].p));
+    if (t2 >= 2 && cam_.pdf_pos > 0.0f && sensor_pair_[0] == 'S')
+      th.eye[1].pdf_fwd = parallel_jacobian(th.eye[1], th.eye[0], glm::normalize(th.eye[1].p - th.eye[0].p));
     prepare_joins(th, s2, t2);  // the ratios of the re-split subpaths
-    sum += mis_weight(th, s2, t2, nullptr, pack(letters));
+    sum += mis_weight(th, s2, t2, nullptr, pack(letters), nullptr, kind);
   }
   th.light = saved_light_eye.light;
   th.eye = saved_light_eye.eye;
@@ -1110,9 +1061,11 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
   Sampler rng(o_.seed, pixel, pass);
+  rng.set_dimension(kEyeDims);
   const int batch = batch_of(pass, o_.batches);
   th.px = px;
   const int nt = eye_subpath(th, rng, px, py);
+  rng.set_dimension(kLightDims);
   const int ns = light_subpath(th, rng);
   th.ns = ns;
   th.nt = nt;
@@ -1134,9 +1087,13 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
     const int s_hi = std::min(s_max, max_bounces_ + 2 - t);
     if (s_hi >= 0 && strategy(0, t) >= 0) connect<Connection::kEmitter>(th, rng, 0, t, batch);
     if (s_hi >= 1 && strategy(1, t) >= 0) connect<Connection::kNee>(th, rng, 1, t, batch);
+    if (s_hi >= 1 && distant_of(t) >= 0) connect<Connection::kDistant>(th, rng, 1, t, batch);
     for (int s = 2; s <= s_hi; ++s)
       if (strategy(s, t) >= 0) connect<Connection::kJoin>(th, rng, s, t, batch);
   }
+  if (has_connectors_ && nt >= 1)
+    for (int s = 1; s <= std::min(ns - (lens_end ? 1 : 0), max_bounces_ + 1); ++s)
+      if (ortho_of(s) >= 0) connect<Connection::kOrtho>(th, rng, s, 1, batch);
 }
 
 }  // namespace
@@ -1153,8 +1110,10 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
   Integrator integrator(*rs, *strategies, o, nullptr);
-  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}};
+  const Integrator general(*rs, *strategies, o, nullptr, /*general_mis=*/true);
+  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
   th.images = &images;
+  th.connectors.resize(strategies->strategies.size());
   std::vector<MisCheck> out;
   for (int i = 0; i < samples; ++i) {
     const int px = i % rs->camera.width, py = (i / rs->camera.width) % rs->camera.height;
@@ -1167,7 +1126,9 @@ Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profil
         if (strategies->find(s, t) < 0) continue;
         const float sum = integrator.weight_sum_if_valid(th, s, t);
         if (sum < 0.0f) continue;  // not a path this connection forms
-        out.push_back({integrator.label(th, s, t), s, t, sum, integrator.packed_label(th, s, t)});
+        const float weight = integrator.own_weight(th, s, t);
+        const float weight_general = general.own_weight(th, s, t);
+        out.push_back({integrator.label(th, s, t), s, t, sum, weight, weight_general, integrator.packed_label(th, s, t)});
       }
   }
   return out;
@@ -1197,9 +1158,10 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
       [&] {
         Integrator::Thread th{Histogram(layout, classifier),
                               std::vector<ClassImages::PixelSum>(static_cast<std::size_t>(out.images.width()), ClassImages::PixelSum(out.images)),
-                              {}, {}, 0, {}, {}};
+                              {}, {}, 0, {}, {}, {}};
         th.images = &out.images;
         th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
+        th.connectors.resize(strategies->strategies.size());
         return th;
       });
   const int w = rs->camera.width, h = rs->camera.height;
@@ -1231,6 +1193,21 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
     Result<bool> m = out.histogram.merge(th.hist);
     if (!m) return m.error();
     out.rays += th.rays;
+  }
+  // Connector statistics, in the profile's order (integer sums: the same for every thread count).
+  for (std::size_t i = 0; i < strategies->strategies.size(); ++i) {
+    const Strategy& st = strategies->strategies[i];
+    if (st.connector == ConnectorKind::kNone) continue;
+    ConnectorStats total{st.name, to_string(st.connector)};
+    for (const Integrator::Thread& th : locals) {
+      const ConnectorStats& c = th.connectors[i];
+      total.attempts += c.attempts;
+      total.successes += c.successes;
+      total.outside += c.outside;
+      total.occluded += c.occluded;
+      total.no_transport += c.no_transport;
+    }
+    out.connectors.push_back(total);
   }
   out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

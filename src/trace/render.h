@@ -4,10 +4,14 @@
 // The profile's plain-join strategies (s, DD, t) are run as BDPT connections between a light
 // subpath of s vertices and an eye subpath of t vertices; s = 0 is an eye path hitting an area
 // light, s = 1 next-event estimation, t = 1 a light-tracing splat to the camera, t = 0 a light
-// path hitting a finite lens. Contributions are combined with the power heuristic over the
-// strategies the profile runs; for a given string exactly the strategies whose language
-// contains it have nonzero density (their join vertices are both D), so deltas are handled by
-// letters, never by huge numbers. Profiles naming a connector are refused until connectors land.
+// path hitting a finite lens. The projection connectors run too: distant-projection (0, DSD, t)
+// joins an eye subpath of t vertices to the aperture point of a distant light found by
+// projecting its last vertex against the light's direction, and ortho-projection (s, DSD, 0)
+// joins a light subpath of s vertices to the film point of an orthographic sensor found by
+// projecting its last vertex along the view direction. Contributions are combined with the
+// power heuristic over the strategies the profile runs; for a given string exactly the
+// strategies whose language contains it have nonzero density, so deltas are handled by letters,
+// never by huge numbers. Profiles naming the mirror or manifold connector are refused by name.
 // Shadow rays are queued per thread and traced sixteen at a time as one Embree packet
 // (OcclusionBatch); a contribution is recorded once its segment is found clear.
 //
@@ -55,6 +59,18 @@ struct RenderOptions {
   const std::atomic<bool>* cancel = nullptr;  // set to stop early; the result is marked incomplete
 };
 
+// What a connector did during a render (DESIGN §4): every attempt either succeeds (its
+// contribution is recorded) or fails for one reason.
+struct ConnectorStats {
+  std::string strategy;            // the profile's name for the strategy
+  std::string connector;           // "distant-projection", "ortho-projection"
+  std::uint64_t attempts = 0;      // joins tried (one per eye or light vertex where it may stand)
+  std::uint64_t successes = 0;     // contributions recorded
+  std::uint64_t outside = 0;       // the projection missed the aperture (or the film)
+  std::uint64_t occluded = 0;      // a segment it built was blocked
+  std::uint64_t no_transport = 0;  // built, but the BSDF or emission towards it is zero
+};
+
 struct RenderOutput {
   Histogram histogram;
   ClassImages images;
@@ -64,25 +80,33 @@ struct RenderOutput {
   bool complete = true;
   double time_s = 0;
   std::uint64_t rays = 0;      // rays cast (intersections and shadow rays)
+  std::vector<ConnectorStats> connectors{};  // one per connector strategy of the profile, in its order
 };
 
-// Which plain-join (s, t) pairs a profile runs, as a predicate; an error names the first
-// connector the tracer does not run.
+// The strategies of a profile the tracer runs: plain joins and the two projection connectors.
+// runnable_strategies() names the first connector the tracer does not run (mirror, manifold).
 struct StrategySet {
   std::vector<Strategy> strategies;
-  // Index of the profile strategy that runs (s, t), or -1.
+  // Index of the profile strategy that runs the plain join (s, DD, t), or -1.
   int find(int s, int t) const;
+  // Index of the profile strategy that runs connector `k` with s letters before its chain and t
+  // after it, or -1.
+  int find_connector(ConnectorKind k, int s, int t) const;
 };
+
 Result<StrategySet> runnable_strategies(const Profile& profile);
 
 // A check of the MIS weights (for tests): trace `samples` pairs of subpaths and, for every full
 // path that a connection (s, t) with s != 1 and t != 1 of the profile forms from their vertices,
 // the sum over every strategy the profile runs for that string of the weight it computes when it
-// samples those same vertices. Each sum must be 1.
+// samples those same vertices. Each sum must be 1. Also the connection's own weight as the
+// renderer computes it (with its per-sample sums when the profile runs every plain join) and as
+// the general recurrence computes it: the two must agree.
 struct MisCheck {
   std::string path;
   int s = 0, t = 0;
   double weight_sum = 0.0;
+  double weight = 0.0, weight_general = 0.0;
   std::string recorded;  // the label as the renderer packs and records it: must equal `path`
 };
 Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed,

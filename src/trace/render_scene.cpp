@@ -2,25 +2,15 @@
 
 #include <cmath>
 
-namespace pathex {
+#include "trace/rng.h"
 
-LightType letter_type(EmitterKind k) {
-  switch (k) {
-    case EmitterKind::kArea: return LightType::kArea;
-    case EmitterKind::kPoint:
-    case EmitterKind::kSpot: return LightType::kPoint;
-    case EmitterKind::kDistant: return LightType::kDistant;
-    case EmitterKind::kLaser: return LightType::kLaser;
-  }
-  return LightType::kPoint;
-}
+namespace pathex {
 
 Result<RenderScene> make_render_scene(const Scene& scene) {
   RenderScene rs;
   Result<std::unique_ptr<EmbreeScene>> geometry = EmbreeScene::build(scene);
   if (!geometry) return geometry.error();
   rs.geometry = std::move(*geometry);
-  rs.scene_extent = rs.geometry->extent();
   rs.light_of_shape.assign(scene.shapes.size(), -1);
   for (std::size_t i = 0; i < scene.shapes.size(); ++i) {
     const Shape& s = scene.shapes[i];
@@ -29,60 +19,52 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     // A zero-area emitter emits nothing; it is not a light (and would have an infinite density).
     if (!s.emissive() || !(rs.geometry->shape_area(static_cast<int>(i)) > 0.0f)) continue;
     RenderLight l;
-    l.type = EmitterKind::kArea;
-    l.power = s.emission;
+    l.params = AreaLightParams{s.emission, s.two_sided};
     l.shape = static_cast<int>(i);
-    l.two_sided = s.two_sided;
+    l.pdf_pos = 1.0f / rs.geometry->shape_area(l.shape);
     rs.light_of_shape[i] = static_cast<int>(rs.lights.size());
     rs.lights.push_back(l);
   }
   for (const Light& light : scene.lights) {
     RenderLight l;
     if (const auto* p = std::get_if<PointLight>(&light)) {
-      l.type = EmitterKind::kPoint;
-      l.position = p->position;
-      l.power = p->intensity;
+      l.params = PointLightParams{p->position, p->intensity};
     } else if (const auto* s = std::get_if<SpotLight>(&light)) {
-      l.type = EmitterKind::kSpot;
-      l.position = s->position;
-      l.direction = s->direction;
-      l.power = s->intensity;
-      l.cos_cone = std::cos(glm::radians(s->cone_degrees));
+      const float cos_cone = std::cos(glm::radians(s->cone_degrees));
+      l.params = SpotLightParams{s->position, s->direction, s->intensity, cos_cone, cos_cone};  // a hard edge
     } else if (const auto* d = std::get_if<DistantLight>(&light)) {
-      l.type = EmitterKind::kDistant;
-      l.direction = d->direction;
-      l.power = d->irradiance;
-      l.ap_corner = d->aperture_corner;
-      l.ap_edge1 = d->aperture_edge1;
-      l.ap_edge2 = d->aperture_edge2;
-      const glm::vec3 n = glm::cross(d->aperture_edge1, d->aperture_edge2);
-      l.ap_area = glm::length(n);
-      l.ap_normal = n / l.ap_area;
+      const DistantLightParams params{d->direction, d->irradiance, d->aperture_corner, d->aperture_edge1, d->aperture_edge2};
+      l.params = params;
+      l.pdf_pos = 1.0f / aperture_area(params);
     } else {
       const LaserLight& z = std::get<LaserLight>(light);
-      l.type = EmitterKind::kLaser;
-      l.position = z.position;
-      l.direction = z.direction;
-      l.power = z.power;
+      l.params = LaserParams{z.position, z.direction, z.power};
     }
     rs.lights.push_back(l);
   }
   // --- the sensor ---
   const Camera& c = scene.camera;
-  RenderCamera& cam = rs.camera;
+  RenderSensor& cam = rs.camera;
   cam.type = c.type;
-  cam.position = c.position;
-  cam.forward = glm::normalize(c.look_at - c.position);
-  cam.right = glm::normalize(glm::cross(cam.forward, c.up));
-  cam.up = glm::cross(cam.right, cam.forward);
   cam.width = c.width;
   cam.height = c.height;
-  cam.tan_y = std::tan(glm::radians(c.fov_degrees) * 0.5f);
-  cam.tan_x = cam.tan_y * static_cast<float>(c.width) / static_cast<float>(c.height);
-  cam.lens_radius = c.aperture_radius;
-  cam.focus_distance = c.focus_distance;
-  cam.film_width = c.film_width;
-  cam.film_height = c.film_height;
+  const glm::vec3 forward = glm::normalize(c.look_at - c.position);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
+  const glm::vec3 up = glm::cross(right, forward);
+  const float tan_y = std::tan(glm::radians(c.fov_degrees) * 0.5f);
+  const float tan_x = tan_y * static_cast<float>(c.width) / static_cast<float>(c.height);
+  switch (c.type) {
+    case SensorType::kPinhole: cam.params = PinholeParams{c.position, forward, right, up, tan_x, tan_y}; break;
+    case SensorType::kLens:
+      cam.params = ThinLensParams{c.position, forward, right, up, tan_x, tan_y, c.aperture_radius, c.focus_distance};
+      cam.pdf_pos = 1.0f / (kPi * c.aperture_radius * c.aperture_radius);
+      break;
+    case SensorType::kOrthographic:
+      cam.params = OrthographicParams{c.position, forward, right, up, 0.5f * c.film_width, 0.5f * c.film_height};
+      cam.pdf_pos = 1.0f / (c.film_width * c.film_height);
+      break;
+    case SensorType::kSpotmeter: cam.params = SpotMeterParams{c.position, forward}; break;
+  }
   return rs;
 }
 

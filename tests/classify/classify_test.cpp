@@ -308,7 +308,7 @@ TEST(ClassFiles, ErrorsNameTheJsonPointer) {
       {R"({"classes": [{"name": "1x", "expr": "LDE"}]})", ErrorCode::kBadFile, "f.json:/classes/0/name",
        "invalid class name '1x', expected a letter or '_' then letters, digits, '_' or '-'", 0},
       {R"({"classes": [{"name": "a", "expr": "LDE", "notation": "bogus"}]})", ErrorCode::kBadFile,
-       "f.json:/classes/0/notation", "expected \"full\" or \"heckbert\"", 0},
+       "f.json:/classes/0/notation", "expected \"full\", \"heckbert\" or \"lpe\"", 0},
       {R"({"classes": [{"name": "a", "expr": "LDE", "colour": "red"}]})", ErrorCode::kBadFile,
        "f.json:/classes/0/colour", "unknown key 'colour', expected one of name, expr, notation, description", 0},
       {R"({"classes": [{"name": "a"}]})", ErrorCode::kBadFile, "f.json:/classes/0/expr", "expected a string expression", 0},

@@ -278,7 +278,7 @@ TEST(CliExplain, NotationAndUsageErrors) {
 
   const CliRun light = pathex({"explain", "--light", "point", "LSDE"});
   EXPECT_EQ(light.code, 2);
-  EXPECT_EQ(light.err, "pathex: error: --light and --sensor apply to --notation heckbert only\n");
+  EXPECT_EQ(light.err, "pathex: error: --light and --sensor apply to --notation heckbert and lpe only\n");
   const CliRun bad_light = pathex({"explain", "--notation", "heckbert", "--light", "candle", "LSDE"});
   EXPECT_EQ(bad_light.code, 2);
   EXPECT_EQ(bad_light.err,

@@ -68,6 +68,14 @@ TEST(SeedFacts, PointMirrorDiffuseOrthographic) {
   // mirror connector joins c1..c3, ortho-projection c3..c5.
   for (const char* r : kPlainJoin) EXPECT_EQ(verdict("LSDSDSDE", r), Verdict::kUnreachable) << r;
   EXPECT_EQ(verdict("LSDSDSDE", "bdpt+mirror"), Verdict::kReachable);
+  // The mirror connector stands only where its S is an interior vertex: not at c0..c2 or at
+  // ck..c(k+2), where the S letters are the light's or the sensor's.
+  EXPECT_EQ(verdict("LSDSDE", "bdpt+mirror"), Verdict::kUnreachable);
+  const Profile mirror = *resolve_profile("bdpt+mirror", kLimits);
+  const Strategy& connector = mirror.strategies[1];
+  EXPECT_FALSE(strategy_samples(connector, "LSDSDE", std::nullopt));   // c1..c3: the sensor's S
+  EXPECT_FALSE(strategy_samples(connector, "LDSDDE", std::nullopt));   // c0..c2: the light's S
+  EXPECT_TRUE(strategy_samples(connector, "LSDSDSE", std::nullopt));  // c1..c3, S at x1
   EXPECT_EQ(verdict("LSDSDSDE", "bdpt+ortho"), Verdict::kReachable);
   const std::vector<ChainEvidence> ev = chain_evidence("LSDSDSDE");
   ASSERT_EQ(ev.size(), 3u);
@@ -246,6 +254,10 @@ TEST(Profiles, BadProfilesNameTheJsonPointer) {
        "chain 'DSD' has specular letters, so it needs a connector (mirror, distant-projection, ortho-projection or manifold); a plain join is DD"},
       {R"({"name": "x", "strategies": [{"s": 1, "chain": "DSD", "t": 2, "connector": "distant-projection"}]})",
        "p.json:/strategies/0/s", "the distant-projection connector joins at c0..c2, so s must be 0"},
+      {R"({"name": "x", "strategies": [{"s": "0..", "chain": "DSD", "t": "1..", "connector": "mirror"}]})",
+       "p.json:/strategies/0/s", "the mirror connector constructs interior vertices only, so s and t must be at least 1 (found s 0.., t 1..)"},
+      {R"({"name": "x", "strategies": [{"s": 1, "chain": "DS+D", "t": "0..", "connector": "manifold"}]})",
+       "p.json:/strategies/0/t", "the manifold connector constructs interior vertices only, so s and t must be at least 1 (found s 1, t 0..)"},
       {R"({"name": "x", "strategies": [{"s": 0, "chain": "DD", "t": 2, "connector": "warp"}]})", "p.json:/strategies/0/connector",
        "unknown connector 'warp', expected mirror, distant-projection, ortho-projection or manifold"},
       {R"({"name": "x", "strategies": []})", "p.json:/strategies", "expected a non-empty array of strategies"},

@@ -235,6 +235,45 @@ TEST(ImportPbrt, LookAtWithoutAMirroringScaleShowsTheWorldMirrored) {
   expect_near(flipped.camera.position, glm::vec3(0, 0, 5), "camera");
 }
 
+TEST(ImportPbrt, TransformsAttributeScopesAndOrientation) {
+  const Scene s = load(write("transforms.pbrt",
+                             "Scale -1 1 1\nLookAt 0 0 9  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nLightSource \"point\"\n"
+                             "AttributeBegin\n  Translate 1 2 3\n  Rotate 90 1 0 0\n  Shape \"disk\" \"float radius\" 0.5\nAttributeEnd\n"
+                             "Shape \"sphere\" \"float radius\" 0.5\n"
+                             "ConcatTransform [2 0 0 0  0 2 0 0  0 0 2 0  1 0 0 1]\n"
+                             "AttributeBegin\n  ReverseOrientation\n  AreaLightSource \"diffuse\" \"rgb L\" [1 2 3]\n"
+                             "  Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\nAttributeEnd\n"
+                             "Shape \"sphere\"\n"));
+  ASSERT_EQ(s.shapes.size(), 4u);
+  const auto& disk = std::get<DiskShape>(s.shapes[0].geometry);
+  expect_near(disk.center, glm::vec3(1, 2, 3), "Translate");
+  expect_near(disk.normal, glm::vec3(0, -1, 0), "Rotate 90 about x takes +z to -y");
+  expect_near(std::get<SphereShape>(s.shapes[1].geometry).center, glm::vec3(0), "AttributeEnd restores the transform");
+  const auto& quad = std::get<QuadShape>(s.shapes[2].geometry);
+  expect_near(quad.corner, glm::vec3(1, 0, 0), "ConcatTransform lists the matrix column by column");
+  expect_near(glm::cross(quad.edge1, quad.edge2), glm::vec3(0, 0, -4), "ReverseOrientation turns the front to -z");
+  expect_near(s.shapes[2].emission, glm::vec3(1, 2, 3), "the area light");
+  EXPECT_FALSE(s.shapes[3].emissive()) << "AttributeEnd ends the area light";
+  const auto& sphere = std::get<SphereShape>(s.shapes[3].geometry);
+  expect_near(sphere.center, glm::vec3(1, 0, 0), "the transform outlives the attribute block");
+  EXPECT_FLOAT_EQ(sphere.radius, 2.0f);
+}
+
+TEST(ImportMitsuba, TransformOperationsApplyInOrder) {
+  const Scene s = load(write("order.xml",
+                             "<scene version=\"3.0.0\"><sensor type=\"perspective\"><float name=\"fov\" value=\"60\"/>"
+                             "<transform name=\"to_world\"><lookat origin=\"0, 0, 9\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>"
+                             "<emitter type=\"point\"/>"
+                             "<shape type=\"sphere\"><transform name=\"to_world\"><scale value=\"2\"/><translate x=\"1\"/></transform></shape>"
+                             "<shape type=\"sphere\"><transform name=\"to_world\"><matrix value=\"1 0 0 5  0 1 0 0  0 0 1 0  0 0 0 1\"/></transform></shape>"
+                             "</scene>"));
+  ASSERT_EQ(s.shapes.size(), 2u);
+  const auto& a = std::get<SphereShape>(s.shapes[0].geometry);
+  expect_near(a.center, glm::vec3(1, 0, 0), "scale, then translate");
+  EXPECT_FLOAT_EQ(a.radius, 2.0f);
+  expect_near(std::get<SphereShape>(s.shapes[1].geometry).center, glm::vec3(5, 0, 0), "matrix is row by row");
+}
+
 TEST(ImportPbrt, FovIsTheShorterImageAxis) {
   auto fov = [](int w, int h) {
     const std::string text = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nFilm \"rgb\" \"integer xresolution\" " +
@@ -373,6 +412,7 @@ std::vector<Refusal> refusals() {
       {"normals.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1 0 0 1 0 0 1]\n", "normals.pbrt:4:53",
        "per-vertex normals and tangents (N) are not supported: pathex shades meshes with their face normals"},
       {"include.pbrt", "Include \"missing.pbrt\"\n", "include.pbrt:4:1", "cannot open the included file 'missing.pbrt'"},
+      {"self.pbrt", "Include \"loop.pbrt\"\n", "loop.pbrt:1:1", "Include/Import nested more than 32 deep (a file including itself?)"},
       {"end.pbrt", "AttributeEnd\n", "end.pbrt:4:1", "AttributeEnd has no matching AttributeBegin"},
       {"string.pbrt", "Shape \"sphere\n", "string.pbrt:4:7", "unterminated string, expected a closing '\"' on the same line"},
       {"nolight.pbrt", "Shape \"sphere\"\n", "nolight.pbrt", "the scene has no light: expected a light source or an emitting shape"},
@@ -381,6 +421,8 @@ std::vector<Refusal> refusals() {
        "shape \"cube\" is not supported, expected obj, ply, sphere, rectangle or disk"},
       {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",
        "emitter \"envmap\" is not supported, expected point, spot, directional, or area inside a shape"},
+      {"plastic.xml", "  <bsdf type=\"plastic\" id=\"unused\"/>\n</scene>\n", "plastic.xml:2:3",
+       "bsdf \"plastic\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, blendbsdf or twosided"},
       {"medium.xml", "  <medium type=\"homogeneous\"/>\n</scene>\n", "medium.xml:2:3",
        "<medium> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)"},
       {"rough-glass.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"roughdielectric\"/>\n  </shape>\n</scene>\n", "rough-glass.xml:3:5",
@@ -404,12 +446,16 @@ std::vector<Refusal> refusals() {
   };
 }
 
+// loop.pbrt includes itself (for self.pbrt).
+void write_fixtures() { write("loop.pbrt", "Include \"loop.pbrt\"\n"); }
+
 std::string full_text(const Refusal& r) {
   const std::string f = r.file;
   return (f.size() > 5 && f.substr(f.size() - 5) == ".pbrt" ? kPbrtHead : kXmlHead) + r.text;
 }
 
 TEST(ImportRefusals, LibraryNamesFileLineColumnAndWhat) {
+  write_fixtures();
   for (const Refusal& r : refusals()) {
     const Result<Scene> s = load_scene_file(write(r.file, full_text(r)));
     ASSERT_FALSE(s.ok()) << r.file;
@@ -419,6 +465,7 @@ TEST(ImportRefusals, LibraryNamesFileLineColumnAndWhat) {
 }
 
 TEST(ImportRefusals, CliPrintsTheSameLineAndExits2) {
+  write_fixtures();
   for (const Refusal& r : refusals()) {
     const std::string path = write(r.file, full_text(r));
     const pathex::test::CliRun run = pathex::test::run_pathex("trace " + path + " --quiet --out " + scratch() + "/out");
@@ -446,6 +493,9 @@ TEST(ImportRefusals, PlyMeshesWithNormalsOrCurvedQuads) {
   EXPECT_EQ(relative(b.error().message),
             "the PLY mesh 'curved.ply' has a non-planar quad (face 0), which pbrt renders as a curved bilinear patch; pathex supports planar "
             "quads only");
+  const Result<Scene> c = load_scene_file(write("ply-obj.pbrt", kPbrtHead + "Shape \"plymesh\" \"string filename\" \"mesh.obj\"\n"));
+  ASSERT_FALSE(c.ok());
+  EXPECT_EQ(relative(c.error().message), "the mesh 'mesh.obj' is not a .ply file");
 }
 
 }  // namespace

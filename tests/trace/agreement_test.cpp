@@ -36,7 +36,9 @@ HistogramReport render_scene(const Scene& scene, const Profile& profile, std::ui
 
 TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
   const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes";
-  const char* const profiles[] = {"pt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer"};
+  // Every built-in profile the tracer runs (bdpt, the reference, is checked against R below too).
+  const char* const profiles[] = {"pt",           "pt-nee",       "lt",           "pbrt-v4-lightpath", "mitsuba3-ptracer",
+                                  "pt-nee+distant", "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path",     "bdpt+ortho"};
   int compared = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".json") continue;
@@ -48,6 +50,12 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
     const Profile bdpt = *resolve_profile("bdpt", Limits{});
     const HistogramReport reference = render_scene(scene, bdpt, spp);
     EXPECT_EQ(reference.nonfinite_samples, 0u) << entry.path().filename();
+    const CompiledProfile bdpt_checker = *compile_profile(bdpt, kBounces, Limits{});
+    for (const PathEstimate& p : reference.paths) {
+      if (p.estimate.luminance != 0.0) {
+        EXPECT_TRUE(bdpt_checker.reachable.accepts(p.path)) << entry.path().filename() << ": " << p.path;
+      }
+    }
     std::map<std::string, const PathEstimate*> by_path;
     for (const PathEstimate& p : reference.paths) by_path[p.path] = &p;
     for (const char* name : profiles) {

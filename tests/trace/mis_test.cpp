@@ -4,6 +4,7 @@
 // (the vertices re-split at its join, densities recomputed as it would sample them) and summed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "io/profile_json.h"
@@ -21,7 +22,8 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
     if (entry.path().extension() != ".json") continue;
     Result<Scene> scene = load_scene_file(entry.path().string());
     ASSERT_TRUE(scene.ok()) << scene.error().render();
-    for (const char* renderer : {"bdpt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer"}) {
+    for (const char* renderer : {"bdpt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer", "pt-nee+distant",
+                                 "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path", "bdpt+ortho"}) {
       Result<Profile> profile = resolve_profile(renderer, Limits{});
       Result<std::vector<MisCheck>> checks = check_mis_weights(*scene, *profile, 11, 300);
       ASSERT_TRUE(checks.ok()) << checks.error().render();
@@ -31,6 +33,10 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
         EXPECT_NEAR(c.weight_sum, 1.0, 1e-4) << entry.path().filename() << " " << renderer << " " << c.path << " (s="
                                               << c.s << ", t=" << c.t << ")";
         EXPECT_EQ(c.recorded, c.path) << "the packed label differs (s=" << c.s << ", t=" << c.t << ")";
+        // The per-sample sums (profiles running every plain join) are a special case of the
+        // general recurrence and must give its weight.
+        EXPECT_NEAR(c.weight, c.weight_general, 1e-5 * std::max(1.0, c.weight_general))
+            << entry.path().filename() << " " << renderer << " " << c.path << " (s=" << c.s << ", t=" << c.t << ")";
       }
     }
   }

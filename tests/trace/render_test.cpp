@@ -164,6 +164,30 @@ TEST(ClosedForm, PointLightOverAPlane) {
   }
 }
 
+// A spot light (hard edge, half angle 30°) at height h over the plane, pointing straight down:
+// inside its cone the floor's radiance is the point light's, rho I cos(theta) / (pi d^2), and
+// outside it is 0. The edge is decided once, in trace/emitters.h (the cone's boundary itself emits
+// nothing), and every strategy reads it there: next-event estimation, light tracing and bdpt agree
+// with the closed form. Class LSD D DSE.
+TEST(ClosedForm, SpotLightOverAPlaneIsThePointLightInsideItsCone) {
+  const double rho = 0.6, intensity = 2.0, h = 1.0, cos_cone = std::cos(30.0 * kPi / 180.0);
+  const std::string scene = std::string("{") + kFloorCamera + R"(,
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+    "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"}],
+    "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], "cone": 30, "intensity": [2, 2, 2]}]})";
+  const double expected = floor_reference([&](const glm::dvec3& p) {
+    const double d2 = p.x * p.x + h * h + p.z * p.z;
+    const double cos_theta = h / std::sqrt(d2);
+    return cos_theta > cos_cone ? rho * intensity * cos_theta / (kPi * d2) : 0.0;
+  });
+  ASSERT_GT(expected, 0.0);
+  for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
+    Rendered r = render_json(scene, renderer, {"LSDDDSE"}, 256);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    expect_close(r.report.classes[0].estimate, expected, 3.0, 0.005, std::string(renderer) + " spot over plane");
+  }
+}
+
 // DESIGN §9: a planar mirror of reflectance R throws a caustic that is the floor lit by the
 // light's mirror image with intensity R I. Light at height 1, a large mirror facing down at
 // height 2 (image light at height 3), the camera below the mirror. Class LSD S D DSE, which
@@ -186,6 +210,90 @@ TEST(ClosedForm, MirrorCausticIsTheImageLight) {
   }
   Rendered pt = render_json(scene, "pt-nee", {"LSDSDDSE"}, 16);
   EXPECT_EQ(pt.report.classes[0].estimate.luminance, 0.0);  // the checker says unreachable; so does the tracer
+}
+
+// DESIGN §9: a distant light of irradiance E (perpendicular to its direction) through a window:
+// the floor's irradiance is E cos θ inside the window's projection and 0 outside, so its radiance
+// there is rho E cos θ / pi. Class LDS D DSE: the distant-projection connector samples it (as a
+// production path tracer samples the sun), light tracing and bdpt join it at the camera, and
+// pt-nee cannot (its value stays exactly 0).
+TEST(ClosedForm, SunPatchThroughAWindowIsECosTheta) {
+  const double rho = 0.6, irradiance = 2.0;
+  const glm::dvec3 dir = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
+  const std::string scene = std::string("{") + kFloorCamera + R"(,
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+    "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"}],
+    "lights": [{"type": "distant", "direction": [0.3, -1, 0.2], "irradiance": [2, 2, 2],
+                "aperture": {"corner": [-0.5, 2, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1]}}]})";
+  const double expected = floor_reference([&](const glm::dvec3& p) {
+    const glm::dvec3 q = p - dir * ((2.0 - p.y) / -dir.y);  // against the light, up to the window's plane
+    const bool lit = q.x >= -0.5 && q.x < 0.5 && q.z >= -0.5 && q.z < 0.5;
+    return lit ? rho * irradiance * -dir.y / kPi : 0.0;
+  });
+  ASSERT_GT(expected, 0.0);
+  for (const auto& [renderer, spp] : {std::pair<const char*, std::uint64_t>{"pt-nee+distant", 64}, {"lt", 256}, {"bdpt", 256}}) {
+    Rendered r = render_json(scene, renderer, {"LDSDDSE"}, spp);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    expect_close(r.report.classes[0].estimate, expected, 3.0, 0.005, std::string(renderer) + " sun patch");
+  }
+  Rendered pt = render_json(scene, "pt-nee", {"LDSDDSE"}, 16);
+  EXPECT_EQ(pt.report.classes[0].estimate.luminance, 0.0);
+  // The connector's statistics account for every attempt: eye vertices outside the window's
+  // projection miss the aperture; with nothing between floor and window nothing is occluded.
+  Rendered d = render_json(scene, "pt-nee+distant", {"LDSDDSE"}, 16);
+  ASSERT_EQ(d.out.connectors.size(), 1u);
+  const ConnectorStats& c = d.out.connectors[0];
+  EXPECT_EQ(c.strategy, "nee-distant");
+  EXPECT_EQ(c.connector, "distant-projection");
+  EXPECT_GT(c.successes, 0u);
+  EXPECT_GT(c.outside, 0u);
+  EXPECT_EQ(c.occluded, 0u);
+  EXPECT_EQ(c.attempts, c.successes + c.outside + c.occluded + c.no_transport);
+}
+
+// An orthographic sensor (film 2 x 2 looking straight down from height 3) over a diffuse floor,
+// a point light of intensity I at height h = 1 and a vertical mirror of reflectance R at x = 2.
+// Image means (the film's average radiance):
+//   LSDSDE   the light seen directly: I / A_film (ortho-projection only);
+//   LSDDSDE  the lit floor, rho I h / (pi d^3) averaged over the film (ortho-projection and
+//            next-event estimation, combined by MIS);
+//   LSDSDSDE the mirror's caustic, the same with the image light at x = 3.5 and intensity R I
+//            (ortho-projection only).
+TEST(ClosedForm, OrthographicSensorSeesLightFloorAndMirrorCaustic) {
+  const double rho = 0.6, intensity = 2.0, refl = 0.8, film_area = 4.0;
+  const std::string scene = R"({"camera": {"type": "orthographic", "position": [0, 3, 0], "look_at": [0, 0, 0], "up": [0, 0, -1],
+                                           "film_width": 2, "film_height": 2, "width": 8, "height": 8},
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                  "mirror": {"type": "mirror", "reflectance": [0.8, 0.8, 0.8]}},
+    "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"},
+               {"type": "quad", "corner": [2, 0, -10], "edge1": [0, 10, 0], "edge2": [0, 0, 20], "material": "mirror"}],
+    "lights": [{"type": "point", "position": [0.5, 1, 0], "intensity": [2, 2, 2]}]})";
+  // The film's mean of rho I' h / (pi d^3) for a light of intensity I' at (lx, 1, 0), by the
+  // midpoint rule on a 400 x 400 grid (relative error below 1e-5).
+  const auto floor_mean = [&](double lx, double light_intensity) {
+    const int n = 400;
+    double sum = 0;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const double x = -1.0 + 2.0 * (i + 0.5) / n, z = -1.0 + 2.0 * (j + 0.5) / n;
+        const double d = std::sqrt((x - lx) * (x - lx) + 1.0 + z * z);
+        sum += rho * light_intensity / (kPi * d * d * d);
+      }
+    return sum / (n * n);
+  };
+  const std::vector<std::pair<std::string, double>> expected = {
+      {"LSDSDE", intensity / film_area}, {"LSDDSDE", floor_mean(0.5, intensity)}, {"LSDSDSDE", floor_mean(3.5, refl * intensity)}};
+  std::vector<std::string> classes;
+  for (const auto& [c, v] : expected) classes.push_back(c);
+  Rendered r = render_json(scene, "bdpt+ortho", classes, 64);
+  EXPECT_EQ(r.report.nonfinite_samples, 0u);
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    expect_close(r.report.classes[i].estimate, expected[i].second, 3.0, 0.005, "bdpt+ortho " + expected[i].first);
+  // Without the connector only the lit floor is reachable (next-event estimation).
+  Rendered plain = render_json(scene, "bdpt", classes, 64);
+  EXPECT_EQ(plain.report.classes[0].estimate.luminance, 0.0);
+  expect_close(plain.report.classes[1].estimate, expected[1].second, 3.0, 0.005, "bdpt LSDDSDE");
+  EXPECT_EQ(plain.report.classes[2].estimate.luminance, 0.0);
 }
 
 // Every sensor measures radiance: inside the emitting sphere every wall point has L_e / (1 - rho),
@@ -319,13 +427,15 @@ TEST(Labels, PointLightWithPinholeOnlyProducesSDprefixAndDSsuffix) {
   EXPECT_NEAR(r.report.classes[0].share, 1.0, 1e-12);
 }
 
-TEST(Profiles, ConnectorProfilesAreRefusedByName) {
-  Result<Profile> p = resolve_profile("bdpt+mirror", Limits{});
+TEST(Profiles, ConnectorsTheTracerDoesNotRunAreRefusedByName) {
+  Result<Profile> p = resolve_profile("pt-nee+manifold", Limits{});
   Result<StrategySet> s = runnable_strategies(*p);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().message,
-            "renderer 'bdpt+mirror' uses the connector 'mirror' (strategy 'mirror'), which the tracer does not run yet; "
-            "it runs plain joins (s, DD, t) only");
+            "renderer 'pt-nee+manifold' uses the connector 'manifold' (strategy 'manifold-nee'), which the tracer does not run "
+            "yet; it runs plain joins (s, DD, t) and the distant-projection and ortho-projection connectors");
+  for (const char* name : {"pt-nee+distant", "bdpt+ortho", "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path"})
+    EXPECT_TRUE(runnable_strategies(*resolve_profile(name, Limits{})).ok()) << name;
 }
 
 }  // namespace

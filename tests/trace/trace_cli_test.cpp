@@ -93,12 +93,35 @@ TEST(TraceCli, JsonToStdoutMatchesTheFile) {
   std::filesystem::remove_all(dir);
 }
 
+// A profile with a connector adds "connectors" to histogram.json and a row per connector to the
+// table; every attempt is counted once, as a success or under one failure reason.
+TEST(TraceCli, ConnectorStatisticsInTheJsonAndTheTable) {
+  const std::string dir = out_dir("connectors");
+  const CliRun r = run("trace samples/scenes/sun-window.json --renderer pt-nee+distant --spp 1 --threads 2 --no-images --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\nconnectors     attempts  successes   outside  occluded  no transport\n  nee-distant "), std::string::npos)
+      << r.out;
+  std::ifstream in(dir + "/histogram.json");
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(in);
+  ASSERT_EQ(j["connectors"].size(), 1u);
+  const nlohmann::ordered_json& c = j["connectors"][0];
+  EXPECT_EQ(c["strategy"], "nee-distant");
+  EXPECT_EQ(c["connector"], "distant-projection");
+  const nlohmann::ordered_json& f = c["failures"];
+  EXPECT_GT(c["successes"].get<std::uint64_t>(), 0u);
+  EXPECT_EQ(c["attempts"].get<std::uint64_t>(), c["successes"].get<std::uint64_t>() + f["outside"].get<std::uint64_t>() +
+                                                    f["occluded"].get<std::uint64_t>() + f["no_transport"].get<std::uint64_t>());
+  for (const auto& p : j["paths"]) EXPECT_EQ(p["path"].get<std::string>().substr(0, 4), "LDSD") << p["path"];
+  std::filesystem::remove_all(dir);
+}
+
 TEST(TraceCli, RefusalsExitTwo) {
-  const CliRun connector = run("trace --renderer bdpt+mirror --out /tmp/pathex-never");
+  const CliRun connector = run("trace --renderer pt-nee+manifold --out /tmp/pathex-never");
   EXPECT_EQ(connector.code, 2);
   EXPECT_EQ(connector.err,
-            "pathex: error: renderer 'bdpt+mirror' uses the connector 'mirror' (strategy 'mirror'), which the tracer does "
-            "not run yet; it runs plain joins (s, DD, t) only\n");
+            "pathex: error: renderer 'pt-nee+manifold' uses the connector 'manifold' (strategy 'manifold-nee'), which the "
+            "tracer does not run yet; it runs plain joins (s, DD, t) and the distant-projection and ortho-projection "
+            "connectors\n");
   EXPECT_FALSE(std::filesystem::exists("/tmp/pathex-never"));
   EXPECT_EQ(run("trace samples/scenes/nosuch.json").code, 2);
   EXPECT_EQ(run("trace --spp 0").code, 2);

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# bench/fuzz.sh SECONDS [HARNESS...]: installs clang-14 and builds the libFuzzer harnesses
+# (`setup.sh --fuzz`, fuzz/), then runs each in
+# turn, one at a time, SECONDS in total split evenly (default: all six harnesses: expression,
+# class_file, profile, check_file, scene, obj). Each starts from its seed corpus (made here from
+# grammar/corpus/, tests/scene/bad/, tests/reach/checks/ and samples/) and its dictionary
+# (fuzz/dict/). libFuzzer runs in fork mode and keeps going after a finding; findings (crash-*,
+# timeout-*, oom-*, leak-*) land in build-fuzz/findings/HARNESS/, the grown corpora in
+# build-fuzz/corpus/HARNESS/. Exit 1 when there are findings. Run it niced on a shared machine:
+#   nice -n 19 bash bench/fuzz.sh 3600
+set -euo pipefail
+cd "$(dirname "$0")/.."
+total=${1:?usage: bench/fuzz.sh SECONDS [HARNESS...]}
+shift
+harnesses=("$@")
+[ ${#harnesses[@]} -gt 0 ] || harnesses=(expression class_file profile check_file scene obj)
+per=$(( total / ${#harnesses[@]} ))
+[ "$per" -ge 1 ] || per=1
+
+bash setup.sh --fuzz
+cmake --build build-fuzz -j2 --target $(printf 'fuzz_%s ' "${harnesses[@]}") >/dev/null
+
+# --- seed corpora ---
+seeds=build-fuzz/seeds
+rm -rf "$seeds"
+mkdir -p "$seeds"/{expression,class_file,profile,check_file,scene,obj}
+python3 - "$seeds" <<'PY'
+import json, pathlib, sys
+seeds = pathlib.Path(sys.argv[1])
+exprs = []
+for f in ("grammar/corpus/valid.json", "grammar/corpus/invalid.json"):
+    exprs += [e["expr"] for e in json.loads(pathlib.Path(f).read_text())]
+for i, e in enumerate(exprs):
+    (seeds / "expression" / f"corpus-{i}").write_text(e)
+    entry = {"classes": [{"name": f"c{i}", "expr": e}, {"name": "h", "expr": "LSDE", "notation": "heckbert"}]}
+    (seeds / "class_file" / f"corpus-{i}.json").write_text(json.dumps(entry))
+PY
+cp samples/classes/*.json "$seeds/class_file/"
+cp samples/renderers/*.json "$seeds/profile/"
+cp samples/checks/*.json tests/reach/checks/*.json "$seeds/check_file/"
+cp samples/scenes/*.json tests/scene/bad/*.json "$seeds/scene/"
+cp tests/scene/bad/*.obj samples/scenes/meshes/*.obj "$seeds/obj/"
+
+# --- runs ---
+status=0
+for h in "${harnesses[@]}"; do
+  mkdir -p "build-fuzz/corpus/$h" "build-fuzz/findings/$h"
+  echo "fuzz_$h: $per s"
+  build-fuzz/fuzz/fuzz_$h -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
+    -max_total_time="$per" -timeout=10 -close_fd_mask=1 -rss_limit_mb=2048 -dict="fuzz/dict/$h.dict" \
+    -artifact_prefix="build-fuzz/findings/$h/" "build-fuzz/corpus/$h" "$seeds/$h" \
+    > "build-fuzz/findings/$h.log" 2>&1 || true
+  n=$(find "build-fuzz/findings/$h" -type f | wc -l)
+  echo "fuzz_$h: $(grep -o 'cov: [0-9]*' "build-fuzz/findings/$h.log" | tail -1), $n findings"
+  [ "$n" -eq 0 ] || status=1
+done
+exit $status
