@@ -312,7 +312,6 @@ TEST(Mpi, ADyingRankFailsTheRunAndTheOthersWorkIsKept) {
   const CliRun r = mpirun("-n 3 sh -c " + pathex::test::shell_quote(body));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("process rank 1"), std::string::npos) << r.out;  // mpirun's message
-  EXPECT_NE(r.out.find("pathex: rank 0 stopped after"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(ranks + "/histogram.json"));
   EXPECT_TRUE(fs::exists(ranks + ".ranks/rank-0.shard") || fs::exists(ranks + ".ranks/rank-2.shard")) << r.out;
   // Whatever the others rendered is kept; resuming renders the rest and gives the bytes of one run.
