@@ -17,7 +17,7 @@ harnesses=("$@")
 per=$(( total / ${#harnesses[@]} ))
 [ "$per" -ge 1 ] || per=1
 
-bash setup.sh --fuzz
+[ -f build-fuzz/CMakeCache.txt ] || bash setup.sh --fuzz  # the first run installs clang-14 and configures
 cmake --build build-fuzz -j2 --target $(printf 'fuzz_%s ' "${harnesses[@]}") >/dev/null
 
 # --- seed corpora ---

@@ -37,14 +37,14 @@ int main(int argc, char** argv) {
   using namespace pathex;
   const int pairs = argc > 1 ? std::max(1, std::atoi(argv[1])) : 30;
   const bool phases = argc > 2 && std::string(argv[2]) == "--phases";
-  const Scene scene = *load_scene_json(default_scene_json(), ".", "default");
-  const Profile bdpt = *resolve_profile("bdpt", Limits{});
+  const Scene scene = load_scene_json(default_scene_json(), ".", "default").expect("a benchmark input");
+  const Profile bdpt = resolve_profile("bdpt", Limits{}).expect("a benchmark input");
   ClassTable table;
   std::vector<const PathClass*> classes;
   (void)read_class_file(std::string(PATHEX_SOURCE_DIR) + "/samples/classes/twenty.json", ClassOptions{}, &table);
   for (const auto& c : table.user_classes()) classes.push_back(c.get());
-  const Classifier none = *Classifier::build({}, Limits{});
-  const Classifier twenty = *Classifier::build(classes, Limits{});
+  const Classifier none = Classifier::build({}, Limits{}).expect("a benchmark input");
+  const Classifier twenty = Classifier::build(classes, Limits{}).expect("a benchmark input");
   RenderOptions plain;
   plain.threads = 1;
   plain.spp = 16;

@@ -30,7 +30,7 @@ namespace pathex {
 namespace {
 
 const Scene& cornell() {
-  static const Scene s = *load_scene_json(default_scene_json(), ".", "default");
+  static const Scene s = load_scene_json(default_scene_json(), ".", "default").expect("a benchmark input");
   return s;
 }
 
@@ -99,8 +99,12 @@ std::uint64_t plain_embree_loop(const RenderScene& rs, std::uint64_t count, std:
 // iterations of the tracer's rate over the plain loop's (CPU time).
 void BM_TracerRays(benchmark::State& state) {
   const char* const names[] = {"bdpt", "pt-nee", "pt", "lt"};
-  const Profile profile = *resolve_profile(names[state.range(0)], Limits{});
+  const Profile profile = resolve_profile(names[state.range(0)], Limits{}).expect("a benchmark input");
   Result<RenderScene> rs = make_render_scene(cornell());
+  if (!rs) {
+    state.SkipWithError(rs.error().render().c_str());
+    return;
+  }
   std::uint64_t rays = 0;
   double tracer_s = 0, plain_s = 0;
   std::vector<double> ratios;
@@ -108,6 +112,10 @@ void BM_TracerRays(benchmark::State& state) {
     const double t0 = cpu_seconds();
     Result<RenderOutput> out = render(cornell(), profile, nullptr, options(1, 4));
     const double t1 = cpu_seconds();
+    if (!out) {
+      state.SkipWithError(out.error().render().c_str());
+      return;
+    }
     benchmark::DoNotOptimize(plain_embree_loop(*rs, out->rays, rays));
     const double t2 = cpu_seconds();
     rays += out->rays;
@@ -133,16 +141,16 @@ BENCHMARK(BM_TracerRays)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRe
 // the second, minus 1: the median shrugs off an iteration that the shared machine slowed on one
 // side only.
 void BM_RenderClasses(benchmark::State& state) {
-  const Profile bdpt = *resolve_profile("bdpt", Limits{});
+  const Profile bdpt = resolve_profile("bdpt", Limits{}).expect("a benchmark input");
   ClassTable table;
   std::vector<const PathClass*> classes, builtin_classes;
   (void)read_class_file(std::string(PATHEX_SOURCE_DIR) + "/samples/classes/twenty.json", ClassOptions{}, &table);
   for (const auto& c : table.user_classes()) classes.push_back(c.get());
   for (const auto& c : ClassTable::builtins().builtin_classes())  // as src/cli/trace.cpp
     if (c->name != "all") builtin_classes.push_back(c.get());
-  const Classifier none = *Classifier::build({}, Limits{});
-  const Classifier twenty = *Classifier::build(classes, Limits{});
-  const Classifier builtin = *Classifier::build(builtin_classes, Limits{});
+  const Classifier none = Classifier::build({}, Limits{}).expect("a benchmark input");
+  const Classifier twenty = Classifier::build(classes, Limits{}).expect("a benchmark input");
+  const Classifier builtin = Classifier::build(builtin_classes, Limits{}).expect("a benchmark input");
   const int arg = static_cast<int>(state.range(0));
   const bool control = arg == 0;
   RenderOptions plain = options(1, 16), classified = options(1, 16);
@@ -162,6 +170,10 @@ void BM_RenderClasses(benchmark::State& state) {
       Result<RenderOutput> out = with ? render(cornell(), bdpt, control ? &none : &twenty, classified)
                                       : render(cornell(), bdpt, base, plain);
       (with ? with_s : without_s) += cpu_seconds() - t0;
+      if (!out) {
+        state.SkipWithError(out.error().render().c_str());
+        return;
+      }
       if (with) image_bytes = out->images.memory_bytes();
     }
     ratios.push_back(with_s / without_s);
@@ -182,6 +194,10 @@ BENCHMARK(BM_RenderClasses)->Arg(0)->Arg(20)->Arg(21)->Arg(5)->Unit(benchmark::k
 // the per-iteration ratios of single-ray time over batched time.
 void BM_ShadowRays(benchmark::State& state) {
   Result<RenderScene> rs = make_render_scene(cornell());
+  if (!rs) {
+    state.SkipWithError(rs.error().render().c_str());
+    return;
+  }
   const EmbreeScene& es = *rs->geometry;
   struct Segment {
     glm::vec3 a, na, ea, b, nb, eb;
@@ -223,7 +239,7 @@ BENCHMARK(BM_ShadowRays)->Unit(benchmark::kMillisecond)->UseRealTime();
 // Thread scaling, interleaved: each iteration renders with one thread and then with two (wall
 // time); `speedup` is the summed one-thread time over the summed two-thread time.
 void BM_RenderThreads(benchmark::State& state) {
-  const Profile bdpt = *resolve_profile("bdpt", Limits{});
+  const Profile bdpt = resolve_profile("bdpt", Limits{}).expect("a benchmark input");
   double one_s = 0, two_s = 0;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -264,7 +280,7 @@ void BM_MillionTriangles(benchmark::State& state) {
       "shapes": [{"type": "mesh", "file": "grid.obj", "material": "white"}],
       "lights": [{"type": "point", "position": [0, 2, 0], "intensity": [5, 5, 5]}]})";
   }
-  const Profile pt = *resolve_profile("pt-nee", Limits{});
+  const Profile pt = resolve_profile("pt-nee", Limits{}).expect("a benchmark input");
   for (auto _ : state) {
     Result<Scene> s = load_scene_file((dir / "mesh.json").string());
     if (!s) {

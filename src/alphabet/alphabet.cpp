@@ -1,5 +1,7 @@
 #include "alphabet/alphabet.h"
 
+#include <cstdio>
+
 namespace pathex {
 
 std::optional<Letter> letter_from_char(char c) {
@@ -76,6 +78,20 @@ std::optional<SensorType> sensor_type_from_letters(std::string_view two) {
   return std::nullopt;
 }
 
+std::string describe_char_at(std::string_view text, std::size_t pos) {
+  const auto c = static_cast<unsigned char>(text[pos]);
+  // The length of a well-formed UTF-8 sequence starting here (RFC 3629), or 0.
+  std::size_t n = c < 0x80 ? 1 : (c >= 0xC2 && c <= 0xDF) ? 2 : (c >= 0xE0 && c <= 0xEF) ? 3 : (c >= 0xF0 && c <= 0xF4) ? 4 : 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if (pos + i >= text.size() || (static_cast<unsigned char>(text[pos + i]) & 0xC0) != 0x80) n = 0;
+  if (n == 0 || c < 0x20 || c == 0x7F) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "byte 0x%02X", static_cast<unsigned>(c));
+    return buf;
+  }
+  return "'" + std::string(text.substr(pos, n)) + "'";
+}
+
 Result<FullPath> parse_full_path(std::string_view s, std::size_t max_length) {
   Error e;
   e.code = ErrorCode::kBadPath;
@@ -90,7 +106,8 @@ Result<FullPath> parse_full_path(std::string_view s, std::size_t max_length) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (!letter_from_char(s[i])) {
       e.column = static_cast<int>(i) + 1;
-      e.message = std::string("unexpected character '") + s[i] + "', expected one of L E S D";
+      const std::string found = describe_char_at(s, i);
+      e.message = "unexpected " + (found[0] == '\'' ? "character " + found : found) + ", expected one of L E S D";
       return e;
     }
   }

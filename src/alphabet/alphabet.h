@@ -54,6 +54,11 @@ struct FullPath {
   char c(int i) const { return text[static_cast<std::size_t>(i) + 1]; }  // scattering letter c_i
 };
 
+// The character at byte `pos` of `text` as messages show it: 'x'; a whole UTF-8 sequence such as
+// 'é' or 'Ψ' rather than its first byte; "byte 0xC3" for a control byte or a byte that does not
+// start a valid sequence. Messages built from it are valid UTF-8 whatever the input.
+std::string describe_char_at(std::string_view text, std::size_t pos);
+
 // Checks shape and letters; errors carry the 1-based column of the first offending character.
 Result<FullPath> parse_full_path(std::string_view s, std::size_t max_length);
 

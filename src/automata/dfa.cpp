@@ -3,9 +3,8 @@
 // determinize() is the textbook subset construction over ε-closed sets of NFA states, with a
 // budget: past Limits::max_states DFA states it stops and says which option raises the budget
 // (RE2's DFA gives up the same way when it runs out of memory). minimize() refines the partition
-// {accepting, rejecting} by the classes of each state's four successors until it is stable
-// (Moore's algorithm: the same minimal automaton as Hopcroft's, simpler, and fast at the sizes
-// path classes have), then numbers the states canonically.
+// {accepting, rejecting} with Hopcroft's algorithm (O(n log n): a 30,000-letter literal
+// minimises in milliseconds), then numbers the states canonically.
 #include "automata/dfa.h"
 
 #include <algorithm>
@@ -13,18 +12,11 @@
 #include <deque>
 #include <unordered_map>
 
+#include "core/budget.h"
 #include "core/hash.h"
 
 namespace pathex {
 namespace {
-
-struct ArrHash {
-  std::size_t operator()(const std::array<int, 5>& v) const {
-    std::size_t h = 1469598103934665603ULL;
-    for (int x : v) h = (h ^ static_cast<std::size_t>(x)) * 1099511628211ULL;
-    return h;
-  }
-};
 
 // States reachable from the start, renumbered breadth-first in letter order. Applied to a minimal
 // DFA this is the canonical numbering.
@@ -121,6 +113,7 @@ Result<Dfa> determinize(const Nfa& n, const Limits& limits) {
     auto it = ids.find(set);
     if (it != ids.end()) return it->second;
     const int id = static_cast<int>(sets.size());
+    WorkBudget::charge(4 * (set.size() + 1));  // sorting and hashing the subset cost more than a product pair
     bool acc = false;
     for (int s : set) acc = acc || s == n.accept;
     d.accept.push_back(acc ? 1 : 0);
@@ -154,36 +147,99 @@ Result<Dfa> determinize(const Nfa& n, const Limits& limits) {
 
 std::vector<int> refine_partition(const std::vector<std::int32_t>& next, const std::vector<int>& labels,
                                   int* blocks) {
+  // Hopcroft's algorithm: a worklist of splitters (block B, letter l); each splits every block
+  // into the states whose l-successor lies in B and the rest. Only the smaller half of a split
+  // needs to become a splitter, so each state enters the worklist O(log n) times and the whole
+  // refinement is O(n log n) (Moore's round-by-round refinement took n rounds on a literal).
   const std::size_t n = labels.size();
-  std::vector<int> cls(n);
-  int count = 0;
+  WorkBudget::charge(n);  // the n log n of the splits is bounded by the state cap on n
+  // Predecessors by letter, as one array per letter indexed by target (counting sort).
+  std::vector<std::vector<int>> pred_begin(kNumLetters, std::vector<int>(n + 1, 0));
+  std::vector<std::vector<int>> preds(kNumLetters, std::vector<int>(n));
+  for (std::size_t l = 0; l < kNumLetters; ++l) {
+    std::vector<int>& begin = pred_begin[l];
+    for (std::size_t s = 0; s < n; ++s) ++begin[static_cast<std::size_t>(next[s * kNumLetters + l]) + 1];
+    for (std::size_t t = 0; t < n; ++t) begin[t + 1] += begin[t];
+    std::vector<int> fill(begin.begin(), begin.end() - 1);
+    for (std::size_t s = 0; s < n; ++s)
+      preds[l][static_cast<std::size_t>(fill[static_cast<std::size_t>(next[s * kNumLetters + l])]++)] = static_cast<int>(s);
+  }
+  // The partition: `elems` lists the states block by block; block b is elems[first[b], end[b]).
+  std::vector<int> block(n), elems(n), pos(n), first, end, marked;
   {
     std::unordered_map<int, int> ids;
     for (std::size_t s = 0; s < n; ++s) {
-      auto [it, inserted] = ids.emplace(labels[s], count);
-      if (inserted) ++count;
-      cls[s] = it->second;
+      auto [it, inserted] = ids.emplace(labels[s], static_cast<int>(ids.size()));
+      block[s] = it->second;
     }
-  }
-  std::unordered_map<std::array<int, 5>, int, ArrHash> sig;
-  std::vector<int> next_cls(n);
-  while (true) {
-    sig.clear();
-    sig.reserve(n);
-    int next_count = 0;
+    const std::size_t count = ids.size();
+    first.assign(count, 0);
+    end.assign(count, 0);
+    marked.assign(count, 0);
+    for (std::size_t s = 0; s < n; ++s) ++end[static_cast<std::size_t>(block[s])];
+    int at = 0;
+    for (std::size_t b = 0; b < count; ++b) {
+      first[b] = at;
+      at += end[b];
+      end[b] = first[b];
+    }
     for (std::size_t s = 0; s < n; ++s) {
-      std::array<int, 5> key{cls[s], 0, 0, 0, 0};
-      for (std::size_t l = 0; l < kNumLetters; ++l) key[l + 1] = cls[static_cast<std::size_t>(next[s * kNumLetters + l])];
-      auto [it, inserted] = sig.emplace(key, next_count);
-      if (inserted) ++next_count;
-      next_cls[s] = it->second;
+      const std::size_t b = static_cast<std::size_t>(block[s]);
+      pos[s] = end[b];
+      elems[static_cast<std::size_t>(end[b]++)] = static_cast<int>(s);
     }
-    cls.swap(next_cls);
-    if (next_count == count) break;
-    count = next_count;
   }
-  *blocks = count;
-  return cls;
+  std::vector<std::pair<int, int>> work;               // (block, letter)
+  std::vector<std::array<std::uint8_t, kNumLetters>> queued(first.size(), {1, 1, 1, 1});
+  for (int b = 0; b < static_cast<int>(first.size()); ++b)
+    for (int l = 0; l < kNumLetters; ++l) work.push_back({b, l});
+  std::vector<int> xs, touched;
+  while (!work.empty()) {
+    const auto [b, l] = work.back();
+    work.pop_back();
+    queued[static_cast<std::size_t>(b)][static_cast<std::size_t>(l)] = 0;
+    // The states whose l-successor is in block b (each state has one l-successor: no repeats).
+    xs.clear();
+    for (int i = first[static_cast<std::size_t>(b)]; i < end[static_cast<std::size_t>(b)]; ++i) {
+      const std::size_t t = static_cast<std::size_t>(elems[static_cast<std::size_t>(i)]);
+      for (int j = pred_begin[static_cast<std::size_t>(l)][t]; j < pred_begin[static_cast<std::size_t>(l)][t + 1]; ++j)
+        xs.push_back(preds[static_cast<std::size_t>(l)][static_cast<std::size_t>(j)]);
+    }
+    // Move each to the front of its block.
+    touched.clear();
+    for (int s : xs) {
+      const std::size_t c = static_cast<std::size_t>(block[static_cast<std::size_t>(s)]);
+      const int to = first[c] + marked[c]++;
+      if (marked[c] == 1) touched.push_back(static_cast<int>(c));
+      const int other = elems[static_cast<std::size_t>(to)];
+      std::swap(elems[static_cast<std::size_t>(to)], elems[static_cast<std::size_t>(pos[static_cast<std::size_t>(s)])]);
+      pos[static_cast<std::size_t>(other)] = pos[static_cast<std::size_t>(s)];
+      pos[static_cast<std::size_t>(s)] = to;
+    }
+    // Split every block that is only partly marked; the marked part becomes a new block.
+    for (int ci : touched) {
+      const std::size_t c = static_cast<std::size_t>(ci);
+      const int m = marked[c];
+      marked[c] = 0;
+      if (m == end[c] - first[c]) continue;
+      const int d = static_cast<int>(first.size());
+      first.push_back(first[c]);
+      end.push_back(first[c] + m);
+      marked.push_back(0);
+      queued.push_back({0, 0, 0, 0});
+      first[c] += m;
+      for (int i = first.back(); i < end.back(); ++i) block[static_cast<std::size_t>(elems[static_cast<std::size_t>(i)])] = d;
+      const bool d_smaller = m <= end[c] - first[c];
+      for (int a = 0; a < kNumLetters; ++a) {
+        const std::size_t ai = static_cast<std::size_t>(a);
+        const int add = queued[c][ai] || d_smaller ? d : ci;
+        queued[static_cast<std::size_t>(add)][ai] = 1;
+        work.push_back({add, a});
+      }
+    }
+  }
+  *blocks = static_cast<int>(first.size());
+  return block;
 }
 
 Dfa minimize(const Dfa& in) {
@@ -206,16 +262,21 @@ Dfa minimize(const Dfa& in) {
 }
 
 Result<Dfa> compile(const Regex& r, const Limits& limits) {
-  Result<Nfa> n = build_nfa(r, limits);
-  if (!n) return n.error();
-  Result<Dfa> d = determinize(*n, limits);
-  if (!d) {
+  Result<Dfa> d = within_budget(limits, [&]() -> Result<Dfa> {
+    Result<Nfa> n = build_nfa(r, limits);
+    if (!n) return n.error();
+    Result<Dfa> sub = determinize(*n, limits);
+    if (!sub) return sub.error();
+    return minimize(*sub);
+  });
+  if (!d && d.error().source.empty()) {
+    // The subset construction and the work budget concern the whole expression.
     Error e = d.error();
     e.source = r.source;
     e.column = r.source.empty() ? 0 : 1;
     return e;
   }
-  return minimize(*d);
+  return d;
 }
 
 std::string to_dot(const Dfa& d, const std::string& title) {

@@ -3,8 +3,11 @@
 // the copies fit under Limits::max_states — the check that keeps nested counters from exploding.
 #include "automata/nfa.h"
 
+#include <unordered_map>
+
 #include "automata/dfa.h"
 #include "automata/ops.h"
+#include "core/budget.h"
 
 namespace pathex {
 namespace {
@@ -40,6 +43,7 @@ class Builder {
     if (!failed_) { failed_ = true; err_ = std::move(e); }
   }
   int state() {
+    WorkBudget::charge(1);
     nfa_.states.emplace_back();
     return static_cast<int>(nfa_.states.size()) - 1;
   }
@@ -142,8 +146,23 @@ class Builder {
   }
 
   // `&` and `~`: compile operands to minimal DFAs, combine, embed the live part as a fragment.
+  // The combined DFA is computed once per node: a repetition embeds the same node many times
+  // (`(S{1000}&D*){1000}` used to compile S{1000} a thousand times).
   Frag embed_boolean(int i) {
     const Node& n = r_.at(i);
+    auto cached = booleans_.find(i);
+    if (cached == booleans_.end()) {
+      Result<Dfa> d = combine_boolean(n);
+      if (!d) { fail(d.error()); return {}; }
+      cached = booleans_.emplace(i, std::move(d.value())).first;
+    }
+    const Dfa& d = cached->second;
+    const std::vector<std::uint8_t>& live = live_.try_emplace(i, d.live()).first->second;
+    return embed_dfa(n, d, live);
+  }
+
+  // The DFA of an `&` or `~` node: its operands' minimal DFAs, intersected or complemented.
+  Result<Dfa> combine_boolean(const Node& n) {
     Regex sub;
     sub.source = r_.source;
     std::vector<Dfa> parts;
@@ -151,17 +170,17 @@ class Builder {
       sub.nodes = r_.nodes;
       sub.root = k;
       Result<Dfa> d = compile(sub, limits_);
-      if (!d) { fail(d.error()); return {}; }
+      if (!d) return d.error();
       parts.push_back(std::move(d.value()));
     }
-    Dfa d;
-    if (n.kind == NodeKind::kNot) {
-      d = dfa_complement(parts[0]);
-    } else {
-      d = parts[0];
-      for (std::size_t j = 1; j < parts.size(); ++j) d = dfa_intersect(d, parts[j]);
-    }
-    const std::vector<std::uint8_t> live = d.live();
+    if (n.kind == NodeKind::kNot) return dfa_complement(parts[0]);
+    Dfa d = parts[0];
+    for (std::size_t j = 1; j < parts.size(); ++j) d = dfa_intersect(d, parts[j]);
+    return d;
+  }
+
+  // The embedding of node i's combined DFA d as a fragment.
+  Frag embed_dfa(const Node& n, const Dfa& d, const std::vector<std::uint8_t>& live) {
     if (!reserve(static_cast<std::size_t>(d.num_states) + 2, n.column)) return {};
     const int base = static_cast<int>(nfa_.states.size());
     for (int s = 0; s < d.num_states; ++s) state();
@@ -182,6 +201,8 @@ class Builder {
   const Regex& r_;
   const Limits& limits_;
   Nfa nfa_;
+  std::unordered_map<int, Dfa> booleans_;                     // node index -> its combined DFA
+  std::unordered_map<int, std::vector<std::uint8_t>> live_;   // node index -> that DFA's live states
   bool failed_ = false;
   Error err_;
 };

@@ -7,6 +7,8 @@
 #include <functional>
 #include <unordered_map>
 
+#include "core/budget.h"
+
 namespace pathex {
 namespace {
 
@@ -23,6 +25,7 @@ Dfa product(const Dfa& a, const Dfa& b, const std::function<bool(bool, bool)>& o
   std::unordered_map<std::uint64_t, int> id;
   std::vector<std::pair<int, int>> pairs;
   auto intern = [&](int x, int y) {
+    WorkBudget::charge(1);
     const std::uint64_t key = (static_cast<std::uint64_t>(x) << 32) | static_cast<std::uint32_t>(y);
     auto [it, inserted] = id.emplace(key, static_cast<int>(pairs.size()));
     if (inserted) pairs.push_back({x, y});
@@ -88,6 +91,25 @@ Dfa dfa_universe() {
   }
   d.next[5 * kNumLetters + kE] = 6;
   d.accept[6] = 1;
+  return minimize(d);
+}
+
+Dfa dfa_universe_bounded(int max_bounces) {
+  // States: 0 start; 1 + i after L and i scattering letters, i = 0 .. max_bounces + 4; then
+  // accept and dead. Built directly: no parse, no limit to trip over.
+  const int top = std::max(max_bounces, 0) + 4;
+  const int accept = top + 2, dead = top + 3;
+  Dfa d;
+  d.num_states = top + 4;
+  d.next.assign(static_cast<std::size_t>(d.num_states) * kNumLetters, dead);
+  d.accept.assign(static_cast<std::size_t>(d.num_states), 0);
+  d.next[0 * kNumLetters + kL] = 1;
+  for (int i = 0; i <= top; ++i) {
+    const std::size_t row = static_cast<std::size_t>(1 + i) * kNumLetters;
+    if (i < top) d.next[row + kS] = d.next[row + kD] = 2 + i;
+    if (i >= 4) d.next[row + kE] = accept;
+  }
+  d.accept[static_cast<std::size_t>(accept)] = 1;
   return minimize(d);
 }
 
@@ -197,28 +219,42 @@ std::vector<std::string> enumerate_members(const Dfa& a, int max_len, std::size_
   if (max_len < 0 || max_count == 0) return out;
   // can[r][s]: some word of exactly r letters leads from s to acceptance.
   const std::size_t n = static_cast<std::size_t>(a.num_states);
+  WorkBudget::charge((static_cast<std::size_t>(max_len) + 1) * n);
   std::vector<std::vector<std::uint8_t>> can(static_cast<std::size_t>(max_len) + 1, std::vector<std::uint8_t>(n, 0));
   for (std::size_t s = 0; s < n; ++s) can[0][s] = a.accept[s];
   for (int r = 1; r <= max_len; ++r)
     for (std::size_t s = 0; s < n; ++s)
       for (int l = 0; l < kNumLetters && !can[static_cast<std::size_t>(r)][s]; ++l)
         can[static_cast<std::size_t>(r)][s] = can[static_cast<std::size_t>(r) - 1][static_cast<std::size_t>(a.step(static_cast<int>(s), l))];
+  // Depth-first in letter order within one length gives lexicographic order. The walk keeps its
+  // own stack (a member can be as long as the automaton is large: no recursion on input size).
   std::string word;
-  // Depth-first in letter order within one length gives lexicographic order.
-  std::function<void(int, int)> walk = [&](int s, int remaining) {
-    if (out.size() >= max_count) return;
-    if (remaining == 0) { out.push_back(word); return; }
-    for (int l = 0; l < kNumLetters; ++l) {
-      const int t = a.step(s, l);
+  std::vector<std::pair<int, int>> stack;  // (state, next letter to try) per letter of `word`
+  for (int len = 0; len <= max_len && out.size() < max_count; ++len) {
+    if (!can[static_cast<std::size_t>(len)][static_cast<std::size_t>(a.start)]) continue;
+    word.clear();
+    stack.assign(1, {a.start, 0});
+    while (!stack.empty() && out.size() < max_count) {
+      auto& [s, l] = stack.back();
+      const int remaining = len - static_cast<int>(word.size());
+      if (remaining == 0) {
+        out.push_back(word);
+        stack.pop_back();
+        if (!word.empty()) word.pop_back();
+        continue;
+      }
+      if (l == kNumLetters) {
+        stack.pop_back();
+        if (!word.empty()) word.pop_back();
+        continue;
+      }
+      const int letter = l++;
+      const int t = a.step(s, letter);
       if (!can[static_cast<std::size_t>(remaining) - 1][static_cast<std::size_t>(t)]) continue;
-      word.push_back(letter_char(l));
-      walk(t, remaining - 1);
-      word.pop_back();
-      if (out.size() >= max_count) return;
+      word.push_back(letter_char(letter));
+      stack.push_back({t, 0});
     }
-  };
-  for (int len = 0; len <= max_len && out.size() < max_count; ++len)
-    if (can[static_cast<std::size_t>(len)][static_cast<std::size_t>(a.start)]) walk(a.start, len);
+  }
   return out;
 }
 
@@ -226,6 +262,7 @@ std::vector<BigUint> count_by_length(const Dfa& a, int max_len) {
   std::vector<BigUint> counts;
   if (max_len < 0) return counts;
   const std::size_t n = static_cast<std::size_t>(a.num_states);
+  WorkBudget::charge((static_cast<std::size_t>(max_len) + 1) * n);
   // ways[s] = number of words of the current length leading from the start to s.
   std::vector<BigUint> ways(n), next(n);
   ways[static_cast<std::size_t>(a.start)] = BigUint(1);

@@ -18,6 +18,7 @@ namespace pathex {
 Dfa dfa_empty();                   // ∅
 Dfa dfa_all();                     // every string of D E L S, ε included
 Dfa dfa_universe();                // U = L[SD]{4,}E, the valid full paths
+Dfa dfa_universe_bounded(int max_bounces);  // L[SD]{4, max_bounces + 4}E: at most max_bounces interior vertices
 Dfa dfa_word(std::string_view w);  // {w}
 
 Dfa dfa_union(const Dfa& a, const Dfa& b);

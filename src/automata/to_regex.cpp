@@ -128,6 +128,21 @@ Expr e_alt(const Expr& a, const Expr& b) {
   return eps ? e_opt(u) : u;
 }
 
+// y+, with (a*b)+ = (a|b)*b and (ba*)+ = b(a|b)* for letter sets a and b: every string over a∪b
+// that ends (starts) with a letter of b. State elimination produces the left side for "[SD]*D".
+Expr e_plus(const Expr& y) {
+  if (y.kind == Kind::kCat && y.kids.size() == 2) {
+    const Expr& first = y.kids[0];
+    const Expr& second = y.kids[1];
+    auto star_of_set = [](const Expr& e) { return e.kind == Kind::kStar && e.kids[0].kind == Kind::kSet; };
+    if (star_of_set(first) && second.kind == Kind::kSet)
+      return node(Kind::kCat, {node(Kind::kStar, {e_set(first.kids[0].mask | second.mask)}), second});
+    if (first.kind == Kind::kSet && star_of_set(second))
+      return node(Kind::kCat, {first, node(Kind::kStar, {e_set(first.mask | second.kids[0].mask)})});
+  }
+  return node(Kind::kPlus, {y});
+}
+
 Expr e_cat(const Expr& a, const Expr& b) {
   if (a.kind == Kind::kEmpty || b.kind == Kind::kEmpty) return leaf(Kind::kEmpty);
   if (a.kind == Kind::kEps) return b;
@@ -145,11 +160,13 @@ Expr e_cat(const Expr& a, const Expr& b) {
       const std::vector<Expr> body = items(y);
       if (i >= body.size() && run_equals(v, i - body.size(), body)) {
         v.erase(v.begin() + static_cast<long>(i - body.size()), v.begin() + static_cast<long>(i + 1));
-        v.insert(v.begin() + static_cast<long>(i - body.size()), node(Kind::kPlus, {y}));
+        const std::vector<Expr> plus = items(e_plus(y));
+        v.insert(v.begin() + static_cast<long>(i - body.size()), plus.begin(), plus.end());
         changed = true;
       } else if (run_equals(v, i + 1, body)) {
         v.erase(v.begin() + static_cast<long>(i), v.begin() + static_cast<long>(i + 1 + body.size()));
-        v.insert(v.begin() + static_cast<long>(i), node(Kind::kPlus, {y}));
+        const std::vector<Expr> plus = items(e_plus(y));
+        v.insert(v.begin() + static_cast<long>(i), plus.begin(), plus.end());
         changed = true;
       } else if (i + 1 < v.size() && v[i + 1].kids.size() == 1 && v[i + 1].kids[0] == y &&
                  (v[i + 1].kind == Kind::kStar || v[i + 1].kind == Kind::kOpt || v[i + 1].kind == Kind::kPlus)) {

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "automata/ops.h"
+#include "core/budget.h"
 #include "core/hash.h"
 
 namespace pathex {
@@ -44,6 +45,7 @@ Result<Classifier::Direction> build_direction(const std::vector<Dfa>& dfas, std:
     std::vector<int> members;
     for (std::size_t i = 0; i < n; ++i)
       if (dfas[i].accept[static_cast<std::size_t>(t[i])]) members.push_back(static_cast<int>(i));
+    WorkBudget::charge(n + 1);
     labels.push_back(static_cast<int>(intern_set(members)));
     ids.emplace(t, id);
     tuples.push_back(std::move(t));
@@ -98,6 +100,10 @@ Result<Classifier::Direction> build_direction(const std::vector<Dfa>& dfas, std:
 }  // namespace
 
 Result<Classifier> Classifier::build(const std::vector<const PathClass*>& classes, const Limits& limits) {
+  return within_budget(limits, [&]() -> Result<Classifier> { return build_unbudgeted(classes, limits); });
+}
+
+Result<Classifier> Classifier::build_unbudgeted(const std::vector<const PathClass*>& classes, const Limits& limits) {
   Classifier c;
   std::vector<Dfa> fwd, bwd;
   for (const PathClass* pc : classes) {

@@ -63,6 +63,7 @@ class Classifier {
   int num_sets() const { return static_cast<int>(sets_.size()); }
 
  private:
+  static Result<Classifier> build_unbudgeted(const std::vector<const PathClass*>& classes, const Limits& limits);
   static const std::uint8_t kColumn[256];
   std::vector<std::string> names_;
   std::vector<std::vector<int>> sets_;  // class-set id -> sorted class indices; shared by both directions

@@ -160,8 +160,30 @@ Estimate batch_means(const std::vector<ExactRgb>& batch_sums, const std::vector<
   return e;
 }
 
+namespace {
+
+// One row of the path table: the estimate of `sums` (per batch) and each strategy's share of its
+// luminance, for the strategies that contributed.
+PathEstimate path_estimate(const Histogram& h, std::string name, const std::vector<ExactRgb>& sums,
+                           const std::vector<std::uint64_t>& batch_samples, std::uint64_t contributions,
+                           const std::vector<ExactRgb>& strategy_sums) {
+  PathEstimate pe;
+  pe.path = std::move(name);
+  pe.estimate = batch_means(sums, batch_samples, contributions);
+  ExactRgb total{};
+  for (const ExactRgb& s : sums) add_to(total, s);
+  const double lum = luminance(to_double(total));
+  for (std::size_t s = 0; s < strategy_sums.size(); ++s) {
+    if (is_zero(strategy_sums[s])) continue;
+    pe.strategies.emplace_back(h.layout().strategies[s], lum != 0 ? luminance(to_double(strategy_sums[s])) / lum : 0.0);
+  }
+  return pe;
+}
+
+}  // namespace
+
 Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, const Classifier* classifier,
-                                    const std::vector<ClassInfo>& classes) {
+                                    const std::vector<ClassInfo>& classes, std::optional<std::uint64_t> max_paths) {
   const int nb = h.num_batches();
   const std::size_t B = static_cast<std::size_t>(nb);
   if (!classes.empty() && (classifier == nullptr || classifier->num_classes() != static_cast<int>(classes.size())))
@@ -202,20 +224,11 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
         class_counts[ks] += count;
       }
     }
-    PathEstimate pe;
-    pe.path = h.path(p);
-    pe.estimate = batch_means(path_sums, n, count);
-    ExactRgb path_total{};
-    for (const ExactRgb& s : path_sums) add_to(path_total, s);
-    const double path_lum = luminance(to_double(path_total));
-    for (int s = 0; s < h.num_strategies(); ++s) {
-      const ExactRgb& ss = h.strategy_sum(p, s);
-      if (is_zero(ss)) continue;
-      pe.strategies.emplace_back(h.layout().strategies[static_cast<std::size_t>(s)],
-                                 path_lum != 0 ? luminance(to_double(ss)) / path_lum : 0.0);
-    }
-    report.paths.push_back(std::move(pe));
+    std::vector<ExactRgb> strategy_sums(static_cast<std::size_t>(h.num_strategies()));
+    for (int s = 0; s < h.num_strategies(); ++s) strategy_sums[static_cast<std::size_t>(s)] = h.strategy_sum(p, s);
+    report.paths.push_back(path_estimate(h, h.path(p), path_sums, n, count, strategy_sums));
   }
+  report.distinct_paths = report.paths.size();
   report.total = batch_means(total_sums, n, total_count);
   for (std::size_t k = 0; k < classes.size(); ++k) {
     ClassEstimate ce;
@@ -225,10 +238,38 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     ce.share = report.total.luminance != 0 ? ce.estimate.luminance / report.total.luminance : 0.0;
     report.classes.push_back(std::move(ce));
   }
-  std::sort(report.paths.begin(), report.paths.end(), [](const PathEstimate& a, const PathEstimate& b) {
-    if (a.estimate.luminance != b.estimate.luminance) return a.estimate.luminance > b.estimate.luminance;
-    return a.path < b.path;
+  // Rows by luminance, largest first. report.paths[i] is still path id i here, which is what
+  // lets the rows past max_paths be summed from the exact cells.
+  std::vector<Histogram::PathId> order(report.paths.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<Histogram::PathId>(i);
+  std::sort(order.begin(), order.end(), [&](Histogram::PathId a, Histogram::PathId b) {
+    const PathEstimate& pa = report.paths[a];
+    const PathEstimate& pb = report.paths[b];
+    if (pa.estimate.luminance != pb.estimate.luminance) return pa.estimate.luminance > pb.estimate.luminance;
+    return pa.path < pb.path;
   });
+  report.max_paths = max_paths;
+  const std::size_t listed = max_paths ? std::min<std::size_t>(order.size(), *max_paths) : order.size();
+  if (listed < order.size()) {
+    std::vector<ExactRgb> other_sums(B, ExactRgb{});
+    std::vector<ExactRgb> other_strategy_sums(static_cast<std::size_t>(h.num_strategies()), ExactRgb{});
+    std::uint64_t other_count = 0;
+    for (std::size_t i = listed; i < order.size(); ++i) {
+      const Histogram::PathId p = order[i];
+      for (int b = 0; b < nb; ++b) {
+        add_to(other_sums[static_cast<std::size_t>(b)], h.cell(p, b).sum);
+        other_count += h.cell(p, b).contributions;
+      }
+      for (int s = 0; s < h.num_strategies(); ++s)
+        add_to(other_strategy_sums[static_cast<std::size_t>(s)], h.strategy_sum(p, s));
+    }
+    report.other = path_estimate(h, "other", other_sums, n, other_count, other_strategy_sums);
+    report.other_paths = order.size() - listed;
+  }
+  std::vector<PathEstimate> rows;
+  rows.reserve(listed);
+  for (std::size_t i = 0; i < listed; ++i) rows.push_back(std::move(report.paths[order[i]]));
+  report.paths = std::move(rows);
   return report;
 }
 

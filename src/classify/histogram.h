@@ -256,6 +256,7 @@ struct RunInfo {
   std::uint64_t spp = 0;
   std::uint64_t seed = 0;
   bool complete = true;  // false for an interrupted render that wrote what it had
+  std::uint64_t spp_requested = 0;  // what was asked (spp is what was done; they differ when interrupted)
   bool operator==(const RunInfo&) const = default;
 };
 
@@ -285,13 +286,21 @@ struct HistogramReport {
   Estimate total;
   std::vector<ClassEstimate> classes;  // in classifier order
   std::vector<PathEstimate> paths;     // by luminance, largest first; ties by path string
+  std::uint64_t distinct_paths = 0;    // every path sampled, listed in `paths` or summed in `other`
+  std::optional<std::uint64_t> max_paths;  // the bound on `paths` in force, if any
+  // The paths past the first max_paths, summed exactly into one row (path "other"), and how many.
+  std::optional<PathEstimate> other;
+  std::uint64_t other_paths = 0;
 };
 
 // Estimates for the total, each class of `classifier` (described by `classes`, one entry per
 // classifier class, in order; the classifier may be null when `classes` is empty) and each path.
+// With `max_paths`, only the largest max_paths paths get a row each and the rest are summed into
+// `other` (the total and the classes always count every path).
 // Fails with kUsage if contributions were recorded in a batch with no registered samples or if
 // `classes` does not match the classifier, and with kLimit if the sums may have overflowed.
 Result<HistogramReport> make_report(const Histogram& histogram, const RunInfo& run, const Classifier* classifier,
-                                    const std::vector<ClassInfo>& classes);
+                                    const std::vector<ClassInfo>& classes,
+                                    std::optional<std::uint64_t> max_paths = std::nullopt);
 
 }  // namespace pathex

@@ -3,6 +3,7 @@
 #include <cctype>
 
 #include "automata/ops.h"
+#include "core/budget.h"
 #include "regex/lpe.h"
 #include "regex/parser.h"
 
@@ -35,6 +36,7 @@ Error with_source(Error e, std::string_view text) {
 // E then anything: the shape of every member of an eye-first expression.
 const Dfa& starts_with_e() {
   static const Dfa d = [] {
+    ExemptFromBudget exempt;
     Dfa x;
     x.num_states = 3;  // 0 start, 1 after E (accepting, absorbing), 2 dead
     x.next = {2, 1, 2, 2, 1, 1, 1, 1, 2, 2, 2, 2};
@@ -47,6 +49,7 @@ const Dfa& starts_with_e() {
 // Classic L[SD]*E.
 const Dfa& classic_universe() {
   static const Dfa d = [] {
+    ExemptFromBudget exempt;
     Dfa x;
     x.num_states = 4;  // 0 start, 1 after L (loops on S D), 2 accept, 3 dead
     x.next.assign(16, 3);
@@ -91,7 +94,12 @@ std::string to_string(Notation n) {
   return "full";
 }
 
-Dfa ends_universe(const EndTypes& ends) { return *expand_ends(classic_universe(), ends, Limits{}); }
+Dfa ends_universe(const EndTypes& ends) {
+  ExemptFromBudget exempt;
+  return expand_ends(classic_universe(), ends, Limits{}).expect("L[SD]*E expands under the default limits");
+}
+
+Result<PathClass> compile_class_unbudgeted(std::string_view text, const ClassOptions& options, const ClassTable* names);
 
 namespace {
 
@@ -118,6 +126,16 @@ Result<PathClass> compile_lpe(std::string_view text, const ClassOptions& options
 }  // namespace
 
 Result<PathClass> compile_class(std::string_view text, const ClassOptions& options, const ClassTable* names) {
+  Result<PathClass> c = within_budget(options.limits, [&] { return compile_class_unbudgeted(text, options, names); });
+  if (!c && c.error().source.empty()) {
+    Error e = with_source(c.error(), text);
+    e.column = 1;
+    return e;
+  }
+  return c;
+}
+
+Result<PathClass> compile_class_unbudgeted(std::string_view text, const ClassOptions& options, const ClassTable* names) {
   if (options.notation == Notation::kLpe) return compile_lpe(text, options);
   const ClassTable& table = names ? *names : ClassTable::builtins();
   Error notation_error;
@@ -184,11 +202,11 @@ Result<PathClass> compile_class(std::string_view text, const ClassOptions& optio
 ClassTable::ClassTable() = default;
 
 ClassTable::ClassTable(BuiltinTag) : is_builtin_table_(true) {
+  ExemptFromBudget exempt;  // built on first use, by whichever operation comes first
   ClassOptions options;
   for (const BuiltinDef& b : kBuiltins) {
-    Result<PathClass> c = compile_class(b.expr, options, this);
     // The built-in expressions are constants of this file; tests compile each of them.
-    auto pc = std::make_unique<PathClass>(std::move(*c));
+    auto pc = std::make_unique<PathClass>(compile_class(b.expr, options, this).expect("a built-in class compiles"));
     pc->name = b.name;
     pc->description = b.description;
     builtin_.push_back(std::move(pc));

@@ -12,6 +12,8 @@
 #include "cli/reach_common.h"
 #include "io/atomic_file.h"
 #include "io/class_file.h"
+#include "io/input_file.h"
+#include "io/json_reader.h"
 #include "io/junit.h"
 #include "io/reach_json.h"
 
@@ -56,9 +58,7 @@ struct Outcome {
 };
 
 Error bad(const std::string& file, const std::string& pointer, std::string message) {
-  Error e = make_error(ErrorCode::kBadFile, std::move(message));
-  e.where = file + ":" + pointer;
-  return e;
+  return JsonReader(file).fail(pointer, std::move(message));
 }
 
 // Relative paths in a check file are tried against the check file's folder, then the current one.
@@ -72,19 +72,16 @@ std::string resolve(const std::string& check_file, const std::string& p) {
 }
 
 Result<std::vector<Case>> parse_check(const std::string& text, const std::string& file) {
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& ex) {
-    return bad(file, "/", std::string("not valid JSON: ") + ex.what());
-  }
+  Result<nlohmann::json> parsed = parse_json(text, file);
+  if (!parsed) return parsed.error();
+  const nlohmann::json& doc = *parsed;
   if (!doc.is_object()) return bad(file, "/", "expected an object with a \"cases\" array");
   for (const auto& [k, v] : doc.items())
     if (k != "cases" && k != "$schema" && k != "description")
-      return bad(file, "/" + k, "unknown key '" + k + "', expected cases");
-  if (!doc.contains("cases") || !doc["cases"].is_array()) return bad(file, "/cases", "expected an array of cases");
+      return bad(file, "/" + pointer_token(k), "unknown key '" + k + "', expected cases");
+  if (!doc.contains("cases") || !doc.at("cases").is_array()) return bad(file, "/cases", "expected an array of cases");
   std::vector<Case> cases;
-  const auto& arr = doc["cases"];
+  const auto& arr = doc.at("cases");
   for (std::size_t i = 0; i < arr.size(); ++i) {
     const std::string ptr = "/cases/" + std::to_string(i);
     const auto& jc = arr[i];
@@ -92,38 +89,37 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
     for (const auto& [k, v] : jc.items())
       if (k != "name" && k != "renderer" && k != "scene" && k != "max_bounces" && k != "require" && k != "notation" &&
           k != "classes" && k != "description")
-        return bad(file, ptr + "/" + k,
+        return bad(file, ptr + "/" + pointer_token(k),
                    "unknown key '" + k + "', expected one of name, renderer, scene, max_bounces, require, notation, classes, description");
     Case c;
     c.pointer = ptr;
-    if (!jc.contains("name") || !jc["name"].is_string()) return bad(file, ptr + "/name", "expected a string case name");
-    c.name = jc["name"];
-    if (!jc.contains("renderer") || !jc["renderer"].is_string())
+    if (!jc.contains("name") || !jc.at("name").is_string()) return bad(file, ptr + "/name", "expected a string case name");
+    c.name = jc.at("name").get<std::string>();
+    if (!jc.contains("renderer") || !jc.at("renderer").is_string())
       return bad(file, ptr + "/renderer", "expected a renderer: a built-in profile name or a profile file");
-    c.renderer = jc["renderer"];
+    c.renderer = jc.at("renderer").get<std::string>();
     if (c.renderer.find('/') != std::string::npos || c.renderer.ends_with(".json")) c.renderer = resolve(file, c.renderer);
     if (jc.contains("scene")) {
-      if (!jc["scene"].is_string()) return bad(file, ptr + "/scene", "expected a scene file path");
-      c.scene = resolve(file, jc["scene"]);
+      if (!jc.at("scene").is_string()) return bad(file, ptr + "/scene", "expected a scene file path");
+      c.scene = resolve(file, jc.at("scene").get<std::string>());
     }
     if (jc.contains("classes")) {
-      if (!jc["classes"].is_string()) return bad(file, ptr + "/classes", "expected a class file path");
-      c.classes = resolve(file, jc["classes"]);
+      if (!jc.at("classes").is_string()) return bad(file, ptr + "/classes", "expected a class file path");
+      c.classes = resolve(file, jc.at("classes").get<std::string>());
     }
-    if (jc.contains("max_bounces") && !jc["max_bounces"].is_null()) {
-      const auto& m = jc["max_bounces"];
-      if (!m.is_number_integer() || m.get<long long>() < 0 || m.get<long long>() > 10000)
-        return bad(file, ptr + "/max_bounces", "expected a non-negative integer, found " + m.dump());
-      c.max_bounces = m.get<int>();
+    if (jc.contains("max_bounces") && !jc.at("max_bounces").is_null()) {
+      Result<long long> m = JsonReader(file).integer(jc, "max_bounces", ptr, 0, kMaxBouncesCeiling);
+      if (!m) return m.error();
+      c.max_bounces = static_cast<int>(*m);
     }
     if (jc.contains("notation")) {
-      const auto n = jc["notation"].is_string() ? notation_from_string(jc["notation"].get<std::string>()) : std::nullopt;
+      const auto n = jc.at("notation").is_string() ? notation_from_string(jc.at("notation").get<std::string>()) : std::nullopt;
       if (!n) return bad(file, ptr + "/notation", "expected \"full\", \"heckbert\" or \"lpe\"");
       c.notation = *n;
     }
-    if (!jc.contains("require") || !jc["require"].is_array() || jc["require"].empty())
+    if (!jc.contains("require") || !jc.at("require").is_array() || jc.at("require").empty())
       return bad(file, ptr + "/require", "expected a non-empty array of requirements");
-    const auto& reqs = jc["require"];
+    const auto& reqs = jc.at("require");
     for (std::size_t j = 0; j < reqs.size(); ++j) {
       const std::string rp = ptr + "/require/" + std::to_string(j);
       const auto& jr = reqs[j];
@@ -132,19 +128,19 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
       r.pointer = rp;
       for (const auto& [k, v] : jr.items())
         if (k != "class" && k != "verdict" && k != "covers-scene")
-          return bad(file, rp + "/" + k, "unknown key '" + k + "', expected class and verdict, or covers-scene");
+          return bad(file, rp + "/" + pointer_token(k), "unknown key '" + k + "', expected class and verdict, or covers-scene");
       if (jr.contains("covers-scene")) {
-        if (jr["covers-scene"] != true) return bad(file, rp + "/covers-scene", "expected true");
+        if (jr.at("covers-scene") != true) return bad(file, rp + "/covers-scene", "expected true");
         if (jr.contains("class") || jr.contains("verdict"))
           return bad(file, rp, "covers-scene stands alone: no class or verdict beside it");
         r.covers_scene = true;
       } else {
-        if (!jr.contains("class") || !jr["class"].is_string())
+        if (!jr.contains("class") || !jr.at("class").is_string())
           return bad(file, rp + "/class", "expected a class: an expression or a $name");
-        if (!jr.contains("verdict") || !jr["verdict"].is_string())
+        if (!jr.contains("verdict") || !jr.at("verdict").is_string())
           return bad(file, rp + "/verdict", "expected a verdict: reachable, not-unreachable, unreachable, partial or empty");
-        r.cls = jr["class"];
-        r.verdict = jr["verdict"];
+        r.cls = jr.at("class").get<std::string>();
+        r.verdict = jr.at("verdict").get<std::string>();
         if (r.verdict != "reachable" && r.verdict != "not-unreachable" && r.verdict != "unreachable" &&
             r.verdict != "partial" && r.verdict != "empty")
           return bad(file, rp + "/verdict",
@@ -171,28 +167,39 @@ std::string chains_text(const std::vector<ChainEvidence>& chains) {
   return s;
 }
 
-int run(const CheckArgs& a) {
-  std::string text;
-  Result<bool> read = read_text_file(a.file, &text);
-  if (!read) return report(read.error());
-  Result<std::vector<Case>> cases = parse_check(text, a.file);
-  if (!cases) return report(cases.error());
+// An error about a file a case refers to (an unknown renderer, a scene or class file that cannot
+// be read) is placed at the case's key in the check file, naming the referenced file; an error
+// inside a file that was read (a bad scene or profile) keeps its own location.
+Error at_case_key(Error e, const std::string& check_file, const std::string& pointer, const std::string& referenced) {
+  if (!e.where.empty() && e.where != referenced) return e;
+  if (e.where == referenced && !referenced.empty()) e.message = referenced + ": " + e.message;
+  e.where = check_file + ":" + pointer;
+  return e;
+}
 
+// Decides every requirement of every case, in order.
+Result<std::vector<Outcome>> decide(const CheckArgs& a, const std::vector<Case>& cases) {
   ReachCache cache(a.limits);
   std::vector<Outcome> outcomes;
-  for (const Case& c : *cases) {
-    ReachSetup setup;
-    if (int rc = prepare_reach(cache, {c.renderer}, c.scene, c.max_bounces, &setup)) return rc;
+  for (const Case& c : cases) {
+    Result<const CompiledProfile*> compiled = cache.compiled(c.renderer, c.max_bounces);
+    if (!compiled) return at_case_key(compiled.error(), a.file, c.pointer + "/renderer", c.renderer);
+    const CompiledProfile& cp = **compiled;
     ClassOptions copts;
     copts.limits = a.limits;
     copts.notation = c.notation;
-    if (setup.scene_ends) copts.ends = *setup.scene_ends;
+    std::optional<Dfa> universe;
+    if (!c.scene.empty()) {
+      Result<const SceneUniverse*> scene = cache.scene(c.scene);
+      if (!scene) return at_case_key(scene.error(), a.file, c.pointer + "/scene", c.scene);
+      universe = (*scene)->universe;
+      copts.ends = (*scene)->ends;
+    }
     ClassTable table;
     if (!c.classes.empty()) {
       Result<bool> r = read_class_file(c.classes, copts, &table);
-      if (!r) return report(r.error());
+      if (!r) return at_case_key(r.error(), a.file, c.pointer + "/classes", c.classes);
     }
-    const CompiledProfile& cp = setup.compiled.front();
     for (const Requirement& r : c.require) {
       const auto t0 = std::chrono::steady_clock::now();
       Outcome o;
@@ -200,7 +207,7 @@ int run(const CheckArgs& a) {
       o.r = &r;
       QueryOptions qo;
       qo.max_bounces = c.max_bounces;
-      qo.universe = setup.universe;
+      qo.universe = universe;
       qo.witnesses = 1;
       qo.max_len = 0;
       qo.limits = a.limits;
@@ -208,10 +215,14 @@ int run(const CheckArgs& a) {
       if (!pc) {
         Error e = pc.error();
         e.where = a.file + ":" + r.pointer + (r.covers_scene ? "" : "/class");
-        return report(e);
+        return e;
       }
       Result<QueryResult> q = query(*pc, cp, qo);
-      if (!q) return report(q.error());
+      if (!q) {
+        Error e = q.error();
+        e.where = a.file + ":" + r.pointer;
+        return e;
+      }
       o.verdict = to_string(q->verdict);
       o.passed = r.covers_scene ? (q->verdict == Verdict::kReachable || q->verdict == Verdict::kEmpty)
                                 : satisfies(r.verdict, q->verdict);
@@ -225,6 +236,27 @@ int run(const CheckArgs& a) {
       outcomes.push_back(std::move(o));
     }
   }
+  return outcomes;
+}
+
+// Reports a check that could not be run; with --junit, the report holds it as an <error>.
+int fail(const CheckArgs& a, const Error& e) {
+  if (!a.junit.empty()) {
+    const JUnitCase error_case{"pathex check", a.file, 0.0, false, true, "the check file could not be run", e.render()};
+    Result<bool> w = write_file_atomic(a.junit, junit_xml(a.file, {error_case}));
+    if (!w) report(w.error());
+  }
+  return report(e);
+}
+
+int run(const CheckArgs& a) {
+  Result<std::string> text = read_input_file(a.file, a.limits.max_file_bytes);
+  if (!text) return fail(a, text.error());
+  Result<std::vector<Case>> cases = parse_check(*text, a.file);
+  if (!cases) return fail(a, cases.error());
+  Result<std::vector<Outcome>> decided = decide(a, *cases);
+  if (!decided) return fail(a, decided.error());
+  const std::vector<Outcome>& outcomes = *decided;
 
   int failed = 0;
   std::vector<JUnitCase> junit;
@@ -244,7 +276,7 @@ int run(const CheckArgs& a) {
     } else if (!o.passed && o.verdict == "empty") {
       details = "the class has no path in this universe";
     }
-    junit.push_back({o.c->name, o.r->describe(), o.time_s, !o.passed, message, details});
+    junit.push_back({o.c->name, o.r->describe(), o.time_s, !o.passed, false, message, details});
     if (a.json) {
       nlohmann::json jr = {{"case", o.c->name}, {"renderer", o.c->renderer}, {"requirement", o.r->describe()},
                            {"passed", o.passed}, {"verdict", o.verdict}};

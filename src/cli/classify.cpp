@@ -17,6 +17,12 @@ struct ClassifyArgs {
   Limits limits;
 };
 
+// One JSON line. A line of input need not be UTF-8 (a stray byte is reported as bad, not a crash):
+// bytes that are not are written as U+FFFD.
+std::string json_line(const nlohmann::json& j) {
+  return j.dump(-1, ' ', /*ensure_ascii=*/false, nlohmann::json::error_handler_t::replace);
+}
+
 int run(const ClassifyArgs& a) {
   Result<ClassOptions> opts = class_options(a.notation, a.limits);
   if (!opts) return report(opts.error());
@@ -45,7 +51,7 @@ int run(const ClassifyArgs& a) {
       e.where = "stdin:" + std::to_string(line_no);
       bad = true;
       if (a.json) {
-        std::cout << nlohmann::json{{"line", line_no}, {"path", line}, {"error", e.render()}}.dump() << "\n";
+        std::cout << json_line({{"line", line_no}, {"path", line}, {"error", e.render()}}) << "\n";
       } else {
         report(e);
       }
@@ -55,7 +61,7 @@ int run(const ClassifyArgs& a) {
     if (a.json) {
       nlohmann::json names = nlohmann::json::array();
       for (int m : members) names.push_back(cl->name(m));
-      std::cout << nlohmann::json{{"line", line_no}, {"path", p->text}, {"classes", names}}.dump() << "\n";
+      std::cout << json_line({{"line", line_no}, {"path", p->text}, {"classes", names}}) << "\n";
     } else {
       std::cout << p->text << "\t";
       if (members.empty()) std::cout << "-";

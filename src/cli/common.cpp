@@ -7,15 +7,34 @@
 
 namespace pathex::cli {
 
+const CLI::Validator& non_negative() {
+  static const CLI::Validator v(
+      [](std::string& value) -> std::string {
+        const std::size_t first = value.find_first_not_of(" \t");
+        if (first != std::string::npos && value[first] == '-')
+          return "expected a non-negative integer, got '" + value + "'";
+        return "";
+      },
+      /*validator_desc=*/"", /*validator_name=*/"non-negative");
+  return v;
+}
+
 void add_limit_options(CLI::App* app, Limits* limits) {
+  // Each limit has a floor of 1 (0 for none would refuse everything) and the ceiling the engine
+  // provably survives (core/limits.h); a negative value is refused, never wrapped around.
   app->add_option("--max-states", limits->max_states, "Largest automaton (NFA or DFA states) to build")
-      ->capture_default_str()->group("Limits");
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxStatesCeiling))->group("Limits");
   app->add_option("--max-depth", limits->max_depth, "Deepest nesting of groups and operators")
-      ->capture_default_str()->group("Limits");
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(1, kMaxDepthCeiling))->group("Limits");
   app->add_option("--max-repeat", limits->max_repeat, "Largest count in {n}, {n,} and {n,m}")
-      ->capture_default_str()->group("Limits");
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(1, kMaxRepeatCeiling))->group("Limits");
   app->add_option("--max-length", limits->max_length, "Longest full-path string accepted as input")
-      ->capture_default_str()->group("Limits");
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxLengthCeiling))->group("Limits");
+  app->add_option("--max-work", limits->max_work,
+                  "Work budget of one operation: automaton states built, subset elements, counting cells")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxWorkCeiling))->group("Limits");
+  app->add_option("--max-file-size", limits->max_file_bytes, "Largest input file read (class, profile, check, scene, mesh), bytes")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxFileBytesCeiling))->group("Limits");
 }
 
 void add_notation_options(CLI::App* app, NotationOptions* n) {
@@ -23,11 +42,27 @@ void add_notation_options(CLI::App* app, NotationOptions* n) {
                   "full (L c0 c1 … E), heckbert (L w E, one letter per interior vertex) or lpe (OSL light path "
                   "expression, camera first: C<RD>L)")
       ->check(CLI::IsMember({"full", "heckbert", "lpe"}))->capture_default_str();
-  app->add_option("--light", n->lights, "Light types for Heckbert and LPE notation: area, distant, point, laser (default all)")
-      ->delimiter(',')->allow_extra_args(false);
-  app->add_option("--sensor", n->sensors,
-                  "Sensor types for Heckbert and LPE notation: lens, pinhole, orthographic, spotmeter (default all)")
-      ->delimiter(',')->allow_extra_args(false);
+  // The type names list the choices ("LIST:{area,distant,point,laser}"): --help shows them and
+  // the generated bash completion offers them.
+  std::string lights, sensors;
+  for (LightType t : kAllLightTypes) lights += (lights.empty() ? "" : ",") + to_string(t);
+  for (SensorType t : kAllSensorTypes) sensors += (sensors.empty() ? "" : ",") + to_string(t);
+  app->add_option("--light", n->lights, "Light types for Heckbert and LPE notation, one comma-separated list (default all)")
+      ->delimiter(',')->allow_extra_args(false)->type_name("LIST:{" + lights + "}");
+  app->add_option("--sensor", n->sensors, "Sensor types for Heckbert and LPE notation, one comma-separated list (default all)")
+      ->delimiter(',')->allow_extra_args(false)->type_name("LIST:{" + sensors + "}");
+}
+
+std::optional<std::string> misused_list_option(int argc, char** argv) {
+  for (int i = 1; i + 2 < argc; ++i) {
+    const std::string option = argv[i], next = argv[i + 2];
+    const bool light = option == "--light" && light_type_from_string(next);
+    const bool sensor = option == "--sensor" && sensor_type_from_string(next);
+    if (light || sensor)
+      return option + " takes one comma-separated list, such as " + option + " " + argv[i + 1] + "," + next +
+             "; '" + next + "' after it would be read as an expression";
+  }
+  return std::nullopt;
 }
 
 Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limits) {

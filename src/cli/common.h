@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,13 @@ struct NotationOptions {
 };
 
 void add_limit_options(CLI::App* app, Limits* limits);
+// Refuses a value with a minus sign: CLI11 reads "-1" into an unsigned option as 2^64 - 1.
+const CLI::Validator& non_negative();
 void add_notation_options(CLI::App* app, NotationOptions* n);
+// `--light point area` reads `area` as an expression, because --light takes one comma-separated
+// list. Returns the message for such a command line (a type name right after the value of --light
+// or --sensor), else nothing.
+std::optional<std::string> misused_list_option(int argc, char** argv);
 // Turns the notation options into ClassOptions, or an error naming the bad value.
 Result<ClassOptions> class_options(const NotationOptions& n, const Limits& limits);
 

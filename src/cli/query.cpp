@@ -97,7 +97,14 @@ int run(const QueryArgs& a) {
     std::vector<QueryResult> row;
     for (const CompiledProfile& cp : setup.compiled) {
       Result<QueryResult> q = query(*pc, cp, qo);
-      if (!q) return report(q.error());
+      if (!q) {
+        // The query as a whole exceeded a limit: name the expression and the renderer.
+        Error err = q.error();
+        err.where = "renderer " + cp.profile->name;
+        err.source = e;
+        err.column = 1;
+        return report(err);
+      }
       q->expression = e;
       row.push_back(std::move(*q));
     }
@@ -146,7 +153,7 @@ Command add_query(CLI::App& app) {
       ->allow_extra_args(false);
   sub->add_option("--scene", args->scene, "Restrict the universe to this scene's lights, sensor and materials");
   sub->add_option("--max-bounces", args->max_bounces, "Only paths with at most N interior vertices; overrides the profiles' bound")
-      ->check(CLI::Range(0, 10000));
+      ->check(CLI::Range(0, kMaxBouncesCeiling));
   sub->add_option("--witnesses", args->witnesses, "Witnesses per side")->capture_default_str()->check(CLI::Range(0, 1000));
   sub->add_option("--max-len", args->max_len, "Count members up to this many letters (default: max-bounces + 6, or 14)")
       ->check(CLI::Range(0, 10000));

@@ -29,7 +29,8 @@ Result<const CompiledProfile*> ReachCache::compiled(const std::string& name_or_p
 Result<const SceneUniverse*> ReachCache::scene(const std::string& path) {
   auto it = scenes_.find(path);
   if (it != scenes_.end()) return static_cast<const SceneUniverse*>(&it->second);
-  Result<Scene> s = load_scene_file(path);
+  // The universe needs the scene's light, sensor and material types, never its triangles.
+  Result<Scene> s = load_scene_file(path, SceneLoadOptions{limits_.max_file_bytes, /*triangles=*/false});
   if (!s) return s.error();
   const SceneTypes types = scene_types(*s);
   SceneUniverse u;

@@ -63,7 +63,8 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
   info.spp = header.passes.count();
   info.seed = id.seed;
   info.complete = header.passes == header.share;
-  Result<HistogramReport> rep = make_report(sums.histogram, info, classes.classifier.get(), classes.infos);
+  info.spp_requested = header.spp;
+  Result<HistogramReport> rep = make_report(sums.histogram, info, classes.classifier.get(), classes.infos, id.max_paths);
   if (!rep) return rep.error();
 
   WrittenReport out{std::move(*rep), {}};

@@ -19,9 +19,11 @@ struct RenderersArgs {
 };
 
 int run(const RenderersArgs& a) {
-  const Dfa local = dfa_intersect(compile_class("L.*DD.*E", ClassOptions{})->dfa, dfa_universe());
+  const Dfa& local = ClassTable::builtins().find("local")->dfa;  // L.*DD.*E ∩ U
+  Result<std::vector<Profile>> profiles = builtin_profiles(a.limits);
+  if (!profiles) return report(profiles.error());
   nlohmann::json arr = nlohmann::json::array();
-  for (const Profile& p : builtin_profiles(a.limits)) {
+  for (const Profile& p : *profiles) {
     Result<CompiledProfile> cp = compile_profile(p, std::nullopt, a.limits);
     if (!cp) return report(cp.error());
     const Dfa missed = dfa_difference(dfa_universe(), cp->reachable);

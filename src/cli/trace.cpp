@@ -1,6 +1,7 @@
 // pathex trace: render a scene, label every sampled path, write the path-class histogram, the
 // per-class EXR and PNG previews, and print where the light went, class by class, next to what the
 // checker says the renderer can reach.
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -15,6 +16,7 @@
 #include "cli/common.h"
 #include "cli/reach_common.h"
 #include "cli/render_job.h"
+#include "cli/trace_checks.h"
 #include "core/hash.h"
 #include "core/version.h"
 #include "io/atomic_file.h"
@@ -22,7 +24,9 @@
 #include "io/histogram_json.h"
 #include "io/image_io.h"
 #include "io/output_set.h"
+#include "io/input_file.h"
 #include "io/profile_json.h"
+#include "io/progress.h"
 #include "scene/scene_hash.h"
 #include "scene/universe.h"
 #include "trace/render.h"
@@ -43,6 +47,8 @@ struct TraceArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   std::optional<int> max_bounces;
+  std::string resolution;  // "WxH"; empty: the scene's
+  std::uint64_t max_paths = 1000;
   int top_paths = 8;
   bool json = false;
   bool quiet = false;
@@ -72,11 +78,19 @@ std::string gib(std::uint64_t bytes) {
   return buf;
 }
 
-std::string format_seconds(double s) {
-  char buf[32];
-  if (s < 60) std::snprintf(buf, sizeof buf, "%.0f s", s);
-  else std::snprintf(buf, sizeof buf, "%.0f min %02.0f s", std::floor(s / 60), std::fmod(s, 60));
+// An absolute estimate: the mean pixel luminance and its standard error, "0.01234 ± 0.00012".
+std::string absolute(const Estimate& e) {
+  char buf[64];
+  if (std::isfinite(e.std_error)) std::snprintf(buf, sizeof buf, "%.5f ± %.5f", e.luminance, e.std_error);
+  else std::snprintf(buf, sizeof buf, "%.5f (too few batches for an error)", e.luminance);
   return buf;
+}
+
+// The terminal's width in columns (stderr's), or 80 when it does not say.
+int terminal_columns() {
+  winsize w{};
+  if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &w) == 0 && w.ws_col > 0) return w.ws_col;
+  return 80;
 }
 
 // "i/n" with 0 ≤ i < n.
@@ -128,8 +142,12 @@ struct Job {
 
 Result<bool> load_fresh(const TraceArgs& a, Job* job) {
   Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
-                                        : load_scene_file(a.scene);
+                                        : load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
   if (!scene) return scene.error();
+  // The content hash is the file's; the resolution is an option of the render, kept beside it.
+  const std::string scene_hash = scene_content_hash(*scene);
+  if (!a.resolution.empty())
+    if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return r.error();
   Result<Profile> profile = resolve_profile(a.renderer, a.limits);
   if (!profile) return profile.error();
   Result<StrategySet> runnable = runnable_strategies(*profile);
@@ -139,7 +157,7 @@ Result<bool> load_fresh(const TraceArgs& a, Job* job) {
   id.pathex = pathex_version();
   id.scene = a.scene.empty() ? "default (embedded cornell)" : a.scene;
   id.scene_file = a.scene.empty() ? "" : std::filesystem::absolute(a.scene).lexically_normal().string();
-  id.scene_hash = scene_content_hash(*scene);
+  id.scene_hash = scene_hash;
   id.renderer = profile->name;
   const bool builtin = std::any_of(builtin_profile_texts().begin(), builtin_profile_texts().end(),
                                    [&](const BuiltinProfileText& t) { return a.renderer == t.name; });
@@ -155,13 +173,16 @@ Result<bool> load_fresh(const TraceArgs& a, Job* job) {
   id.rr_depth = defaults.rr_depth;
   id.batches = defaults.batches;
   id.images = !a.no_images;
-  id.width = id.images ? scene->camera.width : 0;
-  id.height = id.images ? scene->camera.height : 0;
+  id.width = scene->camera.width;
+  id.height = scene->camera.height;
+  id.max_paths = a.max_paths;
   for (const Strategy& st : runnable->strategies) id.strategies.push_back(st.name);
 
   std::string class_text;
   if (!a.classes_file.empty()) {
-    if (Result<bool> r = read_text_file(a.classes_file, &class_text); !r) return r.error();
+    Result<std::string> text = read_input_file(a.classes_file, a.limits.max_file_bytes);
+    if (!text) return text.error();
+    class_text = std::move(*text);
     id.classes_file = std::filesystem::absolute(a.classes_file).lexically_normal().string();
   }
   Result<std::unique_ptr<RenderClasses>> classes =
@@ -195,11 +216,16 @@ Result<bool> load_resumed(const TraceArgs& a, Job* job) {
   Result<CombinedRender> combined = combine_shards(*files, a.limits);
   if (!combined) return combined.error();
   const RenderIdentity& id = combined->header.identity;
-  Result<Scene> scene = id.scene_file.empty() ? load_scene_json(default_scene_json(), ".", id.scene) : load_scene_file(id.scene_file);
+  Result<Scene> scene = id.scene_file.empty()
+                            ? load_scene_json(default_scene_json(), ".", id.scene)
+                            : load_scene_file(id.scene_file, SceneLoadOptions{a.limits.max_file_bytes});
   if (!scene) return scene.error();
   if (scene_content_hash(*scene) != id.scene_hash)
     return make_error(ErrorCode::kUsage, "the scene " + id.scene + " changed since " + a.resume + " was rendered (content hash " +
                                              scene_content_hash(*scene) + ", the render's " + id.scene_hash + ")");
+  // The render's resolution (the scene's, or --resolution's).
+  scene->camera.width = id.width;
+  scene->camera.height = id.height;
   Result<Profile> profile = resolve_profile(id.renderer_source, a.limits);
   if (!profile) return profile.error();
   if (profile_hash(*profile) != id.renderer_hash)
@@ -242,6 +268,13 @@ int run(const TraceArgs& a) {
     out_set.emplace(std::move(*prepared));
   }
 
+  // The checker's view of the profile, for the warning now and the table after the render.
+  ReachCache cache(a.limits);
+  Result<const CompiledProfile*> cp = cache.compiled(id.renderer_source, id.max_bounces);
+  if (!cp) return report(cp.error());
+  const Dfa universe = scene_universe(scene_types(*job.scene));
+  if (rank == 0) warn_unreachable_lights(*job.scene, *job.profile, **cp, universe, id.max_bounces, a.limits);
+
   // --- render this process's part of the passes still missing ---
   const PassSet todo = job.header.share.minus(job.header.passes);
   RenderOptions ro;
@@ -274,11 +307,13 @@ int run(const TraceArgs& a) {
     const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (a.time_limit > 0 && el >= a.time_limit) g_cancel.store(true);
     if (!show_progress) return;
-    const double f = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
-    const int bar = static_cast<int>(f * 30);
-    std::fprintf(stderr, "\r[%.*s%*s] %5.1f%%  %.2f M samples/s  %s left   ", bar, "##############################",
-                 30 - bar, "", 100 * f, el > 0 ? static_cast<double>(done) / el * 1e-6 : 0.0,
-                 format_seconds(f > 0 ? el / f - el : 0).c_str());
+    Progress p;
+    p.fraction = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
+    p.samples_per_s = el > 0 ? static_cast<double>(done) / el : 0.0;
+    p.seconds_left = p.fraction > 0 ? el / p.fraction - el : 0;
+    // Padded to the width it was fitted to, so a shorter line covers a longer one.
+    const int columns = terminal_columns();
+    std::fprintf(stderr, "\r%-*s", std::max(columns - 1, 0), progress_line(p, columns).c_str());
     std::fflush(stderr);
   };
   g_cancel.store(false);
@@ -288,7 +323,7 @@ int run(const TraceArgs& a) {
   Result<RenderOutput> out = render(*job.scene, *job.profile, job.classes->classifier.get(), ro);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
-  if (show_progress) std::fprintf(stderr, "\r%70s\r", "");
+  if (show_progress) std::fprintf(stderr, "\r%*s\r", std::max(terminal_columns() - 1, 0), "");
   if (!out) return report(out.error());
 
   RenderSums sums{std::move(out->histogram), std::move(out->images)};
@@ -350,11 +385,8 @@ int run(const TraceArgs& a) {
 
   // --- the table: classes with the checker's verdict, then the most important exact paths ---
   const std::vector<const PathClass*>& classes = job.classes->classes;
-  ReachCache cache(a.limits);
-  Result<const CompiledProfile*> cp = cache.compiled(id.renderer_source, id.max_bounces);
-  if (!cp) return report(cp.error());
   QueryOptions qo;
-  qo.universe = scene_universe(scene_types(*job.scene));
+  qo.universe = universe;
   qo.max_bounces = id.max_bounces;
   qo.witnesses = 0;
   qo.max_len = 0;
@@ -363,14 +395,15 @@ int run(const TraceArgs& a) {
     std::cout << " (passes " << header.passes.to_string() << " of " << job.header.spp << ")";
   std::cout << ", " << std::fixed << std::setprecision(2) << out->time_s << " s" << (complete ? "" : " (interrupted)")
             << ", non-finite samples " << rep->nonfinite_samples << "\n";
-  std::cout << "image mean luminance " << std::setprecision(5) << rep->total.luminance << " ± " << rep->total.std_error
-            << "\n\n";
+  std::cout << "image mean luminance " << absolute(rep->total) << "\n"
+            << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n\n";
   for (std::size_t i = 0; i < rep->classes.size(); ++i) {
     const ClassEstimate& c = rep->classes[i];
     Result<QueryResult> q = query(*classes[i], **cp, qo);
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
-              << "; " << id.renderer << ": " << (q ? to_string(q->verdict) : "?") << "\n";
+              << "; " << id.renderer << ": " << (q ? to_string(q->verdict) : "?") << "; luminance "
+              << absolute(c.estimate) << "\n";
   }
   if (!out->connectors.empty()) {
     int width = 10;
@@ -388,7 +421,7 @@ int run(const TraceArgs& a) {
     const double share = rep->total.luminance > 0 ? p.estimate.luminance / rep->total.luminance : 0.0;
     const double err = rep->total.luminance > 0 ? p.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << "  " << std::left << std::setw(16) << p.path << std::right << std::setw(8) << percent(share) << "  ±"
-              << percent(std::isfinite(err) ? err : 0.0, 2) << "  via";
+              << percent(std::isfinite(err) ? err : 0.0, 2) << "  luminance " << absolute(p.estimate) << "  via";
     for (const auto& [name, s] : p.strategies) std::cout << " " << name << " " << percent(s);
     std::cout << "\n";
   }
@@ -416,11 +449,16 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--renderer", args->renderer, "Renderer profile: built-in name or file")->capture_default_str();
   sub->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 24));
   sub->add_option("--classes", args->classes_file, "Class file; default: the built-in classes");
-  sub->add_option("--seed", args->seed, "Random seed")->capture_default_str();
+  sub->add_option("--seed", args->seed, "Random seed (0 to 2^64 - 1)")->capture_default_str()->check(non_negative());
   sub->add_option("--threads", args->threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
   sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices (k - 1); default: the profile's bound, else 16")
       ->check(CLI::Range(0, 1000));
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
+  sub->add_option("--resolution", args->resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
+      ->type_name("WxH");
+  sub->add_option("--max-paths", args->max_paths,
+                  "Rows of histogram.json's path table; the rest are summed into one \"other\" row")
+      ->capture_default_str()->check(non_negative());
   sub->add_option("--top", args->top_paths, "Exact paths to list")->capture_default_str()->check(CLI::Range(0, 100000));
   sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
@@ -435,7 +473,8 @@ Command add_trace(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   add_limit_options(sub, &args->limits);
   return {sub, [args, sub] {
-            for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--seed", "--max-bounces", "--out", "--no-images", "--shard"})
+            for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
+                                  "--resolution", "--max-paths"})
               if (sub->count(o) > 0) args->settings_given.push_back(o);
             return run(*args);
           }};

@@ -1,5 +1,8 @@
 #include "core/error.h"
 
+#include <cstdio>
+#include <cstdlib>
+
 namespace pathex {
 
 std::string Error::render() const {
@@ -14,6 +17,13 @@ std::string Error::render() const {
     out += '^';
   }
   return out;
+}
+
+void result_misuse(const char* what, const char* file, unsigned line) {
+  if (line == 0 && file != nullptr && *file != '\0') std::fprintf(stderr, "pathex: internal error: %s: %s\n", what, file);
+  else if (line == 0) std::fprintf(stderr, "pathex: internal error: %s (through operator* or ->)\n", what);
+  else std::fprintf(stderr, "pathex: internal error: %s (%s:%u)\n", what, file, line);
+  std::abort();
 }
 
 }  // namespace pathex

@@ -4,6 +4,7 @@
 // code 2; the library never prints and never exits.
 #pragma once
 
+#include <source_location>
 #include <string>
 #include <utility>
 #include <variant>
@@ -38,25 +39,56 @@ inline Error make_error(ErrorCode code, std::string message) {
   return e;
 }
 
+// Dereferencing a Result that was never checked is a bug even when it happens to hold a value:
+// the day the input changes it aborts (issue 17: `*compile(...)` of a constant that a user's
+// --max-bounces made too large). So a Result remembers whether ok() (or operator bool) was asked,
+// and every accessor of the value or the error refuses to run before that: an unchecked access
+// aborts with the source line on the first test that runs it, whichever way the Result went.
+// Together with [[nodiscard]] on the type, the only way to reach a value is to look first.
+[[noreturn]] void result_misuse(const char* what, const char* file, unsigned line);
+
 template <class T>
 class [[nodiscard]] Result {
  public:
   Result(T value) : v_(std::move(value)) {}          // NOLINT(google-explicit-constructor)
   Result(Error error) : v_(std::move(error)) {}      // NOLINT(google-explicit-constructor)
-  bool ok() const { return v_.index() == 0; }
+  [[nodiscard]] bool ok() const {
+    checked_ = true;
+    return v_.index() == 0;
+  }
   explicit operator bool() const { return ok(); }
-  T& value() & { return std::get<0>(v_); }
-  const T& value() const& { return std::get<0>(v_); }
-  T&& value() && { return std::get<0>(std::move(v_)); }
-  T& operator*() & { return value(); }
-  const T& operator*() const& { return value(); }
-  T* operator->() { return &value(); }
-  const T* operator->() const { return &value(); }
-  const Error& error() const { return std::get<1>(v_); }
-  Error& error() { return std::get<1>(v_); }
+
+  T& value(std::source_location at = std::source_location::current()) & { return get(at); }
+  const T& value(std::source_location at = std::source_location::current()) const& { return get(at); }
+  T&& value(std::source_location at = std::source_location::current()) && { return std::move(get(at)); }
+  // Operators cannot take the caller's location; a misuse through them is reported without it.
+  T& operator*() & { return get(std::source_location()); }
+  const T& operator*() const& { return get(std::source_location()); }
+  T* operator->() { return &get(std::source_location()); }
+  const T* operator->() const { return &get(std::source_location()); }
+  // For results that cannot fail, such as the engine's own constant expressions compiled under
+  // default limits: the value, or an abort naming `why` and the error (a bug, never bad input).
+  T expect(const char* why) && {
+    if (!ok()) result_misuse(why, get_error(std::source_location()).render().c_str(), 0);
+    return std::move(get(std::source_location()));
+  }
+  const Error& error(std::source_location at = std::source_location::current()) const { return get_error(at); }
+  Error& error(std::source_location at = std::source_location::current()) { return get_error(at); }
 
  private:
+  T& get(const std::source_location& at) const {
+    if (!checked_) result_misuse("value of a Result read before ok() was checked", at.file_name(), at.line());
+    if (v_.index() != 0) result_misuse("value of a Result read although it holds an error", at.file_name(), at.line());
+    return const_cast<T&>(*std::get_if<0>(&v_));
+  }
+  Error& get_error(const std::source_location& at) const {
+    if (!checked_) result_misuse("error of a Result read before ok() was checked", at.file_name(), at.line());
+    if (v_.index() != 1) result_misuse("error of a Result read although it holds a value", at.file_name(), at.line());
+    return const_cast<Error&>(*std::get_if<1>(&v_));
+  }
+
   std::variant<T, Error> v_;
+  mutable bool checked_ = false;
 };
 
 }  // namespace pathex

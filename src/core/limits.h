@@ -3,6 +3,11 @@
 // exhausting memory. Defaults are chosen so that every realistic path class fits with room to spare
 // while a pathological one, such as (S|D)*S(S|D){40} whose DFA has 2^41 states, fails in well
 // under a second.
+//
+// Each limit also has a ceiling: the largest value an option accepts (negative values are refused
+// too). The ceilings are what the implementation provably survives: recursion over the syntax
+// tree is at most max_depth frames deep (every other input-dependent loop is iterative), and the
+// work budget bounds the time of everything else.
 #pragma once
 
 #include <cstddef>
@@ -15,7 +20,20 @@ struct Limits {
   int max_depth = 100;               // --max-depth: nesting depth of parentheses and operators
   int max_repeat = 1000;             // --max-repeat: the largest n or m in {n}, {n,}, {n,m}
   std::size_t max_length = 100000;   // --max-length: letters in one full-path string
+  std::size_t max_work = 20000000;   // --max-work: work units of one operation (see core/budget.h)
+  std::size_t max_file_bytes = std::size_t{64} << 20;  // --max-file-size: bytes of one input file
 };
+
+// The ceilings of the options above and of --max-bounces. kMaxDepthCeiling keeps the syntax
+// tree's recursion (parser, printer, Thompson construction, nested & and ~) within about 1 MiB of
+// stack: tests/regex/parser_test.cpp walks a tree of that height in every recursive routine.
+inline constexpr std::size_t kMaxStatesCeiling = 10000000;
+inline constexpr int kMaxDepthCeiling = 1000;
+inline constexpr int kMaxRepeatCeiling = 100000;
+inline constexpr std::size_t kMaxLengthCeiling = 100000000;
+inline constexpr std::size_t kMaxWorkCeiling = 4000000000;
+inline constexpr std::size_t kMaxFileBytesCeiling = std::size_t{16} << 30;
+inline constexpr int kMaxBouncesCeiling = 10000;
 
 // "the DFA exceeds the limit of 100000 states (raise it with --max-states)" and friends.
 std::string limit_message(const std::string& what, std::size_t limit, const std::string& unit,

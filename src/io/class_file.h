@@ -19,10 +19,7 @@ namespace pathex {
 // end types for entries that do not override them.
 Result<bool> load_class_file(const std::string& text, const std::string& filename, const ClassOptions& options,
                              ClassTable* table);
-// Reads the file, then load_class_file.
+// Reads the file (at most options.limits.max_file_bytes), then load_class_file.
 Result<bool> read_class_file(const std::string& filename, const ClassOptions& options, ClassTable* table);
-
-// Reads a whole file into *out; errors name the file.
-Result<bool> read_text_file(const std::string& filename, std::string* out);
 
 }  // namespace pathex

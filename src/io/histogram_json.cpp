@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/json_reader.h"
+
 namespace pathex {
 namespace {
 
@@ -144,9 +146,12 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
   doc["scene"] = r.run.scene;
   doc["renderer"] = r.run.renderer;
   doc["spp"] = r.run.spp;
+  doc["spp_requested"] = r.run.spp_requested;
   doc["seed"] = r.run.seed;
   doc["complete"] = r.run.complete;
   doc["nonfinite_samples"] = r.nonfinite_samples;
+  doc["distinct_paths"] = r.distinct_paths;
+  doc["max_paths"] = r.max_paths ? json(*r.max_paths) : json(nullptr);
   json total = json::object();
   put_estimate(total, r.total);
   doc["total"] = std::move(total);
@@ -161,15 +166,22 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
   }
   doc["classes"] = std::move(classes);
   json paths = json::array();
-  for (const PathEstimate& p : r.paths) {
+  auto put_path = [&](const PathEstimate& p, std::optional<std::uint64_t> summed) {
     json j = json::object();
     j["path"] = p.path;
+    if (summed) {
+      j["paths"] = *summed;
+      j["note"] = "the sum of the " + std::to_string(*summed) + " paths past the first " +
+                  std::to_string(r.paths.size()) + " (--max-paths)";
+    }
     put_estimate(j, p.estimate);
     json strategies = json::object();
     for (const auto& [name, share] : p.strategies) strategies[name] = share;
     j["strategies"] = std::move(strategies);
     paths.push_back(std::move(j));
-  }
+  };
+  for (const PathEstimate& p : r.paths) put_path(p, std::nullopt);
+  if (r.other) put_path(*r.other, r.other_paths);
   doc["paths"] = std::move(paths);
   if (raw != nullptr) doc["raw"] = raw_to_json(*raw);
   return doc;
@@ -278,9 +290,13 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
   r.run.scene = rd.str(doc, "", "scene");
   r.run.renderer = rd.str(doc, "", "renderer");
   r.run.spp = rd.uint(doc, "", "spp");
+  // Keys added after the first format are optional, so older files still read.
+  if (doc.contains("spp_requested")) r.run.spp_requested = rd.uint(doc, "", "spp_requested");
   r.run.seed = rd.uint(doc, "", "seed");
   r.run.complete = rd.boolean(doc, "", "complete");
   r.nonfinite_samples = rd.uint(doc, "", "nonfinite_samples");
+  if (doc.contains("distinct_paths")) r.distinct_paths = rd.uint(doc, "", "distinct_paths");
+  if (doc.contains("max_paths") && !doc["max_paths"].is_null()) r.max_paths = rd.uint(doc, "", "max_paths");
   if (const json* t = rd.field(doc, "", "total")) r.total = rd.estimate(*t, "/total", /*samples_required=*/false);
   if (const json* classes = rd.array(doc, "", "classes")) {
     for (std::size_t i = 0; i < classes->size() && !rd.failed(); ++i) {
@@ -300,6 +316,8 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
       const std::string pp = "/paths/" + std::to_string(i);
       PathEstimate p;
       p.path = rd.str(pj, pp, "path");
+      const bool other = p.path == "other";  // the sum of the rows past max_paths; never a full path
+      if (other) r.other_paths = rd.uint(pj, pp, "paths");
       p.estimate = rd.estimate(pj, pp, /*samples_required=*/true);
       if (const json* s = rd.field(pj, pp, "strategies")) {
         if (!s->is_object()) rd.fail(pp + "/strategies", "expected an object of strategy shares");
@@ -307,9 +325,11 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
           for (const auto& [name, share] : s->items())
             p.strategies.emplace_back(name, rd.number(share, pp + "/strategies/" + name));
       }
-      r.paths.push_back(std::move(p));
+      if (other) r.other = std::move(p);
+      else r.paths.push_back(std::move(p));
     }
   }
+  if (!doc.contains("distinct_paths")) r.distinct_paths = r.paths.size();
   if (rd.failed()) return rd.error();
   if (auto it = doc.find("raw"); it != doc.end()) {
     Result<Histogram> h = raw_from_json(*it, filename, "/raw");
@@ -320,15 +340,9 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
 }
 
 Result<HistogramFile> parse_histogram_json(const std::string& text, const std::string& filename) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& ex) {
-    Error e = make_error(ErrorCode::kBadFile, std::string("not valid JSON: ") + ex.what());
-    e.where = filename;
-    return e;
-  }
-  return histogram_from_json(doc, filename);
+  Result<json> doc = parse_ordered_json(text, filename);
+  if (!doc) return doc.error();
+  return histogram_from_json(*doc, filename);
 }
 
 }  // namespace pathex

@@ -8,14 +8,19 @@
 //
 //   scene              string   the scene file (or the embedded default's name)
 //   renderer           string   the renderer profile's name
-//   spp                integer  samples per pixel
+//   spp                integer  samples per pixel rendered
+//   spp_requested      integer  samples per pixel asked for (more than spp when interrupted)
 //   seed               integer
 //   complete           bool     false when the render was interrupted and wrote what it had
 //   nonfinite_samples  integer  contributions that were NaN, infinite or ≥ 2^50 (never added; must be 0)
+//   distinct_paths     integer  distinct paths sampled (rows of `paths`, plus those summed in "other")
+//   max_paths          integer  the bound on the rows of `paths` (--max-paths), or null for none
 //   total    {estimate [r,g,b], luminance, stderr, samples}
 //   classes  [{name, expr, estimate [r,g,b], luminance, stderr, samples, share}]   in class-file order
 //   paths    [{path, estimate [r,g,b], luminance, stderr, samples, strategies {name: share}}]
-//            sorted by luminance, largest first
+//            sorted by luminance, largest first; at most max_paths of them, then, when more paths
+//            were sampled, one row {path: "other", paths: n, note, estimate, …} that sums the rest
+//            exactly ("other" is never a full path: those begin with L)
 //   raw      optional: the exact accumulator state, for merging (below)
 //
 // An estimate is the mean pixel value over the image (RGB, and its Rec. 709 luminance); stderr is

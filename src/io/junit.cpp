@@ -23,10 +23,11 @@ std::string xml_escape(const std::string& s) {
 }
 
 std::string junit_xml(const std::string& suite, const std::vector<JUnitCase>& cases) {
-  int failures = 0;
+  int failures = 0, errors = 0;
   double total = 0.0;
   for (const JUnitCase& c : cases) {
-    failures += c.failed ? 1 : 0;
+    failures += c.failed && !c.error ? 1 : 0;
+    errors += c.error ? 1 : 0;
     total += c.time_s;
   }
   auto seconds = [](double t) {
@@ -36,18 +37,20 @@ std::string junit_xml(const std::string& suite, const std::vector<JUnitCase>& ca
   };
   std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   x += "<testsuites name=\"pathex\" tests=\"" + std::to_string(cases.size()) + "\" failures=\"" + std::to_string(failures) +
-       "\" errors=\"0\" time=\"" + seconds(total) + "\">\n";
+       "\" errors=\"" + std::to_string(errors) + "\" time=\"" + seconds(total) + "\">\n";
   x += "  <testsuite name=\"" + xml_escape(suite) + "\" tests=\"" + std::to_string(cases.size()) + "\" failures=\"" +
-       std::to_string(failures) + "\" errors=\"0\" skipped=\"0\" time=\"" + seconds(total) + "\">\n";
+       std::to_string(failures) + "\" errors=\"" + std::to_string(errors) + "\" skipped=\"0\" time=\"" + seconds(total) + "\">\n";
   for (const JUnitCase& c : cases) {
     x += "    <testcase classname=\"" + xml_escape(c.classname) + "\" name=\"" + xml_escape(c.name) + "\" time=\"" +
          seconds(c.time_s) + "\"";
-    if (!c.failed) {
+    if (!c.failed && !c.error) {
       x += "/>\n";
       continue;
     }
-    x += ">\n      <failure message=\"" + xml_escape(c.message) + "\" type=\"pathex.requirement\">" +
-         xml_escape(c.details) + "</failure>\n    </testcase>\n";
+    const char* element = c.error ? "error" : "failure";
+    x += ">\n      <" + std::string(element) + " message=\"" + xml_escape(c.message) + "\" type=\"" +
+         (c.error ? "pathex.input" : "pathex.requirement") + "\">" + xml_escape(c.details) + "</" + element +
+         ">\n    </testcase>\n";
   }
   x += "  </testsuite>\n</testsuites>\n";
   return x;

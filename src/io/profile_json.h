@@ -21,6 +21,7 @@ const std::vector<BuiltinProfileText>& builtin_profile_texts();
 Result<Profile> parse_profile(const std::string& text, const std::string& filename, const Limits& limits);
 // A built-in name (pt, pt-nee, lt, bdpt, …) or a path to a profile file.
 Result<Profile> resolve_profile(const std::string& name_or_path, const Limits& limits);
-std::vector<Profile> builtin_profiles(const Limits& limits);
+// Every built-in profile, parsed under `limits`.
+Result<std::vector<Profile>> builtin_profiles(const Limits& limits);
 
 }  // namespace pathex

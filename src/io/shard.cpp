@@ -8,8 +8,11 @@
 #include <array>
 #include <cstring>
 #include <fstream>
+#include <limits>
 
 #include <nlohmann/json.hpp>
+
+#include "io/json_reader.h"
 
 namespace pathex {
 namespace {
@@ -126,73 +129,60 @@ json identity_json(const RenderIdentity& id) {
   j["ends"] = {{"lights", id.lights}, {"sensor", id.sensor}};
   j["seed"] = id.seed;
   j["options"] = {{"max_bounces", id.max_bounces}, {"rr_depth", id.rr_depth}, {"batches", id.batches},
-                  {"width", id.width},           {"height", id.height},     {"images", id.images}};
+                  {"width", id.width},           {"height", id.height},     {"images", id.images},
+                  {"max_paths", id.max_paths}};
   j["strategies"] = id.strategies;
   return j;
 }
 
-// Reads typed header values, remembering the first error with its JSON pointer.
-class HeaderReader {
+// Reads the header through the one JSON reader (io/json_reader.h), keeping its first error (a
+// located kBadFile at "file:/pointer"), so the walk below reads as a list of fields.
+class HeaderFields {
  public:
-  explicit HeaderReader(const std::string& path) : path_(path) {}
+  using Json = nlohmann::json;
+  explicit HeaderFields(const std::string& path) : rd_(path) {}
   std::optional<Error> error;
 
-  const json* at(const json& obj, const std::string& ptr, const char* key) {
-    if (error) return nullptr;
-    if (!obj.is_object() || !obj.contains(key)) {
-      fail(ptr, std::string("missing key \"") + key + "\"");
-      return nullptr;
-    }
-    return &obj[key];
+  // `obj` must be an object with exactly these keys.
+  bool object(const Json& obj, const std::string& ptr, std::initializer_list<const char*> keys) {
+    return take(rd_.keys(obj, ptr, keys), false);
   }
-  std::string str(const json& obj, const std::string& ptr, const char* key) {
-    const json* v = at(obj, ptr, key);
-    if (v == nullptr) return {};
-    if (!v->is_string()) return fail(ptr + "/" + key, "expected a string"), std::string();
-    return v->get<std::string>();
+  const Json& at(const Json& obj, const char* key) { return obj.at(key); }  // after object()
+  std::string str(const Json& obj, const std::string& ptr, const char* key) {
+    return take(rd_.string(obj, key, ptr), std::string());
   }
-  std::uint64_t uint(const json& obj, const std::string& ptr, const char* key) {
-    const json* v = at(obj, ptr, key);
-    if (v == nullptr) return 0;
-    if (!v->is_number_unsigned()) return fail(ptr + "/" + key, "expected a non-negative integer"), 0;
-    return v->get<std::uint64_t>();
+  std::uint64_t uint(const Json& obj, const std::string& ptr, const char* key) {
+    return take(rd_.unsigned_integer(obj, key, ptr, std::numeric_limits<std::uint64_t>::max()), std::uint64_t{0});
   }
-  int small(const json& obj, const std::string& ptr, const char* key) {
-    const std::uint64_t v = uint(obj, ptr, key);
-    if (v > 1u << 30) return fail(ptr + "/" + key, "expected at most 2^30"), 0;
-    return static_cast<int>(v);
+  int small(const Json& obj, const std::string& ptr, const char* key) {
+    return static_cast<int>(take(rd_.integer(obj, key, ptr, 0, 1 << 30), 0LL));
   }
-  double number(const json& obj, const std::string& ptr, const char* key) {
-    const json* v = at(obj, ptr, key);
-    if (v == nullptr) return 0;
-    if (!v->is_number()) return fail(ptr + "/" + key, "expected a number"), 0.0;
-    return v->get<double>();
+  double number(const Json& obj, const std::string& ptr, const char* key) {
+    return take(rd_.number(obj, key, ptr, 0, std::numeric_limits<double>::max()), 0.0);
   }
-  bool boolean(const json& obj, const std::string& ptr, const char* key) {
-    const json* v = at(obj, ptr, key);
-    if (v == nullptr) return false;
-    if (!v->is_boolean()) return fail(ptr + "/" + key, "expected true or false"), false;
-    return v->get<bool>();
+  bool boolean(const Json& obj, const std::string& ptr, const char* key) {
+    return take(rd_.boolean(obj, key, ptr), false);
   }
-  std::vector<std::string> strings(const json& obj, const std::string& ptr, const char* key) {
-    const json* v = at(obj, ptr, key);
+  std::vector<std::string> strings(const Json& obj, const std::string& ptr, const char* key) {
     std::vector<std::string> out;
-    if (v == nullptr) return out;
-    if (!v->is_array()) return fail(ptr + "/" + key, "expected an array of strings"), out;
-    for (std::size_t i = 0; i < v->size(); ++i) {
-      if (!(*v)[i].is_string()) return fail(ptr + "/" + key + "/" + std::to_string(i), "expected a string"), out;
-      out.push_back((*v)[i].get<std::string>());
+    const std::string p = ptr + "/" + key;
+    if (error) return out;
+    const Json& v = obj.at(key);
+    if (!v.is_array()) return fail(p, "expected an array of strings, found " + JsonReader::kind(v)), out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_string()) return fail(p + "/" + std::to_string(i), "expected a string, found " + JsonReader::kind(v[i])), out;
+      out.push_back(v[i].get<std::string>());
     }
     return out;
   }
-  PassSet passes(const json& obj, const char* key) {
+  PassSet passes(const Json& obj, const char* key) {
     PassSet set;
-    const json* p = at(obj, "", key);
-    if (p == nullptr) return set;
     const std::string ptr = std::string("/") + key;
-    if (!p->is_array()) return fail(ptr, "expected an array of [first, last) pairs"), set;
-    for (std::size_t i = 0; i < p->size(); ++i) {
-      const json& r = (*p)[i];
+    if (error) return set;
+    const Json& p = obj.at(key);
+    if (!p.is_array()) return fail(ptr, "expected an array of [first, last) pairs, found " + JsonReader::kind(p)), set;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Json& r = p[i];
       if (!r.is_array() || r.size() != 2 || !r[0].is_number_unsigned() || !r[1].is_number_unsigned() ||
           r[0].get<std::uint64_t>() >= r[1].get<std::uint64_t>() || (!set.empty() && r[0].get<std::uint64_t>() <= set.end())) {
         fail(ptr + "/" + std::to_string(i), "expected [first, last) with first < last, after the previous range");
@@ -202,53 +192,68 @@ class HeaderReader {
     }
     return set;
   }
-  void fail(const std::string& ptr, const std::string& message) {
-    if (error) return;
-    Error e = make_error(ErrorCode::kBadFile, message);
-    e.where = path_ + ":" + ptr;
-    error = std::move(e);
+  void fail(const std::string& ptr, std::string message) {
+    if (!error) error = rd_.fail(ptr, std::move(message));
   }
 
  private:
-  const std::string& path_;
+  template <class T, class U>
+  T take(Result<T> r, U fallback) {
+    if (error) return static_cast<T>(fallback);
+    if (!r.ok()) {
+      error = r.error();
+      return static_cast<T>(fallback);
+    }
+    return std::move(r.value());
+  }
+  JsonReader rd_;
 };
 
-Result<ShardHeader> header_from_json(const json& j, const std::string& path) {
-  HeaderReader rd(path);
+Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string& path) {
+  HeaderFields rd(path);
   ShardHeader h;
   RenderIdentity& id = h.identity;
-  if (!j.is_object()) return rd.fail("/", "expected a JSON object"), *rd.error;
+  if (!rd.object(j, "", {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "spp",
+                         "share", "passes", "run"}))
+    return *rd.error;
+  for (const char* key : {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "spp",
+                          "share", "passes", "run"})
+    if (!j.contains(key)) return rd.fail(std::string("/") + key, std::string("missing ") + key), *rd.error;
   id.pathex = rd.str(j, "", "pathex");
   // Objects of three strings: {name, file, hash} and the like.
   const auto strings3 = [&](const char* key, const std::array<std::pair<const char*, std::string*>, 3>& fields) {
-    if (const json* o = rd.at(j, "", key))
-      for (const auto& [name, out] : fields) *out = rd.str(*o, std::string("/") + key, name);
+    const std::string ptr = std::string("/") + key;
+    if (!rd.object(j.at(key), ptr, {fields[0].first, fields[1].first, fields[2].first})) return;
+    for (const auto& [name, out] : fields) *out = rd.str(j.at(key), ptr, name);
   };
   strings3("scene", {{{"name", &id.scene}, {"file", &id.scene_file}, {"hash", &id.scene_hash}}});
   strings3("renderer", {{{"name", &id.renderer}, {"source", &id.renderer_source}, {"hash", &id.renderer_hash}}});
   strings3("classes", {{{"file", &id.classes_file}, {"text", &id.classes_text}, {"hash", &id.classes_hash}}});
-  if (const json* e = rd.at(j, "", "ends")) {
-    id.lights = rd.strings(*e, "/ends", "lights");
-    id.sensor = rd.str(*e, "/ends", "sensor");
+  if (rd.object(j.at("ends"), "/ends", {"lights", "sensor"})) {
+    id.lights = rd.strings(j.at("ends"), "/ends", "lights");
+    id.sensor = rd.str(j.at("ends"), "/ends", "sensor");
   }
   id.seed = rd.uint(j, "", "seed");
   h.spp = rd.uint(j, "", "spp");
-  if (const json* o = rd.at(j, "", "options")) {
-    id.max_bounces = rd.small(*o, "/options", "max_bounces");
-    id.rr_depth = rd.small(*o, "/options", "rr_depth");
-    id.batches = rd.small(*o, "/options", "batches");
-    id.width = rd.small(*o, "/options", "width");
-    id.height = rd.small(*o, "/options", "height");
-    id.images = rd.boolean(*o, "/options", "images");
+  const nlohmann::json& o = j.at("options");
+  if (rd.object(o, "/options", {"max_bounces", "rr_depth", "batches", "width", "height", "images", "max_paths"})) {
+    id.max_bounces = rd.small(o, "/options", "max_bounces");
+    id.rr_depth = rd.small(o, "/options", "rr_depth");
+    id.batches = rd.small(o, "/options", "batches");
+    id.width = rd.small(o, "/options", "width");
+    id.height = rd.small(o, "/options", "height");
+    id.images = rd.boolean(o, "/options", "images");
+    id.max_paths = rd.uint(o, "/options", "max_paths");
   }
   if (!rd.error && (id.batches < 1 || id.batches > 1000000)) rd.fail("/options/batches", "expected 1 to 1000000 batches");
   id.strategies = rd.strings(j, "", "strategies");
   h.share = rd.passes(j, "share");
   h.passes = rd.passes(j, "passes");
-  if (const json* r = rd.at(j, "", "run")) {
-    h.run.time_s = rd.number(*r, "/run", "time_s");
-    h.run.threads = rd.small(*r, "/run", "threads");
-    h.run.rays = rd.uint(*r, "/run", "rays");
+  const nlohmann::json& r = j.at("run");
+  if (rd.object(r, "/run", {"time_s", "threads", "rays"})) {
+    h.run.time_s = rd.number(r, "/run", "time_s");
+    h.run.threads = rd.small(r, "/run", "threads");
+    h.run.rays = rd.uint(r, "/run", "rays");
   }
   if (rd.error) return *rd.error;
   return h;
@@ -287,12 +292,12 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
   if (auto d = option("max_bounces", a.max_bounces, b.max_bounces)) return d;
   if (auto d = option("rr_depth", a.rr_depth, b.rr_depth)) return d;
   if (auto d = option("batch count", a.batches, b.batches)) return d;
-  if (a.width != b.width || a.height != b.height || a.images != b.images) {
-    const auto size = [](const RenderIdentity& i) {
-      return i.images ? std::to_string(i.width) + "x" + std::to_string(i.height) : std::string("no images");
-    };
-    return differ("another image size", size(a), size(b));
-  }
+  if (a.width != b.width || a.height != b.height)
+    return differ("another resolution", std::to_string(a.width) + "x" + std::to_string(a.height),
+                  std::to_string(b.width) + "x" + std::to_string(b.height));
+  if (a.images != b.images)
+    return differ("another image setting", a.images ? "images" : "--no-images", b.images ? "images" : "--no-images");
+  if (auto d = option("--max-paths", static_cast<long long>(a.max_paths), static_cast<long long>(b.max_paths))) return d;
   // Derived from what the hashes cover; different only in a hand-made file.
   if (a.strategies != b.strategies || a.lights != b.lights || a.sensor != b.sensor || a.classes_text != b.classes_text)
     return std::optional<std::string>("another render description (strategies, end types or class text)");
@@ -384,13 +389,9 @@ Result<ShardFile> parse_shard(std::string bytes, const std::string& path) {
   if (crc32_of(bytes.data(), size - 4) != stored)
     return file_error(path, "corrupted shard file: its CRC-32 does not match its contents");
 
-  json hj;
-  try {
-    hj = json::parse(bytes.begin() + 16, bytes.begin() + 16 + static_cast<std::ptrdiff_t>(head_size));
-  } catch (const json::exception& e) {
-    return file_error(path, std::string("shard header is not valid JSON: ") + e.what());
-  }
-  Result<ShardHeader> header = header_from_json(hj, path);
+  Result<nlohmann::json> hj = parse_json(std::string_view(bytes).substr(16, head_size), path);
+  if (!hj) return hj.error();
+  Result<ShardHeader> header = header_from_json(*hj, path);
   if (!header) return header.error();
   ShardFile f;
   f.path = path;

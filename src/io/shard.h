@@ -26,7 +26,7 @@
 // absolute file), hash}, "classes" {file (absolute, "" for the built-in classes), text (the class
 // file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
-// {max_bounces, rr_depth, batches, width, height, images}, "strategies" [names], "share" and
+// {max_bounces, rr_depth, batches, width, height, images, max_paths}, "strategies" [names], "share" and
 // "passes" (each [[first, last), …]: the passes the run was asked for, and those whose sums this
 // file holds), "run" {time_s, threads, rays}.
 //
@@ -76,8 +76,9 @@ struct RenderIdentity {
   int max_bounces = 16;
   int rr_depth = 3;
   int batches = kDefaultBatches;
-  int width = 0, height = 0;  // of the images (0 × 0 without images)
+  int width = 0, height = 0;  // the camera's resolution (the scene's, or --resolution's)
   bool images = true;
+  std::uint64_t max_paths = 1000;  // rows of histogram.json's path table (--max-paths)
   std::vector<std::string> strategies;  // the histogram's strategy names
   bool operator==(const RenderIdentity&) const = default;
 };
@@ -112,7 +113,8 @@ struct ShardFile {
   std::size_t body_offset = 0, body_size = 0;
 };
 // Errors (kBadFile) name the file: not a shard file, another format version, truncated,
-// corrupted (checksum), or a header value of the wrong type (with its JSON pointer).
+// corrupted (checksum), or a header value of the wrong type (with its JSON pointer). The header is
+// read by the one JSON reader (io/json_reader.h); unknown keys are refused like missing ones.
 Result<ShardFile> parse_shard(std::string bytes, const std::string& path);
 Result<ShardFile> read_shard(const std::string& path);
 

@@ -6,6 +6,7 @@
 #include <cctype>
 
 #include "automata/ops.h"
+#include "core/budget.h"
 #include "regex/parser.h"
 
 namespace pathex {
@@ -15,6 +16,12 @@ Result<Dfa> compile_text(const std::string& text, const Limits& limits) {
   Result<Regex> r = parse(text, limits);
   if (!r) return r.error();
   return compile(*r, limits);
+}
+
+// A fixed language of this file, built once outside any operation's budget.
+Dfa constant_language(const char* text) {
+  ExemptFromBudget exempt;
+  return compile_text(text, Limits{}).expect("a constant chain language compiles");
 }
 
 std::string range_regex(const Range& r) {
@@ -112,21 +119,23 @@ std::string Strategy::describe() const {
   return d;
 }
 
-Result<bool> check_strategy(Strategy* st, const Limits& limits, const std::string& pointer) {
+namespace {
+
+Result<bool> check_strategy_unbudgeted(Strategy* st, const Limits& limits, const std::string& pointer) {
   Result<Dfa> chain = compile_text(st->chain, limits);
   if (!chain) {
     Error e = chain.error();
     e.where = pointer + "/chain";
     return e;
   }
-  static const Dfa ds_star_d = *compile_text("DS*D", Limits{});
+  static const Dfa ds_star_d = constant_language("DS*D");
   if (!is_subset(*chain, ds_star_d))
     return pointer_error(pointer + "/chain", "chain '" + st->chain + "' is not within DS*D (a chain runs from one D separator to the next; " +
                                                  "it contains " + *shortest_member(dfa_difference(*chain, ds_star_d)) + ")");
   if (is_empty(*chain)) return pointer_error(pointer + "/chain", "chain '" + st->chain + "' is empty");
   static const Dfa dd = dfa_word("DD");
   static const Dfa dsd = dfa_word("DSD");
-  static const Dfa ds_plus_d = *compile_text("DS+D", Limits{});
+  static const Dfa ds_plus_d = constant_language("DS+D");
   switch (st->connector) {
     case ConnectorKind::kNone:
       if (!is_equivalent(*chain, dd))
@@ -164,31 +173,46 @@ Result<bool> check_strategy(Strategy* st, const Limits& limits, const std::strin
   return true;
 }
 
+}  // namespace
+
+Result<bool> check_strategy(Strategy* st, const Limits& limits, const std::string& pointer) {
+  Result<bool> r = within_budget(limits, [&] { return check_strategy_unbudgeted(st, limits, pointer); });
+  if (!r && r.error().where.empty()) {
+    Error e = r.error();
+    e.where = pointer + "/chain";
+    return e;
+  }
+  return r;
+}
+
 Dfa bounded_universe(std::optional<int> max_bounces) {
-  if (!max_bounces) return dfa_universe();
-  return *compile_text("L[SD]{4," + std::to_string(*max_bounces + 4) + "}E", Limits{});
+  return max_bounces ? dfa_universe_bounded(*max_bounces) : dfa_universe();
 }
 
 Result<Dfa> strategy_language(const Strategy& st, std::optional<int> max_bounces, const Limits& limits) {
-  Result<Dfa> prefix = compile_text("L[SD]" + range_regex(st.s), limits);
-  if (!prefix) return prefix.error();
-  Result<Dfa> suffix = compile_text("[SD]" + range_regex(st.t) + "E", limits);
-  if (!suffix) return suffix.error();
-  Result<Dfa> a = dfa_concat(*prefix, st.chain_dfa, limits);
-  if (!a) return a.error();
-  Result<Dfa> b = dfa_concat(*a, *suffix, limits);
-  if (!b) return b.error();
-  return dfa_intersect(*b, bounded_universe(max_bounces));
+  return within_budget(limits, [&]() -> Result<Dfa> {
+    Result<Dfa> prefix = compile_text("L[SD]" + range_regex(st.s), limits);
+    if (!prefix) return prefix.error();
+    Result<Dfa> suffix = compile_text("[SD]" + range_regex(st.t) + "E", limits);
+    if (!suffix) return suffix.error();
+    Result<Dfa> a = dfa_concat(*prefix, st.chain_dfa, limits);
+    if (!a) return a.error();
+    Result<Dfa> b = dfa_concat(*a, *suffix, limits);
+    if (!b) return b.error();
+    return dfa_intersect(*b, bounded_universe(max_bounces));
+  });
 }
 
 Result<Dfa> reachable_language(const Profile& p, std::optional<int> max_bounces, const Limits& limits) {
-  Dfa r = dfa_empty();
-  for (const Strategy& st : p.strategies) {
-    Result<Dfa> l = strategy_language(st, max_bounces, limits);
-    if (!l) return l.error();
-    r = dfa_union(r, *l);
-  }
-  return r;
+  return within_budget(limits, [&]() -> Result<Dfa> {
+    Dfa r = dfa_empty();
+    for (const Strategy& st : p.strategies) {
+      Result<Dfa> l = strategy_language(st, max_bounces, limits);
+      if (!l) return l.error();
+      r = dfa_union(r, *l);
+    }
+    return r;
+  });
 }
 
 bool strategy_samples(const Strategy& st, const std::string& path, std::optional<int> max_bounces) {

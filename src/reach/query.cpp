@@ -1,6 +1,7 @@
 #include "reach/query.h"
 
 #include "automata/ops.h"
+#include "core/budget.h"
 
 namespace pathex {
 namespace {
@@ -53,6 +54,8 @@ std::string join_and(const std::vector<std::string>& parts) {
   return s;
 }
 
+Result<QueryResult> query_unbudgeted(const PathClass& c, const CompiledProfile& r, const QueryOptions& o);
+
 std::vector<std::string> strategies_for(const std::string& path, const CompiledProfile& r) {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < r.profile->strategies.size(); ++i)
@@ -73,17 +76,19 @@ std::string to_string(Verdict v) {
 }
 
 Result<CompiledProfile> compile_profile(const Profile& p, std::optional<int> max_bounces, const Limits& limits) {
-  CompiledProfile c;
-  c.profile = &p;
-  c.max_bounces = max_bounces ? max_bounces : p.max_bounces;
-  c.reachable = dfa_empty();
-  for (const Strategy& st : p.strategies) {
-    Result<Dfa> l = strategy_language(st, c.max_bounces, limits);
-    if (!l) return l.error();
-    c.reachable = dfa_union(c.reachable, *l);
-    c.strategy_languages.push_back(std::move(*l));
-  }
-  return c;
+  return within_budget(limits, [&]() -> Result<CompiledProfile> {
+    CompiledProfile c;
+    c.profile = &p;
+    c.max_bounces = max_bounces ? max_bounces : p.max_bounces;
+    c.reachable = dfa_empty();
+    for (const Strategy& st : p.strategies) {
+      Result<Dfa> l = strategy_language(st, c.max_bounces, limits);
+      if (!l) return l.error();
+      c.reachable = dfa_union(c.reachable, *l);
+      c.strategy_languages.push_back(std::move(*l));
+    }
+    return c;
+  });
 }
 
 std::vector<ChainEvidence> chain_evidence(const std::string& path) {
@@ -117,6 +122,12 @@ std::string unreachable_reason(const std::string& path, const CompiledProfile& r
 }
 
 Result<QueryResult> query(const PathClass& c, const CompiledProfile& r, const QueryOptions& o) {
+  return within_budget(o.limits, [&]() -> Result<QueryResult> { return query_unbudgeted(c, r, o); });
+}
+
+namespace {
+
+Result<QueryResult> query_unbudgeted(const PathClass& c, const CompiledProfile& r, const QueryOptions& o) {
   QueryResult q;
   q.expression = c.name.empty() ? c.text : "$" + c.name;
   q.renderer = r.profile->name;
@@ -154,5 +165,7 @@ Result<QueryResult> query(const PathClass& c, const CompiledProfile& r, const Qu
   }
   return q;
 }
+
+}  // namespace
 
 }  // namespace pathex

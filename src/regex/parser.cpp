@@ -12,7 +12,6 @@
 #include "regex/parser.h"
 
 #include <cctype>
-#include <cstdio>
 #include <string>
 
 #include "regex/repeat.h"
@@ -57,20 +56,7 @@ class Parser {
 
   // The character at the cursor as messages show it: 'x'; a whole UTF-8 sequence such as 'Ψ'
   // rather than its first byte; "byte 0x01" for a control or stray byte; "the end".
-  std::string found() const {
-    if (at_end()) return "the end";
-    const auto c = static_cast<unsigned char>(peek());
-    std::size_t n = 1;
-    if (c >= 0xC0 && c <= 0xF7) {
-      while (n < 4 && pos_ + n < text_.size() && (static_cast<unsigned char>(text_[pos_ + n]) & 0xC0) == 0x80) ++n;
-    }
-    if ((c >= 0x80 && n == 1) || c < 0x20 || c == 0x7F) {
-      char buf[16];
-      std::snprintf(buf, sizeof buf, "byte 0x%02X", static_cast<unsigned>(c));
-      return buf;
-    }
-    return "'" + std::string(text_.substr(pos_, n)) + "'";
-  }
+  std::string found() const { return at_end() ? "the end" : describe_char_at(text_, pos_); }
 
   Error fail(int column, std::string message, ErrorCode code = ErrorCode::kSyntax) {
     if (!failed_) {

@@ -49,6 +49,20 @@ Result<std::string> SceneFiles::read(const std::string& path, const Location& fr
   return std::move(ss).str();
 }
 
+std::optional<Error> check_light_value(glm::vec3 v, const Location& at) {
+  for (int i = 0; i < 3; ++i) {
+    if (!(v[i] >= 0.0f)) return located(at, "a light's emission must be non-negative");
+    if (v[i] > kMaxLightValue) {
+      std::ostringstream found;
+      found << v[i];
+      return located(at, "a light's emission (" + found.str() +
+                             " after scale) exceeds 1e9: the tracer sums contributions exactly below 2^50 and drops larger ones; "
+                             "scale the scene's lights down (the image scales with them)");
+    }
+  }
+  return std::nullopt;
+}
+
 // --- materials ---
 
 namespace {

@@ -16,6 +16,7 @@
 // - The scene rules of scene.h (a shape, a light, a camera that sees a shape), reported at the file.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,10 @@ class SceneFiles {
  private:
   std::string base_dir_;
 };
+
+// A light's emission (radiance, intensity or irradiance, after any scale) must be non-negative and
+// at most kMaxLightValue (scene.h), as in JSON scenes; the error names `at`.
+std::optional<Error> check_light_value(glm::vec3 v, const Location& at);
 
 // A mixture of `a` (weight 1 - w) and `b` (weight w), flattened: mixtures of mixtures become one
 // mixture whose weights are the products along the way (both formats' mix and blend choose one

@@ -431,7 +431,7 @@ class Importer {
       Props e(this, emitters[0], "<emitter type=\"area\">");
       MI_TRY(radiance, e.color("radiance", vec3(1.0f)));
       if (auto u = e.unused()) return u;
-      if (glm::any(glm::lessThan(radiance, vec3(0.0f)))) return located(where(emitters[0]), "radiance must be non-negative");
+      if (auto bad = import::check_light_value(radiance, where(emitters[0]))) return bad;
       s.emission = radiance;
     }
     MI_TRY(m, p.transform("to_world"));
@@ -504,13 +504,13 @@ class Importer {
         d = v;
       }
       if (!(glm::length(d) > 0.0f)) return located(where(n), "the direction is zero");
-      if (glm::any(glm::lessThan(e, vec3(0.0f)))) return located(where(n), "irradiance must be non-negative");
+      if (auto bad = import::check_light_value(e, where(n))) return bad;
       if (auto u = p.unused()) return u;
       builder_.add_distant(d, e);
       return std::nullopt;
     }
     MI_TRY(intensity, p.color("intensity", vec3(1.0f)));
-    if (glm::any(glm::lessThan(intensity, vec3(0.0f)))) return located(where(n), "intensity must be non-negative");
+    if (auto bad = import::check_light_value(intensity, where(n))) return bad;
     vec3 position = import::apply_point(m, vec3(0.0f));
     if (pugi::xml_node pn = p.find("position")) {
       if (has_to_world) return located(where(pn), "give position or to_world, not both");

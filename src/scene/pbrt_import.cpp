@@ -485,7 +485,7 @@ class Importer {
       PBRT_TRY(two, ps.boolean("twosided", false));
       if (ps.find("power")) return located(ps.find("power")->at, "parameter 'power' is not supported: give L and scale");
       if (auto e = ps.unused(what)) return e;
-      if (l.x < 0 || l.y < 0 || l.z < 0 || scale < 0) return located(at, "an area light's radiance must be non-negative");
+      if (auto e = import::check_light_value(l * static_cast<float>(scale), at)) return e;
       gs_.area = AreaLight{l * static_cast<float>(scale), two};
       return std::nullopt;
     }
@@ -585,8 +585,8 @@ class Importer {
     if (!point && !spot && !distant) return located(at, "light \"" + type + "\" is not supported, expected point, spot, distant or an AreaLightSource");
     PBRT_TRY(value, ps.rgb(distant ? "L" : "I", vec3(1.0f), false));
     PBRT_TRY(scale, ps.number("scale", 1.0));
-    if (value.x < 0 || value.y < 0 || value.z < 0 || scale < 0) return located(at, "a light's emission must be non-negative");
     const vec3 emitted = value * static_cast<float>(scale);
+    if (auto e = import::check_light_value(emitted, at)) return e;
     PBRT_TRY(from, ps.point("from", vec3(0.0f)));
     if (point) {
       builder_.add_light(PointLight{import::apply_point(gs_.ctm, from), emitted});

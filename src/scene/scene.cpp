@@ -18,6 +18,9 @@
 #include <nlohmann/json.hpp>
 #include <tiny_obj_loader.h>
 
+#include "io/input_file.h"
+#include "io/json_reader.h"
+
 namespace pathex {
 namespace {
 
@@ -26,75 +29,10 @@ using glm::vec3;
 
 float max_component(vec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
 
-// One reference token of a JSON pointer (RFC 6901): '~' is written "~0" and '/' is "~1".
-std::string pointer_token(std::string_view key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
-}
-
-class Reader {
+// The shared JSON reader (io/json_reader.h) plus the scene's own kind of value, the 3-vector.
+class Reader : public JsonReader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  Error fail(const std::string& pointer, std::string message) const {
-    Error e = make_error(ErrorCode::kBadFile, std::move(message));
-    e.where = file_ + ":" + (pointer.empty() ? "/" : pointer);
-    return e;
-  }
-
-  // The keys of `j` must be among `allowed` (plus "$schema" and "description").
-  Result<bool> keys(const json& j, const std::string& ptr, std::initializer_list<const char*> allowed) const {
-    if (!j.is_object()) return fail(ptr, "expected an object, found " + kind(j));
-    for (const auto& [key, value] : j.items()) {
-      bool ok = key == "$schema" || key == "description";
-      for (const char* a : allowed) ok = ok || key == a;
-      if (!ok) {
-        std::string list;
-        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        return fail(ptr + "/" + pointer_token(key), "unknown key '" + key + "', expected one of " + list);
-      }
-    }
-    return true;
-  }
-
-  static std::string kind(const json& j) {
-    if (j.is_null()) return "null";
-    if (j.is_boolean()) return "a boolean";
-    if (j.is_number()) return "a number";
-    if (j.is_string()) return "a string";
-    if (j.is_array()) return "an array";
-    return "an object";
-  }
-
-  Result<double> number(const json& j, const std::string& key, const std::string& ptr, double lo, double hi,
-                        std::optional<double> fallback = std::nullopt) const {
-    const std::string p = ptr + "/" + key;
-    if (!j.contains(key)) {
-      if (fallback) return *fallback;
-      return fail(p, "missing " + key + ", expected a number");
-    }
-    const json& v = j.at(key);
-    if (!v.is_number()) return fail(p, "expected a number, found " + kind(v));
-    const double x = v.get<double>();
-    if (!std::isfinite(x)) return fail(p, "expected a finite number");
-    if (x < lo || x > hi) return fail(p, "expected a number in [" + fmt(lo) + ", " + fmt(hi) + "], found " + fmt(x));
-    return x;
-  }
-
-  Result<int> integer(const json& j, const std::string& key, const std::string& ptr, int lo, int hi, int fallback) const {
-    const std::string p = ptr + "/" + key;
-    if (!j.contains(key)) return fallback;
-    const json& v = j.at(key);
-    if (!v.is_number_integer()) return fail(p, "expected an integer, found " + v.dump());
-    const long long x = v.get<long long>();
-    if (x < lo || x > hi) return fail(p, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " + std::to_string(x));
-    return static_cast<int>(x);
-  }
+  using JsonReader::JsonReader;
 
   // A 3-vector; `nonneg` for colours, `unit` requires a non-zero length (normalised by callers).
   Result<vec3> vector3(const json& j, const std::string& key, const std::string& ptr, bool required,
@@ -133,21 +71,6 @@ class Reader {
     return v;
   }
 
-  Result<std::string> string(const json& j, const std::string& key, const std::string& ptr) const {
-    const std::string p = ptr + "/" + key;
-    if (!j.contains(key)) return fail(p, "missing " + key + ", expected a string");
-    if (!j.at(key).is_string()) return fail(p, "expected a string, found " + kind(j.at(key)));
-    return j.at(key).get<std::string>();
-  }
-
-  static std::string fmt(double x) {
-    std::ostringstream s;
-    s << x;
-    return s.str();
-  }
-
- private:
-  std::string file_;
 };
 
 #define PATHEX_TRY(var, expr)      \
@@ -306,11 +229,14 @@ std::optional<std::string> check_corner(std::string_view item, const long long c
   return std::nullopt;
 }
 
-std::optional<Error> check_obj(const std::string& path, std::string_view text) {
+// Checks every `v` and `f` line, keeps the vertex positions and counts the faces.
+std::optional<Error> scan_obj(const std::string& path, std::string_view text, std::vector<vec3>* positions,
+                              std::size_t* faces) {
   long long counts[3] = {0, 0, 0};  // v, vt, vn defined so far
   std::vector<std::string_view> words;
   int line_no = 0;
   std::size_t pos = 0;
+  *faces = 0;
   while (pos < text.size()) {
     std::size_t eol = text.find('\n', pos);
     if (eol == std::string_view::npos) eol = text.size();
@@ -324,12 +250,15 @@ std::optional<Error> check_obj(const std::string& path, std::string_view text) {
     if (tag == "v") {
       if (words.size() < 4)
         return obj_error(path, line_no, "a vertex needs 3 coordinates, found " + std::to_string(words.size() - 1));
+      vec3 p;
       for (std::size_t i = 1; i < 4; ++i) {
         double x = 0;
         if (!parse_double(words[i], &x)) return obj_error(path, line_no, "bad vertex coordinate '" + std::string(words[i]) + "', expected a number");
         if (!std::isfinite(x) || std::fabs(x) > 1e30)
           return obj_error(path, line_no, "vertex coordinate " + std::string(words[i]) + " is not finite (or beyond 1e30)");
+        p[static_cast<int>(i - 1)] = static_cast<float>(x);
       }
+      positions->push_back(p);
       ++counts[0];
     } else if (tag == "vt") {
       ++counts[1];
@@ -337,37 +266,32 @@ std::optional<Error> check_obj(const std::string& path, std::string_view text) {
       ++counts[2];
     } else if (tag == "f") {
       if (words.size() < 4) return obj_error(path, line_no, "a face needs at least 3 vertices, found " + std::to_string(words.size() - 1));
+      if (words.size() - 1 > kMaxFaceCorners)
+        return obj_error(path, line_no, "a face of " + std::to_string(words.size() - 1) + " corners exceeds the limit of " +
+                                            std::to_string(kMaxFaceCorners) + " (split or triangulate it in the modeller)");
       for (std::size_t i = 1; i < words.size(); ++i)
         if (std::optional<std::string> m = check_corner(words[i], counts)) return obj_error(path, line_no, *m);
+      ++*faces;
     }
   }
   return std::nullopt;
 }
 
-Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file) {
-  const std::string path = (std::filesystem::path(base_dir) / file).string();
-  if (!std::ifstream(path, std::ios::binary)) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
-  Result<MeshShape> mesh = load_obj_mesh(path);
-  if (!mesh) return mesh.error();
-  if (mesh->triangles.empty()) return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
-  mesh->file = file;
-  return mesh;
-}
-
-}  // namespace
-
-Result<MeshShape> load_obj_mesh(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    Error e = make_error(ErrorCode::kBadFile, "cannot open the mesh");
-    e.where = path;
-    return e;
-  }
+// The OBJ at `path`: checked and scanned for its vertices and faces, then (if asked) triangulated.
+Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& options, std::size_t* faces) {
+  MeshShape mesh;
+  mesh.file = path;
   {  // the text is released before tinyobjloader reads the file again, to keep peak memory low
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (std::optional<Error> e = check_obj(path, std::move(ss).str())) return *e;
+    Result<std::string> text = read_input_file(path, options.max_file_bytes);
+    if (!text) {
+      if (text.error().code == ErrorCode::kLimit) return text.error();
+      Error e = make_error(ErrorCode::kBadFile, "cannot open the mesh");
+      e.where = path;
+      return e;
+    }
+    if (std::optional<Error> e = scan_obj(path, *text, &mesh.positions, faces)) return *e;
   }
+  if (!options.triangles) return mesh;  // the positions alone: bounds and types, no triangulation
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
@@ -377,9 +301,8 @@ Result<MeshShape> load_obj_mesh(const std::string& path) {
     e.where = path;
     return e;
   }
-  MeshShape mesh;
-  mesh.file = path;
   const auto& v = reader.GetAttrib().vertices;
+  mesh.positions.clear();
   mesh.positions.reserve(v.size() / 3);
   for (std::size_t i = 0; i + 2 < v.size(); i += 3) mesh.positions.emplace_back(v[i], v[i + 1], v[i + 2]);
   for (const auto& shape : reader.GetShapes())
@@ -387,7 +310,36 @@ Result<MeshShape> load_obj_mesh(const std::string& path) {
       mesh.triangles.emplace_back(static_cast<unsigned>(shape.mesh.indices[i].vertex_index),
                                   static_cast<unsigned>(shape.mesh.indices[i + 1].vertex_index),
                                   static_cast<unsigned>(shape.mesh.indices[i + 2].vertex_index));
+  // check_obj and tinyobjloader split some bytes differently (a NUL, a lone carriage return): a
+  // face tinyobjloader kept may then name a vertex it did not read (found by fuzz/obj_fuzz.cpp).
+  for (const glm::uvec3& t : mesh.triangles)
+    if (std::max(t.x, std::max(t.y, t.z)) >= mesh.positions.size()) {
+      Error e = make_error(ErrorCode::kBadFile, "a face refers to a vertex that was not read; expected plain text lines "
+                                                "(no NUL bytes or lone carriage returns)");
+      e.where = path;
+      return e;
+    }
   return mesh;
+}
+
+Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file,
+                           const SceneLoadOptions& options) {
+  const std::string path = (std::filesystem::path(base_dir) / file).string();
+  if (!std::ifstream(path, std::ios::binary)) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+  std::size_t faces = 0;
+  Result<MeshShape> mesh = read_obj(path, options, &faces);
+  if (!mesh) return mesh.error();
+  if (faces == 0 || (options.triangles && mesh->triangles.empty()))
+    return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
+  mesh->file = file;
+  return mesh;
+}
+
+}  // namespace
+
+Result<MeshShape> load_obj_mesh(const std::string& path, const SceneLoadOptions& options) {
+  std::size_t faces = 0;
+  return read_obj(path, options, &faces);
 }
 
 namespace {
@@ -578,8 +530,8 @@ Result<Camera> read_camera(const Reader& r, const json& j, const std::string& pt
   } else {
     PATHEX_TRY(w, r.integer(j, "width", ptr, 1, 16384, 64));
     PATHEX_TRY(h, r.integer(j, "height", ptr, 1, 16384, 64));
-    c.width = w;
-    c.height = h;
+    c.width = static_cast<int>(w);
+    c.height = static_cast<int>(h);
   }
   return c;
 }
@@ -626,7 +578,7 @@ Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr)
 }
 
 Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr, const Scene& scene,
-                         const std::string& base_dir) {
+                         const std::string& base_dir, const SceneLoadOptions& options) {
   if (!j.is_object()) return r.fail(ptr, "expected a shape object, found " + Reader::kind(j));
   PATHEX_TRY(type, r.string(j, "type", ptr));
   Shape s;
@@ -690,7 +642,7 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
     s.geometry = DiskShape{apply_point(m, c), wn, static_cast<float>(rad) * scale};
   } else {
     PATHEX_TRY(file, r.string(j, "file", ptr));
-    PATHEX_TRY(mesh, load_obj(r, ptr, base_dir, file));
+    PATHEX_TRY(mesh, load_obj(r, ptr, base_dir, file, options));
     for (vec3& p : mesh.positions) p = apply_point(m, p);
     s.geometry = std::move(mesh);
   }
@@ -699,16 +651,10 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
 
 }  // namespace
 
-Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name) {
+Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
+                              const SceneLoadOptions& options) {
   const Reader r(name);
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::exception& ex) {  // parse errors, and numbers beyond a double (out_of_range)
-    std::string what = ex.what();  // "[json.exception.parse_error.101] parse error at line 1, …"
-    if (const std::size_t tag = what.find("] "); what.rfind("[json.exception", 0) == 0 && tag != std::string::npos) what.erase(0, tag + 2);
-    return r.fail("", "not valid JSON: " + what);
-  }
+  PATHEX_TRY(doc, parse_json(text, name));
   if (auto k = r.keys(doc, "", {"camera", "materials", "shapes", "lights"}); !k) return k.error();
   Scene scene;
   scene.name = name;
@@ -724,7 +670,7 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   if (!doc.contains("shapes") || !doc["shapes"].is_array()) return r.fail("/shapes", "expected an array of shapes");
   if (doc["shapes"].empty()) return r.fail("/shapes", "the scene is empty: expected at least one shape");
   for (std::size_t i = 0; i < doc["shapes"].size(); ++i) {
-    PATHEX_TRY(s, read_shape(r, doc["shapes"][i], "/shapes/" + std::to_string(i), scene, base_dir));
+    PATHEX_TRY(s, read_shape(r, doc["shapes"][i], "/shapes/" + std::to_string(i), scene, base_dir, options));
     scene.shapes.push_back(std::move(s));
   }
   // --- lights ---
@@ -753,20 +699,19 @@ std::optional<SceneRuleViolation> check_scene_rules(const Scene& scene) {
   return std::nullopt;
 }
 
-Result<Scene> load_scene_file(const std::string& path) {
+Result<Scene> load_scene_file(const std::string& path, const SceneLoadOptions& options) {
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".pbrt") return load_scene_pbrt(path);
   if (ext == ".xml") return load_scene_mitsuba(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  Result<std::string> text = read_input_file(path, options.max_file_bytes);
+  if (!text) {
+    if (text.error().code == ErrorCode::kLimit) return text.error();
     Error e = make_error(ErrorCode::kBadFile, "cannot open the scene file");
     e.where = path;
     return e;
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return load_scene_json(ss.str(), dir.empty() ? "." : dir, path);
+  return load_scene_json(*text, dir.empty() ? "." : dir, path, options);
 }
 
 SceneTypes scene_types(const Scene& scene) {

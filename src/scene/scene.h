@@ -25,6 +25,7 @@
 
 #include "alphabet/alphabet.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "scene/material.h"
 
 namespace pathex {
@@ -91,6 +92,17 @@ struct Scene {
   Camera camera;
 };
 
+// How much of a scene to load.
+struct SceneLoadOptions {
+  std::size_t max_file_bytes = Limits{}.max_file_bytes;  // the scene file and each mesh (--max-file-size)
+  // false: meshes keep their vertex positions but are not triangulated (enough for the scene's
+  // universe and the camera check; what `query --scene` and `check` need).
+  bool triangles = true;
+};
+// An OBJ face may have at most this many corners (tinyobjloader's triangulation of one polygon
+// is quadratic in its corners; a modeller's n-gons are far smaller).
+inline constexpr std::size_t kMaxFaceCorners = 1024;
+
 // The largest emission, intensity, irradiance or power component a scene may give. The tracer sums
 // contributions exactly in fixed point and counts one of 2^50 (about 1.1e15) or more as non-finite
 // (classify/histogram.h); 1e9 leaves a factor of 1e6 for what geometry and sampling multiply a
@@ -98,14 +110,15 @@ struct Scene {
 inline constexpr float kMaxLightValue = 1e9f;
 
 // `base_dir` resolves relative mesh paths; `name` prefixes error locations.
-Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name);
+Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
+                              const SceneLoadOptions& options = {});
 // The entry point of every command: dispatches on the extension. `.pbrt` is a pbrt-v4 scene
 // (scene/pbrt_import.h), `.xml` a Mitsuba 3 scene (scene/mitsuba_import.h), anything else JSON.
-Result<Scene> load_scene_file(const std::string& path);
+Result<Scene> load_scene_file(const std::string& path, const SceneLoadOptions& options = {});
 
 // An OBJ file's triangles (polygons fan-triangulated); errors name the OBJ file and line. The
 // result may have no triangles: callers say where the mesh was asked for.
-Result<MeshShape> load_obj_mesh(const std::string& path);
+Result<MeshShape> load_obj_mesh(const std::string& path, const SceneLoadOptions& options = {});
 
 // The scene-level rules above (a shape, a light, a camera that sees a shape), which every loader
 // checks once the scene is complete: the first one violated, with the JSON pointer it concerns.

@@ -170,7 +170,7 @@ TEST(Laws, ConstantsAndWords) {
   EXPECT_EQ(dfa_all().next, (std::vector<std::int32_t>{0, 0, 0, 0}));
   for (const Dfa& d : {dfa_empty(), dfa_all(), dfa_universe(), dfa_word(""), dfa_word("LDSE"), dfa_word("SSSS")})
     EXPECT_TRUE(canonical(d));
-  EXPECT_EQ(dfa_universe(), *compile(*parse("L[SD]{4,}E", kLimits), kLimits));
+  EXPECT_EQ(dfa_universe(), compile(parse("L[SD]{4,}E", kLimits).expect("a test input"), kLimits).expect("a test input"));
   EXPECT_EQ(dfa_universe().num_states, 8) << "start; after L with 0, 1, 2, 3, 4+ letters; after E; dead";
   for (const char* w : {"", "D", "LDSE", "SSSSSSSS"}) {
     const Dfa d = dfa_word(w);
@@ -191,10 +191,10 @@ TEST(Laws, DeMorgan) {
     EXPECT_EQ(not_and, dfa_union(dfa_complement(a.dfa), dfa_complement(b.dfa))) << what;
     // The same laws through the parser and compile().
     const std::string x = "(" + a.text + ")", y = "(" + b.text + ")";
-    EXPECT_EQ(*compile(*parse("~(" + x + "|" + y + ")", kLimits), kLimits), not_or) << what;
-    EXPECT_EQ(*compile(*parse("~" + x + "&~" + y, kLimits), kLimits), not_or) << what;
-    EXPECT_EQ(*compile(*parse("~(" + x + "&" + y + ")", kLimits), kLimits), not_and) << what;
-    EXPECT_EQ(*compile(*parse("~" + x + "|~" + y, kLimits), kLimits), not_and) << what;
+    EXPECT_EQ(compile(parse("~(" + x + "|" + y + ")", kLimits).expect("a test input"), kLimits).expect("a test input"), not_or) << what;
+    EXPECT_EQ(compile(parse("~" + x + "&~" + y, kLimits).expect("a test input"), kLimits).expect("a test input"), not_or) << what;
+    EXPECT_EQ(compile(parse("~(" + x + "&" + y + ")", kLimits).expect("a test input"), kLimits).expect("a test input"), not_and) << what;
+    EXPECT_EQ(compile(parse("~" + x + "|~" + y, kLimits).expect("a test input"), kLimits).expect("a test input"), not_and) << what;
     EXPECT_TABLE_EQ(dfa_table(not_or), combine(a.table, b.table, [](bool p, bool q) { return !(p || q); }), what);
     EXPECT_TABLE_EQ(dfa_table(not_and), combine(a.table, b.table, [](bool p, bool q) { return !(p && q); }), what);
   }
@@ -210,9 +210,9 @@ TEST(Laws, ComplementIsAnInvolutionAndPartitionsEverything) {
     EXPECT_TRUE(is_empty(dfa_intersect(a.dfa, na))) << label(seed, a);
     EXPECT_EQ(dfa_union(a.dfa, na), dfa_all()) << label(seed, a);
     const std::string x = "(" + a.text + ")";
-    EXPECT_EQ(*compile(*parse("~~" + x, kLimits), kLimits), a.dfa) << label(seed, a);
-    EXPECT_EQ(*compile(*parse(x + "&~" + x, kLimits), kLimits), dfa_empty()) << label(seed, a);
-    EXPECT_EQ(*compile(*parse(x + "|~" + x, kLimits), kLimits), dfa_all()) << label(seed, a);
+    EXPECT_EQ(compile(parse("~~" + x, kLimits).expect("a test input"), kLimits).expect("a test input"), a.dfa) << label(seed, a);
+    EXPECT_EQ(compile(parse(x + "&~" + x, kLimits).expect("a test input"), kLimits).expect("a test input"), dfa_empty()) << label(seed, a);
+    EXPECT_EQ(compile(parse(x + "|~" + x, kLimits).expect("a test input"), kLimits).expect("a test input"), dfa_all()) << label(seed, a);
     EXPECT_TABLE_EQ(dfa_table(na), combine(a.table, a.table, [](bool p, bool) { return !p; }), label(seed, a));
   }
 }
@@ -237,7 +237,7 @@ TEST(Laws, UnionIntersectionDifferenceConcatAgreeWithTheOracle) {
         want[k] = a.table[oracle::shortlex_index(s.substr(0, m))] && b.table[oracle::shortlex_index(s.substr(m))];
     }
     EXPECT_TABLE_EQ(dfa_table(*cat), want, "concatenation of " + what);
-    EXPECT_EQ(*cat, *compile(*parse("(" + a.text + ")(" + b.text + ")", kLimits), kLimits)) << what;
+    EXPECT_EQ(*cat, compile(parse("(" + a.text + ")(" + b.text + ")", kLimits).expect("a test input"), kLimits).expect("a test input")) << what;
   }
 }
 
@@ -333,7 +333,7 @@ TEST(Laws, CanonicalNumberingMakesEqualLanguagesEqualValues) {
   };
   std::vector<Dfa> firsts;
   for (const auto& group : groups) {
-    const Dfa first = *compile(*parse(group[0], kLimits), kLimits);
+    const Dfa first = compile(parse(group[0], kLimits).expect("a test input"), kLimits).expect("a test input");
     EXPECT_TRUE(canonical(first)) << group[0];
     for (const std::string& t : group) {
       const Case c = make_case(t);
@@ -381,14 +381,14 @@ TEST(Laws, ReversalIsAnInvolutionAndReadsStringsBackwards) {
     }
     EXPECT_TABLE_EQ(dfa_table(*r), want, "reversal of " + label(seed, a));
     // The tree of the reversed language (regex/ast.h) compiles to the same automaton.
-    EXPECT_EQ(*compile(reversed(a.ast), kLimits), *r) << label(seed, a);
+    EXPECT_EQ(compile(reversed(a.ast), kLimits).expect("a test input"), *r) << label(seed, a);
   }
 }
 
 TEST(Laws, ReversalStopsAtTheStateLimit) {
   // (S|D){12}S(S|D)* needs 15 states (12 counted letters, the S, the accepting loop, dead); its
   // reversal (S|D)*S(S|D){12} must remember the last 13 letters: 2^13 states plus the dead one.
-  const Dfa d = *compile(*parse("(S|D){12}S(S|D)*", kLimits), kLimits);
+  const Dfa d = compile(parse("(S|D){12}S(S|D)*", kLimits).expect("a test input"), kLimits).expect("a test input");
   EXPECT_EQ(d.num_states, 15);
   Result<Dfa> full = dfa_reverse(d, kLimits);
   ASSERT_TRUE(full.ok());

@@ -220,10 +220,10 @@ TEST(OracleCompile, DetectsAWrongDfa) {
   EXPECT_EQ(report, "  'LSDSDDSSSE': oracle accepts, the DFA does not\n");
   report.clear();
   const Regex six = parse_or_die("S{2,6}");
-  EXPECT_EQ(disagreements(six, *compile(parse_or_die("S{2,5}"), kLimits), kMaxLen, &report), 1u);
+  EXPECT_EQ(disagreements(six, compile(parse_or_die("S{2,5}"), kLimits).expect("a test input"), kMaxLen, &report), 1u);
   EXPECT_EQ(report, "  'SSSSSS': oracle accepts, the DFA does not\n");
   report.clear();
-  EXPECT_EQ(disagreements(parse_or_die("~(S{2,6})"), *compile(parse_or_die("~(S{2,5})"), kLimits), kMaxLen, &report), 1u);
+  EXPECT_EQ(disagreements(parse_or_die("~(S{2,6})"), compile(parse_or_die("~(S{2,5})"), kLimits).expect("a test input"), kMaxLen, &report), 1u);
   EXPECT_EQ(report, "  'SSSSSS': oracle rejects, the DFA does not\n");
 }
 

@@ -317,7 +317,9 @@ TEST(Histogram, NonFiniteContributionsAreCountedAndNeverAdded) {
   Result<HistogramReport> rc = make_report(clean, RunInfo{}, nullptr, {});
   Result<HistogramReport> rd = make_report(dirty, RunInfo{}, nullptr, {});
   ASSERT_TRUE(rc && rd);
+  ASSERT_TRUE(rd.ok());
   EXPECT_EQ(rd->nonfinite_samples, 6u);
+  ASSERT_TRUE(rc.ok());
   EXPECT_EQ(rd->total.rgb, rc->total.rgb);
   EXPECT_EQ(rd->total.samples, 2u);
   EXPECT_DOUBLE_EQ(rd->total.rgb[0], 3.0 / 4);

@@ -112,14 +112,17 @@ TEST(Resume, AnInterruptedRenderResumedIsTheUninterruptedRender) {
   EXPECT_EQ(histogram(cut)["complete"], true);
 }
 
+// Also: the resolution and the path table's bound come back from the folder.
 TEST(Resume, AShardResumedIsTheWholeShard) {
-  const std::string args = "trace samples/scenes/cornell.json --spp 16 --shard 1/2 --quiet";
+  const std::string args = "trace samples/scenes/cornell.json --spp 16 --shard 1/2 --resolution 40x30 --max-paths 5 --quiet";
   const std::string whole = dir("whole"), cut = dir("cut");
   ASSERT_EQ(run_pathex(args + " --out " + whole).code, 0);
   ASSERT_EQ(run_pathex(args + " --time 0.000001 --out " + cut).code, 1);
   EXPECT_EQ(histogram(cut)["spp"], 4);
   ASSERT_EQ(run_pathex("trace --resume " + cut + " --quiet").code, 0);
   expect_same_outputs(whole, cut, "resumed shard");
+  EXPECT_EQ(histogram(cut)["max_paths"], 5);
+  EXPECT_EQ(histogram(cut)["paths"].back()["path"], "other");
 }
 
 TEST(Resume, TakesItsSettingsFromTheFolder) {

@@ -1,6 +1,9 @@
 // Pass sets and the shard file format (io/shard.h): exact round trips of the sums, and every
 // damaged file refused with its own message.
 #include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <nlohmann/json.hpp>
 
 #include "core/pass_set.h"
 #include "io/shard.h"
@@ -104,12 +107,60 @@ TEST(ShardFile, EveryTruncationAndEveryFlippedByteIsRefused) {
     Result<ShardFile> file = parse_shard(bad, "x.shard");
     ASSERT_FALSE(file) << i;
   }
-  EXPECT_EQ(parse_shard("hello, world, not a shard", "x").error().message,
-            "not a pathex shard file (it does not begin with \"PXSHARD\")");
+  const auto message = [](const std::string& b) {
+    Result<ShardFile> file = parse_shard(b, "x");
+    return file ? std::string("(read)") : file.error().message;
+  };
+  EXPECT_EQ(message("hello, world, not a shard"), "not a pathex shard file (it does not begin with \"PXSHARD\")");
   std::string v2 = bytes;
   v2[8] = 2;
-  EXPECT_EQ(parse_shard(v2, "x").error().message, "shard file format version 2; this pathex reads version 1");
-  EXPECT_EQ(parse_shard(bytes + "x", "x").error().message, "corrupted shard file: 1 bytes after its checksum");
+  EXPECT_EQ(message(v2), "shard file format version 2; this pathex reads version 1");
+  EXPECT_EQ(message(bytes + "x"), "corrupted shard file: 1 bytes after its checksum");
+}
+
+// The file with its JSON header replaced by `head` (lengths and checksum made right again), as a
+// newer or hand-edited writer would make it.
+std::string with_header(const std::string& bytes, const std::string& head) {
+  std::uint32_t h = 0;
+  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
+  std::string out = bytes.substr(0, 12);
+  for (std::size_t i = 0; i < 4; ++i) out.push_back(static_cast<char>((head.size() >> (8 * i)) & 0xff));
+  out += head + bytes.substr(16 + h, bytes.size() - 16 - h - 4);
+  const auto crc = static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
+  for (std::size_t i = 0; i < 4; ++i) out.push_back(static_cast<char>((crc >> (8 * i)) & 0xff));
+  return out;
+}
+
+// The header goes through the one JSON reader: a wrong value is refused at its JSON pointer.
+TEST(ShardFile, HeaderErrorsNameTheFileAndThePointer) {
+  Fixture f;
+  const std::string bytes = encode_shard(f.header, f.histogram, f.images);
+  std::uint32_t h = 0;
+  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
+  const nlohmann::ordered_json head = nlohmann::ordered_json::parse(bytes.substr(16, h));
+  const auto refusal = [&](const nlohmann::ordered_json& j) {
+    Result<ShardFile> file = parse_shard(with_header(bytes, j.dump()), "x.shard");
+    return file ? std::string("(read)") : file.error().render();
+  };
+  EXPECT_EQ(refusal(head), "(read)");  // the rewriting itself is sound
+  nlohmann::ordered_json j = head;
+  j["options"]["images"] = "yes";
+  EXPECT_EQ(refusal(j), "x.shard:/options/images: expected true or false, found a string");
+  j = head;
+  j["seed"] = -1;
+  EXPECT_EQ(refusal(j), "x.shard:/seed: expected an integer in [0, 18446744073709551615], found -1");
+  j = head;
+  j["colour"] = 1;
+  EXPECT_EQ(refusal(j).rfind("x.shard:/colour: unknown key 'colour', expected one of pathex, scene,", 0), 0u) << refusal(j);
+  j = head;
+  j.erase("passes");
+  EXPECT_EQ(refusal(j), "x.shard:/passes: missing passes");
+  j = head;
+  j["passes"] = {{4, 2}};
+  EXPECT_EQ(refusal(j), "x.shard:/passes/0: expected [first, last) with first < last, after the previous range");
+  Result<ShardFile> bad_json = parse_shard(with_header(bytes, "{\"pathex\": "), "x.shard");
+  ASSERT_FALSE(bad_json);
+  EXPECT_EQ(bad_json.error().message.rfind("not valid JSON: ", 0), 0u) << bad_json.error().message;
 }
 
 }  // namespace

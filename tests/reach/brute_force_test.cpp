@@ -61,14 +61,16 @@ std::string random_middle(std::mt19937_64& rng, int depth) {
 TEST(BruteForce, VerdictsAgreeWithStrategyDefinitions) {
   std::mt19937_64 rng(20261122);
   const std::vector<std::string> paths = valid_paths_up_to_10();
-  const std::vector<Profile> profiles = builtin_profiles(kLimits);
+  Result<std::vector<Profile>> parsed = builtin_profiles(kLimits);
+  ASSERT_TRUE(parsed.ok());
+  const std::vector<Profile>& profiles = *parsed;
   ASSERT_GE(profiles.size(), 13u);
   std::vector<CompiledProfile> compiled;
   std::vector<std::vector<Regex>> chains;
   for (const Profile& p : profiles) {
-    compiled.push_back(*compile_profile(p, kBound, kLimits));
+    compiled.push_back(compile_profile(p, kBound, kLimits).expect("a test input"));
     chains.emplace_back();
-    for (const Strategy& st : p.strategies) chains.back().push_back(*parse(st.chain, kLimits));
+    for (const Strategy& st : p.strategies) chains.back().push_back(parse(st.chain, kLimits).expect("a test input"));
   }
   // R itself, path by path, for every profile.
   for (std::size_t i = 0; i < profiles.size(); ++i)
@@ -101,7 +103,7 @@ TEST(BruteForce, VerdictsAgreeWithStrategyDefinitions) {
                            : !any_out          ? Verdict::kReachable
                            : !any_in           ? Verdict::kUnreachable
                                                : Verdict::kPartial;
-      const Verdict got = query(*pc, compiled[i], qo)->verdict;
+      const Verdict got = query(*pc, compiled[i], qo).expect("a test input").verdict;
       ASSERT_EQ(got, want) << expr << " with " << profiles[i].name;
       (want == Verdict::kPartial ? partial : want == Verdict::kReachable ? reachable : want == Verdict::kUnreachable ? unreachable : empty)++;
     }

@@ -40,7 +40,7 @@ const char* const kPlainJoin[] = {"pt", "pt-nee", "lt", "bdpt", "pbrt-v4-path", 
 
 TEST(SeedFacts, BdptReachesExactlyTheLocalPaths) {
   // "local path sampling reaches exactly the paths that contain DD" (Veach 8.3.3).
-  const Dfa local = compile_class("L.*DD.*E", ClassOptions{})->dfa;
+  const Dfa local = compile_class("L.*DD.*E", ClassOptions{}).expect("a test input").dfa;
   EXPECT_TRUE(is_equivalent(compiled("bdpt").reachable, local));
   EXPECT_EQ(verdict("$local", "bdpt"), Verdict::kReachable);
   EXPECT_EQ(verdict("~$local", "bdpt"), Verdict::kUnreachable);
@@ -50,7 +50,8 @@ TEST(SeedFacts, PointLightSeenByOrthographicCamera) {
   // LSDSDE: a point light seen directly by an orthographic camera. No plain join can sample it.
   for (const char* r : kPlainJoin) EXPECT_EQ(verdict("LSDSDE", r), Verdict::kUnreachable) << r;
   EXPECT_EQ(verdict("LSDSDE", "bdpt+ortho"), Verdict::kReachable);
-  Result<QueryResult> q = query(*compile_class("LSDSDE", ClassOptions{}), compiled("bdpt"), QueryOptions{});
+  Result<QueryResult> q = query(compile_class("LSDSDE", ClassOptions{}).expect("a test input"), compiled("bdpt"), QueryOptions{});
+  ASSERT_TRUE(q.ok());
   ASSERT_EQ(q->unreachable.size(), 1u);
   const Witness& w = q->unreachable[0];
   EXPECT_EQ(w.path, "LSDSDE");
@@ -71,7 +72,7 @@ TEST(SeedFacts, PointMirrorDiffuseOrthographic) {
   // The mirror connector stands only where its S is an interior vertex: not at c0..c2 or at
   // ck..c(k+2), where the S letters are the light's or the sensor's.
   EXPECT_EQ(verdict("LSDSDE", "bdpt+mirror"), Verdict::kUnreachable);
-  const Profile mirror = *resolve_profile("bdpt+mirror", kLimits);
+  const Profile mirror = resolve_profile("bdpt+mirror", kLimits).expect("a test input");
   const Strategy& connector = mirror.strategies[1];
   EXPECT_FALSE(strategy_samples(connector, "LSDSDE", std::nullopt));   // c1..c3: the sensor's S
   EXPECT_FALSE(strategy_samples(connector, "LDSDDE", std::nullopt));   // c0..c2: the light's S
@@ -169,8 +170,8 @@ TEST(TypeTable, HeckbertClassesOverSceneTypes) {
   Result<PathClass> pc = compile_class("LDE", o);
   ASSERT_TRUE(pc.ok());
   EXPECT_EQ(enumerate_members(pc->dfa, 20, 10), std::vector<std::string>({"LSDDDSE"}));
-  EXPECT_EQ(query(*pc, compiled("pt"), QueryOptions{})->verdict, Verdict::kUnreachable);
-  EXPECT_EQ(query(*pc, compiled("pt-nee"), QueryOptions{})->verdict, Verdict::kReachable);
+  EXPECT_EQ(query(*pc, compiled("pt"), QueryOptions{}).expect("a test input").verdict, Verdict::kUnreachable);
+  EXPECT_EQ(query(*pc, compiled("pt-nee"), QueryOptions{}).expect("a test input").verdict, Verdict::kReachable);
 }
 
 // --- bounds, evidence, counts ---
@@ -179,7 +180,8 @@ TEST(Query, MaxBouncesMakesLongPathsUnreachable) {
   // pbrt-v4-path has maxdepth 5: LDD D{5} DSE reachable, D{6} not.
   EXPECT_EQ(verdict("LDDD{5}DSE", "pbrt-v4-path"), Verdict::kReachable);
   EXPECT_EQ(verdict("LDDD{6}DSE", "pbrt-v4-path"), Verdict::kUnreachable);
-  Result<QueryResult> q = query(*compile_class("LDDD+DSE", ClassOptions{}), compiled("pbrt-v4-path"), QueryOptions{});
+  Result<QueryResult> q = query(compile_class("LDDD+DSE", ClassOptions{}).expect("a test input"), compiled("pbrt-v4-path"), QueryOptions{});
+  ASSERT_TRUE(q.ok());
   EXPECT_EQ(q->verdict, Verdict::kPartial);
   EXPECT_TRUE(q->finite_reachable);
   EXPECT_FALSE(q->finite_unreachable);
@@ -189,7 +191,8 @@ TEST(Query, MaxBouncesMakesLongPathsUnreachable) {
 }
 
 TEST(Query, ReachableWitnessesNameTheirStrategies) {
-  Result<QueryResult> q = query(*compile_class("LDDDDSE", ClassOptions{}), compiled("pt-nee"), QueryOptions{});
+  Result<QueryResult> q = query(compile_class("LDDDDSE", ClassOptions{}).expect("a test input"), compiled("pt-nee"), QueryOptions{});
+  ASSERT_TRUE(q.ok());
   ASSERT_EQ(q->reachable.size(), 1u);
   EXPECT_EQ(q->reachable[0].strategies, std::vector<std::string>({"emitter-hit", "nee"}));
 }
@@ -200,7 +203,8 @@ TEST(Query, CountsByLengthAreExact) {
   // reaches those with ab = DD by an emitter hit (4, any sensor); NEE needs c1 c2 = DD but c2 = S.
   QueryOptions o;
   o.max_len = 8;
-  Result<QueryResult> q = query(*compile_class("$caustic", ClassOptions{}), compiled("pt-nee"), o);
+  Result<QueryResult> q = query(compile_class("$caustic", ClassOptions{}).expect("a test input"), compiled("pt-nee"), o);
+  ASSERT_TRUE(q.ok());
   EXPECT_EQ(q->counts_class[7].to_string(), "0");
   EXPECT_EQ(q->counts_class[8].to_string(), "16");
   EXPECT_EQ(q->counts_reachable[8].to_string(), "4");
@@ -210,15 +214,18 @@ TEST(Query, CountsByLengthAreExact) {
 
 TEST(Query, EmptyClassInARestrictedUniverse) {
   QueryOptions o;
-  o.universe = compile_class("LSD.*DSE", ClassOptions{})->dfa;  // point lights and a pinhole
-  Result<QueryResult> q = query(*compile_class("LDD.*E", ClassOptions{}), compiled("bdpt"), o);
+  o.universe = compile_class("LSD.*DSE", ClassOptions{}).expect("a test input").dfa;  // point lights and a pinhole
+  Result<QueryResult> q = query(compile_class("LDD.*E", ClassOptions{}).expect("a test input"), compiled("bdpt"), o);
+  ASSERT_TRUE(q.ok());
   EXPECT_EQ(q->verdict, Verdict::kEmpty);
 }
 
 // --- profiles ---
 
 TEST(Profiles, EveryBuiltinParses) {
-  EXPECT_EQ(builtin_profiles(kLimits).size(), builtin_profile_texts().size());
+  Result<std::vector<Profile>> all = builtin_profiles(kLimits);
+  ASSERT_TRUE(all.ok());
+  EXPECT_EQ(all->size(), builtin_profile_texts().size());
   for (const BuiltinProfileText& b : builtin_profile_texts()) {
     Result<Profile> p = parse_profile(b.json, b.name, kLimits);
     EXPECT_TRUE(p.ok()) << b.name << ": " << (p.ok() ? "" : p.error().render());
@@ -262,7 +269,7 @@ TEST(Profiles, BadProfilesNameTheJsonPointer) {
        "unknown connector 'warp', expected mirror, distant-projection, ortho-projection or manifold"},
       {R"({"name": "x", "strategies": []})", "p.json:/strategies", "expected a non-empty array of strategies"},
       {R"({"name": "x", "max_bounces": -1, "strategies": [{"s": 0, "t": 2}]})", "p.json:/max_bounces",
-       "expected a non-negative integer (or null for unbounded), found -1"},
+       "expected a non-negative integer up to 10000 (or null for unbounded), found -1"},
       {R"({"strategies": [{"s": 0, "t": 2}]})", "p.json:/name", "expected a non-empty string name"},
       {R"({"name": "x", "strategies": [{"s": 0, "chain": "D(D", "t": 2}]})", "p.json:/strategies/0/chain",
        "missing ')' to close this '('"},
@@ -276,9 +283,9 @@ TEST(Profiles, BadProfilesNameTheJsonPointer) {
 }
 
 TEST(Profiles, RangeParsing) {
-  EXPECT_EQ(parse_range("2")->to_string(), "2");
-  EXPECT_EQ(parse_range("0..1")->to_string(), "0..1");
-  EXPECT_EQ(parse_range("2..")->to_string(), "2..");
+  EXPECT_EQ(parse_range("2").expect("a test input").to_string(), "2");
+  EXPECT_EQ(parse_range("0..1").expect("a test input").to_string(), "0..1");
+  EXPECT_EQ(parse_range("2..").expect("a test input").to_string(), "2..");
   EXPECT_FALSE(parse_range("..2").ok());
   EXPECT_FALSE(parse_range("-1").ok());
   EXPECT_FALSE(parse_range("a").ok());

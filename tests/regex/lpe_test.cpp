@@ -160,11 +160,14 @@ TEST(LpeEmit, BuiltinsAndKnownAnswers) {
   for (const auto& c : ClassTable::builtins().builtin_classes()) expect_round_trip(c->dfa, "$" + c->name);
   Result<LpeEmission> caustic = emit_lpe(full("$caustic"), Limits{});
   ASSERT_TRUE(caustic.ok());
+  EXPECT_EQ(caustic->lpe, "C[DGS]*[DG]S+[LO]");  // (S*[DG])+ is written [DGS]*[DG]
   EXPECT_TRUE(caustic->exact);
   Result<LpeEmission> direct = emit_lpe(full("$direct"), Limits{});
+  ASSERT_TRUE(direct.ok());
   EXPECT_EQ(direct->lpe, "C[DGS][LO]");
   EXPECT_TRUE(direct->exact);
   Result<LpeEmission> emission = emit_lpe(full("$emission"), Limits{});
+  ASSERT_TRUE(emission.ok());
   EXPECT_EQ(emission->lpe, "C[LO]");
 
   // A point light seen by an orthographic camera: the LPE is CL and loses both types.
@@ -179,10 +182,11 @@ TEST(LpeEmit, BuiltinsAndKnownAnswers) {
 
   // $local allows every light and sensor type but ties DD to the ends: an LPE cannot say so.
   Result<LpeEmission> local = emit_lpe(full("$local"), Limits{});
+  ASSERT_TRUE(local.ok());
   EXPECT_EQ(local->lpe, "C[DGS]*[LO]");
   EXPECT_EQ(local->losses, (std::vector<std::string>{
                                "the class ties its interior letters to particular light or sensor types; an LPE cannot"}));
-  EXPECT_TRUE(emit_lpe(full("LSDE"), Limits{})->empty);
+  EXPECT_TRUE(emit_lpe(full("LSDE"), Limits{}).expect("a test input").empty);
 }
 
 // Random classes: unions of a few random full paths and random end-product classes.
@@ -212,10 +216,11 @@ TEST(LpeFullPathForm, IsTheClassAndFactorsTheEnds) {
     }
     EXPECT_EQ(full(*f), cls) << e["full"].get<std::string>() << " printed as " << *f;
   }
-  EXPECT_EQ(*full_path_expression(lpe("C<RD>L"), Limits{}), "L..D..E");
-  EXPECT_EQ(*full_path_expression(lpe("C<RD>S+L"), Limits{}), "L..S+D..E");
-  EXPECT_EQ(*full_path_expression(lpe("C.*DS+L"), Limits{}), "L..S+D.*..E");
-  EXPECT_EQ(*full_path_expression(lpe("CO"), Limits{}), "LDD..E");
+  EXPECT_EQ(full_path_expression(lpe("C<RD>L"), Limits{}).expect("a test input"), "L..D..E");
+  EXPECT_EQ(full_path_expression(lpe("C<RD>S+L"), Limits{}).expect("a test input"), "L..S+D..E");
+  EXPECT_EQ(full_path_expression(lpe("C.*DS+L"), Limits{}).expect("a test input"), "L..S+D.*..E");
+  EXPECT_EQ(full_path_expression(lpe("CO"), Limits{}).expect("a test input"), "LDD..E");
+  EXPECT_EQ(full_path_expression(lpe("C<RD>.*"), Limits{}).expect("a test input"), "L...*D..E");
 }
 
 // State elimination alone, on random DFAs of random expressions, printed in full notation.
@@ -232,14 +237,14 @@ TEST(ToRegex, EliminationGivesTheSameLanguage) {
     }
     Result<Regex> r = parse(expr, Limits{});
     ASSERT_TRUE(r.ok()) << expr;
-    const Dfa d = *compile(*r, Limits{});
+    const Dfa d = compile(*r, Limits{}).expect("a test input");
     Result<Expr> x = dfa_to_expr(d, 2000, 100000);
     ASSERT_TRUE(x.ok());
     const std::string text = to_full_notation(*x);
     if (nullable(*x)) continue;  // ε cannot be written on its own in pathex syntax
     Result<Regex> back = parse(text, Limits{});
     ASSERT_TRUE(back.ok()) << expr << " -> " << text;
-    EXPECT_EQ(*compile(*back, Limits{}), d) << expr << " -> " << text;
+    EXPECT_EQ(compile(*back, Limits{}).expect("a test input"), d) << expr << " -> " << text;
   }
 }
 
@@ -250,6 +255,7 @@ TEST(HeckbertHint, HeckbertStringsInFullNotationGetOne) {
       ", which writes two letters for each light and sensor; for Heckbert's classic L…E add --notation heckbert";
   auto hint = [](const std::string& text) {
     Result<PathClass> c = compile_class(text, ClassOptions{});
+    EXPECT_TRUE(c.ok()) << text;
     return heckbert_hint(text, *c, ClassOptions{}, nullptr);
   };
   EXPECT_EQ(hint("LSDE"), "'LSDE' matches no path in full notation" + tail);

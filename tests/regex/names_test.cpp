@@ -20,7 +20,7 @@ TEST(Names, EyeFirstClassIsReversedWhereItIsUsed) {
   ASSERT_NE(both, nullptr);
   EXPECT_FALSE(both->eye_first);
   EXPECT_EQ(enumerate_members(both->dfa, 7, 10), std::vector<std::string>({"LDDDDE", "LSDDDE", "LSDDDDE"}));
-  EXPECT_TRUE(is_equivalent(table.find("cam")->dfa, compile_class("LSD*E", ClassOptions{})->dfa));
+  EXPECT_TRUE(is_equivalent(table.find("cam")->dfa, compile_class("LSD*E", ClassOptions{}).expect("a test input").dfa));
 }
 
 TEST(Names, ClassFilesAreFullNotationUnlessAnEntrySaysSo) {

@@ -93,12 +93,12 @@ Rendered render_small(Scene scene, std::uint64_t seed, std::uint64_t spp) {
   o.seed = seed;
   o.threads = 2;
   o.max_bounces = 6;
-  const Profile profile = *resolve_profile("pt-nee", Limits{});
+  const Profile profile = resolve_profile("pt-nee", Limits{}).expect("a test input");
   Result<RenderOutput> out = render(scene, profile, nullptr, o);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
   RunInfo info;
   info.spp = spp;
-  Rendered r{*make_report(out->histogram, info, nullptr, {}), {}};
+  Rendered r{make_report(out->histogram, info, nullptr, {}).expect("a test input"), {}};
   const ImageLayer total = out->images.layer(0, 1.0 / static_cast<double>(spp));
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x)
@@ -415,8 +415,13 @@ std::vector<Refusal> refusals() {
       {"self.pbrt", "Include \"loop.pbrt\"\n", "loop.pbrt:1:1", "Include/Import nested more than 32 deep (a file including itself?)"},
       {"end.pbrt", "AttributeEnd\n", "end.pbrt:4:1", "AttributeEnd has no matching AttributeBegin"},
       {"string.pbrt", "Shape \"sphere\n", "string.pbrt:4:7", "unterminated string, expected a closing '\"' on the same line"},
+      {"bright.pbrt", "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1] \"float scale\" 1e12\n", "bright.pbrt:4:1",
+       "a light's emission (1e+12 after scale) exceeds 1e9: the tracer sums contributions exactly below 2^50 and drops larger ones; scale "
+       "the scene's lights down (the image scales with them)"},
       {"nolight.pbrt", "Shape \"sphere\"\n", "nolight.pbrt", "the scene has no light: expected a light source or an emitting shape"},
       // Mitsuba 3
+      {"negative.xml", "  <emitter type=\"point\">\n    <rgb name=\"intensity\" value=\"1, -1, 1\"/>\n  </emitter>\n</scene>\n", "negative.xml:2:3",
+       "a light's emission must be non-negative"},
       {"cube.xml", "  <shape type=\"cube\"/>\n</scene>\n", "cube.xml:2:3",
        "shape \"cube\" is not supported, expected obj, ply, sphere, rectangle or disk"},
       {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",

@@ -31,7 +31,7 @@ HistogramReport render_scene(const Scene& scene, const Profile& profile, std::ui
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
   RunInfo info;
   info.spp = spp;
-  return *make_report(out->histogram, info, nullptr, {});
+  return make_report(out->histogram, info, nullptr, {}).expect("a test input");
 }
 
 TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
@@ -47,10 +47,10 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
     Scene scene = *loaded;
     if (scene.camera.type != SensorType::kSpotmeter) scene.camera.width = scene.camera.height = 16;
     const std::uint64_t spp = scene.camera.type == SensorType::kSpotmeter ? 8192 : 128;
-    const Profile bdpt = *resolve_profile("bdpt", Limits{});
+    const Profile bdpt = resolve_profile("bdpt", Limits{}).expect("a test input");
     const HistogramReport reference = render_scene(scene, bdpt, spp);
     EXPECT_EQ(reference.nonfinite_samples, 0u) << entry.path().filename();
-    const CompiledProfile bdpt_checker = *compile_profile(bdpt, kBounces, Limits{});
+    const CompiledProfile bdpt_checker = compile_profile(bdpt, kBounces, Limits{}).expect("a test input");
     for (const PathEstimate& p : reference.paths) {
       if (p.estimate.luminance != 0.0) {
         EXPECT_TRUE(bdpt_checker.reachable.accepts(p.path)) << entry.path().filename() << ": " << p.path;
@@ -59,8 +59,8 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
     std::map<std::string, const PathEstimate*> by_path;
     for (const PathEstimate& p : reference.paths) by_path[p.path] = &p;
     for (const char* name : profiles) {
-      const Profile profile = *resolve_profile(name, Limits{});
-      const CompiledProfile checker = *compile_profile(profile, kBounces, Limits{});
+      const Profile profile = resolve_profile(name, Limits{}).expect("a test input");
+      const CompiledProfile checker = compile_profile(profile, kBounces, Limits{}).expect("a test input");
       const HistogramReport r = render_scene(scene, profile, spp);
       const std::string where = entry.path().filename().string() + " with " + name;
       EXPECT_EQ(r.nonfinite_samples, 0u) << where;

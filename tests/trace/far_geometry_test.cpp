@@ -38,6 +38,7 @@ Mean render_mean(const std::string& scene_json) {
   RenderOptions o;
   o.spp = 16;
   o.seed = 11;
+  EXPECT_TRUE(profile.ok());  // a helper returning a value: the read below aborts if it is not
   Result<RenderOutput> out = render(*scene, *profile, nullptr, o);
   EXPECT_TRUE(out.ok());
   if (!out) return {};

@@ -25,6 +25,7 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
     for (const char* renderer : {"bdpt", "pt-nee", "lt", "pbrt-v4-lightpath", "mitsuba3-ptracer", "pt-nee+distant",
                                  "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path", "bdpt+ortho"}) {
       Result<Profile> profile = resolve_profile(renderer, Limits{});
+      ASSERT_TRUE(profile.ok());
       Result<std::vector<MisCheck>> checks = check_mis_weights(*scene, *profile, 11, 300);
       ASSERT_TRUE(checks.ok()) << checks.error().render();
       for (const MisCheck& c : *checks) {

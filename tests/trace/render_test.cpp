@@ -41,7 +41,7 @@ Rendered render_json(const std::string& scene_json, const std::string& renderer,
     infos.push_back({c, c});
   }
   static std::vector<std::unique_ptr<Classifier>> keep_cl;
-  keep_cl.push_back(std::make_unique<Classifier>(*Classifier::build(pcs, Limits{})));
+  keep_cl.push_back(std::make_unique<Classifier>(Classifier::build(pcs, Limits{}).expect("a test input")));
   RenderOptions o;
   o.spp = spp;
   o.seed = seed;
@@ -366,6 +366,7 @@ TEST(Images, OffLeavesTheHistogramExactlyTheSameAndTheImageEmpty) {
   with.threads = 2;
   RenderOptions without = with;
   without.images = false;
+  ASSERT_TRUE(profile.ok());
   Result<RenderOutput> a = render(*scene, *profile, nullptr, with);
   Result<RenderOutput> b = render(*scene, *profile, nullptr, without);
   ASSERT_TRUE(a.ok() && b.ok());
@@ -404,6 +405,8 @@ TEST(Interrupt, KeepsFinishedPassesAndMarksIncomplete) {
   o.progress = [&](std::uint64_t done, std::uint64_t) {
     if (done >= 3 * 12 * 12) cancel.store(true);  // once the third pass is done
   };
+  ASSERT_TRUE(scene.ok());
+  ASSERT_TRUE(profile.ok());
   Result<RenderOutput> out = render(*scene, *profile, nullptr, o);
   ASSERT_TRUE(out.ok());
   EXPECT_FALSE(out->complete);
@@ -429,13 +432,14 @@ TEST(Labels, PointLightWithPinholeOnlyProducesSDprefixAndDSsuffix) {
 
 TEST(Profiles, ConnectorsTheTracerDoesNotRunAreRefusedByName) {
   Result<Profile> p = resolve_profile("pt-nee+manifold", Limits{});
+  ASSERT_TRUE(p.ok());
   Result<StrategySet> s = runnable_strategies(*p);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().message,
             "renderer 'pt-nee+manifold' uses the connector 'manifold' (strategy 'manifold-nee'), which the tracer does not run "
             "yet; it runs plain joins (s, DD, t) and the distant-projection and ortho-projection connectors");
   for (const char* name : {"pt-nee+distant", "bdpt+ortho", "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path"})
-    EXPECT_TRUE(runnable_strategies(*resolve_profile(name, Limits{})).ok()) << name;
+    EXPECT_TRUE(runnable_strategies(resolve_profile(name, Limits{}).expect("a test input")).ok()) << name;
 }
 
 }  // namespace

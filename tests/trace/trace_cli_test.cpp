@@ -35,7 +35,8 @@ TEST(TraceCli, WritesHistogramExrAndPreviews) {
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(in);
   std::vector<std::string> keys;
   for (const auto& [k, v] : j.items()) keys.push_back(k);
-  EXPECT_EQ(keys, std::vector<std::string>({"scene", "renderer", "spp", "seed", "complete", "nonfinite_samples", "total",
+  EXPECT_EQ(keys, std::vector<std::string>({"scene", "renderer", "spp", "spp_requested", "seed", "complete",
+                                            "nonfinite_samples", "distinct_paths", "max_paths", "total",
                                             "classes", "paths"}));
   EXPECT_EQ(j["scene"], "samples/scenes/closed-sphere-point.json");
   EXPECT_EQ(j["renderer"], "bdpt");
@@ -75,7 +76,8 @@ TEST(TraceCli, TableShowsSharesAndVerdicts) {
   const std::string dir = out_dir("table");
   const CliRun r = run("trace samples/scenes/point-mirror-caustic.json --renderer pt-nee --spp 4 --out " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("caustic: 0.0 % of the image, ±0.00 %; pt-nee: unreachable\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("caustic: 0.0 % of the image, ±0.00 %; pt-nee: unreachable; luminance 0.00000 ± 0.00000\n"),
+            std::string::npos) << r.out;
   EXPECT_NE(r.out.find("direct: "), std::string::npos);
   EXPECT_NE(r.out.find("most important paths\n  LSDDDSE"), std::string::npos) << r.out;
   std::filesystem::remove_all(dir);

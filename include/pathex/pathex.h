@@ -1,0 +1,136 @@
+// pathex: the installed C++ API.
+//
+// Three things a rendering engineer's program or CI does with pathex, and nothing more:
+//   1. compile a path class (a full-path regular expression such as "L.*DD.*E") and test paths;
+//   2. ask whether a renderer profile can sample the class (the checker's verdict and witnesses);
+//   3. classify full-path strings by a set of named classes in one pass.
+//
+//   #include <pathex/pathex.h>
+//   pathex::api::PathClass caustic("L..S+D.*..E");
+//   if (!caustic.ok()) { std::cerr << caustic.error() << "\n"; return 2; }
+//   pathex::api::Answer a = pathex::api::query(caustic, pathex::api::Renderer("pt-nee"));
+//   // a.verdict == Verdict::kPartial, a.unreachable_witnesses.front() == "LDSDDE" …
+//
+// Errors are values, as in RE2: an object that could not be built has ok() == false and error()
+// holds the same located message the `pathex` command prints (a caret under the expression, the
+// file and JSON pointer, what was expected). Nothing here throws, prints or exits. Every object
+// is an immutable value, cheap to copy and safe to share between threads.
+//
+// The full-path notation, the built-in names ($all, $local, $direct, $indirect, $caustic,
+// $emission), the renderer profiles and the verdicts are those of the `pathex` command: see its
+// README. In CMake:
+//
+//   find_package(pathex 0.1 REQUIRED)
+//   target_link_libraries(my_tool PRIVATE pathex::pathex)
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+// The API lives in pathex::api so that it never collides with the library's internal types.
+namespace pathex::api {
+
+// "0.1.0": the version of the installed library (and of the `pathex` command built with it).
+std::string_view version();
+
+// How an expression is written: full-path letters (L, E, S, D with two letters at each end) or
+// classic Heckbert strings such as "LS+DE", whose L and E stand for every light and sensor type.
+enum class Notation { kFull, kHeckbert };
+
+// A path class: an expression compiled to its minimal automaton, intersected with the valid full
+// paths L[SD]{4,}E. An expression written eye-first (E…L) denotes the reversed paths.
+class PathClass {
+ public:
+  explicit PathClass(std::string_view expression, Notation notation = Notation::kFull);
+
+  bool ok() const;
+  const std::string& error() const;  // empty when ok()
+
+  const std::string& expression() const;  // as written
+  // Whether `full_path` (such as "LDDSDE") belongs to the class; false for a malformed path and
+  // for a class that is not ok().
+  bool matches(std::string_view full_path) const;
+  bool empty() const;       // no valid full path belongs to the class
+  int dfa_states() const;   // states of the minimal DFA (complete: with its dead state)
+  // The first `n` members in shortlex order (fewer letters first, then D < E < L < S), up to
+  // `max_letters` letters each.
+  std::vector<std::string> shortest(int n, int max_letters = 24) const;
+
+ private:
+  friend struct Access;
+  struct Impl;
+  std::shared_ptr<const Impl> impl_;
+};
+
+// A renderer profile: a built-in name (pt, pt-nee, lt, bdpt, pbrt-v4-path, …) or the path of a
+// profile JSON file (schema grammar/profile.schema.json).
+class Renderer {
+ public:
+  explicit Renderer(const std::string& name_or_file);
+
+  bool ok() const;
+  const std::string& error() const;
+  const std::string& name() const;  // the profile's own name
+  // The built-in profiles' names, in the order `pathex renderers` lists them.
+  static std::vector<std::string> builtin_names();
+
+ private:
+  friend struct Access;
+  struct Impl;
+  std::shared_ptr<const Impl> impl_;
+};
+
+enum class Verdict {
+  kEmpty,        // no valid path of the universe belongs to the class
+  kReachable,    // every path of the class can be sampled by the renderer
+  kPartial,      // some can, some cannot
+  kUnreachable,  // none can
+};
+std::string_view to_string(Verdict v);  // "empty", "reachable", "partial", "unreachable"
+
+struct QueryOptions {
+  // Bounds the class (at most N interior vertices) and overrides the profile's own bound.
+  std::optional<int> max_bounces;
+  // A scene file: restricts the universe to its light types, sensor type and materials.
+  std::string scene;
+};
+
+// The checker's answer for one class and one renderer. When !ok(), error says why (a bad scene,
+// a class that is not ok(), a limit) and the other fields are empty.
+struct Answer {
+  Verdict verdict = Verdict::kEmpty;
+  std::vector<std::string> reachable_witnesses;    // shortest paths the renderer samples
+  std::vector<std::string> unreachable_witnesses;  // shortest paths it never samples
+  std::string error;
+  bool ok() const { return error.empty(); }
+};
+
+Answer query(const PathClass& path_class, const Renderer& renderer, const QueryOptions& options = {});
+
+// Named classes compiled into one automaton: classifying a path is one pass over its letters.
+class ClassSet {
+ public:
+  // The built-in classes ($local, $emission, $direct, $indirect, $caustic; $all left out).
+  static ClassSet builtins();
+  // A class file (schema grammar/classes.schema.json); errors name the file and JSON pointer.
+  static ClassSet from_file(const std::string& filename);
+  // (name, expression) pairs in order; each expression may use the built-ins and earlier names.
+  static ClassSet from_expressions(const std::vector<std::pair<std::string, std::string>>& named_expressions);
+
+  bool ok() const;
+  const std::string& error() const;
+  const std::vector<std::string>& names() const;
+  // The names of the classes `full_path` belongs to, in the set's order (none for a malformed path).
+  std::vector<std::string> classify(std::string_view full_path) const;
+
+ private:
+  ClassSet() = default;
+  friend struct Access;
+  struct Impl;
+  std::shared_ptr<const Impl> impl_;
+};
+
+}  // namespace pathex::api

@@ -1,0 +1,230 @@
+// The installed API (include/pathex/pathex.h): value types over the library's own stages.
+//
+// Each public object holds a shared, immutable Impl built once by its constructor; a failed
+// construction keeps the rendered Error (the same text the CLI prints) and nothing else. Nothing
+// here adds behaviour: compile_class, resolve_profile, query, read_class_file and the Classifier
+// are the functions the `pathex` command calls.
+#include "pathex/pathex.h"
+
+#include <utility>
+
+#include "automata/ops.h"
+#include "classify/classifier.h"
+#include "classify/pathclass.h"
+#include "io/class_file.h"
+#include "io/profile_json.h"
+#include "reach/query.h"
+#include "scene/scene.h"
+#include "scene/universe.h"
+
+namespace pathex::api {
+
+// --- the private halves of the public classes ---
+
+struct PathClass::Impl {
+  std::string expression;
+  std::string error;
+  std::optional<pathex::PathClass> compiled;
+};
+
+struct Renderer::Impl {
+  std::string requested;
+  std::string error;
+  std::optional<Profile> profile;
+};
+
+struct ClassSet::Impl {
+  std::string error;
+  ClassTable table;  // owns the user's classes the classifier was built from
+  std::vector<std::string> names;
+  std::optional<Classifier> classifier;
+};
+
+// The one friend of the public classes: the functions below reach their private halves through it.
+struct Access {
+  static const PathClass::Impl& of(const PathClass& c) { return *c.impl_; }
+  static const Renderer::Impl& of(const Renderer& r) { return *r.impl_; }
+  static ClassSet with(std::shared_ptr<const ClassSet::Impl> impl) {
+    ClassSet s;
+    s.impl_ = std::move(impl);
+    return s;
+  }
+  // Builds the classifier over `classes`, or records why not.
+  static void build_classifier(const std::vector<const pathex::PathClass*>& classes, ClassSet::Impl* impl) {
+    for (const pathex::PathClass* c : classes) impl->names.push_back(c->name);
+    Result<Classifier> cl = Classifier::build(classes, Limits{});
+    if (!cl) {
+      impl->error = cl.error().render();
+      impl->names.clear();
+      return;
+    }
+    impl->classifier = std::move(*cl);
+  }
+};
+
+namespace {
+
+Verdict from_internal(pathex::Verdict v) {
+  switch (v) {
+    case pathex::Verdict::kEmpty: return Verdict::kEmpty;
+    case pathex::Verdict::kReachable: return Verdict::kReachable;
+    case pathex::Verdict::kPartial: return Verdict::kPartial;
+    case pathex::Verdict::kUnreachable: return Verdict::kUnreachable;
+  }
+  return Verdict::kEmpty;
+}
+
+Answer failed(std::string error) {
+  Answer a;
+  a.error = std::move(error);
+  return a;
+}
+
+}  // namespace
+
+std::string_view version() { return PATHEX_VERSION; }
+
+// --- PathClass ---
+
+PathClass::PathClass(std::string_view expression, Notation notation) {
+  auto impl = std::make_shared<Impl>();
+  impl->expression = std::string(expression);
+  ClassOptions options;
+  options.notation = notation == Notation::kHeckbert ? pathex::Notation::kHeckbert : pathex::Notation::kFull;
+  Result<pathex::PathClass> c = compile_class(expression, options, &ClassTable::builtins());
+  if (c) {
+    impl->compiled = std::move(*c);
+  } else {
+    impl->error = c.error().render();
+  }
+  impl_ = std::move(impl);
+}
+
+bool PathClass::ok() const { return impl_->error.empty(); }
+const std::string& PathClass::error() const { return impl_->error; }
+const std::string& PathClass::expression() const { return impl_->expression; }
+
+bool PathClass::matches(std::string_view full_path) const {
+  return impl_->compiled && impl_->compiled->dfa.accepts(full_path);
+}
+
+bool PathClass::empty() const { return !impl_->compiled || is_empty(impl_->compiled->dfa); }
+
+int PathClass::dfa_states() const { return impl_->compiled ? impl_->compiled->dfa.num_states : 0; }
+
+std::vector<std::string> PathClass::shortest(int n, int max_letters) const {
+  if (!impl_->compiled || n <= 0) return {};
+  return enumerate_members(impl_->compiled->dfa, max_letters, static_cast<std::size_t>(n));
+}
+
+// --- Renderer ---
+
+Renderer::Renderer(const std::string& name_or_file) {
+  auto impl = std::make_shared<Impl>();
+  impl->requested = name_or_file;
+  Result<Profile> p = resolve_profile(name_or_file, Limits{});
+  if (p) {
+    impl->profile = std::move(*p);
+  } else {
+    impl->error = p.error().render();
+  }
+  impl_ = std::move(impl);
+}
+
+bool Renderer::ok() const { return impl_->error.empty(); }
+const std::string& Renderer::error() const { return impl_->error; }
+const std::string& Renderer::name() const { return impl_->profile ? impl_->profile->name : impl_->requested; }
+
+std::vector<std::string> Renderer::builtin_names() {
+  std::vector<std::string> names;
+  for (const BuiltinProfileText& t : builtin_profile_texts()) names.emplace_back(t.name);
+  return names;
+}
+
+std::string_view to_string(Verdict v) {
+  switch (v) {
+    case Verdict::kEmpty: return "empty";
+    case Verdict::kReachable: return "reachable";
+    case Verdict::kPartial: return "partial";
+    case Verdict::kUnreachable: return "unreachable";
+  }
+  return "empty";
+}
+
+// --- query ---
+
+Answer query(const PathClass& path_class, const Renderer& renderer, const QueryOptions& options) {
+  if (!path_class.ok()) return failed(path_class.error());
+  if (!renderer.ok()) return failed(renderer.error());
+  const Limits limits;
+  pathex::QueryOptions qo;
+  qo.max_bounces = options.max_bounces;
+  qo.limits = limits;
+  if (!options.scene.empty()) {
+    Result<Scene> s = load_scene_file(options.scene);
+    if (!s) return failed(s.error().render());
+    qo.universe = scene_universe(scene_types(*s));
+  }
+  Result<CompiledProfile> r = compile_profile(*Access::of(renderer).profile, options.max_bounces, limits);
+  if (!r) return failed(r.error().render());
+  Result<QueryResult> q = pathex::query(*Access::of(path_class).compiled, *r, qo);
+  if (!q) return failed(q.error().render());
+  Answer a;
+  a.verdict = from_internal(q->verdict);
+  for (const Witness& w : q->reachable) a.reachable_witnesses.push_back(w.path);
+  for (const Witness& w : q->unreachable) a.unreachable_witnesses.push_back(w.path);
+  return a;
+}
+
+// --- ClassSet ---
+
+ClassSet ClassSet::builtins() {
+  auto impl = std::make_shared<Impl>();
+  std::vector<const pathex::PathClass*> classes;
+  for (const auto& c : pathex::ClassTable::builtins().builtin_classes())
+    if (c->name != "all") classes.push_back(c.get());
+  Access::build_classifier(classes, impl.get());
+  return Access::with(std::move(impl));
+}
+
+ClassSet ClassSet::from_file(const std::string& filename) {
+  auto impl = std::make_shared<Impl>();
+  Result<bool> r = read_class_file(filename, ClassOptions{}, &impl->table);
+  if (!r) {
+    impl->error = r.error().render();
+    return Access::with(std::move(impl));
+  }
+  std::vector<const pathex::PathClass*> classes;
+  for (const auto& c : impl->table.user_classes()) classes.push_back(c.get());
+  Access::build_classifier(classes, impl.get());
+  return Access::with(std::move(impl));
+}
+
+ClassSet ClassSet::from_expressions(const std::vector<std::pair<std::string, std::string>>& named_expressions) {
+  auto impl = std::make_shared<Impl>();
+  std::vector<const pathex::PathClass*> classes;
+  for (const auto& [name, expression] : named_expressions) {
+    Result<const pathex::PathClass*> c = impl->table.add(name, expression, ClassOptions{});
+    if (!c) {
+      impl->error = c.error().render();
+      return Access::with(std::move(impl));
+    }
+    classes.push_back(*c);
+  }
+  Access::build_classifier(classes, impl.get());
+  return Access::with(std::move(impl));
+}
+
+bool ClassSet::ok() const { return impl_->error.empty(); }
+const std::string& ClassSet::error() const { return impl_->error; }
+const std::vector<std::string>& ClassSet::names() const { return impl_->names; }
+
+std::vector<std::string> ClassSet::classify(std::string_view full_path) const {
+  std::vector<std::string> out;
+  if (!impl_->classifier) return out;
+  for (int m : impl_->classifier->members(impl_->classifier->classify(full_path)))
+    out.push_back(impl_->classifier->name(m));
+  return out;
+}
+
+}  // namespace pathex::api

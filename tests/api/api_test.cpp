@@ -1,0 +1,133 @@
+// The installed API (<pathex/pathex.h>) against the answers the `pathex` command gives: the same
+// automata, verdicts, witnesses, classes and located error messages. (tests/package builds
+// examples/ against the installed package; this test covers the API's cases in the build tree.)
+#include "pathex/pathex.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "support/cli_run.h"
+
+namespace {
+
+namespace px = pathex::api;
+
+TEST(Api, PathClassCompilesMatchesAndListsMembers) {
+  const px::PathClass local("L.*DD.*E");
+  ASSERT_TRUE(local.ok()) << local.error();
+  EXPECT_EQ(local.error(), "");
+  EXPECT_EQ(local.expression(), "L.*DD.*E");
+  EXPECT_TRUE(local.matches("LDDDDE"));
+  EXPECT_TRUE(local.matches("LSDDSE"));
+  EXPECT_FALSE(local.matches("LSDSDE"));  // no two adjacent D
+  EXPECT_FALSE(local.matches("LDDE"));    // not a valid full path (too short)
+  EXPECT_FALSE(local.matches("hello"));
+  EXPECT_FALSE(local.empty());
+  // `pathex explain 'L..S+D.*..E'`: 10 states; shortlex D < E < L < S.
+  const px::PathClass caustic("L..S+D.*..E");
+  EXPECT_EQ(caustic.dfa_states(), 10);
+  EXPECT_EQ(caustic.shortest(3), (std::vector<std::string>{"LDDSDDDE", "LDDSDDSE", "LDDSDSDE"}));
+  EXPECT_TRUE(px::PathClass("LSSSSE & LDDDDE").empty());
+}
+
+TEST(Api, EyeFirstAndHeckbertNotation) {
+  EXPECT_TRUE(px::PathClass("EDS*DL").matches("LDSDDE") == px::PathClass("LDS*DE").matches("LDSDDE"));
+  EXPECT_TRUE(px::PathClass("EDDDDL").matches("LDDDDE"));
+  const px::PathClass heckbert("LSDE", px::Notation::kHeckbert);
+  ASSERT_TRUE(heckbert.ok()) << heckbert.error();
+  EXPECT_TRUE(heckbert.matches("LSDSDDSE"));   // point light, mirror, diffuse, pinhole
+  EXPECT_FALSE(heckbert.matches("LSDDDDSE"));  // two diffuse vertices is LDDE
+}
+
+TEST(Api, ErrorsAreTheCommandsLocatedMessages) {
+  const px::PathClass bad("L(DD");
+  EXPECT_FALSE(bad.ok());
+  const pathex::test::CliRun cli = pathex::test::run_pathex_args({"explain", "L(DD"});
+  EXPECT_EQ("pathex: error: " + bad.error() + "\n", cli.err);
+  EXPECT_FALSE(bad.matches("LDDDDE"));
+  EXPECT_EQ(bad.dfa_states(), 0);
+  EXPECT_TRUE(bad.shortest(5).empty());
+  const px::Answer a = px::query(bad, px::Renderer("bdpt"));
+  EXPECT_FALSE(a.ok());
+  EXPECT_EQ(a.error, bad.error());
+}
+
+TEST(Api, QueryGivesTheCheckersVerdictsAndWitnesses) {
+  const px::PathClass caustic("$caustic");
+  const px::Answer nee = px::query(caustic, px::Renderer("pt-nee"));
+  ASSERT_TRUE(nee.ok()) << nee.error;
+  EXPECT_EQ(nee.verdict, px::Verdict::kPartial);
+  ASSERT_FALSE(nee.unreachable_witnesses.empty());
+  EXPECT_EQ(nee.unreachable_witnesses.front(), "LDSSDDDE");
+  EXPECT_EQ(px::to_string(px::query(px::PathClass("L.*DD.*E"), px::Renderer("bdpt")).verdict), "reachable");
+  // The README's example: a point light seen in a mirror by an orthographic camera.
+  EXPECT_EQ(px::query(px::PathClass("LSDSDE"), px::Renderer("pt-nee")).verdict, px::Verdict::kUnreachable);
+  EXPECT_EQ(px::query(px::PathClass("LSDSDE"), px::Renderer("bdpt+ortho")).verdict, px::Verdict::kReachable);
+  // Bounds and scenes: beyond the bound nothing is left; a scene without point lights has no LSD….
+  px::QueryOptions bounded;
+  bounded.max_bounces = 2;
+  EXPECT_EQ(px::query(px::PathClass("L......+E"), px::Renderer("bdpt"), bounded).verdict, px::Verdict::kPartial);
+  bounded.max_bounces = 1;
+  EXPECT_EQ(px::query(px::PathClass("L......+E"), px::Renderer("bdpt"), bounded).verdict, px::Verdict::kEmpty);
+  px::QueryOptions cornell;
+  cornell.scene = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/cornell.json";
+  EXPECT_EQ(px::query(px::PathClass("LSD.*E"), px::Renderer("bdpt"), cornell).verdict, px::Verdict::kEmpty);
+  px::QueryOptions missing;
+  missing.scene = "/nonexistent/scene.json";
+  const px::Answer no_scene = px::query(caustic, px::Renderer("bdpt"), missing);
+  EXPECT_FALSE(no_scene.ok());
+  EXPECT_NE(no_scene.error.find("/nonexistent/scene.json"), std::string::npos) << no_scene.error;
+}
+
+TEST(Api, RenderersByNameOrFile) {
+  const std::vector<std::string> names = px::Renderer::builtin_names();
+  ASSERT_GE(names.size(), 4u);
+  EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 4),
+            (std::vector<std::string>{"pt", "pt-nee", "lt", "bdpt"}));
+  for (const std::string& n : names) EXPECT_TRUE(px::Renderer(n).ok()) << n;
+  const px::Renderer file(std::string(PATHEX_SOURCE_DIR) + "/samples/renderers/pt-nee.json");
+  ASSERT_TRUE(file.ok()) << file.error();
+  EXPECT_EQ(file.name(), "pt-nee");
+  const px::Renderer unknown("no-such-renderer");
+  EXPECT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().find("no-such-renderer"), std::string::npos);
+  EXPECT_FALSE(px::query(px::PathClass("$all"), unknown).ok());
+}
+
+TEST(Api, ClassSetsClassifyInOnePass) {
+  const px::ClassSet builtins = px::ClassSet::builtins();
+  ASSERT_TRUE(builtins.ok()) << builtins.error();
+  EXPECT_EQ(builtins.names(), (std::vector<std::string>{"local", "emission", "direct", "indirect", "caustic"}));
+  EXPECT_EQ(builtins.classify("LDDSDDSE"), (std::vector<std::string>{"local", "indirect", "caustic"}));
+  EXPECT_EQ(builtins.classify("LDDDDE"), (std::vector<std::string>{"local", "emission"}));
+  EXPECT_TRUE(builtins.classify("LDXDDE").empty());
+
+  const px::ClassSet mine = px::ClassSet::from_expressions({{"glass", "L.*SS.*E"}, {"glass-caustic", "$glass & $caustic"}});
+  ASSERT_TRUE(mine.ok()) << mine.error();
+  EXPECT_EQ(mine.classify("LDDSSDDSE"), (std::vector<std::string>{"glass", "glass-caustic"}));
+  EXPECT_EQ(mine.classify("LDDDSSDSE"), (std::vector<std::string>{"glass"}));  // c2 is D: not a caustic
+
+  const px::ClassSet undefined = px::ClassSet::from_expressions({{"a", "$nope"}});
+  EXPECT_FALSE(undefined.ok());
+  EXPECT_TRUE(undefined.names().empty());
+  EXPECT_TRUE(undefined.classify("LDDDDE").empty());
+}
+
+TEST(Api, ClassFilesWithTheirErrors) {
+  const px::ClassSet basic = px::ClassSet::from_file(std::string(PATHEX_SOURCE_DIR) + "/samples/classes/basic.json");
+  ASSERT_TRUE(basic.ok()) << basic.error();
+  EXPECT_FALSE(basic.names().empty());
+  const std::filesystem::path bad = pathex::test::scratch_dir() / "bad-classes.json";
+  std::ofstream(bad) << R"({"classes": [{"name": "x", "expr": "L(("}]})";
+  const px::ClassSet refused = px::ClassSet::from_file(bad.string());
+  EXPECT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().rfind(bad.string() + ":/classes/0/expr", 0), 0u) << refused.error();
+}
+
+TEST(Api, VersionIsTheProjects) {
+  EXPECT_EQ("pathex " + std::string(px::version()) + "\n", pathex::test::run_pathex_args({"--version"}).out);
+}
+
+}  // namespace
