@@ -150,8 +150,6 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
   info.spp = out->spp_done;
   info.spp_requested = o.spp;
   info.seed = o.seed;
-  info.threads = o.threads;
-  info.time_s = out->time_s;
   info.complete = out->complete;
   Result<HistogramReport> hist = make_report(out->histogram, info, &*classifier, infos);
   if (!hist) return hist.error();

@@ -104,10 +104,8 @@ int run(BiasArgs a) {
   if (!out_set) return report(out_set.error());
   Result<Profile> renderer = resolve_profile(a.renderer, a.options.limits);
   if (!renderer) return report(renderer.error());
-  ClassTable table;
-  Result<std::vector<const PathClass*>> classes = render_classes(a.classes_file, *scene, a.options.limits, &table);
+  Result<std::unique_ptr<RenderClasses>> classes = bias_classes(a.classes_file, *scene, a.options.limits);
   if (!classes) return report(classes.error());
-  if (std::optional<Error> e = reserved_missed_class(a.classes_file, table)) return report(*e);
 
   // --- the reference render and what the renderer misses ---
   a.options.images = !a.no_images;
@@ -115,10 +113,9 @@ int run(BiasArgs a) {
     const RenderWatch watch(!a.quiet);
     a.options.progress = watch.progress();
     a.options.cancel = watch.cancel();
-    return measure_missed(*scene, a.scene, *renderer, a.reference, *classes, a.options);
+    return measure_missed(*scene, a.scene, *renderer, a.reference, (*classes)->classes, a.options);
   }();
   if (!run) return report(run.error());
-  run->histogram.run.threads = a.options.threads > 0 ? a.options.threads : static_cast<int>(std::thread::hardware_concurrency());
   const nlohmann::ordered_json doc = to_json(run->report);
   const std::string bias_text = doc.dump(2) + "\n";
 

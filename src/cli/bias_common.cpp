@@ -2,33 +2,27 @@
 
 #include "cli/estimate_text.h"
 #include "cli/witness_text.h"
-#include "io/class_file.h"
+#include "io/input_file.h"
 #include "io/histogram_json.h"
 #include "io/reach_json.h"
 
 namespace pathex::cli {
 
-Result<std::vector<const PathClass*>> render_classes(const std::string& classes_file, const Scene& scene,
-                                                     const Limits& limits, ClassTable* table) {
-  ClassOptions copts;
-  copts.limits = limits;
+Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_file, const Scene& scene,
+                                                    const Limits& limits) {
+  RenderIdentity ends;
   const SceneTypes types = scene_types(scene);
-  copts.ends.lights.assign(types.lights.begin(), types.lights.end());
-  copts.ends.sensors = {types.sensor};
-  std::vector<const PathClass*> classes;
+  for (LightType l : types.lights) ends.lights.push_back(to_string(l));
+  ends.sensor = to_string(types.sensor);
+  std::string text;
   if (!classes_file.empty()) {
-    Result<bool> r = read_class_file(classes_file, copts, table);
-    if (!r) return r.error();
-    for (const auto& c : table->user_classes()) classes.push_back(c.get());
-  } else {
-    for (const auto& c : ClassTable::builtins().builtin_classes())
-      if (c->name != "all") classes.push_back(c.get());
+    Result<std::string> read = read_input_file(classes_file, limits.max_file_bytes);
+    if (!read) return read.error();
+    text = std::move(*read);
   }
-  return classes;
-}
-
-std::optional<Error> reserved_missed_class(const std::string& classes_file, const ClassTable& table) {
-  const auto& user = table.user_classes();
+  Result<std::unique_ptr<RenderClasses>> classes = compile_render_classes(text, classes_file, ends, limits);
+  if (!classes) return classes.error();
+  const auto& user = (*classes)->table.user_classes();
   for (std::size_t i = 0; i < user.size(); ++i)
     if (user[i]->name == kMissedClass) {
       Error e = make_error(ErrorCode::kBadValue, std::string("the class name '") + kMissedClass +
@@ -37,7 +31,7 @@ std::optional<Error> reserved_missed_class(const std::string& classes_file, cons
       e.where = classes_file + ":/classes/" + std::to_string(i) + "/name";
       return e;
     }
-  return std::nullopt;
+  return classes;
 }
 
 Result<BiasRun> measure_missed(const Scene& scene, const std::string& scene_name, const Profile& renderer,

@@ -8,20 +8,18 @@
 #include <nlohmann/json.hpp>
 
 #include "bias/bias.h"
+#include "cli/render_job.h"
 #include "classify/pathclass.h"
 #include "core/error.h"
 #include "scene/scene.h"
 
 namespace pathex::cli {
 
-// The classes of a render of `scene`: the class file's (`classes_file`, compiled into *table,
-// which must outlive them) or, without one, the built-ins but $all. Heckbert and LPE entries get
-// the scene's light and sensor types.
-Result<std::vector<const PathClass*>> render_classes(const std::string& classes_file, const Scene& scene,
-                                                     const Limits& limits, ClassTable* table);
-
-// The class file entry named "missed" (reserved for bias's layer) as a located error, or nothing.
-std::optional<Error> reserved_missed_class(const std::string& classes_file, const ClassTable& table);
+// The classes of a render of `scene`, as trace compiles them (cli/render_job.h): the class file's
+// or, without one, the built-ins but $all; Heckbert and LPE entries get the scene's light and
+// sensor types. A class file entry named "missed" (bias's layer) is refused at its JSON pointer.
+Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_file, const Scene& scene,
+                                                    const Limits& limits);
 
 // The reference for `renderer` (`reference`: a name or file, or empty for the default) and its
 // render with the measurement of what `renderer` misses.

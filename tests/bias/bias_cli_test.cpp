@@ -116,15 +116,18 @@ TEST(BiasCli, TraceMissedLine) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("\nthis renderer cannot sample 69."), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" of what bdpt finds (luminance "), std::string::npos) << r.out;
-  const CliRun cornell = run_pathex("trace --renderer pt --spp 1 --resolution 8x8 --missed --no-images --out " + out_dir("trace2"));
+  const CliRun cornell =
+      run_pathex("trace --renderer pt --spp 1 --resolution 8x8 --missed --reference bdpt --no-images --out " + out_dir("trace2"));
   // pt rendered up to trace's bound of 16 misses the light beyond it, which the reference finds (up to 24).
   EXPECT_NE(cornell.out.find("\nthis renderer cannot sample "), std::string::npos) << cornell.out;
-  const CliRun json = run_pathex("trace --renderer pt --spp 1 --resolution 8x8 --missed --reference bdpt --no-images --json --out " +
-                                 out_dir("trace3"));
-  const nlohmann::json j = nlohmann::json::parse(json.out);
-  EXPECT_EQ(j["missed"]["reference"], "bdpt");
-  EXPECT_EQ(j["missed"]["reference_max_bounces"], 24);  // trace's bound 16, plus 8
+  const nlohmann::json j = nlohmann::json::parse(pathex::test::read_file(out_dir("trace2") + "/missed.json"));
+  EXPECT_EQ(j["reference"]["name"], "bdpt");
+  EXPECT_EQ(j["reference"]["max_bounces"], 24);  // trace's bound 16, plus 8
   EXPECT_EQ(j["missed"]["exact"], false);
+  const CliRun shard = run_pathex("trace --spp 2 --shard 0/2 --missed --out " + out_dir("trace3"));
+  EXPECT_EQ(shard.code, 2);
+  EXPECT_EQ(shard.err, "pathex: error: --missed measures a whole render in one process: it cannot be given with --shard, "
+                       "--resume or MPI\n");
   EXPECT_EQ(run_pathex("trace --reference bdpt --out " + out_dir("trace4")).code, 2);  // --reference needs --missed
 }
 
