@@ -151,7 +151,8 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
   info.spp_requested = o.spp;
   info.seed = o.seed;
   info.complete = out->complete;
-  Result<HistogramReport> hist = make_report(out->histogram, info, &*classifier, infos);
+  // histogram.json's report, like trace's: max_paths rows and one "other" row summing the rest.
+  Result<HistogramReport> hist = make_report(out->histogram, info, &*classifier, infos, o.max_paths);
   if (!hist) return hist.error();
 
   // --- the report ---
@@ -193,13 +194,15 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
     if (std::optional<std::string> w = shortest_member(dfa_intersect(c.dfa, neither))) mc.neither = explained(*w, *ref);
     rep.classes.push_back(std::move(mc));
   }
-  // Missed paths: R's verdict once per distinct path of the histogram (its rows), never per sample.
+  // Missed paths: R's verdict once per row of the report (a distinct path), never per sample; the
+  // missed paths past the rows are counted by their class set, decided when the path was interned.
+  std::uint64_t missed_paths = 0;
+  for (Histogram::PathId id = 0; id < out->histogram.num_paths(); ++id) {
+    const std::vector<int>& members = classifier->members(out->histogram.class_set(id));
+    missed_paths += std::binary_search(members.begin(), members.end(), n) ? 1 : 0;
+  }
   for (const PathEstimate& p : hist->paths) {
     if (r->reachable.accepts(p.path)) continue;
-    if (rep.paths.size() >= o.max_paths) {
-      ++rep.other_missed_paths;
-      continue;
-    }
     MissedPath mp;
     mp.estimate = p;
     mp.share = rep.total.luminance > 0 ? p.estimate.luminance / rep.total.luminance : 0.0;
@@ -207,6 +210,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
     mp.reason = unreachable_reason(p.path, *r);
     rep.paths.push_back(std::move(mp));
   }
+  rep.other_missed_paths = missed_paths - rep.paths.size();
   if (std::optional<std::string> w = shortest_member(missed)) rep.shortest = explained(*w, *r);
   if (std::optional<std::string> first = shortest_member(neither)) {
     for (const std::string& w : enumerate_members(neither, static_cast<int>(first->size()) + 8,
@@ -215,12 +219,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
     rep.neither_finite = is_finite(neither);
   }
 
-  // histogram.json keeps the user's classes and "missed" (the per-class parts are in the report)
-  // and, like trace's, max_paths rows and one "other" row summing the rest exactly.
-  if (hist->paths.size() > o.max_paths) {
-    hist = make_report(out->histogram, info, &*classifier, infos, o.max_paths);
-    if (!hist) return hist.error();
-  }
+  // histogram.json keeps the user's classes and "missed" (the per-class parts are in the report).
   hist->classes.resize(static_cast<std::size_t>(n + 1));
   return BiasRun{std::move(rep), std::move(*out), std::move(*hist)};
 }

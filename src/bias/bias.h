@@ -70,8 +70,8 @@ struct BiasOptions {
   std::optional<int> reference_bounces;  // the reference's; default: reference_bound()
   bool images = true;                    // the total, class and missed images
   int witnesses = 3;                     // of the paths neither R nor the reference samples
-  // Rows of the path tables: the reference histogram's (the rest summed into one "other" row, as
-  // `trace --max-paths`) and the missed paths' (the rest counted in other_missed_paths).
+  // Rows of the reference histogram's path table (the rest summed into one "other" row, as
+  // `trace --max-paths`); the missed paths are listed from these rows.
   std::uint64_t max_paths = 1000;
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
   const std::atomic<bool>* cancel = nullptr;
@@ -120,8 +120,10 @@ struct BiasReport {
   bool covered = false;
   std::optional<Witness> shortest;      // the shortest path R cannot sample (the checker's), with why
   std::vector<MissedClass> classes;     // in class-file order
-  std::vector<MissedPath> paths;        // the missed paths the reference sampled, largest first, at most max_paths
-  std::uint64_t other_missed_paths = 0; // missed paths past max_paths (their light: missed minus the rows)
+  // The missed paths among the reference histogram's max_paths largest rows, largest first, and
+  // how many more missed paths it sampled (their light is the missed light minus these rows').
+  std::vector<MissedPath> paths;
+  std::uint64_t other_missed_paths = 0;
   // The paths neither R nor the reference can sample (within the reference's bound): the checker's
   // shortest witnesses, each with the reference's reason; empty when there are none. Their light is
   // not known, which is not 0.

@@ -157,6 +157,26 @@ TEST(Bias, MissedIsTheSumOfTheUnreachablePathsOfTheSameBdptRender) {
   EXPECT_EQ(plain.total.luminance, run.report.total.luminance);  // the same samples, bit for bit
 }
 
+// --max-paths caps the rows: the missed paths past them are counted, their light is still in
+// the missed total (an exact class sum), and histogram.json's "other" row sums the rest.
+TEST(Bias, MaxPathsCapsTheRowsNotTheSums) {
+  const Scene scene = load(sample("point-mirror-caustic.json"));
+  BiasOptions o;
+  o.spp = 4;
+  o.max_paths = 1;
+  const Profile r = profile("pt-nee");
+  const BiasRun capped = run_bias(scene, "test", r, profile("bdpt"), builtin_classes(), o).expect("a run");
+  ASSERT_EQ(capped.report.paths.size(), 1u);
+  EXPECT_EQ(capped.report.paths[0].estimate.path, "LSDDSE");  // the largest row of the histogram
+  EXPECT_EQ(capped.report.other_missed_paths, 1u);            // LSDSDDSE
+  EXPECT_EQ(capped.histogram.paths.size(), 1u);
+  ASSERT_TRUE(capped.histogram.other.has_value());
+  o.max_paths = 1000;
+  const BiasRun all = run_bias(scene, "test", r, profile("bdpt"), builtin_classes(), o).expect("a run");
+  EXPECT_EQ(all.report.other_missed_paths, 0u);
+  EXPECT_EQ(capped.report.missed.luminance, all.report.missed.luminance);
+}
+
 TEST(Bias, PtMissesNothingInTheCornellBoxAndEverythingUnderAPointLight) {
   const BiasRun cornell = bias(load(sample("cornell.json")), "pt", 4);
   EXPECT_TRUE(cornell.report.covered);
