@@ -245,12 +245,17 @@ int run(const TraceArgs& a) {
     out_set.emplace(std::move(*prepared));
   }
 
-  // The checker's view of the profile, for the warning now and the table after the render.
+  // The checker's view of the profile, for the warning now and the table after the render (rank
+  // 0 prints both; the other ranks skip the compilation).
   ReachCache cache(a.limits);
-  Result<const CompiledProfile*> cp = cache.compiled(id.renderer_source, id.max_bounces);
-  if (!cp) return report(cp.error());
+  const CompiledProfile* compiled = nullptr;
   const Dfa universe = scene_universe(scene_types(*job.scene));
-  if (rank == 0) warn_unreachable_lights(*job.scene, *job.profile, **cp, universe, id.max_bounces, a.limits);
+  if (rank == 0) {
+    Result<const CompiledProfile*> cp = cache.compiled(id.renderer_source, id.max_bounces);
+    if (!cp) return report(cp.error());
+    compiled = *cp;
+    warn_unreachable_lights(*job.scene, *job.profile, *compiled, universe, id.max_bounces, a.limits);
+  }
 
   // --- render this process's part of the passes still missing ---
   const PassSet todo = job.header.share.minus(job.header.passes);
@@ -382,7 +387,7 @@ int run(const TraceArgs& a) {
   std::cout << "\n";
   for (std::size_t i = 0; i < rep->classes.size(); ++i) {
     const ClassEstimate& c = rep->classes[i];
-    Result<QueryResult> q = query(*classes[i], **cp, qo);
+    Result<QueryResult> q = query(*classes[i], *compiled, qo);
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << id.renderer << ": " << (q ? to_string(q->verdict) : "?") << "; luminance "
