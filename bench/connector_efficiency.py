@@ -10,6 +10,10 @@ renderer's median efficiency over the first one's (DESIGN §8: Veach's efficienc
 
     python3 bench/connector_efficiency.py build/pathex samples/scenes/sun-window.json LDSDDSE \\
         --renderer pt-nee+distant --renderer lt --spp 16 --rounds 5
+    python3 bench/connector_efficiency.py build/pathex samples/scenes/point-mirror-caustic.json LSDSDDSE \\
+        --renderer pt-nee+mirror --renderer bdpt --renderer lt --spp 64 --rounds 5
+
+The last line says how many times more efficient the first renderer is than the best of the others.
 """
 import argparse
 import json
@@ -63,6 +67,10 @@ def main():
         eff = med(3)
         print(f"  {r:16s} estimate {med(0):.6g} ± {med(1):.3g}  CPU {med(2):.3f} s  efficiency {eff:.4g}"
               f"  ({eff / ref:.3g} × {args.renderer[0]})")
+    if len(args.renderer) > 1:
+        best = max(args.renderer[1:], key=lambda r: statistics.median(x[3] for x in results[r]))
+        best_eff = statistics.median(x[3] for x in results[best])
+        print(f"  {args.renderer[0]} against the best of the others ({best}): {ref / best_eff:.3g} ×")
 
 
 if __name__ == "__main__":

@@ -221,6 +221,7 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
 
   es->areas_.assign(scene.shapes.size(), 0.0f);
   es->quad_normals_.assign(scene.shapes.size(), vec3(0.0f));
+  es->shape_errors_.assign(scene.shapes.size(), vec3(0.0f));
   es->triangle_cdf_.resize(scene.shapes.size());
   for (std::size_t si = 0; si < scene.shapes.size(); ++si) {
     const Shape& shape = scene.shapes[si];
@@ -273,6 +274,7 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
       }
       es->areas_[si] = glm::length(glm::cross(q->edge1, q->edge2));
       es->quad_normals_[si] = glm::normalize(glm::cross(q->edge1, q->edge2));
+      es->shape_errors_[si] = parallelogram_error(q->corner, q->edge1, q->edge2);
     } else {
       // --- sphere or disk: exact user geometry ---
       const bool sphere = std::holds_alternative<SphereShape>(shape.geometry);
@@ -289,6 +291,7 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
       } else {
         const DiskShape& s = std::get<DiskShape>(shape.geometry);
         es->areas_[si] = kPi * s.radius * s.radius;
+        es->shape_errors_[si] = disk_error(s);
       }
     }
     rtcCommitGeometry(g);
@@ -331,7 +334,7 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
     h.normal = len > 0.0f ? n / len : -glm::normalize(d);  // degenerate triangles face the ray
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
     h.normal = quad_normals_[static_cast<std::size_t>(h.shape)];
-    h.error = parallelogram_error(q->corner, q->edge1, q->edge2);  // the projection too: p lies within the quad
+    h.error = shape_errors_[static_cast<std::size_t>(h.shape)];  // the projection too: p lies within the quad
     if (detail == HitDetail::kFull) {
       h.uv = glm::clamp(quad_uv(*q, p), 0.0f, 1.0f);
       h.position = q->corner + h.uv.x * q->edge1 + h.uv.y * q->edge2;
@@ -349,7 +352,7 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
     h.normal = k.normal;
     const vec3 local = Frame::from_normal(k.normal).to_local(p - k.center);
     h.position = p - local.z * k.normal;
-    h.error = disk_error(k);
+    h.error = shape_errors_[static_cast<std::size_t>(h.shape)];
     if (detail == HitDetail::kFull)
       h.uv = {unit_angle(local.y, local.x), std::min(std::sqrt(local.x * local.x + local.y * local.y) / k.radius, 1.0f)};
   }
@@ -457,7 +460,7 @@ SurfaceSample EmbreeScene::sample_shape(int shape_index, glm::vec2 u) const {
     s.normal = glm::length(n) > 0.0f ? glm::normalize(n) : vec3(0.0f, 0.0f, 1.0f);
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
     s.position = q->corner + u.x * q->edge1 + u.y * q->edge2;
-    s.error = parallelogram_error(q->corner, q->edge1, q->edge2);
+    s.error = shape_errors_[static_cast<std::size_t>(shape_index)];
     s.normal = quad_normals_[static_cast<std::size_t>(shape_index)];  // normalize(e1 × e2), once per scene
   } else if (const auto* sp = std::get_if<SphereShape>(&shape.geometry)) {
     s.normal = sample_uniform_sphere(u);
@@ -468,7 +471,7 @@ SurfaceSample EmbreeScene::sample_shape(int shape_index, glm::vec2 u) const {
     const glm::vec2 p = sample_concentric_disk(u) * d.radius;
     const Frame f = Frame::from_normal(d.normal);
     s.position = d.center + f.to_world(vec3(p.x, p.y, 0.0f));
-    s.error = disk_error(d);
+    s.error = shape_errors_[static_cast<std::size_t>(shape_index)];
     s.normal = d.normal;
   }
   return s;

@@ -317,3 +317,6 @@ std::optional<EndpointConnection> hit_lens(const SensorParams& s, const glm::vec
                                            const glm::vec3& direction);
 
 }  // namespace pathex
+
+// The definitions, inline: the integrator calls them on every vertex (see emitters_impl.h).
+#include "trace/emitters_impl.h"  // IWYU pragma: export

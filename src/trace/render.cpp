@@ -46,11 +46,11 @@ int StrategySet::find_connector(ConnectorKind k, int s, int t) const {
 Result<StrategySet> runnable_strategies(const Profile& profile) {
   StrategySet set;
   for (const Strategy& st : profile.strategies) {
-    if (st.connector == ConnectorKind::kMirror || st.connector == ConnectorKind::kManifold)
+    if (st.connector == ConnectorKind::kManifold)
       return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' uses the connector '" + to_string(st.connector) +
                                                "' (strategy '" + st.name +
                                                "'), which the tracer does not run yet; it runs plain joins (s, DD, t) and the "
-                                               "distant-projection and ortho-projection connectors");
+                                               "mirror, distant-projection and ortho-projection connectors");
     set.strategies.push_back(st);
   }
   return set;
@@ -155,6 +155,17 @@ class Integrator {
       ortho_of_[i] = static_cast<std::int16_t>(strategies.find_connector(ConnectorKind::kOrthoProjection, static_cast<int>(i), 0));
       has_connectors_ = has_connectors_ || distant_of_[i] >= 0 || ortho_of_[i] >= 0;
     }
+    mirror_of_.assign(kMaxRuns * kMaxRuns, -1);
+    for (std::size_t a = 1; a < kMaxRuns; ++a)
+      for (std::size_t b = 1; b < kMaxRuns; ++b) {
+        const int m = strategies.find_connector(ConnectorKind::kMirror, static_cast<int>(a), static_cast<int>(b));
+        mirror_of_[a * kMaxRuns + b] = static_cast<std::int16_t>(m);
+        has_mirror_ = has_mirror_ || (m >= 0 && !rs.mirrors.empty());
+      }
+    if (rs.mirrors.empty()) std::fill(mirror_of_.begin(), mirror_of_.end(), std::int16_t{-1});
+    has_connectors_ = has_connectors_ || has_mirror_;
+    mirror_shape_.assign(rs.material_of_shape.size(), 0);
+    for (const PlanarMirror& m : rs.mirrors) mirror_shape_[static_cast<std::size_t>(m.shape)] = 1;
     eye0_runs_ = (runs_mask_[1] >> 1) & 1;
     all_runs_ = !has_connectors_ && !general_mis;  // the per-sample sums below know plain joins only
     for (std::size_t n = 1; n < runs_mask_.size(); ++n) {
@@ -173,10 +184,13 @@ class Integrator {
     PathKey key = 0;
     vec3 c{0.0f};
     int strategy = 0, batch = 0;
-    bool splat = false;
-    bool connector = false;  // counted in the connector's statistics  // to raster point (rx, ry); else to the sample's own pixel, column px
+    bool splat = false;      // to raster point (rx, ry); else to the sample's own pixel, column px
+    bool connector = false;  // counted in the connector's statistics
     float rx = 0.0f, ry = 0.0f;
     int px = 0;
+    // Segments that must all be clear: this lane's and the segments - 1 before it in the batch
+    // (the mirror connector tests two). 0 marks a lane whose contribution sits on a later lane.
+    int segments = 1;
   };
 
   struct Thread {
@@ -189,6 +203,9 @@ class Integrator {
     std::vector<ConnectorStats> connectors;  // indexed by profile strategy (only connectors' are used)
     PathIds ids;
     Vertex sampled;  // connect()'s fresh light or sensor sample
+    Vertex sampled_eye{}, mirror_vertex{};  // the mirror connector's fresh sensor sample and mirror vertex
+    std::vector<Vertex> path{};         // a whole path x0 … xk for path_weight()
+    std::vector<double> rel{}, eye_density{};  // path_weight()'s density ratios and remapped ef
     // The subpaths' letters packed (set by prepare_joins()): light_mask has c0 c1 of y0, then
     // bit i + 1 for y_i's letter; eye_masks[t] has the eye subpath's last t + 1 letters (z(t-1)
     // … z0 and z0's spatial letter) as they sit after c(s) in any connection with t eye vertices.
@@ -365,6 +382,12 @@ class Integrator {
     const auto* d = std::get_if<DistantLightParams>(&l.params);
     return d ? parallelogram_error(d->corner, d->edge1, d->edge2) : vec3(0.0f);
   }
+  // Where a point or spot light is (the integrator picks an area light's points itself).
+  static vec3 light_position(const LightParams& l) {
+    if (const auto* p = std::get_if<PointLightParams>(&l)) return p->position;
+    if (const auto* p = std::get_if<SpotLightParams>(&l)) return p->position;
+    return vec3(0.0f);
+  }
   // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
   void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
     const float w = static_cast<float>(cam_.width), h = static_cast<float>(cam_.height);
@@ -434,6 +457,26 @@ class Integrator {
   }
   template <Connection C>
   void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
+  // The mirror connector (s, DSD, t), s, t >= 1: y(s-1) (a fresh light sample for s = 1) joined to
+  // z(t-1) (a fresh sensor sample for t = 1) across each planar mirror by the image method.
+  void connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const;
+  int mirror_of(int s, int t) const {
+    return static_cast<std::size_t>(s) < kMaxRuns && static_cast<std::size_t>(t) < kMaxRuns
+               ? mirror_of_[static_cast<std::size_t>(s) * kMaxRuns + static_cast<std::size_t>(t)]
+               : -1;
+  }
+  // --- MIS over whole paths, for profiles with the mirror connector ---
+  // Which strategy sampled a contribution, for path_weight().
+  enum class SelfKind : std::uint8_t { kPlain, kDistant, kOrtho, kMirror };
+  // Puts the path x0 … xk of a contribution into th.path: s light vertices (fresh_light for y0 when
+  // given), `middle` when given (the mirror vertex), t eye vertices (fresh_eye for z0 when given).
+  void gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* middle, const Vertex* fresh_eye) const;
+  // Whether the path of connection (s, t) with letters `key` could also be sampled by the mirror
+  // connector (then every strategy weighs it with path_weight()).
+  bool mirror_can_sample(const Thread& th, int s, int t, PathKey key) const;
+  // The power-heuristic weight of strategy `self` (kPlain: split s; kMirror: mirror vertex x_s)
+  // for the path in th.path with letters `key`, from every vertex's two area densities.
+  float path_weight(Thread& th, PathKey key, SelfKind self, int s) const;
   // What connect() has already computed for its join, handed to mis_weight() so that it is not
   // computed twice: the unit direction w from the light end qs to the eye end pt, their squared
   // distance, and the BSDF densities at each end that its BSDF evaluation gave for free.
@@ -462,6 +505,9 @@ class Integrator {
   std::vector<std::int16_t> strategy_of_;  // [s * kMaxRuns + t]: the profile's strategy running (s, t), or -1
   std::array<std::int16_t, kMaxRuns> distant_of_{}, ortho_of_{};  // see distant_of(), ortho_of()
   bool has_connectors_ = false;
+  std::vector<std::int16_t> mirror_of_;  // [s * kMaxRuns + t]: the profile's mirror strategy at (s, t), or -1
+  bool has_mirror_ = false;              // a mirror strategy runs and the scene has a planar mirror
+  std::vector<std::uint8_t> mirror_shape_;  // the shape is a planar mirror
   // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
   // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
   static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
@@ -948,8 +994,15 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee || kind != JoinKind::kPlain ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   const PathKey key = path_key(th, s, t, fresh) | chain_s;
-  const Pending r{key, contrib * mis_weight(th, s, t, fresh, key, joined ? &join : nullptr, kind), strategy_index, batch, splat,
-                  stats != nullptr, rx, ry, th.px};
+  float weight = 0.0f;
+  if (has_mirror_ && mirror_can_sample(th, s, t, key)) {
+    constexpr bool fresh_eye = C == Connection::kSplat || C == Connection::kOrtho;
+    gather(th, s, t, fresh && !fresh_eye ? fresh : nullptr, nullptr, fresh_eye ? fresh : nullptr);
+    weight = path_weight(th, key, kind == JoinKind::kDistant ? SelfKind::kDistant : kind == JoinKind::kOrtho ? SelfKind::kOrtho : SelfKind::kPlain, s);
+  } else {
+    weight = mis_weight(th, s, t, fresh, key, joined ? &join : nullptr, kind);
+  }
+  const Pending r{key, contrib * weight, strategy_index, batch, splat, stats != nullptr, rx, ry, th.px};
   if constexpr (C == Connection::kEmitter || C == Connection::kLens) {
     record(th, r);  // no shadow ray: the path's last edge was traced
   } else {
@@ -961,11 +1014,212 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   }
 }
 
+// --- the mirror connector ---
+
+void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const {
+  const int strategy_index = mirror_of(s, t);
+  ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
+  // Random numbers: a fresh light sample's from one block per t, a fresh sensor sample's from one
+  // block per s, after the seven blocks of connect()'s kinds.
+  constexpr std::uint64_t kLightBlock = 7, kEyeBlock = 8;
+  // --- the light end a: y(s-1), or a fresh light sample ---
+  const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
+  const RenderLight* light = nullptr;
+  if (a) {
+    if (a->kind != Kind::kSurface || !a->finite) return;
+  } else {
+    if (rs_.lights.empty()) return;
+    rng.set_dimension(kJoinDims + (kLightBlock * kMaxRuns + static_cast<std::uint64_t>(t)) * kDimsPerJoin);
+    const std::size_t li = pick_light(rng.get1d());
+    light = &rs_.lights[li];
+    const glm::vec2 up = rng.get2d();
+    if (light_pairs_[li][1] != 'D') return;  // a Dirac direction (distant, laser): no D end
+    Vertex& y0 = th.sampled;
+    y0 = Vertex{};
+    y0.kind = Kind::kLight;
+    y0.light = static_cast<int>(li);
+    y0.pos_letter = light_pairs_[li][0];
+    y0.letter = 'D';
+    const SurfacePoint x = sample_point(*light, up, &y0.err);
+    y0.p = light->is_area() ? x.position : light_position(light->params);
+    y0.n = light->is_area() ? x.normal : vec3(0.0f);
+    y0.ns = y0.n;
+    y0.pdf_fwd = light_pick_ * light->pdf_pos;
+    y0.beta = spatial_emission(light->params) / (light_pick_ * (light->pdf_pos > 0.0f ? light->pdf_pos : 1.0f));
+    a = &y0;
+  }
+  // --- the eye end b: z(t-1), or (t = 1) a fresh sensor sample drawn per mirror ---
+  const Vertex* b = t >= 2 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
+  glm::vec2 u_lens{0.0f};
+  if (b) {
+    if (b->kind != Kind::kSurface || !b->finite) return;
+  } else {
+    if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no D end
+    rng.set_dimension(kJoinDims + (kEyeBlock * kMaxRuns + static_cast<std::uint64_t>(s)) * kDimsPerJoin);
+    u_lens = rng.get2d();
+  }
+  if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
+  // The letters: y(s-1)'s c(s) = D, the mirror's c(s+1) = S, z(t-1)'s c(s+2) = D.
+  const PathKey light_part = s == 1 ? letter_bit(a->pos_letter, 0) : th.light_mask & (bit(s) - 1);
+  const PathKey key = light_part | bit(s + 1) | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + 2)) & ~bit(s + 2)) |
+                      static_cast<PathKey>(s + t + 3) << kLengthShift;
+  for (const PlanarMirror& mirror : rs_.mirrors) {
+    ++stats.attempts;
+    float rx = 0.0f, ry = 0.0f;
+    std::optional<EndpointConnection> c;  // t = 1: the sensor's join to a's image
+    if (t == 1) {
+      c = connect_finite(cam_.params, u_lens, mirror_image(mirror, a->p));
+      if (!c) {
+        ++stats.outside;
+        continue;
+      }
+      Vertex& z0 = th.sampled_eye;
+      z0 = Vertex{};
+      z0.kind = Kind::kCamera;
+      z0.p = c->position;
+      z0.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c->normal;
+      z0.ns = z0.n;
+      z0.letter = 'D';
+      z0.pos_letter = sensor_pair_[1];
+      z0.pdf_fwd = cam_.pdf_pos;
+      to_pixels(c->raster, &rx, &ry);
+      b = &z0;
+    }
+    MirrorMiss miss = MirrorMiss::kNone;
+    const std::optional<MirrorJoin> j = mirror_join(mirror, a->p, b->p, &miss);
+    if (!j) {
+      ++stats.outside;  // off the mirror, or the ends on different sides of its plane
+      continue;
+    }
+    // f at a towards the mirror: the light's directional emission, or the BSDF.
+    const vec3 fa = light ? vec3(directional_emission(light->params, a->n, j->w_a))
+                          : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, j->w_a, a->ns, a->n);
+    // Across the mirror the geometry term is the straight one to the image: |cos_a| |cos_b| / D².
+    vec3 contrib = a->beta * fa * mirror.reflectance * abs_cos(*a, j->w_a);
+    if (t == 1) {
+      contrib *= c->weight;  // We cos / (p D²), D = |a' − sensor point|
+    } else {
+      const vec3 fb = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(b->shape)], b->wo, j->w_b, b->ns, b->n);
+      contrib *= fb * b->beta * (abs_cos(*b, j->w_b) / (j->unfolded * j->unfolded));
+    }
+    if (is_black(contrib)) {
+      ++stats.no_transport;
+      continue;
+    }
+    Vertex& m = th.mirror_vertex;
+    m = Vertex{};
+    m.kind = Kind::kSurface;
+    m.letter = 'S';
+    m.p = j->point;
+    m.n = mirror.normal;
+    m.ns = mirror.normal;
+    m.err = mirror.error;
+    m.shape = mirror.shape;
+    gather(th, s, t, s == 1 ? a : nullptr, &m, t == 1 ? b : nullptr);
+    const Pending r{key, contrib * path_weight(th, key, SelfKind::kMirror, s), strategy_index, batch, t == 1, true, rx, ry, th.px, 2};
+    // Both segments go into one batch; the contribution waits on the second.
+    if (th.shadow.size() + 2 > OcclusionBatch::kCapacity) trace_shadows(th);
+    th.rays += 2;
+    Pending first = r;
+    first.segments = 0;
+    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, a->p, a->n, a->err, m.p, m.n, m.err))] = first;
+    th.pending[static_cast<std::size_t>(th.shadow.add(*rs_.geometry, m.p, m.n, m.err, b->p, b->n, b->err))] = r;
+    if (th.shadow.full()) trace_shadows(th);
+  }
+}
+
+void Integrator::gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* middle, const Vertex* fresh_eye) const {
+  th.path.clear();
+  for (int i = 0; i < s; ++i) th.path.push_back(i == 0 && fresh_light ? *fresh_light : th.light[static_cast<std::size_t>(i)]);
+  if (middle) th.path.push_back(*middle);
+  for (int j = t - 1; j >= 0; --j) th.path.push_back(j == 0 && fresh_eye ? *fresh_eye : th.eye[static_cast<std::size_t>(j)]);
+  Vertex& x0 = th.path.front();
+  if (s == 0) {  // an eye vertex on an area light starts the path
+    x0.kind = Kind::kLight;
+    x0.light = rs_.light_of_shape[static_cast<std::size_t>(x0.shape)];
+  }
+  if (t == 0) th.path.back().kind = Kind::kCamera;  // a light vertex on the lens ends it
+}
+
+bool Integrator::mirror_can_sample(const Thread& th, int s, int t, PathKey key) const {
+  const int k = packed_length(key) - 3;
+  for (int m = 1; m <= k - 1; ++m) {
+    if (((key >> m) & 7) != 2 || mirror_of(m, k - m) < 0) continue;  // c(m) c(m+1) c(m+2) = DSD
+    const Vertex& x = m < s ? th.light[static_cast<std::size_t>(m)] : th.eye[static_cast<std::size_t>(s + t - 1 - m)];
+    if (x.kind == Kind::kSurface && mirror_shape_[static_cast<std::size_t>(x.shape)]) return true;
+  }
+  return false;
+}
+
+float Integrator::path_weight(Thread& th, PathKey key, SelfKind self, int s) const {
+  // Every vertex's area density as the light walk (lf) and as the eye walk (ef) would sample it,
+  // Dirac ones stored as 0 and counted as 1 (remap()), as the subpaths store them. The density of
+  // plain split i (light vertices x0 … x(i-1)) is Π_{v<i} lf(v) Π_{v>=i} ef(v); the mirror
+  // connector's with its vertex at x_m lacks x_m's factor, Π_{v<m} lf(v) Π_{v>m} ef(v); the
+  // projections' are split 1's and split k's with the projected endpoint's area density replaced
+  // by 1 (as in mis_weight()). All are kept relative to split 0's: rel[i] = P_i / P_0.
+  const std::vector<Vertex>& x = th.path;
+  const int k = static_cast<int>(x.size()) - 1, n = k + 1;
+  const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
+  const auto lf = [&](int v) -> double {
+    if (v == 0) return light_pick_ * rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+    if (v == 1 && letter_s(1) && rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos > 0.0f)
+      return parallel_jacobian(x[1], x[0], glm::normalize(x[1].p - x[0].p));  // a distant light's parallel beam
+    if (letter_s(v)) return 0.0;  // x(v-1) is a Dirac
+    return pdf(v >= 2 ? &x[static_cast<std::size_t>(v - 2)] : nullptr, x[static_cast<std::size_t>(v - 1)], x[static_cast<std::size_t>(v)]);
+  };
+  const auto ef = [&](int v) -> double {
+    if (v == k) return cam_.pdf_pos;
+    if (v == k - 1 && letter_s(k + 1) && cam_.pdf_pos > 0.0f)
+      return parallel_jacobian(x[static_cast<std::size_t>(k - 1)], x[static_cast<std::size_t>(k)],
+                               glm::normalize(x[static_cast<std::size_t>(k - 1)].p - x[static_cast<std::size_t>(k)].p));
+    if (letter_s(v + 2)) return 0.0;  // x(v+1) is a Dirac
+    return pdf(v + 2 <= k ? &x[static_cast<std::size_t>(v + 2)] : nullptr, x[static_cast<std::size_t>(v + 1)], x[static_cast<std::size_t>(v)]);
+  };
+  std::vector<double>& rel = th.rel;
+  std::vector<double>& e = th.eye_density;
+  rel.assign(static_cast<std::size_t>(n) + 1, 1.0);
+  e.assign(static_cast<std::size_t>(n), 1.0);
+  for (int v = 0; v <= k; ++v) {
+    e[static_cast<std::size_t>(v)] = remap(static_cast<float>(ef(v)));
+    rel[static_cast<std::size_t>(v) + 1] = rel[static_cast<std::size_t>(v)] * remap(static_cast<float>(lf(v))) / e[static_cast<std::size_t>(v)];
+  }
+  const double light_pos = rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+  const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };
+  const auto mirror_at = [&](int m) {
+    return m >= 1 && m <= k - 1 && dsd_at(m) && mirror_of(m, k - m) >= 0 && x[static_cast<std::size_t>(m)].kind == Kind::kSurface &&
+           mirror_shape_[static_cast<std::size_t>(x[static_cast<std::size_t>(m)].shape)];
+  };
+  double own = 0.0;
+  switch (self) {
+    case SelfKind::kPlain: own = rel[static_cast<std::size_t>(s)]; break;
+    case SelfKind::kDistant: own = rel[1] / light_pos; break;
+    case SelfKind::kOrtho: own = rel[static_cast<std::size_t>(n - 1)] / cam_.pdf_pos; break;
+    case SelfKind::kMirror: own = rel[static_cast<std::size_t>(s)] / e[static_cast<std::size_t>(s)]; break;
+  }
+  double sum = 0.0;
+  const auto add = [&](double p) {
+    const double r = p / own;
+    sum += r * r;
+  };
+  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));
+  const std::uint64_t plain = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
+  for (int i = 0; i <= n; ++i)
+    if ((plain >> i) & 1) add(rel[static_cast<std::size_t>(i)]);
+  if (n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && light_pos > 0.0) add(rel[1] / light_pos);
+  if (n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f) add(rel[static_cast<std::size_t>(n - 1)] / cam_.pdf_pos);
+  for (int m = 1; m <= k - 1; ++m)
+    if (mirror_at(m)) add(rel[static_cast<std::size_t>(m)] / e[static_cast<std::size_t>(m)]);
+  return sum > 0.0 && std::isfinite(sum) ? static_cast<float>(1.0 / sum) : 0.0f;
+}
+
 void Integrator::trace_shadows(Thread& th) const {
   th.shadow.trace(*rs_.geometry);
   for (int lane = 0; lane < th.shadow.size(); ++lane) {
     const Pending& r = th.pending[static_cast<std::size_t>(lane)];
-    const bool visible = th.shadow.visible(lane);
+    if (r.segments == 0) continue;  // its contribution waits on a later lane
+    bool visible = true;
+    for (int i = lane - r.segments + 1; i <= lane; ++i) visible = visible && th.shadow.visible(i);
     if (r.connector) ++(visible ? th.connectors[static_cast<std::size_t>(r.strategy)].successes
                                 : th.connectors[static_cast<std::size_t>(r.strategy)].occluded);
     if (visible) record(th, r);
@@ -1094,6 +1348,11 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   if (has_connectors_ && nt >= 1)
     for (int s = 1; s <= std::min(ns - (lens_end ? 1 : 0), max_bounces_ + 1); ++s)
       if (ortho_of(s) >= 0) connect<Connection::kOrtho>(th, rng, s, 1, batch);
+  // The mirror connector's path has s + t + 1 vertices: s + t - 1 interior ones.
+  if (has_mirror_)
+    for (int t = 1; t <= nt; ++t)
+      for (int s = 1; s <= std::min(s_max, max_bounces_ + 1 - t); ++s)
+        if (mirror_of(s, t) >= 0) connect_mirror(th, rng, s, t, batch);
 }
 
 }  // namespace

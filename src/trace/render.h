@@ -11,8 +11,10 @@
 // projecting its last vertex along the view direction. Contributions are combined with the
 // power heuristic over the strategies the profile runs; for a given string exactly the
 // strategies whose language contains it have nonzero density, so deltas are handled by letters,
-// never by huge numbers. Profiles naming the mirror or manifold connector are refused by name.
-// Shadow rays are queued per thread and traced sixteen at a time as one Embree packet
+// never by huge numbers. The mirror connector (s, DSD, t), s, t >= 1, joins y(s-1) and z(t-1)
+// across a planar mirror by the image method (trace/joins/mirror.h); in its profiles a path it
+// could also sample is weighed over whole-path densities. Profiles naming the manifold connector
+// are refused by name. Shadow rays are queued per thread and traced sixteen at a time as one Embree packet
 // (OcclusionBatch); a contribution is recorded once its segment is found clear.
 //
 // Determinism: every random number is a function of (seed, pixel, pass, dimension), and all
@@ -63,11 +65,11 @@ struct RenderOptions {
 // contribution is recorded) or fails for one reason.
 struct ConnectorStats {
   std::string strategy;            // the profile's name for the strategy
-  std::string connector;           // "distant-projection", "ortho-projection"
+  std::string connector;           // "mirror", "distant-projection", "ortho-projection"
   std::uint64_t attempts = 0;      // joins tried (one per eye or light vertex where it may stand)
   std::uint64_t successes = 0;     // contributions recorded
-  std::uint64_t outside = 0;       // the projection missed the aperture (or the film)
-  std::uint64_t occluded = 0;      // a segment it built was blocked
+  std::uint64_t outside = 0;       // the projection missed the aperture (or the film); off the mirror
+  std::uint64_t occluded = 0;      // a segment it built was blocked (any of them)
   std::uint64_t no_transport = 0;  // built, but the BSDF or emission towards it is zero
 };
 
@@ -83,8 +85,8 @@ struct RenderOutput {
   std::vector<ConnectorStats> connectors{};  // one per connector strategy of the profile, in its order
 };
 
-// The strategies of a profile the tracer runs: plain joins and the two projection connectors.
-// runnable_strategies() names the first connector the tracer does not run (mirror, manifold).
+// The strategies of a profile the tracer runs: plain joins and the mirror and projection
+// connectors. runnable_strategies() names the first connector the tracer does not run (manifold).
 struct StrategySet {
   std::vector<Strategy> strategies;
   // Index of the profile strategy that runs the plain join (s, DD, t), or -1.

@@ -16,6 +16,15 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     const Shape& s = scene.shapes[i];
     rs.material_of_shape.push_back(&scene.materials[static_cast<std::size_t>(s.material)]);
     rs.emission_of_shape.push_back(s.emission);
+    // Planar mirrors, for the mirror connector: quads of a pure mirror material.
+    const auto* quad = std::get_if<QuadShape>(&s.geometry);
+    const auto* mirror = std::get_if<Mirror>(rs.material_of_shape.back());
+    if (quad && mirror && !s.emissive()) {
+      const glm::vec3 n = glm::cross(quad->edge1, quad->edge2);
+      if (glm::length(n) > 0.0f)
+        rs.mirrors.push_back({static_cast<int>(i), quad->corner, quad->edge1, quad->edge2, glm::normalize(n),
+                              mirror->reflectance, parallelogram_error(quad->corner, quad->edge1, quad->edge2)});
+    }
     // A zero-area emitter emits nothing; it is not a light (and would have an infinite density).
     if (!s.emissive() || !(rs.geometry->shape_area(static_cast<int>(i)) > 0.0f)) continue;
     RenderLight l;

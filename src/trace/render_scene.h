@@ -22,6 +22,7 @@
 #include "scene/scene.h"
 #include "trace/embree_scene.h"
 #include "trace/emitters.h"
+#include "trace/joins/mirror.h"
 
 namespace pathex {
 
@@ -52,6 +53,7 @@ struct RenderScene {
   std::vector<glm::vec3> emission_of_shape;  // Le, zero for non-emitters
   std::vector<int> light_of_shape;           // index into lights, -1 for non-emitters
   std::vector<RenderLight> lights;
+  std::vector<PlanarMirror> mirrors;         // quads of a pure mirror material (the mirror connector's)
   RenderSensor camera;
 };
 

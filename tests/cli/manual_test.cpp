@@ -118,7 +118,7 @@ TEST(BashCompletion, CompletesCommandsOptionsAndChoices) {
   EXPECT_EQ(complete("pathex tr"), "trace\n");
   EXPECT_EQ(complete("pathex c"), "classify\ncheck\n");
   EXPECT_EQ(complete("pathex trace --re"), "--renderer\n--resolution\n--reference\n--resume\n");
-  EXPECT_EQ(complete("pathex trace --renderer pt"), "pt\npt-nee\npt-nee+distant\npt-nee+manifold\n");
+  EXPECT_EQ(complete("pathex trace --renderer pt"), "pt\npt-nee\npt-nee+distant\npt-nee+mirror\npt-nee+manifold\n");
   EXPECT_EQ(complete("pathex query --notation ''"), "full\nheckbert\nlpe\n");
   EXPECT_EQ(complete("pathex explain --light p"), "point\n");
   EXPECT_EQ(complete("pathex query --sensor ''"), "lens\npinhole\northographic\nspotmeter\n");

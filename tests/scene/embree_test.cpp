@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <fstream>
 #include <random>
 #include <thread>
@@ -464,3 +466,26 @@ TEST(Embree, OcclusionBatchAgreesWithVisibleAtEveryBatchSize) {
 
 }  // namespace
 }  // namespace pathex
+
+// The offset's last step, on four lanes of bits, against its definition std::nextafter(x, ±inf):
+// every sign of x and dir, zeros of both signs, subnormals, the largest float, infinities, NaN.
+TEST(Embree, AwayIsNextafterTowardsTheSignOfDir) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<float> xs = {0.0f, -0.0f, 1.0f, -1.0f, 1e-45f, -1e-45f, 1e-38f, 3.5f, -1e30f,
+                                 std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(), inf, -inf,
+                                 std::numeric_limits<float>::quiet_NaN(), 0.1f, -123.456f};
+  const std::vector<float> dirs = {0.0f, -0.0f, 1e-30f, -1e-30f, 2.0f, -2.0f};
+  const auto expected = [](float x, float dir) {
+    if (dir == 0.0f || !std::isfinite(x)) return x;
+    return std::nextafter(x, dir > 0.0f ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity());
+  };
+  const auto same_bits = [](float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  for (float x : xs)
+    for (float dx : dirs)
+      for (float dy : dirs) {
+        const glm::vec3 r = pathex::EmbreeScene::away(glm::vec3(x, -x, x), glm::vec3(dx, dy, -dx));
+        EXPECT_TRUE(same_bits(r.x, expected(x, dx))) << x << " towards " << dx << ": " << r.x;
+        EXPECT_TRUE(same_bits(r.y, expected(-x, dy))) << -x << " towards " << dy << ": " << r.y;
+        EXPECT_TRUE(same_bits(r.z, expected(x, -dx))) << x << " towards " << -dx << ": " << r.z;
+      }
+}

@@ -251,6 +251,71 @@ TEST(ClosedForm, SunPatchThroughAWindowIsECosTheta) {
   EXPECT_EQ(c.attempts, c.successes + c.outside + c.occluded + c.no_transport);
 }
 
+// DESIGN §9: a planar mirror of reflectance R throws a caustic on a diffuse floor: the floor lit by
+// the light's mirror image, of intensity R I, wherever the line from the image to the floor point
+// crosses the mirror. A point light at (0.3, 0.8, 0), a vertical mirror in the plane x = 1 (z in
+// [-1.5, 1.5], y in [0, 1]); the camera sees the floor only at x < 1 (the mirror hides the rest).
+// Class LSDSDDSE: light, mirror, floor, camera. The mirror connector (pt-nee+mirror: next-event
+// estimation towards the image) matches the closed form; pt-nee cannot sample the class at all.
+TEST(ClosedForm, MirrorCausticIsTheFloorLitByTheImageLight) {
+  const double rho = 0.6, intensity = 2.0, refl = 0.8;
+  const glm::dvec3 image(1.7, 0.8, 0.0);  // (0.3, 0.8, 0) reflected through x = 1
+  const std::string scene = std::string("{") + kFloorCamera + R"(,
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                  "mirror": {"type": "mirror", "reflectance": [0.8, 0.8, 0.8]}},
+    "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"},
+               {"type": "quad", "corner": [1, 0, 1.5], "edge1": [0, 0, -3], "edge2": [0, 1, 0], "material": "mirror"}],
+    "lights": [{"type": "point", "position": [0.3, 0.8, 0], "intensity": [2, 2, 2]}]})";
+  const double expected = floor_reference([&](const glm::dvec3& p) {
+    if (p.x >= 1.0) return 0.0;  // behind the mirror: hidden from the camera, and no caustic there
+    const double f = (1.0 - p.x) / (image.x - p.x);  // where the line to the image crosses x = 1
+    const glm::dvec3 m = p + f * (image - p);
+    if (!(m.y >= 0.0 && m.y < 1.0 && m.z > -1.5 && m.z <= 1.5)) return 0.0;
+    const glm::dvec3 d = image - p;
+    const double d2 = glm::dot(d, d);
+    return rho * refl * intensity * (d.y / std::sqrt(d2)) / (kPi * d2);
+  });
+  ASSERT_GT(expected, 0.0);
+  Rendered r = render_json(scene, "pt-nee+mirror", {"LSDSDDSE"}, 64);
+  EXPECT_EQ(r.report.nonfinite_samples, 0u);
+  expect_close(r.report.classes[0].estimate, expected, 3.0, 0.005, "pt-nee+mirror caustic");
+  // bdpt+mirror weighs the connector against light tracing (s = 3, t = 1) by MIS: the same value.
+  Rendered b = render_json(scene, "bdpt+mirror", {"LSDSDDSE"}, 64);
+  expect_close(b.report.classes[0].estimate, expected, 3.0, 0.005, "bdpt+mirror caustic");
+  Rendered pt = render_json(scene, "pt-nee", {"LSDSDDSE"}, 16);
+  EXPECT_EQ(pt.report.classes[0].estimate.luminance, 0.0);
+  // Every attempt is accounted for: eye vertices whose line to the image misses the mirror are
+  // off it; nothing stands between the mirror and the floor.
+  ASSERT_EQ(r.out.connectors.size(), 1u);
+  const ConnectorStats& c = r.out.connectors[0];
+  EXPECT_EQ(c.strategy, "mirror-nee");
+  EXPECT_EQ(c.connector, "mirror");
+  EXPECT_GT(c.successes, 0u);
+  EXPECT_GT(c.outside, 0u);
+  EXPECT_EQ(c.occluded, 0u);
+  EXPECT_EQ(c.attempts, c.successes + c.outside + c.occluded + c.no_transport);
+}
+
+// A blocker between the light and the mirror: the connector tests both of its segments, so the
+// caustic vanishes and every join that reached the mirror is counted as occluded.
+TEST(MirrorConnector, EitherSegmentBlockedBlocksTheJoin) {
+  const std::string scene = std::string("{") + kFloorCamera + R"(,
+    "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]},
+                  "mirror": {"type": "mirror", "reflectance": [0.8, 0.8, 0.8]},
+                  "black": {"type": "diffuse", "albedo": [0, 0, 0]}},
+    "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"},
+               {"type": "quad", "corner": [1, 0, 1.5], "edge1": [0, 0, -3], "edge2": [0, 1, 0], "material": "mirror"},
+               {"type": "quad", "corner": [0.6, -1, 3], "edge1": [0, 0, -6], "edge2": [0, 3, 0], "material": "black"}],
+    "lights": [{"type": "point", "position": [0.3, 0.8, 0], "intensity": [2, 2, 2]}]})";
+  Rendered r = render_json(scene, "pt-nee+mirror", {"LSDSDDSE"}, 8);
+  EXPECT_EQ(r.report.classes[0].estimate.luminance, 0.0);
+  ASSERT_EQ(r.out.connectors.size(), 1u);
+  const ConnectorStats& c = r.out.connectors[0];
+  EXPECT_EQ(c.successes, 0u);
+  EXPECT_GT(c.occluded, 0u);
+  EXPECT_EQ(c.attempts, c.successes + c.outside + c.occluded + c.no_transport);
+}
+
 // An orthographic sensor (film 2 x 2 looking straight down from height 3) over a diffuse floor,
 // a point light of intensity I at height h = 1 and a vertical mirror of reflectance R at x = 2.
 // Image means (the film's average radiance):
@@ -437,8 +502,8 @@ TEST(Profiles, ConnectorsTheTracerDoesNotRunAreRefusedByName) {
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().message,
             "renderer 'pt-nee+manifold' uses the connector 'manifold' (strategy 'manifold-nee'), which the tracer does not run "
-            "yet; it runs plain joins (s, DD, t) and the distant-projection and ortho-projection connectors");
-  for (const char* name : {"pt-nee+distant", "bdpt+ortho", "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path"})
+            "yet; it runs plain joins (s, DD, t) and the mirror, distant-projection and ortho-projection connectors");
+  for (const char* name : {"pt-nee+distant", "bdpt+ortho", "bdpt+mirror", "pt-nee+mirror", "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path"})
     EXPECT_TRUE(runnable_strategies(resolve_profile(name, Limits{}).expect("a test input")).ok()) << name;
 }
 

@@ -122,7 +122,7 @@ TEST(TraceCli, RefusalsExitTwo) {
   EXPECT_EQ(connector.code, 2);
   EXPECT_EQ(connector.err,
             "pathex: error: renderer 'pt-nee+manifold' uses the connector 'manifold' (strategy 'manifold-nee'), which the "
-            "tracer does not run yet; it runs plain joins (s, DD, t) and the distant-projection and ortho-projection "
+            "tracer does not run yet; it runs plain joins (s, DD, t) and the mirror, distant-projection and ortho-projection "
             "connectors\n");
   EXPECT_FALSE(std::filesystem::exists("/tmp/pathex-never"));
   EXPECT_EQ(run("trace samples/scenes/nosuch.json").code, 2);

@@ -1,28 +1,35 @@
-// Emission and importance functions (see emitters.h for the conventions: symbolic deltas, the
-// starting throughput `weight`, the image-mean normalisation of W_e).
-#include "trace/emitters.h"
+// The definitions of emitters.h (see there for the conventions: symbolic deltas, the starting
+// throughput `weight`, the image-mean normalisation of W_e). They are inline, in a header that
+// emitters.h includes, because the integrator calls them through the handles on every vertex: as
+// calls into another translation unit (std::visit cannot be inlined across one) they cost the
+// Cornell box 4-6 % of its instructions (bench/README.md, "Emitters inline").
+#pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <utility>
+#include <variant>
 
 #include <glm/geometric.hpp>
 
+#include "trace/emitters.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
 
 namespace pathex {
-namespace {
+namespace emitter_detail {
 
-bool finite_vec(const glm::vec3& v) {
+inline bool finite_vec(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-bool is_black(const glm::vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+inline bool is_black(const glm::vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
 
-bool in_unit_square(glm::vec2 r) { return r.x >= 0.0f && r.x < 1.0f && r.y >= 0.0f && r.y < 1.0f; }
+inline bool in_unit_square(glm::vec2 r) { return r.x >= 0.0f && r.x < 1.0f && r.y >= 0.0f && r.y < 1.0f; }
 
 // Unit direction and length of `v`, or false when v is zero or not finite.
-bool unit_and_length(const glm::vec3& v, glm::vec3* dir, float* length) {
+inline bool unit_and_length(const glm::vec3& v, glm::vec3* dir, float* length) {
   const float len = glm::length(v);
   if (!(len > 0.0f) || !std::isfinite(len)) return false;
   *dir = v * (1.0f / len);
@@ -31,8 +38,8 @@ bool unit_and_length(const glm::vec3& v, glm::vec3* dir, float* length) {
 }
 
 // Film coordinates (2x − 1, 1 − 2y) of a raster position, and back.
-glm::vec2 raster_to_film(glm::vec2 r) { return {2.0f * r.x - 1.0f, 1.0f - 2.0f * r.y}; }
-glm::vec2 film_to_raster(glm::vec2 f) { return {0.5f * (f.x + 1.0f), 0.5f * (1.0f - f.y)}; }
+inline glm::vec2 raster_to_film(glm::vec2 r) { return {2.0f * r.x - 1.0f, 1.0f - 2.0f * r.y}; }
+inline glm::vec2 film_to_raster(glm::vec2 f) { return {0.5f * (f.x + 1.0f), 0.5f * (1.0f - f.y)}; }
 
 // --- perspective image geometry shared by the pinhole and the thin lens ---
 
@@ -42,50 +49,50 @@ struct Perspective {
   float image_area() const { return 4.0f * tan_half_x * tan_half_y; }
   // The unit-distance image point of a raster position, as a direction from the centre.
   glm::vec3 direction(glm::vec2 raster) const {
-    const glm::vec2 f = raster_to_film(raster);
+    const glm::vec2 f = emitter_detail::raster_to_film(raster);
     return glm::normalize(forward + (f.x * tan_half_x) * right + (f.y * tan_half_y) * up);
   }
   // The raster position of a direction with positive cos θ = dot(w, forward).
   glm::vec2 raster(const glm::vec3& w, float cos_theta) const {
-    return film_to_raster({glm::dot(w, right) / (cos_theta * tan_half_x),
+    return emitter_detail::film_to_raster({glm::dot(w, right) / (cos_theta * tan_half_x),
                            glm::dot(w, up) / (cos_theta * tan_half_y)});
   }
 };
 
-Perspective perspective(const PinholeParams& p) {
+inline Perspective perspective(const PinholeParams& p) {
   return {p.forward, p.right, p.up, p.tan_half_x, p.tan_half_y};
 }
-Perspective perspective(const ThinLensParams& p) {
+inline Perspective perspective(const ThinLensParams& p) {
   return {p.forward, p.right, p.up, p.tan_half_x, p.tan_half_y};
 }
 
 // 1 / (A cos⁴θ) and 1 / (A cos³θ), the pinhole's importance and direction density.
-float perspective_we(float area, float cos_theta) {
+inline float perspective_we(float area, float cos_theta) {
   const float c2 = cos_theta * cos_theta;
   return 1.0f / (area * c2 * c2);
 }
-float perspective_pdf_dir(float area, float cos_theta) {
+inline float perspective_pdf_dir(float area, float cos_theta) {
   return 1.0f / (area * cos_theta * cos_theta * cos_theta);
 }
 
-float lens_area(const ThinLensParams& p) { return kPi * p.lens_radius * p.lens_radius; }
+inline float lens_area(const ThinLensParams& p) { return kPi * p.lens_radius * p.lens_radius; }
 
-}  // namespace
+}  // namespace emitter_detail
 
-float area_to_solid_angle(float pdf_area, float distance, float abs_cos) {
+inline float area_to_solid_angle(float pdf_area, float distance, float abs_cos) {
   if (!(abs_cos > 0.0f)) return 0.0f;
   return pdf_area * (distance * distance) / abs_cos;
 }
 
 // --- area light ---
 
-glm::vec3 emitted_radiance(const AreaLightParams& p, const glm::vec3& n, const glm::vec3& w) {
+inline glm::vec3 emitted_radiance(const AreaLightParams& p, const glm::vec3& n, const glm::vec3& w) {
   const float c = glm::dot(n, w);
   if (c > 0.0f || (p.two_sided && c < 0.0f)) return p.radiance;
   return glm::vec3(0.0f);
 }
 
-std::optional<EndpointRay> sample_ray(const AreaLightParams& p, const SurfacePoint& x, glm::vec2 u) {
+inline std::optional<EndpointRay> sample_ray(const AreaLightParams& p, const SurfacePoint& x, glm::vec2 u) {
   if (!(x.pdf_area > 0.0f) || !std::isfinite(x.pdf_area)) return std::nullopt;
   float side = 1.0f;
   if (p.two_sided) {  // pick a side with u.x and stretch it back to [0, 1)
@@ -109,17 +116,17 @@ std::optional<EndpointRay> sample_ray(const AreaLightParams& p, const SurfacePoi
   return r;
 }
 
-RayPdf pdf_ray(const AreaLightParams& p, const SurfacePoint& x, const glm::vec3& direction) {
+inline RayPdf pdf_ray(const AreaLightParams& p, const SurfacePoint& x, const glm::vec3& direction) {
   const float c = glm::dot(x.normal, direction);
   const bool emits = c > 0.0f || (p.two_sided && c < 0.0f);
   const float sides = p.two_sided ? 2.0f : 1.0f;
   return {x.pdf_area, emits ? std::abs(c) * kInvPi / sides : 0.0f, false, false};
 }
 
-std::optional<EndpointConnection> connect(const AreaLightParams& p, const SurfacePoint& x,
+inline std::optional<EndpointConnection> connect(const AreaLightParams& p, const SurfacePoint& x,
                                           const glm::vec3& ref) {
   EndpointConnection c;
-  if (!unit_and_length(x.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  if (!emitter_detail::unit_and_length(x.position - ref, &c.wi, &c.distance)) return std::nullopt;
   const float cos_signed = -glm::dot(x.normal, c.wi);  // at the light, towards ref
   const float cos_l = std::abs(cos_signed);
   const bool emits = cos_signed > 0.0f || (p.two_sided && cos_signed < 0.0f);  // as emitted_radiance()
@@ -130,17 +137,17 @@ std::optional<EndpointConnection> connect(const AreaLightParams& p, const Surfac
   c.pdf_dir = area_to_solid_angle(x.pdf_area, c.distance, cos_l);
   c.weight = c.value * (cos_l / (c.distance * c.distance * x.pdf_area));
   c.delta = false;
-  if (!finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
+  if (!emitter_detail::finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
   return c;
 }
 
-glm::vec3 power(const AreaLightParams& p, float area) {
+inline glm::vec3 power(const AreaLightParams& p, float area) {
   return p.radiance * (kPi * std::max(area, 0.0f) * (p.two_sided ? 2.0f : 1.0f));
 }
 
 // --- point light ---
 
-std::optional<EndpointRay> sample_ray(const PointLightParams& p, glm::vec2 u) {
+inline std::optional<EndpointRay> sample_ray(const PointLightParams& p, glm::vec2 u) {
   EndpointRay r;
   r.origin = p.position;
   r.direction = sample_uniform_sphere(u);
@@ -152,43 +159,43 @@ std::optional<EndpointRay> sample_ray(const PointLightParams& p, glm::vec2 u) {
   return r;
 }
 
-RayPdf pdf_ray(const PointLightParams&, const glm::vec3&) {
+inline RayPdf pdf_ray(const PointLightParams&, const glm::vec3&) {
   return {1.0f, kUniformSpherePdf, true, false};
 }
 
-std::optional<EndpointConnection> connect(const PointLightParams& p, const glm::vec3& ref) {
+inline std::optional<EndpointConnection> connect(const PointLightParams& p, const glm::vec3& ref) {
   EndpointConnection c;
-  if (!unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  if (!emitter_detail::unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
   c.position = p.position;
   c.value = p.intensity;
   c.weight = p.intensity / (c.distance * c.distance);
   c.delta = true;
-  if (!finite_vec(c.weight)) return std::nullopt;
+  if (!emitter_detail::finite_vec(c.weight)) return std::nullopt;
   return c;
 }
 
-glm::vec3 power(const PointLightParams& p) { return p.intensity * (4.0f * kPi); }
+inline glm::vec3 power(const PointLightParams& p) { return p.intensity * (4.0f * kPi); }
 
 // --- spot light ---
 
-float spot_falloff(const SpotLightParams& p, float cos_theta) {
+inline float spot_falloff(const SpotLightParams& p, float cos_theta) {
   if (!(cos_theta > p.cos_total)) return 0.0f;  // the cone's boundary itself emits nothing
   if (cos_theta >= p.cos_falloff_start) return 1.0f;
   const float t = (cos_theta - p.cos_total) / (p.cos_falloff_start - p.cos_total);
   return t * t * (3.0f - 2.0f * t);
 }
 
-glm::vec3 intensity(const SpotLightParams& p, const glm::vec3& direction) {
+inline glm::vec3 intensity(const SpotLightParams& p, const glm::vec3& direction) {
   return p.intensity * spot_falloff(p, glm::dot(direction, p.axis));
 }
 
-std::optional<EndpointRay> sample_ray(const SpotLightParams& p, glm::vec2 u) {
+inline std::optional<EndpointRay> sample_ray(const SpotLightParams& p, glm::vec2 u) {
   const glm::vec3 local = sample_uniform_cone(u, p.cos_total);
   EndpointRay r;
   r.origin = p.position;
   r.direction = glm::normalize(Frame::from_normal(p.axis).to_world(local));
   r.value = p.intensity * spot_falloff(p, local.z);
-  if (is_black(r.value)) return std::nullopt;  // the cone's rim, where the falloff is 0
+  if (emitter_detail::is_black(r.value)) return std::nullopt;  // the cone's rim, where the falloff is 0
   const float pdf_dir = uniform_cone_pdf(p.cos_total);
   r.pdf = {1.0f, pdf_dir, true, false};
   r.weight = r.value / pdf_dir;
@@ -197,37 +204,37 @@ std::optional<EndpointRay> sample_ray(const SpotLightParams& p, glm::vec2 u) {
   return r;
 }
 
-RayPdf pdf_ray(const SpotLightParams& p, const glm::vec3& direction) {
+inline RayPdf pdf_ray(const SpotLightParams& p, const glm::vec3& direction) {
   const bool inside = glm::dot(direction, p.axis) > p.cos_total;
   return {1.0f, inside ? uniform_cone_pdf(p.cos_total) : 0.0f, true, false};
 }
 
-std::optional<EndpointConnection> connect(const SpotLightParams& p, const glm::vec3& ref) {
+inline std::optional<EndpointConnection> connect(const SpotLightParams& p, const glm::vec3& ref) {
   EndpointConnection c;
-  if (!unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  if (!emitter_detail::unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
   c.value = intensity(p, -c.wi);
-  if (is_black(c.value)) return std::nullopt;
+  if (emitter_detail::is_black(c.value)) return std::nullopt;
   c.position = p.position;
   c.weight = c.value / (c.distance * c.distance);
   c.delta = true;
-  if (!finite_vec(c.weight)) return std::nullopt;
+  if (!emitter_detail::finite_vec(c.weight)) return std::nullopt;
   return c;
 }
 
-glm::vec3 power(const SpotLightParams& p) {
+inline glm::vec3 power(const SpotLightParams& p) {
   return p.intensity * (2.0f * kPi * (1.0f - 0.5f * (p.cos_falloff_start + p.cos_total)));
 }
 
 // --- distant light through an aperture ---
 
-float aperture_area(const DistantLightParams& p) { return glm::length(glm::cross(p.edge1, p.edge2)); }
+inline float aperture_area(const DistantLightParams& p) { return glm::length(glm::cross(p.edge1, p.edge2)); }
 
-namespace {
-glm::vec3 aperture_normal(const DistantLightParams& p) {
+namespace emitter_detail {
+inline glm::vec3 aperture_normal(const DistantLightParams& p) {
   return glm::normalize(glm::cross(p.edge1, p.edge2));
 }
 // Parallelogram coordinates (a, b) of a point in the aperture's plane.
-glm::vec2 aperture_coords(const DistantLightParams& p, const glm::vec3& x) {
+inline glm::vec2 aperture_coords(const DistantLightParams& p, const glm::vec3& x) {
   const glm::vec3 d = x - p.corner;
   const float e11 = glm::dot(p.edge1, p.edge1), e12 = glm::dot(p.edge1, p.edge2),
               e22 = glm::dot(p.edge2, p.edge2);
@@ -235,12 +242,12 @@ glm::vec2 aperture_coords(const DistantLightParams& p, const glm::vec3& x) {
   const float det = e11 * e22 - e12 * e12;
   return {(d1 * e22 - d2 * e12) / det, (d2 * e11 - d1 * e12) / det};
 }
-}  // namespace
+}  // namespace emitter_detail
 
-std::optional<EndpointRay> sample_ray(const DistantLightParams& p, glm::vec2 u) {
+inline std::optional<EndpointRay> sample_ray(const DistantLightParams& p, glm::vec2 u) {
   const float area = aperture_area(p);
   if (!(area > 0.0f)) return std::nullopt;
-  const glm::vec3 n = aperture_normal(p);
+  const glm::vec3 n = emitter_detail::aperture_normal(p);
   EndpointRay r;
   r.origin = p.corner + u.x * p.edge1 + u.y * p.edge2;
   r.direction = p.direction;
@@ -248,23 +255,23 @@ std::optional<EndpointRay> sample_ray(const DistantLightParams& p, glm::vec2 u) 
   r.value = p.irradiance;
   r.pdf = {1.0f / area, 1.0f, false, true};
   r.weight = p.irradiance * (std::abs(glm::dot(n, p.direction)) * area);
-  if (is_black(r.weight)) return std::nullopt;  // light parallel to the aperture
+  if (emitter_detail::is_black(r.weight)) return std::nullopt;  // light parallel to the aperture
   r.pos_letter = DistantLightParams::kPosLetter;
   r.dir_letter = DistantLightParams::kDirLetter;
   return r;
 }
 
-RayPdf pdf_ray(const DistantLightParams& p, const glm::vec3& origin) {
+inline RayPdf pdf_ray(const DistantLightParams& p, const glm::vec3& origin) {
   const float area = aperture_area(p);
-  const glm::vec2 ab = aperture_coords(p, origin);
+  const glm::vec2 ab = emitter_detail::aperture_coords(p, origin);
   const bool inside = area > 0.0f && ab.x >= 0.0f && ab.x < 1.0f && ab.y >= 0.0f && ab.y < 1.0f;
   return {inside ? 1.0f / area : 0.0f, 1.0f, false, true};
 }
 
-std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm::vec3& ref) {
+inline std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm::vec3& ref) {
   const float area = aperture_area(p);
   if (!(area > 0.0f)) return std::nullopt;
-  const glm::vec3 n = aperture_normal(p);
+  const glm::vec3 n = emitter_detail::aperture_normal(p);
   // ref − t · direction lies in the aperture's plane: t = dot(ref − corner, n) / dot(direction, n).
   const float denom = glm::dot(p.direction, n);
   if (denom == 0.0f) return std::nullopt;
@@ -272,7 +279,7 @@ std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm
   if (!(t > 0.0f) || !std::isfinite(t)) return std::nullopt;
   EndpointConnection c;
   c.position = ref - t * p.direction;
-  const glm::vec2 ab = aperture_coords(p, c.position);
+  const glm::vec2 ab = emitter_detail::aperture_coords(p, c.position);
   if (!(ab.x >= 0.0f && ab.x < 1.0f && ab.y >= 0.0f && ab.y < 1.0f)) return std::nullopt;
   c.normal = n;
   c.wi = -p.direction;
@@ -283,14 +290,14 @@ std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm
   return c;
 }
 
-glm::vec3 power(const DistantLightParams& p) {
+inline glm::vec3 power(const DistantLightParams& p) {
   if (!(aperture_area(p) > 0.0f)) return glm::vec3(0.0f);
-  return p.irradiance * (aperture_area(p) * std::abs(glm::dot(p.direction, aperture_normal(p))));
+  return p.irradiance * (aperture_area(p) * std::abs(glm::dot(p.direction, emitter_detail::aperture_normal(p))));
 }
 
 // --- laser ---
 
-std::optional<EndpointRay> sample_ray(const LaserParams& p) {
+inline std::optional<EndpointRay> sample_ray(const LaserParams& p) {
   EndpointRay r;
   r.origin = p.position;
   r.direction = p.direction;
@@ -302,25 +309,25 @@ std::optional<EndpointRay> sample_ray(const LaserParams& p) {
   return r;
 }
 
-RayPdf pdf_ray(const LaserParams&) { return {1.0f, 1.0f, true, true}; }
+inline RayPdf pdf_ray(const LaserParams&) { return {1.0f, 1.0f, true, true}; }
 
-std::optional<EndpointConnection> connect(const LaserParams&, const glm::vec3&) {
+inline std::optional<EndpointConnection> connect(const LaserParams&, const glm::vec3&) {
   return std::nullopt;
 }
 
-glm::vec3 power(const LaserParams& p) { return p.power; }
+inline glm::vec3 power(const LaserParams& p) { return p.power; }
 
 // --- pinhole ---
 
-std::optional<EndpointRay> sample_ray(const PinholeParams& p, glm::vec2 raster) {
-  const Perspective cam = perspective(p);
+inline std::optional<EndpointRay> sample_ray(const PinholeParams& p, glm::vec2 raster) {
+  const emitter_detail::Perspective cam = emitter_detail::perspective(p);
   EndpointRay r;
   r.origin = p.position;
   r.direction = cam.direction(raster);
   r.normal = p.forward;
   const float cos_theta = glm::dot(r.direction, p.forward);
   if (!(cos_theta > 0.0f)) return std::nullopt;
-  const float pdf_dir = perspective_pdf_dir(cam.image_area(), cos_theta);
+  const float pdf_dir = emitter_detail::perspective_pdf_dir(cam.image_area(), cos_theta);
   r.value = glm::vec3(pdf_dir / cos_theta);  // We = 1 / (A cos⁴θ)
   r.pdf = {1.0f, pdf_dir, true, false};
   r.weight = glm::vec3(1.0f);  // We cos / p_dir = 1 exactly
@@ -330,49 +337,49 @@ std::optional<EndpointRay> sample_ray(const PinholeParams& p, glm::vec2 raster) 
   return r;
 }
 
-glm::vec3 importance(const PinholeParams& p, const glm::vec3& direction, glm::vec2* raster) {
+inline glm::vec3 importance(const PinholeParams& p, const glm::vec3& direction, glm::vec2* raster) {
   const float cos_theta = glm::dot(direction, p.forward);
   if (!(cos_theta > 0.0f)) return glm::vec3(0.0f);
-  const Perspective cam = perspective(p);
+  const emitter_detail::Perspective cam = emitter_detail::perspective(p);
   const glm::vec2 r = cam.raster(direction, cos_theta);
-  if (!in_unit_square(r)) return glm::vec3(0.0f);
+  if (!emitter_detail::in_unit_square(r)) return glm::vec3(0.0f);
   if (raster) *raster = r;
-  return glm::vec3(perspective_we(cam.image_area(), cos_theta));
+  return glm::vec3(emitter_detail::perspective_we(cam.image_area(), cos_theta));
 }
 
-RayPdf pdf_ray(const PinholeParams& p, const glm::vec3& direction) {
+inline RayPdf pdf_ray(const PinholeParams& p, const glm::vec3& direction) {
   // importance()'s test of the image, without its value (MIS asks for this density often).
   const float cos_theta = glm::dot(direction, p.forward);
   if (!(cos_theta > 0.0f)) return {1.0f, 0.0f, true, false};
-  const Perspective cam = perspective(p);
-  if (!in_unit_square(cam.raster(direction, cos_theta))) return {1.0f, 0.0f, true, false};
-  return {1.0f, perspective_pdf_dir(cam.image_area(), cos_theta), true, false};
+  const emitter_detail::Perspective cam = emitter_detail::perspective(p);
+  if (!emitter_detail::in_unit_square(cam.raster(direction, cos_theta))) return {1.0f, 0.0f, true, false};
+  return {1.0f, emitter_detail::perspective_pdf_dir(cam.image_area(), cos_theta), true, false};
 }
 
-std::optional<EndpointConnection> connect(const PinholeParams& p, const glm::vec3& ref) {
+inline std::optional<EndpointConnection> connect(const PinholeParams& p, const glm::vec3& ref) {
   EndpointConnection c;
-  if (!unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  if (!emitter_detail::unit_and_length(p.position - ref, &c.wi, &c.distance)) return std::nullopt;
   c.value = importance(p, -c.wi, &c.raster);
-  if (is_black(c.value)) return std::nullopt;
+  if (emitter_detail::is_black(c.value)) return std::nullopt;
   const float cos_theta = glm::dot(-c.wi, p.forward);
   c.position = p.position;
   c.normal = p.forward;
   c.weight = c.value * (cos_theta / (c.distance * c.distance));
   c.delta = true;
-  if (!finite_vec(c.weight)) return std::nullopt;
+  if (!emitter_detail::finite_vec(c.weight)) return std::nullopt;
   return c;
 }
 
 // --- thin lens ---
 
-glm::vec3 lens_point(const ThinLensParams& p, glm::vec2 u_lens) {
+inline glm::vec3 lens_point(const ThinLensParams& p, glm::vec2 u_lens) {
   const glm::vec2 d = sample_concentric_disk(u_lens) * p.lens_radius;
   return p.position + d.x * p.right + d.y * p.up;
 }
 
-std::optional<EndpointRay> sample_ray(const ThinLensParams& p, glm::vec2 raster, glm::vec2 u_lens) {
+inline std::optional<EndpointRay> sample_ray(const ThinLensParams& p, glm::vec2 raster, glm::vec2 u_lens) {
   if (!(p.lens_radius > 0.0f) || !(p.focus_distance > 0.0f)) return std::nullopt;
-  const Perspective cam = perspective(p);
+  const emitter_detail::Perspective cam = emitter_detail::perspective(p);
   // The point on the plane of focus that the pinhole ray through the lens centre would reach.
   const glm::vec3 pinhole_dir = cam.direction(raster);
   const glm::vec3 focus =
@@ -380,14 +387,14 @@ std::optional<EndpointRay> sample_ray(const ThinLensParams& p, glm::vec2 raster,
   EndpointRay r;
   r.origin = lens_point(p, u_lens);
   float dist;
-  if (!unit_and_length(focus - r.origin, &r.direction, &dist)) return std::nullopt;
+  if (!emitter_detail::unit_and_length(focus - r.origin, &r.direction, &dist)) return std::nullopt;
   r.normal = p.forward;
   const float cos_theta = glm::dot(r.direction, p.forward);
   if (!(cos_theta > 0.0f)) return std::nullopt;
   const float area = cam.image_area();
-  const float a_lens = lens_area(p);
-  r.value = glm::vec3(perspective_we(area, cos_theta) / a_lens);
-  r.pdf = {1.0f / a_lens, perspective_pdf_dir(area, cos_theta), false, false};
+  const float a_lens = emitter_detail::lens_area(p);
+  r.value = glm::vec3(emitter_detail::perspective_we(area, cos_theta) / a_lens);
+  r.pdf = {1.0f / a_lens, emitter_detail::perspective_pdf_dir(area, cos_theta), false, false};
   r.weight = glm::vec3(1.0f);  // We cos / (p_pos p_dir) = 1 exactly
   r.pos_letter = ThinLensParams::kPosLetter;
   r.dir_letter = ThinLensParams::kDirLetter;
@@ -395,7 +402,7 @@ std::optional<EndpointRay> sample_ray(const ThinLensParams& p, glm::vec2 raster,
   return r;
 }
 
-glm::vec3 importance(const ThinLensParams& p, const glm::vec3& origin, const glm::vec3& direction,
+inline glm::vec3 importance(const ThinLensParams& p, const glm::vec3& origin, const glm::vec3& direction,
                      glm::vec2* raster) {
   const float cos_theta = glm::dot(direction, p.forward);
   if (!(cos_theta > 0.0f) || !(p.lens_radius > 0.0f)) return glm::vec3(0.0f);
@@ -408,49 +415,49 @@ glm::vec3 importance(const ThinLensParams& p, const glm::vec3& origin, const glm
   const glm::vec3 v = focus - p.position;
   const float depth = glm::dot(v, p.forward);
   if (!(depth > 0.0f)) return glm::vec3(0.0f);
-  const Perspective cam = perspective(p);
-  const glm::vec2 r = film_to_raster({glm::dot(v, p.right) / (depth * p.tan_half_x),
+  const emitter_detail::Perspective cam = emitter_detail::perspective(p);
+  const glm::vec2 r = emitter_detail::film_to_raster({glm::dot(v, p.right) / (depth * p.tan_half_x),
                                       glm::dot(v, p.up) / (depth * p.tan_half_y)});
-  if (!in_unit_square(r)) return glm::vec3(0.0f);
+  if (!emitter_detail::in_unit_square(r)) return glm::vec3(0.0f);
   if (raster) *raster = r;
-  return glm::vec3(perspective_we(cam.image_area(), cos_theta) / lens_area(p));
+  return glm::vec3(emitter_detail::perspective_we(cam.image_area(), cos_theta) / emitter_detail::lens_area(p));
 }
 
-RayPdf pdf_ray(const ThinLensParams& p, const glm::vec3& origin, const glm::vec3& direction) {
+inline RayPdf pdf_ray(const ThinLensParams& p, const glm::vec3& origin, const glm::vec3& direction) {
   glm::vec2 raster;
-  if (is_black(importance(p, origin, direction, &raster))) return {0.0f, 0.0f, false, false};
+  if (emitter_detail::is_black(importance(p, origin, direction, &raster))) return {0.0f, 0.0f, false, false};
   const float cos_theta = glm::dot(direction, p.forward);
-  return {1.0f / lens_area(p), perspective_pdf_dir(perspective(p).image_area(), cos_theta), false,
+  return {1.0f / emitter_detail::lens_area(p), emitter_detail::perspective_pdf_dir(emitter_detail::perspective(p).image_area(), cos_theta), false,
           false};
 }
 
-namespace {
+namespace emitter_detail {
 // The join of `ref` to the lens point `x`.
-std::optional<EndpointConnection> connect_lens_point(const ThinLensParams& p, const glm::vec3& x,
+inline std::optional<EndpointConnection> connect_lens_point(const ThinLensParams& p, const glm::vec3& x,
                                                      const glm::vec3& ref) {
   EndpointConnection c;
-  if (!unit_and_length(x - ref, &c.wi, &c.distance)) return std::nullopt;
+  if (!emitter_detail::unit_and_length(x - ref, &c.wi, &c.distance)) return std::nullopt;
   c.value = importance(p, x, -c.wi, &c.raster);
-  if (is_black(c.value)) return std::nullopt;
+  if (emitter_detail::is_black(c.value)) return std::nullopt;
   const float cos_lens = glm::dot(-c.wi, p.forward);
-  const float a_lens = lens_area(p);
+  const float a_lens = emitter_detail::lens_area(p);
   c.position = x;
   c.normal = p.forward;
   c.pdf_dir = area_to_solid_angle(1.0f / a_lens, c.distance, cos_lens);
   c.weight = c.value * (cos_lens * a_lens / (c.distance * c.distance));
   c.delta = false;
-  if (!finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
+  if (!emitter_detail::finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
   return c;
 }
-}  // namespace
+}  // namespace emitter_detail
 
-std::optional<EndpointConnection> connect(const ThinLensParams& p, glm::vec2 u_lens,
+inline std::optional<EndpointConnection> connect(const ThinLensParams& p, glm::vec2 u_lens,
                                           const glm::vec3& ref) {
   if (!(p.lens_radius > 0.0f)) return std::nullopt;
-  return connect_lens_point(p, lens_point(p, u_lens), ref);
+  return emitter_detail::connect_lens_point(p, lens_point(p, u_lens), ref);
 }
 
-std::optional<EndpointConnection> hit_lens(const ThinLensParams& p, const glm::vec3& origin,
+inline std::optional<EndpointConnection> hit_lens(const ThinLensParams& p, const glm::vec3& origin,
                                            const glm::vec3& direction) {
   if (!(p.lens_radius > 0.0f)) return std::nullopt;
   const float denom = glm::dot(direction, p.forward);
@@ -461,19 +468,19 @@ std::optional<EndpointConnection> hit_lens(const ThinLensParams& p, const glm::v
   const glm::vec3 off = x - p.position;
   const float u = glm::dot(off, p.right), v = glm::dot(off, p.up);
   if (!(u * u + v * v < p.lens_radius * p.lens_radius)) return std::nullopt;
-  return connect_lens_point(p, x, origin);
+  return emitter_detail::connect_lens_point(p, x, origin);
 }
 
 // --- orthographic ---
 
-namespace {
-float film_area(const OrthographicParams& p) { return 4.0f * p.half_width * p.half_height; }
-}  // namespace
+namespace emitter_detail {
+inline float film_area(const OrthographicParams& p) { return 4.0f * p.half_width * p.half_height; }
+}  // namespace emitter_detail
 
-std::optional<EndpointRay> sample_ray(const OrthographicParams& p, glm::vec2 raster) {
-  const float area = film_area(p);
+inline std::optional<EndpointRay> sample_ray(const OrthographicParams& p, glm::vec2 raster) {
+  const float area = emitter_detail::film_area(p);
   if (!(area > 0.0f)) return std::nullopt;
-  const glm::vec2 f = raster_to_film(raster);
+  const glm::vec2 f = emitter_detail::raster_to_film(raster);
   EndpointRay r;
   r.origin = p.position + (f.x * p.half_width) * p.right + (f.y * p.half_height) * p.up;
   r.direction = p.forward;
@@ -487,25 +494,25 @@ std::optional<EndpointRay> sample_ray(const OrthographicParams& p, glm::vec2 ras
   return r;
 }
 
-RayPdf pdf_ray(const OrthographicParams& p, const glm::vec3& origin) {
-  const float area = film_area(p);
+inline RayPdf pdf_ray(const OrthographicParams& p, const glm::vec3& origin) {
+  const float area = emitter_detail::film_area(p);
   const glm::vec3 d = origin - p.position;
   const glm::vec2 r =
-      film_to_raster({glm::dot(d, p.right) / p.half_width, glm::dot(d, p.up) / p.half_height});
-  const bool inside = area > 0.0f && in_unit_square(r);
+      emitter_detail::film_to_raster({glm::dot(d, p.right) / p.half_width, glm::dot(d, p.up) / p.half_height});
+  const bool inside = area > 0.0f && emitter_detail::in_unit_square(r);
   return {inside ? 1.0f / area : 0.0f, 1.0f, false, true};
 }
 
-std::optional<EndpointConnection> connect(const OrthographicParams& p, const glm::vec3& ref) {
-  const float area = film_area(p);
+inline std::optional<EndpointConnection> connect(const OrthographicParams& p, const glm::vec3& ref) {
+  const float area = emitter_detail::film_area(p);
   if (!(area > 0.0f)) return std::nullopt;
   const glm::vec3 d = ref - p.position;
   const float depth = glm::dot(d, p.forward);
   if (!(depth > 0.0f) || !std::isfinite(depth)) return std::nullopt;
   EndpointConnection c;
   c.raster =
-      film_to_raster({glm::dot(d, p.right) / p.half_width, glm::dot(d, p.up) / p.half_height});
-  if (!in_unit_square(c.raster)) return std::nullopt;
+      emitter_detail::film_to_raster({glm::dot(d, p.right) / p.half_width, glm::dot(d, p.up) / p.half_height});
+  if (!emitter_detail::in_unit_square(c.raster)) return std::nullopt;
   c.position = ref - depth * p.forward;
   c.normal = p.forward;
   c.wi = -p.forward;
@@ -518,7 +525,7 @@ std::optional<EndpointConnection> connect(const OrthographicParams& p, const glm
 
 // --- spot meter ---
 
-std::optional<EndpointRay> sample_ray(const SpotMeterParams& p) {
+inline std::optional<EndpointRay> sample_ray(const SpotMeterParams& p) {
   EndpointRay r;
   r.origin = p.position;
   r.direction = p.direction;
@@ -531,60 +538,73 @@ std::optional<EndpointRay> sample_ray(const SpotMeterParams& p) {
   return r;
 }
 
-RayPdf pdf_ray(const SpotMeterParams&) { return {1.0f, 1.0f, true, true}; }
+inline RayPdf pdf_ray(const SpotMeterParams&) { return {1.0f, 1.0f, true, true}; }
 
-std::optional<EndpointConnection> connect(const SpotMeterParams&, const glm::vec3&) {
+inline std::optional<EndpointConnection> connect(const SpotMeterParams&, const glm::vec3&) {
   return std::nullopt;
 }
 
 // --- the handles ---
 
-namespace {
+namespace emitter_detail {
 template <class... F>
 struct Overloaded : F... {
   using F::operator()...;
 };
 template <class... F>
 Overloaded(F...) -> Overloaded<F...>;
-}  // namespace
 
-Letter pos_letter(const LightParams& l) {
-  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kPosLetter; }, l);
+// std::visit as a chain of index tests, which the compiler inlines with the kind's function
+// (GCC compiles std::visit to a table of calls that it does not inline): the integrator's calls
+// through the handles then cost what a switch over the kinds would.
+template <std::size_t I = 0, class F, class V>
+[[gnu::always_inline]] inline decltype(auto) visit(F&& f, const V& v) {
+  if constexpr (I + 1 == std::variant_size_v<V>) {
+    return f(*std::get_if<I>(&v));
+  } else {
+    if (v.index() == I) return f(*std::get_if<I>(&v));
+    return visit<I + 1>(std::forward<F>(f), v);
+  }
 }
-Letter dir_letter(const LightParams& l) {
-  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kDirLetter; }, l);
+}  // namespace emitter_detail
+
+inline Letter pos_letter(const LightParams& l) {
+  return emitter_detail::visit([](const auto& p) { return std::decay_t<decltype(p)>::kPosLetter; }, l);
 }
-Letter pos_letter(const SensorParams& s) {
-  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kPosLetter; }, s);
+inline Letter dir_letter(const LightParams& l) {
+  return emitter_detail::visit([](const auto& p) { return std::decay_t<decltype(p)>::kDirLetter; }, l);
 }
-Letter dir_letter(const SensorParams& s) {
-  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kDirLetter; }, s);
+inline Letter pos_letter(const SensorParams& s) {
+  return emitter_detail::visit([](const auto& p) { return std::decay_t<decltype(p)>::kPosLetter; }, s);
+}
+inline Letter dir_letter(const SensorParams& s) {
+  return emitter_detail::visit([](const auto& p) { return std::decay_t<decltype(p)>::kDirLetter; }, s);
 }
 
-std::optional<EndpointRay> sample_ray(const LightParams& l, const SurfacePoint& x, glm::vec2 u) {
-  return std::visit(Overloaded{[&](const AreaLightParams& p) { return sample_ray(p, x, u); },
+inline std::optional<EndpointRay> sample_ray(const LightParams& l, const SurfacePoint& x, glm::vec2 u) {
+  return emitter_detail::visit(emitter_detail::Overloaded{[&](const AreaLightParams& p) { return sample_ray(p, x, u); },
                                [&](const LaserParams& p) { return sample_ray(p); },
                                [&](const auto& p) { return sample_ray(p, u); }},
                     l);
 }
 
-RayPdf pdf_ray(const LightParams& l, const SurfacePoint& x, const glm::vec3& direction) {
-  return std::visit(Overloaded{[&](const AreaLightParams& p) { return pdf_ray(p, x, direction); },
+inline RayPdf pdf_ray(const LightParams& l, const SurfacePoint& x, const glm::vec3& direction) {
+  return emitter_detail::visit(emitter_detail::Overloaded{[&](const AreaLightParams& p) { return pdf_ray(p, x, direction); },
                                [&](const DistantLightParams& p) { return pdf_ray(p, x.position); },
                                [&](const LaserParams& p) { return pdf_ray(p); },
                                [&](const auto& p) { return pdf_ray(p, direction); }},
                     l);
 }
 
-std::optional<EndpointConnection> connect(const LightParams& l, const SurfacePoint& x,
+inline std::optional<EndpointConnection> connect(const LightParams& l, const SurfacePoint& x,
                                           const glm::vec3& ref) {
-  return std::visit(Overloaded{[&](const AreaLightParams& p) { return connect(p, x, ref); },
+  return emitter_detail::visit(emitter_detail::Overloaded{[&](const AreaLightParams& p) { return connect(p, x, ref); },
                                [&](const auto& p) { return connect(p, ref); }},
                     l);
 }
 
-glm::vec3 spatial_emission(const LightParams& l) {
-  return std::visit(Overloaded{[](const AreaLightParams& p) { return p.radiance; },
+inline glm::vec3 spatial_emission(const LightParams& l) {
+  return emitter_detail::visit(emitter_detail::Overloaded{[](const AreaLightParams& p) { return p.radiance; },
                                [](const PointLightParams& p) { return p.intensity; },
                                [](const SpotLightParams& p) { return p.intensity; },
                                [](const DistantLightParams& p) { return p.irradiance; },
@@ -592,49 +612,49 @@ glm::vec3 spatial_emission(const LightParams& l) {
                     l);
 }
 
-float directional_emission(const LightParams& l, const glm::vec3& n, const glm::vec3& w) {
-  return std::visit(
-      Overloaded{[&](const AreaLightParams& p) { return is_black(emitted_radiance(p, n, w)) ? 0.0f : 1.0f; },
+inline float directional_emission(const LightParams& l, const glm::vec3& n, const glm::vec3& w) {
+  return emitter_detail::visit(
+      emitter_detail::Overloaded{[&](const AreaLightParams& p) { return emitter_detail::is_black(emitted_radiance(p, n, w)) ? 0.0f : 1.0f; },
                  [](const PointLightParams&) { return 1.0f; },
                  [&](const SpotLightParams& p) { return spot_falloff(p, glm::dot(w, p.axis)); },
                  [](const auto&) { return 0.0f; }},
       l);
 }
 
-std::optional<EndpointRay> sample_ray(const SensorParams& s, glm::vec2 raster, glm::vec2 u_lens) {
-  return std::visit(Overloaded{[&](const ThinLensParams& p) { return sample_ray(p, raster, u_lens); },
+inline std::optional<EndpointRay> sample_ray(const SensorParams& s, glm::vec2 raster, glm::vec2 u_lens) {
+  return emitter_detail::visit(emitter_detail::Overloaded{[&](const ThinLensParams& p) { return sample_ray(p, raster, u_lens); },
                                [&](const SpotMeterParams& p) { return sample_ray(p); },
                                [&](const auto& p) { return sample_ray(p, raster); }},
                     s);
 }
 
-RayPdf pdf_ray(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction) {
-  return std::visit(Overloaded{[&](const PinholeParams& p) { return pdf_ray(p, direction); },
+inline RayPdf pdf_ray(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction) {
+  return emitter_detail::visit(emitter_detail::Overloaded{[&](const PinholeParams& p) { return pdf_ray(p, direction); },
                                [&](const ThinLensParams& p) { return pdf_ray(p, origin, direction); },
                                [&](const OrthographicParams& p) { return pdf_ray(p, origin); },
                                [&](const SpotMeterParams& p) { return pdf_ray(p); }},
                     s);
 }
 
-std::optional<EndpointConnection> connect_finite(const SensorParams& s, glm::vec2 u_lens,
+inline std::optional<EndpointConnection> connect_finite(const SensorParams& s, glm::vec2 u_lens,
                                                  const glm::vec3& ref) {
-  return std::visit(
-      Overloaded{[&](const PinholeParams& p) { return connect(p, ref); },
+  return emitter_detail::visit(
+      emitter_detail::Overloaded{[&](const PinholeParams& p) { return connect(p, ref); },
                  [&](const ThinLensParams& p) { return connect(p, u_lens, ref); },
                  [](const auto&) { return std::optional<EndpointConnection>(); }},
       s);
 }
 
-glm::vec3 importance(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction,
+inline glm::vec3 importance(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction,
                      glm::vec2* raster) {
-  return std::visit(
-      Overloaded{[&](const PinholeParams& p) { return importance(p, direction, raster); },
+  return emitter_detail::visit(
+      emitter_detail::Overloaded{[&](const PinholeParams& p) { return importance(p, direction, raster); },
                  [&](const ThinLensParams& p) { return importance(p, origin, direction, raster); },
                  [](const auto&) { return glm::vec3(0.0f); }},
       s);
 }
 
-std::optional<EndpointConnection> hit_lens(const SensorParams& s, const glm::vec3& origin,
+inline std::optional<EndpointConnection> hit_lens(const SensorParams& s, const glm::vec3& origin,
                                            const glm::vec3& direction) {
   if (const auto* p = std::get_if<ThinLensParams>(&s)) return hit_lens(*p, origin, direction);
   return std::nullopt;
