@@ -62,5 +62,6 @@ Command add_query(CLI::App& app);
 Command add_check(CLI::App& app);
 Command add_renderers(CLI::App& app);
 Command add_trace(CLI::App& app);
+Command add_converge(CLI::App& app);
 
 }  // namespace pathex::cli

@@ -649,13 +649,46 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
   return s;
 }
 
+// "reference": the closed form the scene declares (scene.h, ClosedFormReference). The class
+// expressions are compiled where they are used (pathex converge), with their pointers.
+Result<ClosedFormReference> read_reference(const Reader& r, const nlohmann::json& j, const std::string& ptr) {
+  if (!j.is_object()) return r.fail(ptr, "expected {\"source\": …, \"classes\": [{\"name\", \"class\", \"luminance\"}, …]}");
+  if (auto k = r.keys(j, ptr, {"source", "uniform", "classes"}); !k) return k.error();
+  ClosedFormReference ref;
+  PATHEX_TRY(source, r.string(j, "source", ptr));
+  ref.source = source;
+  if (j.contains("uniform")) {
+    if (!j["uniform"].is_boolean()) return r.fail(ptr + "/uniform", "expected true or false");
+    ref.uniform = j["uniform"].get<bool>();
+  }
+  if (!j.contains("classes") || !j["classes"].is_array() || j["classes"].empty())
+    return r.fail(ptr + "/classes", "expected a non-empty array of {name, class, luminance}");
+  for (std::size_t i = 0; i < j["classes"].size(); ++i) {
+    const std::string cp = ptr + "/classes/" + std::to_string(i);
+    const nlohmann::json& c = j["classes"][i];
+    if (!c.is_object()) return r.fail(cp, "expected {name, class, luminance}");
+    if (auto k = r.keys(c, cp, {"name", "class", "luminance"}); !k) return k.error();
+    ReferenceClass rc;
+    PATHEX_TRY(name, r.string(c, "name", cp));
+    PATHEX_TRY(expr, r.string(c, "class", cp));
+    PATHEX_TRY(lum, r.number(c, "luminance", cp, 0.0, 1e30));
+    for (const ReferenceClass& before : ref.classes)
+      if (before.name == name) return r.fail(cp + "/name", "the class name '" + name + "' is used twice");
+    rc.name = name;
+    rc.expr = expr;
+    rc.luminance = lum;
+    ref.classes.push_back(std::move(rc));
+  }
+  return ref;
+}
+
 }  // namespace
 
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
                               const SceneLoadOptions& options) {
   const Reader r(name);
   PATHEX_TRY(doc, parse_json(text, name));
-  if (auto k = r.keys(doc, "", {"camera", "materials", "shapes", "lights"}); !k) return k.error();
+  if (auto k = r.keys(doc, "", {"camera", "materials", "shapes", "lights", "reference"}); !k) return k.error();
   Scene scene;
   scene.name = name;
   // --- materials ---
@@ -689,6 +722,10 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   PATHEX_TRY(cam, read_camera(r, doc["camera"], "/camera"));
   scene.camera = cam;
   if (!camera_sees_geometry(scene)) return r.fail("/camera", kSeesNothing);
+  if (doc.contains("reference")) {
+    PATHEX_TRY(ref, read_reference(r, doc["reference"], "/reference"));
+    scene.reference = std::move(ref);
+  }
   return scene;
 }
 

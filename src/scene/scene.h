@@ -83,6 +83,23 @@ struct Camera {
   int width = 64, height = 64;      // spot meter: 1 x 1
 };
 
+// A closed-form reference a scene declares (DESIGN §9), which `pathex converge` measures renderers
+// against: the exact image mean (mean pixel luminance) of some path classes. JSON:
+//   "reference": {"source": "why these values are exact", "uniform": true,
+//                 "classes": [{"name": "1 bounce", "class": "LSDDDSE", "luminance": 0.159155}, …]}
+// `uniform` says that every pixel of each class has that value (inside a closed sphere), so
+// per-pixel errors can be measured too. A class named "total" is the whole image (class $all).
+struct ReferenceClass {
+  std::string name;
+  std::string expr;        // full notation
+  double luminance = 0.0;  // exact image mean
+};
+struct ClosedFormReference {
+  std::string source;
+  bool uniform = false;
+  std::vector<ReferenceClass> classes;
+};
+
 struct Scene {
   std::string name;
   std::vector<std::string> material_names;
@@ -90,6 +107,7 @@ struct Scene {
   std::vector<Shape> shapes;
   std::vector<Light> lights;
   Camera camera;
+  std::optional<ClosedFormReference> reference;  // "reference", when the scene declares one
 };
 
 // How much of a scene to load.
