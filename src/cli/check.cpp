@@ -15,7 +15,10 @@
 #include "io/input_file.h"
 #include "io/json_reader.h"
 #include "io/junit.h"
+#include "io/profile_json.h"
 #include "io/reach_json.h"
+#include "scene/scene.h"
+#include "trace/render.h"
 
 namespace pathex::cli {
 namespace {
@@ -30,9 +33,14 @@ struct CheckArgs {
 struct Requirement {
   std::string pointer;
   bool covers_scene = false;
+  // {"finite": true, "spp": N, "seed": N}: a render of the case's scene with its renderer has no
+  // non-finite sample (DESIGN §7: any is a bug).
+  bool finite = false;
+  std::uint64_t spp = 16, seed = 1;
   std::string cls;
   std::string verdict;  // reachable, not-unreachable, unreachable, partial, empty
   std::string describe() const {
+    if (finite) return "renders finite (" + std::to_string(spp) + " spp, seed " + std::to_string(seed) + ")";
     return covers_scene ? "covers the scene" : cls + " is " + verdict;
   }
 };
@@ -123,12 +131,29 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
     for (std::size_t j = 0; j < reqs.size(); ++j) {
       const std::string rp = ptr + "/require/" + std::to_string(j);
       const auto& jr = reqs[j];
-      if (!jr.is_object()) return bad(file, rp, "expected {\"class\": …, \"verdict\": …} or {\"covers-scene\": true}");
+      if (!jr.is_object())
+        return bad(file, rp, "expected {\"class\": …, \"verdict\": …}, {\"covers-scene\": true} or {\"finite\": true}");
       Requirement r;
       r.pointer = rp;
+      if (jr.contains("finite")) {
+        for (const auto& [k, v] : jr.items())
+          if (k != "finite" && k != "spp" && k != "seed")
+            return bad(file, rp + "/" + pointer_token(k), "unknown key '" + k + "', expected finite with optional spp and seed");
+        if (jr.at("finite") != true) return bad(file, rp + "/finite", "expected true");
+        if (c.scene.empty()) return bad(file, ptr + "/scene", "a finite requirement renders the case's scene: expected a scene file path");
+        Result<long long> spp = JsonReader(file).integer(jr, "spp", rp, 1, 1 << 20, 16);
+        if (!spp) return spp.error();
+        Result<long long> seed = JsonReader(file).integer(jr, "seed", rp, 0, std::numeric_limits<long long>::max(), 1);
+        if (!seed) return seed.error();
+        r.finite = true;
+        r.spp = static_cast<std::uint64_t>(*spp);
+        r.seed = static_cast<std::uint64_t>(*seed);
+        c.require.push_back(std::move(r));
+        continue;
+      }
       for (const auto& [k, v] : jr.items())
         if (k != "class" && k != "verdict" && k != "covers-scene")
-          return bad(file, rp + "/" + pointer_token(k), "unknown key '" + k + "', expected class and verdict, or covers-scene");
+          return bad(file, rp + "/" + pointer_token(k), "unknown key '" + k + "', expected class and verdict, covers-scene, or finite");
       if (jr.contains("covers-scene")) {
         if (jr.at("covers-scene") != true) return bad(file, rp + "/covers-scene", "expected true");
         if (jr.contains("class") || jr.contains("verdict"))
@@ -177,6 +202,28 @@ Error at_case_key(Error e, const std::string& check_file, const std::string& poi
   return e;
 }
 
+// A finite requirement: renders the case's scene with its renderer (no images) and returns "" when
+// no contribution was non-finite, else how many and where the first arose.
+Result<std::string> render_finite(const Case& c, const Requirement& r, const Limits& limits) {
+  Result<Scene> scene = load_scene_file(c.scene, SceneLoadOptions{limits.max_file_bytes});
+  if (!scene) return scene.error();
+  Result<Profile> profile = resolve_profile(c.renderer, limits);
+  if (!profile) return profile.error();
+  RenderOptions ro;
+  ro.spp = r.spp;
+  ro.seed = r.seed;
+  ro.max_bounces = c.max_bounces;
+  ro.images = false;
+  Result<RenderOutput> out = render(*scene, *profile, nullptr, ro);
+  if (!out) return out.error();
+  const std::uint64_t n = out->histogram.nonfinite();
+  if (n == 0) return std::string();
+  std::string s = std::to_string(n) + " non-finite samples";
+  if (out->first_nonfinite)
+    s += "; the first from strategy " + out->first_nonfinite->strategy + " on path " + out->first_nonfinite->path;
+  return s;
+}
+
 // Decides every requirement of every case, in order.
 Result<std::vector<Outcome>> decide(const CheckArgs& a, const std::vector<Case>& cases) {
   ReachCache cache(a.limits);
@@ -205,6 +252,15 @@ Result<std::vector<Outcome>> decide(const CheckArgs& a, const std::vector<Case>&
       Outcome o;
       o.c = &c;
       o.r = &r;
+      if (r.finite) {
+        Result<std::string> found = render_finite(c, r, a.limits);
+        if (!found) return at_case_key(found.error(), a.file, c.pointer + "/scene", c.scene);
+        o.passed = found->empty();
+        o.verdict = o.passed ? "no non-finite sample" : *found;
+        o.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        outcomes.push_back(std::move(o));
+        continue;
+      }
       QueryOptions qo;
       qo.max_bounces = c.max_bounces;
       qo.universe = universe;

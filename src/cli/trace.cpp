@@ -171,6 +171,14 @@ int run(const TraceArgs& a) {
   std::signal(SIGINT, SIG_DFL);
   if (show_progress) std::fprintf(stderr, "\r%*s\r", std::max(terminal_columns() - 1, 0), "");
   if (!out) return report(out.error());
+  // Non-finite samples are bugs (DESIGN §7): say so, and where the first arose.
+  if (const std::uint64_t n = out->histogram.nonfinite(); n > 0) {
+    std::cerr << "pathex: warning: " << n << " non-finite samples (dropped; any is a bug)";
+    if (const auto& f = out->first_nonfinite)
+      std::cerr << "; the first from strategy " << f->strategy << " on path " << f->path << " (near pixel (" << f->x << ", "
+                << f->y << "), pass " << f->pass << ")";
+    std::cerr << "\n";
+  }
 
   RunInfo info;
   info.scene = scene_name;
@@ -199,6 +207,8 @@ int run(const TraceArgs& a) {
                       {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
     doc["connectors"] = std::move(list);
   }
+  if (const auto& f = out->first_nonfinite)
+    doc["first_nonfinite"] = {{"strategy", f->strategy}, {"path", f->path}, {"pixel", {f->x, f->y}}, {"pass", f->pass}};
   const std::string json_text = doc.dump(2) + "\n";
   {
     const SignalShield shield;
