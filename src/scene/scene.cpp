@@ -58,7 +58,8 @@ class Reader : public JsonReader {
     return out;
   }
 
-  // An emission, intensity, irradiance or power: a non-negative 3-vector of at most kMaxLightValue.
+  // An emission, intensity, irradiance or power: a non-negative 3-vector of at most kMaxLightValue
+  // whose nonzero components are at least kMinLightValue.
   Result<vec3> light_value(const json& j, const std::string& key, const std::string& ptr, bool required) const {
     Result<vec3> v = vector3(j, key, ptr, required, vec3(0.0f), /*nonneg=*/true);
     if (!v) return v;
@@ -68,6 +69,11 @@ class Reader : public JsonReader {
                     "expected at most 1e9, found " + fmt((*v)[i]) +
                         ": the tracer sums contributions exactly below 2^50 (about 1.1e15) and drops larger ones, so "
                         "brighter lights would lose samples; scale the scene's lights down (the image scales with them)");
+      else if ((*v)[i] > 0.0f && (*v)[i] < kMinLightValue)
+        return fail(ptr + "/" + key + "/" + std::to_string(i),
+                    "expected 0 or at least 1e-6, found " + fmt((*v)[i]) +
+                        ": the tracer sums contributions exactly on a grid of 2^-64 (about 5.4e-20), so dimmer lights "
+                        "would round to nothing; scale the scene's lights up (the image scales with them)");
     return v;
   }
 

@@ -126,6 +126,10 @@ inline constexpr std::size_t kMaxFaceCorners = 1024;
 // (classify/histogram.h); 1e9 leaves a factor of 1e6 for what geometry and sampling multiply a
 // light's value by. Physical values stay far below it (the sun's radiance is about 2e7 W/(m^2 sr)).
 inline constexpr float kMaxLightValue = 1e9f;
+// The smallest nonzero one (0 is allowed: a light of zero power). Contributions are summed on a
+// fixed-point grid of 2^-64 (about 5.4e-20): with a margin of 1e-6 for geometry, a contribution of
+// 1e-12 still has 2^24 grid steps, single precision; a light of 1e-20 would round to a black image.
+inline constexpr float kMinLightValue = 1e-6f;
 
 // `base_dir` resolves relative mesh paths; `name` prefixes error locations.
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
