@@ -49,17 +49,21 @@ double variance_relative_error(const std::vector<double>& x) {
 
 namespace {
 
-// The upper quantile of the standard normal distribution (Acklam's rational approximation of the
-// inverse, relative error below 1.2e-9), for 0 < alpha < 0.5.
-double normal_upper_quantile(double alpha) {
-  const double p = alpha;
-  const double q = std::sqrt(-2.0 * std::log(p));
-  const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
-                      -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
-  const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00, 3.754408661907416e+00};
-  const double lower = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-                       ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-  return -lower;  // the lower tail's quantile at p, negated
+// P(χ²_k > x) for an integer k, in closed form: for even k, e^(-x/2) Σ_{i<k/2} (x/2)^i / i!; for
+// odd k, erfc(sqrt(x/2)) + e^(-x/2) Σ_{i=1}^{(k-1)/2} (x/2)^(i-1/2) / Γ(i + 1/2).
+double chi2_survival(double x, int k) {
+  const double h = 0.5 * x;
+  double sum = 0.0;
+  if (k % 2 == 0) {
+    double term = 1.0;
+    for (int i = 0; i < k / 2; ++i) {
+      sum += term;
+      term *= h / (i + 1);
+    }
+    return std::exp(-h) * sum;
+  }
+  for (int i = 1; i <= (k - 1) / 2; ++i) sum += std::exp((i - 0.5) * std::log(h) - h - std::lgamma(i + 0.5));
+  return std::erfc(std::sqrt(h)) + sum;
 }
 
 double median(std::vector<double> v) {
@@ -73,11 +77,14 @@ double median(std::vector<double> v) {
 }  // namespace
 
 double chi2_upper_quantile(int dof, double alpha) {
-  const double k = static_cast<double>(dof);
-  const double z = normal_upper_quantile(alpha);
-  const double a = 2.0 / (9.0 * k);
-  const double t = 1.0 - a + z * std::sqrt(a);
-  return k * t * t * t;
+  // Bisection on the survival function, which falls from 1 at x = 0.
+  double lo = 0.0, hi = 10.0 + 10.0 * dof;
+  while (chi2_survival(hi, dof) > alpha) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (chi2_survival(mid, dof) > alpha ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 StderrCheck check_stderr(const std::vector<RungError>& rungs, double reference, double reference_stderr) {

@@ -50,8 +50,8 @@ std::vector<double> class_batch_means(const Histogram& histogram, const Classifi
 // ε above for these batch means; NaN for fewer than 4 batches or when they are all equal.
 double variance_relative_error(const std::vector<double>& batch_means);
 
-// The upper quantile of the χ² distribution with `dof` degrees of freedom: the x with
-// P(χ²_dof > x) = alpha (Wilson–Hilferty, within 1 % for dof ≥ 1 at alpha ≥ 1e-4).
+// The upper quantile of the χ² distribution with `dof` ≥ 1 degrees of freedom: the x with
+// P(χ²_dof > x) = alpha (the survival function in closed form for integer dof, solved by bisection).
 double chi2_upper_quantile(int dof, double alpha);
 
 // One rung as the checks see it.

@@ -356,8 +356,8 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
     const RungResult& at = rungs[static_cast<std::size_t>(s.check.max_z_rung)];
     s.warning = "the reported stderr disagrees with the true error: chi2 " + fmt(s.check.chi2, "%.3g") + " over " +
                 std::to_string(s.check.dof) + " rungs (limit " + fmt(s.check.limit, "%.3g") + " at p = 0.001), " +
-                (std::isfinite(s.check.max_abs_z) ? fmt(s.check.max_abs_z, "%.1f") + " sigma off"
-                                                  : std::string("a zero stderr with a nonzero error")) +
+                (at.classes[row].std_error > 0.0 ? fmt(s.check.max_abs_z, "%.1f") + " sigma off"
+                                                  : "a stderr of 0 with an error of " + fmt(s.error[static_cast<std::size_t>(s.check.max_z_rung)], "%.3g")) +
                 " at " + at.budget.text();
   }
   if (s.check.unstable)
