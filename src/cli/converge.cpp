@@ -399,18 +399,11 @@ int run(const ConvergeArgs& a) {
   if (Result<StrategySet> ok = runnable_strategies(*ref_profile); !ok) return report(ok.error());
 
   // --- classes: the class file's, else the closed form's, else the built-ins; "total" first ---
-  ClassOptions copts;
-  copts.limits = a.limits;
-  const SceneTypes types = scene_types(*scene);
-  copts.ends.lights.assign(types.lights.begin(), types.lights.end());
-  copts.ends.sensors = {types.sensor};
+  const ClassOptions copts = scene_class_options(*scene, a.limits);
   ClassTable table;
   std::vector<std::unique_ptr<PathClass>> owned;
   std::vector<const PathClass*> classes;
-  if (!a.classes_file.empty()) {
-    if (Result<bool> r = read_class_file(a.classes_file, copts, &table); !r) return report(r.error());
-    for (const auto& c : table.user_classes()) classes.push_back(c.get());
-  } else if (scene->reference) {
+  if (a.classes_file.empty() && scene->reference) {
     for (std::size_t i = 0; i < scene->reference->classes.size(); ++i) {
       const ReferenceClass& rc = scene->reference->classes[i];
       if (rc.name == "total") continue;
@@ -426,8 +419,9 @@ int run(const ConvergeArgs& a) {
       classes.push_back(owned.back().get());
     }
   } else {
-    for (const auto& c : ClassTable::builtins().builtin_classes())
-      if (c->name != "all") classes.push_back(c.get());
+    Result<std::vector<const PathClass*>> listed = render_classes(a.classes_file, copts, &table);
+    if (!listed) return report(listed.error());
+    classes = *listed;
   }
   Result<Classifier> classifier = Classifier::build(classes, a.limits);
   if (!classifier) return report(classifier.error());

@@ -99,21 +99,11 @@ int run(const TraceArgs& a) {
   if (!profile) return report(profile.error());
   if (Result<StrategySet> runnable = runnable_strategies(*profile); !runnable) return report(runnable.error());
 
-  ClassOptions copts;
-  copts.limits = a.limits;
-  const SceneTypes types = scene_types(*scene);
-  copts.ends.lights.assign(types.lights.begin(), types.lights.end());
-  copts.ends.sensors = {types.sensor};
+  const ClassOptions copts = scene_class_options(*scene, a.limits);
   ClassTable table;
-  std::vector<const PathClass*> classes;
-  if (!a.classes_file.empty()) {
-    Result<bool> r = read_class_file(a.classes_file, copts, &table);
-    if (!r) return report(r.error());
-    for (const auto& c : table.user_classes()) classes.push_back(c.get());
-  } else {
-    for (const auto& c : ClassTable::builtins().builtin_classes())
-      if (c->name != "all") classes.push_back(c.get());
-  }
+  Result<std::vector<const PathClass*>> render_class_list = render_classes(a.classes_file, copts, &table);
+  if (!render_class_list) return report(render_class_list.error());
+  const std::vector<const PathClass*>& classes = *render_class_list;
   Result<Classifier> classifier = Classifier::build(classes, a.limits);
   if (!classifier) return report(classifier.error());
   std::vector<ClassInfo> infos;
@@ -124,7 +114,7 @@ int run(const TraceArgs& a) {
   ReachCache cache(a.limits);
   Result<const CompiledProfile*> cp = cache.compiled(a.renderer, bound);
   if (!cp) return report(cp.error());
-  const Dfa universe = scene_universe(types);
+  const Dfa universe = scene_universe(scene_types(*scene));
   warn_unreachable_lights(*scene, *profile, **cp, universe, bound, a.limits);
 
   // --- render ---
