@@ -32,6 +32,7 @@
 #include "classify/convergence.h"
 #include "cli/common.h"
 #include "cli/converge_plot.h"
+#include "cli/render_job.h"
 #include "cli/trace_checks.h"
 #include "io/atomic_file.h"
 #include "io/class_file.h"
@@ -399,11 +400,28 @@ int run(const ConvergeArgs& a) {
   if (Result<StrategySet> ok = runnable_strategies(*ref_profile); !ok) return report(ok.error());
 
   // --- classes: the class file's, else the closed form's, else the built-ins; "total" first ---
-  const ClassOptions copts = scene_class_options(*scene, a.limits);
-  ClassTable table;
+  // The class file's classes, or the built-ins (as trace compiles them), unless the scene declares a
+  // closed form and no class file is given: then its classes.
+  const SceneTypes types = scene_types(*scene);
+  RenderIdentity ends;
+  for (LightType l : types.lights) ends.lights.push_back(to_string(l));
+  ends.sensor = to_string(types.sensor);
+  std::string class_text;
+  if (!a.classes_file.empty()) {
+    Result<std::string> text = read_input_file(a.classes_file, a.limits.max_file_bytes);
+    if (!text) return report(text.error());
+    class_text = std::move(*text);
+  }
+  Result<std::unique_ptr<RenderClasses>> listed = compile_render_classes(class_text, a.classes_file, ends, a.limits);
+  if (!listed) return report(listed.error());
   std::vector<std::unique_ptr<PathClass>> owned;
-  std::vector<const PathClass*> classes;
+  std::vector<const PathClass*> classes = (*listed)->classes;
   if (a.classes_file.empty() && scene->reference) {
+    ClassOptions copts;
+    copts.limits = a.limits;
+    copts.ends.lights.assign(types.lights.begin(), types.lights.end());
+    copts.ends.sensors = {types.sensor};
+    classes.clear();
     for (std::size_t i = 0; i < scene->reference->classes.size(); ++i) {
       const ReferenceClass& rc = scene->reference->classes[i];
       if (rc.name == "total") continue;
@@ -418,10 +436,6 @@ int run(const ConvergeArgs& a) {
       owned.back()->text = rc.expr;
       classes.push_back(owned.back().get());
     }
-  } else {
-    Result<std::vector<const PathClass*>> listed = render_classes(a.classes_file, copts, &table);
-    if (!listed) return report(listed.error());
-    classes = *listed;
   }
   Result<Classifier> classifier = Classifier::build(classes, a.limits);
   if (!classifier) return report(classifier.error());

@@ -8,9 +8,7 @@
 #include <vector>
 
 #include "classify/pathclass.h"
-#include "io/class_file.h"
 #include "io/profile_json.h"
-#include "scene/universe.h"
 #include "trace/render.h"
 
 namespace pathex::cli {
@@ -105,28 +103,6 @@ void warn_unreachable_lights(const Scene& scene, const Profile& profile, const C
               << light_letters(type) << "…E), so its light is missing from the image; renderers that reach it: "
               << alternatives[type] << " (--renderer NAME)\n";
   }
-}
-
-ClassOptions scene_class_options(const Scene& scene, const Limits& limits) {
-  ClassOptions copts;
-  copts.limits = limits;
-  const SceneTypes types = scene_types(scene);
-  copts.ends.lights.assign(types.lights.begin(), types.lights.end());
-  copts.ends.sensors = {types.sensor};
-  return copts;
-}
-
-Result<std::vector<const PathClass*>> render_classes(const std::string& classes_file, const ClassOptions& options,
-                                                     ClassTable* table) {
-  std::vector<const PathClass*> classes;
-  if (!classes_file.empty()) {
-    if (Result<bool> r = read_class_file(classes_file, options, table); !r) return r.error();
-    for (const auto& c : table->user_classes()) classes.push_back(c.get());
-  } else {
-    for (const auto& c : ClassTable::builtins().builtin_classes())
-      if (c->name != "all") classes.push_back(c.get());
-  }
-  return classes;
 }
 
 }  // namespace pathex::cli

@@ -5,23 +5,12 @@
 
 #include <string>
 
-#include <vector>
-
-#include "classify/pathclass.h"
 #include "core/error.h"
 #include "core/limits.h"
 #include "reach/query.h"
 #include "scene/scene.h"
 
 namespace pathex::cli {
-
-// The class options of a render of `scene`: its light and sensor types end Heckbert classes.
-ClassOptions scene_class_options(const Scene& scene, const Limits& limits);
-
-// The classes a render measures (trace, converge): the class file's, compiled with `options` into
-// *table (which must outlive them), else the built-ins without $all.
-Result<std::vector<const PathClass*>> render_classes(const std::string& classes_file, const ClassOptions& options,
-                                                     ClassTable* table);
 
 // --resolution WxH, each from 1 to 16384, into the camera; a spot meter measures one pixel.
 Result<bool> apply_resolution(const std::string& text, Camera* camera);
