@@ -666,8 +666,6 @@ int run(const ConvergeArgs& a) {
       info.spp = ref_run->spp;
       info.spp_requested = ref_run->spp;
       info.seed = ref_run->seed;
-      info.threads = doc["threads"].get<int>();
-      info.time_s = ref_run->wall_s;
       std::vector<ClassInfo> infos;
       for (std::size_t i = 1; i < rows.size(); ++i) infos.push_back({rows[i].name, rows[i].expr});
       Result<HistogramReport> rep = make_report(ref_run->output->histogram, info, &*classifier, infos, std::uint64_t{1000});
