@@ -67,5 +67,6 @@ Command add_renderers(CLI::App& app);
 Command add_trace(CLI::App& app);
 Command add_merge(CLI::App& app);
 Command add_converge(CLI::App& app);
+Command add_bias(CLI::App& app);
 
 }  // namespace pathex::cli
