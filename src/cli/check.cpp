@@ -17,7 +17,10 @@
 #include "io/input_file.h"
 #include "io/json_reader.h"
 #include "io/junit.h"
+#include "io/profile_json.h"
 #include "io/reach_json.h"
+#include "scene/scene.h"
+#include "trace/render.h"
 
 namespace pathex::cli {
 namespace {
@@ -37,14 +40,22 @@ struct MissedRequirement {
   std::string reference;  // empty: bias's default reference
 };
 
+// {"finite": true, "spp": N, "seed": N}: a render of the case's scene with its renderer has no
+// non-finite sample (DESIGN §7: any is a bug).
+struct FiniteRequirement {
+  std::uint64_t spp = 16, seed = 1;
+};
+
 struct Requirement {
   std::string pointer;
   bool covers_scene = false;
   std::optional<MissedRequirement> missed;
+  std::optional<FiniteRequirement> finite;
   std::string cls;
   std::string verdict;  // reachable, not-unreachable, unreachable, partial, empty
   std::string describe() const {
     if (missed) return "misses at most " + percent(missed->max_share, 2) + " of the scene's light";
+    if (finite) return "renders finite (" + std::to_string(finite->spp) + " spp, seed " + std::to_string(finite->seed) + ")";
     return covers_scene ? "covers the scene" : cls + " is " + verdict;
   }
 };
@@ -157,13 +168,28 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
       const std::string rp = ptr + "/require/" + std::to_string(j);
       const auto& jr = reqs[j];
       if (!jr.is_object())
-        return bad(file, rp, "expected {\"class\": …, \"verdict\": …}, {\"covers-scene\": true} or {\"missed\": {…}}");
+        return bad(file, rp,
+                   "expected {\"class\": …, \"verdict\": …}, {\"covers-scene\": true}, {\"missed\": {…}} or {\"finite\": true}");
       Requirement r;
       r.pointer = rp;
+      if (jr.contains("finite")) {
+        for (const auto& [k, v] : jr.items())
+          if (k != "finite" && k != "spp" && k != "seed")
+            return bad(file, rp + "/" + pointer_token(k), "unknown key '" + k + "', expected finite with optional spp and seed");
+        if (jr.at("finite") != true) return bad(file, rp + "/finite", "expected true");
+        if (c.scene.empty()) return bad(file, ptr + "/scene", "a finite requirement renders the case's scene: expected a scene file path");
+        Result<long long> spp = JsonReader(file).integer(jr, "spp", rp, 1, 1 << 20, 16);
+        if (!spp) return spp.error();
+        Result<long long> seed = JsonReader(file).integer(jr, "seed", rp, 0, std::numeric_limits<long long>::max(), 1);
+        if (!seed) return seed.error();
+        r.finite = FiniteRequirement{static_cast<std::uint64_t>(*spp), static_cast<std::uint64_t>(*seed)};
+        c.require.push_back(std::move(r));
+        continue;
+      }
       for (const auto& [k, v] : jr.items())
         if (k != "class" && k != "verdict" && k != "covers-scene" && k != "missed")
           return bad(file, rp + "/" + pointer_token(k),
-                     "unknown key '" + k + "', expected class and verdict, or covers-scene, or missed");
+                     "unknown key '" + k + "', expected class and verdict, or covers-scene, or missed, or finite");
       if (jr.contains("missed")) {
         if (jr.size() != 1) return bad(file, rp, "missed stands alone: no other key beside it");
         if (c.scene.empty()) return bad(file, rp + "/missed", "a missed requirement needs the case's scene");
@@ -216,6 +242,28 @@ Error at_case_key(Error e, const std::string& check_file, const std::string& poi
   if (e.where == referenced && !referenced.empty()) e.message = referenced + ": " + e.message;
   e.where = check_file + ":" + pointer;
   return e;
+}
+
+// A finite requirement: renders the case's scene with its renderer (no images) and returns "" when
+// no contribution was non-finite, else how many and where the first arose.
+Result<std::string> render_finite(const Case& c, const Requirement& r, ReachCache& cache, const Limits& limits) {
+  Result<Scene> scene = load_scene_file(c.scene, SceneLoadOptions{limits.max_file_bytes});
+  if (!scene) return scene.error();
+  Result<const Profile*> profile = cache.profile(c.renderer);
+  if (!profile) return profile.error();
+  RenderOptions ro;
+  ro.spp = r.finite->spp;
+  ro.seed = r.finite->seed;
+  ro.max_bounces = c.max_bounces;
+  ro.images = false;
+  Result<RenderOutput> out = render(*scene, **profile, nullptr, ro);
+  if (!out) return out.error();
+  const std::uint64_t n = out->histogram.nonfinite();
+  if (n == 0) return std::string();
+  std::string s = std::to_string(n) + " non-finite samples";
+  if (out->first_nonfinite)
+    s += "; the first from strategy " + out->first_nonfinite->strategy + " on path " + out->first_nonfinite->path;
+  return s;
 }
 
 // A missed requirement: one reference render of the case's scene (pathex bias) without images. It
@@ -272,9 +320,16 @@ Result<std::vector<Outcome>> decide(const CheckArgs& a, const std::vector<Case>&
       Outcome o;
       o.c = &c;
       o.r = &r;
-      if (r.missed) {
-        Result<bool> m = decide_missed(a, cache, c, r, &o);
-        if (!m) return m.error();
+      if (r.missed || r.finite) {
+        if (r.missed) {
+          Result<bool> m = decide_missed(a, cache, c, r, &o);
+          if (!m) return m.error();
+        } else {
+          Result<std::string> found = render_finite(c, r, cache, a.limits);
+          if (!found) return at_case_key(found.error(), a.file, c.pointer + "/scene", c.scene);
+          o.passed = found->empty();
+          o.verdict = o.passed ? "no non-finite sample" : *found;
+        }
         o.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         outcomes.push_back(std::move(o));
         continue;

@@ -291,6 +291,14 @@ int run(const TraceArgs& a) {
     return render(*job.scene, *job.profile, job.classes->classifier.get(), ro);
   }();
   if (!out) return report(out.error());
+  // Non-finite samples are bugs (DESIGN §7): say so, and where the first arose.
+  if (const std::uint64_t n = out->histogram.nonfinite(); n > 0) {
+    std::cerr << "pathex: warning: " << n << " non-finite samples (dropped; any is a bug)";
+    if (const auto& f = out->first_nonfinite)
+      std::cerr << "; the first from strategy " << f->strategy << " on path " << f->path << " (near pixel (" << f->x << ", "
+                << f->y << "), pass " << f->pass << ")";
+    std::cerr << "\n";
+  }
 
   // --- --missed: a reference render of the same scene, spp and seed measures what this one misses ---
   std::optional<BiasReport> missed;

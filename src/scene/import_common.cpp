@@ -59,6 +59,13 @@ std::optional<Error> check_light_value(glm::vec3 v, const Location& at) {
                              " after scale) exceeds 1e9: the tracer sums contributions exactly below 2^50 and drops larger ones; "
                              "scale the scene's lights down (the image scales with them)");
     }
+    if (v[i] > 0.0f && v[i] < kMinLightValue) {
+      std::ostringstream found;
+      found << v[i];
+      return located(at, "a light's emission (" + found.str() +
+                             " after scale) is below 1e-6: the tracer sums contributions exactly on a grid of 2^-64 and "
+                             "dimmer lights would round to nothing; scale the scene's lights up (the image scales with them)");
+    }
   }
   return std::nullopt;
 }

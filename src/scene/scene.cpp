@@ -58,7 +58,8 @@ class Reader : public JsonReader {
     return out;
   }
 
-  // An emission, intensity, irradiance or power: a non-negative 3-vector of at most kMaxLightValue.
+  // An emission, intensity, irradiance or power: a non-negative 3-vector of at most kMaxLightValue
+  // whose nonzero components are at least kMinLightValue.
   Result<vec3> light_value(const json& j, const std::string& key, const std::string& ptr, bool required) const {
     Result<vec3> v = vector3(j, key, ptr, required, vec3(0.0f), /*nonneg=*/true);
     if (!v) return v;
@@ -68,6 +69,11 @@ class Reader : public JsonReader {
                     "expected at most 1e9, found " + fmt((*v)[i]) +
                         ": the tracer sums contributions exactly below 2^50 (about 1.1e15) and drops larger ones, so "
                         "brighter lights would lose samples; scale the scene's lights down (the image scales with them)");
+      else if ((*v)[i] > 0.0f && (*v)[i] < kMinLightValue)
+        return fail(ptr + "/" + key + "/" + std::to_string(i),
+                    "expected 0 or at least 1e-6, found " + fmt((*v)[i]) +
+                        ": the tracer sums contributions exactly on a grid of 2^-64 (about 5.4e-20), so dimmer lights "
+                        "would round to nothing; scale the scene's lights up (the image scales with them)");
     return v;
   }
 
@@ -649,13 +655,46 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
   return s;
 }
 
+// "reference": the closed form the scene declares (scene.h, ClosedFormReference). The class
+// expressions are compiled where they are used (pathex converge), with their pointers.
+Result<ClosedFormReference> read_reference(const Reader& r, const nlohmann::json& j, const std::string& ptr) {
+  if (!j.is_object()) return r.fail(ptr, "expected {\"source\": …, \"classes\": [{\"name\", \"class\", \"luminance\"}, …]}");
+  if (auto k = r.keys(j, ptr, {"source", "uniform", "classes"}); !k) return k.error();
+  ClosedFormReference ref;
+  PATHEX_TRY(source, r.string(j, "source", ptr));
+  ref.source = source;
+  if (j.contains("uniform")) {
+    if (!j["uniform"].is_boolean()) return r.fail(ptr + "/uniform", "expected true or false");
+    ref.uniform = j["uniform"].get<bool>();
+  }
+  if (!j.contains("classes") || !j["classes"].is_array() || j["classes"].empty())
+    return r.fail(ptr + "/classes", "expected a non-empty array of {name, class, luminance}");
+  for (std::size_t i = 0; i < j["classes"].size(); ++i) {
+    const std::string cp = ptr + "/classes/" + std::to_string(i);
+    const nlohmann::json& c = j["classes"][i];
+    if (!c.is_object()) return r.fail(cp, "expected {name, class, luminance}");
+    if (auto k = r.keys(c, cp, {"name", "class", "luminance"}); !k) return k.error();
+    ReferenceClass rc;
+    PATHEX_TRY(name, r.string(c, "name", cp));
+    PATHEX_TRY(expr, r.string(c, "class", cp));
+    PATHEX_TRY(lum, r.number(c, "luminance", cp, 0.0, 1e30));
+    for (const ReferenceClass& before : ref.classes)
+      if (before.name == name) return r.fail(cp + "/name", "the class name '" + name + "' is used twice");
+    rc.name = name;
+    rc.expr = expr;
+    rc.luminance = lum;
+    ref.classes.push_back(std::move(rc));
+  }
+  return ref;
+}
+
 }  // namespace
 
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
                               const SceneLoadOptions& options) {
   const Reader r(name);
   PATHEX_TRY(doc, parse_json(text, name));
-  if (auto k = r.keys(doc, "", {"camera", "materials", "shapes", "lights"}); !k) return k.error();
+  if (auto k = r.keys(doc, "", {"camera", "materials", "shapes", "lights", "reference"}); !k) return k.error();
   Scene scene;
   scene.name = name;
   // --- materials ---
@@ -689,6 +728,10 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   PATHEX_TRY(cam, read_camera(r, doc["camera"], "/camera"));
   scene.camera = cam;
   if (!camera_sees_geometry(scene)) return r.fail("/camera", kSeesNothing);
+  if (doc.contains("reference")) {
+    PATHEX_TRY(ref, read_reference(r, doc["reference"], "/reference"));
+    scene.reference = std::move(ref);
+  }
   return scene;
 }
 

@@ -83,6 +83,23 @@ struct Camera {
   int width = 64, height = 64;      // spot meter: 1 x 1
 };
 
+// A closed-form reference a scene declares (DESIGN §9), which `pathex converge` measures renderers
+// against: the exact image mean (mean pixel luminance) of some path classes. JSON:
+//   "reference": {"source": "why these values are exact", "uniform": true,
+//                 "classes": [{"name": "1 bounce", "class": "LSDDDSE", "luminance": 0.159155}, …]}
+// `uniform` says that every pixel of each class has that value (inside a closed sphere), so
+// per-pixel errors can be measured too. A class named "total" is the whole image (class $all).
+struct ReferenceClass {
+  std::string name;
+  std::string expr;        // full notation
+  double luminance = 0.0;  // exact image mean
+};
+struct ClosedFormReference {
+  std::string source;
+  bool uniform = false;
+  std::vector<ReferenceClass> classes;
+};
+
 struct Scene {
   std::string name;
   std::vector<std::string> material_names;
@@ -90,6 +107,7 @@ struct Scene {
   std::vector<Shape> shapes;
   std::vector<Light> lights;
   Camera camera;
+  std::optional<ClosedFormReference> reference;  // "reference", when the scene declares one
 };
 
 // How much of a scene to load.
@@ -108,6 +126,10 @@ inline constexpr std::size_t kMaxFaceCorners = 1024;
 // (classify/histogram.h); 1e9 leaves a factor of 1e6 for what geometry and sampling multiply a
 // light's value by. Physical values stay far below it (the sun's radiance is about 2e7 W/(m^2 sr)).
 inline constexpr float kMaxLightValue = 1e9f;
+// The smallest nonzero one (0 is allowed: a light of zero power). Contributions are summed on a
+// fixed-point grid of 2^-64 (about 5.4e-20): with a margin of 1e-6 for geometry, a contribution of
+// 1e-12 still has 2^24 grid steps, single precision; a light of 1e-20 would round to a black image.
+inline constexpr float kMinLightValue = 1e-6f;
 
 // `base_dir` resolves relative mesh paths; `name` prefixes error locations.
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,

@@ -229,6 +229,11 @@ class Integrator {
     // from start to end, so which rays share a packet does not depend on the thread count.
     OcclusionBatch shadow = OcclusionBatch();
     std::array<Pending, OcclusionBatch::kCapacity> pending{};
+    // The sample in progress (pass, row), and the first non-finite contribution this thread
+    // recorded, for the warning that names it (render() keeps the earliest over the threads).
+    std::uint64_t pass = 0;
+    int py = 0;
+    std::optional<NonfiniteSample> first_nonfinite{};
   };
 
   // A vertex's density ratio in the MIS sums, a Dirac's densities (stored as 0) counting as 1.
@@ -841,6 +846,9 @@ void Integrator::record(Thread& th, const Pending& r) const {
   ExactRgb e;
   if (!to_exact(rgb, &e)) {
     th.hist.add_nonfinite();
+    if (!th.first_nonfinite)
+      th.first_nonfinite = NonfiniteSample{strategies_.strategies[static_cast<std::size_t>(r.strategy)].name, unpack(r.key),
+                                           th.pass, r.px, th.py};
     return;
   }
   if (is_zero(e)) return;
@@ -1318,6 +1326,8 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   rng.set_dimension(kEyeDims);
   const int batch = batch_of(pass, o_.batches);
   th.px = px;
+  th.py = py;
+  th.pass = pass;
   const int nt = eye_subpath(th, rng, px, py);
   rng.set_dimension(kLightDims);
   const int ns = light_subpath(th, rng);
@@ -1452,6 +1462,8 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
     Result<bool> m = out.histogram.merge(th.hist);
     if (!m) return m.error();
     out.rays += th.rays;
+    if (th.first_nonfinite && (!out.first_nonfinite || th.first_nonfinite->order() < out.first_nonfinite->order()))
+      out.first_nonfinite = th.first_nonfinite;
   }
   // Connector statistics, in the profile's order (integer sums: the same for every thread count).
   for (std::size_t i = 0; i < strategies->strategies.size(); ++i) {

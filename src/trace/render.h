@@ -26,6 +26,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "classify/classifier.h"
@@ -73,6 +74,18 @@ struct ConnectorStats {
   std::uint64_t no_transport = 0;  // built, but the BSDF or emission towards it is zero
 };
 
+// Where a render's first non-finite contribution arose (they are bugs: DESIGN §7). "First" is by
+// (pass, row, column) of the sample in progress when the contribution was recorded (shadow rays are
+// traced in packets, so that may be a little after the sample that made it), the same for every
+// thread count.
+struct NonfiniteSample {
+  std::string strategy;  // the profile's name for the strategy
+  std::string path;      // its full-path string
+  std::uint64_t pass = 0;
+  int x = 0, y = 0;      // the pixel of a camera sample (for a splat: the sample's column and row)
+  std::tuple<std::uint64_t, int, int> order() const { return {pass, y, x}; }
+};
+
 struct RenderOutput {
   Histogram histogram;
   ClassImages images;
@@ -83,6 +96,7 @@ struct RenderOutput {
   double time_s = 0;
   std::uint64_t rays = 0;      // rays cast (intersections and shadow rays)
   std::vector<ConnectorStats> connectors{};  // one per connector strategy of the profile, in its order
+  std::optional<NonfiniteSample> first_nonfinite{};  // when histogram.nonfinite() > 0
 };
 
 // The strategies of a profile the tracer runs: plain joins and the mirror and projection

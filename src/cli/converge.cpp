@@ -1,0 +1,754 @@
+// pathex converge: what accuracy costs in time (DESIGN §8, issue 13). Renders a ladder of budgets
+// per renderer, measures each rung's error against a reference (a closed form the scene declares,
+// an earlier run's histogram.json or EXR, or a long reference run it makes itself), and reports
+// time, estimate, reported and true error, per-pixel RMS error and efficiency 1/(error² × time)
+// per renderer, class and rung; checks that each renderer's reported standard error tells the
+// truth (classify/convergence.h); writes converge.json and a log-log plot (SVG and PNG) as one
+// output set; and ends its table with the most efficient renderer per class.
+//
+// Rendering goes through the tracer's library entry point, render(), one call per rung
+// (run_rung below): the ladder is a plain loop over independent rungs, each a function of its
+// renderer, budget and seed.
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <stop_token>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "classify/convergence.h"
+#include "cli/common.h"
+#include "cli/converge_plot.h"
+#include "cli/render_job.h"
+#include "cli/trace_checks.h"
+#include "io/atomic_file.h"
+#include "io/class_file.h"
+#include "io/histogram_json.h"
+#include "io/image_io.h"
+#include "io/input_file.h"
+#include "io/output_set.h"
+#include "io/profile_json.h"
+#include "scene/universe.h"
+#include "trace/render.h"
+
+namespace pathex::cli {
+namespace {
+
+struct ConvergeArgs {
+  std::string scene;
+  std::vector<std::string> renderers;
+  std::string classes_file;
+  std::string spp_list;
+  std::string time_list;
+  std::string reference;
+  std::string reference_renderer;
+  std::uint64_t reference_factor = 4;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  std::optional<int> max_bounces;
+  std::string resolution;
+  std::string out = "pathex-converge";
+  bool json = false;
+  bool quiet = false;
+  Limits limits;
+};
+
+// --- budgets ---
+
+// One rung's budget: samples per pixel, or seconds of wall time (the render stops after the chunk
+// in progress when they run out).
+struct Budget {
+  std::uint64_t spp = 0;  // 0 for a time budget
+  double seconds = 0.0;
+  std::string text() const {
+    std::ostringstream s;
+    if (spp) s << spp << " spp";
+    else s << seconds << " s";
+    return s.str();
+  }
+};
+
+// "4,16,64" (positive integers, strictly increasing) or "1,4,16" (positive seconds).
+Result<std::vector<Budget>> parse_ladder(const std::string& text, bool time, const std::string& option) {
+  std::vector<Budget> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    Budget b;
+    try {
+      std::size_t used = 0;
+      if (time) b.seconds = std::stod(item, &used);
+      else b.spp = std::stoull(item, &used);
+      if (used != item.size() || item.empty() || item[0] == '-') throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      return make_error(ErrorCode::kUsage, option + " '" + text + "': '" + item + "' is not a " +
+                                               (time ? "number of seconds" : "whole number of samples per pixel") +
+                                               "; expected a comma-separated list such as " + (time ? "1,4,16" : "4,16,64,256"));
+    }
+    if (time ? !(b.seconds > 0.0 && b.seconds <= 86400.0) : (b.spp < 1 || b.spp > (1u << 24)))
+      return make_error(ErrorCode::kUsage, option + " '" + text + "': " + item + " is out of range, expected " +
+                                               (time ? "0 < seconds <= 86400" : "1 to 16777216 spp"));
+    if (!out.empty() && (time ? b.seconds <= out.back().seconds : b.spp <= out.back().spp))
+      return make_error(ErrorCode::kUsage, option + " '" + text + "': budgets must increase");
+    out.push_back(b);
+  }
+  if (out.empty() || text.back() == ',') return make_error(ErrorCode::kUsage, option + " '" + text + "': expected a list such as 4,16,64");
+  return out;
+}
+
+// --- the classes measured, and the reference ---
+
+// Row 0 is the whole image ("total"); row i > 0 is classifier class i − 1.
+struct ClassRow {
+  std::string name;
+  std::string expr;
+  std::optional<double> reference;         // image mean luminance
+  double reference_stderr = 0.0;           // 0 for a closed form
+  std::optional<std::vector<float>> pixels;  // per-pixel reference luminance, row-major
+};
+
+struct Reference {
+  std::string kind;    // "closed-form", "file", "run"
+  std::string source;  // the formula, the file, or the run that made it
+  nlohmann::ordered_json run;  // for "run": renderer, spp, seed, time
+};
+
+double cpu_seconds() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+std::vector<float> luminance_image(const RgbImage& im) {
+  std::vector<float> out(static_cast<std::size_t>(im.width) * static_cast<std::size_t>(im.height));
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = static_cast<float>(luminance({im.rgb[3 * i], im.rgb[3 * i + 1], im.rgb[3 * i + 2]}));
+  return out;
+}
+
+// --- signals: Ctrl-C keeps the finished rungs ---
+
+std::atomic<bool> g_interrupted{false};
+std::atomic<bool> g_stop{false};  // what render() polls: Ctrl-C or a rung's time running out
+extern "C" void on_interrupt(int) {
+  g_interrupted.store(true);
+  g_stop.store(true);
+}
+
+// --- one rung ---
+
+struct RungSetup {
+  const Scene* scene = nullptr;
+  const Classifier* classifier = nullptr;
+  int threads = 0;
+  std::optional<int> max_bounces;  // unset: each profile's own bound, else 16 (as trace)
+};
+
+struct ClassMeasure {
+  double estimate = 0.0;
+  double std_error = 0.0;
+  double stability = 0.0;
+  std::optional<double> rms_pixel;  // against the per-pixel reference, when there is one
+};
+
+struct RungResult {
+  Budget budget;
+  std::uint64_t seed = 0;
+  std::uint64_t spp = 0;  // done
+  double cpu_s = 0.0, wall_s = 0.0;
+  std::uint64_t nonfinite = 0;
+  std::vector<ClassMeasure> classes;  // per ClassRow
+  std::optional<RenderOutput> output;  // kept for the reference run
+  bool interrupted = false;           // by Ctrl-C: the rung is not kept
+};
+
+// Renders one rung: `profile` at `budget` with `seed`. A time budget stops the render after the
+// chunk in progress when the time is up; Ctrl-C (g_interrupted) stops it and marks it interrupted.
+Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, const Budget& budget, std::uint64_t seed,
+                            const std::vector<ClassRow>& rows) {
+  RenderOptions ro;
+  ro.spp = budget.spp ? budget.spp : (std::uint64_t{1} << 24);
+  ro.seed = seed;
+  ro.threads = setup.threads;
+  ro.max_bounces = setup.max_bounces;
+  for (int i = 0; i < setup.classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
+  ro.cancel = &g_stop;
+  g_stop.store(g_interrupted.load());
+  std::mutex m;
+  std::condition_variable_any cv;
+  std::jthread timer;
+  if (!budget.spp)
+    timer = std::jthread([&](std::stop_token st) {
+      std::unique_lock lock(m);
+      if (!cv.wait_for(lock, st, std::chrono::duration<double>(budget.seconds), [] { return false; }) && !st.stop_requested())
+        g_stop.store(true);
+    });
+  const double cpu0 = cpu_seconds();
+  const auto wall0 = std::chrono::steady_clock::now();
+  Result<RenderOutput> out = render(*setup.scene, profile, setup.classifier, ro);
+  const double cpu1 = cpu_seconds();
+  const auto wall1 = std::chrono::steady_clock::now();
+  if (timer.joinable()) {
+    timer.request_stop();
+    timer.join();
+  }
+  if (!out) return out.error();
+  RungResult r;
+  r.budget = budget;
+  r.seed = seed;
+  r.spp = out->spp_done;
+  r.cpu_s = cpu1 - cpu0;
+  r.wall_s = std::chrono::duration<double>(wall1 - wall0).count();
+  r.interrupted = g_interrupted.load() || out->spp_done == 0;
+  if (r.interrupted) return r;
+  RunInfo info;
+  info.spp = out->spp_done;
+  std::vector<ClassInfo> infos;
+  for (std::size_t i = 1; i < rows.size(); ++i) infos.push_back({rows[i].name, rows[i].expr});
+  Result<HistogramReport> rep = make_report(out->histogram, info, setup.classifier, infos, std::uint64_t{0});
+  if (!rep) return rep.error();
+  r.nonfinite = rep->nonfinite_samples;
+  const std::vector<ImageLayer> layers = out->images.layers(1.0 / static_cast<double>(out->spp_done));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Estimate& e = i == 0 ? rep->total : rep->classes[i - 1].estimate;
+    ClassMeasure c;
+    c.estimate = e.luminance;
+    c.std_error = e.std_error;
+    c.stability = variance_relative_error(class_batch_means(out->histogram, setup.classifier, static_cast<int>(i) - 1));
+    if (rows[i].pixels) {
+      const std::vector<float> lum = luminance_image(layers[i].image);
+      double sum = 0.0;
+      for (std::size_t p = 0; p < lum.size(); ++p) {
+        const double d = static_cast<double>(lum[p]) - static_cast<double>((*rows[i].pixels)[p]);
+        sum += d * d;
+      }
+      c.rms_pixel = lum.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(lum.size()));
+    }
+    r.classes.push_back(c);
+  }
+  r.output = std::move(*out);
+  return r;
+}
+
+// --- reference from a file: an earlier run's histogram.json (with classes.exr beside it, or
+// the EXR of the same name), or an EXR alone ---
+
+Result<bool> load_reference_file(const std::string& file, int width, int height, std::vector<ClassRow>* rows) {
+  namespace fs = std::filesystem;
+  std::string exr;
+  if (file.ends_with(".json")) {
+    Result<std::string> text = read_input_file(file, std::uint64_t{1} << 30);
+    if (!text) return text.error();
+    Result<HistogramFile> h = parse_histogram_json(*text, file);
+    if (!h) return h.error();
+    for (ClassRow& row : *rows) {
+      if (row.name == "total") {
+        row.reference = h->report.total.luminance;
+        row.reference_stderr = std::isfinite(h->report.total.std_error) ? h->report.total.std_error : 0.0;
+        continue;
+      }
+      for (const ClassEstimate& c : h->report.classes)
+        if (c.name == row.name) {
+          row.reference = c.estimate.luminance;
+          row.reference_stderr = std::isfinite(c.estimate.std_error) ? c.estimate.std_error : 0.0;
+        }
+    }
+    const fs::path p(file);
+    for (const fs::path& beside : {fs::path(p).replace_extension(".exr"), p.parent_path() / "classes.exr"}) {
+      std::error_code ec;
+      if (fs::exists(beside, ec)) {
+        exr = beside.string();
+        break;
+      }
+    }
+  } else if (file.ends_with(".exr")) {
+    exr = file;
+  } else {
+    return make_error(ErrorCode::kUsage, "--reference " + file + ": expected a histogram.json or an .exr file of an earlier run");
+  }
+  if (!exr.empty()) {
+    Result<std::vector<ImageLayer>> layers = read_exr_layers(exr);
+    if (!layers) return layers.error();
+    for (ClassRow& row : *rows)
+      for (const ImageLayer& l : *layers)
+        if (l.name == row.name) {
+          if (l.image.width != width || l.image.height != height) {
+            Error e = make_error(ErrorCode::kUsage, "the reference image is " + std::to_string(l.image.width) + " x " +
+                                                        std::to_string(l.image.height) + " pixels, the ladder's " +
+                                                        std::to_string(width) + " x " + std::to_string(height) +
+                                                        "; render both at the same --resolution");
+            e.where = exr;
+            return e;
+          }
+          row.pixels = luminance_image(l.image);
+          if (!file.ends_with(".json")) {  // an EXR alone: the image mean is the reference
+            double s = 0.0;
+            for (float v : *row.pixels) s += v;
+            row.reference = row.pixels->empty() ? 0.0 : s / static_cast<double>(row.pixels->size());
+          }
+        }
+  }
+  for (const ClassRow& row : *rows)
+    if (row.reference) return true;
+  return make_error(ErrorCode::kUsage, "--reference " + file + " has none of the classes measured (by name: total or the class file's)");
+}
+
+// --- numbers for the table and JSON ---
+
+nlohmann::ordered_json number_or_null(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); }
+
+std::string fmt(double v, const char* f = "%.5g") {
+  if (!std::isfinite(v)) return "-";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+// Per renderer and class: the ladder's statistics.
+struct Series {
+  std::vector<double> error, z, efficiency;
+  double pooled_efficiency = std::numeric_limits<double>::quiet_NaN();
+  double slope = std::numeric_limits<double>::quiet_NaN();
+  StderrCheck check;
+  std::string warning;
+};
+
+Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const ClassRow& cr) {
+  Series s;
+  if (!cr.reference) return s;
+  std::vector<RungError> re;
+  std::vector<double> times;
+  double sum_e2t = 0.0;
+  int n = 0;
+  for (const RungResult& r : rungs) {
+    const ClassMeasure& m = r.classes[row];
+    const double err = std::fabs(m.estimate - *cr.reference);
+    const double rounding = kRoundingFloor * std::fabs(*cr.reference);
+    const double sigma =
+        std::sqrt(m.std_error * m.std_error + cr.reference_stderr * cr.reference_stderr + rounding * rounding);
+    s.error.push_back(err);
+    s.z.push_back(sigma > 0.0 ? (m.estimate - *cr.reference) / sigma : std::numeric_limits<double>::quiet_NaN());
+    s.efficiency.push_back(err > 0.0 && r.cpu_s > 0.0 ? 1.0 / (err * err * r.cpu_s) : std::numeric_limits<double>::quiet_NaN());
+    times.push_back(r.cpu_s);
+    re.push_back({m.estimate, m.std_error, m.stability});
+    if (r.cpu_s > 0.0) {
+      sum_e2t += err * err * r.cpu_s;
+      ++n;
+    }
+  }
+  if (n > 0 && sum_e2t > 0.0) s.pooled_efficiency = static_cast<double>(n) / sum_e2t;
+  s.slope = loglog_slope(times, s.error);
+  s.check = check_stderr(re, *cr.reference, cr.reference_stderr);
+  if (s.check.disagrees) {
+    const RungResult& at = rungs[static_cast<std::size_t>(s.check.max_z_rung)];
+    s.warning = "the reported stderr disagrees with the true error: chi2 " + fmt(s.check.chi2, "%.3g") + " over " +
+                std::to_string(s.check.dof) + " rungs (limit " + fmt(s.check.limit, "%.3g") + " at p = 0.001), " +
+                (at.classes[row].std_error > 0.0 ? fmt(s.check.max_abs_z, "%.1f") + " sigma off"
+                                                  : "a stderr of 0 with an error of " + fmt(s.error[static_cast<std::size_t>(s.check.max_z_rung)], "%.3g")) +
+                " at " + at.budget.text();
+  }
+  if (s.check.unstable)
+    s.warning += std::string(s.warning.empty() ? "" : "; ") + "the stderr is unstable: its batch variance has a relative error of " +
+                 fmt(s.check.stability, "%.2f") + " (limit " + fmt(kUnstableVariance, "%.2f") + "): a few batches carry the estimate";
+  return s;
+}
+
+int run(const ConvergeArgs& a) {
+  const double cpu_start = cpu_seconds();
+  const auto wall_start = std::chrono::steady_clock::now();
+  double render_wall = 0.0, render_cpu = 0.0;  // inside render(): the ladder and the reference run
+  // --- budgets ---
+  if (!a.spp_list.empty() && !a.time_list.empty())
+    return report(make_error(ErrorCode::kUsage, "--spp and --time are alternatives: give one ladder"));
+  const bool by_time = !a.time_list.empty();
+  Result<std::vector<Budget>> ladder =
+      parse_ladder(by_time ? a.time_list : (a.spp_list.empty() ? "4,16,64,256" : a.spp_list), by_time, by_time ? "--time" : "--spp");
+  if (!ladder) return report(ladder.error());
+  if (a.renderers.empty()) return report(make_error(ErrorCode::kUsage, "name at least one --renderer"));
+
+  // --- scene, output folder, profiles ---
+  Result<Scene> scene = load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
+  if (!scene) return report(scene.error());
+  if (!a.resolution.empty())
+    if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return report(r.error());
+  Result<OutputSet> out_set = OutputSet::prepare(a.out);
+  if (!out_set) return report(out_set.error());
+  std::vector<Profile> profiles;
+  for (const std::string& name : a.renderers) {
+    Result<Profile> p = resolve_profile(name, a.limits);
+    if (!p) return report(p.error());
+    if (Result<StrategySet> ok = runnable_strategies(*p); !ok) return report(ok.error());
+    profiles.push_back(std::move(*p));
+  }
+  const std::string ref_renderer_name = a.reference_renderer.empty() ? a.renderers.front() : a.reference_renderer;
+  Result<Profile> ref_profile = resolve_profile(ref_renderer_name, a.limits);
+  if (!ref_profile) return report(ref_profile.error());
+  if (Result<StrategySet> ok = runnable_strategies(*ref_profile); !ok) return report(ok.error());
+
+  // --- classes: the class file's, else the closed form's, else the built-ins; "total" first ---
+  // The class file's classes, or the built-ins (as trace compiles them), unless the scene declares a
+  // closed form and no class file is given: then its classes.
+  const SceneTypes types = scene_types(*scene);
+  RenderIdentity ends;
+  for (LightType l : types.lights) ends.lights.push_back(to_string(l));
+  ends.sensor = to_string(types.sensor);
+  std::string class_text;
+  if (!a.classes_file.empty()) {
+    Result<std::string> text = read_input_file(a.classes_file, a.limits.max_file_bytes);
+    if (!text) return report(text.error());
+    class_text = std::move(*text);
+  }
+  Result<std::unique_ptr<RenderClasses>> listed = compile_render_classes(class_text, a.classes_file, ends, a.limits);
+  if (!listed) return report(listed.error());
+  std::vector<std::unique_ptr<PathClass>> owned;
+  std::vector<const PathClass*> classes = (*listed)->classes;
+  if (a.classes_file.empty() && scene->reference) {
+    ClassOptions copts;
+    copts.limits = a.limits;
+    copts.ends.lights.assign(types.lights.begin(), types.lights.end());
+    copts.ends.sensors = {types.sensor};
+    classes.clear();
+    for (std::size_t i = 0; i < scene->reference->classes.size(); ++i) {
+      const ReferenceClass& rc = scene->reference->classes[i];
+      if (rc.name == "total") continue;
+      Result<PathClass> pc = compile_class(rc.expr, copts);
+      if (!pc) {
+        Error e = pc.error();
+        e.where = a.scene + ":/reference/classes/" + std::to_string(i) + "/class";
+        return report(e);
+      }
+      owned.push_back(std::make_unique<PathClass>(std::move(*pc)));
+      owned.back()->name = rc.name;
+      owned.back()->text = rc.expr;
+      classes.push_back(owned.back().get());
+    }
+  }
+  Result<Classifier> classifier = Classifier::build(classes, a.limits);
+  if (!classifier) return report(classifier.error());
+  std::vector<ClassRow> rows{{"total", "$all", std::nullopt, 0.0, std::nullopt}};
+  for (const PathClass* c : classes) rows.push_back({c->name, c->text, std::nullopt, 0.0, std::nullopt});
+
+  RungSetup setup{&*scene, &*classifier, a.threads, a.max_bounces};
+  const int width = scene->camera.width, height = scene->camera.height;
+  const std::uint64_t base_seed = a.seed;
+  std::signal(SIGINT, on_interrupt);
+  g_interrupted.store(false);
+  const bool progress = !a.quiet && ::isatty(STDERR_FILENO);
+
+  // --- the reference ---
+  Reference ref;
+  std::optional<RungResult> ref_run;
+  if (!a.reference.empty()) {
+    if (Result<bool> r = load_reference_file(a.reference, width, height, &rows); !r) return report(r.error());
+    ref.kind = "file";
+    ref.source = a.reference;
+  } else if (scene->reference) {
+    for (ClassRow& row : rows)
+      for (const ReferenceClass& rc : scene->reference->classes)
+        if (rc.name == row.name) {
+          row.reference = rc.luminance;
+          if (scene->reference->uniform)
+            row.pixels = std::vector<float>(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
+                                            static_cast<float>(rc.luminance));
+        }
+    ref.kind = "closed-form";
+    ref.source = scene->reference->source;
+  } else {
+    Budget rb = ladder->back();
+    if (rb.spp) rb.spp *= a.reference_factor;
+    else rb.seconds *= static_cast<double>(a.reference_factor);
+    const std::uint64_t seed = base_seed ^ 0x5eed5eed5eedULL;
+    if (progress) std::cerr << "pathex: reference run: " << ref_profile->name << " at " << rb.text() << "\n";
+    Result<RungResult> r = run_rung(setup, *ref_profile, rb, seed, rows);
+    if (!r) return report(r.error());
+    render_wall += r->wall_s;
+    render_cpu += r->cpu_s;
+    if (r->interrupted) {
+      std::signal(SIGINT, SIG_DFL);
+      std::cerr << "pathex: interrupted during the reference run; nothing written\n";
+      return kExitNo;
+    }
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      rows[i].reference = r->classes[i].estimate;
+      rows[i].reference_stderr = std::isfinite(r->classes[i].std_error) ? r->classes[i].std_error : 0.0;
+    }
+    const std::vector<ImageLayer> layers = r->output->images.layers(1.0 / static_cast<double>(r->spp));
+    for (std::size_t i = 0; i < rows.size(); ++i) rows[i].pixels = luminance_image(layers[i].image);
+    ref.kind = "run";
+    ref.source = "a reference run of " + ref_profile->name + " at " + std::to_string(r->spp) + " spp, seed " +
+                 std::to_string(seed) + ", written to " + a.out + "/reference.json and reference.exr";
+    ref.run = {{"renderer", ref_profile->name}, {"spp", r->spp}, {"seed", seed}, {"cpu_s", r->cpu_s}, {"wall_s", r->wall_s},
+               {"nonfinite_samples", r->nonfinite}};
+    ref_run = std::move(*r);
+  }
+
+  // --- the ladder: every renderer at every budget, each rung its own render and seed ---
+  std::vector<std::vector<RungResult>> results(profiles.size());
+  bool complete = true;
+  for (std::size_t k = 0; k < profiles.size() && complete; ++k)
+    for (std::size_t i = 0; i < ladder->size(); ++i) {
+      const std::uint64_t seed = base_seed + 1000 * k + i;
+      if (progress) std::cerr << "\rpathex: " << profiles[k].name << " at " << (*ladder)[i].text() << "        " << std::flush;
+      Result<RungResult> r = run_rung(setup, profiles[k], (*ladder)[i], seed, rows);
+      if (!r) return report(r.error());
+      render_wall += r->wall_s;
+      render_cpu += r->cpu_s;
+      if (r->interrupted) {
+        complete = false;
+        break;
+      }
+      r->output.reset();  // the ladder keeps its numbers only
+      results[k].push_back(std::move(*r));
+    }
+  if (progress) std::cerr << "\r" << std::string(60, ' ') << "\r" << std::flush;
+  std::signal(SIGINT, SIG_DFL);
+
+  // --- statistics ---
+  std::vector<std::vector<Series>> series(profiles.size());
+  std::vector<std::string> warnings;
+  for (std::size_t k = 0; k < profiles.size(); ++k) {
+    std::uint64_t nonfinite = 0;
+    for (const RungResult& r : results[k]) nonfinite += r.nonfinite;
+    if (nonfinite > 0)
+      warnings.push_back(profiles[k].name + ": " + std::to_string(nonfinite) + " non-finite samples (a bug: numbers must stay finite)");
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      series[k].push_back(analyse(results[k], i, rows[i]));
+      if (!series[k].back().warning.empty()) warnings.push_back(profiles[k].name + " on " + rows[i].name + ": " + series[k].back().warning);
+    }
+  }
+  // The most efficient renderer per class (pooled efficiency 1 / mean(error² × CPU time)).
+  nlohmann::ordered_json best = nlohmann::ordered_json::array();
+  std::vector<std::string> best_lines;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    int top = -1, second = -1;
+    for (std::size_t k = 0; k < profiles.size(); ++k) {
+      const double e = series[k][i].pooled_efficiency;
+      if (!std::isfinite(e)) continue;
+      if (top < 0 || e > series[static_cast<std::size_t>(top)][i].pooled_efficiency) {
+        second = top;
+        top = static_cast<int>(k);
+      } else if (second < 0 || e > series[static_cast<std::size_t>(second)][i].pooled_efficiency) {
+        second = static_cast<int>(k);
+      }
+    }
+    if (top < 0) continue;
+    const double et = series[static_cast<std::size_t>(top)][i].pooled_efficiency;
+    nlohmann::ordered_json b = {{"class", rows[i].name}, {"renderer", profiles[static_cast<std::size_t>(top)].name}, {"efficiency", et}};
+    std::string line = rows[i].name + ": " + profiles[static_cast<std::size_t>(top)].name + " (efficiency " + fmt(et, "%.3g");
+    if (second >= 0) {
+      const double es = series[static_cast<std::size_t>(second)][i].pooled_efficiency;
+      b["runner_up"] = profiles[static_cast<std::size_t>(second)].name;
+      b["ratio"] = et / es;
+      line += ", " + fmt(et / es, "%.2f") + "x " + profiles[static_cast<std::size_t>(second)].name + "'s";
+    } else {
+      b["runner_up"] = nullptr;
+      b["ratio"] = nullptr;
+    }
+    if (!series[static_cast<std::size_t>(top)][i].warning.empty()) line += "; its stderr is flagged";
+    best.push_back(b);
+    best_lines.push_back(line + ")");
+  }
+
+  // --- converge.json ---
+  nlohmann::ordered_json doc;
+  doc["scene"] = a.scene;
+  doc["complete"] = complete;
+  doc["budget"] = by_time ? "time" : "spp";
+  nlohmann::ordered_json lad = nlohmann::ordered_json::array();
+  for (const Budget& b : *ladder) lad.push_back(b.spp ? nlohmann::ordered_json(b.spp) : nlohmann::ordered_json(b.seconds));
+  doc["ladder"] = lad;
+  doc["seed"] = a.seed;
+  doc["threads"] = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
+  doc["max_bounces"] = a.max_bounces ? nlohmann::ordered_json(*a.max_bounces) : nlohmann::ordered_json(nullptr);
+  doc["resolution"] = {width, height};
+  nlohmann::ordered_json jref = {{"kind", ref.kind}, {"source", ref.source}};
+  if (ref.kind == "run") jref["run"] = ref.run;
+  nlohmann::ordered_json jrefc = nlohmann::ordered_json::array();
+  for (const ClassRow& r : rows)
+    jrefc.push_back({{"name", r.name}, {"expr", r.expr}, {"luminance", r.reference ? number_or_null(*r.reference) : nullptr},
+                     {"stderr", r.reference_stderr}, {"per_pixel", r.pixels.has_value()}});
+  jref["classes"] = jrefc;
+  doc["reference"] = jref;
+  doc["stderr_check"] = {{"alpha", kStderrCheckAlpha}, {"unstable_variance", kUnstableVariance}};
+  nlohmann::ordered_json jren = nlohmann::ordered_json::array();
+  for (std::size_t k = 0; k < profiles.size(); ++k) {
+    std::uint64_t nonfinite = 0;
+    for (const RungResult& r : results[k]) nonfinite += r.nonfinite;
+    nlohmann::ordered_json jc = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const Series& s = series[k][i];
+      nlohmann::ordered_json jr = nlohmann::ordered_json::array();
+      for (std::size_t j = 0; j < results[k].size(); ++j) {
+        const RungResult& r = results[k][j];
+        const ClassMeasure& m = r.classes[i];
+        jr.push_back({{"budget", r.budget.spp ? nlohmann::ordered_json(r.budget.spp) : nlohmann::ordered_json(r.budget.seconds)},
+                      {"spp", r.spp},
+                      {"seed", r.seed},
+                      {"cpu_s", r.cpu_s},
+                      {"wall_s", r.wall_s},
+                      {"estimate", m.estimate},
+                      {"stderr", number_or_null(m.std_error)},
+                      {"error", j < s.error.size() ? number_or_null(s.error[j]) : nullptr},
+                      {"z", j < s.z.size() ? number_or_null(s.z[j]) : nullptr},
+                      {"rms_pixel_error", m.rms_pixel ? number_or_null(*m.rms_pixel) : nullptr},
+                      {"stderr_stability", number_or_null(m.stability)},
+                      {"efficiency", j < s.efficiency.size() ? number_or_null(s.efficiency[j]) : nullptr}});
+      }
+      jc.push_back({{"name", rows[i].name},
+                    {"expr", rows[i].expr},
+                    {"rungs", jr},
+                    {"slope", number_or_null(s.slope)},
+                    {"efficiency", number_or_null(s.pooled_efficiency)},
+                    {"stderr_check",
+                     {{"chi2", number_or_null(s.check.chi2)}, {"dof", s.check.dof}, {"limit", s.check.limit},
+                      {"max_abs_z", number_or_null(s.check.max_abs_z)}, {"stability", number_or_null(s.check.stability)},
+                      {"disagrees", s.check.disagrees}, {"unstable", s.check.unstable}}},
+                    {"warning", s.warning.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.warning)}});
+    }
+    jren.push_back({{"name", profiles[k].name}, {"nonfinite_samples", nonfinite}, {"classes", jc}});
+  }
+  doc["renderers"] = jren;
+  doc["best"] = best;
+  doc["warnings"] = warnings;
+
+  // --- the plot: one panel per class with a reference ---
+  std::vector<PlotPanel> panels;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (!rows[i].reference) continue;
+    PlotPanel p{rows[i].name == "total" ? "total (the whole image)" : rows[i].name + "  " + rows[i].expr, {}};
+    for (std::size_t k = 0; k < profiles.size(); ++k) {
+      PlotSeries ps{profiles[k].name, {}, series[k][i].error, {}};
+      for (const RungResult& r : results[k]) {
+        ps.time.push_back(r.cpu_s);
+        ps.std_error.push_back(r.classes[i].std_error);
+      }
+      p.series.push_back(std::move(ps));
+    }
+    panels.push_back(std::move(p));
+  }
+  Result<PlotFiles> plot = draw_convergence_plot(panels);
+  if (!plot) return report(plot.error());
+
+  // Overhead: everything but render() — references, statistics, the plot (the writing below is
+  // measured by bench/converge_overhead.py from the outside).
+  const double wall_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  const double cpu_total = cpu_seconds() - cpu_start;
+  doc["timing"] = {{"render_wall_s", render_wall}, {"render_cpu_s", render_cpu},
+                   {"overhead_wall_s", wall_total - render_wall}, {"overhead_cpu_s", cpu_total - render_cpu},
+                   {"overhead_pct", render_wall > 0 ? 100.0 * (wall_total - render_wall) / render_wall : 0.0}};
+  const std::string json_text = doc.dump(2) + "\n";
+
+  // --- outputs: one set, whole or not at all ---
+  {
+    const SignalShield shield;
+    Result<bool> written = out_set->write([&](const std::string& dir) -> Result<bool> {
+      if (Result<bool> w = write_file_atomic(dir + "/converge.json", json_text); !w) return w;
+      if (Result<bool> w = write_file_atomic(dir + "/converge.svg", plot->svg); !w) return w;
+      if (Result<bool> w = write_file_atomic(dir + "/converge.png", plot->png); !w) return w;
+      if (!ref_run) return true;
+      RunInfo info;
+      info.scene = a.scene;
+      info.renderer = ref_profile->name;
+      info.spp = ref_run->spp;
+      info.spp_requested = ref_run->spp;
+      info.seed = ref_run->seed;
+      std::vector<ClassInfo> infos;
+      for (std::size_t i = 1; i < rows.size(); ++i) infos.push_back({rows[i].name, rows[i].expr});
+      Result<HistogramReport> rep = make_report(ref_run->output->histogram, info, &*classifier, infos, std::uint64_t{1000});
+      if (!rep) return rep.error();
+      if (Result<bool> w = write_file_atomic(dir + "/reference.json", histogram_json_text(*rep)); !w) return w;
+      return write_exr(dir + "/reference.exr", ref_run->output->images.layers(1.0 / static_cast<double>(ref_run->spp)));
+    });
+    if (!written) return report(written.error());
+  }
+  if (a.json) {
+    std::cout << json_text;
+    return complete ? kExitOk : kExitNo;
+  }
+
+  // --- the table ---
+  std::cout << "scene " << a.scene << ", reference: " << ref.kind << " (" << ref.source << ")"
+            << (complete ? "" : "; interrupted: the finished rungs only") << "\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::cout << "\nclass " << rows[i].name << " " << rows[i].expr << ": reference "
+              << (rows[i].reference ? fmt(*rows[i].reference, "%.6g") : std::string("none (no errors measured)"));
+    if (rows[i].reference && rows[i].reference_stderr > 0) std::cout << " ± " << fmt(rows[i].reference_stderr, "%.2g");
+    std::cout << "\n  " << std::left << std::setw(16) << "renderer" << std::right << std::setw(10) << "budget" << std::setw(9)
+              << "cpu s" << std::setw(9) << "wall s" << std::setw(12) << "estimate" << std::setw(11) << "stderr" << std::setw(11)
+              << "error" << std::setw(7) << "z" << std::setw(11) << "rms/pixel" << std::setw(11) << "efficiency" << "\n";
+    for (std::size_t k = 0; k < profiles.size(); ++k) {
+      const Series& s = series[k][i];
+      for (std::size_t j = 0; j < results[k].size(); ++j) {
+        const RungResult& r = results[k][j];
+        const ClassMeasure& m = r.classes[i];
+        std::cout << "  " << std::left << std::setw(16) << profiles[k].name << std::right << std::setw(10)
+                  << (r.budget.spp ? std::to_string(r.spp) + " spp" : fmt(r.budget.seconds, "%g") + " s") << std::setw(9)
+                  << fmt(r.cpu_s, "%.3f") << std::setw(9) << fmt(r.wall_s, "%.3f") << std::setw(12) << fmt(m.estimate)
+                  << std::setw(11) << fmt(m.std_error, "%.3g") << std::setw(11)
+                  << (j < s.error.size() ? fmt(s.error[j], "%.3g") : "-") << std::setw(7)
+                  << (j < s.z.size() ? fmt(s.z[j], "%.1f") : "-") << std::setw(11)
+                  << (m.rms_pixel ? fmt(*m.rms_pixel, "%.3g") : "-") << std::setw(11)
+                  << (j < s.efficiency.size() ? fmt(s.efficiency[j], "%.3g") : "-") << "\n";
+      }
+      if (rows[i].reference && !results[k].empty())
+        std::cout << "  " << profiles[k].name << ": error slope against time " << fmt(s.slope, "%.2f")
+                  << " (1/sqrt(t): -0.5), efficiency " << fmt(s.pooled_efficiency, "%.3g")
+                  << (s.warning.empty() ? "" : "\n  WARNING " + profiles[k].name + ": " + s.warning) << "\n";
+    }
+  }
+  if (!warnings.empty()) {
+    std::cout << "\nwarnings\n";
+    for (const std::string& w : warnings) std::cout << "  " << w << "\n";
+  }
+  std::cout << "\nwrote " << a.out << "/converge.json, converge.svg and converge.png" << (ref_run ? ", reference.json and reference.exr" : "")
+            << "\n\nmost efficient renderer per class (1 / mean(error^2 x CPU time) over the ladder)\n";
+  for (const std::string& l : best_lines) std::cout << "  " << l << "\n";
+  return complete ? kExitOk : kExitNo;
+}
+
+}  // namespace
+
+Command add_converge(CLI::App& app) {
+  auto args = std::make_shared<ConvergeArgs>();
+  CLI::App* sub = app.add_subcommand("converge", "What accuracy costs in time: error against time per renderer and class");
+  sub->footer("Example:\n  pathex converge samples/scenes/closed-sphere-point.json --renderer pt-nee --renderer bdpt --renderer lt\n"
+              "Renders every renderer at every budget of the ladder (--spp 4,16,64,256 by default, or --time in seconds),\n"
+              "measures each rung against a reference (the scene's closed form, --reference FILE, or a reference run it makes),\n"
+              "checks that the reported stderr agrees with the true error, and writes DIR/converge.json, converge.svg and\n"
+              "converge.png as one set. Ctrl-C keeps the finished rungs (exit 1).");
+  sub->add_option("SCENE", args->scene, "Scene file")->required();
+  sub->add_option("--renderer", args->renderers, "Renderer profile (repeat for several): built-in name or file")->required();
+  sub->add_option("--classes", args->classes_file, "Class file; default: the scene's closed-form classes, else the built-ins");
+  sub->add_option("--spp", args->spp_list, "Ladder of samples per pixel, increasing (default 4,16,64,256)")->type_name("N,N,...");
+  sub->add_option("--time", args->time_list, "Ladder of wall-clock seconds per render, increasing")->type_name("S,S,...");
+  sub->add_option("--reference", args->reference, "An earlier run's histogram.json (classes.exr beside it adds per-pixel errors) or EXR");
+  sub->add_option("--reference-renderer", args->reference_renderer,
+                  "Renderer of the reference run made when the scene declares no closed form and --reference is not given; default: the first --renderer");
+  sub->add_option("--reference-factor", args->reference_factor, "The reference run's budget over the ladder's largest")
+      ->capture_default_str()->check(CLI::Range(1, 1024));
+  sub->add_option("--seed", args->seed, "Base seed: rung i of renderer k uses seed + 1000 k + i")->capture_default_str()->check(non_negative());
+  sub->add_option("--threads", args->threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+  sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices; default: each profile's bound, else 16")->check(CLI::Range(0, 1000));
+  sub->add_option("--resolution", args->resolution, "Image size WIDTHxHEIGHT; default: the scene's")->type_name("WxH");
+  sub->add_option("--out", args->out, "Output folder")->capture_default_str();
+  sub->add_flag("--json", args->json, "Print converge.json to stdout instead of the table");
+  sub->add_flag("--quiet", args->quiet, "No progress lines");
+  add_limit_options(sub, &args->limits);
+  return {sub, [args] { return run(*args); }};
+}
+
+}  // namespace pathex::cli
