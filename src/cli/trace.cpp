@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <ctime>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
@@ -44,6 +45,9 @@ struct TraceArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   std::optional<int> max_bounces;
+  SamplerKind sampler = RenderOptions{}.sampler;  // the defaults of these three: RenderOptions'
+  int rr_depth = RenderOptions{}.rr_depth;
+  float rr_threshold = RenderOptions{}.rr_threshold;
   std::string resolution;  // "WxH"; empty: the scene's
   std::uint64_t max_paths = 1000;
   int top_paths = 8;
@@ -82,6 +86,32 @@ std::string gib(std::uint64_t bytes) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(bytes) / static_cast<double>(std::uint64_t{1} << 30));
   return buf;
+}
+
+// CPU seconds used by this process so far, all threads.
+double process_cpu_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// histogram.json's "efficiency": Veach's efficiency of the image-mean estimate, 1 / (relative
+// variance × CPU seconds of the render), with its two factors. Independent of the spp (the
+// variance falls as the time grows), so two settings compare without a reference. Null when the
+// total has no finite relative error (a black image, fewer than two batches of passes).
+nlohmann::ordered_json efficiency_json(const Estimate& total, double cpu_s) {
+  const double rel = total.luminance > 0.0 ? total.std_error / total.luminance : 0.0;
+  const double rel_var = rel * rel;
+  nlohmann::ordered_json e;
+  e["cpu_s"] = cpu_s;
+  if (std::isfinite(rel_var) && rel_var > 0.0 && cpu_s > 0.0) {
+    e["relative_variance"] = rel_var;
+    e["per_cpu_s"] = 1.0 / (rel_var * cpu_s);
+  } else {
+    e["relative_variance"] = nullptr;
+    e["per_cpu_s"] = nullptr;
+  }
+  return e;
 }
 
 int run(const TraceArgs& a) {
@@ -133,6 +163,9 @@ int run(const TraceArgs& a) {
   ro.seed = a.seed;
   ro.threads = a.threads;
   ro.max_bounces = bound;
+  ro.sampler = a.sampler;
+  ro.rr_depth = a.rr_depth;
+  ro.rr_threshold = a.rr_threshold;
   // Without image outputs the render keeps the histogram alone (the same histogram).
   ro.images = !a.no_images;
   if (ro.images)
@@ -167,7 +200,9 @@ int run(const TraceArgs& a) {
   g_cancel.store(false);
   ro.cancel = &g_cancel;
   std::signal(SIGINT, on_sigint);
+  const double cpu_start = process_cpu_seconds();
   Result<RenderOutput> out = render(*scene, *profile, &*classifier, ro);
+  const double cpu_s = process_cpu_seconds() - cpu_start;
   std::signal(SIGINT, SIG_DFL);
   if (show_progress) std::fprintf(stderr, "\r%*s\r", std::max(terminal_columns() - 1, 0), "");
   if (!out) return report(out.error());
@@ -199,6 +234,9 @@ int run(const TraceArgs& a) {
                       {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
     doc["connectors"] = std::move(list);
   }
+  doc["sampler"] = to_string(a.sampler);
+  doc["roulette"] = {{"depth", a.rr_depth}, {"threshold", a.rr_threshold}};
+  doc["efficiency"] = efficiency_json(rep->total, cpu_s);
   const std::string json_text = doc.dump(2) + "\n";
   {
     const SignalShield shield;
@@ -278,6 +316,17 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices (k - 1); default: the profile's bound, else 16")
       ->check(CLI::Range(0, 1000));
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
+  sub->add_option("--sampler", args->sampler,
+                  "Random numbers: sobol (Owen-scrambled Sobol points, stratified per pixel) or independent")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, SamplerKind>{{"independent", SamplerKind::kIndependent},
+                                                                              {"sobol", SamplerKind::kSobol}}))
+      ->default_str(to_string(RenderOptions{}.sampler));
+  sub->add_option("--rr-depth", args->rr_depth,
+                  "Russian roulette from this vertex of a subpath on (the camera or light point is the first)")
+      ->capture_default_str()->check(CLI::Range(1, 1000));
+  sub->add_option("--rr-threshold", args->rr_threshold,
+                  "Russian roulette only below this throughput (relative to the subpath's start); 0: no roulette")
+      ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
   sub->add_option("--resolution", args->resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
       ->type_name("WxH");
   sub->add_option("--max-paths", args->max_paths,
