@@ -247,14 +247,14 @@ struct Estimate {
 Estimate batch_means(const std::vector<ExactRgb>& batch_sums, const std::vector<std::uint64_t>& batch_samples,
                      std::uint64_t contributions);
 
-// What the caller knows about the run; copied into the report as is.
+// What the render was; copied into the report as is. Only what the result is a function of: how
+// long it took and on how many threads is not here (pathex trace writes that to run.json), so
+// that the report of a render is the same bytes however it was split, interrupted or resumed.
 struct RunInfo {
   std::string scene;
   std::string renderer;
   std::uint64_t spp = 0;
   std::uint64_t seed = 0;
-  int threads = 0;
-  double time_s = 0;
   bool complete = true;  // false for an interrupted render that wrote what it had
   std::uint64_t spp_requested = 0;  // what was asked (spp is what was done; they differ when interrupted)
   bool operator==(const RunInfo&) const = default;

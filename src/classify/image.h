@@ -91,6 +91,19 @@ class ClassImages {
   std::vector<ImageLayer> layers(double scale) const;
   std::size_t memory_bytes() const;
 
+  // --- the exact state, tile by tile (shard files, MPI reductions) ---
+  // A plane (a combination of layers, see above) is num_tiles() tiles of kTile × kTile pixels;
+  // a tile is kTileWords words: per pixel (row-major in the tile) per channel the low then the
+  // high word of the 128-bit sum. Pixels of an edge tile outside the image stay zero.
+  static constexpr int kTile = 8;
+  static constexpr std::size_t kTileWords = kTile * kTile * 6;
+  std::size_t num_planes() const { return num_slots_; }
+  std::size_t num_tiles() const { return tiles_x() * static_cast<std::size_t>((height_ + kTile - 1) / kTile); }
+  // The tile's words, or null when nothing was ever added to it. Read after all writers are done.
+  const std::uint64_t* tile_words(std::size_t plane, std::size_t tile) const;
+  // Adds kTileWords words to the tile (exactly, as 128-bit sums); not thread-safe.
+  void add_tile(std::size_t plane, std::size_t tile, const std::uint64_t* words);
+
   // The contributions of one sample (or of all samples of one pixel) summed per plane (the class
   // sets whose classes have the same layers share one) without atomics; flush() adds them to
   // `images`, which must be the image it was made for, and clears the buffer. One per thread.
@@ -163,11 +176,8 @@ class ClassImages {
  private:
   // A plane is a directory of 8 × 8-pixel tiles, each allocated when first touched, so that a
   // combination of layers that only a few pixels see costs only their tiles.
-  static constexpr int kTile = 8;
-  static constexpr std::size_t kTileWords = kTile * kTile * 6;
   using TileDirectory = std::atomic<std::uint64_t*>;  // an array of num_tiles() of these
   std::size_t tiles_x() const { return static_cast<std::size_t>((width_ + kTile - 1) / kTile); }
-  std::size_t num_tiles() const { return tiles_x() * static_cast<std::size_t>((height_ + kTile - 1) / kTile); }
   std::size_t tile_index(int x, int y) const {
     return static_cast<std::size_t>(y / kTile) * tiles_x() + static_cast<std::size_t>(x / kTile);
   }
@@ -178,7 +188,8 @@ class ClassImages {
   std::uint64_t num_pixels() const { return static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_); }
   // The six words of pixel (x, y) in the plane of `slot`, allocating on first use; or, const,
   // null when that tile was never touched.
-  std::uint64_t* words(std::size_t slot, int x, int y);
+  std::uint64_t* words(std::size_t slot, int x, int y) { return tile(slot, tile_index(x, y)) + in_tile_index(x, y); }
+  std::uint64_t* tile(std::size_t slot, std::size_t tile);  // allocating on first use
   void add_to_slot(std::size_t slot, int x, int y, const ExactRgb& c);  // (x, y) inside
   const std::uint64_t* words_if_any(std::size_t slot, int x, int y) const;
   void release();

@@ -54,6 +54,9 @@ void print_notation_hint(const std::string& expr, const PathClass& pc, const Cla
 // Prints "pathex: error: <rendered error>" to stderr and returns kExitBadInput.
 int report(const Error& e);
 
+// Parses the command line, runs the subcommand and returns the exit code (cli/app.cpp).
+int run_command_line(int argc, char** argv);
+
 // Registration of each subcommand (one file each).
 Command add_explain(CLI::App& app);
 Command add_match(CLI::App& app);
@@ -62,5 +65,6 @@ Command add_query(CLI::App& app);
 Command add_check(CLI::App& app);
 Command add_renderers(CLI::App& app);
 Command add_trace(CLI::App& app);
+Command add_merge(CLI::App& app);
 
 }  // namespace pathex::cli

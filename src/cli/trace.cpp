@@ -14,18 +14,21 @@
 #include <sstream>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
 #include "cli/common.h"
 #include "cli/reach_common.h"
+#include "cli/render_job.h"
 #include "cli/trace_checks.h"
+#include "core/hash.h"
+#include "core/version.h"
 #include "io/atomic_file.h"
 #include "io/class_file.h"
 #include "io/histogram_json.h"
 #include "io/image_io.h"
 #include "io/output_set.h"
+#include "io/input_file.h"
 #include "io/profile_json.h"
 #include "io/progress.h"
+#include "scene/scene_hash.h"
 #include "scene/universe.h"
 #include "trace/render.h"
 
@@ -54,17 +57,28 @@ struct TraceArgs {
   bool json = false;
   bool quiet = false;
   bool no_images = false;
-  ExrCompression exr_compression = ExrOptions{}.compression;
+  std::string shard;       // "i/n"
+  std::string resume;      // a render folder
+  double time_limit = 0;   // seconds; 0: none
   std::uint64_t max_memory = kDefaultMaxMemory;
+  std::vector<std::string> settings_given;  // render settings named on the command line (refused with --resume)
   Limits limits;
 };
 
 std::atomic<bool> g_cancel{false};
-extern "C" void on_sigint(int) { g_cancel.store(true); }
+// Ctrl-C, and SIGTERM (how mpirun stops the other ranks when one fails), end the render after the
+// chunk in progress; what was rendered is written, marked incomplete.
+extern "C" void on_stop(int) { g_cancel.store(true); }
 
 std::string percent(double share, int decimals = 1) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.*f %%", decimals, 100.0 * share);
+  return buf;
+}
+
+std::string gib(std::uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(bytes) / static_cast<double>(std::uint64_t{1} << 30));
   return buf;
 }
 
@@ -83,10 +97,160 @@ int terminal_columns() {
   return 80;
 }
 
-std::string gib(std::uint64_t bytes) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(bytes) / static_cast<double>(std::uint64_t{1} << 30));
-  return buf;
+// "i/n" with 0 ≤ i < n.
+Result<std::pair<std::uint64_t, std::uint64_t>> parse_shard_option(const std::string& text) {
+  const auto bad = [&] {
+    return make_error(ErrorCode::kUsage, "--shard " + text + ": expected i/n, shard i of n with 0 <= i < n (e.g. 0/4)");
+  };
+  const std::size_t slash = text.find('/');
+  if (slash == std::string::npos) return bad();
+  std::uint64_t i = 0, n = 0;
+  try {
+    std::size_t used_i = 0, used_n = 0;
+    if (text.empty() || text[0] == '-' || text[slash + 1] == '-') return bad();
+    i = std::stoull(text.substr(0, slash), &used_i);
+    n = std::stoull(text.substr(slash + 1), &used_n);
+    if (used_i != slash || used_n != text.size() - slash - 1) return bad();
+  } catch (const std::exception&) {
+    return bad();
+  }
+  if (n == 0 || i >= n) return bad();
+  return std::make_pair(i, n);
+}
+
+std::string profile_hash(const Profile& p) {
+  Fnv64 h;
+  h.add(p.name);
+  for (const Strategy& st : p.strategies) h.add(st.name + " " + st.describe());
+  h.add(p.max_bounces.value_or(-1));
+  return h.hex();
+}
+
+std::string classes_hash(const std::string& text, const RenderClasses& classes) {
+  Fnv64 h;
+  h.add(text);
+  for (const ClassInfo& c : classes.infos) h.add(c.name + "=" + c.expr);
+  return h.hex();
+}
+
+// The render to run: what it renders and the passes it is asked for, with what an earlier,
+// interrupted run of it already holds (--resume).
+struct Job {
+  std::optional<Scene> scene;
+  std::optional<Profile> profile;
+  std::unique_ptr<RenderClasses> classes;
+  ShardHeader header;  // identity, spp, share; passes: those already held
+  std::optional<CombinedRender> resumed;
+  std::string out;
+};
+
+Result<bool> load_fresh(const TraceArgs& a, Job* job) {
+  Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
+                                        : load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
+  if (!scene) return scene.error();
+  // The content hash is the file's; the resolution is an option of the render, kept beside it.
+  const std::string scene_hash = scene_content_hash(*scene);
+  if (!a.resolution.empty())
+    if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return r.error();
+  Result<Profile> profile = resolve_profile(a.renderer, a.limits);
+  if (!profile) return profile.error();
+  Result<StrategySet> runnable = runnable_strategies(*profile);
+  if (!runnable) return runnable.error();
+
+  RenderIdentity& id = job->header.identity;
+  id.pathex = pathex_version();
+  id.scene = a.scene.empty() ? "default (embedded cornell)" : a.scene;
+  id.scene_file = a.scene.empty() ? "" : std::filesystem::absolute(a.scene).lexically_normal().string();
+  id.scene_hash = scene_hash;
+  id.renderer = profile->name;
+  const bool builtin = std::any_of(builtin_profile_texts().begin(), builtin_profile_texts().end(),
+                                   [&](const BuiltinProfileText& t) { return a.renderer == t.name; });
+  id.renderer_source = builtin ? a.renderer : std::filesystem::absolute(a.renderer).lexically_normal().string();
+  id.renderer_hash = profile_hash(*profile);
+  const SceneTypes types = scene_types(*scene);
+  for (LightType l : types.lights) id.lights.push_back(to_string(l));
+  id.sensor = to_string(types.sensor);
+  id.seed = a.seed;
+  // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
+  id.max_bounces = a.max_bounces.value_or(profile->max_bounces.value_or(16));
+  const RenderOptions defaults;
+  id.sampler = to_string(a.sampler);
+  id.rr_depth = a.rr_depth;
+  id.rr_threshold = a.rr_threshold;
+  id.batches = defaults.batches;
+  id.images = !a.no_images;
+  id.width = scene->camera.width;
+  id.height = scene->camera.height;
+  id.max_paths = a.max_paths;
+  for (const Strategy& st : runnable->strategies) id.strategies.push_back(st.name);
+
+  std::string class_text;
+  if (!a.classes_file.empty()) {
+    Result<std::string> text = read_input_file(a.classes_file, a.limits.max_file_bytes);
+    if (!text) return text.error();
+    class_text = std::move(*text);
+    id.classes_file = std::filesystem::absolute(a.classes_file).lexically_normal().string();
+  }
+  Result<std::unique_ptr<RenderClasses>> classes =
+      compile_render_classes(class_text, a.classes_file.empty() ? "" : a.classes_file, id, a.limits);
+  if (!classes) return classes.error();
+  id.classes_text = class_text;
+  id.classes_hash = classes_hash(class_text, **classes);
+
+  job->header.spp = a.spp;
+  job->header.share = PassSet::range(0, a.spp);
+  if (!a.shard.empty()) {
+    Result<std::pair<std::uint64_t, std::uint64_t>> shard = parse_shard_option(a.shard);
+    if (!shard) return shard.error();
+    job->header.share = job->header.share.part(shard->first, shard->second);
+  }
+  job->scene = std::move(*scene);
+  job->profile = std::move(*profile);
+  job->classes = std::move(*classes);
+  job->out = a.out;
+  return true;
+}
+
+// --resume DIR: the render's settings come from DIR's shard files; the scene and the profile are
+// loaded again from where the render found them and must not have changed.
+Result<bool> load_resumed(const TraceArgs& a, Job* job) {
+  if (!a.settings_given.empty())
+    return make_error(ErrorCode::kUsage, "--resume takes the render's settings from " + a.resume + "; " +
+                                             a.settings_given.front() + " cannot be given with it");
+  Result<std::vector<std::string>> files = render_folder_shards(a.resume);
+  if (!files) return files.error();
+  Result<CombinedRender> combined = combine_shards(*files, a.limits);
+  if (!combined) return combined.error();
+  const RenderIdentity& id = combined->header.identity;
+  Result<Scene> scene = id.scene_file.empty()
+                            ? load_scene_json(default_scene_json(), ".", id.scene)
+                            : load_scene_file(id.scene_file, SceneLoadOptions{a.limits.max_file_bytes});
+  if (!scene) return scene.error();
+  if (scene_content_hash(*scene) != id.scene_hash)
+    return make_error(ErrorCode::kUsage, "the scene " + id.scene + " changed since " + a.resume + " was rendered (content hash " +
+                                             scene_content_hash(*scene) + ", the render's " + id.scene_hash + ")");
+  // The render's resolution (the scene's, or --resolution's).
+  scene->camera.width = id.width;
+  scene->camera.height = id.height;
+  Result<Profile> profile = resolve_profile(id.renderer_source, a.limits);
+  if (!profile) return profile.error();
+  if (profile_hash(*profile) != id.renderer_hash)
+    return make_error(ErrorCode::kUsage, "the renderer profile " + id.renderer_source + " changed since " + a.resume +
+                                             " was rendered");
+  job->header.identity = id;
+  job->header.spp = combined->header.spp;
+  job->header.share = combined->header.share;
+  job->header.passes = combined->header.passes;
+  job->scene = std::move(*scene);
+  job->profile = std::move(*profile);
+  job->classes = std::move(combined->classes);
+  job->resumed = std::move(*combined);
+  job->out = a.resume;
+  return true;
+}
+
+std::string rank_shard_path(const std::string& dir, int rank) {
+  return ranks_folder(dir) + "/rank-" + std::to_string(rank) + kShardExtension;
 }
 
 // CPU seconds used by this process so far, all threads.
@@ -96,175 +260,159 @@ double process_cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// histogram.json's "efficiency": Veach's efficiency of the image-mean estimate, 1 / (relative
-// variance × CPU seconds of the render), with its two factors. Independent of the spp (the
-// variance falls as the time grows), so two settings compare without a reference. Null when the
-// total has no finite relative error (a black image, fewer than two batches of passes).
-nlohmann::ordered_json efficiency_json(const Estimate& total, double cpu_s) {
-  const double rel = total.luminance > 0.0 ? total.std_error / total.luminance : 0.0;
-  const double rel_var = rel * rel;
-  nlohmann::ordered_json e;
-  e["cpu_s"] = cpu_s;
-  if (std::isfinite(rel_var) && rel_var > 0.0 && cpu_s > 0.0) {
-    e["relative_variance"] = rel_var;
-    e["per_cpu_s"] = 1.0 / (rel_var * cpu_s);
-  } else {
-    e["relative_variance"] = nullptr;
-    e["per_cpu_s"] = nullptr;
-  }
-  return e;
-}
-
 int run(const TraceArgs& a) {
-  // --- scene, profile, classes ---
-  Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
-                                        : load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
-  if (!scene) return report(scene.error());
-  if (!a.resolution.empty())
-    if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return report(r.error());
+  Job job;
+  if (Result<bool> r = a.resume.empty() ? load_fresh(a, &job) : load_resumed(a, &job); !r) return report(r.error());
+  const RenderIdentity& id = job.header.identity;
+  Cluster* cluster = current_cluster();
+  const int rank = cluster != nullptr ? cluster->rank() : 0;
+  const int ranks = cluster != nullptr ? cluster->size() : 1;
+  // Connector statistics (histogram.json "connectors") are per process and not yet kept in shard
+  // files, so a render that is split or resumed must not use a connector.
+  for (const Strategy& st : job.profile->strategies)
+    if (st.connector != ConnectorKind::kNone && (!a.shard.empty() || !a.resume.empty() || ranks > 1))
+      return report(make_error(ErrorCode::kUsage, "the " + job.profile->name + " profile uses the " + to_string(st.connector) +
+                                                      " connector, whose statistics are not merged yet: --shard, --resume and MPI runs need a profile without connectors"));
   // The output folder is checked before the render, not after it.
-  Result<OutputSet> out_set = OutputSet::prepare(a.out);
-  if (!out_set) return report(out_set.error());
-  const std::string scene_name = a.scene.empty() ? "default (embedded cornell)" : a.scene;
-  Result<Profile> profile = resolve_profile(a.renderer, a.limits);
-  if (!profile) return report(profile.error());
-  if (Result<StrategySet> runnable = runnable_strategies(*profile); !runnable) return report(runnable.error());
-
-  ClassOptions copts;
-  copts.limits = a.limits;
-  const SceneTypes types = scene_types(*scene);
-  copts.ends.lights.assign(types.lights.begin(), types.lights.end());
-  copts.ends.sensors = {types.sensor};
-  ClassTable table;
-  std::vector<const PathClass*> classes;
-  if (!a.classes_file.empty()) {
-    Result<bool> r = read_class_file(a.classes_file, copts, &table);
-    if (!r) return report(r.error());
-    for (const auto& c : table.user_classes()) classes.push_back(c.get());
-  } else {
-    for (const auto& c : ClassTable::builtins().builtin_classes())
-      if (c->name != "all") classes.push_back(c.get());
+  std::optional<OutputSet> out_set;
+  if (rank == 0) {
+    Result<OutputSet> prepared = OutputSet::prepare(job.out);
+    if (!prepared) return report(prepared.error());
+    out_set.emplace(std::move(*prepared));
   }
-  Result<Classifier> classifier = Classifier::build(classes, a.limits);
-  if (!classifier) return report(classifier.error());
-  std::vector<ClassInfo> infos;
-  for (const PathClass* c : classes) infos.push_back({c->name, c->text});
 
-  // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
-  const int bound = a.max_bounces.value_or(profile->max_bounces.value_or(16));
+  // The checker's view of the profile, for the warning now and the table after the render.
   ReachCache cache(a.limits);
-  Result<const CompiledProfile*> cp = cache.compiled(a.renderer, bound);
+  Result<const CompiledProfile*> cp = cache.compiled(id.renderer_source, id.max_bounces);
   if (!cp) return report(cp.error());
-  const Dfa universe = scene_universe(types);
-  warn_unreachable_lights(*scene, *profile, **cp, universe, bound, a.limits);
+  const Dfa universe = scene_universe(scene_types(*job.scene));
+  if (rank == 0) warn_unreachable_lights(*job.scene, *job.profile, **cp, universe, id.max_bounces, a.limits);
 
-  // --- render ---
+  // --- render this process's part of the passes still missing ---
+  const PassSet todo = job.header.share.minus(job.header.passes);
   RenderOptions ro;
-  ro.spp = a.spp;
-  ro.seed = a.seed;
+  ro.spp = job.header.spp;
+  ro.passes = todo.part(static_cast<std::uint64_t>(rank), static_cast<std::uint64_t>(ranks));
+  ro.seed = id.seed;
   ro.threads = a.threads;
-  ro.max_bounces = bound;
-  ro.sampler = a.sampler;
-  ro.rr_depth = a.rr_depth;
-  ro.rr_threshold = a.rr_threshold;
+  ro.max_bounces = id.max_bounces;
+  ro.sampler = id.sampler == "sobol" ? SamplerKind::kSobol : SamplerKind::kIndependent;
+  ro.rr_depth = id.rr_depth;
+  ro.rr_threshold = static_cast<float>(id.rr_threshold);
+  ro.batches = id.batches;
   // Without image outputs the render keeps the histogram alone (the same histogram).
-  ro.images = !a.no_images;
+  ro.images = id.images;
   if (ro.images)
-    for (int i = 0; i < classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
+    for (int i = 0; i < job.classes->classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
   // --- memory: the images and their writing, estimated before the render ---
   const int num_layers = 1 + static_cast<int>(ro.layer_classes.size());
-  const std::uint64_t need = ro.images ? render_memory_estimate(scene->camera.width, scene->camera.height, num_layers) : 0;
+  const std::uint64_t need = ro.images ? render_memory_estimate(id.width, id.height, num_layers) : 0;
   if (need > a.max_memory) {
     Error e = make_error(ErrorCode::kLimit,
-                         "the images would take about " + gib(need) + " (" + std::to_string(scene->camera.width) + " x " +
-                             std::to_string(scene->camera.height) + " pixels, " + std::to_string(num_layers) +
+                         "the images would take about " + gib(need) + " (" + std::to_string(id.width) + " x " +
+                             std::to_string(id.height) + " pixels, " + std::to_string(num_layers) +
                              " layers), more than --max-memory " + gib(a.max_memory) +
                              "; pass --no-images for the histogram alone, render fewer pixels or classes, or raise --max-memory");
-    e.where = scene_name + ":/camera";
+    e.where = id.scene + ":/camera";
     return report(e);
   }
-  const bool show_progress = !a.quiet && ::isatty(STDERR_FILENO);
+  const bool show_progress = rank == 0 && !a.quiet && ::isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
-  if (show_progress) {
-    ro.progress = [start](std::uint64_t done, std::uint64_t total) {
-      Progress p;
-      p.fraction = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
-      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      p.samples_per_s = el > 0 ? static_cast<double>(done) / el : 0.0;
-      p.seconds_left = p.fraction > 0 ? el / p.fraction - el : 0;
-      // Padded to the width it was fitted to, so a shorter line covers a longer one.
-      const int columns = terminal_columns();
-      std::fprintf(stderr, "\r%-*s", std::max(columns - 1, 0), progress_line(p, columns).c_str());
-      std::fflush(stderr);
-    };
-  }
+  ro.progress = [&](std::uint64_t done, std::uint64_t total) {
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (a.time_limit > 0 && el >= a.time_limit) g_cancel.store(true);
+    if (!show_progress) return;
+    Progress p;
+    p.fraction = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
+    p.samples_per_s = el > 0 ? static_cast<double>(done) / el : 0.0;
+    p.seconds_left = p.fraction > 0 ? el / p.fraction - el : 0;
+    // Padded to the width it was fitted to, so a shorter line covers a longer one.
+    const int columns = terminal_columns();
+    std::fprintf(stderr, "\r%-*s", std::max(columns - 1, 0), progress_line(p, columns).c_str());
+    std::fflush(stderr);
+  };
   g_cancel.store(false);
   ro.cancel = &g_cancel;
-  std::signal(SIGINT, on_sigint);
+  std::signal(SIGINT, on_stop);
+  std::signal(SIGTERM, on_stop);
   const double cpu_start = process_cpu_seconds();
-  Result<RenderOutput> out = render(*scene, *profile, &*classifier, ro);
+  Result<RenderOutput> out = render(*job.scene, *job.profile, job.classes->classifier.get(), ro);
   const double cpu_s = process_cpu_seconds() - cpu_start;
   std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
   if (show_progress) std::fprintf(stderr, "\r%*s\r", std::max(terminal_columns() - 1, 0), "");
   if (!out) return report(out.error());
 
-  RunInfo info;
-  info.scene = scene_name;
-  info.renderer = profile->name;
-  info.spp = out->spp_done;
-  info.spp_requested = a.spp;
-  info.seed = a.seed;
-  info.threads = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
-  info.time_s = out->time_s;
-  info.complete = out->complete;
-  Result<HistogramReport> rep = make_report(out->histogram, info, &*classifier, infos, a.max_paths);
-  if (!rep) return report(rep.error());
+  RenderSums sums{std::move(out->histogram), std::move(out->images)};
+  ShardHeader header = job.header;
+  header.passes = out->passes_done;
+  header.run = {out->time_s, ro.threads > 0 ? ro.threads : static_cast<int>(std::thread::hardware_concurrency()), out->rays,
+                cpu_s};
 
-  // --- outputs: one set, whole or not at all, shielded from signals (io/output_set.h) ---
-  // histogram.json, plus what each connector did ("connectors": [{strategy, connector, attempts,
-  // successes, failures {outside, occluded, no_transport}}] in the profile's order; absent when the
-  // profile has none).
-  nlohmann::ordered_json doc = to_json(*rep);
-  if (!out->connectors.empty()) {
-    nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const ConnectorStats& c : out->connectors)
-      list.push_back({{"strategy", c.strategy},
-                      {"connector", c.connector},
-                      {"attempts", c.attempts},
-                      {"successes", c.successes},
-                      {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
-    doc["connectors"] = std::move(list);
+  // --- MPI: keep this rank's work in a shard file, then sum every rank's into rank 0's ---
+  if (cluster != nullptr) {
+    const std::string mine = rank_shard_path(job.out, rank);
+    std::error_code ec;
+    std::filesystem::create_directories(ranks_folder(job.out), ec);
+    if (Result<bool> w = write_file_atomic(mine, encode_shard(header, sums.histogram, sums.images)); !w) return report(w.error());
+    if (g_cancel.load())
+      std::fprintf(stderr, "pathex: rank %d stopped after %s of its passes; they are kept in %s ('pathex trace --resume %s' finishes the render)\n",
+                   rank, out->passes_done.to_string().c_str(), mine.c_str(), job.out.c_str());
+    if (Result<bool> r = cluster->reduce(&sums, &header.passes, &header.run); !r) return report(r.error());
   }
-  doc["sampler"] = to_string(a.sampler);
-  doc["roulette"] = {{"depth", a.rr_depth}, {"threshold", a.rr_threshold}};
-  doc["efficiency"] = efficiency_json(rep->total, cpu_s);
-  const std::string json_text = doc.dump(2) + "\n";
-  {
+  if (job.resumed) {
+    if (Result<bool> m = sums.histogram.merge(job.resumed->sums.histogram); !m) return report(m.error());
+    if (Result<bool> m = sums.images.merge(job.resumed->sums.images); !m) return report(m.error());
+    header.passes.add(job.resumed->header.passes);
+    header.run.time_s += job.resumed->header.run.time_s;
+    header.run.rays += job.resumed->header.run.rays;
+    header.run.cpu_s += job.resumed->header.run.cpu_s;
+  }
+
+  // --- outputs (rank 0): one set, whole or not at all, shielded from signals (io/output_set.h) ---
+  std::optional<WrittenReport> written;
+  std::optional<Error> failure;
+  if (rank == 0) {
     const SignalShield shield;
-    Result<bool> written = out_set->write([&](const std::string& dir) -> Result<bool> {
-      if (Result<bool> w = write_file_atomic(dir + "/histogram.json", json_text); !w) return w;
-      if (a.no_images) return true;
-      const std::vector<ImageLayer> layers = out->images.layers(out->spp_done ? 1.0 / static_cast<double>(out->spp_done) : 0.0);
-      ExrOptions exr;
-      exr.compression = a.exr_compression;
-      if (Result<bool> w = write_exr(dir + "/classes.exr", layers, exr); !w) return w;
-      return write_previews(dir, layers);
+    Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
+      Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, out->connectors);
+      if (!r) return r.error();
+      written = std::move(*r);
+      return true;
     });
-    if (!written) return report(written.error());
+    if (!w) failure = w.error();
   }
+  if (cluster != nullptr) {
+    // Every rank's work is in render.shard once rank 0 has written it: the ranks' files go.
+    if (cluster->count_failures(!failure) == 0) {
+      std::error_code ec;
+      std::filesystem::remove(rank_shard_path(job.out, rank), ec);
+    }
+    if (rank != 0) return kExitOk;
+  }
+  if (failure) return report(*failure);
+  {  // the ranks' files of a failed MPI run, now held by render.shard
+    std::error_code ec;
+    std::filesystem::remove_all(ranks_folder(job.out), ec);
+  }
+  const HistogramReport* rep = &written->report;
+  const bool complete = rep->run.complete;
   if (a.json) {
-    std::cout << json_text;
-    return out->complete ? kExitOk : kExitNo;
+    std::cout << written->json_text;
+    return complete ? kExitOk : kExitNo;
   }
 
   // --- the table: classes with the checker's verdict, then the most important exact paths ---
+  const std::vector<const PathClass*>& classes = job.classes->classes;
   QueryOptions qo;
   qo.universe = universe;
-  qo.max_bounces = bound;
+  qo.max_bounces = id.max_bounces;
   qo.witnesses = 0;
   qo.max_len = 0;
-  std::cout << "scene " << scene_name << ", renderer " << profile->name << ", " << out->spp_done << " spp, "
-            << std::fixed << std::setprecision(2) << out->time_s << " s" << (out->complete ? "" : " (interrupted)")
+  std::cout << "scene " << id.scene << ", renderer " << id.renderer << ", " << rep->run.spp << " spp";
+  if (!(job.header.share == PassSet::range(0, job.header.spp)))
+    std::cout << " (passes " << header.passes.to_string() << " of " << job.header.spp << ")";
+  std::cout << ", " << std::fixed << std::setprecision(2) << out->time_s << " s" << (complete ? "" : " (interrupted)")
             << ", non-finite samples " << rep->nonfinite_samples << "\n";
   std::cout << "image mean luminance " << absolute(rep->total) << "\n"
             << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n\n";
@@ -273,7 +421,7 @@ int run(const TraceArgs& a) {
     Result<QueryResult> q = query(*classes[i], **cp, qo);
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
-              << "; " << profile->name << ": " << (q ? to_string(q->verdict) : "?") << "; luminance "
+              << "; " << id.renderer << ": " << (q ? to_string(q->verdict) : "?") << "; luminance "
               << absolute(c.estimate) << "\n";
   }
   if (!out->connectors.empty()) {
@@ -296,8 +444,12 @@ int run(const TraceArgs& a) {
     for (const auto& [name, s] : p.strategies) std::cout << " " << name << " " << percent(s);
     std::cout << "\n";
   }
-  std::cout << "\nwrote " << a.out << "/histogram.json" << (a.no_images ? "" : ", classes.exr and PNG previews") << "\n";
-  return out->complete ? kExitOk : kExitNo;
+  std::cout << "\nwrote " << job.out << "/histogram.json" << (id.images ? ", classes.exr and PNG previews" : "") << ", "
+            << kRenderShardName << "\n";
+  if (!complete)
+    std::cout << "interrupted: 'pathex trace --resume " << job.out << "' renders the missing passes "
+              << job.header.share.minus(header.passes).to_string() << "\n";
+  return complete ? kExitOk : kExitNo;
 }
 
 }  // namespace
@@ -309,7 +461,9 @@ Command add_trace(CLI::App& app) {
               "  pathex trace samples/scenes/point-mirror-caustic.json --renderer pt-nee --spp 64 --out out/\n"
               "Writes DIR/histogram.json, DIR/classes.exr (a layer per class and the total) and DIR/<layer>.png,\n"
               "as one set that replaces the previous one whole (DIR must hold only what pathex wrote there).\n"
-              "Ctrl-C stops early and writes what was rendered, marked \"complete\": false (exit 1).");
+              "Also DIR/render.shard (the exact sums, for merge and --resume) and DIR/run.json (time, threads).\n"
+              "Ctrl-C, SIGTERM or --time stop early and write what was rendered, marked \"complete\": false (exit 1);\n"
+              "'pathex trace --resume DIR' renders the rest. Split a render: --shard 0/4 … 3/4, then pathex merge.");
   sub->add_option("SCENE", args->scene, "Scene file (grammar/scene.schema.json); default: the embedded Cornell box");
   sub->add_option("--renderer", args->renderer, "Renderer profile: built-in name or file")->capture_default_str();
   sub->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 24));
@@ -339,18 +493,21 @@ Command add_trace(CLI::App& app) {
   sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs and the per-pixel sums behind them (the histogram is the same)");
-  sub->add_option("--exr-compression", args->exr_compression,
-                  "classes.exr's lossless compression: rle (fast), zip (smaller files, about 8 times the CPU time) or none")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, ExrCompression>{{"rle", ExrCompression::kRle},
-                                                                                {"zip", ExrCompression::kZip},
-                                                                                {"none", ExrCompression::kNone}}))
-      ->default_str("rle");
   sub->add_option("--max-memory", args->max_memory,
                   "Refuse a render whose images (and their writing) would take more, estimated before rendering; e.g. 512M, 16G")
       ->transform(CLI::AsSizeValue(false))
       ->default_str("4G");
+  sub->add_option("--shard", args->shard, "Render shard i of n of the passes (i/n, 0 <= i < n); merge the shards with pathex merge");
+  sub->add_option("--resume", args->resume, "Continue the interrupted render in this folder to its requested spp (settings come from the folder)");
+  sub->add_option("--time", args->time_limit, "Stop after this many seconds (at the end of a chunk of passes); --resume continues")
+      ->check(CLI::PositiveNumber);
   add_limit_options(sub, &args->limits);
-  return {sub, [args] { return run(*args); }};
+  return {sub, [args, sub] {
+            for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
+                                  "--resolution", "--max-paths", "--sampler", "--rr-depth", "--rr-threshold"})
+              if (sub->count(o) > 0) args->settings_given.push_back(o);
+            return run(*args);
+          }};
 }
 
 }  // namespace pathex::cli

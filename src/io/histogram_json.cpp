@@ -148,8 +148,6 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
   doc["spp"] = r.run.spp;
   doc["spp_requested"] = r.run.spp_requested;
   doc["seed"] = r.run.seed;
-  doc["threads"] = r.run.threads;
-  doc["time_s"] = r.run.time_s;
   doc["complete"] = r.run.complete;
   doc["nonfinite_samples"] = r.nonfinite_samples;
   doc["distinct_paths"] = r.distinct_paths;
@@ -295,13 +293,6 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
   // Keys added after the first format are optional, so older files still read.
   if (doc.contains("spp_requested")) r.run.spp_requested = rd.uint(doc, "", "spp_requested");
   r.run.seed = rd.uint(doc, "", "seed");
-  if (const json* t = rd.field(doc, "", "threads")) {
-    if (!t->is_number_integer() || t->get<std::int64_t>() < 0 || t->get<std::int64_t>() > 1 << 20)
-      rd.fail("/threads", "expected a thread count");
-    else
-      r.run.threads = t->get<int>();
-  }
-  r.run.time_s = rd.number(doc, "", "time_s");
   r.run.complete = rd.boolean(doc, "", "complete");
   r.nonfinite_samples = rd.uint(doc, "", "nonfinite_samples");
   if (doc.contains("distinct_paths")) r.distinct_paths = rd.uint(doc, "", "distinct_paths");

@@ -1,5 +1,9 @@
 // histogram.json: the path-class histogram of a render (issue 4 "Outputs"), and back.
 //
+// The document is a function of what was rendered (scene, renderer, classes, seed, the passes
+// taken) and nothing else: the wall time and thread count of the run go to run.json beside it, so
+// that a sharded, merged, resumed or MPI render writes the same bytes as one process.
+//
 // Keys (stable; objects are written in this order):
 //
 //   scene              string   the scene file (or the embedded default's name)
@@ -7,8 +11,6 @@
 //   spp                integer  samples per pixel rendered
 //   spp_requested      integer  samples per pixel asked for (more than spp when interrupted)
 //   seed               integer
-//   threads            integer
-//   time_s             number   wall-clock render time in seconds
 //   complete           bool     false when the render was interrupted and wrote what it had
 //   nonfinite_samples  integer  contributions that were NaN, infinite or ≥ 2^50 (never added; must be 0)
 //   distinct_paths     integer  distinct paths sampled (rows of `paths`, plus those summed in "other")

@@ -230,6 +230,25 @@ Result<long long> JsonReader::integer(const json& j, const std::string& key, con
   return x;
 }
 
+Result<std::uint64_t> JsonReader::unsigned_integer(const json& j, const std::string& key, const std::string& ptr,
+                                                   std::uint64_t hi) const {
+  const std::string p = ptr + "/" + pointer_token(key);
+  if (!j.is_object() || !j.contains(key)) return fail(p, "missing " + key + ", expected an integer");
+  const json& v = j.at(key);
+  if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<long long>() >= 0))
+    return fail(p, "expected an integer in [0, " + std::to_string(hi) + "], found " + v.dump());
+  const std::uint64_t x = v.get<std::uint64_t>();
+  if (x > hi) return fail(p, "expected an integer in [0, " + std::to_string(hi) + "], found " + std::to_string(x));
+  return x;
+}
+
+Result<bool> JsonReader::boolean(const json& j, const std::string& key, const std::string& ptr) const {
+  const std::string p = ptr + "/" + pointer_token(key);
+  if (!j.is_object() || !j.contains(key)) return fail(p, "missing " + key + ", expected true or false");
+  if (!j.at(key).is_boolean()) return fail(p, "expected true or false, found " + kind(j.at(key)));
+  return j.at(key).get<bool>();
+}
+
 Result<std::string> JsonReader::string(const json& j, const std::string& key, const std::string& ptr) const {
   const std::string p = ptr + "/" + pointer_token(key);
   if (!j.is_object() || !j.contains(key)) return fail(p, "missing " + key + ", expected a string");

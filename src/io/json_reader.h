@@ -11,6 +11,7 @@
 // silently does nothing.
 #pragma once
 
+#include <cstdint>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -56,8 +57,13 @@ class JsonReader {
   // j[key] as an integer in [lo, hi]; `fallback` when the key is absent (else an error).
   Result<long long> integer(const json& j, const std::string& key, const std::string& ptr, long long lo, long long hi,
                             std::optional<long long> fallback = std::nullopt) const;
+  // j[key] as an integer in [0, hi], up to 2^64 - 1 (seeds, counts); required.
+  Result<std::uint64_t> unsigned_integer(const json& j, const std::string& key, const std::string& ptr,
+                                         std::uint64_t hi) const;
   // j[key] as a string (required).
   Result<std::string> string(const json& j, const std::string& key, const std::string& ptr) const;
+  // j[key] as true or false (required).
+  Result<bool> boolean(const json& j, const std::string& key, const std::string& ptr) const;
 
  private:
   std::string file_;

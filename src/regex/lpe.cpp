@@ -10,7 +10,7 @@
 #include <set>
 #include <string>
 
-#include "regex/repeat.h"
+#include "regex/parse_cursor.h"
 
 namespace pathex {
 namespace {
@@ -46,13 +46,11 @@ std::uint8_t scatter_bit(char c) {
 
 constexpr const char* kEvents = "an event (C R T L O, D G S, '.', '<', '[' or '(')";
 
-class LpeParser {
+class LpeParser : detail::ParseCursor {
  public:
   LpeParser(std::string_view text, const std::vector<LightType>& lights, const std::vector<SensorType>& sensors,
             const Limits& limits)
-      : text_(text), lights_(lights), sensors_(sensors), limits_(limits) {
-    out_.source = std::string(text);
-  }
+      : ParseCursor(text, limits), lights_(lights), sensors_(sensors) {}
 
   Result<Regex> run() {
     skip_space();
@@ -64,42 +62,6 @@ class LpeParser {
   }
 
  private:
-  // --- lexing helpers ---
-  bool at_end() const { return pos_ >= text_.size(); }
-  char peek() const { return text_[pos_]; }
-  int col() const { return static_cast<int>(pos_) + 1; }
-  void skip_space() {
-    while (!at_end() && std::isspace(static_cast<unsigned char>(peek()))) ++pos_;
-  }
-  std::string found() const {
-    if (at_end()) return "the end";
-    const auto c = static_cast<unsigned char>(peek());
-    if (c < 0x20 || c >= 0x7F) return "a non-ASCII or control byte";
-    return "'" + std::string(1, peek()) + "'";
-  }
-
-  Error fail(int column, std::string message, ErrorCode code = ErrorCode::kSyntax) {
-    if (!failed_) {
-      failed_ = true;
-      err_.code = code;
-      err_.column = column;
-      err_.message = std::move(message);
-      err_.source = std::string(text_);
-    }
-    return err_;
-  }
-
-  void fail_depth(int column) {
-    fail(column, limit_message("nesting depth", static_cast<std::size_t>(limits_.max_depth), "levels", "--max-depth"),
-         ErrorCode::kLimit);
-  }
-
-  int add(Node n, int column) {
-    n.column = column;
-    const int i = out_.add(std::move(n));
-    if (out_.at(i).height > limits_.max_depth) fail_depth(column);
-    return i;
-  }
   int set_node(LetterMask m, int column) {
     Node n;
     n.kind = NodeKind::kSet;
@@ -260,55 +222,13 @@ class LpeParser {
   int parse_item() {
     int cur = parse_primary();
     if (failed_) return -1;
-    skip_space();
-    if (at_end()) return cur;
-    const char c = peek();
-    const int column = col();
-    int min = 0, max = 0;
-    if (c == '*') { min = 0; max = kUnbounded; ++pos_; }
-    else if (c == '+') { min = 1; max = kUnbounded; ++pos_; }
-    else if (c == '?') { min = 0; max = 1; ++pos_; }
-    else if (c == '{') {
-      if (!parse_braces(&min, &max)) return -1;
-    } else {
-      return cur;
-    }
-    Node n;
-    n.kind = NodeKind::kRepeat;
-    n.min = min;
-    n.max = max;
-    n.kids = {cur};
-    cur = add(std::move(n), column);
+    const int rep = parse_repetition(cur);
+    if (rep < 0 || rep == cur) return rep;
+    cur = rep;
     skip_space();
     if (!failed_ && !at_end() && (peek() == '*' || peek() == '+' || peek() == '?' || peek() == '{'))
       fail(col(), "'" + std::string(1, peek()) + "' after a repetition: an LPE item takes one; group it first, as in (D*)+");
     return failed_ ? -1 : cur;
-  }
-
-  // '{' n '}' | '{' n ',' '}' | '{' n ',' m '}' (regex/repeat.h).
-  bool parse_braces(int* min, int* max) {
-    Result<RepeatCounts> c = read_repeat(text_, &pos_, limits_, [this](std::size_t at) {
-      const std::size_t here = pos_;
-      pos_ = at;
-      std::string f = found();
-      pos_ = here;
-      return f;
-    });
-    if (!c) {
-      fail(c.error().column, c.error().message, c.error().code);
-      return false;
-    }
-    *min = c->min;
-    *max = c->max;
-    return true;
-  }
-
-  bool descend(int column) {
-    if (++nesting_ >= limits_.max_depth) {
-      fail_depth(column);
-      return false;
-    }
-    return true;
   }
 
   // primary := symbol | '.' | '<' tuple '>' | '(' seq ')' | '[' item+ ']' | '[^' symbol+ ']'
@@ -558,15 +478,8 @@ class LpeParser {
     return event_node(types, scatters, open);
   }
 
-  std::string_view text_;
   const std::vector<LightType>& lights_;
   const std::vector<SensorType>& sensors_;
-  const Limits& limits_;
-  std::size_t pos_ = 0;
-  int nesting_ = 0;
-  Regex out_;
-  bool failed_ = false;
-  Error err_;
 };
 
 }  // namespace

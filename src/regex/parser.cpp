@@ -14,7 +14,7 @@
 #include <cctype>
 #include <string>
 
-#include "regex/repeat.h"
+#include "regex/parse_cursor.h"
 
 namespace pathex {
 namespace {
@@ -24,12 +24,10 @@ constexpr const char* kOperand = "a letter, '.', '[', '(', '~' or '$name'";
 bool is_name_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
 bool is_name_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; }
 
-class Parser {
+class Parser : detail::ParseCursor {
  public:
   Parser(std::string_view text, const Limits& limits, const NameLookup& names)
-      : text_(text), limits_(limits), names_(names) {
-    out_.source = std::string(text);
-  }
+      : ParseCursor(text, limits), names_(names) {}
 
   Result<Regex> run() {
     skip_space();
@@ -46,50 +44,6 @@ class Parser {
   }
 
  private:
-  // --- lexing helpers ---
-  bool at_end() const { return pos_ >= text_.size(); }
-  char peek() const { return text_[pos_]; }
-  int col() const { return static_cast<int>(pos_) + 1; }
-  void skip_space() {
-    while (!at_end() && std::isspace(static_cast<unsigned char>(peek()))) ++pos_;
-  }
-
-  // The character at the cursor as messages show it: 'x'; a whole UTF-8 sequence such as 'Ψ'
-  // rather than its first byte; "byte 0x01" for a control or stray byte; "the end".
-  std::string found() const { return at_end() ? "the end" : describe_char_at(text_, pos_); }
-
-  Error fail(int column, std::string message, ErrorCode code = ErrorCode::kSyntax) {
-    if (!failed_) {
-      failed_ = true;
-      err_.code = code;
-      err_.column = column;
-      err_.message = std::move(message);
-      err_.source = std::string(text_);
-    }
-    return err_;
-  }
-
-  void fail_depth(int column) {
-    fail(column, limit_message("nesting depth", static_cast<std::size_t>(limits_.max_depth), "levels", "--max-depth"),
-         ErrorCode::kLimit);
-  }
-
-  int add(Node n, int column) {
-    n.column = column;
-    const int i = out_.add(std::move(n));
-    if (out_.at(i).height > limits_.max_depth) fail_depth(column);
-    return i;
-  }
-
-  // Entering a '(' or '~' at `column`: one more level of recursion.
-  bool descend(int column) {
-    if (++nesting_ >= limits_.max_depth) {
-      fail_depth(column);
-      return false;
-    }
-    return true;
-  }
-
   // Starts an atom? (Used to decide whether concatenation continues.) Any letter does, so that
   // lowercase and unknown letters get their own message from parse_atom.
   bool starts_term() const {
@@ -200,43 +154,12 @@ class Parser {
   int parse_postfix() {
     int cur = parse_atom();
     while (!failed_) {
-      skip_space();
-      if (at_end()) break;
-      const char c = peek();
-      const int column = col();
-      int min = 0, max = 0;
-      if (c == '*') { min = 0; max = kUnbounded; ++pos_; }
-      else if (c == '+') { min = 1; max = kUnbounded; ++pos_; }
-      else if (c == '?') { min = 0; max = 1; ++pos_; }
-      else if (c == '{') {
-        if (!parse_braces(&min, &max)) return -1;
-      } else break;
-      Node n;
-      n.kind = NodeKind::kRepeat;
-      n.min = min;
-      n.max = max;
-      n.kids = {cur};
-      cur = add(std::move(n), column);
+      const int rep = parse_repetition(cur);
+      if (rep < 0) return -1;
+      if (rep == cur) break;
+      cur = rep;
     }
     return failed_ ? -1 : cur;
-  }
-
-  // '{' n '}' | '{' n ',' '}' | '{' n ',' m '}' (regex/repeat.h).
-  bool parse_braces(int* min, int* max) {
-    Result<RepeatCounts> c = read_repeat(text_, &pos_, limits_, [this](std::size_t at) {
-      const std::size_t here = pos_;
-      pos_ = at;
-      std::string f = found();
-      pos_ = here;
-      return f;
-    });
-    if (!c) {
-      fail(c.error().column, c.error().message, c.error().code);
-      return false;
-    }
-    *min = c->min;
-    *max = c->max;
-    return true;
   }
 
   // atom := letter | '.' | set | '(' alt ')' | '$' name. The cursor is on a character for which
@@ -359,15 +282,8 @@ class Parser {
     return root;
   }
 
-  std::string_view text_;
-  const Limits& limits_;
   const NameLookup& names_;
-  std::size_t pos_ = 0;
-  int nesting_ = 0;      // open '(' and pending '~' on the recursion stack
   int open_groups_ = 0;  // open '(' only: decides between "unmatched ')'" and "expected ')'"
-  Regex out_;
-  bool failed_ = false;
-  Error err_;
 };
 
 }  // namespace

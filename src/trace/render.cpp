@@ -1177,10 +1177,10 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   // Passes run in chunks: a pixel takes a chunk's passes back to back, so that its camera
   // contributions reach the shared image once per chunk (and its part of the scene stays in
   // cache); cancelling stops on a whole chunk, so every finished pass covers the whole image.
-  std::uint64_t pass = 0;
-  while (pass < o.spp) {
+  const PassSet todo = o.passes.value_or(PassSet::range(0, o.spp));
+  for (const PassRange& chunk : todo.chunks(kPassesPerChunk)) {
     if (o.cancel && o.cancel->load()) break;
-    const std::uint64_t first = pass, end = std::min(o.spp, pass + kPassesPerChunk);
+    const std::uint64_t first = chunk.first, end = chunk.last;
     tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& rows) {
       Integrator::Thread& th = locals.local();
       for (int y = rows.begin(); y < rows.end(); ++y) {
@@ -1190,11 +1190,11 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
       }
     });
     for (std::uint64_t p = first; p < end; ++p) out.histogram.add_samples(batch_of(p, o.batches), pixels);
-    pass = end;
-    if (o.progress) o.progress(pass * pixels, o.spp * pixels);
+    out.passes_done.add(first, end);
+    if (o.progress) o.progress(out.passes_done.count() * pixels, todo.count() * pixels);
   }
-  out.spp_done = pass;
-  out.complete = pass == o.spp;
+  out.spp_done = out.passes_done.count();
+  out.complete = out.passes_done == todo;
   for (Integrator::Thread& th : locals) {
     th.splats.flush(out.images);
     Result<bool> m = out.histogram.merge(th.hist);

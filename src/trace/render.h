@@ -30,6 +30,7 @@
 #include "classify/histogram.h"
 #include "classify/image.h"
 #include "core/error.h"
+#include "core/pass_set.h"
 #include "reach/profile.h"
 #include "scene/scene.h"
 #include "trace/rng.h"
@@ -42,6 +43,9 @@ inline constexpr std::uint64_t kPassesPerChunk = 4;
 
 struct RenderOptions {
   std::uint64_t spp = 16;              // samples (passes) per pixel
+  // The passes to take (a shard's share, what a resumed render still lacks); unset: [0, spp).
+  // The outputs of renders of disjoint pass sets add up exactly to the render of their union.
+  std::optional<PassSet> passes;
   std::uint64_t seed = 1;
   int threads = 0;                     // 0: all cores
   std::optional<int> max_bounces;      // interior vertices, k - 1; unset: the profile's bound, else 16
@@ -51,7 +55,7 @@ struct RenderOptions {
   // 0 turns roulette off. Defaults chosen by efficiency (bench/efficiency.py, README).
   int rr_depth = 3;
   float rr_threshold = 1.0f;
-  SamplerKind sampler = SamplerKind::kIndependent;  // --sampler
+  SamplerKind sampler = SamplerKind::kSobol;  // --sampler
   int batches = kDefaultBatches;       // for batch-means standard errors
   std::vector<int> layer_classes;      // classifier classes that get an image layer
   // Accumulate the images at all. Off (`pathex trace --no-images`), the render keeps only the
@@ -79,6 +83,7 @@ struct RenderOutput {
   ClassImages images;
   std::vector<std::string> strategy_names;
   std::uint64_t spp_done = 0;  // passes completed (all pixels) — spp unless cancelled
+  PassSet passes_done{};       // which ones (spp_done of them)
   bool complete = true;
   double time_s = 0;
   std::uint64_t rays = 0;      // rays cast (intersections and shadow rays)

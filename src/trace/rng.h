@@ -86,7 +86,7 @@ class Sampler {
         // sobol: the key is the pixel's (the pass is the point's index); passes past 2^32 start a
         // new scrambled sequence.
         key_(stream_key(seed, pixel, kind == SamplerKind::kSobol ? sample >> 32 : sample)),
-        index_(static_cast<std::uint32_t>(sample)) {}
+        reversed_index_(sobol::reverse_bits(static_cast<std::uint32_t>(sample))) {}
 
   float get1d() { return at(dim_++); }
   glm::vec2 get2d() {
@@ -94,14 +94,14 @@ class Sampler {
       const float a = get1d();
       return {a, get1d()};
     }
-    const std::array<std::uint32_t, 2> p = sobol::point2(index_, sobol_seeds(dim_, /*pair=*/true));
+    const std::array<std::uint32_t, 2> p = sobol::point2(reversed_index_, sobol_seeds(dim_, /*pair=*/true));
     dim_ += 2;
     return {sobol::to_unit_float(p[0]), sobol::to_unit_float(p[1])};
   }
   // The number get1d() would draw at an absolute dimension, without moving the cursor.
   float at(std::uint64_t dim) const {
     if (kind_ == SamplerKind::kIndependent) return bits_to_unit_float(stream_bits(key_, dim));
-    return sobol::to_unit_float(sobol::point1(index_, sobol_seeds(dim, /*pair=*/false)));
+    return sobol::to_unit_float(sobol::point1(reversed_index_, sobol_seeds(dim, /*pair=*/false)));
   }
 
   std::uint64_t dimension() const { return dim_; }
@@ -114,12 +114,12 @@ class Sampler {
   sobol::Seeds sobol_seeds(std::uint64_t dim, bool pair) const {
     const std::uint64_t h = stream_bits(key_, dim);
     return {static_cast<std::uint32_t>(h), static_cast<std::uint32_t>(h >> 32),
-            pair ? static_cast<std::uint32_t>(mix64(h ^ 0x452821e638d01377ULL)) : 0u};
+            pair ? static_cast<std::uint32_t>((h * kGoldenGamma) >> 29) : 0u};  // the y seed: another 32 of h's bits, mixed
   }
 
   SamplerKind kind_;
   std::uint64_t key_;
-  std::uint32_t index_;
+  std::uint32_t reversed_index_;  // sobol: the pass, bit-reversed
   std::uint64_t dim_ = 0;
 };
 

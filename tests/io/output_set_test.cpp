@@ -181,11 +181,13 @@ Interrupted interrupt_everywhere(int sig, bool leftovers_allowed, int step = 1) 
     const CliRun r = trace(out, classes, env);
     ++st.runs;
     const auto now = contents(out);
-    // The histogram records the run's time, so a new set is recognised by its file names and
-    // images; an old one must be byte for byte the old set.
+    // run.json and render.shard record the run's time (and the histogram's new classes differ
+    // from the old), so a new set is recognised by its file names and images; an old one must be
+    // byte for byte the old set.
+    const auto timed = [](const std::string& k) { return k == "histogram.json" || k == "run.json" || k == "render.shard"; };
     std::map<std::string, std::string> names_now, names_new;
-    for (const auto& [k, v] : now) names_now[k] = k == "histogram.json" ? "" : v;
-    for (const auto& [k, v] : new_set) names_new[k] = k == "histogram.json" ? "" : v;
+    for (const auto& [k, v] : now) names_now[k] = timed(k) ? "" : v;
+    for (const auto& [k, v] : new_set) names_new[k] = timed(k) ? "" : v;
     if (now == old_set) {
       ++st.old_sets;
     } else if (names_now == names_new) {

@@ -52,13 +52,8 @@ inline std::string read_file(const std::filesystem::path& p) {
   return ss.str();
 }
 
-// `pathex ARGS` in the source directory, ARGS being shell text (the caller quotes what needs
-// it), with `input` on standard input.
-inline CliRun run_pathex(const std::string& args, const std::string& input = "") {
-  const std::filesystem::path in = scratch_dir() / "stdin.txt", err = scratch_dir() / "stderr.txt";
-  std::ofstream(in, std::ios::binary) << input;
-  const std::string cmd = "cd " + shell_quote(PATHEX_SOURCE_DIR) + " && " + shell_quote(PATHEX_BINARY) + " " + args +
-                          " < " + shell_quote(in.string()) + " 2> " + shell_quote(err.string());
+// A shell command line; its standard output (stderr is the caller's to redirect).
+inline CliRun run_shell(const std::string& cmd) {
   CliRun r;
   const auto start = std::chrono::steady_clock::now();
   FILE* p = popen(cmd.c_str(), "r");
@@ -69,6 +64,17 @@ inline CliRun run_pathex(const std::string& args, const std::string& input = "")
   const int status = pclose(p);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// `pathex ARGS` in the source directory, ARGS being shell text (the caller quotes what needs
+// it), with `input` on standard input.
+inline CliRun run_pathex(const std::string& args, const std::string& input = "") {
+  const std::filesystem::path in = scratch_dir() / "stdin.txt", err = scratch_dir() / "stderr.txt";
+  std::ofstream(in, std::ios::binary) << input;
+  const std::string cmd = "cd " + shell_quote(PATHEX_SOURCE_DIR) + " && " + shell_quote(PATHEX_BINARY) + " " + args +
+                          " < " + shell_quote(in.string()) + " 2> " + shell_quote(err.string());
+  CliRun r = run_shell(cmd);
   r.err = read_file(err);
   return r;
 }

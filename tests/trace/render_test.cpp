@@ -521,7 +521,7 @@ TEST(Sampling, EverySettingAgreesWithTheIndependentSamplerOnTheSampleScenes) {
     const std::string renderer = std::string(file) == "sun-window.json"    ? "pt-nee+distant"
                                  : std::string(file) == "mirror-ortho.json" ? "bdpt+ortho"
                                                                             : "bdpt";
-    const std::uint64_t spp = std::string(file) == "spotmeter-caustic.json" ? 4096 : 32;
+    const std::uint64_t spp = std::string(file) == "spotmeter-caustic.json" ? 2048 : 16;
     const Rendered base = render_scene(load_scene_file(dir + file), renderer, classes, spp, 0, 11, reference, 16);
     for (const Sampling& sampling : every_sampling()) {
       const Rendered r = render_scene(load_scene_file(dir + file), renderer, classes, spp, 0, 12, sampling, 16);

@@ -1,0 +1,229 @@
+// pathex-mpi: the pathex command line with `trace` split across MPI ranks (built when CMake finds
+// MPI, e.g. Debian's OpenMPI). Each rank renders its part of the passes with TBB inside; the
+// exact integer sums are then added on rank 0 by MPI reductions (a user operation adding 128-bit
+// integers, which is associative and commutative, so the result does not depend on the order MPI
+// combines ranks in), and rank 0 writes the outputs: the same bytes as one process.
+//
+// What is reduced, in this order:
+//   paths      the union of the ranks' path strings (gathered on rank 0, sorted, broadcast), so that
+//              every rank lays its histogram out in the same order;
+//   histogram  per path and batch the sums and contribution counts, per path and strategy the
+//              sums, per batch the sample counts and the non-finite count: one 128-bit sum each;
+//              the magnitude bound (saturating) gathered on rank 0;
+//   images     the union of the (plane, tile) pairs some rank touched (a bitwise-or reduction),
+//              then those tiles' words, in blocks of at most 4096 tiles (12 MiB);
+//   passes     gathered on rank 0 as [first, last) pairs.
+// Rank 0 contributes zeros and adds the reduced sums of the others into its own accumulators.
+#include <mpi.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cli/mpi/mpi_cluster.h"
+
+namespace pathex::cli {
+namespace {
+
+using Word = std::uint64_t;
+
+// inout[i] += in[i] for 128-bit integers stored as (low, high) word pairs.
+extern "C" void add_u128(void* in, void* inout, int* len, MPI_Datatype*) {
+  const auto* a = static_cast<const Word*>(in);
+  auto* b = static_cast<Word*>(inout);
+  for (int i = 0; i < *len; ++i) {
+    const Word lo = a[2 * i] + b[2 * i];
+    b[2 * i + 1] += a[2 * i + 1] + (lo < a[2 * i] ? 1 : 0);
+    b[2 * i] = lo;
+  }
+}
+
+void put(std::vector<Word>& v, ExactSum x) {
+  v.push_back(static_cast<Word>(x));
+  v.push_back(static_cast<Word>(x >> 64));
+}
+ExactSum get(const Word* w) { return (static_cast<ExactSum>(w[1]) << 64) | static_cast<ExactSum>(w[0]); }
+
+}  // namespace
+
+MpiCluster::MpiCluster() {
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  MPI_Type_contiguous(2, MPI_UINT64_T, &u128_);
+  MPI_Type_commit(&u128_);
+  MPI_Op_create(&add_u128, /*commute=*/1, &add_);
+}
+
+MpiCluster::~MpiCluster() {
+  MPI_Op_free(&add_);
+  MPI_Type_free(&u128_);
+}
+
+Result<bool> MpiCluster::check(int code, const char* what) const {
+  if (code == MPI_SUCCESS) return true;
+  char text[MPI_MAX_ERROR_STRING];
+  int len = 0;
+  MPI_Error_string(code, text, &len);
+  return make_error(ErrorCode::kBadFile, "rank " + std::to_string(rank_) + ": MPI " + what + " failed: " + std::string(text, static_cast<std::size_t>(len)));
+}
+
+Result<bool> MpiCluster::sum_to_root(std::vector<Word>* words) {
+  if (rank_ == 0) std::fill(words->begin(), words->end(), 0);  // rank 0 adds the others' into its own
+  std::vector<Word> out(rank_ == 0 ? words->size() : 0);
+  const std::size_t pairs = words->size() / 2;
+  constexpr std::size_t kBlock = std::size_t{1} << 20;  // pairs per call, within MPI's int counts
+  for (std::size_t at = 0; at < pairs; at += kBlock) {
+    const int n = static_cast<int>(std::min(kBlock, pairs - at));
+    Result<bool> r = check(MPI_Reduce(words->data() + 2 * at, rank_ == 0 ? out.data() + 2 * at : nullptr, n, u128_, add_, 0,
+                                      MPI_COMM_WORLD),
+                           "reduce");
+    if (!r) return r;
+  }
+  words->swap(out);
+  return true;
+}
+
+Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run) {
+  Histogram& h = sums->histogram;
+  // --- the union of the path strings, on every rank ---
+  std::string mine;
+  for (int p = 0; p < h.num_paths(); ++p) mine += h.path(p) + "\n";
+  const int my_size = static_cast<int>(mine.size());
+  std::vector<int> sizes(static_cast<std::size_t>(size_)), offsets(static_cast<std::size_t>(size_));
+  if (Result<bool> r = check(MPI_Gather(&my_size, 1, MPI_INT, sizes.data(), 1, MPI_INT, 0, MPI_COMM_WORLD), "gather"); !r) return r;
+  std::string all;
+  if (rank_ == 0) {
+    int total = 0;
+    for (int i = 0; i < size_; ++i) offsets[static_cast<std::size_t>(i)] = total, total += sizes[static_cast<std::size_t>(i)];
+    all.resize(static_cast<std::size_t>(total));
+  }
+  if (Result<bool> r = check(MPI_Gatherv(mine.data(), my_size, MPI_CHAR, all.data(), sizes.data(), offsets.data(), MPI_CHAR, 0,
+                                         MPI_COMM_WORLD),
+                             "gather");
+      !r)
+    return r;
+  std::vector<std::string> paths;
+  std::string joined;
+  if (rank_ == 0) {
+    for (std::size_t at = 0; at < all.size();) {
+      const std::size_t nl = all.find('\n', at);
+      paths.push_back(all.substr(at, nl - at));
+      at = nl + 1;
+    }
+    std::sort(paths.begin(), paths.end());
+    paths.erase(std::unique(paths.begin(), paths.end()), paths.end());
+    for (const std::string& p : paths) joined += p + "\n";
+  }
+  std::uint64_t joined_size = joined.size();
+  if (Result<bool> r = check(MPI_Bcast(&joined_size, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD), "broadcast"); !r) return r;
+  joined.resize(joined_size);
+  if (Result<bool> r = check(MPI_Bcast(joined.data(), static_cast<int>(joined_size), MPI_CHAR, 0, MPI_COMM_WORLD), "broadcast"); !r)
+    return r;
+  if (rank_ != 0)
+    for (std::size_t at = 0; at < joined.size();) {
+      const std::size_t nl = joined.find('\n', at);
+      paths.push_back(joined.substr(at, nl - at));
+      at = nl + 1;
+    }
+
+  // --- the histogram's sums ---
+  const int B = h.num_batches(), S = h.num_strategies();
+  std::vector<Word> words;
+  words.reserve((paths.size() * static_cast<std::size_t>(4 * B + 3 * S) + static_cast<std::size_t>(B) + 1) * 2);
+  for (const std::string& p : paths) {
+    const std::optional<Histogram::PathId> id = h.find(p);
+    for (int b = 0; b < B; ++b) {
+      const Histogram::Cell cell = id ? h.cell(*id, b) : Histogram::Cell{};
+      for (int c = 0; c < 3; ++c) put(words, cell.sum[static_cast<std::size_t>(c)]);
+      put(words, cell.contributions);
+    }
+    for (int s = 0; s < S; ++s)
+      for (int c = 0; c < 3; ++c) put(words, id ? h.strategy_sum(*id, s)[static_cast<std::size_t>(c)] : ExactSum{0});
+  }
+  for (int b = 0; b < B; ++b) put(words, h.batch_samples(b));
+  put(words, h.nonfinite());
+  if (Result<bool> r = sum_to_root(&words); !r) return r;
+  std::vector<Word> magnitudes(2 * static_cast<std::size_t>(size_));
+  const Word my_magnitude[2] = {static_cast<Word>(h.magnitude()), static_cast<Word>(h.magnitude() >> 64)};
+  if (Result<bool> r = check(MPI_Gather(my_magnitude, 2, MPI_UINT64_T, magnitudes.data(), 2, MPI_UINT64_T, 0, MPI_COMM_WORLD), "gather");
+      !r)
+    return r;
+  if (rank_ == 0) {
+    const Word* w = words.data();
+    for (const std::string& p : paths) {
+      const Histogram::PathId id = h.intern(p);
+      for (int b = 0; b < B; ++b, w += 8) h.add_cell(id, b, {get(w), get(w + 2), get(w + 4)}, static_cast<std::uint64_t>(get(w + 6)));
+      for (int s = 0; s < S; ++s, w += 6) h.add_strategy_sum(id, s, {get(w), get(w + 2), get(w + 4)});
+    }
+    for (int b = 0; b < B; ++b, w += 2) h.add_samples(b, static_cast<std::uint64_t>(get(w)));
+    h.add_nonfinite(static_cast<std::uint64_t>(get(w)));
+    for (int i = 1; i < size_; ++i) h.add_magnitude(get(&magnitudes[2 * static_cast<std::size_t>(i)]));
+  }
+
+  // --- the images: the tiles any rank touched, in blocks ---
+  ClassImages& im = sums->images;
+  const std::size_t planes = im.num_planes(), tiles = im.num_tiles();
+  std::vector<unsigned char> touched(planes * tiles), any(planes * tiles);
+  for (std::size_t p = 0; p < planes; ++p)
+    for (std::size_t t = 0; t < tiles; ++t) touched[p * tiles + t] = im.tile_words(p, t) != nullptr ? 1 : 0;
+  for (std::size_t at = 0; at < touched.size(); at += std::size_t{1} << 30) {
+    const int n = static_cast<int>(std::min(touched.size() - at, std::size_t{1} << 30));
+    if (Result<bool> r = check(MPI_Allreduce(touched.data() + at, any.data() + at, n, MPI_UNSIGNED_CHAR, MPI_BOR, MPI_COMM_WORLD),
+                               "reduce");
+        !r)
+      return r;
+  }
+  std::vector<std::size_t> cells;
+  for (std::size_t i = 0; i < any.size(); ++i)
+    if (any[i] != 0) cells.push_back(i);
+  constexpr std::size_t kTilesPerBlock = 4096;
+  for (std::size_t at = 0; at < cells.size(); at += kTilesPerBlock) {
+    const std::size_t n = std::min(kTilesPerBlock, cells.size() - at);
+    std::vector<Word> block(n * ClassImages::kTileWords, 0);
+    for (std::size_t k = 0; k < n; ++k)
+      if (const Word* src = im.tile_words(cells[at + k] / tiles, cells[at + k] % tiles))
+        std::memcpy(block.data() + k * ClassImages::kTileWords, src, ClassImages::kTileWords * sizeof(Word));
+    if (Result<bool> r = sum_to_root(&block); !r) return r;
+    if (rank_ == 0)
+      for (std::size_t k = 0; k < n; ++k)
+        im.add_tile(cells[at + k] / tiles, cells[at + k] % tiles, block.data() + k * ClassImages::kTileWords);
+  }
+
+  // --- passes and run figures ---
+  std::vector<Word> ranges;
+  for (const PassRange& r : passes->ranges()) ranges.push_back(r.first), ranges.push_back(r.last);
+  const int my_count = static_cast<int>(ranges.size());
+  if (Result<bool> r = check(MPI_Gather(&my_count, 1, MPI_INT, sizes.data(), 1, MPI_INT, 0, MPI_COMM_WORLD), "gather"); !r) return r;
+  std::vector<Word> all_ranges;
+  if (rank_ == 0) {
+    int total = 0;
+    for (int i = 0; i < size_; ++i) offsets[static_cast<std::size_t>(i)] = total, total += sizes[static_cast<std::size_t>(i)];
+    all_ranges.resize(static_cast<std::size_t>(total));
+  }
+  if (Result<bool> r = check(MPI_Gatherv(ranges.data(), my_count, MPI_UINT64_T, all_ranges.data(), sizes.data(), offsets.data(),
+                                         MPI_UINT64_T, 0, MPI_COMM_WORLD),
+                             "gather");
+      !r)
+    return r;
+  for (std::size_t i = 0; i + 1 < all_ranges.size(); i += 2) passes->add(all_ranges[i], all_ranges[i + 1]);
+  double time_max = 0;
+  std::uint64_t rays = 0;
+  int threads = 0;
+  if (Result<bool> r = check(MPI_Reduce(&run->time_s, &time_max, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
+  if (Result<bool> r = check(MPI_Reduce(&run->rays, &rays, 1, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
+  if (Result<bool> r = check(MPI_Reduce(&run->threads, &threads, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
+  double cpu_sum = 0.0;
+  if (Result<bool> r = check(MPI_Reduce(&run->cpu_s, &cpu_sum, 1, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
+  if (rank_ == 0) *run = {time_max, threads, rays, cpu_sum};
+  return true;
+}
+
+int MpiCluster::count_failures(bool ok) {
+  int failed = ok ? 0 : 1, total = 0;
+  if (MPI_Allreduce(&failed, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD) != MPI_SUCCESS) return size_;
+  return total;
+}
+
+}  // namespace pathex::cli

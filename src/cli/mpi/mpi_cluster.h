@@ -1,0 +1,34 @@
+// The ranks of an MPI job as a Cluster (cli/render_job.h); see mpi_cluster.cpp.
+#pragma once
+
+#include <mpi.h>
+
+#include <vector>
+
+#include "cli/render_job.h"
+
+namespace pathex::cli {
+
+class MpiCluster final : public Cluster {
+ public:
+  MpiCluster();  // after MPI_Init
+  ~MpiCluster() override;
+  MpiCluster(const MpiCluster&) = delete;
+  MpiCluster& operator=(const MpiCluster&) = delete;
+
+  int rank() const override { return rank_; }
+  int size() const override { return size_; }
+  Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run) override;
+  int count_failures(bool ok) override;
+
+ private:
+  Result<bool> check(int code, const char* what) const;
+  // 128-bit sums of `words` (pairs of low, high words) over the ranks, on rank 0 (others: emptied).
+  Result<bool> sum_to_root(std::vector<std::uint64_t>* words);
+
+  int rank_ = 0, size_ = 1;
+  MPI_Datatype u128_{};
+  MPI_Op add_{};
+};
+
+}  // namespace pathex::cli

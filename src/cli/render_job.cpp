@@ -1,0 +1,209 @@
+#include "cli/render_job.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "core/version.h"
+#include "io/atomic_file.h"
+#include "io/class_file.h"
+#include "io/histogram_json.h"
+#include "io/image_io.h"
+
+namespace pathex::cli {
+
+Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string& text, const std::string& filename,
+                                                              const RenderIdentity& identity, const Limits& limits) {
+  ClassOptions copts;
+  copts.limits = limits;
+  for (const std::string& l : identity.lights) {
+    const std::optional<LightType> t = light_type_from_string(l);
+    if (!t) return make_error(ErrorCode::kBadValue, "unknown light type \"" + l + "\"");
+    copts.ends.lights.push_back(*t);
+  }
+  const std::optional<SensorType> sensor = sensor_type_from_string(identity.sensor);
+  if (!sensor) return make_error(ErrorCode::kBadValue, "unknown sensor type \"" + identity.sensor + "\"");
+  copts.ends.sensors = {*sensor};
+  auto out = std::make_unique<RenderClasses>();
+  if (!filename.empty()) {
+    Result<bool> r = load_class_file(text, filename, copts, &out->table);
+    if (!r) return r.error();
+    for (const auto& c : out->table.user_classes()) out->classes.push_back(c.get());
+  } else {
+    for (const auto& c : ClassTable::builtins().builtin_classes())
+      if (c->name != "all") out->classes.push_back(c.get());
+  }
+  Result<Classifier> classifier = Classifier::build(out->classes, limits);
+  if (!classifier) return classifier.error();
+  out->classifier = std::make_unique<Classifier>(std::move(*classifier));
+  for (const PathClass* c : out->classes) out->infos.push_back({c->name, c->text});
+  return out;
+}
+
+RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& classes) {
+  HistogramLayout layout;
+  layout.num_batches = identity.batches;
+  layout.strategies = identity.strategies;
+  std::vector<int> layers;
+  if (identity.images)
+    for (int i = 0; i < classes.classifier->num_classes(); ++i) layers.push_back(i);
+  return {Histogram(layout, classes.classifier.get()),
+          identity.images ? ClassImages(identity.width, identity.height, classes.classifier.get(), layers)
+                          : ClassImages(0, 0, nullptr, {})};
+}
+
+// run.json's "efficiency": Veach's efficiency of the image-mean estimate, 1 / (relative variance ×
+// CPU seconds of rendering), `per_cpu_s`, with the relative variance (the total's squared
+// standard error over its squared luminance). It does not depend on the spp (the variance falls
+// as the time grows), so two settings compare without a reference. Null when the total has no
+// finite relative error (a black image, fewer than two batches of passes) or no CPU time.
+static nlohmann::ordered_json efficiency_json(const Estimate& total, double cpu_s) {
+  const double rel = total.luminance > 0.0 ? total.std_error / total.luminance : 0.0;
+  const double rel_var = rel * rel;
+  nlohmann::ordered_json e;
+  const bool defined = std::isfinite(rel_var) && rel_var > 0.0 && cpu_s > 0.0;
+  e["relative_variance"] = defined ? nlohmann::ordered_json(rel_var) : nlohmann::ordered_json(nullptr);
+  e["per_cpu_s"] = defined ? nlohmann::ordered_json(1.0 / (rel_var * cpu_s)) : nlohmann::ordered_json(nullptr);
+  return e;
+}
+
+Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
+                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors) {
+  const RenderIdentity& id = header.identity;
+  RunInfo info;
+  info.scene = id.scene;
+  info.renderer = id.renderer;
+  info.spp = header.passes.count();
+  info.seed = id.seed;
+  info.complete = header.passes == header.share;
+  info.spp_requested = header.spp;
+  Result<HistogramReport> rep = make_report(sums.histogram, info, classes.classifier.get(), classes.infos, id.max_paths);
+  if (!rep) return rep.error();
+
+  WrittenReport out{std::move(*rep), {}};
+  nlohmann::ordered_json doc = to_json(out.report);
+  if (!connectors.empty()) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const ConnectorStats& c : connectors)
+      list.push_back({{"strategy", c.strategy},
+                      {"connector", c.connector},
+                      {"attempts", c.attempts},
+                      {"successes", c.successes},
+                      {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
+    doc["connectors"] = std::move(list);
+  }
+  out.json_text = doc.dump(2) + "\n";
+  if (Result<bool> w = write_file_atomic(dir + "/histogram.json", out.json_text); !w) return w.error();
+  if (id.images) {
+    const std::uint64_t spp = header.passes.count();
+    const std::vector<ImageLayer> layers = sums.images.layers(spp ? 1.0 / static_cast<double>(spp) : 0.0);
+    if (Result<bool> w = write_exr(dir + "/classes.exr", layers); !w) return w.error();
+    if (Result<bool> w = write_previews(dir, layers); !w) return w.error();
+  }
+  if (Result<bool> w = write_file_atomic(dir + "/" + kRenderShardName, encode_shard(header, sums.histogram, sums.images)); !w)
+    return w.error();
+  nlohmann::ordered_json run = nlohmann::ordered_json::object();
+  run["time_s"] = header.run.time_s;
+  run["threads"] = header.run.threads;
+  run["rays"] = header.run.rays;
+  run["passes"] = header.passes.to_string();
+  run["cpu_s"] = header.run.cpu_s;
+  run["efficiency"] = efficiency_json(out.report.total, header.run.cpu_s);
+  if (Result<bool> w = write_file_atomic(dir + "/run.json", run.dump(2) + "\n"); !w) return w.error();
+  return out;
+}
+
+std::string ranks_folder(const std::string& dir) {
+  std::string d = dir;
+  while (d.size() > 1 && d.back() == '/') d.pop_back();
+  return d + ".ranks";
+}
+
+Result<std::vector<std::string>> render_folder_shards(const std::string& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  bool any_folder = false;
+  for (const std::string& d : {dir, ranks_folder(dir)}) {
+    if (!std::filesystem::is_directory(d, ec)) continue;
+    any_folder = true;
+    std::vector<std::string> here;
+    for (const auto& entry : std::filesystem::directory_iterator(d, ec))
+      if (entry.path().extension() == kShardExtension) here.push_back(entry.path().string());
+    if (ec) {
+      Error e = make_error(ErrorCode::kBadFile, "cannot list the folder: " + ec.message());
+      e.where = d;
+      return e;
+    }
+    std::sort(here.begin(), here.end());
+    names.insert(names.end(), here.begin(), here.end());
+  }
+  if (names.empty()) {
+    Error e = make_error(ErrorCode::kBadFile, any_folder ? std::string("no shard file (*") + kShardExtension +
+                                                               ") in the folder: is it a pathex trace output folder?"
+                                                         : std::string("not a render folder (no such directory)"));
+    e.where = dir;
+    return e;
+  }
+  return names;
+}
+
+Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits) {
+  std::optional<CombinedRender> out;
+  std::vector<std::pair<std::string, PassSet>> seen;  // each file's passes, for naming an overlap
+  for (const std::string& path : paths) {
+    Result<ShardFile> file = read_shard(path);
+    if (!file) return file.error();
+    const ShardHeader& h = file->header;
+    if (h.identity.pathex != pathex_version())
+      return make_error(ErrorCode::kUsage, path + " was rendered by another pathex version (" + h.identity.pathex + " against " +
+                                               pathex_version() + ")");
+    if (!out) {
+      // The first file fixes the render: its classes are compiled and its layout laid out.
+      Result<std::unique_ptr<RenderClasses>> classes =
+          compile_render_classes(h.identity.classes_text, h.identity.classes_file, h.identity, limits);
+      if (!classes) {
+        Error e = classes.error();
+        e.message = "the class file recorded in " + path + " does not compile: " + e.message;
+        return e;
+      }
+      RenderSums sums = empty_sums(h.identity, **classes);
+      ShardHeader header;
+      header.identity = h.identity;
+      out.emplace(CombinedRender{std::move(header), std::move(*classes), std::move(sums)});
+    } else {
+      if (std::optional<std::string> d = identity_difference(h.identity, out->header.identity))
+        return make_error(ErrorCode::kUsage, path + " and " + seen.front().first + " are not of one render: " + *d);
+      for (const auto& [other, passes] : seen)
+        if (const PassSet both = passes.intersect(h.passes); !both.empty())
+          return make_error(ErrorCode::kUsage, "passes " + both.to_string() + " are in both " + other + " and " + path +
+                                                   ": the renders to merge must hold disjoint passes");
+    }
+    if (Result<bool> r = add_shard_sums(*file, &out->sums.histogram, &out->sums.images); !r) return r.error();
+    ShardHeader& header = out->header;
+    header.spp = std::max(header.spp, h.spp);
+    header.share.add(h.share);
+    header.passes.add(h.passes);
+    header.run.time_s += h.run.time_s;
+    header.run.threads = std::max(header.run.threads, h.run.threads);
+    header.run.rays += h.run.rays;
+    header.run.cpu_s += h.run.cpu_s;
+    seen.emplace_back(path, h.passes);
+  }
+  if (!out) return make_error(ErrorCode::kUsage, "no shard files to combine");
+  return std::move(*out);
+}
+
+}  // namespace pathex::cli
+
+namespace pathex::cli {
+namespace {
+Cluster* g_cluster = nullptr;
+}  // namespace
+
+Cluster* current_cluster() { return g_cluster; }
+void set_cluster(Cluster* cluster) { g_cluster = cluster; }
+
+}  // namespace pathex::cli

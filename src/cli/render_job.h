@@ -1,0 +1,100 @@
+// What `pathex trace`, `pathex merge` and the MPI ranks share: the classes a render is labelled
+// with, rebuilt from a RenderIdentity (so a merge needs neither the scene nor the class file), and
+// the one routine that turns a render's exact sums into its output folder. Every render's outputs
+// go through write_render_outputs, which is why a merge, a resumed render and an MPI run write
+// exactly the bytes of one uninterrupted process.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "classify/classifier.h"
+#include "classify/histogram.h"
+#include "classify/image.h"
+#include "classify/pathclass.h"
+#include "core/error.h"
+#include "core/limits.h"
+#include "core/pass_set.h"
+#include "io/shard.h"
+#include "trace/render.h"
+
+namespace pathex::cli {
+
+// The classes of a render, compiled: the class file's entries (or the built-ins but $all).
+struct RenderClasses {
+  ClassTable table;
+  std::vector<const PathClass*> classes;
+  std::unique_ptr<Classifier> classifier;
+  std::vector<ClassInfo> infos;
+};
+// Compiles `text` (a class file's contents, read from `filename`; both "" for the built-in
+// classes) against the end types of `identity` (lights, sensor).
+Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string& text, const std::string& filename,
+                                                              const RenderIdentity& identity, const Limits& limits);
+
+// A render's exact state: what a shard file holds.
+struct RenderSums {
+  Histogram histogram;
+  ClassImages images;
+};
+// Empty sums laid out for `identity` and `classes`: every class gets an image layer.
+RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& classes);
+
+// The render folder's outputs: histogram.json, classes.exr and the PNGs (unless the identity has
+// no images), the shard file render.shard, and run.json (how the run went: never compared).
+// `header.passes` are the passes the sums hold; histogram.json's spp is their number and it is
+// complete when they are all of header.share. Each file is written whole or not at all.
+struct WrittenReport {
+  HistogramReport report;
+  std::string json_text;
+};
+// histogram.json also lists what each connector did ("connectors": [{strategy, connector,
+// attempts, successes, failures {outside, occluded, no_transport}}] in the profile's order;
+// absent when the profile has none).
+Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
+                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors = {});
+
+// Where the MPI ranks of a render into `dir` keep their own shard files until rank 0 has written
+// the outputs: the folder "<dir>.ranks" beside it (the output folder holds only its set).
+std::string ranks_folder(const std::string& dir);
+
+// The shard files of a render folder: every *.shard in it and in its ranks folder, by name; an
+// error if there is none.
+Result<std::vector<std::string>> render_folder_shards(const std::string& dir);
+
+inline constexpr const char* kRenderShardName = "render.shard";
+
+// Shard files combined into one render's state: the identity they share, the largest requested
+// spp, the union of their shares and of their passes, and the sum of their sums.
+struct CombinedRender {
+  ShardHeader header;
+  std::unique_ptr<RenderClasses> classes;
+  RenderSums sums;
+};
+// Reads the files one at a time (one file's bytes in memory at once). Refuses damaged files
+// (kBadFile), files of another pathex build than this one, and (kUsage, naming both files) files
+// of different renders (identity_difference) or holding the same pass twice (naming the passes).
+Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits);
+
+}  // namespace pathex::cli
+
+namespace pathex::cli {
+
+// The processes one render is split across: one by default; pathex-mpi installs its MPI ranks
+// (cli/mpi/) before running the command line. Each rank renders a part of the run's passes.
+class Cluster {
+ public:
+  virtual ~Cluster() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  // Collective: adds every rank's sums, passes and run figures into rank 0's, exactly. The other
+  // ranks' arguments are left unspecified. Fails naming a rank that did not take part.
+  virtual Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run) = 0;
+  // Collective: the number of ranks whose `ok` is false, on every rank (0 when all succeeded).
+  virtual int count_failures(bool ok) = 0;
+};
+Cluster* current_cluster();  // null: one process
+void set_cluster(Cluster* cluster);
+
+}  // namespace pathex::cli

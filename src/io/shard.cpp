@@ -1,0 +1,470 @@
+// Shard files (format in shard.h): framing and checksum first, then the JSON header, then the
+// varint-encoded exact sums.
+#include "io/shard.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "io/json_reader.h"
+
+namespace pathex {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+constexpr char kMagic[8] = {'P', 'X', 'S', 'H', 'A', 'R', 'D', '\n'};
+constexpr std::size_t kFixedBytes = 8 + 4 + 4 + 8 + 4;  // magic, version, H, N, CRC
+
+std::uint32_t crc32_of(const char* data, std::size_t n) {
+  return static_cast<std::uint32_t>(
+      crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(data), static_cast<z_size_t>(n)));
+}
+
+template <class T>
+void put_le(std::string& out, T v) {
+  for (std::size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+}
+template <class T>
+T get_le(const std::string& in, std::size_t at) {
+  T v = 0;
+  for (std::size_t i = 0; i < sizeof(T); ++i) v |= static_cast<T>(static_cast<unsigned char>(in[at + i])) << (8 * i);
+  return v;
+}
+
+// --- body encoding ---
+
+class Writer {
+ public:
+  void u(std::uint64_t v) {
+    while (v >= 0x80) {
+      out_.push_back(static_cast<char>((v & 0x7f) | 0x80));
+      v >>= 7;
+    }
+    out_.push_back(static_cast<char>(v));
+  }
+  void x(ExactSum v) {
+    ExactSum z = (v << 1) ^ static_cast<ExactSum>(static_cast<SignedExactSum>(v) >> 127);
+    while (z >= 0x80) {
+      out_.push_back(static_cast<char>((static_cast<unsigned>(z) & 0x7f) | 0x80));
+      z >>= 7;
+    }
+    out_.push_back(static_cast<char>(z));
+  }
+  void rgb(const ExactRgb& c) {
+    x(c[0]);
+    x(c[1]);
+    x(c[2]);
+  }
+  void text(const std::string& s) {
+    u(s.size());
+    out_ += s;
+  }
+  std::string& bytes() { return out_; }
+
+ private:
+  std::string out_;
+};
+
+// Reads the body; any read past its end sets failed() and returns zeros, so a decoder checks once.
+class Reader {
+ public:
+  Reader(const char* p, std::size_t n) : p_(p), end_(p + n) {}
+  bool failed() const { return failed_; }
+  bool at_end() const { return p_ == end_; }
+  std::uint64_t u() {
+    std::uint64_t v = 0;
+    for (int shift = 0; shift < 64; shift += 7) {
+      if (p_ == end_) return fail();
+      const auto b = static_cast<unsigned char>(*p_++);
+      v |= static_cast<std::uint64_t>(b & 0x7f) << shift;
+      if (b < 0x80) return v;
+    }
+    return fail();
+  }
+  ExactSum x() {
+    ExactSum z = 0;
+    for (int shift = 0; shift < 128; shift += 7) {
+      if (p_ == end_) return fail();
+      const auto b = static_cast<unsigned char>(*p_++);
+      z |= static_cast<ExactSum>(b & 0x7f) << shift;
+      if (b < 0x80) return (z >> 1) ^ (ExactSum{0} - (z & 1));
+    }
+    return fail();
+  }
+  ExactRgb rgb() { return {x(), x(), x()}; }
+  std::string text() {
+    const std::uint64_t n = u();
+    if (n > static_cast<std::uint64_t>(end_ - p_)) return fail(), std::string();
+    std::string s(p_, static_cast<std::size_t>(n));
+    p_ += n;
+    return s;
+  }
+
+ private:
+  std::uint64_t fail() {
+    failed_ = true;
+    p_ = end_;
+    return 0;
+  }
+  const char* p_;
+  const char* end_;
+  bool failed_ = false;
+};
+
+// --- header ---
+
+json identity_json(const RenderIdentity& id) {
+  json j = json::object();
+  j["pathex"] = id.pathex;
+  j["scene"] = {{"name", id.scene}, {"file", id.scene_file}, {"hash", id.scene_hash}};
+  j["renderer"] = {{"name", id.renderer}, {"source", id.renderer_source}, {"hash", id.renderer_hash}};
+  j["classes"] = {{"file", id.classes_file}, {"text", id.classes_text}, {"hash", id.classes_hash}};
+  j["ends"] = {{"lights", id.lights}, {"sensor", id.sensor}};
+  j["seed"] = id.seed;
+  j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"rr_depth", id.rr_depth},
+                  {"rr_threshold", id.rr_threshold}, {"batches", id.batches},
+                  {"width", id.width},           {"height", id.height},     {"images", id.images},
+                  {"max_paths", id.max_paths}};
+  j["strategies"] = id.strategies;
+  return j;
+}
+
+// Reads the header through the one JSON reader (io/json_reader.h), keeping its first error (a
+// located kBadFile at "file:/pointer"), so the walk below reads as a list of fields.
+class HeaderFields {
+ public:
+  using Json = nlohmann::json;
+  explicit HeaderFields(const std::string& path) : rd_(path) {}
+  std::optional<Error> error;
+
+  // `obj` must be an object with exactly these keys.
+  bool object(const Json& obj, const std::string& ptr, std::initializer_list<const char*> keys) {
+    return take(rd_.keys(obj, ptr, keys), false);
+  }
+  const Json& at(const Json& obj, const char* key) { return obj.at(key); }  // after object()
+  std::string str(const Json& obj, const std::string& ptr, const char* key) {
+    return take(rd_.string(obj, key, ptr), std::string());
+  }
+  std::uint64_t uint(const Json& obj, const std::string& ptr, const char* key) {
+    return take(rd_.unsigned_integer(obj, key, ptr, std::numeric_limits<std::uint64_t>::max()), std::uint64_t{0});
+  }
+  int small(const Json& obj, const std::string& ptr, const char* key) {
+    return static_cast<int>(take(rd_.integer(obj, key, ptr, 0, 1 << 30), 0LL));
+  }
+  double number(const Json& obj, const std::string& ptr, const char* key) {
+    return take(rd_.number(obj, key, ptr, 0, std::numeric_limits<double>::max()), 0.0);
+  }
+  bool boolean(const Json& obj, const std::string& ptr, const char* key) {
+    return take(rd_.boolean(obj, key, ptr), false);
+  }
+  std::vector<std::string> strings(const Json& obj, const std::string& ptr, const char* key) {
+    std::vector<std::string> out;
+    const std::string p = ptr + "/" + key;
+    if (error) return out;
+    const Json& v = obj.at(key);
+    if (!v.is_array()) return fail(p, "expected an array of strings, found " + JsonReader::kind(v)), out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_string()) return fail(p + "/" + std::to_string(i), "expected a string, found " + JsonReader::kind(v[i])), out;
+      out.push_back(v[i].get<std::string>());
+    }
+    return out;
+  }
+  PassSet passes(const Json& obj, const char* key) {
+    PassSet set;
+    const std::string ptr = std::string("/") + key;
+    if (error) return set;
+    const Json& p = obj.at(key);
+    if (!p.is_array()) return fail(ptr, "expected an array of [first, last) pairs, found " + JsonReader::kind(p)), set;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Json& r = p[i];
+      if (!r.is_array() || r.size() != 2 || !r[0].is_number_unsigned() || !r[1].is_number_unsigned() ||
+          r[0].get<std::uint64_t>() >= r[1].get<std::uint64_t>() || (!set.empty() && r[0].get<std::uint64_t>() <= set.end())) {
+        fail(ptr + "/" + std::to_string(i), "expected [first, last) with first < last, after the previous range");
+        break;
+      }
+      set.add(r[0].get<std::uint64_t>(), r[1].get<std::uint64_t>());
+    }
+    return set;
+  }
+  void fail(const std::string& ptr, std::string message) {
+    if (!error) error = rd_.fail(ptr, std::move(message));
+  }
+
+ private:
+  template <class T, class U>
+  T take(Result<T> r, U fallback) {
+    if (error) return static_cast<T>(fallback);
+    if (!r.ok()) {
+      error = r.error();
+      return static_cast<T>(fallback);
+    }
+    return std::move(r.value());
+  }
+  JsonReader rd_;
+};
+
+Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string& path) {
+  HeaderFields rd(path);
+  ShardHeader h;
+  RenderIdentity& id = h.identity;
+  if (!rd.object(j, "", {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "spp",
+                         "share", "passes", "run"}))
+    return *rd.error;
+  for (const char* key : {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "spp",
+                          "share", "passes", "run"})
+    if (!j.contains(key)) return rd.fail(std::string("/") + key, std::string("missing ") + key), *rd.error;
+  id.pathex = rd.str(j, "", "pathex");
+  // Objects of three strings: {name, file, hash} and the like.
+  const auto strings3 = [&](const char* key, const std::array<std::pair<const char*, std::string*>, 3>& fields) {
+    const std::string ptr = std::string("/") + key;
+    if (!rd.object(j.at(key), ptr, {fields[0].first, fields[1].first, fields[2].first})) return;
+    for (const auto& [name, out] : fields) *out = rd.str(j.at(key), ptr, name);
+  };
+  strings3("scene", {{{"name", &id.scene}, {"file", &id.scene_file}, {"hash", &id.scene_hash}}});
+  strings3("renderer", {{{"name", &id.renderer}, {"source", &id.renderer_source}, {"hash", &id.renderer_hash}}});
+  strings3("classes", {{{"file", &id.classes_file}, {"text", &id.classes_text}, {"hash", &id.classes_hash}}});
+  if (rd.object(j.at("ends"), "/ends", {"lights", "sensor"})) {
+    id.lights = rd.strings(j.at("ends"), "/ends", "lights");
+    id.sensor = rd.str(j.at("ends"), "/ends", "sensor");
+  }
+  id.seed = rd.uint(j, "", "seed");
+  h.spp = rd.uint(j, "", "spp");
+  const nlohmann::json& o = j.at("options");
+  if (rd.object(o, "/options", {"max_bounces", "sampler", "rr_depth", "rr_threshold", "batches", "width", "height", "images",
+                                "max_paths"})) {
+    id.max_bounces = rd.small(o, "/options", "max_bounces");
+    id.sampler = rd.str(o, "/options", "sampler");
+    id.rr_depth = rd.small(o, "/options", "rr_depth");
+    id.rr_threshold = rd.number(o, "/options", "rr_threshold");
+    id.batches = rd.small(o, "/options", "batches");
+    id.width = rd.small(o, "/options", "width");
+    id.height = rd.small(o, "/options", "height");
+    id.images = rd.boolean(o, "/options", "images");
+    id.max_paths = rd.uint(o, "/options", "max_paths");
+  }
+  if (!rd.error && (id.batches < 1 || id.batches > 1000000)) rd.fail("/options/batches", "expected 1 to 1000000 batches");
+  id.strategies = rd.strings(j, "", "strategies");
+  h.share = rd.passes(j, "share");
+  h.passes = rd.passes(j, "passes");
+  const nlohmann::json& r = j.at("run");
+  if (rd.object(r, "/run", {"time_s", "threads", "rays", "cpu_s"})) {
+    h.run.time_s = rd.number(r, "/run", "time_s");
+    h.run.cpu_s = rd.number(r, "/run", "cpu_s");
+    h.run.threads = rd.small(r, "/run", "threads");
+    h.run.rays = rd.uint(r, "/run", "rays");
+  }
+  if (rd.error) return *rd.error;
+  return h;
+}
+
+Error file_error(const std::string& path, const std::string& message) {
+  Error e = make_error(ErrorCode::kBadFile, message);
+  e.where = path;
+  return e;
+}
+
+}  // namespace
+
+std::optional<std::string> identity_difference(const RenderIdentity& a, const RenderIdentity& b) {
+  const auto differ = [](const std::string& what, const std::string& x, const std::string& y) {
+    return std::optional<std::string>(what + " (" + x + " against " + y + ")");
+  };
+  if (a.pathex != b.pathex) return differ("another pathex version", a.pathex, b.pathex);
+  if (a.scene_hash != b.scene_hash)
+    return differ("another scene", "content hash " + a.scene_hash + ", " + a.scene,
+                  "content hash " + b.scene_hash + ", " + b.scene);
+  if (a.renderer_hash != b.renderer_hash || a.renderer != b.renderer)
+    return differ("another renderer profile", a.renderer + ", hash " + a.renderer_hash,
+                  b.renderer + ", hash " + b.renderer_hash);
+  if (a.seed != b.seed) return differ("another seed", std::to_string(a.seed), std::to_string(b.seed));
+  if (a.classes_hash != b.classes_hash) {
+    const auto name = [](const RenderIdentity& i) {
+      return (i.classes_file.empty() ? std::string("the built-in classes") : i.classes_file) + ", hash " + i.classes_hash;
+    };
+    return differ("another class file", name(a), name(b));
+  }
+  const auto option = [&](const char* name, long long x, long long y) -> std::optional<std::string> {
+    if (x == y) return std::nullopt;
+    return differ(std::string("another ") + name, std::to_string(x), std::to_string(y));
+  };
+  if (auto d = option("max_bounces", a.max_bounces, b.max_bounces)) return d;
+  if (a.sampler != b.sampler) return differ("another sampler", a.sampler, b.sampler);
+  if (auto d = option("rr_depth", a.rr_depth, b.rr_depth)) return d;
+  if (a.rr_threshold != b.rr_threshold)
+    return differ("another rr_threshold", std::to_string(a.rr_threshold), std::to_string(b.rr_threshold));
+  if (auto d = option("batch count", a.batches, b.batches)) return d;
+  if (a.width != b.width || a.height != b.height)
+    return differ("another resolution", std::to_string(a.width) + "x" + std::to_string(a.height),
+                  std::to_string(b.width) + "x" + std::to_string(b.height));
+  if (a.images != b.images)
+    return differ("another image setting", a.images ? "images" : "--no-images", b.images ? "images" : "--no-images");
+  if (auto d = option("--max-paths", static_cast<long long>(a.max_paths), static_cast<long long>(b.max_paths))) return d;
+  // Derived from what the hashes cover; different only in a hand-made file.
+  if (a.strategies != b.strategies || a.lights != b.lights || a.sensor != b.sensor || a.classes_text != b.classes_text)
+    return std::optional<std::string>("another render description (strategies, end types or class text)");
+  return std::nullopt;
+}
+
+std::string encode_shard(const ShardHeader& header, const Histogram& h, const ClassImages& images) {
+  json hj = identity_json(header.identity);
+  hj["spp"] = header.spp;
+  const auto passes_json = [](const PassSet& set) {
+    json a = json::array();
+    for (const PassRange& r : set.ranges()) a.push_back(json::array({r.first, r.last}));
+    return a;
+  };
+  hj["share"] = passes_json(header.share);
+  hj["passes"] = passes_json(header.passes);
+  hj["run"] = {{"time_s", header.run.time_s}, {"threads", header.run.threads}, {"rays", header.run.rays},
+               {"cpu_s", header.run.cpu_s}};
+  const std::string head = hj.dump(1) + "\n";
+
+  Writer w;
+  // --- histogram ---
+  for (int b = 0; b < h.num_batches(); ++b) w.u(h.batch_samples(b));
+  w.u(h.nonfinite());
+  w.x(h.magnitude());
+  std::vector<Histogram::PathId> order(static_cast<std::size_t>(h.num_paths()));
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<Histogram::PathId>(i);
+  std::sort(order.begin(), order.end(), [&](auto a, auto b) { return h.path(a) < h.path(b); });
+  w.u(order.size());
+  for (Histogram::PathId p : order) {
+    w.text(h.path(p));
+    for (int b = 0; b < h.num_batches(); ++b) {
+      w.u(h.cell(p, b).contributions);
+      w.rgb(h.cell(p, b).sum);
+    }
+    for (int s = 0; s < h.num_strategies(); ++s) w.rgb(h.strategy_sum(p, s));
+  }
+  // --- images ---
+  const std::size_t planes = images.num_planes(), tiles = images.num_tiles();
+  std::vector<std::pair<std::size_t, std::size_t>> stored;
+  for (std::size_t p = 0; p < planes; ++p)
+    for (std::size_t t = 0; t < tiles; ++t)
+      if (const std::uint64_t* words = images.tile_words(p, t);
+          words != nullptr && std::any_of(words, words + ClassImages::kTileWords, [](std::uint64_t v) { return v != 0; }))
+        stored.emplace_back(p, t);
+  w.u(planes);
+  w.u(tiles);
+  w.u(stored.size());
+  for (const auto& [p, t] : stored) {
+    w.u(p);
+    w.u(t);
+    const std::uint64_t* words = images.tile_words(p, t);
+    for (std::size_t i = 0; i < ClassImages::kTileWords; i += 2)
+      w.x((static_cast<ExactSum>(words[i + 1]) << 64) | static_cast<ExactSum>(words[i]));
+  }
+
+  std::string out(kMagic, sizeof kMagic);
+  put_le<std::uint32_t>(out, kShardFormatVersion);
+  put_le<std::uint32_t>(out, static_cast<std::uint32_t>(head.size()));
+  out += head;
+  put_le<std::uint64_t>(out, w.bytes().size());
+  out += w.bytes();
+  put_le<std::uint32_t>(out, crc32_of(out.data(), out.size()));
+  return out;
+}
+
+Result<ShardFile> parse_shard(std::string bytes, const std::string& path) {
+  if (bytes.size() < 16 || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
+    if (bytes.size() < 16 && std::memcmp(bytes.data(), kMagic, std::min(bytes.size(), sizeof kMagic)) == 0)
+      return file_error(path, "truncated shard file: " + std::to_string(bytes.size()) + " bytes");
+    return file_error(path, "not a pathex shard file (it does not begin with \"PXSHARD\")");
+  }
+  const auto version = get_le<std::uint32_t>(bytes, 8);
+  if (version != kShardFormatVersion)
+    return file_error(path, "shard file format version " + std::to_string(version) + "; this pathex reads version " +
+                                std::to_string(kShardFormatVersion));
+  const std::uint64_t head_size = get_le<std::uint32_t>(bytes, 12);
+  const std::uint64_t size = bytes.size();
+  const auto truncated = [&](std::uint64_t expected) {
+    return file_error(path, "truncated shard file: " + std::to_string(size) + " bytes, its header says at least " +
+                                std::to_string(expected));
+  };
+  if (size < kFixedBytes + head_size) return truncated(kFixedBytes + head_size);
+  const std::uint64_t body_size = get_le<std::uint64_t>(bytes, 16 + head_size);
+  if (body_size > size || size - kFixedBytes - head_size < body_size) return truncated(kFixedBytes + head_size + body_size);
+  if (size != kFixedBytes + head_size + body_size)
+    return file_error(path, "corrupted shard file: " + std::to_string(size - kFixedBytes - head_size - body_size) +
+                                " bytes after its checksum");
+  const auto stored = get_le<std::uint32_t>(bytes, size - 4);
+  if (crc32_of(bytes.data(), size - 4) != stored)
+    return file_error(path, "corrupted shard file: its CRC-32 does not match its contents");
+
+  Result<nlohmann::json> hj = parse_json(std::string_view(bytes).substr(16, head_size), path);
+  if (!hj) return hj.error();
+  Result<ShardHeader> header = header_from_json(*hj, path);
+  if (!header) return header.error();
+  ShardFile f;
+  f.path = path;
+  f.header = std::move(*header);
+  f.body_offset = 24 + head_size;
+  f.body_size = body_size;
+  f.bytes = std::move(bytes);
+  return f;
+}
+
+Result<ShardFile> read_shard(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return file_error(path, "cannot open the shard file");
+  const std::streamoff size = in.tellg();
+  std::string bytes(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)), '\0');
+  in.seekg(0);
+  if (size < 0 || !in.read(bytes.data(), size)) return file_error(path, "cannot read the shard file");
+  return parse_shard(std::move(bytes), path);
+}
+
+Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* images) {
+  const RenderIdentity& id = f.header.identity;
+  if (h->num_batches() != id.batches || h->layout().strategies != id.strategies)
+    return file_error(f.path, "the shard's histogram layout (batches, strategies) is not the merge's");
+  Reader r(f.bytes.data() + f.body_offset, f.body_size);
+  const auto bad = [&](const std::string& what) { return file_error(f.path, "malformed shard body: " + what); };
+  // --- histogram ---
+  const int B = h->num_batches(), S = h->num_strategies();
+  for (int b = 0; b < B; ++b) h->add_samples(b, r.u());
+  h->add_nonfinite(r.u());
+  h->add_magnitude(r.x());
+  const std::uint64_t paths = r.u();
+  for (std::uint64_t i = 0; i < paths && !r.failed(); ++i) {
+    const std::string path = r.text();
+    if (r.failed()) break;
+    const Histogram::PathId id_ = h->intern(path);
+    for (int b = 0; b < B; ++b) {
+      const std::uint64_t n = r.u();
+      h->add_cell(id_, b, r.rgb(), n);
+    }
+    for (int s = 0; s < S; ++s) h->add_strategy_sum(id_, s, r.rgb());
+  }
+  if (r.failed()) return bad("the histogram ends early");
+  // --- images ---
+  const std::uint64_t planes = r.u(), tiles = r.u(), stored = r.u();
+  if (r.failed()) return bad("the image section ends early");
+  if (stored > 0 && (planes != images->num_planes() || tiles != images->num_tiles()))
+    return bad("its images have " + std::to_string(planes) + " planes of " + std::to_string(tiles) +
+               " tiles; the merge's have " + std::to_string(images->num_planes()) + " of " +
+               std::to_string(images->num_tiles()));
+  std::vector<std::uint64_t> words(ClassImages::kTileWords);
+  for (std::uint64_t i = 0; i < stored; ++i) {
+    const std::uint64_t p = r.u(), t = r.u();
+    if (r.failed() || p >= planes || t >= tiles) return bad("a stored tile is out of range");
+    for (std::size_t k = 0; k < ClassImages::kTileWords; k += 2) {
+      const ExactSum v = r.x();
+      words[k] = static_cast<std::uint64_t>(v);
+      words[k + 1] = static_cast<std::uint64_t>(v >> 64);
+    }
+    if (r.failed()) return bad("the image section ends early");
+    images->add_tile(static_cast<std::size_t>(p), static_cast<std::size_t>(t), words.data());
+  }
+  if (!r.at_end()) return bad("bytes after the image section");
+  return true;
+}
+
+}  // namespace pathex

@@ -1,0 +1,128 @@
+// Shard files: the exact state of a render, so that renders of disjoint sets of passes merge into
+// exactly the bytes of one render of their union (`pathex trace --shard`, `pathex merge`,
+// `pathex trace --resume`, MPI ranks that outlive a failed run).
+//
+// A render is fully described by what it was made from (the RenderIdentity: scene content,
+// profile, classes, seed, options) and the set of passes it took; its outputs are functions of
+// exact integer sums (classify/histogram.h, classify/image.h), which add. A shard file holds those
+// sums, not the floats of the outputs.
+//
+// File layout, version 1 (all integers little-endian):
+//
+//   offset  size  what
+//   0       8     magic "PXSHARD\n"
+//   8       4     format version (1)
+//   12      4     H: header length in bytes
+//   16      H     header: a JSON object (UTF-8), keys below
+//   16+H    8     N: body length in bytes
+//   24+H    N     body: the exact sums, encoded as below
+//   24+H+N  4     CRC-32 (ISO-HDLC, zlib's crc32) of every byte before it
+//
+// A file whose length is not 28 + H + N is truncated (or has trailing bytes); a CRC mismatch
+// means it was corrupted. Either is refused before anything else is read.
+//
+// Header keys: "pathex" (version of the writer), "scene" {name, file (absolute, "" for the
+// embedded default), hash (scene_content_hash)}, "renderer" {name, source (built-in name or
+// absolute file), hash}, "classes" {file (absolute, "" for the built-in classes), text (the class
+// file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
+// Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
+// {max_bounces, sampler, rr_depth, rr_threshold, batches, width, height, images, max_paths}, "strategies" [names], "share" and
+// "passes" (each [[first, last), …]: the passes the run was asked for, and those whose sums this
+// file holds), "run" {time_s, threads, rays}.
+//
+// Body, in this order. `u` is an unsigned LEB128 varint; `x` is a 128-bit fixed-point sum
+// zigzag-encoded ((v << 1) ^ (v >> 127), arithmetic shift) as an unsigned LEB128 varint, so zero
+// is one byte and a typical sum (64 fraction bits) eleven.
+//   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P; then per
+//              path, by string: u length, the letters, B × (u contributions, 3 × x sums),
+//              S × 3 × x strategy sums (B batches, S strategies from the header)
+//   images:    u planes, u tiles per plane, u number of stored tiles T; then per tile, by plane
+//              then tile: u plane, u tile, ClassImages::kTileWords / 2 × x (per pixel, per
+//              channel, of the tile's 8 × 8 pixels). Tiles with nothing in them are not stored.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "classify/histogram.h"
+#include "classify/image.h"
+#include "core/error.h"
+#include "core/pass_set.h"
+
+namespace pathex {
+
+inline constexpr std::uint32_t kShardFormatVersion = 1;
+inline constexpr const char* kShardExtension = ".shard";
+
+// What must agree for two renders to merge: all but the names and files (the same scene, profile
+// and class file may sit at other paths on other machines: they are compared by content hash),
+// and the requested spp (see merge).
+struct RenderIdentity {
+  std::string pathex;        // pathex_version() of the writer
+  std::string scene;         // as the user named it (histogram.json "scene")
+  std::string scene_file;    // absolute; "" for the embedded default
+  std::string scene_hash;    // scene_content_hash
+  std::string renderer;      // the profile's name (histogram.json "renderer")
+  std::string renderer_source;  // as resolved: a built-in name or an absolute file
+  std::string renderer_hash;
+  std::string classes_file;  // absolute; "" for the built-in classes
+  std::string classes_text;  // the class file's text; "" for the built-in classes
+  std::string classes_hash;
+  std::vector<std::string> lights;  // the scene's light types ("area", …)
+  std::string sensor;               // and sensor type
+  std::uint64_t seed = 1;
+  int max_bounces = 16;
+  std::string sampler = "sobol";  // RenderOptions::sampler, by name
+  int rr_depth = 3;
+  double rr_threshold = 1.0;  // RenderOptions::rr_threshold (a float, exact as a double)
+  int batches = kDefaultBatches;
+  int width = 0, height = 0;  // the camera's resolution (the scene's, or --resolution's)
+  bool images = true;
+  std::uint64_t max_paths = 1000;  // rows of histogram.json's path table (--max-paths)
+  std::vector<std::string> strategies;  // the histogram's strategy names
+  bool operator==(const RenderIdentity&) const = default;
+};
+
+// The first difference between two identities, as a phrase naming it and both values
+// ("another scene (content hash 0a… against 1b…)"), or nullopt when they agree.
+std::optional<std::string> identity_difference(const RenderIdentity& a, const RenderIdentity& b);
+
+// How a shard's render went (informative; never compared).
+struct ShardRun {
+  double time_s = 0;
+  int threads = 0;
+  std::uint64_t rays = 0;
+  double cpu_s = 0;  // CPU seconds of rendering, all threads (summed over shards, resumes and ranks)
+};
+
+struct ShardHeader {
+  RenderIdentity identity;
+  std::uint64_t spp = 0;  // requested: the whole render is the passes [0, spp)
+  PassSet share;          // the passes the run that wrote the file was asked for (a shard's share)
+  PassSet passes;         // the passes whose sums the file holds (within share; all of it when complete)
+  ShardRun run;
+};
+
+// The file's bytes. `histogram` and `images` hold the sums of exactly `header.passes`.
+std::string encode_shard(const ShardHeader& header, const Histogram& histogram, const ClassImages& images);
+
+// A shard file checked (length, CRC) and its header parsed; the body is decoded by add_shard_sums.
+struct ShardFile {
+  std::string path;
+  ShardHeader header;
+  std::string bytes;  // the whole file
+  std::size_t body_offset = 0, body_size = 0;
+};
+// Errors (kBadFile) name the file: not a shard file, another format version, truncated,
+// corrupted (checksum), or a header value of the wrong type (with its JSON pointer). The header is
+// read by the one JSON reader (io/json_reader.h); unknown keys are refused like missing ones.
+Result<ShardFile> parse_shard(std::string bytes, const std::string& path);
+Result<ShardFile> read_shard(const std::string& path);
+
+// Adds the file's sums to `histogram` and `images`, which must have the file's layout: the
+// histogram's batches and strategies, the images' size and planes (built from the same classes).
+Result<bool> add_shard_sums(const ShardFile& file, Histogram* histogram, ClassImages* images);
+
+}  // namespace pathex

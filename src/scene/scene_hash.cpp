@@ -1,0 +1,83 @@
+#include "scene/scene_hash.h"
+
+#include <type_traits>
+
+#include "core/hash.h"
+
+namespace pathex {
+namespace {
+
+// Each alternative of a variant is preceded by its index, so that two kinds with the same fields
+// hash differently.
+void hash_basic(Fnv64& h, const BasicMaterial& m) {
+  h.add(static_cast<std::uint32_t>(m.index()));
+  std::visit([&](const auto& k) { h.add(k); }, m);
+}
+
+void hash_material(Fnv64& h, const Material& m) {
+  h.add(static_cast<std::uint32_t>(m.index()));
+  std::visit(
+      [&](const auto& k) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(k)>, Mixture>) {
+          h.add(static_cast<std::uint64_t>(k.components.size()));
+          for (const Mixture::Component& c : k.components) {
+            h.add(c.weight);
+            hash_basic(h, c.material);
+          }
+        } else {
+          h.add(k);
+        }
+      },
+      m);
+}
+
+void hash_geometry(Fnv64& h, const ShapeGeometry& g) {
+  h.add(static_cast<std::uint32_t>(g.index()));
+  std::visit(
+      [&](const auto& k) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(k)>, MeshShape>) {
+          h.add(static_cast<std::uint64_t>(k.positions.size()));
+          h.bytes(k.positions.data(), k.positions.size() * sizeof(glm::vec3));
+          h.add(static_cast<std::uint64_t>(k.triangles.size()));
+          h.bytes(k.triangles.data(), k.triangles.size() * sizeof(glm::uvec3));
+        } else {
+          h.add(k);
+        }
+      },
+      g);
+}
+
+}  // namespace
+
+std::string scene_content_hash(const Scene& scene) {
+  Fnv64 h;
+  h.add(static_cast<std::uint64_t>(scene.materials.size()));
+  for (const Material& m : scene.materials) hash_material(h, m);
+  h.add(static_cast<std::uint64_t>(scene.shapes.size()));
+  for (const Shape& s : scene.shapes) {
+    hash_geometry(h, s.geometry);
+    h.add(s.material);
+    h.add(s.emission);
+    h.add(s.two_sided);
+  }
+  h.add(static_cast<std::uint64_t>(scene.lights.size()));
+  for (const Light& l : scene.lights) {
+    h.add(static_cast<std::uint32_t>(l.index()));
+    std::visit([&](const auto& k) { h.add(k); }, l);
+  }
+  const Camera& c = scene.camera;
+  h.add(static_cast<std::uint32_t>(c.type));
+  h.add(c.position);
+  h.add(c.look_at);
+  h.add(c.up);
+  h.add(c.fov_degrees);
+  h.add(c.aperture_radius);
+  h.add(c.focus_distance);
+  h.add(c.film_width);
+  h.add(c.film_height);
+  h.add(c.width);
+  h.add(c.height);
+  return h.hex();
+}
+
+}  // namespace pathex

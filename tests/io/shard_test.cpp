@@ -1,0 +1,167 @@
+// Pass sets and the shard file format (io/shard.h): exact round trips of the sums, and every
+// damaged file refused with its own message.
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/pass_set.h"
+#include "io/shard.h"
+
+namespace pathex {
+namespace {
+
+TEST(PassSet, PartsAreDisjointCoverTheSetAndDifferByAtMostOne) {
+  PassSet set = PassSet::range(0, 10);
+  set.add(20, 27);  // 17 passes
+  for (std::uint64_t n : {1u, 2u, 3u, 7u, 17u, 40u}) {
+    PassSet all;
+    std::uint64_t smallest = ~0ull, largest = 0;
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const PassSet part = set.part(i, n);
+      EXPECT_TRUE(all.intersect(part).empty()) << n;
+      all.add(part);
+      smallest = std::min(smallest, part.count());
+      largest = std::max(largest, part.count());
+    }
+    EXPECT_EQ(all, set) << n;
+    EXPECT_LE(largest - smallest, 1u) << n;
+  }
+  EXPECT_EQ(set.part(1, 3).to_string(), "5-9, 20");
+  EXPECT_EQ(PassSet::range(0, 8).part(1, 2).to_string(), "4-7");
+}
+
+TEST(PassSet, SetOperationsAndText) {
+  PassSet a = PassSet::range(0, 16);
+  PassSet b = PassSet::range(4, 8);
+  b.add(12, 13);
+  EXPECT_EQ(a.minus(b).to_string(), "0-3, 8-11, 13-15");
+  EXPECT_EQ(a.intersect(b), b);
+  EXPECT_EQ(b.count(), 5u);
+  b.add(8, 12);  // joins the neighbours
+  EXPECT_EQ(b.ranges().size(), 1u);
+  EXPECT_EQ(PassSet().to_string(), "none");
+  EXPECT_EQ(PassSet::range(0, 10).chunks(4).size(), 3u);
+  EXPECT_EQ(PassSet::range(0, 10).chunks(4).back(), (PassRange{8, 10}));
+}
+
+struct Fixture {
+  Fixture() {
+    header.identity.pathex = "test";
+    header.identity.strategies = {"a", "b"};
+    header.identity.batches = 3;
+    header.spp = 8;
+    header.share = PassSet::range(0, 8);
+    header.passes = PassSet::range(0, 4);
+    HistogramLayout layout{3, {"a", "b"}};
+    histogram = Histogram(layout);
+    const Histogram::PathId p = histogram.intern("LDDDSE"), q = histogram.intern("LSDDSE");
+    histogram.add(p, 0, 0, {1.0, 2.0, 3.0});
+    histogram.add(q, 2, 1, {-0.5, 1e10, 1e-19});  // negative, large and tiny sums
+    histogram.add_samples(0, 5);
+    histogram.add_nonfinite(2);
+    images.add(3, 9, 0, *to_exact({0.25, 0.5, -1.0}));
+  }
+  ShardHeader header;
+  Histogram histogram;
+  ClassImages images{10, 10, nullptr, {}};
+};
+
+TEST(ShardFile, RoundTripsTheExactSums) {
+  Fixture f;
+  const std::string bytes = encode_shard(f.header, f.histogram, f.images);
+  Result<ShardFile> file = parse_shard(bytes, "x.shard");
+  ASSERT_TRUE(file) << file.error().render();
+  EXPECT_EQ(file->header.passes, f.header.passes);
+  EXPECT_EQ(file->header.identity, f.header.identity);
+  Histogram h(f.histogram.layout());
+  ClassImages im(10, 10, nullptr, {});
+  ASSERT_TRUE(add_shard_sums(*file, &h, &im));
+  ASSERT_EQ(h.num_paths(), 2);
+  for (int p = 0; p < 2; ++p) {
+    const Histogram::PathId id = *h.find(f.histogram.path(p));
+    for (int b = 0; b < 3; ++b) {
+      EXPECT_EQ(h.cell(id, b).sum, f.histogram.cell(p, b).sum);
+      EXPECT_EQ(h.cell(id, b).contributions, f.histogram.cell(p, b).contributions);
+    }
+    for (int s = 0; s < 2; ++s) EXPECT_EQ(h.strategy_sum(id, s), f.histogram.strategy_sum(p, s));
+  }
+  EXPECT_EQ(h.batch_samples(0), 5u);
+  EXPECT_EQ(h.nonfinite(), 2u);
+  EXPECT_EQ(h.magnitude(), f.histogram.magnitude());
+  EXPECT_EQ(im.sum(0, 3, 9), f.images.sum(0, 3, 9));
+  EXPECT_EQ(im.sum(0, 4, 9), ExactRgb{});
+}
+
+TEST(ShardFile, EveryTruncationAndEveryFlippedByteIsRefused) {
+  Fixture f;
+  const std::string bytes = encode_shard(f.header, f.histogram, f.images);
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    Result<ShardFile> file = parse_shard(bytes.substr(0, n), "x.shard");
+    ASSERT_FALSE(file) << n;
+    EXPECT_EQ(file.error().where, "x.shard");
+  }
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    std::string bad = bytes;
+    bad[i] = static_cast<char>(bad[i] ^ 0x01);
+    Result<ShardFile> file = parse_shard(bad, "x.shard");
+    ASSERT_FALSE(file) << i;
+  }
+  const auto message = [](const std::string& b) {
+    Result<ShardFile> file = parse_shard(b, "x");
+    return file ? std::string("(read)") : file.error().message;
+  };
+  EXPECT_EQ(message("hello, world, not a shard"), "not a pathex shard file (it does not begin with \"PXSHARD\")");
+  std::string v2 = bytes;
+  v2[8] = 2;
+  EXPECT_EQ(message(v2), "shard file format version 2; this pathex reads version 1");
+  EXPECT_EQ(message(bytes + "x"), "corrupted shard file: 1 bytes after its checksum");
+}
+
+// The file with its JSON header replaced by `head` (lengths and checksum made right again), as a
+// newer or hand-edited writer would make it.
+std::string with_header(const std::string& bytes, const std::string& head) {
+  std::uint32_t h = 0;
+  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
+  std::string out = bytes.substr(0, 12);
+  for (std::size_t i = 0; i < 4; ++i) out.push_back(static_cast<char>((head.size() >> (8 * i)) & 0xff));
+  out += head + bytes.substr(16 + h, bytes.size() - 16 - h - 4);
+  const auto crc = static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
+  for (std::size_t i = 0; i < 4; ++i) out.push_back(static_cast<char>((crc >> (8 * i)) & 0xff));
+  return out;
+}
+
+// The header goes through the one JSON reader: a wrong value is refused at its JSON pointer.
+TEST(ShardFile, HeaderErrorsNameTheFileAndThePointer) {
+  Fixture f;
+  const std::string bytes = encode_shard(f.header, f.histogram, f.images);
+  std::uint32_t h = 0;
+  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
+  const nlohmann::ordered_json head = nlohmann::ordered_json::parse(bytes.substr(16, h));
+  const auto refusal = [&](const nlohmann::ordered_json& j) {
+    Result<ShardFile> file = parse_shard(with_header(bytes, j.dump()), "x.shard");
+    return file ? std::string("(read)") : file.error().render();
+  };
+  EXPECT_EQ(refusal(head), "(read)");  // the rewriting itself is sound
+  nlohmann::ordered_json j = head;
+  j["options"]["images"] = "yes";
+  EXPECT_EQ(refusal(j), "x.shard:/options/images: expected true or false, found a string");
+  j = head;
+  j["seed"] = -1;
+  EXPECT_EQ(refusal(j), "x.shard:/seed: expected an integer in [0, 18446744073709551615], found -1");
+  j = head;
+  j["colour"] = 1;
+  EXPECT_EQ(refusal(j).rfind("x.shard:/colour: unknown key 'colour', expected one of pathex, scene,", 0), 0u) << refusal(j);
+  j = head;
+  j.erase("passes");
+  EXPECT_EQ(refusal(j), "x.shard:/passes: missing passes");
+  j = head;
+  j["passes"] = {{4, 2}};
+  EXPECT_EQ(refusal(j), "x.shard:/passes/0: expected [first, last) with first < last, after the previous range");
+  Result<ShardFile> bad_json = parse_shard(with_header(bytes, "{\"pathex\": "), "x.shard");
+  ASSERT_FALSE(bad_json);
+  EXPECT_EQ(bad_json.error().message.rfind("not valid JSON: ", 0), 0u) << bad_json.error().message;
+}
+
+}  // namespace
+}  // namespace pathex
