@@ -34,16 +34,8 @@ import subprocess
 import sys
 import tempfile
 
-
-def cpu_run(cmd):
-    """Runs cmd, returns its CPU seconds (user + system); exits on failure."""
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
-    err = proc.stderr.read().decode()
-    proc.stderr.close()
-    if os.waitstatus_to_exitcode(status) != 0:
-        sys.exit(f"{shlex.join(cmd)} failed: {err}")
-    return usage.ru_utime + usage.ru_stime
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cli_ab import cpu_run  # noqa: E402  (the one CPU-time runner: user + system time from os.wait4)
 
 
 def scene_args(scene, resolution, max_bounces):

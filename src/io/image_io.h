@@ -31,7 +31,7 @@ std::uint64_t render_memory_estimate(int width, int height, int layers);
 
 // --- OpenEXR ---
 
-// Lossless compressions (`pathex trace --exr-compression`). RLE is the default: it encodes the
+// Lossless compressions. RLE is the default (pathex trace writes it): it encodes the
 // Cornell box's six 256 x 256 layers in about an eighth of ZIP's CPU time, for files about 1.5
 // times as large (bench/README.md, "Per-run overhead").
 enum class ExrCompression : std::uint8_t { kRle, kZip, kNone };
