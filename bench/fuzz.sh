@@ -4,10 +4,13 @@
 # turn, one at a time, SECONDS in total split evenly (default: all six harnesses: expression,
 # class_file, profile, check_file, scene, obj). Each starts from its seed corpus (made here from
 # grammar/corpus/, tests/scene/bad/, tests/reach/checks/ and samples/) and its dictionary
-# (fuzz/dict/). libFuzzer runs in fork mode and keeps going after a finding; findings (crash-*,
-# timeout-*, oom-*, leak-*) land in build-fuzz/findings/HARNESS/, the grown corpora in
-# build-fuzz/corpus/HARNESS/. Exit 1 when there are findings. Run it niced on a shared machine:
-#   nice -n 19 bash bench/fuzz.sh 3600
+# (fuzz/dict/). Each harness runs under small limits (fuzz_support.h), so that one input costs
+# milliseconds and an input past 5 s (-timeout) is a hang the work budget missed; a process over
+# 1 GiB (-rss_limit_mb) is a finding too. libFuzzer runs in fork mode and keeps going after a
+# finding; findings (crash-*, timeout-*, oom-*, leak-*) land in build-fuzz/findings/HARNESS/, the
+# grown corpora in build-fuzz/corpus/HARNESS/, libFuzzer's log in build-fuzz/findings/HARNESS.log.
+# Prints each harness's executions and exits 1 when there are findings.
+#   bash bench/fuzz.sh 3600
 set -euo pipefail
 cd "$(dirname "$0")/.."
 total=${1:?usage: bench/fuzz.sh SECONDS [HARNESS...]}
@@ -46,12 +49,16 @@ status=0
 for h in "${harnesses[@]}"; do
   mkdir -p "build-fuzz/corpus/$h" "build-fuzz/findings/$h"
   echo "fuzz_$h: $per s"
-  build-fuzz/fuzz/fuzz_$h -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
-    -max_total_time="$per" -timeout=10 -close_fd_mask=1 -rss_limit_mb=2048 -dict="fuzz/dict/$h.dict" \
+  before=$(find "build-fuzz/findings/$h" -type f | wc -l)  # earlier runs' findings stay
+  TIMEFORMAT='%U+%S'  # the CPU seconds it got (user + system), fork-mode children included
+  cpu=$( { time build-fuzz/fuzz/fuzz_$h -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
+    -max_total_time="$per" -timeout=5 -close_fd_mask=1 -rss_limit_mb=1024 -dict="fuzz/dict/$h.dict" \
     -artifact_prefix="build-fuzz/findings/$h/" "build-fuzz/corpus/$h" "$seeds/$h" \
-    > "build-fuzz/findings/$h.log" 2>&1 || true
-  n=$(find "build-fuzz/findings/$h" -type f | wc -l)
-  echo "fuzz_$h: $(grep -o 'cov: [0-9]*' "build-fuzz/findings/$h.log" | tail -1), $n findings"
+    > "build-fuzz/findings/$h.log" 2>&1 || true; } 2>&1 )
+  n=$(( $(find "build-fuzz/findings/$h" -type f | wc -l) - before ))
+  # fork mode's status lines: "#EXECS: cov: C ft: F corp: N exec/s R oom/timeout/crash: …"
+  last=$(grep -E '^#[0-9]+: cov:' "build-fuzz/findings/$h.log" | tail -1)
+  echo "fuzz_$h: $(sed -E 's/^#([0-9]+): cov: ([0-9]+).* exec\/s:? ([0-9]+).*/\1 executions (\3 per second), coverage \2/' <<<"$last"), $(awk -F+ '{printf "%.0f", $1 + $2}' <<<"$cpu") s of CPU, $n findings"
   [ "$n" -eq 0 ] || status=1
 done
 exit $status

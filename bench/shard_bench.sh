@@ -6,8 +6,10 @@
 #            single render's render.shard against its histogram.json + classes.exr + PNGs, and
 #            the 16 shards' files against theirs;
 #   mpi      `mpirun -n 2 pathex-mpi trace --threads 1` against `pathex trace --threads 1`, the
-#            two run alternately ROUNDS times, wall time including process start; the speedup of
-#            each pair and their median (target >= 1.8x). Skipped without build/pathex-mpi.
+#            two run alternately ROUNDS times, wall time including process start and CPU time of
+#            every process; per pair the wall speedup (target >= 1.8x), the CPU efficiency and the
+#            speedup the CPU times predict on an idle machine; their medians, and how busy the
+#            machine was. Skipped without build/pathex-mpi.
 # Usage: bash bench/shard_bench.sh [merge|size|mpi|all] (default all). Scratch: $TMPDIR/pathex-shard-bench.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,12 +27,15 @@ median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[
 outputs_bytes() { (cd "$1" && cat histogram.json classes.exr ./*.png | wc -c); }
 
 if [ "$what" = merge ] || [ "$what" = size ] || [ "$what" = all ]; then
-  if [ ! -f "$work/s15/render.shard" ]; then
+  # Shards of another pathex build (the version names the commit) are refused: render again.
+  if [ ! -f "$work/s15/render.shard" ] || ! "$P" merge "$work"/s{0..15} --quiet --out "$work/check" 2> /dev/null; then
+    rm -rf "$work"/s* "$work/check" "$work/merged"
     echo "rendering 16 shards of $scene, 16 spp, 20 classes (one pass each) ..."
     for i in $(seq 0 15); do
       "$P" trace "$scene" --classes "$classes" --spp 16 --shard "$i/16" --quiet --out "$work/s$i" > /dev/null
     done
   fi
+  rm -rf "$work/check"
   if [ "$what" != size ]; then
     times=(); cpus=()
     for r in 1 2 3; do
@@ -41,9 +46,21 @@ if [ "$what" = merge ] || [ "$what" = size ] || [ "$what" = all ]; then
     done
     printf 'merge of 16 shards (512x512, 20 classes, 16 spp): wall %s s, CPU (user + sys) %s s (medians of 3; load average %s)\n' \
       "$(printf '%s\n' "${times[@]}" | median)" "$(printf '%s\n' "${cpus[@]}" | median)" "$(cut -d' ' -f1-3 /proc/loadavg)"
+    # The same outputs from one shard (the merged render's): what writing them costs, apart from
+    # reading and adding the 16 files.
+    times=(); cpus=()
+    for r in 1 2 3; do
+      rm -rf "$work/rewritten"
+      /usr/bin/time -f '%e %U %S' -o "$work/time.txt" "$P" merge "$work/merged" --quiet --out "$work/rewritten"
+      read -r wall user sys < "$work/time.txt"
+      times+=("$wall"); cpus+=("$(echo "$user + $sys" | bc -l)")
+    done
+    printf '  of which writing the outputs (a merge of the merged render alone): wall %s s, CPU %s s\n' \
+      "$(printf '%s\n' "${times[@]}" | median)" "$(printf '%s\n' "${cpus[@]}" | median)"
   fi
   if [ "$what" != merge ]; then
-    [ -f "$work/merged/render.shard" ] || "$P" merge "$work"/s{0..15} --quiet --out "$work/merged"
+    rm -rf "$work/merged"
+    "$P" merge "$work"/s{0..15} --quiet --out "$work/merged"
     shard=$(wc -c < "$work/merged/render.shard")
     out=$(outputs_bytes "$work/merged")
     echo "render.shard of the 16-spp render: $shard bytes; its outputs: $out bytes; ratio $(echo "scale=3; $shard / $out" | bc -l)"
@@ -60,17 +77,42 @@ if [ "$what" = mpi ] || [ "$what" = all ]; then
   if [ ! -x "$MPI" ]; then
     echo "mpi: skipped ($MPI is not built: MPI was not found at configure time)"
   else
+    # Wall time (including process start) and CPU time (user + sys) of each process: the CPU
+    # figures say what the split costs whatever the load: efficiency = CPU of one process / CPU
+    # of both ranks, and the speedup two idle cores would give = CPU of one process / (the
+    # slower rank's CPU + the 2-rank run's start-up and reduction, measured as its wall time
+    # minus its slower rank's wall time).
     args=(trace samples/scenes/cornell.json --spp "${SPP:-256}" --threads 1 --quiet)
-    speedups=()
+    speedups=(); efficiencies=(); idle_speedups=()
+    cpu_idle() { awk '/^cpu /{print $5 + $6, $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9}' /proc/stat; }
+    read -r idle0 all0 < <(cpu_idle)
     for r in $(seq 1 "$rounds"); do
-      t0=$(now); "$P" "${args[@]}" --out "$work/one" > /dev/null; t1=$(now)
-      mpirun --oversubscribe --allow-run-as-root -n 2 "$MPI" "${args[@]}" --out "$work/two" > /dev/null; t2=$(now)
-      one=$(echo "$t1 - $t0" | bc -l); two=$(echo "$t2 - $t1" | bc -l)
+      t0=$(now)
+      /usr/bin/time -f '%e %U %S' -o "$work/one.time" "$P" "${args[@]}" --out "$work/one" > /dev/null
+      t1=$(now)
+      mpirun --oversubscribe --allow-run-as-root -n 2 sh -c \
+        '/usr/bin/time -f "%e %U %S" -o "$0.$OMPI_COMM_WORLD_RANK" "$@"' "$work/rank.time" "$MPI" "${args[@]}" --out "$work/two" > /dev/null
+      t2=$(now)
       cmp -s "$work/one/histogram.json" "$work/two/histogram.json" || { echo "mpi: outputs differ"; exit 1; }
+      cmp -s "$work/one/classes.exr" "$work/two/classes.exr" || { echo "mpi: images differ"; exit 1; }
+      read -r _ u1 s1 < "$work/one.time"
+      read -r w_a u_a s_a < "$work/rank.time.0"
+      read -r w_b u_b s_b < "$work/rank.time.1"
+      one=$(echo "$t1 - $t0" | bc -l); two=$(echo "$t2 - $t1" | bc -l)
+      cpu1=$(echo "$u1 + $s1" | bc -l); cpu_a=$(echo "$u_a + $s_a" | bc -l); cpu_b=$(echo "$u_b + $s_b" | bc -l)
+      slow_cpu=$(echo "if ($cpu_a > $cpu_b) $cpu_a else $cpu_b" | bc -l)
+      slow_wall=$(echo "if ($w_a > $w_b) $w_a else $w_b" | bc -l)
+      overhead=$(echo "$two - $slow_wall" | bc -l)
       speedups+=("$(echo "$one / $two" | bc -l)")
-      printf 'round %d: 1 process %.2f s, 2 ranks %.2f s, speedup %.3f\n' "$r" "$one" "$two" "${speedups[-1]}"
+      efficiencies+=("$(echo "$cpu1 / ($cpu_a + $cpu_b)" | bc -l)")
+      idle_speedups+=("$(echo "$cpu1 / ($slow_cpu + $overhead)" | bc -l)")
+      printf 'round %d: 1 process %.2f s wall %.2f s CPU; 2 ranks %.2f s wall, ranks %.2f + %.2f s CPU, mpirun start-up and exit %.2f s; wall speedup %.3f, CPU efficiency %.3f, idle-machine speedup %.3f\n' \
+        "$r" "$one" "$cpu1" "$two" "$cpu_a" "$cpu_b" "$overhead" "${speedups[-1]}" "${efficiencies[-1]}" "${idle_speedups[-1]}"
     done
-    printf 'mpi 2 ranks x 1 thread against 1 process x 1 thread: median speedup %.3f (load average %s)\n' \
-      "$(printf '%s\n' "${speedups[@]}" | median)" "$(cut -d' ' -f1-3 /proc/loadavg)"
+    read -r idle1 all1 < <(cpu_idle)
+    busy=$(echo "100 * (1 - ($idle1 - $idle0) / ($all1 - $all0))" | bc -l)
+    printf 'mpi 2 ranks x 1 thread against 1 process x 1 thread (medians of %d rounds): wall speedup %.3f, CPU efficiency %.3f, idle-machine speedup %.3f (machine %.0f %% busy during the runs, load average %s)\n' \
+      "$rounds" "$(printf '%s\n' "${speedups[@]}" | median)" "$(printf '%s\n' "${efficiencies[@]}" | median)" \
+      "$(printf '%s\n' "${idle_speedups[@]}" | median)" "$busy" "$(cut -d' ' -f1-3 /proc/loadavg)"
   fi
 fi

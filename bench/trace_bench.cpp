@@ -17,6 +17,7 @@
 #include <fstream>
 #include <random>
 
+#include "bias/bias.h"
 #include "classify/classifier.h"
 #include "io/class_file.h"
 #include "io/profile_json.h"
@@ -295,6 +296,73 @@ void BM_MillionTriangles(benchmark::State& state) {
   std::filesystem::remove_all(dir);
 }
 BENCHMARK(BM_MillionTriangles)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
+// pathex bias against the reference render it is made of (issue 18: "one reference render plus
+// < 1 %"), interleaved: each iteration runs run_bias (pt-nee against bdpt, the built-in classes,
+// their images and the missed layer, the checker's languages, the per-class queries and the
+// per-path verdicts) and, alone, the bdpt render `pathex trace` would run (the built-in classes
+// and their layers) with its report, on the same scene, spp, seed and bound, one thread.
+// `overhead_pct` is the median of the per-iteration ratios minus 1, `extra_ms` the median of the
+// differences (what bias adds whatever the render's length). Arg 0: a control, the plain
+// render against itself; 1: the Cornell box; 2: the point light and mirror
+// (samples/scenes/point-mirror-caustic.json).
+void BM_BiasOverhead(benchmark::State& state) {
+  const int arg = static_cast<int>(state.range(0));
+  static const Scene mirror =
+      load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/point-mirror-caustic.json").expect("a benchmark input");
+  const Scene& scene = arg == 2 ? mirror : cornell();
+  const Profile bdpt = resolve_profile("bdpt", Limits{}).expect("a benchmark input");
+  const Profile pt_nee = resolve_profile("pt-nee", Limits{}).expect("a benchmark input");
+  std::vector<const PathClass*> classes;
+  std::vector<ClassInfo> infos;
+  for (const auto& c : ClassTable::builtins().builtin_classes())  // as src/cli/trace.cpp and bias.cpp
+    if (c->name != "all") {
+      classes.push_back(c.get());
+      infos.push_back({c->name, c->text});
+    }
+  const Classifier builtin = Classifier::build(classes, Limits{}).expect("a benchmark input");
+  const std::uint64_t spp = arg == 2 ? 256 : 16;
+  BiasOptions bo;
+  bo.spp = spp;
+  bo.threads = 1;
+  RenderOptions plain = options(1, spp);
+  plain.max_bounces = reference_bound("pt-nee", std::nullopt, std::nullopt).expect("a bound");
+  for (int i = 0; i < builtin.num_classes(); ++i) plain.layer_classes.push_back(i);
+  const auto reference_alone = [&]() -> bool {
+    Result<RenderOutput> out = render(scene, bdpt, &builtin, plain);
+    return out && make_report(out->histogram, RunInfo{}, &builtin, infos).ok();
+  };
+  std::vector<double> ratios, extra;
+  bool bias_first = false;  // alternated, so that neither side always runs on a warm cache
+  for (auto _ : state) {
+    double bias_s = 0, plain_s = 0;
+    for (int side = 0; side < 2; ++side) {
+      const bool with = (side == 0) == bias_first;
+      const double t0 = cpu_seconds();
+      bool ok = true;
+      if (with && arg != 0) {
+        Result<Profile> ref = choose_reference("", scene, pt_nee, bo);
+        ok = ref && run_bias(scene, "bench", pt_nee, *ref, classes, bo).ok();
+      } else {
+        ok = reference_alone();
+      }
+      (with ? bias_s : plain_s) += cpu_seconds() - t0;
+      if (!ok) {
+        state.SkipWithError("a render failed");
+        return;
+      }
+    }
+    ratios.push_back(bias_s / plain_s);
+    extra.push_back(bias_s - plain_s);
+    bias_first = !bias_first;
+  }
+  state.counters["overhead_pct"] = benchmark::Counter(100.0 * (median(ratios) - 1.0));
+  state.counters["extra_ms"] = benchmark::Counter(1000.0 * median(extra));
+  state.SetLabel(arg == 0 ? "control: the bdpt render against itself"
+                 : arg == 1 ? "Cornell box, pt-nee against bdpt, 16 spp"
+                            : "point light and mirror, pt-nee against bdpt, 256 spp");
+}
+BENCHMARK(BM_BiasOverhead)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(31);
 
 }  // namespace
 }  // namespace pathex

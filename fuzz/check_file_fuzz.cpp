@@ -12,7 +12,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string file = fuzz::write_scratch("check.json", fuzz::as_text(data, size));
   CLI::App app{"pathex"};
   cli::Command check = cli::add_check(app);
-  std::vector<std::string> args = {file, "check"};  // CLI11 parses a reversed vector
+  const Limits l = fuzz::small_limits();
+  std::vector<std::string> args = {"check", file,
+                                   "--max-states", std::to_string(l.max_states),
+                                   "--max-repeat", std::to_string(l.max_repeat),
+                                   "--max-length", std::to_string(l.max_length),
+                                   "--max-work", std::to_string(l.max_work),
+                                   "--max-file-size", std::to_string(l.max_file_bytes)};
+  std::reverse(args.begin(), args.end());  // CLI11 parses a reversed vector
   app.parse(args);
   const int code = check.run();
   if (code < 0 || code > 2) fuzz::finding("an exit code other than 0, 1 or 2");

@@ -5,7 +5,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace pathex;
   ClassTable table;
-  Result<bool> r = load_class_file(std::string(fuzz::as_text(data, size)), "fuzz.json", ClassOptions{}, &table);
+  ClassOptions options;
+  options.limits = fuzz::small_limits();
+  Result<bool> r = load_class_file(std::string(fuzz::as_text(data, size)), "fuzz.json", options, &table);
   if (!r && r.error().message.empty()) fuzz::finding("an error without a message");
   return 0;
 }

@@ -10,6 +10,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (Notation notation : {Notation::kFull, Notation::kHeckbert}) {
     ClassOptions options;
     options.notation = notation;
+    options.limits = fuzz::small_limits();
     Result<PathClass> c = compile_class(text, options);
     if (c) continue;
     if (c.error().message.empty()) fuzz::finding("an error without a message");

@@ -12,10 +12,33 @@
 #include <string>
 #include <string_view>
 
+#include "core/limits.h"
 #include "io/profile_json.h"
 #include "trace/render.h"
 
 namespace pathex::fuzz {
+
+// The limits every harness runs under: small, so that one input costs milliseconds under ASan
+// rather than the second the defaults allow (with the defaults, a run in 2026-12 managed 39
+// expressions in ten minutes). libFuzzer then runs hundreds of inputs a second, and a hang that
+// the work budget does not bound still shows as a timeout. That the defaults themselves stop
+// every known hang within 1 s is measured by bench/hangs.py (README "Limits"). --max-depth stays
+// at its default: its recursion is what the fuzzer should reach.
+inline Limits small_limits() {
+  Limits l;
+  l.max_states = 5000;
+  l.max_repeat = 64;
+  l.max_length = 10000;
+  l.max_work = 200000;
+  l.max_file_bytes = std::size_t{1} << 20;
+  return l;
+}
+
+inline SceneLoadOptions small_scene_options() {
+  SceneLoadOptions o;
+  o.max_file_bytes = small_limits().max_file_bytes;
+  return o;
+}
 
 inline std::string_view as_text(const std::uint8_t* data, std::size_t size) {
   return {reinterpret_cast<const char*>(data), size};

@@ -16,7 +16,7 @@ constexpr const char* kScene = R"({
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace pathex;
   fuzz::write_scratch("mesh.obj", fuzz::as_text(data, size));
-  Result<Scene> scene = load_scene_json(kScene, fuzz::scratch_dir(), "fuzz.json");
+  Result<Scene> scene = load_scene_json(kScene, fuzz::scratch_dir(), "fuzz.json", fuzz::small_scene_options());
   if (!scene) {
     if (scene.error().message.empty()) fuzz::finding("an error without a message");
     return 0;

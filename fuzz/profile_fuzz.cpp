@@ -5,7 +5,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace pathex;
-  const Limits limits;
+  const Limits limits = fuzz::small_limits();
   Result<Profile> p = parse_profile(std::string(fuzz::as_text(data, size)), "fuzz.json", limits);
   if (!p) {
     if (p.error().message.empty()) fuzz::finding("an error without a message");

@@ -4,7 +4,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace pathex;
-  Result<Scene> scene = load_scene_json(fuzz::as_text(data, size), PATHEX_SOURCE_DIR "/tests/scene/bad", "fuzz.json");
+  Result<Scene> scene = load_scene_json(fuzz::as_text(data, size), PATHEX_SOURCE_DIR "/tests/scene/bad", "fuzz.json",
+                                         fuzz::small_scene_options());
   if (!scene) {
     if (scene.error().message.empty()) fuzz::finding("an error without a message");
     return 0;

@@ -88,7 +88,7 @@ class ClassImages {
   ExactRgb sum(int layer, int x, int y) const;
   // The layer as floats, each pixel's sum times `scale` (1 / spp for the pixel's mean).
   ImageLayer layer(int layer, double scale) const;
-  std::vector<ImageLayer> layers(double scale) const;
+  std::vector<ImageLayer> layers(double scale) const;  // every layer, in parallel
   std::size_t memory_bytes() const;
 
   // --- the exact state, tile by tile (shard files, MPI reductions) ---

@@ -8,7 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "automata/ops.h"
+#include "cli/bias_common.h"
 #include "cli/common.h"
+#include "cli/estimate_text.h"
 #include "cli/reach_common.h"
 #include "io/atomic_file.h"
 #include "io/class_file.h"
@@ -27,12 +29,22 @@ struct CheckArgs {
   Limits limits;
 };
 
+// {"missed": {"max_share": 0.01, "spp": 64, "reference": "bdpt"}}: the renderer misses at most
+// max_share of the scene's light as a reference render at spp finds it (pathex bias).
+struct MissedRequirement {
+  double max_share = 0;
+  std::uint64_t spp = 64;
+  std::string reference;  // empty: bias's default reference
+};
+
 struct Requirement {
   std::string pointer;
   bool covers_scene = false;
+  std::optional<MissedRequirement> missed;
   std::string cls;
   std::string verdict;  // reachable, not-unreachable, unreachable, partial, empty
   std::string describe() const {
+    if (missed) return "misses at most " + percent(missed->max_share, 2) + " of the scene's light";
     return covers_scene ? "covers the scene" : cls + " is " + verdict;
   }
 };
@@ -54,6 +66,7 @@ struct Outcome {
   bool passed = false;
   std::string verdict;
   std::optional<Witness> counterexample;
+  std::optional<BiasReport> missed;  // a missed requirement's measurement
   double time_s = 0.0;
 };
 
@@ -69,6 +82,26 @@ std::string resolve(const std::string& check_file, const std::string& p) {
   std::error_code ec;
   if (fs::exists(beside, ec)) return beside.string();
   return p;
+}
+
+// The value of a requirement's "missed" key, through the one JSON reader.
+Result<MissedRequirement> parse_missed(const nlohmann::json& jm, const std::string& file, const std::string& ptr) {
+  const JsonReader reader(file);
+  if (!jm.is_object()) return reader.fail(ptr, "expected {\"max_share\": a share from 0 to 1, \"spp\": samples per pixel}");
+  if (Result<bool> k = reader.keys(jm, ptr, {"max_share", "spp", "reference"}); !k) return k.error();
+  MissedRequirement m;
+  Result<double> share = reader.number(jm, "max_share", ptr, 0.0, 1.0);
+  if (!share) return share.error();
+  m.max_share = *share;
+  Result<long long> spp = reader.integer(jm, "spp", ptr, 1, 1 << 24, 64);
+  if (!spp) return spp.error();
+  m.spp = static_cast<std::uint64_t>(*spp);
+  if (jm.contains("reference")) {
+    Result<std::string> ref = reader.string(jm, "reference", ptr);
+    if (!ref) return ref.error();
+    m.reference = *ref;
+  }
+  return m;
 }
 
 Result<std::vector<Case>> parse_check(const std::string& text, const std::string& file) {
@@ -123,13 +156,21 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
     for (std::size_t j = 0; j < reqs.size(); ++j) {
       const std::string rp = ptr + "/require/" + std::to_string(j);
       const auto& jr = reqs[j];
-      if (!jr.is_object()) return bad(file, rp, "expected {\"class\": …, \"verdict\": …} or {\"covers-scene\": true}");
+      if (!jr.is_object())
+        return bad(file, rp, "expected {\"class\": …, \"verdict\": …}, {\"covers-scene\": true} or {\"missed\": {…}}");
       Requirement r;
       r.pointer = rp;
       for (const auto& [k, v] : jr.items())
-        if (k != "class" && k != "verdict" && k != "covers-scene")
-          return bad(file, rp + "/" + pointer_token(k), "unknown key '" + k + "', expected class and verdict, or covers-scene");
-      if (jr.contains("covers-scene")) {
+        if (k != "class" && k != "verdict" && k != "covers-scene" && k != "missed")
+          return bad(file, rp + "/" + pointer_token(k),
+                     "unknown key '" + k + "', expected class and verdict, or covers-scene, or missed");
+      if (jr.contains("missed")) {
+        if (jr.size() != 1) return bad(file, rp, "missed stands alone: no other key beside it");
+        if (c.scene.empty()) return bad(file, rp + "/missed", "a missed requirement needs the case's scene");
+        Result<MissedRequirement> m = parse_missed(jr.at("missed"), file, rp + "/missed");
+        if (!m) return m.error();
+        r.missed = *m;
+      } else if (jr.contains("covers-scene")) {
         if (jr.at("covers-scene") != true) return bad(file, rp + "/covers-scene", "expected true");
         if (jr.contains("class") || jr.contains("verdict"))
           return bad(file, rp, "covers-scene stands alone: no class or verdict beside it");
@@ -177,6 +218,32 @@ Error at_case_key(Error e, const std::string& check_file, const std::string& poi
   return e;
 }
 
+// A missed requirement: one reference render of the case's scene (pathex bias) without images. It
+// fails when the renderer misses more than max_share of the light; the counterexample is the
+// shortest path it cannot sample, and the details name the largest missed path.
+Result<bool> decide_missed(const CheckArgs& a, ReachCache& cache, const Case& c, const Requirement& r, Outcome* o) {
+  Result<Scene> scene = load_scene_file(c.scene, SceneLoadOptions{a.limits.max_file_bytes});
+  if (!scene) return at_case_key(scene.error(), a.file, c.pointer + "/scene", c.scene);
+  Result<const Profile*> renderer = cache.profile(c.renderer);
+  if (!renderer) return at_case_key(renderer.error(), a.file, c.pointer + "/renderer", c.renderer);
+  BiasOptions bo;
+  bo.spp = r.missed->spp;
+  bo.renderer_bounces = c.max_bounces;
+  bo.images = false;
+  bo.limits = a.limits;
+  const std::string reference = r.missed->reference.empty() || r.missed->reference.find('/') == std::string::npos
+                                    ? r.missed->reference
+                                    : resolve(a.file, r.missed->reference);
+  Result<BiasRun> run = measure_missed(*scene, c.scene, **renderer, reference, {}, bo);
+  if (!run) return at_case_key(run.error(), a.file, r.pointer + "/missed", reference);
+  const BiasReport& b = run->report;
+  o->passed = b.share <= r.missed->max_share;
+  o->verdict = percent(b.share, 2) + " ± " + percent(b.share_std_error, 2) + " of what " + b.reference + " finds";
+  if (!o->passed && b.shortest) o->counterexample = b.shortest;
+  o->missed = b;
+  return true;
+}
+
 // Decides every requirement of every case, in order.
 Result<std::vector<Outcome>> decide(const CheckArgs& a, const std::vector<Case>& cases) {
   ReachCache cache(a.limits);
@@ -205,6 +272,13 @@ Result<std::vector<Outcome>> decide(const CheckArgs& a, const std::vector<Case>&
       Outcome o;
       o.c = &c;
       o.r = &r;
+      if (r.missed) {
+        Result<bool> m = decide_missed(a, cache, c, r, &o);
+        if (!m) return m.error();
+        o.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        outcomes.push_back(std::move(o));
+        continue;
+      }
       QueryOptions qo;
       qo.max_bounces = c.max_bounces;
       qo.universe = universe;
@@ -276,6 +350,11 @@ int run(const CheckArgs& a) {
     } else if (!o.passed && o.verdict == "empty") {
       details = "the class has no path in this universe";
     }
+    if (!o.passed && o.missed && !o.missed->paths.empty()) {
+      const MissedPath& p = o.missed->paths.front();
+      details += "\n      largest missed path " + p.estimate.path + ", " + percent(p.share, 2) + " of the image, chains " +
+                 chains_text(p.chains) + "; " + p.reason;
+    }
     junit.push_back({o.c->name, o.r->describe(), o.time_s, !o.passed, false, message, details});
     if (a.json) {
       nlohmann::json jr = {{"case", o.c->name}, {"renderer", o.c->renderer}, {"requirement", o.r->describe()},
@@ -288,6 +367,15 @@ int run(const CheckArgs& a) {
         jr["counterexample"] = {{"path", o.counterexample->path}, {"chains", chains}};
         if (o.counterexample->reason.empty()) jr["counterexample"]["strategies"] = o.counterexample->strategies;
         else jr["counterexample"]["reason"] = o.counterexample->reason;
+      }
+      if (o.missed) {
+        const BiasReport& b = *o.missed;
+        jr["missed"] = {{"share", b.share}, {"stderr", b.share_std_error}, {"max_share", o.r->missed->max_share},
+                        {"reference", b.reference}, {"spp", b.spp}, {"luminance", b.missed.luminance},
+                        {"total", b.total.luminance}};
+        if (!b.paths.empty())
+          jr["missed"]["largest_path"] = {{"path", b.paths.front().estimate.path}, {"share", b.paths.front().share},
+                                          {"reason", b.paths.front().reason}};
       }
       jcases.push_back(jr);
     } else {

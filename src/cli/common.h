@@ -66,5 +66,6 @@ Command add_check(CLI::App& app);
 Command add_renderers(CLI::App& app);
 Command add_trace(CLI::App& app);
 Command add_merge(CLI::App& app);
+Command add_bias(CLI::App& app);
 
 }  // namespace pathex::cli

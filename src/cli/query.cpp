@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "cli/common.h"
+#include "cli/witness_text.h"
 #include "cli/reach_common.h"
 #include "io/class_file.h"
 #include "io/reach_json.h"
@@ -23,20 +24,6 @@ struct QueryArgs {
   NotationOptions notation;
   Limits limits;
 };
-
-std::string chains_text(const std::vector<ChainEvidence>& chains) {
-  std::string s;
-  for (const ChainEvidence& c : chains) {
-    if (!s.empty()) s += ' ';
-    s += c.chain.letters + "(" + std::to_string(c.chain.from) + ".." + std::to_string(c.chain.to) + ")";
-    if (!c.connectors.empty()) {
-      s += "[";
-      for (std::size_t i = 0; i < c.connectors.size(); ++i) s += (i ? "|" : "") + to_string(c.connectors[i]);
-      s += "]";
-    }
-  }
-  return s;
-}
 
 std::string size_text(bool empty, bool finite) {
   return empty ? "none" : finite ? "finite" : "infinite";

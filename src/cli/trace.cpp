@@ -1,11 +1,7 @@
 // pathex trace: render a scene, label every sampled path, write the path-class histogram, the
 // per-class EXR and PNG previews, and print where the light went, class by class, next to what the
 // checker says the renderer can reach.
-#include <sys/ioctl.h>
-#include <unistd.h>
-
 #include <chrono>
-#include <csignal>
 #include <ctime>
 #include <cstdio>
 #include <filesystem>
@@ -14,9 +10,12 @@
 #include <sstream>
 #include <thread>
 
+#include "cli/bias_common.h"
 #include "cli/common.h"
+#include "cli/estimate_text.h"
 #include "cli/reach_common.h"
 #include "cli/render_job.h"
+#include "cli/render_watch.h"
 #include "cli/trace_checks.h"
 #include "core/hash.h"
 #include "core/version.h"
@@ -27,7 +26,6 @@
 #include "io/output_set.h"
 #include "io/input_file.h"
 #include "io/profile_json.h"
-#include "io/progress.h"
 #include "scene/scene_hash.h"
 #include "scene/universe.h"
 #include "trace/render.h"
@@ -61,40 +59,16 @@ struct TraceArgs {
   std::string resume;      // a render folder
   double time_limit = 0;   // seconds; 0: none
   std::uint64_t max_memory = kDefaultMaxMemory;
+  bool missed = false;       // also measure what the renderer misses (pathex bias)
+  std::string reference;     // the reference for --missed; empty: bias's default
   std::vector<std::string> settings_given;  // render settings named on the command line (refused with --resume)
   Limits limits;
 };
-
-std::atomic<bool> g_cancel{false};
-// Ctrl-C, and SIGTERM (how mpirun stops the other ranks when one fails), end the render after the
-// chunk in progress; what was rendered is written, marked incomplete.
-extern "C" void on_stop(int) { g_cancel.store(true); }
-
-std::string percent(double share, int decimals = 1) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*f %%", decimals, 100.0 * share);
-  return buf;
-}
 
 std::string gib(std::uint64_t bytes) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(bytes) / static_cast<double>(std::uint64_t{1} << 30));
   return buf;
-}
-
-// An absolute estimate: the mean pixel luminance and its standard error, "0.01234 ± 0.00012".
-std::string absolute(const Estimate& e) {
-  char buf[64];
-  if (std::isfinite(e.std_error)) std::snprintf(buf, sizeof buf, "%.5f ± %.5f", e.luminance, e.std_error);
-  else std::snprintf(buf, sizeof buf, "%.5f (too few batches for an error)", e.luminance);
-  return buf;
-}
-
-// The terminal's width in columns (stderr's), or 80 when it does not say.
-int terminal_columns() {
-  winsize w{};
-  if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &w) == 0 && w.ws_col > 0) return w.ws_col;
-  return 80;
 }
 
 // "i/n" with 0 ≤ i < n.
@@ -267,6 +241,9 @@ int run(const TraceArgs& a) {
   Cluster* cluster = current_cluster();
   const int rank = cluster != nullptr ? cluster->rank() : 0;
   const int ranks = cluster != nullptr ? cluster->size() : 1;
+  if (a.missed && (!a.shard.empty() || !a.resume.empty() || ranks > 1))
+    return report(make_error(ErrorCode::kUsage, "--missed measures a whole render in one process: it cannot be given with "
+                                                "--shard, --resume or MPI"));
   // Connector statistics (histogram.json "connectors") are per process and not yet kept in shard
   // files, so a render that is split or resumed must not use a connector.
   for (const Strategy& st : job.profile->strategies)
@@ -281,12 +258,17 @@ int run(const TraceArgs& a) {
     out_set.emplace(std::move(*prepared));
   }
 
-  // The checker's view of the profile, for the warning now and the table after the render.
+  // The checker's view of the profile, for the warning now and the table after the render (rank
+  // 0 prints both; the other ranks skip the compilation).
   ReachCache cache(a.limits);
-  Result<const CompiledProfile*> cp = cache.compiled(id.renderer_source, id.max_bounces);
-  if (!cp) return report(cp.error());
+  const CompiledProfile* compiled = nullptr;
   const Dfa universe = scene_universe(scene_types(*job.scene));
-  if (rank == 0) warn_unreachable_lights(*job.scene, *job.profile, **cp, universe, id.max_bounces, a.limits);
+  if (rank == 0) {
+    Result<const CompiledProfile*> cp = cache.compiled(id.renderer_source, id.max_bounces);
+    if (!cp) return report(cp.error());
+    compiled = *cp;
+    warn_unreachable_lights(*job.scene, *job.profile, *compiled, universe, id.max_bounces, a.limits);
+  }
 
   // --- render this process's part of the passes still missing ---
   const PassSet todo = job.header.share.minus(job.header.passes);
@@ -316,32 +298,34 @@ int run(const TraceArgs& a) {
     e.where = id.scene + ":/camera";
     return report(e);
   }
-  const bool show_progress = rank == 0 && !a.quiet && ::isatty(STDERR_FILENO);
-  const auto start = std::chrono::steady_clock::now();
-  ro.progress = [&](std::uint64_t done, std::uint64_t total) {
-    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (a.time_limit > 0 && el >= a.time_limit) g_cancel.store(true);
-    if (!show_progress) return;
-    Progress p;
-    p.fraction = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
-    p.samples_per_s = el > 0 ? static_cast<double>(done) / el : 0.0;
-    p.seconds_left = p.fraction > 0 ? el / p.fraction - el : 0;
-    // Padded to the width it was fitted to, so a shorter line covers a longer one.
-    const int columns = terminal_columns();
-    std::fprintf(stderr, "\r%-*s", std::max(columns - 1, 0), progress_line(p, columns).c_str());
-    std::fflush(stderr);
-  };
-  g_cancel.store(false);
-  ro.cancel = &g_cancel;
-  std::signal(SIGINT, on_stop);
-  std::signal(SIGTERM, on_stop);
+  const std::atomic<bool>* stopped = nullptr;
   const double cpu_start = process_cpu_seconds();
-  Result<RenderOutput> out = render(*job.scene, *job.profile, job.classes->classifier.get(), ro);
+  Result<RenderOutput> out = [&] {
+    const RenderWatch watch(rank == 0 && !a.quiet, a.time_limit);
+    ro.progress = watch.progress();
+    ro.cancel = stopped = watch.cancel();
+    return render(*job.scene, *job.profile, job.classes->classifier.get(), ro);
+  }();
   const double cpu_s = process_cpu_seconds() - cpu_start;
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
-  if (show_progress) std::fprintf(stderr, "\r%*s\r", std::max(terminal_columns() - 1, 0), "");
   if (!out) return report(out.error());
+
+  // --- --missed: a reference render of the same scene, spp and seed measures what this one misses ---
+  std::optional<BiasReport> missed;
+  if (a.missed) {
+    BiasOptions bo;
+    bo.spp = job.header.spp;
+    bo.seed = id.seed;
+    bo.threads = a.threads;
+    bo.renderer_bounces = id.max_bounces;  // what this render could sample: its own bound
+    bo.images = false;
+    bo.limits = a.limits;
+    const RenderWatch watch(!a.quiet);
+    bo.progress = watch.progress();
+    bo.cancel = watch.cancel();
+    Result<BiasRun> b = measure_missed(*job.scene, id.scene, *job.profile, a.reference, {}, bo);
+    if (!b) return report(b.error());
+    missed = std::move(b->report);
+  }
 
   RenderSums sums{std::move(out->histogram), std::move(out->images)};
   ShardHeader header = job.header;
@@ -355,7 +339,7 @@ int run(const TraceArgs& a) {
     std::error_code ec;
     std::filesystem::create_directories(ranks_folder(job.out), ec);
     if (Result<bool> w = write_file_atomic(mine, encode_shard(header, sums.histogram, sums.images)); !w) return report(w.error());
-    if (g_cancel.load())
+    if (stopped->load())
       std::fprintf(stderr, "pathex: rank %d stopped after %s of its passes; they are kept in %s ('pathex trace --resume %s' finishes the render)\n",
                    rank, out->passes_done.to_string().c_str(), mine.c_str(), job.out.c_str());
     if (Result<bool> r = cluster->reduce(&sums, &header.passes, &header.run); !r) return report(r.error());
@@ -378,6 +362,8 @@ int run(const TraceArgs& a) {
       Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, out->connectors);
       if (!r) return r.error();
       written = std::move(*r);
+      if (missed)  // what pathex bias writes to bias.json, without images
+        if (Result<bool> w = write_file_atomic(dir + "/missed.json", to_json(*missed).dump(2) + "\n"); !w) return w;
       return true;
     });
     if (!w) failure = w.error();
@@ -415,10 +401,12 @@ int run(const TraceArgs& a) {
   std::cout << ", " << std::fixed << std::setprecision(2) << out->time_s << " s" << (complete ? "" : " (interrupted)")
             << ", non-finite samples " << rep->nonfinite_samples << "\n";
   std::cout << "image mean luminance " << absolute(rep->total) << "\n"
-            << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n\n";
+            << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n";
+  if (missed) std::cout << "this renderer " << missed_line(*missed).substr(missed->renderer.size() + 1) << "\n";
+  std::cout << "\n";
   for (std::size_t i = 0; i < rep->classes.size(); ++i) {
     const ClassEstimate& c = rep->classes[i];
-    Result<QueryResult> q = query(*classes[i], **cp, qo);
+    Result<QueryResult> q = query(*classes[i], *compiled, qo);
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << id.renderer << ": " << (q ? to_string(q->verdict) : "?") << "; luminance "
@@ -445,7 +433,7 @@ int run(const TraceArgs& a) {
     std::cout << "\n";
   }
   std::cout << "\nwrote " << job.out << "/histogram.json" << (id.images ? ", classes.exr and PNG previews" : "") << ", "
-            << kRenderShardName << "\n";
+            << kRenderShardName << (missed ? ", missed.json" : "") << "\n";
   if (!complete)
     std::cout << "interrupted: 'pathex trace --resume " << job.out << "' renders the missing passes "
               << job.header.share.minus(header.passes).to_string() << "\n";
@@ -492,6 +480,11 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--top", args->top_paths, "Exact paths to list")->capture_default_str()->check(CLI::Range(0, 100000));
   sub->add_flag("--json", args->json, "Print histogram.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
+  sub->add_flag("--missed", args->missed,
+                "Also render the reference (pathex bias) and print what share of its light this renderer cannot "
+                "sample; writes DIR/missed.json");
+  sub->add_option("--reference", args->reference, "The reference of --missed; default: bdpt plus the connectors the scene needs")
+      ->needs("--missed");
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs and the per-pixel sums behind them (the histogram is the same)");
   sub->add_option("--max-memory", args->max_memory,
                   "Refuse a render whose images (and their writing) would take more, estimated before rendering; e.g. 512M, 16G")

@@ -4,7 +4,6 @@
 // code 2; the library never prints and never exits.
 #pragma once
 
-#include <source_location>
 #include <string>
 #include <utility>
 #include <variant>
@@ -47,6 +46,17 @@ inline Error make_error(ErrorCode code, std::string message) {
 // Together with [[nodiscard]] on the type, the only way to reach a value is to look first.
 [[noreturn]] void result_misuse(const char* what, const char* file, unsigned line);
 
+// Where an accessor was called, like C++20's source location but built on the builtins that GCC
+// and clang-14 both have (clang-14, the fuzz build's compiler, cannot compile the standard
+// library's source-location header).
+struct CallSite {
+  const char* file = "";
+  unsigned line = 0;
+  static constexpr CallSite current(const char* file = __builtin_FILE(), unsigned line = __builtin_LINE()) {
+    return {file, line};
+  }
+};
+
 template <class T>
 class [[nodiscard]] Result {
  public:
@@ -58,32 +68,32 @@ class [[nodiscard]] Result {
   }
   explicit operator bool() const { return ok(); }
 
-  T& value(std::source_location at = std::source_location::current()) & { return get(at); }
-  const T& value(std::source_location at = std::source_location::current()) const& { return get(at); }
-  T&& value(std::source_location at = std::source_location::current()) && { return std::move(get(at)); }
+  T& value(CallSite at = CallSite::current()) & { return get(at); }
+  const T& value(CallSite at = CallSite::current()) const& { return get(at); }
+  T&& value(CallSite at = CallSite::current()) && { return std::move(get(at)); }
   // Operators cannot take the caller's location; a misuse through them is reported without it.
-  T& operator*() & { return get(std::source_location()); }
-  const T& operator*() const& { return get(std::source_location()); }
-  T* operator->() { return &get(std::source_location()); }
-  const T* operator->() const { return &get(std::source_location()); }
+  T& operator*() & { return get(CallSite{}); }
+  const T& operator*() const& { return get(CallSite{}); }
+  T* operator->() { return &get(CallSite{}); }
+  const T* operator->() const { return &get(CallSite{}); }
   // For results that cannot fail, such as the engine's own constant expressions compiled under
   // default limits: the value, or an abort naming `why` and the error (a bug, never bad input).
   T expect(const char* why) && {
-    if (!ok()) result_misuse(why, get_error(std::source_location()).render().c_str(), 0);
-    return std::move(get(std::source_location()));
+    if (!ok()) result_misuse(why, get_error(CallSite{}).render().c_str(), 0);
+    return std::move(get(CallSite{}));
   }
-  const Error& error(std::source_location at = std::source_location::current()) const { return get_error(at); }
-  Error& error(std::source_location at = std::source_location::current()) { return get_error(at); }
+  const Error& error(CallSite at = CallSite::current()) const { return get_error(at); }
+  Error& error(CallSite at = CallSite::current()) { return get_error(at); }
 
  private:
-  T& get(const std::source_location& at) const {
-    if (!checked_) result_misuse("value of a Result read before ok() was checked", at.file_name(), at.line());
-    if (v_.index() != 0) result_misuse("value of a Result read although it holds an error", at.file_name(), at.line());
+  T& get(const CallSite& at) const {
+    if (!checked_) result_misuse("value of a Result read before ok() was checked", at.file, at.line);
+    if (v_.index() != 0) result_misuse("value of a Result read although it holds an error", at.file, at.line);
     return const_cast<T&>(*std::get_if<0>(&v_));
   }
-  Error& get_error(const std::source_location& at) const {
-    if (!checked_) result_misuse("error of a Result read before ok() was checked", at.file_name(), at.line());
-    if (v_.index() != 1) result_misuse("error of a Result read although it holds a value", at.file_name(), at.line());
+  Error& get_error(const CallSite& at) const {
+    if (!checked_) result_misuse("error of a Result read before ok() was checked", at.file, at.line);
+    if (v_.index() != 1) result_misuse("error of a Result read although it holds a value", at.file, at.line);
     return const_cast<Error&>(*std::get_if<1>(&v_));
   }
 

@@ -31,14 +31,8 @@ std::uint64_t render_memory_estimate(int width, int height, int layers);
 
 // --- OpenEXR ---
 
-// Lossless compressions. RLE is the default (pathex trace writes it): it encodes the
-// Cornell box's six 256 x 256 layers in about an eighth of ZIP's CPU time, for files about 1.5
-// times as large (bench/README.md, "Per-run overhead").
-enum class ExrCompression : std::uint8_t { kRle, kZip, kNone };
-
 struct ExrOptions {
   bool half = false;  // 16-bit half channels instead of 32-bit float (values above 65504 become inf)
-  ExrCompression compression = ExrCompression::kRle;
 };
 
 // The EXR file's bytes. All layers must have the same nonzero size and distinct, nonempty names.

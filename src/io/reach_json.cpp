@@ -20,27 +20,29 @@ nlohmann::json to_json(const Strategy& s) {
   return j;
 }
 
+nlohmann::json to_json(const Witness& w) {
+  nlohmann::json o = {{"path", w.path}};
+  nlohmann::json chains = nlohmann::json::array();
+  for (const ChainEvidence& c : w.chains) chains.push_back(to_json(c));
+  o["chains"] = chains;
+  if (w.reason.empty()) o["strategies"] = w.strategies;  // reachable: who samples it
+  else o["reason"] = w.reason;                           // unreachable: why nobody does
+  return o;
+}
+
 nlohmann::json to_json(const QueryResult& q) {
   nlohmann::json j;
   j["expression"] = q.expression;
   j["renderer"] = q.renderer;
   j["verdict"] = to_string(q.verdict);
   j["max_bounces"] = q.max_bounces ? nlohmann::json(*q.max_bounces) : nlohmann::json(nullptr);
-  auto witnesses = [](const std::vector<Witness>& ws, bool reachable) {
+  auto witnesses = [](const std::vector<Witness>& ws) {
     nlohmann::json arr = nlohmann::json::array();
-    for (const Witness& w : ws) {
-      nlohmann::json o = {{"path", w.path}};
-      nlohmann::json chains = nlohmann::json::array();
-      for (const ChainEvidence& c : w.chains) chains.push_back(to_json(c));
-      o["chains"] = chains;
-      if (reachable) o["strategies"] = w.strategies;
-      else o["reason"] = w.reason;
-      arr.push_back(o);
-    }
+    for (const Witness& w : ws) arr.push_back(to_json(w));
     return arr;
   };
-  j["reachable_witnesses"] = witnesses(q.reachable, true);
-  j["unreachable_witnesses"] = witnesses(q.unreachable, false);
+  j["reachable_witnesses"] = witnesses(q.reachable);
+  j["unreachable_witnesses"] = witnesses(q.unreachable);
   // Ascending lengths that have members; counts past 2^64 are decimal strings.
   nlohmann::json counts = nlohmann::json::array();
   for (std::size_t n = 0; n < q.counts_class.size(); ++n) {

@@ -11,6 +11,8 @@ namespace pathex {
 
 nlohmann::json to_json(const QueryResult& q);
 nlohmann::json to_json(const ChainEvidence& c);
+// {path, chains, strategies} for a reachable witness, {path, chains, reason} for an unreachable one.
+nlohmann::json to_json(const Witness& w);
 nlohmann::json to_json(const Strategy& s);
 // A decimal count: a number when it fits 64 bits, else a string of digits.
 nlohmann::json count_json(const BigUint& b);

@@ -7,15 +7,15 @@
 // exact integer sums (classify/histogram.h, classify/image.h), which add. A shard file holds those
 // sums, not the floats of the outputs.
 //
-// File layout, version 1 (all integers little-endian):
+// File layout, version 2 (all integers little-endian; version 1 had the body uncompressed):
 //
 //   offset  size  what
 //   0       8     magic "PXSHARD\n"
-//   8       4     format version (1)
+//   8       4     format version (2)
 //   12      4     H: header length in bytes
 //   16      H     header: a JSON object (UTF-8), keys below
 //   16+H    8     N: body length in bytes
-//   24+H    N     body: the exact sums, encoded as below
+//   24+H    N     body: the exact sums, encoded as below, compressed as one zstd frame (level 1)
 //   24+H+N  4     CRC-32 (ISO-HDLC, zlib's crc32) of every byte before it
 //
 // A file whose length is not 28 + H + N is truncated (or has trailing bytes); a CRC mismatch
@@ -32,7 +32,9 @@
 //
 // Body, in this order. `u` is an unsigned LEB128 varint; `x` is a 128-bit fixed-point sum
 // zigzag-encoded ((v << 1) ^ (v >> 127), arithmetic shift) as an unsigned LEB128 varint, so zero
-// is one byte and a typical sum (64 fraction bits) eleven.
+// is one byte and a typical sum (64 fraction bits) nine or ten. The body is decoded as it is
+// decompressed, a window of 1 MiB at a time, so a file cannot make pathex allocate more than its
+// sums take; a path string is at most 512 KiB.
 //   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P; then per
 //              path, by string: u length, the letters, B × (u contributions, 3 × x sums),
 //              S × 3 × x strategy sums (B batches, S strategies from the header)
@@ -53,7 +55,7 @@
 
 namespace pathex {
 
-inline constexpr std::uint32_t kShardFormatVersion = 1;
+inline constexpr std::uint32_t kShardFormatVersion = 2;
 inline constexpr const char* kShardExtension = ".shard";
 
 // What must agree for two renders to merge: all but the names and files (the same scene, profile

@@ -11,7 +11,6 @@
 // to start at n, to explore beyond the fixed seeds; without it every run checks the same cases.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <functional>

@@ -358,7 +358,7 @@ TEST(ClassFiles, ErrorsNameTheJsonPointer) {
 
 // --- limits ---
 
-TEST(Limits, ExponentialClassFailsQuicklyNamingTheOption) {
+TEST(Limits, ExponentialClassStopsAtTheStateCapWithinTheBudget) {
   std::optional<WorkBudget> budget(std::in_place, Limits{}.max_work);
   Result<PathClass> c = compile_class("(S|D)*S(S|D){40}", ClassOptions{});
   ASSERT_FALSE(c.ok());

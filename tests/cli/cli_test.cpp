@@ -245,7 +245,7 @@ TEST(CliExplain, LimitOptionsAreHonouredAndNamed) {
 // (S|D)*S(S|D){40} is "the 41st letter from the end is S": its DFA has 2^41 states. The subset
 // construction must stop at --max-states and say so (how much work that takes is asserted on the
 // budget's counter in tests/automata/budget_test.cpp, not on a clock).
-TEST(CliLimits, ExponentialDfaFailsQuicklyNamingMaxStates) {
+TEST(CliLimits, ExponentialDfaStopsAtMaxStatesNamingIt) {
   const CliRun r = pathex({"explain", "(S|D)*S(S|D){40}"});
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.out, "");

@@ -254,6 +254,24 @@ TEST(Png, ToneMappingNeverPassesNonFiniteValues) {
   EXPECT_EQ(px, (std::vector<std::uint8_t>{0, 0, 0, 10, 255, 137}));
 }
 
+// The sRGB transfer function (IEC 61966-2-1) rounded to 8 bits, one pow() per value: the table
+// the tone mapping looks codes up in must give exactly this, at every step between two codes.
+TEST(Png, ToneMappingIsTheSrgbCurveAtEveryCode) {
+  const auto srgb8 = [](double v) {
+    const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+    return static_cast<std::uint8_t>(std::lround(255 * e));
+  };
+  RgbImage img{0, 1, {}};
+  for (int i = 0; i <= 300000; ++i) img.rgb.push_back(static_cast<float>(i) / 300000.0f);  // every code, many times
+  for (float v = 1e-7f; v < 1; v *= 1.0001f) img.rgb.push_back(v);                      // and the dark end finely
+  while (img.rgb.size() % 3 != 0) img.rgb.push_back(1.0f);
+  img.width = static_cast<int>(img.rgb.size() / 3);
+  const std::vector<std::uint8_t> px = tonemap_srgb8(img, 1.0);
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < px.size(); ++i) wrong += px[i] != srgb8(static_cast<double>(img.rgb[i]));
+  EXPECT_EQ(wrong, 0u);
+}
+
 TEST(Png, EncodeRefusesMismatchedPixels) {
   Result<std::string> r = encode_png(2, 2, std::vector<std::uint8_t>(11));
   ASSERT_FALSE(r);

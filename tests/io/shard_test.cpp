@@ -113,8 +113,8 @@ TEST(ShardFile, EveryTruncationAndEveryFlippedByteIsRefused) {
   };
   EXPECT_EQ(message("hello, world, not a shard"), "not a pathex shard file (it does not begin with \"PXSHARD\")");
   std::string v2 = bytes;
-  v2[8] = 2;
-  EXPECT_EQ(message(v2), "shard file format version 2; this pathex reads version 1");
+  v2[8] = 3;
+  EXPECT_EQ(message(v2), "shard file format version 3; this pathex reads version 2");
   EXPECT_EQ(message(bytes + "x"), "corrupted shard file: 1 bytes after its checksum");
 }
 

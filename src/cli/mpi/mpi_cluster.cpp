@@ -17,8 +17,10 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli/mpi/mpi_cluster.h"
@@ -69,6 +71,17 @@ Result<bool> MpiCluster::check(int code, const char* what) const {
   return make_error(ErrorCode::kBadFile, "rank " + std::to_string(rank_) + ": MPI " + what + " failed: " + std::string(text, static_cast<std::size_t>(len)));
 }
 
+Result<bool> MpiCluster::wait_for_all(const char* what) {
+  MPI_Request request{};
+  if (Result<bool> r = check(MPI_Ibarrier(MPI_COMM_WORLD, &request), what); !r) return r;
+  for (;;) {
+    int done = 0;
+    if (Result<bool> r = check(MPI_Test(&request, &done, MPI_STATUS_IGNORE), what); !r) return r;
+    if (done != 0) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
 Result<bool> MpiCluster::sum_to_root(std::vector<Word>* words) {
   if (rank_ == 0) std::fill(words->begin(), words->end(), 0);  // rank 0 adds the others' into its own
   std::vector<Word> out(rank_ == 0 ? words->size() : 0);
@@ -86,6 +99,7 @@ Result<bool> MpiCluster::sum_to_root(std::vector<Word>* words) {
 }
 
 Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run) {
+  if (Result<bool> r = wait_for_all("barrier before the reduction"); !r) return r;
   Histogram& h = sums->histogram;
   // --- the union of the path strings, on every rank ---
   std::string mine;
@@ -222,6 +236,7 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
 
 int MpiCluster::count_failures(bool ok) {
   int failed = ok ? 0 : 1, total = 0;
+  if (!wait_for_all("barrier after the outputs").ok()) return size_;
   if (MPI_Allreduce(&failed, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD) != MPI_SUCCESS) return size_;
   return total;
 }

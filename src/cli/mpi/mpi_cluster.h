@@ -23,6 +23,10 @@ class MpiCluster final : public Cluster {
 
  private:
   Result<bool> check(int code, const char* what) const;
+  // Returns once every rank has called it, sleeping (not spinning) while it waits: OpenMPI's
+  // blocking collectives poll at full speed, so a rank done first would take a core from the
+  // ranks still rendering, and every rank one from rank 0 writing the outputs.
+  Result<bool> wait_for_all(const char* what);
   // 128-bit sums of `words` (pairs of low, high words) over the ranks, on rank 0 (others: emptied).
   Result<bool> sum_to_root(std::vector<std::uint64_t>* words);
 
