@@ -1,6 +1,7 @@
 #include "cli/render_job.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 
@@ -54,6 +55,21 @@ RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& class
                           : ClassImages(0, 0, nullptr, {})};
 }
 
+// run.json's "efficiency": Veach's efficiency of the image-mean estimate, 1 / (relative variance ×
+// CPU seconds of rendering), `per_cpu_s`, with the relative variance (the total's squared
+// standard error over its squared luminance). It does not depend on the spp (the variance falls
+// as the time grows), so two settings compare without a reference. Null when the total has no
+// finite relative error (a black image, fewer than two batches of passes) or no CPU time.
+static nlohmann::ordered_json efficiency_json(const Estimate& total, double cpu_s) {
+  const double rel = total.luminance > 0.0 ? total.std_error / total.luminance : 0.0;
+  const double rel_var = rel * rel;
+  nlohmann::ordered_json e;
+  const bool defined = std::isfinite(rel_var) && rel_var > 0.0 && cpu_s > 0.0;
+  e["relative_variance"] = defined ? nlohmann::ordered_json(rel_var) : nlohmann::ordered_json(nullptr);
+  e["per_cpu_s"] = defined ? nlohmann::ordered_json(1.0 / (rel_var * cpu_s)) : nlohmann::ordered_json(nullptr);
+  return e;
+}
+
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
                                            const RenderClasses& classes, const std::vector<ConnectorStats>& connectors) {
   const RenderIdentity& id = header.identity;
@@ -94,6 +110,8 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
   run["threads"] = header.run.threads;
   run["rays"] = header.run.rays;
   run["passes"] = header.passes.to_string();
+  run["cpu_s"] = header.run.cpu_s;
+  run["efficiency"] = efficiency_json(out.report.total, header.run.cpu_s);
   if (Result<bool> w = write_file_atomic(dir + "/run.json", run.dump(2) + "\n"); !w) return w.error();
   return out;
 }
@@ -171,6 +189,7 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
     header.run.time_s += h.run.time_s;
     header.run.threads = std::max(header.run.threads, h.run.threads);
     header.run.rays += h.run.rays;
+    header.run.cpu_s += h.run.cpu_s;
     seen.emplace_back(path, h.passes);
   }
   if (!out) return make_error(ErrorCode::kUsage, "no shard files to combine");

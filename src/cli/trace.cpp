@@ -2,6 +2,7 @@
 // per-class EXR and PNG previews, and print where the light went, class by class, next to what the
 // checker says the renderer can reach.
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
@@ -45,6 +46,9 @@ struct TraceArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   std::optional<int> max_bounces;
+  SamplerKind sampler = RenderOptions{}.sampler;  // the defaults of these three: RenderOptions'
+  int rr_depth = RenderOptions{}.rr_depth;
+  float rr_threshold = RenderOptions{}.rr_threshold;
   std::string resolution;  // "WxH"; empty: the scene's
   std::uint64_t max_paths = 1000;
   int top_paths = 8;
@@ -144,7 +148,9 @@ Result<bool> load_fresh(const TraceArgs& a, Job* job) {
   // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
   id.max_bounces = a.max_bounces.value_or(profile->max_bounces.value_or(16));
   const RenderOptions defaults;
-  id.rr_depth = defaults.rr_depth;
+  id.sampler = to_string(a.sampler);
+  id.rr_depth = a.rr_depth;
+  id.rr_threshold = a.rr_threshold;
   id.batches = defaults.batches;
   id.images = !a.no_images;
   id.width = scene->camera.width;
@@ -221,6 +227,13 @@ std::string rank_shard_path(const std::string& dir, int rank) {
   return ranks_folder(dir) + "/rank-" + std::to_string(rank) + kShardExtension;
 }
 
+// CPU seconds used by this process so far, all threads.
+double process_cpu_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 int run(const TraceArgs& a) {
   Job job;
   if (Result<bool> r = a.resume.empty() ? load_fresh(a, &job) : load_resumed(a, &job); !r) return report(r.error());
@@ -265,7 +278,9 @@ int run(const TraceArgs& a) {
   ro.seed = id.seed;
   ro.threads = a.threads;
   ro.max_bounces = id.max_bounces;
+  ro.sampler = id.sampler == "sobol" ? SamplerKind::kSobol : SamplerKind::kIndependent;
   ro.rr_depth = id.rr_depth;
+  ro.rr_threshold = static_cast<float>(id.rr_threshold);
   ro.batches = id.batches;
   // Without image outputs the render keeps the histogram alone (the same histogram).
   ro.images = id.images;
@@ -284,12 +299,14 @@ int run(const TraceArgs& a) {
     return report(e);
   }
   const std::atomic<bool>* stopped = nullptr;
+  const double cpu_start = process_cpu_seconds();
   Result<RenderOutput> out = [&] {
     const RenderWatch watch(rank == 0 && !a.quiet, a.time_limit);
     ro.progress = watch.progress();
     ro.cancel = stopped = watch.cancel();
     return render(*job.scene, *job.profile, job.classes->classifier.get(), ro);
   }();
+  const double cpu_s = process_cpu_seconds() - cpu_start;
   if (!out) return report(out.error());
   // Non-finite samples are bugs (DESIGN §7): say so, and where the first arose.
   if (const std::uint64_t n = out->histogram.nonfinite(); n > 0) {
@@ -321,7 +338,8 @@ int run(const TraceArgs& a) {
   RenderSums sums{std::move(out->histogram), std::move(out->images)};
   ShardHeader header = job.header;
   header.passes = out->passes_done;
-  header.run = {out->time_s, ro.threads > 0 ? ro.threads : static_cast<int>(std::thread::hardware_concurrency()), out->rays};
+  header.run = {out->time_s, ro.threads > 0 ? ro.threads : static_cast<int>(std::thread::hardware_concurrency()), out->rays,
+                cpu_s};
 
   // --- MPI: keep this rank's work in a shard file, then sum every rank's into rank 0's ---
   if (cluster != nullptr) {
@@ -340,6 +358,7 @@ int run(const TraceArgs& a) {
     header.passes.add(job.resumed->header.passes);
     header.run.time_s += job.resumed->header.run.time_s;
     header.run.rays += job.resumed->header.run.rays;
+    header.run.cpu_s += job.resumed->header.run.cpu_s;
   }
 
   // --- outputs (rank 0): one set, whole or not at all, shielded from signals (io/output_set.h) ---
@@ -450,6 +469,17 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices (k - 1); default: the profile's bound, else 16")
       ->check(CLI::Range(0, 1000));
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
+  sub->add_option("--sampler", args->sampler,
+                  "Random numbers: sobol (Owen-scrambled Sobol points, stratified per pixel) or independent")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, SamplerKind>{{"independent", SamplerKind::kIndependent},
+                                                                              {"sobol", SamplerKind::kSobol}}))
+      ->default_str(to_string(RenderOptions{}.sampler));
+  sub->add_option("--rr-depth", args->rr_depth,
+                  "Russian roulette from this vertex of a subpath on (the camera or light point is the first)")
+      ->capture_default_str()->check(CLI::Range(1, 1000));
+  sub->add_option("--rr-threshold", args->rr_threshold,
+                  "Russian roulette only below this throughput (relative to the subpath's start); 0: no roulette")
+      ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
   sub->add_option("--resolution", args->resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
       ->type_name("WxH");
   sub->add_option("--max-paths", args->max_paths,
@@ -475,7 +505,7 @@ Command add_trace(CLI::App& app) {
   add_limit_options(sub, &args->limits);
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
-                                  "--resolution", "--max-paths"})
+                                  "--resolution", "--max-paths", "--sampler", "--rr-depth", "--rr-threshold"})
               if (sub->count(o) > 0) args->settings_given.push_back(o);
             return run(*args);
           }};

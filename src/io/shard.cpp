@@ -229,7 +229,8 @@ json identity_json(const RenderIdentity& id) {
   j["classes"] = {{"file", id.classes_file}, {"text", id.classes_text}, {"hash", id.classes_hash}};
   j["ends"] = {{"lights", id.lights}, {"sensor", id.sensor}};
   j["seed"] = id.seed;
-  j["options"] = {{"max_bounces", id.max_bounces}, {"rr_depth", id.rr_depth}, {"batches", id.batches},
+  j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"rr_depth", id.rr_depth},
+                  {"rr_threshold", id.rr_threshold}, {"batches", id.batches},
                   {"width", id.width},           {"height", id.height},     {"images", id.images},
                   {"max_paths", id.max_paths}};
   j["strategies"] = id.strategies;
@@ -336,9 +337,12 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   id.seed = rd.uint(j, "", "seed");
   h.spp = rd.uint(j, "", "spp");
   const nlohmann::json& o = j.at("options");
-  if (rd.object(o, "/options", {"max_bounces", "rr_depth", "batches", "width", "height", "images", "max_paths"})) {
+  if (rd.object(o, "/options", {"max_bounces", "sampler", "rr_depth", "rr_threshold", "batches", "width", "height", "images",
+                                "max_paths"})) {
     id.max_bounces = rd.small(o, "/options", "max_bounces");
+    id.sampler = rd.str(o, "/options", "sampler");
     id.rr_depth = rd.small(o, "/options", "rr_depth");
+    id.rr_threshold = rd.number(o, "/options", "rr_threshold");
     id.batches = rd.small(o, "/options", "batches");
     id.width = rd.small(o, "/options", "width");
     id.height = rd.small(o, "/options", "height");
@@ -350,8 +354,9 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   h.share = rd.passes(j, "share");
   h.passes = rd.passes(j, "passes");
   const nlohmann::json& r = j.at("run");
-  if (rd.object(r, "/run", {"time_s", "threads", "rays"})) {
+  if (rd.object(r, "/run", {"time_s", "threads", "rays", "cpu_s"})) {
     h.run.time_s = rd.number(r, "/run", "time_s");
+    h.run.cpu_s = rd.number(r, "/run", "cpu_s");
     h.run.threads = rd.small(r, "/run", "threads");
     h.run.rays = rd.uint(r, "/run", "rays");
   }
@@ -390,7 +395,10 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
     return differ(std::string("another ") + name, std::to_string(x), std::to_string(y));
   };
   if (auto d = option("max_bounces", a.max_bounces, b.max_bounces)) return d;
+  if (a.sampler != b.sampler) return differ("another sampler", a.sampler, b.sampler);
   if (auto d = option("rr_depth", a.rr_depth, b.rr_depth)) return d;
+  if (a.rr_threshold != b.rr_threshold)
+    return differ("another rr_threshold", std::to_string(a.rr_threshold), std::to_string(b.rr_threshold));
   if (auto d = option("batch count", a.batches, b.batches)) return d;
   if (a.width != b.width || a.height != b.height)
     return differ("another resolution", std::to_string(a.width) + "x" + std::to_string(a.height),
@@ -414,7 +422,8 @@ std::string encode_shard(const ShardHeader& header, const Histogram& h, const Cl
   };
   hj["share"] = passes_json(header.share);
   hj["passes"] = passes_json(header.passes);
-  hj["run"] = {{"time_s", header.run.time_s}, {"threads", header.run.threads}, {"rays", header.run.rays}};
+  hj["run"] = {{"time_s", header.run.time_s}, {"threads", header.run.threads}, {"rays", header.run.rays},
+               {"cpu_s", header.run.cpu_s}};
   const std::string head = hj.dump(1) + "\n";
 
   std::string out(kMagic, sizeof kMagic);

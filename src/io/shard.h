@@ -26,7 +26,7 @@
 // absolute file), hash}, "classes" {file (absolute, "" for the built-in classes), text (the class
 // file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
-// {max_bounces, rr_depth, batches, width, height, images, max_paths}, "strategies" [names], "share" and
+// {max_bounces, sampler, rr_depth, rr_threshold, batches, width, height, images, max_paths}, "strategies" [names], "share" and
 // "passes" (each [[first, last), …]: the passes the run was asked for, and those whose sums this
 // file holds), "run" {time_s, threads, rays}.
 //
@@ -76,7 +76,9 @@ struct RenderIdentity {
   std::string sensor;               // and sensor type
   std::uint64_t seed = 1;
   int max_bounces = 16;
+  std::string sampler = "sobol";  // RenderOptions::sampler, by name
   int rr_depth = 3;
+  double rr_threshold = 1.0;  // RenderOptions::rr_threshold (a float, exact as a double)
   int batches = kDefaultBatches;
   int width = 0, height = 0;  // the camera's resolution (the scene's, or --resolution's)
   bool images = true;
@@ -94,6 +96,7 @@ struct ShardRun {
   double time_s = 0;
   int threads = 0;
   std::uint64_t rays = 0;
+  double cpu_s = 0;  // CPU seconds of rendering, all threads (summed over shards, resumes and ranks)
 };
 
 struct ShardHeader {

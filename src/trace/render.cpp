@@ -1,8 +1,9 @@
 // Bidirectional path sampling with full-path labels.
 //
 // For each pixel and pass: an eye subpath z0 z1 … from the sensor and a light subpath y0 y1 …
-// from a light, each extended by local sampling (BSDF sampling, Russian roulette after
-// RenderOptions::rr_depth vertices, at most max_bounces interior vertices on the full path).
+// from a light, each extended by local sampling (BSDF sampling, Russian roulette from
+// RenderOptions::rr_depth vertices on, below rr_threshold; at most max_bounces interior vertices
+// on the full path).
 // Then every (s, t) pair the profile runs is evaluated: s = 0 an eye vertex on an area light,
 // s = 1 a fresh light sample (next-event estimation), t = 1 a fresh sensor sample (a splat), t = 0
 // a light vertex on a thin lens, otherwise a shadow ray between y(s-1) and z(t-1).
@@ -538,6 +539,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   // Russian roulette compares the throughput with the subpath's start, so that a light subpath
   // (whose throughput starts at the light's power) is treated like an eye subpath.
   const float beta_start = std::max(max_component(beta), 1e-30f);
+  float eta2 = 1.0f;  // the product of η² over the refractions so far (radiance walks)
   // `beta` passed in the first vertex already includes the first direction's weight: the caller
   // stores it in path[count - 1].beta and we continue from there.
   while (count < max_vertices) {
@@ -598,12 +600,17 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     const float pdf_rev_dir = bs->is_delta ? 0.0f : bs->pdf_rev;
     prev.pdf_rev = pdf_rev_dir * abs_cos(prev, d) * inv_d2;
     // --- Russian roulette, never mislabelling: the vertices so far stay valid prefixes ---
-    if (count >= o_.rr_depth) {
-      // Termination probability from the throughput lost so far, at most 1/2 per vertex so that a
-      // surviving path's weight grows by at most 2 each time (bounded variance).
-      const float q = std::min(0.5f, std::max(0.0f, 1.0f - max_component(beta) / beta_start));
-      if (rng.get1d() < q) break;
-      beta *= 1.0f / (1.0f - q);
+    // From vertex rr_depth on, a walk whose throughput relative to its start (a refraction's
+    // radiance scaling 1/η² undone, so that entering glass is no loss) is below rr_threshold
+    // survives with probability throughput / threshold, and a survivor carries the threshold.
+    if (mode == TransportMode::kRadiance) eta2 *= bs->eta * bs->eta;
+    if (count >= o_.rr_depth && o_.rr_threshold > 0.0f) {
+      const float u_rr = rng.get1d();  // drawn at every vertex, so the dimensions stay aligned
+      const float survive = max_component(beta) * eta2 / (beta_start * o_.rr_threshold);
+      if (survive < 1.0f) {
+        if (u_rr >= survive) break;
+        beta *= 1.0f / survive;
+      }
     }
     o = v.p;
     d = bs->wi;
@@ -1322,7 +1329,7 @@ float Integrator::weight_sum(Thread& th, int s, int t) const {
 
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
-  Sampler rng(o_.seed, pixel, pass);
+  Sampler rng(o_.seed, pixel, pass, o_.sampler);
   rng.set_dimension(kEyeDims);
   const int batch = batch_of(pass, o_.batches);
   th.px = px;

@@ -36,6 +36,7 @@
 #include "core/pass_set.h"
 #include "reach/profile.h"
 #include "scene/scene.h"
+#include "trace/rng.h"
 
 namespace pathex {
 
@@ -51,7 +52,13 @@ struct RenderOptions {
   std::uint64_t seed = 1;
   int threads = 0;                     // 0: all cores
   std::optional<int> max_bounces;      // interior vertices, k - 1; unset: the profile's bound, else 16
-  int rr_depth = 3;                    // Russian roulette after this many vertices on a subpath
+  // Russian roulette (pathex trace --rr-depth, --rr-threshold): from the rr_depth-th vertex of a
+  // subpath on (its camera or light point is the first), a walk whose throughput relative to its
+  // start has fallen below rr_threshold survives with probability throughput / rr_threshold;
+  // 0 turns roulette off. Defaults chosen by efficiency (bench/efficiency.py, README).
+  int rr_depth = 3;
+  float rr_threshold = 1.0f;
+  SamplerKind sampler = SamplerKind::kSobol;  // --sampler
   int batches = kDefaultBatches;       // for batch-means standard errors
   std::vector<int> layer_classes;      // classifier classes that get an image layer
   // Accumulate the images at all. Off (`pathex trace --no-images`), the render keeps only the

@@ -22,12 +22,15 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+
+#include "trace/sobol.h"
 
 namespace pathex {
 
@@ -62,28 +65,61 @@ constexpr float bits_to_unit_float(std::uint64_t bits) {
 
 inline constexpr float kOneMinusEpsilon = 1.0f - 0x1p-24f;  // the largest float below 1
 
+// Which numbers a Sampler draws (`pathex trace --sampler`): `independent`, the counter-based
+// stream above (every number independent of every other), or `sobol`, Owen-scrambled Sobol points
+// (trace/sobol.h): each pair of dimensions drawn with get2d() is stratified over a pixel's passes
+// (the first 2^k passes put one point in every elementary interval of area 2^-k), each number on
+// its own still uniform and independent across dimension pairs. Both are functions of (seed,
+// pixel, pass, dimension) alone.
+enum class SamplerKind : std::uint8_t { kIndependent, kSobol };
+constexpr const char* to_string(SamplerKind k) { return k == SamplerKind::kSobol ? "sobol" : "independent"; }
+
 // One sample's random numbers, drawn in order of dimension. Copying a Sampler copies its position;
 // set_dimension() gives a strategy a fixed block of dimensions (e.g. 2 per bounce) so that two
-// strategies never consume each other's numbers.
+// strategies never consume each other's numbers. With `sobol`, get2d() draws the pair (d, d + 1)
+// as one stratified 2-D point, so a dimension must always be drawn the same way (as the first of
+// a pair, the second, or alone), which a fixed dimension block gives.
 class Sampler {
  public:
-  Sampler(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample)
-      : key_(stream_key(seed, pixel, sample)) {}
+  Sampler(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample, SamplerKind kind = SamplerKind::kIndependent)
+      : kind_(kind),
+        // sobol: the key is the pixel's (the pass is the point's index); passes past 2^32 start a
+        // new scrambled sequence.
+        key_(stream_key(seed, pixel, kind == SamplerKind::kSobol ? sample >> 32 : sample)),
+        reversed_index_(sobol::reverse_bits(static_cast<std::uint32_t>(sample))) {}
 
-  float get1d() { return bits_to_unit_float(stream_bits(key_, dim_++)); }
+  float get1d() { return at(dim_++); }
   glm::vec2 get2d() {
-    const float a = get1d();
-    return {a, get1d()};
+    if (kind_ == SamplerKind::kIndependent) {
+      const float a = get1d();
+      return {a, get1d()};
+    }
+    const std::array<std::uint32_t, 2> p = sobol::point2(reversed_index_, sobol_seeds(dim_, /*pair=*/true));
+    dim_ += 2;
+    return {sobol::to_unit_float(p[0]), sobol::to_unit_float(p[1])};
   }
-  // The number at an absolute dimension, without moving the cursor.
-  float at(std::uint64_t dim) const { return bits_to_unit_float(stream_bits(key_, dim)); }
+  // The number get1d() would draw at an absolute dimension, without moving the cursor.
+  float at(std::uint64_t dim) const {
+    if (kind_ == SamplerKind::kIndependent) return bits_to_unit_float(stream_bits(key_, dim));
+    return sobol::to_unit_float(sobol::point1(reversed_index_, sobol_seeds(dim, /*pair=*/false)));
+  }
 
   std::uint64_t dimension() const { return dim_; }
   void set_dimension(std::uint64_t dim) { dim_ = dim; }
   std::uint64_t key() const { return key_; }
+  SamplerKind kind() const { return kind_; }
 
  private:
+  // The scrambling seeds of dimension `dim` of this pixel (of the pair starting there).
+  sobol::Seeds sobol_seeds(std::uint64_t dim, bool pair) const {
+    const std::uint64_t h = stream_bits(key_, dim);
+    return {static_cast<std::uint32_t>(h), static_cast<std::uint32_t>(h >> 32),
+            pair ? static_cast<std::uint32_t>((h * kGoldenGamma) >> 29) : 0u};  // the y seed: another 32 of h's bits, mixed
+  }
+
+  SamplerKind kind_;
   std::uint64_t key_;
+  std::uint32_t reversed_index_;  // sobol: the pass, bit-reversed
   std::uint64_t dim_ = 0;
 };
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 
 #include <glm/glm.hpp>
 
@@ -22,10 +23,30 @@ struct Rendered {
   RenderOutput out;
 };
 
+// How a test's render samples: the sampler and the Russian-roulette settings (RenderOptions).
+struct Sampling {
+  SamplerKind sampler = RenderOptions{}.sampler;
+  int rr_depth = RenderOptions{}.rr_depth;
+  float rr_threshold = RenderOptions{}.rr_threshold;
+  std::string name() const {
+    return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
+           std::to_string(rr_threshold);
+  }
+};
+
+Rendered render_scene(Result<Scene> scene, const std::string& renderer, const std::vector<std::string>& classes,
+                      std::uint64_t spp, int threads, std::uint64_t seed, const Sampling& sampling,
+                      std::optional<int> max_bounces);
+
 // Renders `scene_json` with `renderer`, classifying by `classes` (full notation).
 Rendered render_json(const std::string& scene_json, const std::string& renderer, const std::vector<std::string>& classes,
-                std::uint64_t spp, int threads = 0, std::uint64_t seed = 7) {
-  Result<Scene> scene = load_scene_json(scene_json, ".", "test");
+                std::uint64_t spp, int threads = 0, std::uint64_t seed = 7, const Sampling& sampling = {}) {
+  return render_scene(load_scene_json(scene_json, ".", "test"), renderer, classes, spp, threads, seed, sampling, 12);
+}
+
+Rendered render_scene(Result<Scene> scene, const std::string& renderer, const std::vector<std::string>& classes,
+                      std::uint64_t spp, int threads, std::uint64_t seed, const Sampling& sampling,
+                      std::optional<int> max_bounces) {
   EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().render());
   Result<Profile> profile = resolve_profile(renderer, Limits{});
   EXPECT_TRUE(profile.ok());
@@ -46,7 +67,10 @@ Rendered render_json(const std::string& scene_json, const std::string& renderer,
   o.spp = spp;
   o.seed = seed;
   o.threads = threads;
-  o.max_bounces = 12;
+  o.max_bounces = max_bounces;
+  o.sampler = sampling.sampler;
+  o.rr_depth = sampling.rr_depth;
+  o.rr_threshold = sampling.rr_threshold;
   Result<RenderOutput> out = render(*scene, *profile, keep_cl.back().get(), o);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
   RunInfo info;
@@ -505,6 +529,98 @@ TEST(Profiles, ConnectorsTheTracerDoesNotRunAreRefusedByName) {
             "yet; it runs plain joins (s, DD, t) and the mirror, distant-projection and ortho-projection connectors");
   for (const char* name : {"pt-nee+distant", "bdpt+ortho", "bdpt+mirror", "pt-nee+mirror", "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path"})
     EXPECT_TRUE(runnable_strategies(resolve_profile(name, Limits{}).expect("a test input")).ok()) << name;
+}
+
+}  // namespace
+}  // namespace pathex
+
+namespace pathex {
+namespace {
+
+// --- samplers and Russian roulette (issue 19): every setting is unbiased ---
+
+// Both samplers with the roulette settings worth having: the default, pbrt-v4's (every vertex
+// from the third, survival = throughput), a low threshold (roulette only once a path carries
+// less than a tenth), roulette from the first bounce, and none.
+std::vector<Sampling> every_sampling() {
+  std::vector<Sampling> out;
+  for (SamplerKind k : {SamplerKind::kIndependent, SamplerKind::kSobol})
+    for (auto [depth, threshold] : std::vector<std::pair<int, float>>{{RenderOptions{}.rr_depth, RenderOptions{}.rr_threshold},
+                                                                      {3, 1.0f}, {3, 0.1f}, {2, 0.5f}, {3, 0.0f}})
+      out.push_back({k, depth, threshold});
+  return out;
+}
+
+// The closed forms of DESIGN §9 per bounce, within 3 standard errors (plus 1 %), for every
+// sampler and roulette setting and the three estimators.
+TEST(Sampling, EverySamplerAndRouletteSettingMatchesTheClosedForms) {
+  const double rho = 0.5, intensity = 2.0, le = 1.5;
+  std::vector<std::string> point_classes, emitting_classes;
+  for (int n = 1; n <= 4; ++n) point_classes.push_back("LSDD{" + std::to_string(n) + "}DSE");
+  for (int n = 0; n <= 4; ++n) emitting_classes.push_back("LDDD{" + std::to_string(n) + "}DSE");
+  for (const Sampling& sampling : every_sampling())
+    for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
+      const std::string what = std::string(renderer) + ", " + sampling.name();
+      Rendered p = render_json(closed_sphere_point(rho, intensity), renderer, point_classes, 64, 0, 7, sampling);
+      EXPECT_EQ(p.report.nonfinite_samples, 0u) << what;
+      for (int n = 1; n <= 4; ++n)
+        expect_close(p.report.classes[static_cast<std::size_t>(n - 1)].estimate, std::pow(rho, n) * intensity / kPi, 3.0,
+                     0.01, what + ", point light, n=" + std::to_string(n));
+      Rendered e = render_json(closed_sphere_emitting(rho, le), renderer, emitting_classes, 64, 0, 7, sampling);
+      EXPECT_EQ(e.report.nonfinite_samples, 0u) << what;
+      for (int n = 0; n <= 4; ++n)
+        expect_close(e.report.classes[static_cast<std::size_t>(n)].estimate, le * std::pow(rho, n), 3.0, 0.01,
+                     what + ", emitting sphere, n=" + std::to_string(n));
+    }
+}
+
+// The sample scenes, per class of the built-in set: each sampler and roulette setting agrees with
+// the independent sampler under pbrt-v4's roulette (another seed) within 4 standard errors of the
+// difference.
+TEST(Sampling, EverySettingAgreesWithTheIndependentSamplerOnTheSampleScenes) {
+  const std::vector<std::string> classes = {"L....E", "L.....E", "L......+E", "L..S+D.*..E", "L.*DD.*E"};
+  const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/";
+  const Sampling reference{SamplerKind::kIndependent, 3, 1.0f};
+  for (const char* file : {"cornell.json", "point-glass.json", "point-mirror-caustic.json", "sun-window.json",
+                           "laser.json", "mirror-ortho.json", "spotmeter-caustic.json"}) {
+    const std::string renderer = std::string(file) == "sun-window.json"    ? "pt-nee+distant"
+                                 : std::string(file) == "mirror-ortho.json" ? "bdpt+ortho"
+                                                                            : "bdpt";
+    const std::uint64_t spp = std::string(file) == "spotmeter-caustic.json" ? 2048 : 16;
+    const Rendered base = render_scene(load_scene_file(dir + file), renderer, classes, spp, 0, 11, reference, 16);
+    for (const Sampling& sampling : every_sampling()) {
+      const Rendered r = render_scene(load_scene_file(dir + file), renderer, classes, spp, 0, 12, sampling, 16);
+      const std::string what = std::string(file) + ", " + renderer + ", " + sampling.name();
+      EXPECT_EQ(r.report.nonfinite_samples, 0u) << what;
+      for (std::size_t c = 0; c < classes.size(); ++c) {
+        const Estimate& a = base.report.classes[c].estimate;
+        const Estimate& b = r.report.classes[c].estimate;
+        if (a.luminance == 0.0 && b.luminance == 0.0) continue;
+        EXPECT_LE(std::fabs(a.luminance - b.luminance), 4.0 * std::hypot(a.std_error, b.std_error))
+            << what << ", class " << classes[c] << ": " << b.luminance << " ± " << b.std_error << " against "
+            << a.luminance << " ± " << a.std_error;
+      }
+    }
+  }
+}
+
+// Bit-identical for one and two threads with either sampler.
+TEST(Sampling, EachSamplerIsTheSameForOneAndTwoThreads) {
+  for (SamplerKind k : {SamplerKind::kIndependent, SamplerKind::kSobol}) {
+    const Sampling sampling{k, RenderOptions{}.rr_depth, RenderOptions{}.rr_threshold};
+    Rendered a = render_json(closed_sphere_point(0.5, 1.0), "bdpt", {"LSDDDSE"}, 8, 1, 7, sampling);
+    Rendered b = render_json(closed_sphere_point(0.5, 1.0), "bdpt", {"LSDDDSE"}, 8, 2, 7, sampling);
+    EXPECT_EQ(a.report.total.rgb, b.report.total.rgb) << to_string(k);
+    EXPECT_EQ(a.report.total.std_error, b.report.total.std_error) << to_string(k);
+    ASSERT_EQ(a.report.paths.size(), b.report.paths.size()) << to_string(k);
+    for (std::size_t i = 0; i < a.report.paths.size(); ++i) {
+      EXPECT_EQ(a.report.paths[i].path, b.report.paths[i].path);
+      EXPECT_EQ(a.report.paths[i].estimate.rgb, b.report.paths[i].estimate.rgb);
+    }
+    const std::vector<ImageLayer> la = a.out.images.layers(1.0), lb = b.out.images.layers(1.0);
+    ASSERT_EQ(la.size(), lb.size());
+    for (std::size_t i = 0; i < la.size(); ++i) EXPECT_EQ(la[i].image.rgb, lb[i].image.rgb) << to_string(k);
+  }
 }
 
 }  // namespace

@@ -228,7 +228,9 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
   if (Result<bool> r = check(MPI_Reduce(&run->time_s, &time_max, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
   if (Result<bool> r = check(MPI_Reduce(&run->rays, &rays, 1, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
   if (Result<bool> r = check(MPI_Reduce(&run->threads, &threads, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
-  if (rank_ == 0) *run = {time_max, threads, rays};
+  double cpu_sum = 0.0;
+  if (Result<bool> r = check(MPI_Reduce(&run->cpu_s, &cpu_sum, 1, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
+  if (rank_ == 0) *run = {time_max, threads, rays, cpu_sum};
   return true;
 }
 
