@@ -371,7 +371,7 @@ int run(const TraceArgs& a) {
       if (!r) return r.error();
       written = std::move(*r);
       if (missed)  // what pathex bias writes to bias.json, without images
-        if (Result<bool> w = write_file_atomic(dir + "/missed.json", to_json(*missed).dump(2) + "\n"); !w) return w;
+        if (Result<bool> m = write_file_atomic(dir + "/missed.json", to_json(*missed).dump(2) + "\n"); !m) return m;
       return true;
     });
     if (!w) failure = w.error();
@@ -472,7 +472,8 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--sampler", args->sampler,
                   "Random numbers: sobol (Owen-scrambled Sobol points, stratified per pixel) or independent")
       ->transform(CLI::CheckedTransformer(std::map<std::string, SamplerKind>{{"independent", SamplerKind::kIndependent},
-                                                                              {"sobol", SamplerKind::kSobol}}))
+                                                                              {"sobol", SamplerKind::kSobol}})
+                     .description("{independent,sobol}"))  // CLI11 would print the enum's bytes
       ->default_str(to_string(RenderOptions{}.sampler));
   sub->add_option("--rr-depth", args->rr_depth,
                   "Russian roulette from this vertex of a subpath on (the camera or light point is the first)")
