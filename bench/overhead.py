@@ -21,7 +21,7 @@ import tempfile
 import time
 
 
-def run(cmd):
+def run(cmd, out_dir):
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     out = proc.stdout.read()
@@ -31,7 +31,13 @@ def run(cmd):
     if os.waitstatus_to_exitcode(status) != 0:
         sys.exit(f"{' '.join(cmd)} failed: {err}")
     doc = json.loads(out)
-    render_cpu = doc.get("efficiency", {}).get("cpu_s")
+    # The render's own times: run.json beside the outputs (older binaries: the --json output).
+    run_json = os.path.join(out_dir, "run.json")
+    if os.path.exists(run_json):
+        with open(run_json) as f:
+            doc = json.load(f)
+        os.remove(run_json)
+    render_cpu = doc.get("cpu_s", doc.get("efficiency", {}).get("cpu_s"))
     return usage.ru_utime + usage.ru_stime, wall, render_cpu, doc["time_s"]
 
 
@@ -53,10 +59,11 @@ def main():
         for r in range(args.rounds):
             order = args.binaries[r % len(args.binaries):] + args.binaries[:r % len(args.binaries)]
             for i, b in enumerate(order):
+                out_dir = os.path.join(work, f"out{args.binaries.index(b)}")
                 cmd = ([b, "trace"] + ([args.scene] if args.scene else []) +
                        ["--resolution", args.resolution, "--spp", str(args.spp), "--threads", "1", "--quiet", "--json",
-                        "--out", os.path.join(work, f"out{args.binaries.index(b)}")] + args.extra.split())
-                res[b].append(run(cmd))
+                        "--out", out_dir] + args.extra.split())
+                res[b].append(run(cmd, out_dir))
     for b, rs in res.items():
         print(f"{b}: {len(rs)} runs, {args.resolution}, {args.spp} spp")
         print(f"  process CPU        {fmt([x[0] for x in rs])}")
