@@ -66,56 +66,54 @@ constexpr std::uint32_t dimension0(std::uint32_t index) { return reverse_bits(in
 
 namespace detail {
 // Direction numbers of the second Sobol dimension (primitive polynomial x + 1): v_0 = 1/2,
-// v_k = v_(k-1) xor v_(k-1)/2. Point i is the xor of v_k over the set bits k of i; the table
-// holds those xors per byte of the index, bit-reversed (the form the scramble takes them in).
+// v_k = v_(k-1) xor v_(k-1)/2. Point i is the xor of v_k over the set bits k of i. The tables take
+// the index bit-reversed (r = reverse_bits(i), the form the index shuffle leaves it in), a byte at
+// a time: bit j of r's byte b is bit 31 - (8b + j) of i.
 constexpr std::array<std::array<std::uint32_t, 256>, 4> dimension1_tables() {
   std::array<std::uint32_t, 32> v{};
   v[0] = 0x80000000u;
-  for (int k = 1; k < 32; ++k) v[static_cast<std::size_t>(k)] = v[static_cast<std::size_t>(k - 1)] ^ (v[static_cast<std::size_t>(k - 1)] >> 1);
+  for (std::size_t k = 1; k < 32; ++k) v[k] = v[k - 1] ^ (v[k - 1] >> 1);
   std::array<std::array<std::uint32_t, 256>, 4> t{};
   for (std::size_t byte = 0; byte < 4; ++byte)
     for (std::uint32_t b = 0; b < 256; ++b) {
       std::uint32_t x = 0;
       for (std::size_t j = 0; j < 8; ++j)
-        if ((b >> j) & 1u) x ^= v[8 * byte + j];
-      t[byte][b] = reverse_bits(x);
+        if ((b >> j) & 1u) x ^= v[31 - (8 * byte + j)];
+      t[byte][b] = x;
     }
   return t;
 }
 inline constexpr std::array<std::array<std::uint32_t, 256>, 4> kDimension1 = dimension1_tables();
 }  // namespace detail
 
-// The second Sobol dimension, bit-reversed, and as it is: with dimension0 a (0,2)-sequence in
-// base 2.
-constexpr std::uint32_t dimension1_reversed(std::uint32_t index) {
-  return detail::kDimension1[0][index & 0xffu] ^ detail::kDimension1[1][(index >> 8) & 0xffu] ^
-         detail::kDimension1[2][(index >> 16) & 0xffu] ^ detail::kDimension1[3][index >> 24];
+// The second Sobol dimension of index reverse_bits(r); with dimension0 a (0,2)-sequence in base 2.
+constexpr std::uint32_t dimension1_of_reversed(std::uint32_t r) {
+  return detail::kDimension1[0][r & 0xffu] ^ detail::kDimension1[1][(r >> 8) & 0xffu] ^
+         detail::kDimension1[2][(r >> 16) & 0xffu] ^ detail::kDimension1[3][r >> 24];
 }
-constexpr std::uint32_t dimension1(std::uint32_t index) { return reverse_bits(dimension1_reversed(index)); }
+constexpr std::uint32_t dimension1(std::uint32_t index) { return dimension1_of_reversed(reverse_bits(index)); }
 
 // 32 bits of binary fraction as a float in [0, 1): the top 24 bits, exact, never 1.0.
 constexpr float to_unit_float(std::uint32_t bits) { return static_cast<float>(bits >> 8) * 0x1p-24f; }
 
-// The scrambling seeds of one dimension (or pair of dimensions starting there) of one pixel,
-// from a 64-bit hash of (seed, pixel, dimension): the index shuffle and one Owen seed per
-// coordinate.
+// The randomisation of one dimension (or pair of dimensions starting there) of one pixel, from a
+// 64-bit hash of (seed, pixel, dimension): the index shuffle and one digital shift per coordinate.
 struct Seeds {
   std::uint32_t shuffle, x, y;
 };
 
-// Point `index` of the scrambled sequence, one coordinate (dimension 0) or two (dimensions 0, 1):
-//   i = nested_scramble(index, shuffle),
-//   x = nested_scramble(dimension0(i), s.x),  y = nested_scramble(dimension1(i), s.y),
-// computed with three bit reversals instead of seven (dimension0 is a reversal, and a nested
-// scramble is a reversal on each side of laine_karras); `reversed_index` is reverse_bits(index),
-// the same for every dimension of a sample. Test Sobol.PointsAreTheScrambledSequence.
+// Point `index` of the randomised sequence, one coordinate (dimension 0) or two (dimensions 0, 1):
+//   i = nested_scramble(index, shuffle),  x = dimension0(i) ^ s.x,  y = dimension1(i) ^ s.y.
+// `reversed_index` is reverse_bits(index), the same for every dimension of a sample; since
+// nested_scramble is laine_karras between two reversals and dimension0 is a reversal,
+// dimension0(i) = laine_karras(reversed_index, shuffle): no bit reversal per number.
+// Test Sobol.PointsAreTheRandomisedSequence.
 constexpr std::uint32_t point1(std::uint32_t reversed_index, const Seeds& s) {
-  const std::uint32_t i = reverse_bits(laine_karras(reversed_index, s.shuffle));
-  return reverse_bits(laine_karras(i, s.x));
+  return laine_karras(reversed_index, s.shuffle) ^ s.x;
 }
 constexpr std::array<std::uint32_t, 2> point2(std::uint32_t reversed_index, const Seeds& s) {
-  const std::uint32_t i = reverse_bits(laine_karras(reversed_index, s.shuffle));
-  return {reverse_bits(laine_karras(i, s.x)), reverse_bits(laine_karras(dimension1_reversed(i), s.y))};
+  const std::uint32_t r = laine_karras(reversed_index, s.shuffle);  // reverse_bits(i)
+  return {r ^ s.x, dimension1_of_reversed(r) ^ s.y};
 }
 
 }  // namespace pathex::sobol
