@@ -9,7 +9,8 @@ render's own time is the JSON's `time_s` (wall clock) and, where the binary repo
 `efficiency.cpu_s` (CPU seconds); the process's come from os.wait4 and the wall clock around it.
 Overhead = process - render, as CPU seconds (what the shared host cannot steal) and wall seconds
 (which also holds file-system waits, but on a busy host also other processes' time). Prints the
-median and range over rounds of each.
+median and range over rounds of each, and the CPU of a bare `pathex --version` (the process start:
+loading and relocating the linked libraries), the part of the overhead no output setting changes.
 """
 import argparse
 import json
@@ -64,6 +65,13 @@ def main():
                        ["--resolution", args.resolution, "--spp", str(args.spp), "--threads", "1", "--quiet", "--json",
                         "--out", out_dir] + args.extra.split())
                 res[b].append(run(cmd, out_dir))
+    # The process start alone (dynamic loading of the linked libraries): a bare --version, as many times.
+    start = {b: [] for b in args.binaries}
+    for r in range(args.rounds):
+        for b in args.binaries:
+            proc = subprocess.Popen([b, "--version"], stdout=subprocess.DEVNULL)
+            _, _, usage = os.wait4(proc.pid, 0)
+            start[b].append(usage.ru_utime + usage.ru_stime)
     for b, rs in res.items():
         print(f"{b}: {len(rs)} runs, {args.resolution}, {args.spp} spp")
         print(f"  process CPU        {fmt([x[0] for x in rs])}")
@@ -71,6 +79,7 @@ def main():
         if all(x[2] is not None for x in rs):
             print(f"  overhead CPU       {fmt([x[0] - x[2] for x in rs])}   (process CPU - render CPU)")
         print(f"  overhead wall      {fmt([x[1] - x[3] for x in rs])}   (process wall - render wall)")
+        print(f"  --version CPU      {fmt(start[b])}   (process start alone)")
 
 
 if __name__ == "__main__":

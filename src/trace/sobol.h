@@ -1,4 +1,4 @@
-// Owen-scrambled Sobol points: the numbers of the tracer's `sobol` sampler (trace/rng.h, Sampler).
+// Randomised Sobol points: the numbers of the tracer's `sobol` sampler (trace/rng.h, Sampler).
 //
 // The sampler is padded, as pbrt-v4's PaddedSobolSampler and Burley's "Practical Hash-based Owen
 // Scrambling" (JCGT 2020): the integrator draws its numbers one or two at a time (get1d, get2d),
@@ -9,13 +9,14 @@
 // pairs of one sample independent of each other is randomisation keyed by a hash of (seed,
 // pixel, dimension):
 //
-//   - the index of the point, the pass, is shuffled by a nested scramble of its bits (each bit
-//     flipped by a hash of the bits above it). That maps every aligned block of 2^k indices onto an
-//     aligned block of 2^k indices, so the first 2^k passes of a pixel take 2^k consecutive points
-//     of the sequence, which form a (0,k,2)-net; different dimension pairs take different blocks in
-//     different orders, so they are not correlated with each other;
-//   - each coordinate is Owen-scrambled (each bit flipped by a hash of the bits above it), which
-//     keeps the net property and makes every point, on its own, uniform on [0,1)².
+//   - the index of the point, the pass, is shuffled by a nested (Owen) scramble of its bits (each
+//     bit flipped by a hash of the bits above it). That maps every aligned block of 2^k indices
+//     onto an aligned block of 2^k indices, so the first 2^k passes of a pixel take 2^k
+//     consecutive points of the sequence, which form a (0,k,2)-net; different dimension pairs take
+//     different blocks in different orders, so they are not correlated with each other;
+//   - each coordinate is xor-ed with a random word (a random digital shift), which keeps the net
+//     property and makes every point, on its own, uniform on [0,1)² (at 2^-32, past a float's 24
+//     bits).
 //
 // So for every pixel and pair of dimensions the first 2^k passes put exactly one point in each
 // elementary interval of area 2^-k (tests/trace/sampler_test.cpp), while each pass on its own is a
@@ -24,8 +25,16 @@
 // number is a function of (seed, pixel, pass, dimension), as the independent sampler's is, so
 // renders stay bit-identical across thread counts and shards.
 //
-// The scramble is the hash-based one of Laine and Karras (2011) with Vegdahl's constants (as
-// pbrt-v4's FastOwenScrambler): on the bit-reversed word, every step (x ^= x·even, x += seed,
+// Why a digital shift and not an Owen scramble of the coordinates too (pbrt-v4's default): the
+// scramble needs the coordinate bit-reversed and back, three reversals and three hashes per pair,
+// 7.0 ns a number against 1.8 ns now (build/bench/sampler_bench; the independent stream 1.05 ns);
+// with the shift, the first Sobol dimension of the shuffled index is the shuffle's own
+// (bit-reversed) output and the second a table lookup on it, so no bit is reversed per number.
+// On the Cornell box the Owen variant's error was no lower (pt-nee 64 spp, bench/README.md), and
+// the CPU it cost made it less efficient.
+//
+// The index shuffle is the hash-based scramble of Laine and Karras (2011) with Vegdahl's constants
+// (as pbrt-v4's FastOwenScrambler): on the bit-reversed word, every step (x ^= x·even, x += seed,
 // x *= odd) changes a bit only as a function of the bits below it, which is a nested (Owen)
 // permutation of the digits.
 #pragma once
@@ -55,8 +64,8 @@ constexpr std::uint32_t laine_karras(std::uint32_t v, std::uint32_t seed) {
 }
 
 // A nested scramble of the bits of v: each bit flipped by a function of `seed` and of the bits
-// more significant than it. Applied to a point's coordinate it is an Owen scramble; applied to an
-// index it permutes every aligned block of 2^k indices onto an aligned block of 2^k indices.
+// more significant than it. Applied to an index it permutes every aligned block of 2^k indices
+// onto an aligned block of 2^k indices.
 constexpr std::uint32_t nested_scramble(std::uint32_t v, std::uint32_t seed) {
   return reverse_bits(laine_karras(reverse_bits(v), seed));
 }
