@@ -470,7 +470,7 @@ Command add_trace(CLI::App& app) {
       ->check(CLI::Range(0, 1000));
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
   sub->add_option("--sampler", args->sampler,
-                  "Random numbers: sobol (randomised Sobol points, stratified per pixel) or independent")
+                  "Random numbers: sobol (Owen-scrambled Sobol points, stratified per pixel) or independent")
       ->transform(CLI::CheckedTransformer(std::map<std::string, SamplerKind>{{"independent", SamplerKind::kIndependent},
                                                                               {"sobol", SamplerKind::kSobol}})
                      .description("{independent,sobol}"))  // CLI11 would print the enum's bytes

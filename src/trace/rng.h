@@ -66,7 +66,7 @@ constexpr float bits_to_unit_float(std::uint64_t bits) {
 inline constexpr float kOneMinusEpsilon = 1.0f - 0x1p-24f;  // the largest float below 1
 
 // Which numbers a Sampler draws (`pathex trace --sampler`): `independent`, the counter-based
-// stream above (every number independent of every other), or `sobol`, randomised Sobol points
+// stream above (every number independent of every other), or `sobol`, Owen-scrambled Sobol points
 // (trace/sobol.h): each pair of dimensions drawn with get2d() is stratified over a pixel's passes
 // (the first 2^k passes put one point in every elementary interval of area 2^-k), each number on
 // its own still uniform and independent across dimension pairs. Both are functions of (seed,

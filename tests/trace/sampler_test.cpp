@@ -42,14 +42,13 @@ TEST(Sobol, SecondDimensionIsSobolsWithPolynomialXPlusOne) {
       EXPECT_EQ(sobol::dimension1(i ^ j), sobol::dimension1(i) ^ sobol::dimension1(j));
 }
 
-// point1 and point2 are the definition's composition (the shuffled index's Sobol point, digitally
-// shifted), computed without a bit reversal per number.
-TEST(Sobol, PointsAreTheRandomisedSequence) {
+// point1 and point2 are the definition's composition, computed with fewer bit reversals.
+TEST(Sobol, PointsAreTheScrambledSequence) {
   for (std::uint32_t index : {0u, 1u, 7u, 1000u, 0x12345678u, 0xffffffffu})
     for (const sobol::Seeds& s : {sobol::Seeds{0u, 0u, 0u}, sobol::Seeds{1u, 2u, 3u}, sobol::Seeds{0xdeadbeefu, 0x9e3779b9u, 77u}}) {
       const std::uint32_t i = sobol::nested_scramble(index, s.shuffle);
-      const std::uint32_t x = sobol::dimension0(i) ^ s.x;
-      const std::uint32_t y = sobol::dimension1(i) ^ s.y;
+      const std::uint32_t x = sobol::nested_scramble(sobol::dimension0(i), s.x);
+      const std::uint32_t y = sobol::nested_scramble(sobol::dimension1(i), s.y);
       const std::uint32_t r = sobol::reverse_bits(index);
       EXPECT_EQ(sobol::point1(r, s), x);
       EXPECT_EQ(sobol::point2(r, s)[0], x);
@@ -58,7 +57,7 @@ TEST(Sobol, PointsAreTheRandomisedSequence) {
 }
 
 // A nested scramble maps each aligned block of 2^k values onto an aligned block of 2^k values, as
-// a bijection: this is what keeps the index shuffle net-preserving.
+// a bijection: this is what keeps both the index shuffle and the Owen scramble net-preserving.
 TEST(Sobol, NestedScrambleMapsAlignedBlocksOntoAlignedBlocks) {
   for (std::uint32_t seed : {0u, 1u, 0xdeadbeefu, 0x9e3779b9u}) {
     for (int k : {1, 4, 10}) {
