@@ -49,6 +49,7 @@ Histogram::Histogram(HistogramLayout layout, const Classifier* classifier)
     : layout_(std::move(layout)),
       classifier_(classifier),
       cells_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
+      row_sums_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
       batch_samples_(static_cast<std::size_t>(std::max(layout_.num_batches, 0)), 0) {}
 
 Histogram::PathId Histogram::intern(std::string_view path) {
@@ -71,7 +72,6 @@ std::optional<Histogram::PathId> Histogram::find(std::string_view path) const {
 
 namespace {
 
-ExactSum abs_exact(ExactSum v) { return static_cast<SignedExactSum>(v) < 0 ? ExactSum{0} - v : v; }
 
 // a + b, saturating at cap (a, b ≤ cap). Saturation keeps the result order-independent: it is
 // min(cap, Σ) whatever the order of the additions.
@@ -85,14 +85,11 @@ void Histogram::add_exact(PathId id, int batch, int strategy, const ExactRgb& c)
   add_to(cell.sum, c);
   ++cell.contributions;
   if (strategy != kNoStrategy) {
-    const int r = row_of(id, strategy);
+    const int r = technique_row(id, strategy);
     ++rows_[static_cast<std::size_t>(r)].contributions;
-    add_to(row_sums_[static_cast<std::size_t>(r) * static_cast<std::size_t>(layout_.num_batches) +
-                     static_cast<std::size_t>(batch)],
-           c);
+    row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(r)] += luminance_exact(c);
   }
-  // Each |channel| < 2^114, so the sum of three cannot wrap before saturating.
-  magnitude_ = add_saturating(magnitude_, abs_exact(c[0]) + abs_exact(c[1]) + abs_exact(c[2]), kMagnitudeCap);
+  add_magnitude_of(c);
 }
 
 void Histogram::add_cell(PathId id, int batch, const ExactRgb& sum, std::uint64_t contributions) {
@@ -101,7 +98,7 @@ void Histogram::add_cell(PathId id, int batch, const ExactRgb& sum, std::uint64_
   cell.contributions += contributions;
 }
 
-int Histogram::row_of(PathId id, int technique) {
+int Histogram::technique_row(PathId id, int technique) {
   int last = -1;
   for (int r = first_row_[static_cast<std::size_t>(id)]; r >= 0; r = rows_[static_cast<std::size_t>(r)].next) {
     if (rows_[static_cast<std::size_t>(r)].technique == technique) return r;
@@ -109,7 +106,7 @@ int Histogram::row_of(PathId id, int technique) {
   }
   const int r = static_cast<int>(rows_.size());
   rows_.push_back(TechniqueRow{id, technique, 0, -1});
-  row_sums_.resize(row_sums_.size() + static_cast<std::size_t>(layout_.num_batches), ExactRgb{});
+  for (std::vector<ExactSum>& sums : row_sums_) sums.push_back(0);
   (last < 0 ? first_row_[static_cast<std::size_t>(id)] : rows_[static_cast<std::size_t>(last)].next) = r;
   return r;
 }
@@ -121,14 +118,11 @@ std::vector<int> Histogram::sorted_rows(PathId id) const {
   return out;
 }
 
-void Histogram::add_technique(PathId id, int technique, std::uint64_t contributions, const ExactRgb* batch_sums) {
-  const int r = row_of(id, technique);
+void Histogram::add_technique(PathId id, int technique, std::uint64_t contributions, const ExactSum* batch_sums) {
+  const int r = technique_row(id, technique);
   rows_[static_cast<std::size_t>(r)].contributions += contributions;
   if (batch_sums == nullptr) return;
-  for (int b = 0; b < layout_.num_batches; ++b)
-    add_to(row_sums_[static_cast<std::size_t>(r) * static_cast<std::size_t>(layout_.num_batches) +
-                     static_cast<std::size_t>(b)],
-           batch_sums[b]);
+  for (std::size_t b = 0; b < row_sums_.size(); ++b) row_sums_[b][static_cast<std::size_t>(r)] += batch_sums[b];
 }
 
 std::string Technique::name(const HistogramLayout& layout) const {
@@ -156,8 +150,11 @@ Result<bool> Histogram::merge(const Histogram& other) {
       const Cell& src = other.cell(o, b);
       add_cell(id, b, src.sum, src.contributions);
     }
-    for (int r : other.sorted_rows(o))
-      add_technique(id, other.row(r).technique, other.row(r).contributions, &other.row_sums_[static_cast<std::size_t>(r) * static_cast<std::size_t>(layout_.num_batches)]);
+    std::vector<ExactSum> sums(static_cast<std::size_t>(layout_.num_batches));
+    for (int r : other.sorted_rows(o)) {
+      for (int b = 0; b < layout_.num_batches; ++b) sums[static_cast<std::size_t>(b)] = other.row_sum(r, b);
+      add_technique(id, other.row(r).technique, other.row(r).contributions, sums.data());
+    }
   }
   for (std::size_t b = 0; b < batch_samples_.size(); ++b) batch_samples_[b] += other.batch_samples_[b];
   nonfinite_ += other.nonfinite_;
@@ -199,28 +196,26 @@ Estimate batch_means(const std::vector<ExactRgb>& batch_sums, const std::vector<
 
 namespace {
 
-// lum(S_b) − n_b X̄ per batch (0 for a batch without samples), with X̄ as batch_means() computes
-// it, so that a sum compared with itself gives bit-identical deviations.
-std::vector<double> batch_deviations(const std::vector<ExactRgb>& sums, const std::vector<std::uint64_t>& n) {
-  ExactRgb total{};
+// S_b − n_b X̄ per batch for luminance sums S_b (0 for a batch without samples), X̄ = Σ S_b / N: a
+// function of the sums alone, so that a sum compared with itself gives bit-identical deviations.
+std::vector<double> batch_deviations(const std::vector<ExactSum>& sums, const std::vector<std::uint64_t>& n) {
+  ExactSum total = 0;
   std::uint64_t n_total = 0;
   for (std::size_t b = 0; b < sums.size(); ++b) {
-    add_to(total, sums[b]);
+    total += sums[b];
     n_total += n[b];
   }
   std::vector<double> d(sums.size(), 0.0);
   if (n_total == 0) return d;
-  const Rgb sum = to_double(total);
-  const double nt = static_cast<double>(n_total);
-  const double mean = luminance(Rgb{sum[0] / nt, sum[1] / nt, sum[2] / nt});
+  const double mean = to_double(total) / static_cast<double>(n_total);
   for (std::size_t b = 0; b < sums.size(); ++b)
-    if (n[b] != 0) d[b] = luminance(to_double(sums[b])) - static_cast<double>(n[b]) * mean;
+    if (n[b] != 0) d[b] = to_double(sums[b]) - static_cast<double>(n[b]) * mean;
   return d;
 }
 
-// The exact sums of one technique within a path, a class or the "other" row.
+// The exact luminance sums of one technique within a path, a class or the "other" row.
 struct TechniqueSums {
-  std::vector<ExactRgb> sums;  // per batch
+  std::vector<ExactSum> sums;  // per batch
   std::uint64_t contributions = 0;
 };
 using TechniqueTable = std::map<int, TechniqueSums>;  // by Technique::code()
@@ -229,19 +224,22 @@ void add_rows(const Histogram& h, Histogram::PathId p, TechniqueTable* table) {
   const std::size_t B = static_cast<std::size_t>(h.num_batches());
   for (int r = h.first_row(p); r >= 0; r = h.row(r).next) {
     TechniqueSums& t = (*table)[h.row(r).technique];
-    t.sums.resize(B, ExactRgb{});
-    for (std::size_t b = 0; b < B; ++b) add_to(t.sums[b], h.row_sum(r, static_cast<int>(b)));
+    t.sums.resize(B, 0);
+    for (std::size_t b = 0; b < B; ++b) t.sums[b] += h.row_sum(r, static_cast<int>(b));
     t.contributions += h.row(r).contributions;
   }
 }
 
-// Each technique's share of the whole (whose per-batch sums are `whole`), its samples and its
-// part of the whole's batch-means variance (TechniqueEstimate).
-std::vector<TechniqueEstimate> technique_estimates(const HistogramLayout& layout, const std::vector<ExactRgb>& whole,
-                                                   const TechniqueTable& table, const std::vector<std::uint64_t>& n) {
-  ExactRgb total{};
-  for (const ExactRgb& s : whole) add_to(total, s);
-  const double lum = luminance(to_double(total));
+// Each technique's share of the whole (the sum of the table's techniques), its samples and its
+// part of the whole's batch-means variance (TechniqueEstimate), all from luminance sums.
+std::vector<TechniqueEstimate> technique_estimates(const HistogramLayout& layout, const TechniqueTable& table,
+                                                   const std::vector<std::uint64_t>& n) {
+  std::vector<ExactSum> whole(n.size(), 0);
+  for (const auto& [code, t] : table)
+    for (std::size_t b = 0; b < whole.size(); ++b) whole[b] += t.sums[b];
+  ExactSum total = 0;
+  for (ExactSum s : whole) total += s;
+  const double lum = to_double(total);
   const std::vector<double> dw = batch_deviations(whole, n);
   double variance = 0;
   int nonempty = 0;
@@ -251,12 +249,11 @@ std::vector<TechniqueEstimate> technique_estimates(const HistogramLayout& layout
   }
   std::vector<TechniqueEstimate> out;
   for (const auto& [code, t] : table) {
-    ExactRgb sum{};
-    for (const ExactRgb& s : t.sums) add_to(sum, s);
-    if (is_zero(sum) && t.contributions == 0) continue;
+    ExactSum sum = 0;
+    for (ExactSum s : t.sums) sum += s;
     TechniqueEstimate te;
     te.name = Technique::from_code(code).name(layout);
-    te.share = lum != 0 ? luminance(to_double(sum)) / lum : 0.0;
+    te.share = lum != 0 ? to_double(sum) / lum : 0.0;
     te.samples = t.contributions;
     if (nonempty >= 2 && variance > 0) {
       const std::vector<double> dt = batch_deviations(t.sums, n);
@@ -276,7 +273,7 @@ PathEstimate path_estimate(const Histogram& h, std::string name, const std::vect
   PathEstimate pe;
   pe.path = std::move(name);
   pe.estimate = batch_means(sums, batch_samples, contributions);
-  pe.strategies = technique_estimates(h.layout(), sums, techniques, batch_samples);
+  pe.strategies = technique_estimates(h.layout(), techniques, batch_samples);
   return pe;
 }
 
@@ -338,7 +335,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     ce.expr = classes[k].expr;
     ce.estimate = batch_means(class_sums[k], n, class_counts[k]);
     ce.share = report.total.luminance != 0 ? ce.estimate.luminance / report.total.luminance : 0.0;
-    ce.strategies = technique_estimates(h.layout(), class_sums[k], class_techniques[k], n);
+    ce.strategies = technique_estimates(h.layout(), class_techniques[k], n);
     report.classes.push_back(std::move(ce));
   }
   // Rows by luminance, largest first. report.paths[i] is still path id i here, which is what

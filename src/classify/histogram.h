@@ -34,7 +34,7 @@
 // when the batches are equal. It needs at least two batches holding samples; otherwise it is NaN.
 //
 // Memory: per distinct path string, B cells of 64 bytes, and per technique that sampled it a row
-// of B × 48 bytes (about 2 KiB + 1.5 KiB per technique for B = 32). A Histogram has one writer; each worker thread owns one (a
+// of B × 16 bytes (about 2 KiB + 0.5 KiB per technique for B = 32). A Histogram has one writer; each worker thread owns one (a
 // "shard") and the shards are merged at the end.
 #pragma once
 
@@ -111,6 +111,12 @@ inline bool to_exact(const Rgb& c, ExactRgb* out) {
 }
 inline double to_double(ExactSum s) { return static_cast<double>(static_cast<SignedExactSum>(s)) * 0x1p-64; }
 inline Rgb to_double(const ExactRgb& s) { return {to_double(s[0]), to_double(s[1]), to_double(s[2])}; }
+// The Rec. 709 luminance of a contribution already on the grid, rounded to the grid: a function of
+// the contribution alone (what the per-technique sums add, see Histogram::TechniqueRow).
+inline ExactSum luminance_exact(const ExactRgb& c) {
+  const auto v = [&](std::size_t i) { return static_cast<double>(static_cast<SignedExactSum>(c[i])); };
+  return round_to_fixed(0.2126 * v(0) + 0.7152 * v(1) + 0.0722 * v(2));
+}
 inline void add_to(ExactRgb& acc, const ExactRgb& c) {
   acc[0] += c[0];
   acc[1] += c[1];
@@ -165,8 +171,9 @@ class Histogram {
     ExactRgb sum{};                     // exact sum of the contributions of one path in one batch
     std::uint64_t contributions = 0;    // how many nonzero contributions went into it
   };
-  // The contributions of one path by one technique: their count and, in the histogram, an exact
-  // sum per batch (technique_sum()). A path's rows form a list in order of first sight.
+  // The contributions of one path by one technique: their count and, in the histogram, the exact
+  // sum per batch of their luminances (row_sum(): each contribution's Rec. 709 luminance rounded
+  // once to the fixed-point grid). A path's rows form a list in order of first sight.
   struct TechniqueRow {
     PathId path = 0;
     int technique = 0;               // Technique::code()
@@ -208,6 +215,19 @@ class Histogram {
   // The same for a contribution already converted (so that it is rounded once for the histogram
   // and the images). An all-zero contribution is ignored.
   void add_exact(PathId id, int batch, int strategy, const ExactRgb& c);
+  // The same for technique row `row` of path `id` (technique_row(); not kNoStrategy), for callers
+  // that keep rows themselves (trace/accel/path_ids.h).
+  void add_exact_at_row(PathId id, int row, int batch, const ExactRgb& c) {
+    if (is_zero(c)) return;
+    Cell& cell = cell_of(id, batch);
+    add_to(cell.sum, c);
+    ++cell.contributions;
+    ++rows_[static_cast<std::size_t>(row)].contributions;
+    row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(row)] += luminance_exact(c);
+    add_magnitude_of(c);
+  }
+  // The row of (path, technique code), added on first sight.
+  int technique_row(PathId id, int technique);
   // Registers n finished samples of `batch`, whether they contributed or not: n_b above.
   void add_samples(int batch, std::uint64_t n) { batch_samples_[static_cast<std::size_t>(batch)] += n; }
   // Counts non-finite contributions that the caller rejected itself (e.g. after to_exact()).
@@ -224,9 +244,8 @@ class Histogram {
   // The path's first technique row (-1: none); follow TechniqueRow::next for the others.
   int first_row(PathId id) const { return first_row_[static_cast<std::size_t>(id)]; }
   const TechniqueRow& row(int r) const { return rows_[static_cast<std::size_t>(r)]; }
-  const ExactRgb& row_sum(int r, int batch) const {
-    return row_sums_[static_cast<std::size_t>(r) * static_cast<std::size_t>(layout_.num_batches) +
-                     static_cast<std::size_t>(batch)];
+  ExactSum row_sum(int r, int batch) const {
+    return row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(r)];
   }
   int num_rows() const { return static_cast<int>(rows_.size()); }
   // The path's rows ordered by technique code (the order serialised forms use).
@@ -242,8 +261,8 @@ class Histogram {
   // --- restoring a serialised state: exact, like add() ---
   void add_cell(PathId id, int batch, const ExactRgb& sum, std::uint64_t contributions);
   // Adds `contributions` to the row of (path, technique) and, when `batch_sums` is not null, its
-  // B per-batch sums.
-  void add_technique(PathId id, int technique, std::uint64_t contributions, const ExactRgb* batch_sums);
+  // B per-batch luminance sums.
+  void add_technique(PathId id, int technique, std::uint64_t contributions, const ExactSum* batch_sums);
   void add_magnitude(ExactSum m);
 
  private:
@@ -265,10 +284,16 @@ class Histogram {
   // Batch-major, [batch][id]: a render's passes go to batches round-robin, so the cells it adds
   // to at a time are a few batches' rows, not a line of every path's B cells.
   std::vector<std::vector<Cell>> cells_;
-  int row_of(PathId id, int technique);  // the row of (id, technique), added on first sight
+  // Each |channel| < 2^114, so the sum of three cannot wrap before saturating.
+  void add_magnitude_of(const ExactRgb& c) {
+    const auto abs = [](ExactSum v) { return static_cast<SignedExactSum>(v) < 0 ? ExactSum{0} - v : v; };
+    const ExactSum m = abs(c[0]) + abs(c[1]) + abs(c[2]);
+    magnitude_ = m >= kMagnitudeCap - magnitude_ ? kMagnitudeCap : magnitude_ + m;
+  }
   std::vector<int> first_row_;           // per path
   std::vector<TechniqueRow> rows_;
-  std::vector<ExactRgb> row_sums_;       // [row * B + batch]
+  // Batch-major like cells_, [batch][row]: the rows a render adds to at a time are one batch's.
+  std::vector<std::vector<ExactSum>> row_sums_;
   std::vector<std::uint64_t> batch_samples_;
   std::uint64_t nonfinite_ = 0;
   ExactSum magnitude_ = 0;

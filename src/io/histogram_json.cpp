@@ -247,7 +247,7 @@ json raw_to_json(const Histogram& h) {
     for (int r : h.sorted_rows(p)) {
       const Technique t = Technique::from_code(h.row(r).technique);
       json tsums = json::array();
-      for (int b = 0; b < h.num_batches(); ++b) tsums.push_back(exact_rgb_json(h.row_sum(r, b)));
+      for (int b = 0; b < h.num_batches(); ++b) tsums.push_back(exact_to_string(h.row_sum(r, b)));
       techniques.push_back({{"strategy", t.strategy}, {"s", t.s}, {"t", t.t}, {"connector", t.connector},
                             {"contributions", h.row(r).contributions}, {"sums", std::move(tsums)}});
     }
@@ -319,9 +319,9 @@ Result<Histogram> raw_from_json(const json& raw, const std::string& filename, co
         t.t = static_cast<int>(tt);
         t.connector = rd.boolean(tj, tp, "connector");
         const std::uint64_t n = rd.uint(tj, tp, "contributions");
-        std::vector<ExactRgb> tsums(B);
+        std::vector<ExactSum> tsums(B);
         if (const json* sj = rd.array(tj, tp, "sums", B))
-          for (std::size_t b = 0; b < B; ++b) tsums[b] = rd.exact_rgb((*sj)[b], tp + "/sums/" + std::to_string(b));
+          for (std::size_t b = 0; b < B; ++b) tsums[b] = rd.exact((*sj)[b], tp + "/sums/" + std::to_string(b));
         if (rd.failed()) break;
         const std::vector<int> seen = h.sorted_rows(id);
         if (std::any_of(seen.begin(), seen.end(), [&](int r) { return h.row(r).technique == t.code(); })) {

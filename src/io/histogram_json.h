@@ -39,13 +39,13 @@
 //
 // The optional "raw" section carries the Histogram itself — per path and batch the exact
 // fixed-point sums (as the signed hexadecimal strings of exact_to_string) and contribution
-// counts, per path and technique its count and per-batch sums, per batch the sample counts — so that the outputs
+// counts, per path and technique its count and per-batch luminance sums, per batch the sample counts — so that the outputs
 // of separate processes can be parsed back and merged exactly (Histogram::merge):
 //
 //   raw {format: 2, fraction_bits: 64, batches: B, strategies: [names], batch_samples: [B ints],
 //        nonfinite: n, magnitude: "0x…",
 //        paths: [{path, contributions: [B ints], sums: [B × [r,g,b]],
-//                 techniques: [{strategy, s, t, connector, contributions, sums: [B × [r,g,b]]}]}]}
+//                 techniques: [{strategy, s, t, connector, contributions, sums: [B luminance sums]}]}]}
 //   (format 1 had strategy_sums [S × [r,g,b]] instead of techniques; it is refused)
 #pragma once
 

@@ -452,7 +452,7 @@ std::string encode_shard(const ShardHeader& header, const Histogram& h, const Cl
     for (int r : rows) {
       w.u(static_cast<std::uint64_t>(h.row(r).technique));
       w.u(h.row(r).contributions);
-      for (int b = 0; b < h.num_batches(); ++b) w.rgb(h.row_sum(r, b));
+      for (int b = 0; b < h.num_batches(); ++b) w.x(h.row_sum(r, b));
     }
   }
   // --- images ---
@@ -537,7 +537,7 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
   const auto bad = [&](const std::string& what) { return file_error(f.path, "malformed shard body: " + what); };
   // --- histogram ---
   const int B = h->num_batches(), S = h->num_strategies();
-  std::vector<ExactRgb> technique_sums(static_cast<std::size_t>(B));
+  std::vector<ExactSum> technique_sums(static_cast<std::size_t>(B));
   for (int b = 0; b < B; ++b) h->add_samples(b, r.u());
   h->add_nonfinite(r.u());
   h->add_magnitude(r.x());
@@ -553,7 +553,7 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
     const std::uint64_t rows = r.u();
     for (std::uint64_t k = 0; k < rows && !r.failed(); ++k) {
       const std::uint64_t code = r.u(), n = r.u();
-      for (ExactRgb& sum : technique_sums) sum = r.rgb();
+      for (ExactSum& sum : technique_sums) sum = r.x();
       if (r.failed()) break;
       if (code >= (std::uint64_t{1} << 29) || Technique::from_code(static_cast<int>(code)).strategy >= S)
         return bad("a technique of path \"" + path + "\" names no strategy of the render");

@@ -39,7 +39,7 @@
 //   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P; then per
 //              path, by string: u length, the letters, B × (u contributions, 3 × x sums),
 //              u number of technique rows R, then R × (u Technique::code(), u contributions,
-//              B × 3 × x per-batch sums), by code (B batches from the header)
+//              B × x per-batch luminance sums), by code (B batches from the header)
 //   images:    u planes, u tiles per plane, u number of stored tiles T; then per tile, by plane
 //              then tile: u plane, u tile, ClassImages::kTileWords / 2 × x (per pixel, per
 //              channel, of the tile's 8 × 8 pixels). Tiles with nothing in them are not stored.

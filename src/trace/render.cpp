@@ -860,8 +860,8 @@ void Integrator::record(Thread& th, const Pending& r) const {
     return;
   }
   if (is_zero(e)) return;
-  const Histogram::PathId id = th.ids.get(th.hist, r.key);
-  th.hist.add_exact(id, r.batch, r.technique, e);
+  const auto [id, row] = th.ids.get(th.hist, r.key, r.technique);
+  th.hist.add_exact_at_row(id, row, r.batch, e);
   if (!o_.images) return;
   const std::uint32_t set = th.hist.class_set(id);
   if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, e);

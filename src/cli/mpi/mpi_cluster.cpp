@@ -160,8 +160,7 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
       int row = -1;
       for (int r = id ? h.first_row(*id) : -1; r >= 0 && row < 0; r = h.row(r).next)
         if (h.row(r).technique == code) row = r;
-      for (int b = 0; b < B; ++b)
-        for (int c = 0; c < 3; ++c) put(words, row >= 0 ? h.row_sum(row, b)[static_cast<std::size_t>(c)] : ExactSum{0});
+      for (int b = 0; b < B; ++b) put(words, row >= 0 ? h.row_sum(row, b) : ExactSum{0});
       put(words, row >= 0 ? h.row(row).contributions : 0);
       continue;
     }
@@ -182,11 +181,11 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
     return r;
   if (rank_ == 0) {
     const Word* w = words.data();
-    std::vector<ExactRgb> sums(static_cast<std::size_t>(B));
+    std::vector<ExactSum> sums(static_cast<std::size_t>(B));
     for (const std::string& line : paths) {
       if (const std::size_t tab = line.find('\t'); tab != std::string::npos) {
         const auto [p, code] = split(line, tab);
-        for (int b = 0; b < B; ++b, w += 6) sums[static_cast<std::size_t>(b)] = {get(w), get(w + 2), get(w + 4)};
+        for (int b = 0; b < B; ++b, w += 2) sums[static_cast<std::size_t>(b)] = get(w);
         h.add_technique(h.intern(p), code, static_cast<std::uint64_t>(get(w)), sums.data());
         w += 2;
         continue;
