@@ -216,13 +216,13 @@ class Histogram {
   // and the images). An all-zero contribution is ignored.
   void add_exact(PathId id, int batch, int strategy, const ExactRgb& c);
   // The same for technique row `row` of path `id` (technique_row(); not kNoStrategy), for callers
-  // that keep rows themselves (trace/accel/path_ids.h).
+  // that keep rows themselves (trace/accel/path_ids.h) and count the row's contributions
+  // themselves (add_technique() with null sums).
   void add_exact_at_row(PathId id, int row, int batch, const ExactRgb& c) {
     if (is_zero(c)) return;
     Cell& cell = cell_of(id, batch);
     add_to(cell.sum, c);
     ++cell.contributions;
-    ++rows_[static_cast<std::size_t>(row)].contributions;
     row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(row)] += luminance_exact(c);
     add_magnitude_of(c);
   }

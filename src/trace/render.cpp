@@ -1470,6 +1470,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   out.complete = out.passes_done == todo;
   for (Integrator::Thread& th : locals) {
     th.splats.flush(out.images);
+    th.ids.flush(th.hist);
     Result<bool> m = out.histogram.merge(th.hist);
     if (!m) return m.error();
     out.rays += th.rays;

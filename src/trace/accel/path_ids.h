@@ -40,7 +40,8 @@ inline PathKey pack(const std::string& letters) {  // "L c0 … E"
 
 // Per-thread map from (packed string, technique) to the histogram's path id and technique row,
 // so that recording a contribution hashes three words instead of a string and walks no list;
-// Histogram::intern() and technique_row() run once per new pair and thread.
+// Histogram::intern() and technique_row() run once per new pair and thread. The contributions
+// of each pair are counted here, in the slot just read, and handed to the histogram by flush().
 class PathIds {
  public:
   struct Ids {
@@ -51,15 +52,26 @@ class PathIds {
     const std::size_t mask = slots_.size() - 1;
     for (std::size_t i = hash(key, technique) & mask;; i = (i + 1) & mask) {
       Slot& slot = slots_[i];
-      if (slot.key == key && slot.technique == technique) return slot.ids;
+      if (slot.key == key && slot.technique == technique) {
+        ++slot.contributions;
+        return slot.ids;
+      }
       if (slot.key == 0) {
         const Histogram::PathId id = hist.intern(unpack(key));
-        slot = {key, technique, {id, hist.technique_row(id, technique)}};
+        slot = {key, technique, {id, hist.technique_row(id, technique)}, 1};
         const Ids ids = slot.ids;
         if (2 * ++used_ > slots_.size()) grow();
         return ids;
       }
     }
+  }
+  // Adds the contributions counted since the last flush to the histogram's technique rows.
+  void flush(Histogram& hist) {
+    for (Slot& slot : slots_)
+      if (slot.key != 0 && slot.contributions != 0) {
+        hist.add_technique(slot.ids.path, slot.technique, slot.contributions, nullptr);
+        slot.contributions = 0;
+      }
   }
 
  private:
@@ -67,6 +79,7 @@ class PathIds {
     PathKey key = 0;  // 0: empty (a real key has a nonzero length)
     int technique = 0;
     Ids ids;
+    std::uint64_t contributions = 0;  // nonzero contributions of the pair since the last flush
   };
   static std::size_t hash(PathKey key, int technique) {
     return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) ^
