@@ -3,6 +3,7 @@
 #include "classify/histogram.h"
 
 #include <algorithm>
+#include <map>
 
 namespace pathex {
 
@@ -48,6 +49,7 @@ Histogram::Histogram(HistogramLayout layout, const Classifier* classifier)
     : layout_(std::move(layout)),
       classifier_(classifier),
       cells_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
+      row_sums_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
       batch_samples_(static_cast<std::size_t>(std::max(layout_.num_batches, 0)), 0) {}
 
 Histogram::PathId Histogram::intern(std::string_view path) {
@@ -58,7 +60,7 @@ Histogram::PathId Histogram::intern(std::string_view path) {
   ids_.emplace(paths_.back(), id);
   sets_.push_back(classifier_ != nullptr ? classifier_->classify(path) : 0);
   for (std::vector<Cell>& row : cells_) row.emplace_back();
-  strategy_sums_.resize(strategy_sums_.size() + layout_.strategies.size(), ExactRgb{});
+  first_row_.push_back(-1);
   return id;
 }
 
@@ -70,7 +72,6 @@ std::optional<Histogram::PathId> Histogram::find(std::string_view path) const {
 
 namespace {
 
-ExactSum abs_exact(ExactSum v) { return static_cast<SignedExactSum>(v) < 0 ? ExactSum{0} - v : v; }
 
 // a + b, saturating at cap (a, b ≤ cap). Saturation keeps the result order-independent: it is
 // min(cap, Σ) whatever the order of the additions.
@@ -83,12 +84,12 @@ void Histogram::add_exact(PathId id, int batch, int strategy, const ExactRgb& c)
   Cell& cell = cell_of(id, batch);
   add_to(cell.sum, c);
   ++cell.contributions;
-  if (strategy != kNoStrategy)
-    add_to(strategy_sums_[static_cast<std::size_t>(id) * layout_.strategies.size() +
-                          static_cast<std::size_t>(strategy)],
-           c);
-  // Each |channel| < 2^114, so the sum of three cannot wrap before saturating.
-  magnitude_ = add_saturating(magnitude_, abs_exact(c[0]) + abs_exact(c[1]) + abs_exact(c[2]), kMagnitudeCap);
+  if (strategy != kNoStrategy) {
+    const int r = technique_row(id, strategy);
+    ++rows_[static_cast<std::size_t>(r)].contributions;
+    row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(r)] += luminance_exact(c);
+  }
+  add_magnitude_of(c);
 }
 
 void Histogram::add_cell(PathId id, int batch, const ExactRgb& sum, std::uint64_t contributions) {
@@ -97,9 +98,38 @@ void Histogram::add_cell(PathId id, int batch, const ExactRgb& sum, std::uint64_
   cell.contributions += contributions;
 }
 
-void Histogram::add_strategy_sum(PathId id, int strategy, const ExactRgb& sum) {
-  add_to(strategy_sums_[static_cast<std::size_t>(id) * layout_.strategies.size() + static_cast<std::size_t>(strategy)],
-         sum);
+int Histogram::technique_row(PathId id, int technique) {
+  int last = -1;
+  for (int r = first_row_[static_cast<std::size_t>(id)]; r >= 0; r = rows_[static_cast<std::size_t>(r)].next) {
+    if (rows_[static_cast<std::size_t>(r)].technique == technique) return r;
+    last = r;
+  }
+  const int r = static_cast<int>(rows_.size());
+  rows_.push_back(TechniqueRow{id, technique, 0, -1});
+  for (std::vector<ExactSum>& sums : row_sums_) sums.push_back(0);
+  (last < 0 ? first_row_[static_cast<std::size_t>(id)] : rows_[static_cast<std::size_t>(last)].next) = r;
+  return r;
+}
+
+std::vector<int> Histogram::sorted_rows(PathId id) const {
+  std::vector<int> out;
+  for (int r = first_row(id); r >= 0; r = row(r).next) out.push_back(r);
+  std::sort(out.begin(), out.end(), [&](int a, int b) { return row(a).technique < row(b).technique; });
+  return out;
+}
+
+void Histogram::add_technique(PathId id, int technique, std::uint64_t contributions, const ExactSum* batch_sums) {
+  const int r = technique_row(id, technique);
+  rows_[static_cast<std::size_t>(r)].contributions += contributions;
+  if (batch_sums == nullptr) return;
+  for (std::size_t b = 0; b < row_sums_.size(); ++b) row_sums_[b][static_cast<std::size_t>(r)] += batch_sums[b];
+}
+
+std::string Technique::name(const HistogramLayout& layout) const {
+  const std::string base = static_cast<std::size_t>(strategy) < layout.strategies.size()
+                               ? layout.strategies[static_cast<std::size_t>(strategy)]
+                               : "strategy " + std::to_string(strategy);
+  return base + " (" + std::to_string(s) + ", " + (connector ? "DSD" : "DD") + ", " + std::to_string(t) + ")";
 }
 
 void Histogram::add_magnitude(ExactSum m) { magnitude_ = add_saturating(magnitude_, std::min(m, kMagnitudeCap), kMagnitudeCap); }
@@ -120,7 +150,11 @@ Result<bool> Histogram::merge(const Histogram& other) {
       const Cell& src = other.cell(o, b);
       add_cell(id, b, src.sum, src.contributions);
     }
-    for (int s = 0; s < num_strategies(); ++s) add_strategy_sum(id, s, other.strategy_sum(o, s));
+    std::vector<ExactSum> sums(static_cast<std::size_t>(layout_.num_batches));
+    for (int r : other.sorted_rows(o)) {
+      for (int b = 0; b < layout_.num_batches; ++b) sums[static_cast<std::size_t>(b)] = other.row_sum(r, b);
+      add_technique(id, other.row(r).technique, other.row(r).contributions, sums.data());
+    }
   }
   for (std::size_t b = 0; b < batch_samples_.size(); ++b) batch_samples_[b] += other.batch_samples_[b];
   nonfinite_ += other.nonfinite_;
@@ -162,21 +196,84 @@ Estimate batch_means(const std::vector<ExactRgb>& batch_sums, const std::vector<
 
 namespace {
 
-// One row of the path table: the estimate of `sums` (per batch) and each strategy's share of its
-// luminance, for the strategies that contributed.
+// S_b − n_b X̄ per batch for luminance sums S_b (0 for a batch without samples), X̄ = Σ S_b / N: a
+// function of the sums alone, so that a sum compared with itself gives bit-identical deviations.
+std::vector<double> batch_deviations(const std::vector<ExactSum>& sums, const std::vector<std::uint64_t>& n) {
+  ExactSum total = 0;
+  std::uint64_t n_total = 0;
+  for (std::size_t b = 0; b < sums.size(); ++b) {
+    total += sums[b];
+    n_total += n[b];
+  }
+  std::vector<double> d(sums.size(), 0.0);
+  if (n_total == 0) return d;
+  const double mean = to_double(total) / static_cast<double>(n_total);
+  for (std::size_t b = 0; b < sums.size(); ++b)
+    if (n[b] != 0) d[b] = to_double(sums[b]) - static_cast<double>(n[b]) * mean;
+  return d;
+}
+
+// The exact luminance sums of one technique within a path, a class or the "other" row.
+struct TechniqueSums {
+  std::vector<ExactSum> sums;  // per batch
+  std::uint64_t contributions = 0;
+};
+using TechniqueTable = std::map<int, TechniqueSums>;  // by Technique::code()
+
+void add_rows(const Histogram& h, Histogram::PathId p, TechniqueTable* table) {
+  const std::size_t B = static_cast<std::size_t>(h.num_batches());
+  for (int r = h.first_row(p); r >= 0; r = h.row(r).next) {
+    TechniqueSums& t = (*table)[h.row(r).technique];
+    t.sums.resize(B, 0);
+    for (std::size_t b = 0; b < B; ++b) t.sums[b] += h.row_sum(r, static_cast<int>(b));
+    t.contributions += h.row(r).contributions;
+  }
+}
+
+// Each technique's share of the whole (the sum of the table's techniques), its samples and its
+// part of the whole's batch-means variance (TechniqueEstimate), all from luminance sums.
+std::vector<TechniqueEstimate> technique_estimates(const HistogramLayout& layout, const TechniqueTable& table,
+                                                   const std::vector<std::uint64_t>& n) {
+  std::vector<ExactSum> whole(n.size(), 0);
+  for (const auto& [code, t] : table)
+    for (std::size_t b = 0; b < whole.size(); ++b) whole[b] += t.sums[b];
+  ExactSum total = 0;
+  for (ExactSum s : whole) total += s;
+  const double lum = to_double(total);
+  const std::vector<double> dw = batch_deviations(whole, n);
+  double variance = 0;
+  int nonempty = 0;
+  for (std::size_t b = 0; b < dw.size(); ++b) {
+    variance += dw[b] * dw[b];
+    nonempty += n[b] != 0 ? 1 : 0;
+  }
+  std::vector<TechniqueEstimate> out;
+  for (const auto& [code, t] : table) {
+    ExactSum sum = 0;
+    for (ExactSum s : t.sums) sum += s;
+    TechniqueEstimate te;
+    te.name = Technique::from_code(code).name(layout);
+    te.share = lum != 0 ? to_double(sum) / lum : 0.0;
+    te.samples = t.contributions;
+    if (nonempty >= 2 && variance > 0) {
+      const std::vector<double> dt = batch_deviations(t.sums, n);
+      double covariance = 0;
+      for (std::size_t b = 0; b < dt.size(); ++b) covariance += dt[b] * dw[b];
+      te.variance_share = covariance / variance;
+    }
+    out.push_back(std::move(te));
+  }
+  return out;
+}
+
+// One row of the path table: the estimate of `sums` (per batch) and what each technique adds.
 PathEstimate path_estimate(const Histogram& h, std::string name, const std::vector<ExactRgb>& sums,
                            const std::vector<std::uint64_t>& batch_samples, std::uint64_t contributions,
-                           const std::vector<ExactRgb>& strategy_sums) {
+                           const TechniqueTable& techniques) {
   PathEstimate pe;
   pe.path = std::move(name);
   pe.estimate = batch_means(sums, batch_samples, contributions);
-  ExactRgb total{};
-  for (const ExactRgb& s : sums) add_to(total, s);
-  const double lum = luminance(to_double(total));
-  for (std::size_t s = 0; s < strategy_sums.size(); ++s) {
-    if (is_zero(strategy_sums[s])) continue;
-    pe.strategies.emplace_back(h.layout().strategies[s], lum != 0 ? luminance(to_double(strategy_sums[s])) / lum : 0.0);
-  }
+  pe.strategies = technique_estimates(h.layout(), techniques, batch_samples);
   return pe;
 }
 
@@ -203,6 +300,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   std::uint64_t total_count = 0;
   std::vector<std::vector<ExactRgb>> class_sums(classes.size(), std::vector<ExactRgb>(B, ExactRgb{}));
   std::vector<std::uint64_t> class_counts(classes.size(), 0);
+  std::vector<TechniqueTable> class_techniques(classes.size());
   std::vector<ExactRgb> path_sums(B);
 
   for (Histogram::PathId p = 0; p < h.num_paths(); ++p) {
@@ -222,11 +320,12 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
         const std::size_t ks = static_cast<std::size_t>(k);
         for (std::size_t b = 0; b < B; ++b) add_to(class_sums[ks][b], path_sums[b]);
         class_counts[ks] += count;
+        add_rows(h, p, &class_techniques[ks]);
       }
     }
-    std::vector<ExactRgb> strategy_sums(static_cast<std::size_t>(h.num_strategies()));
-    for (int s = 0; s < h.num_strategies(); ++s) strategy_sums[static_cast<std::size_t>(s)] = h.strategy_sum(p, s);
-    report.paths.push_back(path_estimate(h, h.path(p), path_sums, n, count, strategy_sums));
+    TechniqueTable techniques;
+    add_rows(h, p, &techniques);
+    report.paths.push_back(path_estimate(h, h.path(p), path_sums, n, count, techniques));
   }
   report.distinct_paths = report.paths.size();
   report.total = batch_means(total_sums, n, total_count);
@@ -236,6 +335,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     ce.expr = classes[k].expr;
     ce.estimate = batch_means(class_sums[k], n, class_counts[k]);
     ce.share = report.total.luminance != 0 ? ce.estimate.luminance / report.total.luminance : 0.0;
+    ce.strategies = technique_estimates(h.layout(), class_techniques[k], n);
     report.classes.push_back(std::move(ce));
   }
   // Rows by luminance, largest first. report.paths[i] is still path id i here, which is what
@@ -252,7 +352,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   const std::size_t listed = max_paths ? std::min<std::size_t>(order.size(), *max_paths) : order.size();
   if (listed < order.size()) {
     std::vector<ExactRgb> other_sums(B, ExactRgb{});
-    std::vector<ExactRgb> other_strategy_sums(static_cast<std::size_t>(h.num_strategies()), ExactRgb{});
+    TechniqueTable other_techniques;
     std::uint64_t other_count = 0;
     for (std::size_t i = listed; i < order.size(); ++i) {
       const Histogram::PathId p = order[i];
@@ -260,10 +360,9 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
         add_to(other_sums[static_cast<std::size_t>(b)], h.cell(p, b).sum);
         other_count += h.cell(p, b).contributions;
       }
-      for (int s = 0; s < h.num_strategies(); ++s)
-        add_to(other_strategy_sums[static_cast<std::size_t>(s)], h.strategy_sum(p, s));
+      add_rows(h, p, &other_techniques);
     }
-    report.other = path_estimate(h, "other", other_sums, n, other_count, other_strategy_sums);
+    report.other = path_estimate(h, "other", other_sums, n, other_count, other_techniques);
     report.other_paths = order.size() - listed;
   }
   std::vector<PathEstimate> rows;

@@ -33,8 +33,8 @@
 // which is unbiased for independent samples and reduces to the textbook Σ (X_b − X̄)² / (B(B−1))
 // when the batches are equal. It needs at least two batches holding samples; otherwise it is NaN.
 //
-// Memory: per distinct path string, B cells of 64 bytes plus 48 bytes per strategy (about 2.2 KiB
-// for B = 32 and 4 strategies). A Histogram has one writer; each worker thread owns one (a
+// Memory: per distinct path string, B cells of 64 bytes, and per technique that sampled it a row
+// of B × 16 bytes (about 2 KiB + 0.5 KiB per technique for B = 32). A Histogram has one writer; each worker thread owns one (a
 // "shard") and the shards are merged at the end.
 #pragma once
 
@@ -111,6 +111,12 @@ inline bool to_exact(const Rgb& c, ExactRgb* out) {
 }
 inline double to_double(ExactSum s) { return static_cast<double>(static_cast<SignedExactSum>(s)) * 0x1p-64; }
 inline Rgb to_double(const ExactRgb& s) { return {to_double(s[0]), to_double(s[1]), to_double(s[2])}; }
+// The Rec. 709 luminance of a contribution already on the grid, rounded to the grid: a function of
+// the contribution alone (what the per-technique sums add, see Histogram::TechniqueRow).
+inline ExactSum luminance_exact(const ExactRgb& c) {
+  const auto v = [&](std::size_t i) { return static_cast<double>(static_cast<SignedExactSum>(c[i])); };
+  return round_to_fixed(0.2126 * v(0) + 0.7152 * v(1) + 0.0722 * v(2));
+}
 inline void add_to(ExactRgb& acc, const ExactRgb& c) {
   acc[0] += c[0];
   acc[1] += c[1];
@@ -132,18 +138,47 @@ inline int batch_of_pass(std::uint64_t pass, std::uint64_t spp, int num_batches)
 
 struct HistogramLayout {
   int num_batches = kDefaultBatches;    // B ≥ 1; at least 2 for a standard error
-  std::vector<std::string> strategies;  // strategy id = index; shares are reported under these names
+  std::vector<std::string> strategies;  // strategy id = index; techniques are named after these
   bool operator==(const HistogramLayout&) const = default;
+};
+
+// A sampling technique: strategy `strategy` of the layout (a profile strategy) run at one split of
+// a path, s vertices from the light, the strategy's chain, t vertices from the sensor (DESIGN §4:
+// a plain join's chain is DD, a connector's DSD). The histogram keeps exact sums per path,
+// technique and batch, so that a report can say which technique carries a path's estimate and
+// its variance. code() packs it into one non-negative int (strategy, s, t, chain from the most
+// significant bits down: 12, 8, 8 and 1 bits), so that codes sort by strategy, then s, then t;
+// the accumulator and the shard file store codes.
+struct Technique {
+  int strategy = 0;
+  int s = 0, t = 0;
+  bool connector = false;  // the chain is a connector's DSD, not a plain join's DD
+  static constexpr int kMaxStrategies = 1 << 12, kMaxSplit = 255;
+  int code() const { return (strategy << 17) | (s << 9) | (t << 1) | (connector ? 1 : 0); }
+  static Technique from_code(int code) {
+    return {(code >> 17) & 0xfff, (code >> 9) & 0xff, (code >> 1) & 0xff, (code & 1) != 0};
+  }
+  // "bdpt (2, DD, 1)", "mirror (1, DSD, 1)": the strategy's name in the layout and (s, chain, t).
+  std::string name(const HistogramLayout& layout) const;
 };
 
 class Histogram {
  public:
   using PathId = int;
-  static constexpr int kNoStrategy = -1;  // a contribution not attributed to any strategy
+  static constexpr int kNoStrategy = -1;  // a contribution not attributed to any technique
 
   struct Cell {
     ExactRgb sum{};                     // exact sum of the contributions of one path in one batch
     std::uint64_t contributions = 0;    // how many nonzero contributions went into it
+  };
+  // The contributions of one path by one technique: their count and, in the histogram, the exact
+  // sum per batch of their luminances (row_sum(): each contribution's Rec. 709 luminance rounded
+  // once to the fixed-point grid). A path's rows form a list in order of first sight.
+  struct TechniqueRow {
+    PathId path = 0;
+    int technique = 0;               // Technique::code()
+    std::uint64_t contributions = 0;
+    int next = -1;                   // the path's next row, or -1
   };
 
   // With a classifier, intern() also records each path's class-set id (for per-class images).
@@ -165,7 +200,8 @@ class Histogram {
 
   // --- accumulation (not thread-safe: one writer per Histogram) ---
   // Adds a contribution of path `id` from a sample in `batch` (0 ≤ batch < B) sampled by
-  // `strategy` (an index into the layout's strategies, or kNoStrategy); unchecked. Returns
+  // technique `strategy` (a Technique::code() whose strategy indexes the layout's strategies, or
+  // kNoStrategy); unchecked. Returns
   // false, counting it in nonfinite(), when it is not finite or too large (see to_exact()).
   bool add(PathId id, int batch, int strategy, const Rgb& c) {
     std::optional<ExactRgb> e = to_exact(c);
@@ -179,6 +215,19 @@ class Histogram {
   // The same for a contribution already converted (so that it is rounded once for the histogram
   // and the images). An all-zero contribution is ignored.
   void add_exact(PathId id, int batch, int strategy, const ExactRgb& c);
+  // The same for technique row `row` of path `id` (technique_row(); not kNoStrategy), for callers
+  // that keep rows themselves (trace/accel/path_ids.h) and count the row's contributions
+  // themselves (add_technique() with null sums).
+  void add_exact_at_row(PathId id, int row, int batch, const ExactRgb& c) {
+    if (is_zero(c)) return;
+    Cell& cell = cell_of(id, batch);
+    add_to(cell.sum, c);
+    ++cell.contributions;
+    row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(row)] += luminance_exact(c);
+    add_magnitude_of(c);
+  }
+  // The row of (path, technique code), added on first sight.
+  int technique_row(PathId id, int technique);
   // Registers n finished samples of `batch`, whether they contributed or not: n_b above.
   void add_samples(int batch, std::uint64_t n) { batch_samples_[static_cast<std::size_t>(batch)] += n; }
   // Counts non-finite contributions that the caller rejected itself (e.g. after to_exact()).
@@ -192,10 +241,15 @@ class Histogram {
   const Cell& cell(PathId id, int batch) const {
     return cells_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(id)];
   }
-  const ExactRgb& strategy_sum(PathId id, int strategy) const {
-    return strategy_sums_[static_cast<std::size_t>(id) * layout_.strategies.size() +
-                          static_cast<std::size_t>(strategy)];
+  // The path's first technique row (-1: none); follow TechniqueRow::next for the others.
+  int first_row(PathId id) const { return first_row_[static_cast<std::size_t>(id)]; }
+  const TechniqueRow& row(int r) const { return rows_[static_cast<std::size_t>(r)]; }
+  ExactSum row_sum(int r, int batch) const {
+    return row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(r)];
   }
+  int num_rows() const { return static_cast<int>(rows_.size()); }
+  // The path's rows ordered by technique code (the order serialised forms use).
+  std::vector<int> sorted_rows(PathId id) const;
   std::uint64_t batch_samples(int batch) const { return batch_samples_[static_cast<std::size_t>(batch)]; }
   std::uint64_t total_samples() const;
   std::uint64_t nonfinite() const { return nonfinite_; }
@@ -206,7 +260,9 @@ class Histogram {
 
   // --- restoring a serialised state: exact, like add() ---
   void add_cell(PathId id, int batch, const ExactRgb& sum, std::uint64_t contributions);
-  void add_strategy_sum(PathId id, int strategy, const ExactRgb& sum);
+  // Adds `contributions` to the row of (path, technique) and, when `batch_sums` is not null, its
+  // B per-batch luminance sums.
+  void add_technique(PathId id, int technique, std::uint64_t contributions, const ExactSum* batch_sums);
   void add_magnitude(ExactSum m);
 
  private:
@@ -228,7 +284,16 @@ class Histogram {
   // Batch-major, [batch][id]: a render's passes go to batches round-robin, so the cells it adds
   // to at a time are a few batches' rows, not a line of every path's B cells.
   std::vector<std::vector<Cell>> cells_;
-  std::vector<ExactRgb> strategy_sums_;  // id * S + strategy
+  // Each |channel| < 2^114, so the sum of three cannot wrap before saturating.
+  void add_magnitude_of(const ExactRgb& c) {
+    const auto abs = [](ExactSum v) { return static_cast<SignedExactSum>(v) < 0 ? ExactSum{0} - v : v; };
+    const ExactSum m = abs(c[0]) + abs(c[1]) + abs(c[2]);
+    magnitude_ = m >= kMagnitudeCap - magnitude_ ? kMagnitudeCap : magnitude_ + m;
+  }
+  std::vector<int> first_row_;           // per path
+  std::vector<TechniqueRow> rows_;
+  // Batch-major like cells_, [batch][row]: the rows a render adds to at a time are one batch's.
+  std::vector<std::vector<ExactSum>> row_sums_;
   std::vector<std::uint64_t> batch_samples_;
   std::uint64_t nonfinite_ = 0;
   ExactSum magnitude_ = 0;
@@ -265,19 +330,36 @@ struct ClassInfo {
   std::string expr;  // as written in the class file
 };
 
+// What one technique adds to a path's or a class's estimate.
+struct TechniqueEstimate {
+  std::string name;           // Technique::name()
+  double share = 0;           // its luminance / the luminance of the whole (0 when that is 0)
+  std::uint64_t samples = 0;  // its nonzero contributions
+  // Its part of the whole's variance by batch means: Σ_b (S_tb − n_b X̄_t)(S_b − n_b X̄) over
+  // Σ_b (S_b − n_b X̄)², the covariance of its batch estimates with the whole's, over the
+  // whole's variance. The parts of all techniques sum to 1 (a part may be negative when
+  // techniques are anticorrelated). NaN when the whole has no standard error.
+  double variance_share = std::numeric_limits<double>::quiet_NaN();
+  // Equal values (two NaN variance shares are equal: both unknown).
+  bool operator==(const TechniqueEstimate& o) const {
+    return name == o.name && share == o.share && samples == o.samples &&
+           (variance_share == o.variance_share || (std::isnan(variance_share) && std::isnan(o.variance_share)));
+  }
+};
+
 struct ClassEstimate {
   std::string name;
   std::string expr;
   Estimate estimate;
   double share = 0;  // class luminance / total luminance (0 when the total is 0)
+  std::vector<TechniqueEstimate> strategies;  // the techniques of its paths, summed by technique
 };
 
 struct PathEstimate {
   std::string path;
   Estimate estimate;
-  // Strategy name -> share of the path's luminance, for the strategies that contributed, in
-  // layout order.
-  std::vector<std::pair<std::string, double>> strategies;
+  // The techniques that contributed, by strategy, then s, then t.
+  std::vector<TechniqueEstimate> strategies;
 };
 
 struct HistogramReport {

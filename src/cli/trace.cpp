@@ -419,6 +419,7 @@ int run(const TraceArgs& a) {
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << id.renderer << ": " << (q ? to_string(q->verdict) : "?") << "; luminance "
               << absolute(c.estimate) << "\n";
+    if (!c.strategies.empty()) std::cout << "  from " << techniques_text(c.strategies, 3) << "\n";
   }
   if (!out->connectors.empty()) {
     int width = 10;
@@ -437,8 +438,7 @@ int run(const TraceArgs& a) {
     const double err = rep->total.luminance > 0 ? p.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << "  " << std::left << std::setw(16) << p.path << std::right << std::setw(8) << percent(share) << "  ±"
               << percent(std::isfinite(err) ? err : 0.0, 2) << "  luminance " << absolute(p.estimate) << "  via";
-    for (const auto& [name, s] : p.strategies) std::cout << " " << name << " " << percent(s);
-    std::cout << "\n";
+    std::cout << " " << techniques_text(p.strategies, 2) << "\n";
   }
   std::cout << "\nwrote " << job.out << "/histogram.json" << (id.images ? ", classes.exr and PNG previews" : "") << ", "
             << kRenderShardName << (missed ? ", missed.json" : "") << "\n";

@@ -20,6 +20,13 @@ json exact_rgb_json(const ExactRgb& c) {
 }
 json stderr_json(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+json techniques_json(const std::vector<TechniqueEstimate>& ts) {
+  json out = json::object();
+  for (const TechniqueEstimate& t : ts)
+    out[t.name] = {{"share", t.share}, {"samples", t.samples}, {"variance_share", stderr_json(t.variance_share)}};
+  return out;
+}
+
 void put_estimate(json& j, const Estimate& e) {
   j["estimate"] = rgb_json(e.rgb);
   j["luminance"] = e.luminance;
@@ -132,6 +139,29 @@ class Reader {
     return e;
   }
 
+  // {name: {share, samples, variance_share}, …} (TechniqueEstimate); optional under `key`.
+  std::vector<TechniqueEstimate> techniques(const json& obj, const std::string& ptr, const char* key) {
+    std::vector<TechniqueEstimate> out;
+    if (!obj.is_object() || !obj.contains(key)) return out;
+    const json& s = obj[key];
+    const std::string sp = ptr + "/" + key;
+    if (!s.is_object()) {
+      fail(sp, "expected an object of techniques");
+      return out;
+    }
+    for (const auto& [name, tj] : s.items()) {
+      TechniqueEstimate t;
+      t.name = name;
+      const std::string tp = sp + "/" + name;
+      t.share = number(tj, tp, "share");
+      t.samples = uint(tj, tp, "samples");
+      if (const json* v = field(tj, tp, "variance_share"); v != nullptr && !v->is_null())
+        t.variance_share = number(*v, tp + "/variance_share");
+      out.push_back(std::move(t));
+    }
+    return out;
+  }
+
   static constexpr std::size_t kAnySize = static_cast<std::size_t>(-1);
 
  private:
@@ -162,6 +192,7 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
     j["expr"] = c.expr;
     put_estimate(j, c.estimate);
     j["share"] = c.share;
+    j["strategies"] = techniques_json(c.strategies);
     classes.push_back(std::move(j));
   }
   doc["classes"] = std::move(classes);
@@ -175,9 +206,7 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
                   std::to_string(r.paths.size()) + " (--max-paths)";
     }
     put_estimate(j, p.estimate);
-    json strategies = json::object();
-    for (const auto& [name, share] : p.strategies) strategies[name] = share;
-    j["strategies"] = std::move(strategies);
+    j["strategies"] = techniques_json(p.strategies);
     paths.push_back(std::move(j));
   };
   for (const PathEstimate& p : r.paths) put_path(p, std::nullopt);
@@ -193,7 +222,7 @@ std::string histogram_json_text(const HistogramReport& report, const Histogram* 
 
 json raw_to_json(const Histogram& h) {
   json raw = json::object();
-  raw["format"] = 1;
+  raw["format"] = 2;
   raw["fraction_bits"] = kFractionBits;
   raw["batches"] = h.num_batches();
   raw["strategies"] = h.layout().strategies;
@@ -210,15 +239,21 @@ json raw_to_json(const Histogram& h) {
   for (Histogram::PathId p : order) {
     json j = json::object();
     j["path"] = h.path(p);
-    json counts = json::array(), sums = json::array(), strategy_sums = json::array();
+    json counts = json::array(), sums = json::array(), techniques = json::array();
     for (int b = 0; b < h.num_batches(); ++b) {
       counts.push_back(h.cell(p, b).contributions);
       sums.push_back(exact_rgb_json(h.cell(p, b).sum));
     }
-    for (int s = 0; s < h.num_strategies(); ++s) strategy_sums.push_back(exact_rgb_json(h.strategy_sum(p, s)));
+    for (int r : h.sorted_rows(p)) {
+      const Technique t = Technique::from_code(h.row(r).technique);
+      json tsums = json::array();
+      for (int b = 0; b < h.num_batches(); ++b) tsums.push_back(exact_to_string(h.row_sum(r, b)));
+      techniques.push_back({{"strategy", t.strategy}, {"s", t.s}, {"t", t.t}, {"connector", t.connector},
+                            {"contributions", h.row(r).contributions}, {"sums", std::move(tsums)}});
+    }
     j["contributions"] = std::move(counts);
     j["sums"] = std::move(sums);
-    j["strategy_sums"] = std::move(strategy_sums);
+    j["techniques"] = std::move(techniques);
     paths.push_back(std::move(j));
   }
   raw["paths"] = std::move(paths);
@@ -228,7 +263,8 @@ json raw_to_json(const Histogram& h) {
 Result<Histogram> raw_from_json(const json& raw, const std::string& filename, const std::string& ptr) {
   Reader rd(filename);
   if (!raw.is_object()) rd.fail(ptr, "expected an object");
-  if (!rd.failed() && rd.uint(raw, ptr, "format") != 1) rd.fail(ptr + "/format", "expected format 1");
+  if (!rd.failed() && rd.uint(raw, ptr, "format") != 2)
+    rd.fail(ptr + "/format", "expected format 2 (format 1, without per-technique sums, was written by an older pathex)");
   if (!rd.failed() && rd.uint(raw, ptr, "fraction_bits") != static_cast<std::uint64_t>(kFractionBits))
     rd.fail(ptr + "/fraction_bits", "expected " + std::to_string(kFractionBits));
   HistogramLayout layout;
@@ -263,16 +299,37 @@ Result<Histogram> raw_from_json(const json& raw, const std::string& filename, co
       const Histogram::PathId id = h.intern(path);
       const json* counts = rd.array(pj, pp, "contributions", B);
       const json* sums = rd.array(pj, pp, "sums", B);
-      const json* ssums = rd.array(pj, pp, "strategy_sums", S);
+      const json* techniques = rd.array(pj, pp, "techniques");
       if (rd.failed()) break;
       for (std::size_t b = 0; b < B; ++b) {
         const std::string bs = std::to_string(b);
         h.add_cell(id, static_cast<int>(b), rd.exact_rgb((*sums)[b], pp + "/sums/" + bs),
                    rd.uint((*counts)[b], pp + "/contributions/" + bs));
       }
-      for (std::size_t s = 0; s < S; ++s)
-        h.add_strategy_sum(id, static_cast<int>(s),
-                           rd.exact_rgb((*ssums)[s], pp + "/strategy_sums/" + std::to_string(s)));
+      for (std::size_t k = 0; k < techniques->size() && !rd.failed(); ++k) {
+        const json& tj = (*techniques)[k];
+        const std::string tp = pp + "/techniques/" + std::to_string(k);
+        Technique t;
+        const std::uint64_t strategy = rd.uint(tj, tp, "strategy"), s = rd.uint(tj, tp, "s"), tt = rd.uint(tj, tp, "t");
+        if (!rd.failed() && strategy >= S) rd.fail(tp + "/strategy", "expected a strategy index below " + std::to_string(S));
+        if (!rd.failed() && (s > Technique::kMaxSplit || tt > Technique::kMaxSplit))
+          rd.fail(tp, "expected s and t of at most " + std::to_string(Technique::kMaxSplit));
+        t.strategy = static_cast<int>(strategy);
+        t.s = static_cast<int>(s);
+        t.t = static_cast<int>(tt);
+        t.connector = rd.boolean(tj, tp, "connector");
+        const std::uint64_t n = rd.uint(tj, tp, "contributions");
+        std::vector<ExactSum> tsums(B);
+        if (const json* sj = rd.array(tj, tp, "sums", B))
+          for (std::size_t b = 0; b < B; ++b) tsums[b] = rd.exact((*sj)[b], tp + "/sums/" + std::to_string(b));
+        if (rd.failed()) break;
+        const std::vector<int> seen = h.sorted_rows(id);
+        if (std::any_of(seen.begin(), seen.end(), [&](int r) { return h.row(r).technique == t.code(); })) {
+          rd.fail(tp, "technique appears twice");
+          break;
+        }
+        h.add_technique(id, t.code(), n, tsums.data());
+      }
     }
   }
   if (rd.failed()) return rd.error();
@@ -307,6 +364,7 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
       c.expr = rd.str(cj, cp, "expr");
       c.estimate = rd.estimate(cj, cp, /*samples_required=*/true);
       c.share = rd.number(cj, cp, "share");
+      c.strategies = rd.techniques(cj, cp, "strategies");
       r.classes.push_back(std::move(c));
     }
   }
@@ -319,12 +377,7 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
       const bool other = p.path == "other";  // the sum of the rows past max_paths; never a full path
       if (other) r.other_paths = rd.uint(pj, pp, "paths");
       p.estimate = rd.estimate(pj, pp, /*samples_required=*/true);
-      if (const json* s = rd.field(pj, pp, "strategies")) {
-        if (!s->is_object()) rd.fail(pp + "/strategies", "expected an object of strategy shares");
-        else
-          for (const auto& [name, share] : s->items())
-            p.strategies.emplace_back(name, rd.number(share, pp + "/strategies/" + name));
-      }
+      p.strategies = rd.techniques(pj, pp, "strategies");
       if (other) r.other = std::move(p);
       else r.paths.push_back(std::move(p));
     }

@@ -16,8 +16,9 @@
 //   distinct_paths     integer  distinct paths sampled (rows of `paths`, plus those summed in "other")
 //   max_paths          integer  the bound on the rows of `paths` (--max-paths), or null for none
 //   total    {estimate [r,g,b], luminance, stderr, samples}
-//   classes  [{name, expr, estimate [r,g,b], luminance, stderr, samples, share}]   in class-file order
-//   paths    [{path, estimate [r,g,b], luminance, stderr, samples, strategies {name: share}}]
+//   classes  [{name, expr, estimate [r,g,b], luminance, stderr, samples, share, strategies}]
+//            in class-file order
+//   paths    [{path, estimate [r,g,b], luminance, stderr, samples, strategies}]
 //            sorted by luminance, largest first; at most max_paths of them, then, when more paths
 //            were sampled, one row {path: "other", paths: n, note, estimate, …} that sums the rest
 //            exactly ("other" is never a full path: those begin with L)
@@ -26,17 +27,26 @@
 // An estimate is the mean pixel value over the image (RGB, and its Rec. 709 luminance); stderr is
 // the standard error of the luminance by batch means (null when fewer than two batches hold
 // samples); samples counts nonzero contributions; a class's share is its luminance over the
-// total's; a path's strategies give each strategy's share of the path's luminance. `samples` in
-// `total` is an addition to the keys listed in issue 4.
+// total's. `samples` in `total` is an addition to the keys listed in issue 4.
+//
+// `strategies` (of a path, of "other", of a class) says which sampling technique carries the
+// estimate: {"<strategy> (s, chain, t)": {share, samples, variance_share}, …}, one key per
+// technique that contributed — the profile strategy's name and its split: s vertices from the
+// light, the chain (DD for a plain join, DSD for a connector), t vertices from the sensor.
+// share is its luminance over the whole's, samples its nonzero contributions, variance_share its
+// covariance with the whole over the whole's variance by batch means (TechniqueEstimate: the
+// shares of a row sum to 1, and so do its variance shares; null without a standard error).
 //
 // The optional "raw" section carries the Histogram itself — per path and batch the exact
 // fixed-point sums (as the signed hexadecimal strings of exact_to_string) and contribution
-// counts, per path and strategy the exact sums, per batch the sample counts — so that the outputs
+// counts, per path and technique its count and per-batch luminance sums, per batch the sample counts — so that the outputs
 // of separate processes can be parsed back and merged exactly (Histogram::merge):
 //
-//   raw {format: 1, fraction_bits: 64, batches: B, strategies: [names], batch_samples: [B ints],
+//   raw {format: 2, fraction_bits: 64, batches: B, strategies: [names], batch_samples: [B ints],
 //        nonfinite: n, magnitude: "0x…",
-//        paths: [{path, contributions: [B ints], sums: [B × [r,g,b]], strategy_sums: [S × [r,g,b]]}]}
+//        paths: [{path, contributions: [B ints], sums: [B × [r,g,b]],
+//                 techniques: [{strategy, s, t, connector, contributions, sums: [B luminance sums]}]}]}
+//   (format 1 had strategy_sums [S × [r,g,b]] instead of techniques; it is refused)
 #pragma once
 
 #include <optional>

@@ -449,7 +449,13 @@ std::string encode_shard(const ShardHeader& header, const Histogram& h, const Cl
       w.u(h.cell(p, b).contributions);
       w.rgb(h.cell(p, b).sum);
     }
-    for (int s = 0; s < h.num_strategies(); ++s) w.rgb(h.strategy_sum(p, s));
+    const std::vector<int> rows = h.sorted_rows(p);
+    w.u(rows.size());
+    for (int r : rows) {
+      w.u(static_cast<std::uint64_t>(h.row(r).technique));
+      w.u(h.row(r).contributions);
+      for (int b = 0; b < h.num_batches(); ++b) w.x(h.row_sum(r, b));
+    }
   }
   // --- images ---
   const std::size_t planes = images.num_planes(), tiles = images.num_tiles();
@@ -533,6 +539,7 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
   const auto bad = [&](const std::string& what) { return file_error(f.path, "malformed shard body: " + what); };
   // --- histogram ---
   const int B = h->num_batches(), S = h->num_strategies();
+  std::vector<ExactSum> technique_sums(static_cast<std::size_t>(B));
   for (int b = 0; b < B; ++b) h->add_samples(b, r.u());
   h->add_nonfinite(r.u());
   h->add_magnitude(r.x());
@@ -545,7 +552,15 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
       const std::uint64_t n = r.u();
       h->add_cell(id_, b, r.rgb(), n);
     }
-    for (int s = 0; s < S; ++s) h->add_strategy_sum(id_, s, r.rgb());
+    const std::uint64_t rows = r.u();
+    for (std::uint64_t k = 0; k < rows && !r.failed(); ++k) {
+      const std::uint64_t code = r.u(), n = r.u();
+      for (ExactSum& sum : technique_sums) sum = r.x();
+      if (r.failed()) break;
+      if (code >= (std::uint64_t{1} << 29) || Technique::from_code(static_cast<int>(code)).strategy >= S)
+        return bad("a technique of path \"" + path + "\" names no strategy of the render");
+      h->add_technique(id_, static_cast<int>(code), n, technique_sums.data());
+    }
   }
   if (r.failed()) return bad("the histogram ends early");
   // --- images ---

@@ -7,11 +7,12 @@
 // exact integer sums (classify/histogram.h, classify/image.h), which add. A shard file holds those
 // sums, not the floats of the outputs.
 //
-// File layout, version 2 (all integers little-endian; version 1 had the body uncompressed):
+// File layout, version 3 (all integers little-endian; version 1 had the body uncompressed, version
+// 2 per-strategy sums in place of the technique rows):
 //
 //   offset  size  what
 //   0       8     magic "PXSHARD\n"
-//   8       4     format version (2)
+//   8       4     format version (3)
 //   12      4     H: header length in bytes
 //   16      H     header: a JSON object (UTF-8), keys below
 //   16+H    8     N: body length in bytes
@@ -37,7 +38,8 @@
 // sums take; a path string is at most 512 KiB.
 //   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P; then per
 //              path, by string: u length, the letters, B × (u contributions, 3 × x sums),
-//              S × 3 × x strategy sums (B batches, S strategies from the header)
+//              u number of technique rows R, then R × (u Technique::code(), u contributions,
+//              B × x per-batch luminance sums), by code (B batches from the header)
 //   images:    u planes, u tiles per plane, u number of stored tiles T; then per tile, by plane
 //              then tile: u plane, u tile, ClassImages::kTileWords / 2 × x (per pixel, per
 //              channel, of the tile's 8 × 8 pixels). Tiles with nothing in them are not stored.
@@ -55,7 +57,7 @@
 
 namespace pathex {
 
-inline constexpr std::uint32_t kShardFormatVersion = 2;
+inline constexpr std::uint32_t kShardFormatVersion = 3;
 inline constexpr const char* kShardExtension = ".shard";
 
 // What must agree for two renders to merge: all but the names and files (the same scene, profile

@@ -185,6 +185,7 @@ class Integrator {
     PathKey key = 0;
     vec3 c{0.0f};
     int strategy = 0, batch = 0;
+    int technique = 0;       // Technique::code(): the strategy at this (s, chain, t), for the histogram
     bool splat = false;      // to raster point (rx, ry); else to the sample's own pixel, column px
     bool connector = false;  // counted in the connector's statistics
     float rx = 0.0f, ry = 0.0f;
@@ -859,8 +860,8 @@ void Integrator::record(Thread& th, const Pending& r) const {
     return;
   }
   if (is_zero(e)) return;
-  const Histogram::PathId id = th.ids.get(th.hist, r.key);
-  th.hist.add_exact(id, r.batch, r.strategy, e);
+  const auto [id, row] = th.ids.get(th.hist, r.key, r.technique);
+  th.hist.add_exact_at_row(id, row, r.batch, e);
   if (!o_.images) return;
   const std::uint32_t set = th.hist.class_set(id);
   if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, e);
@@ -1017,7 +1018,9 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   } else {
     weight = mis_weight(th, s, t, fresh, key, joined ? &join : nullptr, kind);
   }
-  const Pending r{key, contrib * weight, strategy_index, batch, splat, stats != nullptr, rx, ry, th.px};
+  const int technique =
+      Technique{strategy_index, C == Connection::kDistant ? 0 : s, C == Connection::kOrtho ? 0 : t, kind != JoinKind::kPlain}.code();
+  const Pending r{key, contrib * weight, strategy_index, batch, technique, splat, stats != nullptr, rx, ry, th.px};
   if constexpr (C == Connection::kEmitter || C == Connection::kLens) {
     record(th, r);  // no shadow ray: the path's last edge was traced
   } else {
@@ -1131,7 +1134,8 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     m.err = mirror.error;
     m.shape = mirror.shape;
     gather(th, s, t, s == 1 ? a : nullptr, &m, t == 1 ? b : nullptr);
-    const Pending r{key, contrib * path_weight(th, key, SelfKind::kMirror, s), strategy_index, batch, t == 1, true, rx, ry, th.px, 2};
+    const Pending r{key,  contrib * path_weight(th, key, SelfKind::kMirror, s), strategy_index, batch, Technique{strategy_index, s, t, true}.code(),
+                    t == 1, true, rx, ry, th.px, 2};
     // Both segments go into one batch; the contribution waits on the second.
     if (th.shadow.size() + 2 > OcclusionBatch::kCapacity) trace_shadows(th);
     th.rays += 2;
@@ -1466,6 +1470,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   out.complete = out.passes_done == todo;
   for (Integrator::Thread& th : locals) {
     th.splats.flush(out.images);
+    th.ids.flush(th.hist);
     Result<bool> m = out.histogram.merge(th.hist);
     if (!m) return m.error();
     out.rays += th.rays;

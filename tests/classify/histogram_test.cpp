@@ -184,7 +184,9 @@ std::vector<Sample> sample_stream(int n, int batches) {
     Sample s;
     s.path = paths[rng.next() % paths.size()];
     s.batch = static_cast<int>(static_cast<std::int64_t>(i) * batches / n);
-    s.strategy = static_cast<int>(rng.next() % 3);
+    s.strategy = Technique{static_cast<int>(rng.next() % 3), static_cast<int>(rng.next() % 4), static_cast<int>(rng.next() % 3),
+                           rng.next() % 2 == 0}
+                     .code();
     for (double& c : s.value) c = std::exp((rng.uniform() - 0.5) * 41);
     if (i % 97 == 0) s.value[1] = -s.value[1];  // negative components are summed exactly too
     out.push_back(s);
@@ -216,7 +218,13 @@ void expect_same_state(const Histogram& a, const Histogram& b) {
       EXPECT_TRUE(a.cell(p, bt).sum == b.cell(*q, bt).sum) << a.path(p) << " batch " << bt;
       EXPECT_EQ(a.cell(p, bt).contributions, b.cell(*q, bt).contributions);
     }
-    for (int s = 0; s < a.num_strategies(); ++s) EXPECT_TRUE(a.strategy_sum(p, s) == b.strategy_sum(*q, s));
+    const std::vector<int> ra = a.sorted_rows(p), rb = b.sorted_rows(*q);
+    ASSERT_EQ(ra.size(), rb.size()) << a.path(p);
+    for (std::size_t i = 0; i < ra.size(); ++i) {
+      EXPECT_EQ(a.row(ra[i]).technique, b.row(rb[i]).technique);
+      EXPECT_EQ(a.row(ra[i]).contributions, b.row(rb[i]).contributions);
+      for (int bt = 0; bt < a.num_batches(); ++bt) EXPECT_TRUE(a.row_sum(ra[i], bt) == b.row_sum(rb[i], bt));
+    }
   }
 }
 
@@ -383,13 +391,16 @@ TEST(HistogramReport, SharesOfAPartitionSumToOne) {
   EXPECT_EQ(r->classes[2].estimate.std_error, r->total.std_error);
 }
 
-TEST(HistogramReport, StrategySharesAndOrdering) {
+TEST(HistogramReport, TechniqueSharesVarianceAndOrdering) {
   Histogram h(HistogramLayout{2, {"nee", "emitter-hit", "light-tracing"}});
+  const int nee = Technique{0, 1, 4}.code(), hit = Technique{1, 0, 5}.code(), lt = Technique{2, 4, 1}.code();
   const Histogram::PathId a = h.intern("LDDDSE"), b = h.intern("LSDDSE"), c = h.intern("LDDDDSE");
-  ASSERT_TRUE(h.add(a, 0, 0, gray(3.0)));
-  ASSERT_TRUE(h.add(a, 1, 2, gray(1.0)));
-  ASSERT_TRUE(h.add(b, 0, 1, gray(1.0)));
-  ASSERT_TRUE(h.add(c, 1, 1, gray(1.0)));  // ties with b: ordered by path string
+  ASSERT_TRUE(h.add(a, 0, nee, gray(3.0)));
+  ASSERT_TRUE(h.add(a, 1, lt, gray(1.0)));
+  ASSERT_TRUE(h.add(b, 0, hit, gray(1.0)));
+  ASSERT_TRUE(h.add(b, 1, hit, gray(2.0)));
+  ASSERT_TRUE(h.add(c, 1, hit, gray(1.0)));  // ties with b: ordered by path string
+  ASSERT_TRUE(h.add(c, 1, hit, gray(2.0)));
   h.add_samples(0, 1);
   h.add_samples(1, 1);
   Result<HistogramReport> r = make_report(h, RunInfo{}, nullptr, {});
@@ -398,16 +409,52 @@ TEST(HistogramReport, StrategySharesAndOrdering) {
   EXPECT_EQ(r->paths[0].path, "LDDDSE");
   EXPECT_EQ(r->paths[1].path, "LDDDDSE");
   EXPECT_EQ(r->paths[2].path, "LSDDSE");
-  ASSERT_EQ(r->paths[0].strategies.size(), 2u) << "only the strategies that contributed";
-  EXPECT_EQ(r->paths[0].strategies[0].first, "nee");
-  EXPECT_NEAR(r->paths[0].strategies[0].second, 0.75, 1e-15);
-  EXPECT_EQ(r->paths[0].strategies[1].first, "light-tracing");
-  EXPECT_NEAR(r->paths[0].strategies[1].second, 0.25, 1e-15);
+  ASSERT_EQ(r->paths[0].strategies.size(), 2u) << "only the techniques that contributed";
+  const TechniqueEstimate& n0 = r->paths[0].strategies[0];
+  const TechniqueEstimate& l0 = r->paths[0].strategies[1];
+  EXPECT_EQ(n0.name, "nee (1, DD, 4)");
+  EXPECT_EQ(l0.name, "light-tracing (4, DD, 1)");
+  EXPECT_NEAR(n0.share, 0.75, 1e-15);
+  EXPECT_NEAR(l0.share, 0.25, 1e-15);
+  EXPECT_EQ(n0.samples, 1u);
+  // Batch sums 3 and 1 (mean 2, deviations ±1, Σd² = 2); nee's are 3 and 0 (deviations ±1.5),
+  // light tracing's 0 and 1 (∓0.5): covariances 3 and -1, so variance shares 1.5 and -0.5.
+  EXPECT_DOUBLE_EQ(n0.variance_share, 1.5);
+  EXPECT_DOUBLE_EQ(l0.variance_share, -0.5);
+  // One technique carries all of a path: share and variance share exactly 1.
   ASSERT_EQ(r->paths[2].strategies.size(), 1u);
-  EXPECT_EQ(r->paths[2].strategies[0].first, "emitter-hit");
-  EXPECT_EQ(r->paths[2].strategies[0].second, 1.0);
+  EXPECT_EQ(r->paths[2].strategies[0].name, "emitter-hit (0, DD, 5)");
+  EXPECT_EQ(r->paths[2].strategies[0].share, 1.0);
+  EXPECT_EQ(r->paths[2].strategies[0].variance_share, 1.0);
+  EXPECT_EQ(r->paths[2].strategies[0].samples, 2u);
+  // A path in one batch only has batch sums 3 and 0 — still a variance, all of it this technique's.
+  EXPECT_EQ(r->paths[1].strategies[0].variance_share, 1.0);
   EXPECT_DOUBLE_EQ(r->paths[0].estimate.luminance, 2.0);
-  EXPECT_DOUBLE_EQ(r->total.luminance, 3.0);
+  EXPECT_DOUBLE_EQ(r->total.luminance, 5.0);
+}
+
+TEST(HistogramReport, ClassTechniquesSumTheirPaths) {
+  // Two paths in one class, each with two techniques; the class's rows sum the paths' by technique.
+  Classes classes({{"every", "LD.*E"}});
+  Histogram h(HistogramLayout{4, {"bdpt"}}, &*classes.classifier);
+  const int s0 = Technique{0, 0, 4}.code(), s1 = Technique{0, 1, 3}.code();
+  const Histogram::PathId a = h.intern("LDDDSE"), b = h.intern("LDDSDDSE");
+  Rng rng{7};
+  for (int bt = 0; bt < 4; ++bt) {
+    ASSERT_TRUE(h.add(a, bt, s0, gray(rng.uniform())));
+    ASSERT_TRUE(h.add(a, bt, s1, gray(rng.uniform())));
+    ASSERT_TRUE(h.add(b, bt, s1, gray(rng.uniform())));
+    h.add_samples(bt, 1);
+  }
+  Result<HistogramReport> r = make_report(h, RunInfo{}, &*classes.classifier, classes.info);
+  ASSERT_TRUE(r);
+  const std::vector<TechniqueEstimate>& ts = r->classes[0].strategies;
+  ASSERT_EQ(ts.size(), 2u);
+  EXPECT_EQ(ts[0].name, "bdpt (0, DD, 4)");
+  EXPECT_EQ(ts[0].samples, 4u);
+  EXPECT_EQ(ts[1].samples, 8u);
+  EXPECT_NEAR(ts[0].share + ts[1].share, 1.0, 1e-14);
+  EXPECT_NEAR(ts[0].variance_share + ts[1].variance_share, 1.0, 1e-12);
 }
 
 TEST(HistogramReport, RejectsContributionsWithoutSamples) {

@@ -25,7 +25,7 @@ Histogram shard(int begin, int end) {
   for (int i = begin; i < end; ++i) {
     const int batch = i * 4 / 40;
     const double v = 0.1 * (i % 7) + 1e-6 * i;
-    h.add(h.intern(paths[i % 3]), batch, i % 2, {v, 2 * v, 0.5 * v});
+    h.add(h.intern(paths[i % 3]), batch, Technique{i % 2, 1 - i % 2, 3}.code(), {v, 2 * v, 0.5 * v});
     h.add_samples(batch, 1);
   }
   return h;
@@ -78,13 +78,16 @@ TEST(HistogramJson, HasTheDocumentedKeysInOrder) {
   EXPECT_EQ(keys(doc["total"]), (std::vector<std::string>{"estimate", "luminance", "stderr", "samples"}));
   ASSERT_EQ(doc["classes"].size(), 2u);
   EXPECT_EQ(keys(doc["classes"][0]), (std::vector<std::string>{"name", "expr", "estimate", "luminance", "stderr",
-                                                                "samples", "share"}));
+                                                                "samples", "share", "strategies"}));
+  EXPECT_EQ(keys(doc["classes"][0]["strategies"]), (std::vector<std::string>{"nee (1, DD, 3)", "emitter-hit (0, DD, 3)"}));
   EXPECT_EQ(doc["classes"][1]["name"], "area");
   EXPECT_EQ(doc["classes"][1]["expr"], "LD.*E");
   ASSERT_EQ(doc["paths"].size(), 3u);
   EXPECT_EQ(keys(doc["paths"][0]),
             (std::vector<std::string>{"path", "estimate", "luminance", "stderr", "samples", "strategies"}));
-  EXPECT_EQ(keys(doc["paths"][0]["strategies"]), (std::vector<std::string>{"nee", "emitter-hit"}));
+  EXPECT_EQ(keys(doc["paths"][0]["strategies"]), (std::vector<std::string>{"nee (1, DD, 3)", "emitter-hit (0, DD, 3)"}));
+  EXPECT_EQ(keys(doc["paths"][0]["strategies"]["nee (1, DD, 3)"]),
+            (std::vector<std::string>{"share", "samples", "variance_share"}));
   for (std::size_t i = 1; i < doc["paths"].size(); ++i)
     EXPECT_GE(doc["paths"][i - 1]["luminance"].get<double>(), doc["paths"][i]["luminance"].get<double>());
   EXPECT_FALSE(doc.contains("raw"));
@@ -104,6 +107,7 @@ TEST(HistogramJson, ReportRoundTrips) {
     EXPECT_EQ(b.classes[i].name, r.classes[i].name);
     EXPECT_EQ(b.classes[i].expr, r.classes[i].expr);
     EXPECT_EQ(b.classes[i].share, r.classes[i].share);
+    EXPECT_EQ(b.classes[i].strategies, r.classes[i].strategies);
     expect_same_estimate(b.classes[i].estimate, r.classes[i].estimate);
   }
   ASSERT_EQ(b.paths.size(), r.paths.size());
@@ -166,8 +170,11 @@ TEST(HistogramJson, ErrorsNameTheJsonPointer) {
       {"/total/estimate", json::array({1, 2}), "h.json:/total/estimate", "expected an array of 3 elements"},
       {"/classes/1/share", "half", "h.json:/classes/1/share", "expected a number"},
       {"/paths/2/luminance", nullptr, "h.json:/paths/2/luminance", "expected a number"},
-      {"/paths/0/strategies/nee", json::array(), "h.json:/paths/0/strategies/nee", "expected a number"},
-      {"/paths/1/strategies", 1, "h.json:/paths/1/strategies", "expected an object of strategy shares"},
+      {"/paths/0/strategies/nee (1, DD, 3)/share", json::array(), "h.json:/paths/0/strategies/nee (1, DD, 3)/share",
+       "expected a number"},
+      {"/classes/0/strategies/nee (1, DD, 3)/samples", -2, "h.json:/classes/0/strategies/nee (1, DD, 3)/samples",
+       "expected a non-negative integer"},
+      {"/paths/1/strategies", 1, "h.json:/paths/1/strategies", "expected an object of techniques"},
   };
   for (const Case& c : cases) {
     json doc = good;
@@ -202,14 +209,17 @@ TEST(HistogramJson, RawErrorsNameTheJsonPointer) {
     const char* message;
   };
   const std::vector<Case> cases = {
-      {"/raw/format", 2, "h.json:/raw/format", "expected format 1"},
+      {"/raw/format", 1, "h.json:/raw/format",
+       "expected format 2 (format 1, without per-technique sums, was written by an older pathex)"},
       {"/raw/fraction_bits", 32, "h.json:/raw/fraction_bits", "expected 64"},
       {"/raw/batch_samples", json::array({1, 2}), "h.json:/raw/batch_samples", "expected an array of 4 elements"},
       {"/raw/paths/1/sums/2/1", "0x1g", "h.json:/raw/paths/1/sums/2/1",
        "expected an exact sum: \"0\" or a signed hexadecimal string such as \"0x1f\" or \"-0x1f\""},
       {"/raw/paths/2/path", "LDDDSE", "h.json:/raw/paths/2/path", "path \"LDDDSE\" appears twice"},
-      {"/raw/paths/0/strategy_sums", json::array(), "h.json:/raw/paths/0/strategy_sums",
-       "expected an array of 2 elements"},
+      {"/raw/paths/0/techniques/0/sums", json::array(), "h.json:/raw/paths/0/techniques/0/sums",
+       "expected an array of 4 elements"},
+      {"/raw/paths/0/techniques/1/strategy", 2, "h.json:/raw/paths/0/techniques/1/strategy",
+       "expected a strategy index below 2"},
   };
   for (const Case& c : cases) {
     json doc = good;

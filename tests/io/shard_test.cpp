@@ -56,8 +56,9 @@ struct Fixture {
     HistogramLayout layout{3, {"a", "b"}};
     histogram = Histogram(layout);
     const Histogram::PathId p = histogram.intern("LDDDSE"), q = histogram.intern("LSDDSE");
-    histogram.add(p, 0, 0, {1.0, 2.0, 3.0});
-    histogram.add(q, 2, 1, {-0.5, 1e10, 1e-19});  // negative, large and tiny sums
+    histogram.add(p, 0, Technique{0, 2, 2}.code(), {1.0, 2.0, 3.0});
+    histogram.add(p, 1, Technique{1, 1, 2, true}.code(), {4.0, 2.0, 3.0});
+    histogram.add(q, 2, Technique{1, 3, 1}.code(), {-0.5, 1e10, 1e-19});  // negative, large and tiny sums
     histogram.add_samples(0, 5);
     histogram.add_nonfinite(2);
     images.add(3, 9, 0, *to_exact({0.25, 0.5, -1.0}));
@@ -84,7 +85,13 @@ TEST(ShardFile, RoundTripsTheExactSums) {
       EXPECT_EQ(h.cell(id, b).sum, f.histogram.cell(p, b).sum);
       EXPECT_EQ(h.cell(id, b).contributions, f.histogram.cell(p, b).contributions);
     }
-    for (int s = 0; s < 2; ++s) EXPECT_EQ(h.strategy_sum(id, s), f.histogram.strategy_sum(p, s));
+    const std::vector<int> got = h.sorted_rows(id), want = f.histogram.sorted_rows(p);
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(h.row(got[i]).technique, f.histogram.row(want[i]).technique);
+      EXPECT_EQ(h.row(got[i]).contributions, f.histogram.row(want[i]).contributions);
+      for (int b = 0; b < 3; ++b) EXPECT_EQ(h.row_sum(got[i], b), f.histogram.row_sum(want[i], b));
+    }
   }
   EXPECT_EQ(h.batch_samples(0), 5u);
   EXPECT_EQ(h.nonfinite(), 2u);
@@ -113,8 +120,8 @@ TEST(ShardFile, EveryTruncationAndEveryFlippedByteIsRefused) {
   };
   EXPECT_EQ(message("hello, world, not a shard"), "not a pathex shard file (it does not begin with \"PXSHARD\")");
   std::string v2 = bytes;
-  v2[8] = 3;
-  EXPECT_EQ(message(v2), "shard file format version 3; this pathex reads version 2");
+  v2[8] = 2;  // version 2 had per-strategy sums, not per-technique rows
+  EXPECT_EQ(message(v2), "shard file format version 2; this pathex reads version 3");
   EXPECT_EQ(message(bytes + "x"), "corrupted shard file: 1 bytes after its checksum");
 }
 

@@ -378,6 +378,22 @@ TEST(ClosedForm, OrthographicSensorSeesLightFloorAndMirrorCaustic) {
   EXPECT_EQ(r.report.nonfinite_samples, 0u);
   for (std::size_t i = 0; i < expected.size(); ++i)
     expect_close(r.report.classes[i].estimate, expected[i].second, 3.0, 0.005, "bdpt+ortho " + expected[i].first);
+  // The light seen directly and the caustic come from the connector alone, one technique each
+  // (s letters before its chain): it carries all of the estimate, and all of the caustic's
+  // variance; the light seen directly is the same in every batch, so it has no variance to share.
+  // The lit floor comes from the connector and next-event estimation together.
+  for (std::size_t i : {0u, 2u}) {
+    const std::vector<TechniqueEstimate>& ts = r.report.classes[i].strategies;
+    ASSERT_EQ(ts.size(), 1u) << expected[i].first;
+    EXPECT_EQ(ts[0].name, i == 0 ? "ortho-splat (1, DSD, 0)" : "ortho-splat (3, DSD, 0)");
+    EXPECT_EQ(ts[0].share, 1.0);
+    if (i == 0) EXPECT_TRUE(std::isnan(ts[0].variance_share));
+    else EXPECT_EQ(ts[0].variance_share, 1.0);
+  }
+  double floor_share = 0;
+  for (const TechniqueEstimate& t : r.report.classes[1].strategies) floor_share += t.share;
+  EXPECT_EQ(r.report.classes[1].strategies.size(), 2u);
+  EXPECT_NEAR(floor_share, 1.0, 1e-12);
   // Without the connector only the lit floor is reachable (next-event estimation).
   Rendered plain = render_json(scene, "bdpt", classes, 64);
   EXPECT_EQ(plain.report.classes[0].estimate.luminance, 0.0);

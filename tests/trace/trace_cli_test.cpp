@@ -56,7 +56,13 @@ TEST(TraceCli, WritesHistogramExrAndPreviews) {
     for (const char* key : {"name", "expr", "estimate", "luminance", "stderr", "samples", "share"}) EXPECT_TRUE(c.contains(key)) << key;
   ASSERT_FALSE(j["paths"].empty());
   EXPECT_EQ(j["paths"][0]["path"], "LSDDDSE");  // the largest: one bounce, half of the light
-  EXPECT_TRUE(j["paths"][0]["strategies"].contains("bdpt"));
+  // Every technique is a split of the profile's one strategy, "bdpt (s, DD, t)", here with s + t = 5.
+  double shares = 0;
+  for (const auto& [name, t] : j["paths"][0]["strategies"].items()) {
+    EXPECT_EQ(name.rfind("bdpt (", 0), 0u) << name;
+    shares += t["share"].get<double>();
+  }
+  EXPECT_NEAR(shares, 1.0, 1e-12);
   // One EXR with the total and a layer per class; a PNG per layer.
   pathex::Result<std::vector<pathex::ImageLayer>> layers = pathex::read_exr_layers(dir + "/classes.exr");
   ASSERT_TRUE(layers.ok()) << layers.error().render();
@@ -69,6 +75,44 @@ TEST(TraceCli, WritesHistogramExrAndPreviews) {
   }
   EXPECT_TRUE(names.count("total"));
   EXPECT_TRUE(names.count("caustic-local"));
+  std::filesystem::remove_all(dir);
+}
+
+// Per-technique accounting (issue 13): on the mirror caustic under a point light, bdpt reaches the
+// caustic LSDSDDSE only by light tracing from its floor vertex, (3, DD, 1): a point light cannot be
+// hit and the mirror blocks every other join, so that technique carries all of the class, its
+// estimate and its variance, exactly. The class "local" mixes techniques: their shares and
+// variance shares each sum to 1.
+TEST(TraceCli, ClassesSayWhichTechniqueCarriesThem) {
+  const std::string dir = out_dir("techniques");
+  const CliRun r = run("trace samples/scenes/point-mirror-caustic.json --renderer bdpt --spp 16 --seed 5 --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir + "/histogram.json");
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(in);
+  const nlohmann::ordered_json* caustic = nullptr;
+  const nlohmann::ordered_json* local = nullptr;
+  for (const auto& c : j["classes"]) {
+    if (c["name"] == "caustic") caustic = &c;
+    if (c["name"] == "local") local = &c;
+  }
+  ASSERT_TRUE(caustic != nullptr && local != nullptr);
+  ASSERT_EQ((*caustic)["strategies"].size(), 1u) << (*caustic)["strategies"].dump();
+  const auto& lt = (*caustic)["strategies"]["bdpt (3, DD, 1)"];
+  EXPECT_EQ(lt["share"].get<double>(), 1.0);
+  EXPECT_EQ(lt["variance_share"].get<double>(), 1.0);
+  EXPECT_EQ(lt["samples"], (*caustic)["samples"]);
+  double share = 0, variance = 0;
+  std::uint64_t samples = 0;
+  ASSERT_GE((*local)["strategies"].size(), 3u);
+  for (const auto& [name, t] : (*local)["strategies"].items()) {
+    share += t["share"].get<double>();
+    variance += t["variance_share"].get<double>();
+    samples += t["samples"].get<std::uint64_t>();
+  }
+  EXPECT_NEAR(share, 1.0, 1e-12);
+  EXPECT_NEAR(variance, 1.0, 1e-9);
+  EXPECT_EQ(samples, (*local)["samples"].get<std::uint64_t>());
+  EXPECT_NE(r.out.find("\n  from bdpt (3, DD, 1) 100.0 % (100.0 % of the variance)\n"), std::string::npos) << r.out;
   std::filesystem::remove_all(dir);
 }
 

@@ -101,9 +101,12 @@ Result<bool> MpiCluster::sum_to_root(std::vector<Word>* words) {
 Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run) {
   if (Result<bool> r = wait_for_all("barrier before the reduction"); !r) return r;
   Histogram& h = sums->histogram;
-  // --- the union of the path strings, on every rank ---
+  // --- the union of the path strings and of the (path, technique) rows ("path\tcode"), on every rank ---
   std::string mine;
-  for (int p = 0; p < h.num_paths(); ++p) mine += h.path(p) + "\n";
+  for (int p = 0; p < h.num_paths(); ++p) {
+    mine += h.path(p) + "\n";
+    for (int r = h.first_row(p); r >= 0; r = h.row(r).next) mine += h.path(p) + "\t" + std::to_string(h.row(r).technique) + "\n";
+  }
   const int my_size = static_cast<int>(mine.size());
   std::vector<int> sizes(static_cast<std::size_t>(size_)), offsets(static_cast<std::size_t>(size_));
   if (Result<bool> r = check(MPI_Gather(&my_size, 1, MPI_INT, sizes.data(), 1, MPI_INT, 0, MPI_COMM_WORLD), "gather"); !r) return r;
@@ -143,18 +146,30 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
     }
 
   // --- the histogram's sums ---
-  const int B = h.num_batches(), S = h.num_strategies();
+  const int B = h.num_batches();
+  // A row line's path and technique.
+  const auto split = [](const std::string& line, std::size_t tab) {
+    return std::pair<std::string, int>(line.substr(0, tab), std::stoi(line.substr(tab + 1)));
+  };
   std::vector<Word> words;
-  words.reserve((paths.size() * static_cast<std::size_t>(4 * B + 3 * S) + static_cast<std::size_t>(B) + 1) * 2);
-  for (const std::string& p : paths) {
-    const std::optional<Histogram::PathId> id = h.find(p);
+  words.reserve((paths.size() * static_cast<std::size_t>(4 * B + 1) + static_cast<std::size_t>(B) + 1) * 2);
+  for (const std::string& line : paths) {
+    if (const std::size_t tab = line.find('\t'); tab != std::string::npos) {
+      const auto [p, code] = split(line, tab);
+      const std::optional<Histogram::PathId> id = h.find(p);
+      int row = -1;
+      for (int r = id ? h.first_row(*id) : -1; r >= 0 && row < 0; r = h.row(r).next)
+        if (h.row(r).technique == code) row = r;
+      for (int b = 0; b < B; ++b) put(words, row >= 0 ? h.row_sum(row, b) : ExactSum{0});
+      put(words, row >= 0 ? h.row(row).contributions : 0);
+      continue;
+    }
+    const std::optional<Histogram::PathId> id = h.find(line);
     for (int b = 0; b < B; ++b) {
       const Histogram::Cell cell = id ? h.cell(*id, b) : Histogram::Cell{};
       for (int c = 0; c < 3; ++c) put(words, cell.sum[static_cast<std::size_t>(c)]);
       put(words, cell.contributions);
     }
-    for (int s = 0; s < S; ++s)
-      for (int c = 0; c < 3; ++c) put(words, id ? h.strategy_sum(*id, s)[static_cast<std::size_t>(c)] : ExactSum{0});
   }
   for (int b = 0; b < B; ++b) put(words, h.batch_samples(b));
   put(words, h.nonfinite());
@@ -166,10 +181,17 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
     return r;
   if (rank_ == 0) {
     const Word* w = words.data();
-    for (const std::string& p : paths) {
-      const Histogram::PathId id = h.intern(p);
+    std::vector<ExactSum> sums(static_cast<std::size_t>(B));
+    for (const std::string& line : paths) {
+      if (const std::size_t tab = line.find('\t'); tab != std::string::npos) {
+        const auto [p, code] = split(line, tab);
+        for (int b = 0; b < B; ++b, w += 2) sums[static_cast<std::size_t>(b)] = get(w);
+        h.add_technique(h.intern(p), code, static_cast<std::uint64_t>(get(w)), sums.data());
+        w += 2;
+        continue;
+      }
+      const Histogram::PathId id = h.intern(line);
       for (int b = 0; b < B; ++b, w += 8) h.add_cell(id, b, {get(w), get(w + 2), get(w + 4)}, static_cast<std::uint64_t>(get(w + 6)));
-      for (int s = 0; s < S; ++s, w += 6) h.add_strategy_sum(id, s, {get(w), get(w + 2), get(w + 4)});
     }
     for (int b = 0; b < B; ++b, w += 2) h.add_samples(b, static_cast<std::uint64_t>(get(w)));
     h.add_nonfinite(static_cast<std::uint64_t>(get(w)));

@@ -38,31 +38,52 @@ inline PathKey pack(const std::string& letters) {  // "L c0 … E"
   return key;
 }
 
-// Per-thread map from packed strings to histogram ids, so that recording a contribution hashes
-// two words instead of a string; Histogram::intern() runs once per new path and thread.
+// Per-thread map from (packed string, technique) to the histogram's path id and technique row,
+// so that recording a contribution hashes three words instead of a string and walks no list;
+// Histogram::intern() and technique_row() run once per new pair and thread. The contributions
+// of each pair are counted here, in the slot just read, and handed to the histogram by flush().
 class PathIds {
  public:
-  Histogram::PathId get(Histogram& hist, PathKey key) {
+  struct Ids {
+    Histogram::PathId path = -1;
+    int row = -1;  // Histogram::technique_row() of the technique
+  };
+  Ids get(Histogram& hist, PathKey key, int technique) {
     const std::size_t mask = slots_.size() - 1;
-    for (std::size_t i = hash(key) & mask;; i = (i + 1) & mask) {
+    for (std::size_t i = hash(key, technique) & mask;; i = (i + 1) & mask) {
       Slot& slot = slots_[i];
-      if (slot.key == key) return slot.id;
+      if (slot.key == key && slot.technique == technique) {
+        ++slot.contributions;
+        return slot.ids;
+      }
       if (slot.key == 0) {
         const Histogram::PathId id = hist.intern(unpack(key));
-        slot = {key, id};
+        slot = {key, technique, {id, hist.technique_row(id, technique)}, 1};
+        const Ids ids = slot.ids;
         if (2 * ++used_ > slots_.size()) grow();
-        return id;
+        return ids;
       }
     }
+  }
+  // Adds the contributions counted since the last flush to the histogram's technique rows.
+  void flush(Histogram& hist) {
+    for (Slot& slot : slots_)
+      if (slot.key != 0 && slot.contributions != 0) {
+        hist.add_technique(slot.ids.path, slot.technique, slot.contributions, nullptr);
+        slot.contributions = 0;
+      }
   }
 
  private:
   struct Slot {
     PathKey key = 0;  // 0: empty (a real key has a nonzero length)
-    Histogram::PathId id = -1;
+    int technique = 0;
+    Ids ids;
+    std::uint64_t contributions = 0;  // nonzero contributions of the pair since the last flush
   };
-  static std::size_t hash(PathKey key) {
-    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) ^ mix64(static_cast<std::uint64_t>(key >> 64))));
+  static std::size_t hash(PathKey key, int technique) {
+    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) ^
+                                          mix64(static_cast<std::uint64_t>(key >> 64) ^ static_cast<std::uint64_t>(technique))));
   }
   void grow() {
     std::vector<Slot> old(slots_.size() * 2);
@@ -70,7 +91,7 @@ class PathIds {
     const std::size_t mask = slots_.size() - 1;
     for (const Slot& slot : old) {
       if (slot.key == 0) continue;
-      std::size_t i = hash(slot.key) & mask;
+      std::size_t i = hash(slot.key, slot.technique) & mask;
       while (slots_[i].key != 0) i = (i + 1) & mask;
       slots_[i] = slot;
     }
