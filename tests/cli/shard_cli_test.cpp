@@ -280,18 +280,14 @@ TEST_F(MergeRefuses, AFolderWithoutShards) {
 #define PATHEX_MPI_BINARY ""
 #endif
 
-// `mpirun ARGS` from the source directory; stdout and stderr together.
-CliRun mpirun(const std::string& args) {
-  return pathex::test::run_shell("cd " + pathex::test::shell_quote(PATHEX_SOURCE_DIR) +
-                                 " && mpirun --oversubscribe --allow-run-as-root " + args + " 2>&1");
-}
+using pathex::test::run_mpirun;
 
 TEST(Mpi, ThreeRanksWriteTheBytesOfOneProcess) {
   if (std::string(PATHEX_MPI_BINARY).empty()) GTEST_SKIP() << "pathex-mpi is not built (MPI was not found at configure time)";
   const std::string args = " trace samples/scenes/cornell.json --classes samples/classes/basic.json --spp 10 --quiet --out ";
   const std::string single = dir("single"), ranks = dir("ranks");
   ASSERT_EQ(run_pathex(args + single).code, 0);
-  const CliRun r = mpirun("-n 3 " + pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks + " --threads 1");
+  const CliRun r = run_mpirun("-n 3 " + pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks + " --threads 1");
   ASSERT_EQ(r.code, 0) << r.out;
   expect_same_outputs(single, ranks, "3 MPI ranks");
   // The ranks' own shard files are gone once rank 0 has written render.shard, which holds them all.
@@ -313,7 +309,7 @@ TEST(Mpi, ADyingRankFailsTheRunAndTheOthersWorkIsKept) {
   // which keep what they rendered in their rank files.
   const std::string body = "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then (sleep 2; kill -9 $$) & fi; exec " +
                            pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks;
-  const CliRun r = mpirun("-n 3 sh -c " + pathex::test::shell_quote(body));
+  const CliRun r = run_mpirun("-n 3 sh -c " + pathex::test::shell_quote(body));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("process rank 1"), std::string::npos) << r.out;  // mpirun's message
   EXPECT_FALSE(fs::exists(ranks + "/histogram.json"));
