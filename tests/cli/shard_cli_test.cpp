@@ -268,6 +268,19 @@ TEST_F(MergeRefuses, ATruncatedShard) {
                                     " bytes, its header says at least " + std::to_string(bytes.size()));
 }
 
+TEST_F(MergeRefuses, NamingTheFirstBadFileInTheOrderGiven) {
+  // merge reports the error of the first bad file in the order of the command line (and reads
+  // no further), whatever kind of error a later file has.
+  const std::string c = dir("c");
+  ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/2 --seed 2 --quiet --out " + b_).code, 0);
+  ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/2 --quiet --out " + c).code, 0);
+  std::string bytes = read_file(shard(c));
+  bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x10);
+  std::ofstream(shard(c), std::ios::binary) << bytes;
+  expect_refusal(a_ + " " + b_ + " " + c, shard(b_) + " and " + shard(a_) + " are not of one render: another seed (2 against 1)");
+  expect_refusal(a_ + " " + c + " " + b_, shard(c) + ": corrupted shard file: its CRC-32 does not match its contents");
+}
+
 TEST_F(MergeRefuses, AFolderWithoutShards) {
   const std::string empty = dir("empty");
   fs::create_directories(empty);
