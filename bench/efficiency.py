@@ -90,6 +90,8 @@ def main():
     ap.add_argument("--variant", action="append", default=[],
                     help="LABEL:ARGS, the new binary with extra trace arguments (repeatable); "
                          "without any, the new binary with its defaults")
+    ap.add_argument("--binary", action="append", default=[],
+                    help="LABEL:PATH, one more pathex with its defaults, e.g. an earlier build of the branch (repeatable)")
     ap.add_argument("--image-error", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "bench", "image_error"))
     ap.add_argument("--scene", action="append", default=[], help="scene file (repeatable; default: the embedded Cornell box)")
     ap.add_argument("--resolution", default=None, help="WxH (default: the scene's)")
@@ -112,6 +114,9 @@ def main():
     for v in args.variant:
         label, _, extra = v.partition(":")
         variants.append((label, args.new, shlex.split(extra)))
+    for b in args.binary:
+        label, _, path = b.partition(":")
+        variants.append((label, path, []))
     renderers = args.renderers.split(",")
     spps = [int(s) for s in args.spp.split(",")]
     scenes = args.scene or [None]

@@ -9,7 +9,8 @@ render's own time is the JSON's `time_s` (wall clock) and, where the binary repo
 `efficiency.cpu_s` (CPU seconds); the process's come from os.wait4 and the wall clock around it.
 Overhead = process - render, as CPU seconds (what the shared host cannot steal) and wall seconds
 (which also holds file-system waits, but on a busy host also other processes' time). Prints the
-median and range over rounds of each.
+median and range over rounds of each, and the CPU of a bare `pathex --version` (the process start:
+loading and relocating the linked libraries), the part of the overhead no output setting changes.
 """
 import argparse
 import json
@@ -21,7 +22,7 @@ import tempfile
 import time
 
 
-def run(cmd):
+def run(cmd, out_dir):
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     out = proc.stdout.read()
@@ -31,7 +32,13 @@ def run(cmd):
     if os.waitstatus_to_exitcode(status) != 0:
         sys.exit(f"{' '.join(cmd)} failed: {err}")
     doc = json.loads(out)
-    render_cpu = doc.get("efficiency", {}).get("cpu_s")
+    # The render's own times: run.json beside the outputs (older binaries: the --json output).
+    run_json = os.path.join(out_dir, "run.json")
+    if os.path.exists(run_json):
+        with open(run_json) as f:
+            doc = json.load(f)
+        os.remove(run_json)
+    render_cpu = doc.get("cpu_s", doc.get("efficiency", {}).get("cpu_s"))
     return usage.ru_utime + usage.ru_stime, wall, render_cpu, doc["time_s"]
 
 
@@ -53,10 +60,18 @@ def main():
         for r in range(args.rounds):
             order = args.binaries[r % len(args.binaries):] + args.binaries[:r % len(args.binaries)]
             for i, b in enumerate(order):
+                out_dir = os.path.join(work, f"out{args.binaries.index(b)}")
                 cmd = ([b, "trace"] + ([args.scene] if args.scene else []) +
                        ["--resolution", args.resolution, "--spp", str(args.spp), "--threads", "1", "--quiet", "--json",
-                        "--out", os.path.join(work, f"out{args.binaries.index(b)}")] + args.extra.split())
-                res[b].append(run(cmd))
+                        "--out", out_dir] + args.extra.split())
+                res[b].append(run(cmd, out_dir))
+    # The process start alone (dynamic loading of the linked libraries): a bare --version, as many times.
+    start = {b: [] for b in args.binaries}
+    for r in range(args.rounds):
+        for b in args.binaries:
+            proc = subprocess.Popen([b, "--version"], stdout=subprocess.DEVNULL)
+            _, _, usage = os.wait4(proc.pid, 0)
+            start[b].append(usage.ru_utime + usage.ru_stime)
     for b, rs in res.items():
         print(f"{b}: {len(rs)} runs, {args.resolution}, {args.spp} spp")
         print(f"  process CPU        {fmt([x[0] for x in rs])}")
@@ -64,6 +79,7 @@ def main():
         if all(x[2] is not None for x in rs):
             print(f"  overhead CPU       {fmt([x[0] - x[2] for x in rs])}   (process CPU - render CPU)")
         print(f"  overhead wall      {fmt([x[1] - x[3] for x in rs])}   (process wall - render wall)")
+        print(f"  --version CPU      {fmt(start[b])}   (process start alone)")
 
 
 if __name__ == "__main__":

@@ -190,7 +190,9 @@ class Reader {
   void refill(std::size_t n) {
     if (static_cast<std::size_t>(end_ - p_) >= n || failed_ || finished_) return;
     const std::size_t kept = static_cast<std::size_t>(end_ - p_);
-    std::memmove(window_.data(), p_, kept);
+    // Before the first refill p_ is null, and memmove's arguments must not be, even for 0 bytes
+    // (UBSan's nonnull-attribute check, `pathex merge` in the sanitized build).
+    if (kept > 0) std::memmove(window_.data(), p_, kept);
     ZSTD_outBuffer out{window_.data(), window_.size(), kept};
     while (out.pos < n || (out.pos < out.size && in_.pos < in_.size)) {
       const std::size_t before = out.pos, taken = in_.pos;

@@ -5,6 +5,7 @@
 
 #include "support/cli_run.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -312,22 +313,32 @@ TEST(Mpi, ThreeRanksWriteTheBytesOfOneProcess) {
 
 TEST(Mpi, ADyingRankFailsTheRunAndTheOthersWorkIsKept) {
   if (std::string(PATHEX_MPI_BINARY).empty()) GTEST_SKIP() << "pathex-mpi is not built (MPI was not found at configure time)";
-  // A cheap scene and many passes (several seconds per rank even on a quiet machine, where 1800 spp
-  // took 0.8 s in all and the ranks finished before the kill): chunks of four passes take milliseconds,
-  // well within the second mpirun gives a rank between SIGTERM and SIGKILL.
-  const std::string args = " trace samples/scenes/point-plane.json --spp 36000 --quiet --threads 1 --out ";
+  const std::string args = " trace samples/scenes/point-plane.json --spp 48 --quiet --threads 1 --out ";
   const std::string single = dir("single"), ranks = dir("ranks");
+  fs::remove_all(ranks + ".ranks");
   ASSERT_EQ(run_pathex(args + single).code, 0);
-  // Rank 1 is killed two seconds into the run, while rendering; mpirun then stops ranks 0 and 2,
-  // which keep what they rendered in their rank files.
-  const std::string body = "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then (sleep 2; kill -9 $$) & fi; exec " +
+  // Rank 1 dies by SIGKILL at a point the test controls, with no clock involved: it renders its
+  // passes, and at its first call to write its rank file (the test's signal shim, loaded into rank 1
+  // alone) it waits until ranks 0 and 2 have written theirs, then kills itself. Ranks 0 and 2 then
+  // wait in the reduction for rank 1, which never comes, until mpirun stops them.
+  const std::string rank_file = ranks + ".ranks/rank-";
+  const std::string shim = "LD_PRELOAD=" + pathex::test::shell_quote(PATHEX_SIGNAL_SHIM) +
+                           " ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:verify_asan_link_order=0\" PATHEX_SHIM_AT=1 PATHEX_SHIM_SIGNAL=9" +
+                           " PATHEX_SHIM_DIR=" + pathex::test::shell_quote(rank_file + "1.shard") +
+                           " PATHEX_SHIM_AWAIT=" + pathex::test::shell_quote(rank_file + "0.shard:" + rank_file + "2.shard");
+  const std::string body = "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then export " + shim + "; fi; exec " +
                            pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks;
   const CliRun r = run_mpirun("-n 3 sh -c " + pathex::test::shell_quote(body));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("process rank 1"), std::string::npos) << r.out;  // mpirun's message
   EXPECT_FALSE(fs::exists(ranks + "/histogram.json"));
-  EXPECT_TRUE(fs::exists(ranks + ".ranks/rank-0.shard") || fs::exists(ranks + ".ranks/rank-2.shard")) << r.out;
-  // Whatever the others rendered is kept; resuming renders the rest and gives the bytes of one run.
+  // Ranks 0 and 2 kept their passes; rank 1 left nothing behind, not even a temporary file.
+  ASSERT_TRUE(fs::is_directory(ranks + ".ranks")) << r.out;
+  std::vector<std::string> kept;
+  for (const auto& e : fs::directory_iterator(ranks + ".ranks")) kept.push_back(e.path().filename().string());
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(kept, (std::vector<std::string>{"rank-0.shard", "rank-2.shard"})) << r.out;
+  // Resuming renders rank 1's passes and gives the bytes of one run.
   const CliRun resumed = run_pathex("trace --resume " + ranks + " --quiet");
   ASSERT_EQ(resumed.code, 0) << resumed.err;
   expect_same_outputs(single, ranks, "resumed after a dead rank");

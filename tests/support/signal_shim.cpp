@@ -5,6 +5,9 @@
 //   PATHEX_SHIM_SIGNAL  the signal number (default SIGTERM)
 //   PATHEX_SHIM_DIR     only calls on paths containing this text count (fsync always counts)
 //   PATHEX_SHIM_COUNT   a file that receives the number of calls counted, at exit
+//   PATHEX_SHIM_AWAIT   files (separated by ':') that must all exist before the signal is sent:
+//                       the process waits for them at the Nth call (a synchronisation point
+//                       between processes that the test controls, tests/cli/shard_cli_test.cpp)
 // The signal goes to the process (kill), before the call itself runs.
 #include <dlfcn.h>
 #include <fcntl.h>
@@ -16,6 +19,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <string>
 
 namespace {
 
@@ -28,11 +33,27 @@ bool watched(const char* path) {
   return path != nullptr && (dir == nullptr || std::strstr(path, dir) != nullptr);
 }
 
+// Waits until every file of PATHEX_SHIM_AWAIT exists, polling (stat is not intercepted).
+void await_files() {
+  const char* list = env("PATHEX_SHIM_AWAIT");
+  if (list == nullptr) return;
+  std::string rest = list;
+  while (!rest.empty()) {
+    const std::size_t colon = rest.find(':');
+    const std::string file = rest.substr(0, colon);
+    rest = colon == std::string::npos ? "" : rest.substr(colon + 1);
+    struct stat st {};
+    const timespec pause{0, 10'000'000};
+    while (!file.empty() && ::stat(file.c_str(), &st) != 0) ::nanosleep(&pause, nullptr);
+  }
+}
+
 void count(bool counts) {
   if (!counts) return;
   const long n = ++g_calls;
   const char* at = env("PATHEX_SHIM_AT");
   if (at == nullptr || std::atol(at) != n) return;
+  await_files();
   const char* sig = env("PATHEX_SHIM_SIGNAL");
   ::kill(::getpid(), sig ? std::atoi(sig) : SIGTERM);
 }
