@@ -64,6 +64,16 @@ Histogram::PathId Histogram::intern(std::string_view path) {
   return id;
 }
 
+void Histogram::reserve_paths(std::size_t paths) {
+  if (paths <= paths_.capacity()) return;
+  paths = std::max(paths, 2 * paths_.capacity());  // geometric, like the vectors' own growth
+  paths_.reserve(paths);
+  ids_.reserve(paths);
+  sets_.reserve(paths);
+  for (std::vector<Cell>& row : cells_) row.reserve(paths);
+  first_row_.reserve(paths);
+}
+
 std::optional<Histogram::PathId> Histogram::find(std::string_view path) const {
   auto it = ids_.find(path);
   if (it == ids_.end()) return std::nullopt;

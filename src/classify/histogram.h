@@ -193,6 +193,10 @@ class Histogram {
   // (merge() matches paths by string), dense from 0, and stable.
   PathId intern(std::string_view path);
   std::optional<PathId> find(std::string_view path) const;
+  // Makes room for at least `paths` paths in all (the path table and every batch's cells), growing
+  // geometrically, so that adding that many costs no reallocation: for readers that know a bound
+  // ahead (shard files).
+  void reserve_paths(std::size_t paths);
   int num_paths() const { return static_cast<int>(paths_.size()); }
   const std::string& path(PathId id) const { return paths_[static_cast<std::size_t>(id)]; }
   // The classifier's class-set id of the path; 0 when the histogram has no classifier.

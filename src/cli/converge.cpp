@@ -8,7 +8,11 @@
 //
 // Rendering goes through the tracer's library entry point, render(), one call per rung
 // (run_rung below): the ladder is a plain loop over independent rungs, each a function of its
-// renderer, budget and seed.
+// renderer, budget and seed. Under MPI (`mpirun -n N pathex-mpi converge …`) every rung is split
+// like `pathex trace`: each rank renders its part of the rung's passes, the exact sums are added on
+// rank 0 (Cluster::reduce), which measures the rung from the same sums as one process, so every
+// estimate, stderr and error is the same number; its CPU time is the ranks' sum, its wall time
+// rank 0's. Rank 0 alone shows progress, prints and writes.
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -169,7 +173,8 @@ struct RungResult {
   Budget budget;
   std::uint64_t seed = 0;
   std::uint64_t spp = 0;  // done
-  double cpu_s = 0.0, wall_s = 0.0;
+  double cpu_s = 0.0, wall_s = 0.0;  // under MPI: every rank's CPU, rank 0's wall time (with the reduction)
+  double own_cpu_s = 0.0;             // this process's rendering CPU (cpu_s for one process)
   std::uint64_t nonfinite = 0;
   std::vector<ClassMeasure> classes;  // per ClassRow
   std::optional<RenderOutput> output;  // kept for the reference run
@@ -178,10 +183,16 @@ struct RungResult {
 
 // Renders one rung: `profile` at `budget` with `seed`. A time budget stops the render after the
 // chunk in progress when the time is up; Ctrl-C (g_interrupted) stops it and marks it interrupted.
+// Under MPI every rank calls it for every rung (it is collective): each renders part(rank, ranks)
+// of the passes, and only rank 0's result holds the rung's measures (the others' `classes` are
+// empty). A rung interrupted on any rank is interrupted on all.
 Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, const Budget& budget, std::uint64_t seed,
                             const std::vector<ClassRow>& rows) {
+  Cluster* cluster = current_cluster();
   RenderOptions ro;
   ro.spp = budget.spp ? budget.spp : (std::uint64_t{1} << 24);
+  if (cluster != nullptr)
+    ro.passes = PassSet::range(0, ro.spp).part(static_cast<std::uint64_t>(cluster->rank()), static_cast<std::uint64_t>(cluster->size()));
   ro.seed = seed;
   ro.threads = setup.threads;
   ro.max_bounces = setup.max_bounces;
@@ -201,7 +212,7 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   const auto wall0 = std::chrono::steady_clock::now();
   Result<RenderOutput> out = render(*setup.scene, profile, setup.classifier, ro);
   const double cpu1 = cpu_seconds();
-  const auto wall1 = std::chrono::steady_clock::now();
+  auto wall1 = std::chrono::steady_clock::now();
   if (timer.joinable()) {
     timer.request_stop();
     timer.join();
@@ -210,11 +221,23 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   RungResult r;
   r.budget = budget;
   r.seed = seed;
+  r.cpu_s = r.own_cpu_s = cpu1 - cpu0;
+  if (cluster != nullptr) {
+    RenderSums sums{std::move(out->histogram), std::move(out->images)};
+    ShardRun run{out->time_s, ro.threads, out->rays, r.cpu_s};
+    if (Result<bool> red = cluster->reduce(&sums, &out->passes_done, &run); !red) return red.error();
+    out->histogram = std::move(sums.histogram);
+    out->images = std::move(sums.images);
+    out->spp_done = out->passes_done.count();  // on rank 0, every rank's
+    r.cpu_s = run.cpu_s;
+    wall1 = std::chrono::steady_clock::now();
+  }
+  const bool root = cluster == nullptr || cluster->rank() == 0;
   r.spp = out->spp_done;
-  r.cpu_s = cpu1 - cpu0;
   r.wall_s = std::chrono::duration<double>(wall1 - wall0).count();
-  r.interrupted = g_interrupted.load() || out->spp_done == 0;
-  if (r.interrupted) return r;
+  r.interrupted = g_interrupted.load() || (root && out->spp_done == 0);
+  if (cluster != nullptr) r.interrupted = cluster->count_failures(!r.interrupted) > 0;
+  if (r.interrupted || !root) return r;
   RunInfo info;
   info.spp = out->spp_done;
   std::vector<ClassInfo> infos;
@@ -371,6 +394,7 @@ int run(const ConvergeArgs& a) {
   const double cpu_start = cpu_seconds();
   const auto wall_start = std::chrono::steady_clock::now();
   double render_wall = 0.0, render_cpu = 0.0;  // inside render(): the ladder and the reference run
+  double own_render_cpu = 0.0;                   // the part of render_cpu this process spent (MPI: rank 0's)
   // --- budgets ---
   if (!a.spp_list.empty() && !a.time_list.empty())
     return report(make_error(ErrorCode::kUsage, "--spp and --time are alternatives: give one ladder"));
@@ -385,8 +409,15 @@ int run(const ConvergeArgs& a) {
   if (!scene) return report(scene.error());
   if (!a.resolution.empty())
     if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return report(r.error());
-  Result<OutputSet> out_set = OutputSet::prepare(a.out);
-  if (!out_set) return report(out_set.error());
+  // Under MPI, rank 0 alone writes, prints and shows progress (run_rung).
+  const Cluster* cluster = current_cluster();
+  const bool root = cluster == nullptr || cluster->rank() == 0;
+  std::optional<OutputSet> out_set;
+  if (root) {
+    Result<OutputSet> prepared = OutputSet::prepare(a.out);
+    if (!prepared) return report(prepared.error());
+    out_set.emplace(std::move(*prepared));
+  }
   std::vector<Profile> profiles;
   for (const std::string& name : a.renderers) {
     Result<Profile> p = resolve_profile(name, a.limits);
@@ -447,7 +478,7 @@ int run(const ConvergeArgs& a) {
   const std::uint64_t base_seed = a.seed;
   std::signal(SIGINT, on_interrupt);
   g_interrupted.store(false);
-  const bool progress = !a.quiet && ::isatty(STDERR_FILENO);
+  const bool progress = root && !a.quiet && ::isatty(STDERR_FILENO);
 
   // --- the reference ---
   Reference ref;
@@ -477,17 +508,20 @@ int run(const ConvergeArgs& a) {
     if (!r) return report(r.error());
     render_wall += r->wall_s;
     render_cpu += r->cpu_s;
+    own_render_cpu += r->own_cpu_s;
     if (r->interrupted) {
       std::signal(SIGINT, SIG_DFL);
-      std::cerr << "pathex: interrupted during the reference run; nothing written\n";
+      if (root) std::cerr << "pathex: interrupted during the reference run; nothing written\n";
       return kExitNo;
     }
-    for (std::size_t i = 0; i < rows.size(); ++i) {
+    for (std::size_t i = 0; root && i < rows.size(); ++i) {
       rows[i].reference = r->classes[i].estimate;
       rows[i].reference_stderr = std::isfinite(r->classes[i].std_error) ? r->classes[i].std_error : 0.0;
     }
-    const std::vector<ImageLayer> layers = r->output->images.layers(1.0 / static_cast<double>(r->spp));
-    for (std::size_t i = 0; i < rows.size(); ++i) rows[i].pixels = luminance_image(layers[i].image);
+    if (root) {
+      const std::vector<ImageLayer> layers = r->output->images.layers(1.0 / static_cast<double>(r->spp));
+      for (std::size_t i = 0; i < rows.size(); ++i) rows[i].pixels = luminance_image(layers[i].image);
+    }
     ref.kind = "run";
     ref.source = "a reference run of " + ref_profile->name + " at " + std::to_string(r->spp) + " spp, seed " +
                  std::to_string(seed) + ", written to " + a.out + "/reference.json and reference.exr";
@@ -507,6 +541,7 @@ int run(const ConvergeArgs& a) {
       if (!r) return report(r.error());
       render_wall += r->wall_s;
       render_cpu += r->cpu_s;
+      own_render_cpu += r->own_cpu_s;
       if (r->interrupted) {
         complete = false;
         break;
@@ -516,6 +551,7 @@ int run(const ConvergeArgs& a) {
     }
   if (progress) std::cerr << "\r" << std::string(60, ' ') << "\r" << std::flush;
   std::signal(SIGINT, SIG_DFL);
+  if (!root) return complete ? kExitOk : kExitNo;  // the other ranks have done their part
 
   // --- statistics ---
   std::vector<std::vector<Series>> series(profiles.size());
@@ -573,6 +609,7 @@ int run(const ConvergeArgs& a) {
   doc["ladder"] = lad;
   doc["seed"] = a.seed;
   doc["threads"] = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
+  doc["ranks"] = cluster != nullptr ? cluster->size() : 1;  // MPI ranks, each with `threads`
   doc["max_bounces"] = a.max_bounces ? nlohmann::ordered_json(*a.max_bounces) : nlohmann::ordered_json(nullptr);
   doc["resolution"] = {width, height};
   nlohmann::ordered_json jref = {{"kind", ref.kind}, {"source", ref.source}};
@@ -648,7 +685,7 @@ int run(const ConvergeArgs& a) {
   const double wall_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   const double cpu_total = cpu_seconds() - cpu_start;
   doc["timing"] = {{"render_wall_s", render_wall}, {"render_cpu_s", render_cpu},
-                   {"overhead_wall_s", wall_total - render_wall}, {"overhead_cpu_s", cpu_total - render_cpu},
+                   {"overhead_wall_s", wall_total - render_wall}, {"overhead_cpu_s", cpu_total - own_render_cpu},
                    {"overhead_pct", render_wall > 0 ? 100.0 * (wall_total - render_wall) / render_wall : 0.0}};
   const std::string json_text = doc.dump(2) + "\n";
 

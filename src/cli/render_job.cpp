@@ -153,8 +153,9 @@ Result<std::vector<std::string>> render_folder_shards(const std::string& dir) {
 Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits) {
   std::optional<CombinedRender> out;
   std::vector<std::pair<std::string, PassSet>> seen;  // each file's passes, for naming an overlap
+  std::string buffer;  // the previous file's bytes, whose pages are mapped already
   for (const std::string& path : paths) {
-    Result<ShardFile> file = read_shard(path);
+    Result<ShardFile> file = read_shard(path, std::move(buffer));
     if (!file) return file.error();
     const ShardHeader& h = file->header;
     if (h.identity.pathex != pathex_version())
@@ -191,6 +192,7 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
     header.run.rays += h.run.rays;
     header.run.cpu_s += h.run.cpu_s;
     seen.emplace_back(path, h.passes);
+    buffer = std::move(file->bytes);
   }
   if (!out) return make_error(ErrorCode::kUsage, "no shard files to combine");
   return std::move(*out);

@@ -23,6 +23,9 @@ using json = nlohmann::ordered_json;
 
 constexpr char kMagic[8] = {'P', 'X', 'S', 'H', 'A', 'R', 'D', '\n'};
 constexpr std::size_t kFixedBytes = 8 + 4 + 4 + 8 + 4;  // magic, version, H, N, CRC
+// A file's path count is believed this far when room is made for its paths ahead (a damaged or
+// hostile count costs at most this many paths' cells of address space, untouched).
+constexpr std::uint64_t kMaxReservedPaths = std::uint64_t{1} << 16;
 
 std::uint32_t crc32_of(const char* data, std::size_t n) {
   return static_cast<std::uint32_t>(
@@ -166,12 +169,13 @@ class Reader {
     return fail();
   }
   ExactRgb rgb() { return {x(), x(), x()}; }
-  std::string text() {
+  // A string in the window: valid until the next read (no allocation per path string).
+  std::string_view text() {
     const std::uint64_t n = u();
-    if (n > kMaxText) return fail(), std::string();
+    if (n > kMaxText) return fail(), std::string_view();
     refill(static_cast<std::size_t>(n));
-    if (n > static_cast<std::uint64_t>(end_ - p_)) return fail(), std::string();
-    std::string s(p_, static_cast<std::size_t>(n));
+    if (n > static_cast<std::uint64_t>(end_ - p_)) return fail(), std::string_view();
+    const std::string_view s(p_, static_cast<std::size_t>(n));
     p_ += n;
     return s;
   }
@@ -521,11 +525,12 @@ Result<ShardFile> parse_shard(std::string bytes, const std::string& path) {
   return f;
 }
 
-Result<ShardFile> read_shard(const std::string& path) {
+Result<ShardFile> read_shard(const std::string& path, std::string buffer) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return file_error(path, "cannot open the shard file");
   const std::streamoff size = in.tellg();
-  std::string bytes(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)), '\0');
+  std::string bytes = std::move(buffer);
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)));
   in.seekg(0);
   if (size < 0 || !in.read(bytes.data(), size)) return file_error(path, "cannot read the shard file");
   return parse_shard(std::move(bytes), path);
@@ -544,8 +549,13 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
   h->add_nonfinite(r.u());
   h->add_magnitude(r.x());
   const std::uint64_t paths = r.u();
+  // Room for the file's paths at once, so that the histogram's B rows of cells are not grown path
+  // by path (each regrowth moves every row).
+  if (!r.failed())
+    h->reserve_paths(static_cast<std::size_t>(h->num_paths()) +
+                     static_cast<std::size_t>(std::min<std::uint64_t>(paths, kMaxReservedPaths)));
   for (std::uint64_t i = 0; i < paths && !r.failed(); ++i) {
-    const std::string path = r.text();
+    const std::string_view path = r.text();
     if (r.failed()) break;
     const Histogram::PathId id_ = h->intern(path);
     for (int b = 0; b < B; ++b) {
@@ -558,7 +568,7 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
       for (ExactSum& sum : technique_sums) sum = r.x();
       if (r.failed()) break;
       if (code >= (std::uint64_t{1} << 29) || Technique::from_code(static_cast<int>(code)).strategy >= S)
-        return bad("a technique of path \"" + path + "\" names no strategy of the render");
+        return bad("a technique of path \"" + std::string(path) + "\" names no strategy of the render");
       h->add_technique(id_, static_cast<int>(code), n, technique_sums.data());
     }
   }
@@ -570,7 +580,7 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
     return bad("its images have " + std::to_string(planes) + " planes of " + std::to_string(tiles) +
                " tiles; the merge's have " + std::to_string(images->num_planes()) + " of " +
                std::to_string(images->num_tiles()));
-  std::vector<std::uint64_t> words(ClassImages::kTileWords);
+  std::array<std::uint64_t, ClassImages::kTileWords> words;
   for (std::uint64_t i = 0; i < stored; ++i) {
     const std::uint64_t p = r.u(), t = r.u();
     if (r.failed() || p >= planes || t >= tiles) return bad("a stored tile is out of range");

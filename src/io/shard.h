@@ -123,7 +123,9 @@ struct ShardFile {
 // corrupted (checksum), or a header value of the wrong type (with its JSON pointer). The header is
 // read by the one JSON reader (io/json_reader.h); unknown keys are refused like missing ones.
 Result<ShardFile> parse_shard(std::string bytes, const std::string& path);
-Result<ShardFile> read_shard(const std::string& path);
+// `buffer`: memory to read the file into (a finished ShardFile's `bytes`, whose pages are already
+// mapped: a merge of 16 files of 11 MB spent 0.45 s of CPU faulting in fresh ones).
+Result<ShardFile> read_shard(const std::string& path, std::string buffer = {});
 
 // Adds the file's sums to `histogram` and `images`, which must have the file's layout: the
 // histogram's batches and strategies, the images' size and planes (built from the same classes).

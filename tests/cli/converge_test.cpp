@@ -112,4 +112,53 @@ TEST(Converge, RefusalsExitTwo) {
   EXPECT_EQ(r.err, "pathex: error: --reference nothing.txt: expected a histogram.json or an .exr file of an earlier run\n");
 }
 
+// --- MPI: the rungs split across ranks give the numbers of one process ---
+
+#ifndef PATHEX_MPI_BINARY
+#define PATHEX_MPI_BINARY ""
+#endif
+
+// converge.json without what depends on the clock or the process layout: times, efficiencies (and
+// the ranking made of them), the slopes against time, the output folder's name.
+nlohmann::json without_timing(nlohmann::json j) {
+  j.erase("timing");
+  j.erase("best");
+  j.erase("ranks");
+  j.erase("threads");
+  j["reference"].erase("source");
+  j["reference"]["run"].erase("cpu_s");
+  j["reference"]["run"].erase("wall_s");
+  for (auto& ren : j["renderers"])
+    for (auto& c : ren["classes"]) {
+      c.erase("slope");
+      c.erase("efficiency");
+      for (auto& r : c["rungs"])
+        for (const char* k : {"cpu_s", "wall_s", "efficiency"}) r.erase(k);
+    }
+  return j;
+}
+
+TEST(Converge, MpiRanksSplitEveryRungAndGiveTheNumbersOfOneProcess) {
+  if (std::string(PATHEX_MPI_BINARY).empty()) GTEST_SKIP() << "pathex-mpi is not built (MPI was not found at configure time)";
+  // A reference run of its own (no closed form) and two renderers: every render converge makes,
+  // split three ways.
+  const std::string args = " converge samples/scenes/cornell.json --renderer pt-nee --renderer bdpt --spp 4,8 --resolution 16x16 "
+                           "--threads 1 --json --out ";
+  const std::string one = out_dir("mpi-one"), three = out_dir("mpi-three");
+  const CliRun s = run_pathex(args + one);
+  ASSERT_EQ(s.code, 0) << s.err;
+  const CliRun m = pathex::test::run_mpirun("-n 3 " + pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + three);
+  ASSERT_EQ(m.code, 0) << m.out;
+  // Rank 0 alone prints: one JSON document (the other ranks print nothing).
+  const nlohmann::json printed = nlohmann::json::parse(m.out);
+  const nlohmann::json single = nlohmann::json::parse(s.out);
+  EXPECT_EQ(printed.at("ranks"), 3);
+  EXPECT_EQ(single.at("ranks"), 1);
+  EXPECT_EQ(without_timing(printed), without_timing(single));
+  EXPECT_EQ(pathex::test::read_file(three + "/converge.json"), m.out);
+  // The reference run's outputs are computed from the same exact sums: the same bytes.
+  for (const char* f : {"reference.json", "reference.exr"})
+    EXPECT_TRUE(pathex::test::read_file(one + "/" + f) == pathex::test::read_file(three + "/" + f)) << f << " differs";
+}
+
 }  // namespace

@@ -269,6 +269,19 @@ TEST_F(MergeRefuses, ATruncatedShard) {
                                     " bytes, its header says at least " + std::to_string(bytes.size()));
 }
 
+TEST_F(MergeRefuses, NamingTheFirstBadFileInTheOrderGiven) {
+  // merge reports the error of the first bad file in the order of the command line (and reads
+  // no further), whatever kind of error a later file has.
+  const std::string c = dir("c");
+  ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/2 --seed 2 --quiet --out " + b_).code, 0);
+  ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/2 --quiet --out " + c).code, 0);
+  std::string bytes = read_file(shard(c));
+  bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x10);
+  std::ofstream(shard(c), std::ios::binary) << bytes;
+  expect_refusal(a_ + " " + b_ + " " + c, shard(b_) + " and " + shard(a_) + " are not of one render: another seed (2 against 1)");
+  expect_refusal(a_ + " " + c + " " + b_, shard(c) + ": corrupted shard file: its CRC-32 does not match its contents");
+}
+
 TEST_F(MergeRefuses, AFolderWithoutShards) {
   const std::string empty = dir("empty");
   fs::create_directories(empty);
@@ -281,18 +294,14 @@ TEST_F(MergeRefuses, AFolderWithoutShards) {
 #define PATHEX_MPI_BINARY ""
 #endif
 
-// `mpirun ARGS` from the source directory; stdout and stderr together.
-CliRun mpirun(const std::string& args) {
-  return pathex::test::run_shell("cd " + pathex::test::shell_quote(PATHEX_SOURCE_DIR) +
-                                 " && mpirun --oversubscribe --allow-run-as-root " + args + " 2>&1");
-}
+using pathex::test::run_mpirun;
 
 TEST(Mpi, ThreeRanksWriteTheBytesOfOneProcess) {
   if (std::string(PATHEX_MPI_BINARY).empty()) GTEST_SKIP() << "pathex-mpi is not built (MPI was not found at configure time)";
   const std::string args = " trace samples/scenes/cornell.json --classes samples/classes/basic.json --spp 10 --quiet --out ";
   const std::string single = dir("single"), ranks = dir("ranks");
   ASSERT_EQ(run_pathex(args + single).code, 0);
-  const CliRun r = mpirun("-n 3 " + pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks + " --threads 1");
+  const CliRun r = run_mpirun("-n 3 " + pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks + " --threads 1");
   ASSERT_EQ(r.code, 0) << r.out;
   expect_same_outputs(single, ranks, "3 MPI ranks");
   // The ranks' own shard files are gone once rank 0 has written render.shard, which holds them all.
@@ -319,7 +328,7 @@ TEST(Mpi, ADyingRankFailsTheRunAndTheOthersWorkIsKept) {
                            " PATHEX_SHIM_AWAIT=" + pathex::test::shell_quote(rank_file + "0.shard:" + rank_file + "2.shard");
   const std::string body = "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then export " + shim + "; fi; exec " +
                            pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks;
-  const CliRun r = mpirun("-n 3 sh -c " + pathex::test::shell_quote(body));
+  const CliRun r = run_mpirun("-n 3 sh -c " + pathex::test::shell_quote(body));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("process rank 1"), std::string::npos) << r.out;  // mpirun's message
   EXPECT_FALSE(fs::exists(ranks + "/histogram.json"));

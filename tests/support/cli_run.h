@@ -77,6 +77,12 @@ inline CliRun run_pathex(const std::string& args, const std::string& input = "")
   return r;
 }
 
+// `mpirun --oversubscribe ARGS` in the source directory (as root too, as CI runs), ARGS being shell
+// text; standard output and error together in `out`.
+inline CliRun run_mpirun(const std::string& args) {
+  return run_shell("cd " + shell_quote(PATHEX_SOURCE_DIR) + " && mpirun --oversubscribe --allow-run-as-root " + args + " 2>&1");
+}
+
 // The same with each argument quoted.
 inline CliRun run_pathex_args(const std::vector<std::string>& args, const std::string& input = "") {
   std::string text;

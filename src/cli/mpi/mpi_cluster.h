@@ -27,6 +27,8 @@ class MpiCluster final : public Cluster {
   // blocking collectives poll at full speed, so a rank done first would take a core from the
   // ranks still rendering, and every rank one from rank 0 writing the outputs.
   Result<bool> wait_for_all(const char* what);
+  // `any`[i] = the bitwise or of every rank's `flags`[i] (both of one size on every rank).
+  Result<bool> or_all(const std::vector<unsigned char>& flags, std::vector<unsigned char>* any);
   // 128-bit sums of `words` (pairs of low, high words) over the ranks, on rank 0 (others: emptied).
   Result<bool> sum_to_root(std::vector<std::uint64_t>* words);
 
