@@ -285,6 +285,20 @@ TEST(SpecularChains, TenGlassInterfacesTransmitTToTheTenth) {
   }
 }
 
+// Total internal reflection in a render: a pinhole inside glass looks up at 60 degrees from the
+// interface's normal, beyond the critical angle asin(1 / 1.5) = 41.8 degrees (scene comment). The
+// reflectance there is exactly 1 and nothing is transmitted, so every pixel sees the emitter below
+// (Le = 0.5) alone: LDDSDSE is 0.5 and is the whole image; the brighter emitter above (Le = 1),
+// which a transmitted share would add, contributes nothing.
+TEST(SpecularChains, TotalInternalReflectionReflectsAllAndTransmitsNothing) {
+  for (const char* renderer : {"pt", "pt-nee", "bdpt"}) {
+    const Rendered r = render_file(hard("total-internal-reflection.json"), renderer, {"LDDSDSE"}, 16);
+    EXPECT_EQ(r.nonfinite, 0u) << renderer;
+    expect_close(r.report.classes[0].estimate, 0.5, 3.0, 1e-6, renderer);
+    expect_close(r.report.total, 0.5, 3.0, 1e-6, renderer);
+  }
+}
+
 // --- non-finite samples are failures ---
 
 // A legal scene whose contributions all exceed the fixed-point range (a 1e9 W/sr point light inside

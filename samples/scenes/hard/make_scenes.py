@@ -71,6 +71,18 @@ write('ten-glass-interfaces.json', {
     "materials": {"glass": {"type": "dielectric", "ior": 1.5}, "black": {"type": "diffuse", "albedo": [0, 0, 0]}},
     "shapes": slabs + [{"type": "quad", "corner": [-2, -2, -3], "edge1": [4, 0, 0], "edge2": [0, 4, 0], "material": "black", "emission": [1, 1, 1]}]})
 
+# Total internal reflection: a pinhole below the interface y = 0 (normal +y, glass below) looks up
+# at 60 degrees from the normal, beyond the critical angle asin(1 / 1.5) = 41.8 degrees. The
+# reflectance is exactly 1 there, so the pinhole sees the emitter below (Le = 0.5) and nothing of
+# the emitter above (Le = 1): every pixel's LDDSDSE is exactly 0.5.
+write('total-internal-reflection.json', {
+    "description": "Total internal reflection: a pinhole inside glass (below the ior-1.5 interface y = 0) looks up at 60 degrees from the normal, beyond the critical angle of 41.8 degrees; it sees the emitter below (Le = 0.5) with reflectance 1 and nothing of the emitter above (Le = 1): LDDSDSE is exactly 0.5",
+    "camera": {"type": "pinhole", "position": [0, -1, 0], "look_at": [math.sqrt(3) / 2, -0.5, 0], "up": [0, 0, 1], "fov": 1, "width": 8, "height": 8},
+    "materials": {"glass": {"type": "dielectric", "ior": 1.5}, "black": {"type": "diffuse", "albedo": [0, 0, 0]}},
+    "shapes": [{"type": "quad", "description": "the interface", "corner": [-20, 0, 20], "edge1": [40, 0, 0], "edge2": [0, 0, -40], "material": "glass"},
+               {"type": "quad", "description": "the emitter below, facing up", "corner": [-20, -3, 20], "edge1": [40, 0, 0], "edge2": [0, 0, -40], "material": "black", "emission": [0.5, 0.5, 0.5]},
+               {"type": "quad", "description": "the emitter above, facing down", "corner": [-20, 2, -20], "edge1": [40, 0, 0], "edge2": [0, 0, 40], "material": "black", "emission": [1, 1, 1]}]})
+
 # Grazing at the light, the surface and the sensor (cos theta about 1e-6).
 write('grazing-light.json', {
     "description": "A point light (I = 1) 1e-6 above a diffuse plane (albedo 0.5), seen from above around x = 1: light leaves the light and meets the surface at cos theta about 1e-6; L = rho I h / (pi d^3)",
