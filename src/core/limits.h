@@ -24,10 +24,9 @@ struct Limits {
   std::size_t max_file_bytes = std::size_t{64} << 20;  // --max-file-size: bytes of one input file
 };
 
-// The ceilings of the options above and of --max-bounces. kMaxDepthCeiling bounds the syntax
-// tree's recursion (parser, printer, Thompson construction, nested & and ~): under 2 MiB of stack
-// in a release build, 10 MiB under ASan; core/stack.h gives the command line 64 MiB, and
-// tests/regex/parser_test.cpp runs every recursive routine at the ceiling on a quarter of that.
+// The ceilings of the options above and of --max-bounces. kMaxDepthCeiling keeps the syntax
+// tree's recursion (parser, printer, Thompson construction, nested & and ~) within about 1 MiB of
+// stack: tests/regex/parser_test.cpp walks a tree of that height in every recursive routine.
 inline constexpr std::size_t kMaxStatesCeiling = 10000000;
 inline constexpr int kMaxDepthCeiling = 1000;
 inline constexpr int kMaxRepeatCeiling = 100000;
