@@ -79,7 +79,7 @@ if [ "$what" = merge ] || [ "$what" = size ] || [ "$what" = all ]; then
       read -r wall user sys < "$work/time.txt"
       times+=("$wall"); cpus+=("$(echo "$user + $sys" | bc -l)")
     done
-    printf '  a merge of the merged render's one shard (reading it, writing the outputs): wall %s s, CPU %s s\n' \
+    printf '  a merge of the merged render alone (reading its one shard, writing the outputs): wall %s s, CPU %s s\n' \
       "$(printf '%s\n' "${times[@]}" | median)" "$(printf '%s\n' "${cpus[@]}" | median)"
   fi
   if [ "$what" != merge ]; then
