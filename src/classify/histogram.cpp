@@ -74,6 +74,13 @@ void Histogram::reserve_paths(std::size_t paths) {
   first_row_.reserve(paths);
 }
 
+void Histogram::reserve_rows(std::size_t rows) {
+  if (rows <= rows_.capacity()) return;
+  rows = std::max(rows, 2 * rows_.capacity());
+  rows_.reserve(rows);
+  for (std::vector<ExactSum>& sums : row_sums_) sums.reserve(rows);
+}
+
 std::optional<Histogram::PathId> Histogram::find(std::string_view path) const {
   auto it = ids_.find(path);
   if (it == ids_.end()) return std::nullopt;

@@ -201,7 +201,8 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
           return make_error(ErrorCode::kUsage, "passes " + both.to_string() + " are in both " + other + " and " + path +
                                                    ": the renders to merge must hold disjoint passes");
     }
-    if (Result<bool> r = add_shard_sums(*file, &out->sums.histogram, &out->sums.images); !r) return r.error();
+    const std::size_t files_left = paths.size() - seen.size();  // this one included
+    if (Result<bool> r = add_shard_sums(*file, &out->sums.histogram, &out->sums.images, files_left); !r) return r.error();
     ShardHeader& header = out->header;
     header.spp = std::max(header.spp, h.spp);
     header.share.add(h.share);

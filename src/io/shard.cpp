@@ -26,9 +26,10 @@ static_assert(std::endian::native == std::endian::little, "shard files store raw
 
 constexpr char kMagic[8] = {'P', 'X', 'S', 'H', 'A', 'R', 'D', '\n'};
 constexpr std::size_t kFixedBytes = 8 + 4 + 4 + 8 + 4;  // magic, version, H, N, CRC
-// A file's path count is believed this far when room is made for its paths ahead (a damaged or
-// hostile count costs at most this many paths' cells of address space, untouched).
+// A file's path and row counts are believed this far when room is made for them ahead (a damaged
+// or hostile count costs at most this many paths' cells of address space per file, untouched).
 constexpr std::uint64_t kMaxReservedPaths = std::uint64_t{1} << 16;
+constexpr std::uint64_t kMaxReservedInAll = std::uint64_t{1} << 19;  // for all the files to come
 // A tile's pixels (ClassImages: six words each, the low and high word of R, G and B).
 constexpr std::size_t kTilePixels = ClassImages::kTile * ClassImages::kTile;
 static_assert(kTilePixels == 64 && ClassImages::kTileWords == 6 * kTilePixels);
@@ -479,6 +480,7 @@ std::string encode_shard(const ShardHeader& header, const Histogram& h, const Cl
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<Histogram::PathId>(i);
   std::sort(order.begin(), order.end(), [&](auto a, auto b) { return h.path(a) < h.path(b); });
   w.u(order.size());
+  w.u(static_cast<std::uint64_t>(h.num_rows()));
   for (Histogram::PathId p : order) {
     w.text(h.path(p));
     // Only the batches that hold something: a shard of a few passes fills a few of the B.
@@ -589,7 +591,7 @@ Result<ShardFile> read_shard(const std::string& path, std::string buffer) {
   return parse_shard(std::move(bytes), path);
 }
 
-Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* images) {
+Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* images, std::size_t files) {
   const RenderIdentity& id = f.header.identity;
   if (h->num_batches() != id.batches || h->layout().strategies != id.strategies)
     return file_error(f.path, "the shard's histogram layout (batches, strategies) is not the merge's");
@@ -601,12 +603,17 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
   for (int b = 0; b < B; ++b) h->add_samples(b, r.u());
   h->add_nonfinite(r.u());
   h->add_magnitude(r.x());
-  const std::uint64_t paths = r.u();
-  // Room for the file's paths at once, so that the histogram's B rows of cells are not grown path
-  // by path (each regrowth moves every row).
-  if (!r.failed())
-    h->reserve_paths(static_cast<std::size_t>(h->num_paths()) +
-                     static_cast<std::size_t>(std::min<std::uint64_t>(paths, kMaxReservedPaths)));
+  const std::uint64_t paths = r.u(), rows_in_all = r.u();
+  // Room for the paths and rows of this file and as many more for each file still to come, at
+  // once, so that the histogram's B rows of cells and of row sums are not regrown (each regrowth
+  // moves every row, into fresh pages).
+  if (!r.failed()) {
+    const auto room = [&](std::uint64_t n) {
+      return static_cast<std::size_t>(std::min<std::uint64_t>(std::min(n, kMaxReservedPaths) * std::max<std::size_t>(files, 1), kMaxReservedInAll));
+    };
+    h->reserve_paths(static_cast<std::size_t>(h->num_paths()) + room(paths));
+    h->reserve_rows(static_cast<std::size_t>(h->num_rows()) + room(rows_in_all));
+  }
   // The held batches, each given by its gap after the previous one, so that they come in
   // order; one at or past B makes the body malformed. `next` is one past the previous batch.
   const auto next_batch = [&](std::uint64_t& next) {

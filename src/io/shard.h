@@ -37,7 +37,8 @@
 // is one byte and a typical sum (64 fraction bits) nine or ten. The body is decoded as it is
 // decompressed, a window of 1 MiB at a time, so a file cannot make pathex allocate more than its
 // sums take; a path string is at most 512 KiB.
-//   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P; then per
+//   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P, u number of
+//              technique rows in all (room is made for them ahead); then per
 //              path, by string: u length, the letters; u number of held cells C (batches with a
 //              contribution or a nonzero sum), C × (u gap, u contributions, 3 × x sums); u number
 //              of technique rows R, then R × (u Technique::code(), u contributions, u number of
@@ -137,6 +138,10 @@ Result<ShardFile> read_shard(const std::string& path, std::string buffer = {});
 
 // Adds the file's sums to `histogram` and `images`, which must have the file's layout: the
 // histogram's batches and strategies, the images' size and planes (built from the same classes).
-Result<bool> add_shard_sums(const ShardFile& file, Histogram* histogram, ClassImages* images);
+// `files`: how many files of the same render the caller will add in all (this one included): the
+// histogram makes room ahead for that many times this file's paths and rows (address space
+// only, capped; pages are touched by the paths that come), so that adding the others does not
+// move its batch rows again and again.
+Result<bool> add_shard_sums(const ShardFile& file, Histogram* histogram, ClassImages* images, std::size_t files = 1);
 
 }  // namespace pathex
