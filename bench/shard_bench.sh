@@ -10,6 +10,8 @@
 #            every process; per pair the wall speedup (target >= 1.8x), the CPU efficiency and the
 #            speedup the CPU times predict on an idle machine; their medians, and how busy the
 #            machine was. Skipped without build/pathex-mpi.
+#            With OLD=path/to/another/pathex, `merge` also renders that build's shards and times its
+#            merges alternately with this build's (ratios within one run).
 # Usage: bash bench/shard_bench.sh [merge|size|mpi|all] (default all). Scratch: $TMPDIR/pathex-shard-bench.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,18 +38,40 @@ if [ "$what" = merge ] || [ "$what" = size ] || [ "$what" = all ]; then
     done
   fi
   rm -rf "$work/check"
+  if [ -n "${OLD:-}" ] && [ "$what" != size ]; then
+    if [ ! -f "$work/old-s15/render.shard" ] || ! "$OLD" merge "$work"/old-s{0..15} --quiet --out "$work/check" 2> /dev/null; then
+      rm -rf "$work"/old-s* "$work/check"
+      echo "rendering the 16 shards with $OLD ..."
+      for i in $(seq 0 15); do
+        "$OLD" trace "$scene" --classes "$classes" --spp 16 --shard "$i/16" --quiet --out "$work/old-s$i" > /dev/null
+      done
+    fi
+    rm -rf "$work/check"
+  fi
   if [ "$what" != size ]; then
-    times=(); cpus=()
+    times=(); cpus=(); old_times=(); old_cpus=()
     for r in 1 2 3; do
       rm -rf "$work/merged"
       /usr/bin/time -f '%e %U %S' -o "$work/time.txt" "$P" merge "$work"/s{0..15} --quiet --out "$work/merged"
       read -r wall user sys < "$work/time.txt"
       times+=("$wall"); cpus+=("$(echo "$user + $sys" | bc -l)")
+      if [ -n "${OLD:-}" ]; then
+        rm -rf "$work/old-merged"
+        /usr/bin/time -f '%e %U %S' -o "$work/time.txt" "$OLD" merge "$work"/old-s{0..15} --quiet --out "$work/old-merged"
+        read -r wall user sys < "$work/time.txt"
+        old_times+=("$wall"); old_cpus+=("$(echo "$user + $sys" | bc -l)")
+      fi
     done
     printf 'merge of 16 shards (512x512, 20 classes, 16 spp): wall %s s, CPU (user + sys) %s s (medians of 3; load average %s)\n' \
       "$(printf '%s\n' "${times[@]}" | median)" "$(printf '%s\n' "${cpus[@]}" | median)" "$(cut -d' ' -f1-3 /proc/loadavg)"
-    # The same outputs from one shard (the merged render's): what writing them costs, apart from
-    # reading and adding the 16 files.
+    if [ -n "${OLD:-}" ]; then
+      cmp -s "$work/merged/classes.exr" "$work/old-merged/classes.exr" && cmp -s "$work/merged/histogram.json" "$work/old-merged/histogram.json" \
+        && same="identical outputs" || same="outputs differ"
+      printf '  %s, alternating with it: wall %s s, CPU %s s (%s)\n' "$OLD" \
+        "$(printf '%s\n' "${old_times[@]}" | median)" "$(printf '%s\n' "${old_cpus[@]}" | median)" "$same"
+    fi
+    # The same outputs from one shard (the merged render's): reading that one file and writing the
+    # outputs, apart from reading and adding the 16 files.
     times=(); cpus=()
     for r in 1 2 3; do
       rm -rf "$work/rewritten"
@@ -55,7 +79,7 @@ if [ "$what" = merge ] || [ "$what" = size ] || [ "$what" = all ]; then
       read -r wall user sys < "$work/time.txt"
       times+=("$wall"); cpus+=("$(echo "$user + $sys" | bc -l)")
     done
-    printf '  of which writing the outputs (a merge of the merged render alone): wall %s s, CPU %s s\n' \
+    printf '  a merge of the merged render alone (reading its one shard, writing the outputs): wall %s s, CPU %s s\n' \
       "$(printf '%s\n' "${times[@]}" | median)" "$(printf '%s\n' "${cpus[@]}" | median)"
   fi
   if [ "$what" != merge ]; then

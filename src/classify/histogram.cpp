@@ -74,6 +74,13 @@ void Histogram::reserve_paths(std::size_t paths) {
   first_row_.reserve(paths);
 }
 
+void Histogram::reserve_rows(std::size_t rows) {
+  if (rows <= rows_.capacity()) return;
+  rows = std::max(rows, 2 * rows_.capacity());
+  rows_.reserve(rows);
+  for (std::vector<ExactSum>& sums : row_sums_) sums.reserve(rows);
+}
+
 std::optional<Histogram::PathId> Histogram::find(std::string_view path) const {
   auto it = ids_.find(path);
   if (it == ids_.end()) return std::nullopt;
@@ -333,9 +340,11 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
         add_rows(h, p, &class_techniques[ks]);
       }
     }
-    TechniqueTable techniques;
-    add_rows(h, p, &techniques);
-    report.paths.push_back(path_estimate(h, h.path(p), path_sums, n, count, techniques));
+    // The row's techniques are worked out below, for the rows listed only.
+    PathEstimate pe;
+    pe.path = h.path(p);
+    pe.estimate = batch_means(path_sums, n, count);
+    report.paths.push_back(std::move(pe));
   }
   report.distinct_paths = report.paths.size();
   report.total = batch_means(total_sums, n, total_count);
@@ -377,7 +386,12 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   }
   std::vector<PathEstimate> rows;
   rows.reserve(listed);
-  for (std::size_t i = 0; i < listed; ++i) rows.push_back(std::move(report.paths[order[i]]));
+  for (std::size_t i = 0; i < listed; ++i) {
+    rows.push_back(std::move(report.paths[order[i]]));
+    TechniqueTable techniques;
+    add_rows(h, order[i], &techniques);
+    rows.back().strategies = technique_estimates(h.layout(), techniques, n);
+  }
   report.paths = std::move(rows);
   return report;
 }

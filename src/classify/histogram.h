@@ -191,6 +191,8 @@ class Histogram {
   // geometrically, so that adding that many costs no reallocation: for readers that know a bound
   // ahead (shard files).
   void reserve_paths(std::size_t paths);
+  // The same for technique rows (the row table and every batch's row sums).
+  void reserve_rows(std::size_t rows);
   int num_paths() const { return static_cast<int>(paths_.size()); }
   const std::string& path(PathId id) const { return paths_[static_cast<std::size_t>(id)]; }
   // The classifier's class-set id of the path; 0 when the histogram has no classifier.

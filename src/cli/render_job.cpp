@@ -6,6 +6,7 @@
 #include <optional>
 
 #include <nlohmann/json.hpp>
+#include <tbb/task_group.h>
 
 #include "core/version.h"
 #include "io/atomic_file.h"
@@ -70,8 +71,11 @@ static nlohmann::ordered_json efficiency_json(const Estimate& total, double cpu_
   return e;
 }
 
-Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors) {
+namespace {
+
+// Everything but the shard file: histogram.json, the images, run.json.
+Result<WrittenReport> write_report_and_images(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
+                                              const RenderClasses& classes, const std::vector<ConnectorStats>& connectors) {
   const RenderIdentity& id = header.identity;
   RunInfo info;
   info.scene = id.scene;
@@ -103,8 +107,6 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
     if (Result<bool> w = write_exr(dir + "/classes.exr", layers); !w) return w.error();
     if (Result<bool> w = write_previews(dir, layers); !w) return w.error();
   }
-  if (Result<bool> w = write_file_atomic(dir + "/" + kRenderShardName, encode_shard(header, sums.histogram, sums.images)); !w)
-    return w.error();
   nlohmann::ordered_json run = nlohmann::ordered_json::object();
   run["time_s"] = header.run.time_s;
   run["threads"] = header.run.threads;
@@ -114,6 +116,23 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
   run["efficiency"] = efficiency_json(out.report.total, header.run.cpu_s);
   if (Result<bool> w = write_file_atomic(dir + "/run.json", run.dump(2) + "\n"); !w) return w.error();
   return out;
+}
+
+}  // namespace
+
+Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
+                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors) {
+  // The shard file, the largest output and independent of the others, is encoded and written on
+  // another core while the report and the images are made and written on this one (both read the
+  // sums only). The bytes do not depend on it.
+  std::optional<Result<bool>> shard;
+  tbb::task_group group;
+  group.run([&] { shard.emplace(write_file_atomic(dir + "/" + kRenderShardName, encode_shard(header, sums.histogram, sums.images))); });
+  Result<WrittenReport> rest = write_report_and_images(dir, header, sums, classes, connectors);
+  group.wait();
+  if (!rest) return rest.error();
+  if (!*shard) return shard->error();
+  return rest;
 }
 
 std::string ranks_folder(const std::string& dir) {
@@ -182,7 +201,8 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
           return make_error(ErrorCode::kUsage, "passes " + both.to_string() + " are in both " + other + " and " + path +
                                                    ": the renders to merge must hold disjoint passes");
     }
-    if (Result<bool> r = add_shard_sums(*file, &out->sums.histogram, &out->sums.images); !r) return r.error();
+    const std::size_t files_left = paths.size() - seen.size();  // this one included
+    if (Result<bool> r = add_shard_sums(*file, &out->sums.histogram, &out->sums.images, files_left); !r) return r.error();
     ShardHeader& header = out->header;
     header.spp = std::max(header.spp, h.spp);
     header.share.add(h.share);

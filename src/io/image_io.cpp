@@ -336,22 +336,15 @@ Result<bool> write_previews(const std::string& dir, const std::vector<ImageLayer
   }
   auto total = std::find_if(layers.begin(), layers.end(), [](const ImageLayer& l) { return l.name == "total"; });
   const double exposure = preview_exposure((total != layers.end() ? *total : layers[0]).image);
-  // Encoded in parallel, written in order.
-  std::vector<std::optional<Result<std::string>>> encoded(layers.size());
+  // Encoded and written in parallel (a file's flush to disk waits beside the others' encoding);
+  // the first failure in layer order is the one reported.
+  std::vector<std::optional<Result<bool>>> written(layers.size());
   tbb::parallel_for(std::size_t{0}, layers.size(), [&](std::size_t i) {
-    const RgbImage& image = layers[i].image;
-    encoded[i].emplace(encode_png(image.width, image.height, tonemap_srgb8(image, exposure)));
-  });
-  for (std::size_t i = 0; i < layers.size(); ++i) {
     const std::string path = (dir.empty() ? std::string(".") : dir) + "/" + layers[i].name + ".png";
-    Result<std::string>& bytes = *encoded[i];
-    if (!bytes) {
-      Error e = bytes.error();
-      e.where = path;
-      return e;
-    }
-    if (Result<bool> ok = write_file_atomic(path, *bytes); !ok) return ok;
-  }
+    written[i].emplace(write_png(path, layers[i].image, exposure));
+  });
+  for (std::optional<Result<bool>>& w : written)
+    if (!*w) return std::move(*w);
   return true;
 }
 

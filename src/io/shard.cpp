@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -21,11 +22,17 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
+static_assert(std::endian::native == std::endian::little, "shard files store raw little-endian words");
+
 constexpr char kMagic[8] = {'P', 'X', 'S', 'H', 'A', 'R', 'D', '\n'};
 constexpr std::size_t kFixedBytes = 8 + 4 + 4 + 8 + 4;  // magic, version, H, N, CRC
-// A file's path count is believed this far when room is made for its paths ahead (a damaged or
-// hostile count costs at most this many paths' cells of address space, untouched).
+// A file's path and row counts are believed this far when room is made for them ahead (a damaged
+// or hostile count costs at most this many paths' cells of address space per file, untouched).
 constexpr std::uint64_t kMaxReservedPaths = std::uint64_t{1} << 16;
+constexpr std::uint64_t kMaxReservedInAll = std::uint64_t{1} << 19;  // for all the files to come
+// A tile's pixels (ClassImages: six words each, the low and high word of R, G and B).
+constexpr std::size_t kTilePixels = ClassImages::kTile * ClassImages::kTile;
+static_assert(kTilePixels == 64 && ClassImages::kTileWords == 6 * kTilePixels);
 
 std::uint32_t crc32_of(const char* data, std::size_t n) {
   return static_cast<std::uint32_t>(
@@ -78,6 +85,18 @@ class Writer {
     x(c[0]);
     x(c[1]);
     x(c[2]);
+  }
+  // Eight bytes, little-endian.
+  void raw64(std::uint64_t v) {
+    room(8);
+    for (int i = 0; i < 8; ++i) window_[used_++] = static_cast<char>((v >> (8 * i)) & 0xff);
+  }
+  // A pixel's channel sum: the low word raw, the high word as a zigzag varint of its signed
+  // value (one byte below 2^70 in magnitude, i.e. a sum below 64 on the pixel's grid).
+  void split(std::uint64_t low, std::uint64_t high) {
+    raw64(low);
+    const auto h = static_cast<std::int64_t>(high);
+    u((static_cast<std::uint64_t>(h) << 1) ^ static_cast<std::uint64_t>(h >> 63));
   }
   void text(const std::string& s) {
     u(s.size());
@@ -169,6 +188,20 @@ class Reader {
     return fail();
   }
   ExactRgb rgb() { return {x(), x(), x()}; }
+  std::uint64_t raw64() {
+    refill(8);
+    if (end_ - p_ < 8) return fail();
+    std::uint64_t v;
+    std::memcpy(&v, p_, 8);  // little-endian hosts only (static_assert at the top)
+    p_ += 8;
+    return v;
+  }
+  // Writer::split's pair: the low word and the high word, into `words`.
+  void split(std::uint64_t* words) {
+    words[0] = raw64();
+    const std::uint64_t z = u();
+    words[1] = (z >> 1) ^ (std::uint64_t{0} - (z & 1));
+  }
   // A string in the window: valid until the next read (no allocation per path string).
   std::string_view text() {
     const std::uint64_t n = u();
@@ -447,9 +480,18 @@ std::string encode_shard(const ShardHeader& header, const Histogram& h, const Cl
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<Histogram::PathId>(i);
   std::sort(order.begin(), order.end(), [&](auto a, auto b) { return h.path(a) < h.path(b); });
   w.u(order.size());
+  w.u(static_cast<std::uint64_t>(h.num_rows()));
   for (Histogram::PathId p : order) {
     w.text(h.path(p));
-    for (int b = 0; b < h.num_batches(); ++b) {
+    // Only the batches that hold something: a shard of a few passes fills a few of the B.
+    const auto held = [&](int b) { return h.cell(p, b).contributions != 0 || !is_zero(h.cell(p, b).sum); };
+    int cells = 0;
+    for (int b = 0; b < h.num_batches(); ++b) cells += held(b) ? 1 : 0;
+    w.u(static_cast<std::uint64_t>(cells));
+    for (int b = 0, last = -1; b < h.num_batches(); ++b) {
+      if (!held(b)) continue;
+      w.u(static_cast<std::uint64_t>(b - last - 1));
+      last = b;
       w.u(h.cell(p, b).contributions);
       w.rgb(h.cell(p, b).sum);
     }
@@ -458,7 +500,15 @@ std::string encode_shard(const ShardHeader& header, const Histogram& h, const Cl
     for (int r : rows) {
       w.u(static_cast<std::uint64_t>(h.row(r).technique));
       w.u(h.row(r).contributions);
-      for (int b = 0; b < h.num_batches(); ++b) w.x(h.row_sum(r, b));
+      int sums = 0;
+      for (int b = 0; b < h.num_batches(); ++b) sums += h.row_sum(r, b) != 0 ? 1 : 0;
+      w.u(static_cast<std::uint64_t>(sums));
+      for (int b = 0, last = -1; b < h.num_batches(); ++b) {
+        if (h.row_sum(r, b) == 0) continue;
+        w.u(static_cast<std::uint64_t>(b - last - 1));
+        last = b;
+        w.x(h.row_sum(r, b));
+      }
     }
   }
   // --- images ---
@@ -476,8 +526,13 @@ std::string encode_shard(const ShardHeader& header, const Histogram& h, const Cl
     w.u(p);
     w.u(t);
     const std::uint64_t* words = images.tile_words(p, t);
-    for (std::size_t i = 0; i < ClassImages::kTileWords; i += 2)
-      w.x((static_cast<ExactSum>(words[i + 1]) << 64) | static_cast<ExactSum>(words[i]));
+    std::uint64_t mask = 0;  // the tile's pixels with a nonzero sum
+    for (std::size_t k = 0; k < kTilePixels; ++k)
+      if (std::any_of(words + 6 * k, words + 6 * k + 6, [](std::uint64_t v) { return v != 0; })) mask |= std::uint64_t{1} << k;
+    w.raw64(mask);
+    for (std::size_t k = 0; k < kTilePixels; ++k)
+      if (mask >> k & 1)
+        for (std::size_t c = 0; c < 6; c += 2) w.split(words[6 * k + c], words[6 * k + c + 1]);
   }
   w.finish();
   const std::uint64_t body_size = out.size() - body_at;
@@ -536,7 +591,7 @@ Result<ShardFile> read_shard(const std::string& path, std::string buffer) {
   return parse_shard(std::move(bytes), path);
 }
 
-Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* images) {
+Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* images, std::size_t files) {
   const RenderIdentity& id = f.header.identity;
   if (h->num_batches() != id.batches || h->layout().strategies != id.strategies)
     return file_error(f.path, "the shard's histogram layout (batches, strategies) is not the merge's");
@@ -548,24 +603,47 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
   for (int b = 0; b < B; ++b) h->add_samples(b, r.u());
   h->add_nonfinite(r.u());
   h->add_magnitude(r.x());
-  const std::uint64_t paths = r.u();
-  // Room for the file's paths at once, so that the histogram's B rows of cells are not grown path
-  // by path (each regrowth moves every row).
-  if (!r.failed())
-    h->reserve_paths(static_cast<std::size_t>(h->num_paths()) +
-                     static_cast<std::size_t>(std::min<std::uint64_t>(paths, kMaxReservedPaths)));
+  const std::uint64_t paths = r.u(), rows_in_all = r.u();
+  // Room for the paths and rows of this file and as many more for each file still to come, at
+  // once, so that the histogram's B rows of cells and of row sums are not regrown (each regrowth
+  // moves every row, into fresh pages).
+  if (!r.failed()) {
+    const auto room = [&](std::uint64_t n) {
+      return static_cast<std::size_t>(std::min<std::uint64_t>(std::min(n, kMaxReservedPaths) * std::max<std::size_t>(files, 1), kMaxReservedInAll));
+    };
+    h->reserve_paths(static_cast<std::size_t>(h->num_paths()) + room(paths));
+    h->reserve_rows(static_cast<std::size_t>(h->num_rows()) + room(rows_in_all));
+  }
+  // The held batches, each given by its gap after the previous one, so that they come in
+  // order; one at or past B makes the body malformed. `next` is one past the previous batch.
+  const auto next_batch = [&](std::uint64_t& next) {
+    const std::uint64_t gap = r.u();
+    if (gap >= static_cast<std::uint64_t>(B) - next) return false;
+    next += gap + 1;
+    return true;
+  };
   for (std::uint64_t i = 0; i < paths && !r.failed(); ++i) {
     const std::string_view path = r.text();
     if (r.failed()) break;
     const Histogram::PathId id_ = h->intern(path);
-    for (int b = 0; b < B; ++b) {
+    const std::uint64_t cells = r.u();
+    if (cells > static_cast<std::uint64_t>(B)) return bad("path \"" + std::string(path) + "\" holds more cells than batches");
+    std::uint64_t b1 = 0;  // one past the previous held batch
+    for (std::uint64_t k = 0; k < cells && !r.failed(); ++k) {
+      if (!next_batch(b1)) return bad("a cell of path \"" + std::string(path) + "\" is past the last batch");
       const std::uint64_t n = r.u();
-      h->add_cell(id_, b, r.rgb(), n);
+      h->add_cell(id_, static_cast<int>(b1 - 1), r.rgb(), n);
     }
     const std::uint64_t rows = r.u();
     for (std::uint64_t k = 0; k < rows && !r.failed(); ++k) {
-      const std::uint64_t code = r.u(), n = r.u();
-      for (ExactSum& sum : technique_sums) sum = r.x();
+      const std::uint64_t code = r.u(), n = r.u(), sums = r.u();
+      if (sums > static_cast<std::uint64_t>(B)) return bad("a technique of path \"" + std::string(path) + "\" holds more sums than batches");
+      std::fill(technique_sums.begin(), technique_sums.end(), ExactSum{0});
+      b1 = 0;
+      for (std::uint64_t j = 0; j < sums && !r.failed(); ++j) {
+        if (!next_batch(b1)) return bad("a technique sum of path \"" + std::string(path) + "\" is past the last batch");
+        technique_sums[static_cast<std::size_t>(b1 - 1)] = r.x();
+      }
       if (r.failed()) break;
       if (code >= (std::uint64_t{1} << 29) || Technique::from_code(static_cast<int>(code)).strategy >= S)
         return bad("a technique of path \"" + std::string(path) + "\" names no strategy of the render");
@@ -584,10 +662,14 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
   for (std::uint64_t i = 0; i < stored; ++i) {
     const std::uint64_t p = r.u(), t = r.u();
     if (r.failed() || p >= planes || t >= tiles) return bad("a stored tile is out of range");
-    for (std::size_t k = 0; k < ClassImages::kTileWords; k += 2) {
-      const ExactSum v = r.x();
-      words[k] = static_cast<std::uint64_t>(v);
-      words[k + 1] = static_cast<std::uint64_t>(v >> 64);
+    const std::uint64_t mask = r.raw64();
+    for (std::size_t k = 0; k < kTilePixels; ++k) {
+      std::uint64_t* px = words.data() + 6 * k;
+      if (mask >> k & 1) {
+        for (std::size_t c = 0; c < 6; c += 2) r.split(px + c);
+      } else {
+        std::fill(px, px + 6, std::uint64_t{0});
+      }
     }
     if (r.failed()) return bad("the image section ends early");
     images->add_tile(static_cast<std::size_t>(p), static_cast<std::size_t>(t), words.data());

@@ -7,12 +7,13 @@
 // exact integer sums (classify/histogram.h, classify/image.h), which add. A shard file holds those
 // sums, not the floats of the outputs.
 //
-// File layout, version 3 (all integers little-endian; version 1 had the body uncompressed, version
-// 2 per-strategy sums in place of the technique rows):
+// File layout, version 4 (all integers little-endian; version 1 had the body uncompressed, version
+// 2 per-strategy sums in place of the technique rows, version 3 every batch of every cell and row
+// and every pixel of a stored tile as varints):
 //
 //   offset  size  what
 //   0       8     magic "PXSHARD\n"
-//   8       4     format version (3)
+//   8       4     format version (4)
 //   12      4     H: header length in bytes
 //   16      H     header: a JSON object (UTF-8), keys below
 //   16+H    8     N: body length in bytes
@@ -36,13 +37,21 @@
 // is one byte and a typical sum (64 fraction bits) nine or ten. The body is decoded as it is
 // decompressed, a window of 1 MiB at a time, so a file cannot make pathex allocate more than its
 // sums take; a path string is at most 512 KiB.
-//   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P; then per
-//              path, by string: u length, the letters, B × (u contributions, 3 × x sums),
-//              u number of technique rows R, then R × (u Technique::code(), u contributions,
-//              B × x per-batch luminance sums), by code (B batches from the header)
+//   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P, u number of
+//              technique rows in all (room is made for them ahead); then per
+//              path, by string: u length, the letters; u number of held cells C (batches with a
+//              contribution or a nonzero sum), C × (u gap, u contributions, 3 × x sums); u number
+//              of technique rows R, then R × (u Technique::code(), u contributions, u number of
+//              nonzero batch sums K, K × (u gap, x per-batch luminance sum)), by code. A gap is
+//              the batch's distance after the previous one listed minus one (the first: its
+//              index), so that batches come in order and below B (B from the header); a shard
+//              of one pass holds one batch per cell list.
 //   images:    u planes, u tiles per plane, u number of stored tiles T; then per tile, by plane
-//              then tile: u plane, u tile, ClassImages::kTileWords / 2 × x (per pixel, per
-//              channel, of the tile's 8 × 8 pixels). Tiles with nothing in them are not stored.
+//              then tile: u plane, u tile, 8 bytes: the mask of its 8 × 8 pixels (bit i: pixel i
+//              of the tile, row-major) with a nonzero sum; per pixel of the mask, per channel, the
+//              sum's low 64-bit word as 8 raw bytes, then its high word as the zigzag varint of a
+//              signed 64-bit integer (one byte for sums below 64: most). Tiles with nothing in
+//              them are not stored. Raw words decode with a load where a varint took ten steps.
 #pragma once
 
 #include <cstdint>
@@ -57,7 +66,7 @@
 
 namespace pathex {
 
-inline constexpr std::uint32_t kShardFormatVersion = 3;
+inline constexpr std::uint32_t kShardFormatVersion = 4;
 inline constexpr const char* kShardExtension = ".shard";
 
 // What must agree for two renders to merge: all but the names and files (the same scene, profile
@@ -129,6 +138,10 @@ Result<ShardFile> read_shard(const std::string& path, std::string buffer = {});
 
 // Adds the file's sums to `histogram` and `images`, which must have the file's layout: the
 // histogram's batches and strategies, the images' size and planes (built from the same classes).
-Result<bool> add_shard_sums(const ShardFile& file, Histogram* histogram, ClassImages* images);
+// `files`: how many files of the same render the caller will add in all (this one included): the
+// histogram makes room ahead for that many times this file's paths and rows (address space
+// only, capped; pages are touched by the paths that come), so that adding the others does not
+// move its batch rows again and again.
+Result<bool> add_shard_sums(const ShardFile& file, Histogram* histogram, ClassImages* images, std::size_t files = 1);
 
 }  // namespace pathex
