@@ -8,7 +8,10 @@
 //   PATHEX_SHIM_AWAIT   files (separated by ':') that must all exist before the signal is sent:
 //                       the process waits for them at the Nth call (a synchronisation point
 //                       between processes that the test controls, tests/cli/shard_cli_test.cpp)
-// The signal goes to the process (kill), before the call itself runs.
+// The signal goes to the calling thread (raise), before the call itself runs, so that it arrives
+// exactly at this call. A process-directed kill() would not: the kernel may hand it to another
+// thread (the main thread, which waits for the command line's thread, core/stack.h), whose handler
+// then runs a moment later, after the program has moved on.
 #include <dlfcn.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -55,7 +58,7 @@ void count(bool counts) {
   if (at == nullptr || std::atol(at) != n) return;
   await_files();
   const char* sig = env("PATHEX_SHIM_SIGNAL");
-  ::kill(::getpid(), sig ? std::atoi(sig) : SIGTERM);
+  ::raise(sig ? std::atoi(sig) : SIGTERM);
 }
 
 struct Report {
