@@ -29,6 +29,7 @@
 #include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/frame.h"
+#include "trace/prune.h"
 #include "trace/render_scene.h"
 #include "trace/rng.h"
 
@@ -543,7 +544,8 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   float eta2 = 1.0f;  // the product of η² over the refractions so far (radiance walks)
   // `beta` passed in the first vertex already includes the first direction's weight: the caller
   // stores it in path[count - 1].beta and we continue from there.
-  while (count < max_vertices) {
+  SubpathPrefix live(o_.only, mode == TransportMode::kImportance, path[0].pos_letter, path[0].letter);  // trace/prune.h
+  while (count < max_vertices && live.alive()) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
     const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, HitDetail::kNoUv);  // zero for points: no offset
@@ -616,6 +618,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     o = v.p;
     d = bs->wi;
     if (!std::isfinite(beta.x + beta.y + beta.z)) break;
+    live.extend(v.letter);  // --only: a subpath no requested class can complete stops (DESIGN §11)
   }
   return count;
 }
@@ -850,6 +853,7 @@ float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampl
 }
 
 void Integrator::record(Thread& th, const Pending& r) const {
+  if (o_.only != nullptr && !o_.only->records(r.key)) return;  // --only: not a requested path
   const Rgb rgb{r.c.x, r.c.y, r.c.z};
   ExactRgb e;
   if (!to_exact(rgb, &e)) {
@@ -1010,6 +1014,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   const Vertex* fresh = C == Connection::kSplat || C == Connection::kNee || kind != JoinKind::kPlain ? &sampled : nullptr;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   const PathKey key = path_key(th, s, t, fresh) | chain_s;
+  if (o_.only != nullptr && !o_.only->records(key)) return;  // --only: no MIS weight, no shadow ray for it
   float weight = 0.0f;
   if (has_mirror_ && mirror_can_sample(th, s, t, key)) {
     constexpr bool fresh_eye = C == Connection::kSplat || C == Connection::kOrtho;
