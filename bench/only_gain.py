@@ -30,9 +30,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = os.path.join(ROOT, "samples", "scenes")
 # (label, scene, renderer, class expression, spp, resolution)
 CASES = [
-    ("caustic of point-glass", "point-glass.json", "bdpt", "$caustic", 16, "64x64"),
-    ("$direct on the Cornell box", "cornell.json", "bdpt", "$direct", 8, "64x64"),
-    ("L.{8,}E on the Cornell box", "cornell.json", "bdpt", "L.{8,}E", 8, "64x64"),
+    ("caustic of point-glass", "point-glass.json", "bdpt", "$caustic", 64, "128x128"),
+    ("$direct on the Cornell box", "cornell.json", "bdpt", "$direct", 16, "128x128"),
+    ("L.{8,}E on the Cornell box", "cornell.json", "bdpt", "L.{8,}E", 16, "128x128"),
 ]
 
 
@@ -79,13 +79,13 @@ def main():
     if args.baseline:
         ratios = []
         for r in range(args.rounds):
-            cmd = ["trace", os.path.join(SCENES, "cornell.json"), "--renderer", "pt", "--spp", "16", "--resolution", "64x64",
+            cmd = ["trace", os.path.join(SCENES, "cornell.json"), "--renderer", "pt", "--spp", "64", "--resolution", "128x128",
                    "--threads", "1", "--no-images", "--quiet", "--out", os.path.join(tmp, "out")]
             order = [args.baseline, args.binary] if r % 2 == 0 else [args.binary, args.baseline]
             t = {b: cpu_run([b] + cmd) for b in order}
             ratios.append(t[args.binary] / t[args.baseline])
             print(f"  nothing pruned, round {r}: old {t[args.baseline]:.3f} s, new {t[args.binary]:.3f} s", flush=True)
-        print(f"nothing pruned (Cornell box, pt, 16 spp, 64x64): new / old CPU s median {statistics.median(ratios):.3f}"
+        print(f"nothing pruned (Cornell box, pt, 64 spp, 128x128): new / old CPU s median {statistics.median(ratios):.3f}"
               f" (range {min(ratios):.3f}-{max(ratios):.3f})")
 
 

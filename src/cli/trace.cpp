@@ -257,6 +257,12 @@ int run(const TraceArgs& a) {
   Result<ProfilePruning> pruning =
       prune_profile(*job.profile, id.max_bounces, universe, job.classes->requested_language, a.limits);
   if (!pruning) return report(pruning.error());
+  if (pruning->samples_nothing() && job.classes->requested.empty()) {
+    // Nothing of the scene can be sampled at all: render as asked (a black image, and the warning
+    // about the lights it cannot reach), running the profile whole as before.
+    pruning->profile = *job.profile;
+    pruning->changes.clear();
+  }
   if (pruning->samples_nothing()) {
     std::cout << "nothing to render: no strategy of " << id.renderer << " samples a path of "
               << (id.only.empty() ? "this scene" : "the requested classes in this scene") << " ("

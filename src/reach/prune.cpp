@@ -30,15 +30,19 @@ Result<Range> narrowed(const Strategy& st, bool on_s, std::optional<int> max_bou
   // A full path has s + t + 2 letters between L and E, at most max_bounces + 4.
   const int top = max_bounces ? *max_bounces + 2 : r.lo + 64;
   const int last = r.hi == Range::kOpen ? top : std::min(r.hi, top);
+  // The first value from below and the first from above at which it samples (the hull's ends).
   int lo = -1, hi = -1;
-  for (int v = r.lo; v <= last; ++v) {
+  for (int v = r.lo; v <= last && lo < 0; ++v) {
     Result<bool> yes = samples_at(st, on_s, v, top, max_bounces, target, limits);
     if (!yes) return yes.error();
-    if (!*yes) continue;
-    if (lo < 0) lo = v;
-    hi = v;
+    if (*yes) lo = v;
   }
   if (lo < 0) return r;  // only past `top` (no bound): keep the range
+  for (int v = last; v >= lo && hi < 0; --v) {
+    Result<bool> yes = samples_at(st, on_s, v, top, max_bounces, target, limits);
+    if (!yes) return yes.error();
+    if (*yes) hi = v;
+  }
   // Sampling at (or next to) the last value checked keeps the range's own end: under the bound it is
   // the same strategy (the tracer clamps its subpaths to max_bounces + 2 vertices).
   return Range{lo, hi >= last - 1 ? r.hi : hi};

@@ -11,4 +11,17 @@ Result<RequestedPaths> RequestedPaths::make(const std::vector<const PathClass*>&
   return out;
 }
 
+void SubpathPrefix::start(const RequestedPaths& only, bool light, char pos, char dir) {
+  const Classifier& c = only.classifier();
+  d_ = light ? &c.forward() : &c.backward();
+  s_ = Classifier::step(*d_, d_->start, light ? 'L' : 'E');
+  s_ = Classifier::step(*d_, s_, pos);
+  step(dir);
+}
+
+void SubpathPrefix::step(char letter) {
+  s_ = Classifier::step(*d_, s_, letter);
+  alive_ = d_->alive[s_ / Classifier::kStride] != 0;
+}
+
 }  // namespace pathex

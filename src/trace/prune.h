@@ -44,26 +44,24 @@ class RequestedPaths {
 class SubpathPrefix {
  public:
   // `pos` and `dir`: the end vertex's two letters (c0 c1 of a light; c(k+2) c(k+1) of a sensor).
+  // Inline, the walk pays a test of `only` here and one per vertex; the stepping is out of line,
+  // so that the walk's own code (and what the compiler inlines into it) is as without --only.
   SubpathPrefix(const RequestedPaths* only, bool light, char pos, char dir) {
-    if (only == nullptr) return;
-    const Classifier& c = only->classifier();
-    d_ = light ? &c.forward() : &c.backward();
-    s_ = Classifier::step(*d_, d_->start, light ? 'L' : 'E');
-    s_ = Classifier::step(*d_, s_, pos);
-    s_ = Classifier::step(*d_, s_, dir);
+    if (only != nullptr) [[unlikely]] start(*only, light, pos, dir);
   }
   // Whether some requested class can still be completed from the letters read.
-  bool alive() const { return d_ == nullptr || d_->alive[s_ / Classifier::kStride] != 0; }
-  // Reads the letter of the subpath's newest vertex (the scattering event sampled there); alive().
-  bool extend(char letter) {
-    if (d_ == nullptr) return true;
-    s_ = Classifier::step(*d_, s_, letter);
-    return alive();
+  bool alive() const { return alive_; }
+  // Reads the letter of the subpath's newest vertex (the scattering event sampled there).
+  void extend(char letter) {
+    if (d_ != nullptr) [[unlikely]] step(letter);
   }
 
  private:
+  void start(const RequestedPaths& only, bool light, char pos, char dir);
+  void step(char letter);
   const Classifier::Direction* d_ = nullptr;
   Classifier::State s_ = 0;
+  bool alive_ = true;
 };
 
 }  // namespace pathex

@@ -114,32 +114,12 @@ struct RenderOutput {
 
 // The strategies of a profile the tracer runs: plain joins and the mirror and projection
 // connectors. runnable_strategies() names the first connector the tracer does not run (manifold).
+// The tracer looks them up by (s, chain, t) in a StrategyTable (trace/strategy_table.h).
 struct StrategySet {
   std::vector<Strategy> strategies;
-  // Index of the profile strategy that runs the plain join (s, DD, t), or -1.
-  int find(int s, int t) const;
-  // Index of the profile strategy that runs connector `k` with s letters before its chain and t
-  // after it, or -1.
-  int find_connector(ConnectorKind k, int s, int t) const;
 };
 
 Result<StrategySet> runnable_strategies(const Profile& profile);
-
-// A check of the MIS weights (for tests): trace `samples` pairs of subpaths and, for every full
-// path that a connection (s, t) with s != 1 and t != 1 of the profile forms from their vertices,
-// the sum over every strategy the profile runs for that string of the weight it computes when it
-// samples those same vertices. Each sum must be 1. Also the connection's own weight as the
-// renderer computes it (with its per-sample sums when the profile runs every plain join) and as
-// the general recurrence computes it: the two must agree.
-struct MisCheck {
-  std::string path;
-  int s = 0, t = 0;
-  double weight_sum = 0.0;
-  double weight = 0.0, weight_general = 0.0;
-  std::string recorded;  // the label as the renderer packs and records it: must equal `path`
-};
-Result<std::vector<MisCheck>> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed,
-                                                int samples);
 
 Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
                             const RenderOptions& options);

@@ -2,17 +2,208 @@
 // language contains it, and their MIS weights sum to 1. For random full paths in every sample
 // scene and every profile the tracer runs, each strategy's weight is computed from its own side
 // (the vertices re-split at its join, densities recomputed as it would sample them) and summed.
+//
+// The renderer weighs a plain or projection join by the join-local recurrence (mis_weight(), with
+// per-sample sums when the profile runs every plain join); the general routine, path_weight(),
+// weighs whole paths from every vertex's two densities (profiles with the mirror connector use
+// it). The fast routine is a special case of the general one: the test pins the two equal.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
 
 #include "io/profile_json.h"
 #include "scene/scene.h"
+#include "trace/integrator.h"
 #include "trace/render.h"
 
-namespace pathex {
+namespace pathex::tracer {
+
+// The test's access to the integrator's internals: drives its subpaths and joins by hand.
+struct IntegratorTestAccess {
+  // One sample's eye and light subpaths, as render() traces them.
+  static int trace_subpaths(const Integrator& in, Integrator::Thread& th, Sampler& rng, int px, int py, int* ns) {
+    const int nt = in.eye_subpath(th, rng, px, py);
+    *ns = in.light_subpath(th, rng);
+    th.ns = *ns;
+    th.nt = nt;
+    in.prepare_joins(th, *ns, nt);
+    return nt;
+  }
+  // The full-path string of connection (s, t), spelled out from the vertices.
+  static std::string label(const Integrator& in, const Integrator::Thread& th, int s, int t) {
+    std::string out;
+    in.full_path(th, s, t, nullptr, out);
+    return out;
+  }
+  // The same string as the renderer records it (packed, then spelled out).
+  static std::string packed_label(const Integrator& in, const Integrator::Thread& th, int s, int t) {
+    return unpack(in.path_key(th, s, t, nullptr));
+  }
+  // The weight of connection (s, t) of the current subpaths, as the renderer computes it.
+  static float own_weight(const Integrator& in, Integrator::Thread& th, int s, int t) {
+    in.prepare_joins(th, th.ns, th.nt);
+    return in.mis_weight(th, s, t, nullptr, in.path_key(th, s, t, nullptr));
+  }
+  // The same weight by the general routine over the whole path's densities.
+  static float general_weight(const Integrator& in, Integrator::Thread& th, int s, int t) {
+    in.gather(th, s, t, nullptr, nullptr, nullptr);
+    return in.path_weight(th, in.path_key(th, s, t, nullptr), ConnectorKind::kNone, s);
+  }
+  // Whether (s, t) joins two vertices that can be joined (s = 0: an eye vertex on an area light;
+  // t = 0: a light vertex on the lens; otherwise two surfaces with finite parts).
+  static bool joinable(const Integrator& in, const Integrator::Thread& th, int s, int t) {
+    const Vertex* qs = s > 0 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
+    const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
+    if (s == 0) return pt->kind == Kind::kSurface && in.rs_.light_of_shape[static_cast<std::size_t>(pt->shape)] >= 0;
+    if (t == 0) return qs->kind == Kind::kLens;
+    return qs->kind == Kind::kSurface && pt->kind == Kind::kSurface &&
+           bsdf::has_finite_component(*in.rs_.material_of_shape[static_cast<std::size_t>(qs->shape)]) &&
+           bsdf::has_finite_component(*in.rs_.material_of_shape[static_cast<std::size_t>(pt->shape)]);
+  }
+  // For the full path x0 … xk formed by connection (s, t) of the current subpaths: the sum, over
+  // every strategy (s', t') with s' + t' = s + t that the profile runs and whose join letters are
+  // D (and the projection connectors where the letters are DSD), of the MIS weight it computes
+  // when it samples the same vertices. Must be 1.
+  using Thread = Integrator::Thread;
+  static float weight_sum(const Integrator& in, Thread& th, int s, int t) {
+    // The full path in light-to-eye order, from the two subpaths as connected by (s, t).
+    const int k = s + t - 1;
+    std::vector<Vertex> x;
+    for (int i = 0; i < s; ++i) x.push_back(th.light[static_cast<std::size_t>(i)]);
+    for (int j = t - 1; j >= 0; --j) x.push_back(th.eye[static_cast<std::size_t>(j)]);
+    if (s == 0) {  // the eye vertex on the emitter becomes the light vertex
+      x[0].kind = Kind::kLight;
+      x[0].light = in.rs_.light_of_shape[static_cast<std::size_t>(x[0].shape)];
+    } else if (in.rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) {
+      x[0].shape = in.rs_.lights[static_cast<std::size_t>(x[0].light)].shape;  // so an eye path may hit it
+    }
+    const std::string letters = label(in, th, s, t);
+    const Thread saved_light_eye = th;  // NOLINT: the subpaths, restored below
+    float sum = 0.0f;
+    for (int s2 = 0; s2 <= k + 1; ++s2) {
+      const int t2 = k + 1 - s2;
+      const auto letters_at = [&](int i, int count) { return letters.substr(static_cast<std::size_t>(i) + 1, static_cast<std::size_t>(count)); };
+      bool plain = in.strategy(s2, t2) >= 0 && letters_at(s2, 2) == "DD";
+      if (t2 == 0 && !in.lens_hits_) plain = false;
+      if (s2 == 0 && x[0].kind == Kind::kLight && !in.rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) plain = false;
+      const bool distant = s2 == 1 && in.distant_of(t2) >= 0 && letters_at(0, 3) == "DSD";
+      const bool ortho = t2 == 1 && in.ortho_of(s2) >= 0 && letters_at(k, 3) == "DSD";
+      if (!plain && !distant && !ortho) continue;
+      const ConnectorKind kind = distant ? ConnectorKind::kDistantProjection : ortho ? ConnectorKind::kOrthoProjection : ConnectorKind::kNone;
+      // Re-split: light subpath x0 … x(s2-1), eye subpath xk … x(s2), with forward densities as
+      // each side would have sampled them.
+      for (int i = 0; i < s2; ++i) th.light[static_cast<std::size_t>(i)] = x[static_cast<std::size_t>(i)];
+      for (int j = 0; j < t2; ++j) th.eye[static_cast<std::size_t>(j)] = x[static_cast<std::size_t>(k - j)];
+      if (s2 > 0) {
+        th.light[0].kind = Kind::kLight;
+        th.light[0].pdf_fwd = in.light_pick_ * in.rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+      }
+      if (s2 == 0) {
+        th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;
+      }
+      // Each vertex's direction to its predecessor on its new subpath.
+      for (int i = 0; i < s2; ++i) {
+        Vertex& v = th.light[static_cast<std::size_t>(i)];
+        if (i == 0) v.wo = vec3(0.0f), v.d2_wo = 0.0f;
+        else tracer::link(v, th.light[static_cast<std::size_t>(i - 1)]);
+      }
+      for (int j = 0; j < t2; ++j) {
+        Vertex& v = th.eye[static_cast<std::size_t>(j)];
+        if (j == 0) v.wo = vec3(0.0f), v.d2_wo = 0.0f;
+        else tracer::link(v, th.eye[static_cast<std::size_t>(j - 1)]);
+      }
+      // The letter of x_i in this path (c_{i+1}); a Dirac there keeps both densities through it symbolic.
+      auto specular = [&](int i) { return i >= 1 && i <= k - 1 && letters[static_cast<std::size_t>(i) + 2] == 'S'; };
+      for (int i = 1; i < s2; ++i)
+        th.light[static_cast<std::size_t>(i)].pdf_fwd =
+            specular(i - 1) ? 0.0f
+                            : in.pdf(i > 1 ? &th.light[static_cast<std::size_t>(i - 2)] : nullptr,
+                                  th.light[static_cast<std::size_t>(i - 1)], th.light[static_cast<std::size_t>(i)]);
+      for (int i = 0; i + 2 < s2; ++i)
+        th.light[static_cast<std::size_t>(i)].pdf_rev =
+            specular(i + 1) ? 0.0f
+                            : in.pdf(&th.light[static_cast<std::size_t>(i + 2)], th.light[static_cast<std::size_t>(i + 1)],
+                                  th.light[static_cast<std::size_t>(i)]);
+      if (t2 > 0) th.eye[0].pdf_fwd = in.cam_.pdf_pos;
+      for (int j = 1; j < t2; ++j)
+        th.eye[static_cast<std::size_t>(j)].pdf_fwd =
+            specular(k - (j - 1)) ? 0.0f
+                                  : in.pdf(j > 1 ? &th.eye[static_cast<std::size_t>(j - 2)] : nullptr,
+                                        th.eye[static_cast<std::size_t>(j - 1)], th.eye[static_cast<std::size_t>(j)]);
+      for (int j = 0; j + 2 < t2; ++j)
+        th.eye[static_cast<std::size_t>(j)].pdf_rev =
+            specular(k - (j + 1)) ? 0.0f
+                                  : in.pdf(&th.eye[static_cast<std::size_t>(j + 2)], th.eye[static_cast<std::size_t>(j + 1)],
+                                        th.eye[static_cast<std::size_t>(j)]);
+      // Parallel beams (a distant light's, an orthographic sensor's) give their first vertex a
+      // density per area, as light_subpath() and eye_subpath() set it.
+      if (s2 >= 2 && th.light[0].pdf_fwd > 0.0f && in.light_pairs_[static_cast<std::size_t>(th.light[0].light)][1] == 'S')
+        th.light[1].pdf_fwd = Integrator::parallel_jacobian(th.light[1], th.light[0], glm::normalize(th.light[1].p - th.light[0].p));
+      if (t2 >= 2 && in.cam_.pdf_pos > 0.0f && in.sensor_pair_[0] == 'S')
+        th.eye[1].pdf_fwd = Integrator::parallel_jacobian(th.eye[1], th.eye[0], glm::normalize(th.eye[1].p - th.eye[0].p));
+      in.prepare_joins(th, s2, t2);  // the ratios of the re-split subpaths
+      sum += in.mis_weight(th, s2, t2, nullptr, pack(letters), nullptr, kind);
+    }
+    th.light = saved_light_eye.light;
+    th.eye = saved_light_eye.eye;
+    in.prepare_joins(th, th.ns, th.nt);
+    return sum;
+  }
+};
+
 namespace {
+
+struct MisCheck {
+  std::string path;
+  int s = 0, t = 0;
+  double weight_sum = 0.0;
+  double weight = 0.0;          // as the renderer computes it
+  double weight_recurrence = 0.0;  // by the recurrence without the per-sample sums
+  double weight_general = 0.0;  // by the general routine over whole paths
+  std::string recorded;         // the label as the renderer packs and records it: must equal `path`
+};
+
+// Traces `samples` pairs of subpaths and checks every full path that a plain join (s, t) with
+// s != 1 and t != 1 of the profile forms from their vertices.
+std::vector<MisCheck> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed, int samples) {
+  const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
+  const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
+  RenderOptions o;
+  o.seed = seed;
+  o.max_bounces = std::min(8, profile.max_bounces.value_or(8));
+  HistogramLayout layout;
+  ClassImages images(1, 1, nullptr, {});
+  const Integrator integrator(rs, strategies, o, nullptr);
+  const Integrator recurrence(rs, strategies, o, nullptr, /*general_mis=*/true);
+  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
+  th.images = &images;
+  th.connectors.resize(strategies.strategies.size());
+  const StrategyTable table(strategies.strategies);
+  using A = IntegratorTestAccess;
+  std::vector<MisCheck> out;
+  for (int i = 0; i < samples; ++i) {
+    const int px = i % rs.camera.width, py = (i / rs.camera.width) % rs.camera.height;
+    Sampler rng(seed, static_cast<std::uint64_t>(i), 0);
+    int ns = 0;
+    const int nt = A::trace_subpaths(integrator, th, rng, px, py, &ns);
+    for (int t = 0; t <= nt; ++t)
+      for (int s = 0; s <= ns; ++s) {
+        if (s == 1 || t == 1 || s + t < 2 || s + t - 2 > *o.max_bounces) continue;
+        if (table.plain(s, t) < 0 || !A::joinable(integrator, th, s, t)) continue;
+        const float sum = A::weight_sum(integrator, th, s, t);
+        const float weight = A::own_weight(integrator, th, s, t);
+        const float weight_recurrence = A::own_weight(recurrence, th, s, t);
+        const float weight_general = A::general_weight(integrator, th, s, t);
+        out.push_back({A::label(integrator, th, s, t), s, t, sum, weight, weight_recurrence, weight_general,
+                       A::packed_label(integrator, th, s, t)});
+      }
+  }
+  return out;
+}
 
 TEST(Mis, WeightsOfEveryStrategySumToOne) {
   const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes";
@@ -26,18 +217,19 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
                                  "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path", "bdpt+ortho"}) {
       Result<Profile> profile = resolve_profile(renderer, Limits{});
       ASSERT_TRUE(profile.ok());
-      Result<std::vector<MisCheck>> checks = check_mis_weights(*scene, *profile, 11, 300);
-      ASSERT_TRUE(checks.ok()) << checks.error().render();
-      for (const MisCheck& c : *checks) {
+      for (const MisCheck& c : check_mis_weights(*scene, *profile, 11, 300)) {
         ++checked;
         ++by_length[static_cast<int>(c.path.size())];
-        EXPECT_NEAR(c.weight_sum, 1.0, 1e-4) << entry.path().filename() << " " << renderer << " " << c.path << " (s="
-                                              << c.s << ", t=" << c.t << ")";
-        EXPECT_EQ(c.recorded, c.path) << "the packed label differs (s=" << c.s << ", t=" << c.t << ")";
-        // The per-sample sums (profiles running every plain join) are a special case of the
-        // general recurrence and must give its weight.
-        EXPECT_NEAR(c.weight, c.weight_general, 1e-5 * std::max(1.0, c.weight_general))
-            << entry.path().filename() << " " << renderer << " " << c.path << " (s=" << c.s << ", t=" << c.t << ")";
+        const auto where = [&] {
+          return entry.path().filename().string() + " " + renderer + " " + c.path + " (s=" + std::to_string(c.s) +
+                 ", t=" + std::to_string(c.t) + ")";
+        };
+        EXPECT_NEAR(c.weight_sum, 1.0, 1e-4) << where();
+        EXPECT_EQ(c.recorded, c.path) << "the packed label differs: " << where();
+        // The per-sample sums (profiles running every plain join) and the join-local recurrence
+        // are special cases of the general routine over whole paths and must give its weight.
+        EXPECT_NEAR(c.weight, c.weight_recurrence, 1e-5 * std::max(1.0, c.weight_recurrence)) << where();
+        EXPECT_NEAR(c.weight, c.weight_general, 1e-4 * std::max(1.0, c.weight_general)) << where();
       }
     }
   }
@@ -46,4 +238,4 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
 }
 
 }  // namespace
-}  // namespace pathex
+}  // namespace pathex::tracer

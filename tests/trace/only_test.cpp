@@ -235,14 +235,20 @@ TEST(DeadState, AStoppedSubpathCouldNotHaveContributed) {
       requested += in ? 1 : 0;
       SubpathPrefix light(&only, true, path[1], path[2]);
       bool dead = !light.alive();
-      for (std::size_t i = 3; i + 1 < path.size() && !dead; ++i) dead = !light.extend(path[i]);
+      for (std::size_t i = 3; i + 1 < path.size() && !dead; ++i) {
+        light.extend(path[i]);
+        dead = !light.alive();
+      }
       if (dead) {
         ++dead_light;
         EXPECT_FALSE(in) << expr << ": the light subpath of " << path << " was stopped";
       }
       SubpathPrefix eye(&only, false, path[path.size() - 2], path[path.size() - 3]);
       dead = !eye.alive();
-      for (std::size_t i = path.size() - 4; i >= 1 && !dead; --i) dead = !eye.extend(path[i]);
+      for (std::size_t i = path.size() - 4; i >= 1 && !dead; --i) {
+        eye.extend(path[i]);
+        dead = !eye.alive();
+      }
       if (dead) {
         ++dead_eye;
         EXPECT_FALSE(in) << expr << ": the eye subpath of " << path << " was stopped";
@@ -254,8 +260,8 @@ TEST(DeadState, AStoppedSubpathCouldNotHaveContributed) {
   }
   // Without requested classes nothing is dead.
   SubpathPrefix all(nullptr, true, 'S', 'D');
+  all.extend('S');
   EXPECT_TRUE(all.alive());
-  EXPECT_TRUE(all.extend('S'));
 }
 
 std::string run(const std::string& args, int* status) {
@@ -296,6 +302,19 @@ TEST(Only, ClassesNotAskedForAreReportedNotRendered) {
   const nlohmann::json doc2 = nlohmann::json::parse(json);
   EXPECT_EQ(doc2.at("classes").back().at("name"), "only-1");
   EXPECT_TRUE(doc2.at("classes").back().contains("luminance"));
+  // "render": true in a class file is the same request.
+  const std::string file = ::testing::TempDir() + "/only-classes.json";
+  std::ofstream(file) << R"({"classes": [{"name": "glass", "expr": "$caustic", "render": true},)"
+                      << R"( {"name": "short", "expr": "L.{4,5}E"}, {"name": "long", "expr": "L..S+D.*..E & L.{9,}E"}]})";
+  const std::string listed = run("trace " + kScenes + "point-glass.json --spp 2 --resolution 8x8 --quiet --json --out " + dir +
+                                     " --classes " + file,
+                                 &status);
+  EXPECT_EQ(status, 0) << listed;
+  const nlohmann::json doc3 = nlohmann::json::parse(listed);
+  ASSERT_EQ(doc3.at("classes").size(), 3u);
+  EXPECT_TRUE(doc3.at("classes")[0].contains("luminance"));
+  EXPECT_EQ(doc3.at("classes")[1].value("rendered", true), false);  // not within the caustics
+  EXPECT_TRUE(doc3.at("classes")[2].contains("luminance"));          // within the caustics: estimated
   // Caustics of a scene without a specular material: nothing runs, and the output says why.
   const std::string none = run("trace " + kScenes + "point-plane.json --spp 2 --quiet --out " + dir + "-none --only '$caustic'", &status);
   EXPECT_EQ(status, 1) << none;

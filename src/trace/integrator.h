@@ -1,0 +1,367 @@
+// The integrator behind render() (trace/render.h): bidirectional path sampling over a profile's
+// strategies, every sampled path labelled by its full-path string. The algorithm is in render.cpp;
+// this header declares it so that tests can drive it (tests/trace/mis_test.cpp checks its MIS
+// weights on re-split paths through IntegratorTestAccess).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "classify/classifier.h"
+#include "classify/histogram.h"
+#include "classify/image.h"
+#include "trace/accel/path_ids.h"
+#include "trace/bsdf.h"
+#include "trace/joins/join.h"
+#include "trace/render.h"
+#include "trace/render_scene.h"
+#include "trace/rng.h"
+#include "trace/strategy_table.h"
+#include "trace/vertex.h"
+
+namespace pathex::tracer {
+
+using namespace accel;  // PathKey, PathIds
+static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
+
+class Integrator {
+ public:
+  // `general_mis` (for tests) turns off the per-sample MIS sums, leaving the general recurrence.
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl,
+             bool general_mis = false)
+      : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), classifier_(cl), table_(strategies.strategies) {
+    max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
+    light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
+    lens_hits_ = cam_.type == SensorType::kLens;
+    bool any_t0 = false;
+    for (int s = 0; s < 2 * kMaxVertices; ++s) any_t0 = any_t0 || table_.plain(s, 0) >= 0;
+    lens_hits_ = lens_hits_ && any_t0;
+    // Subpaths are only as long as a strategy can use: s = 1 and t = 1 take fresh samples, so a
+    // light subpath is traced only for some s >= 2 and an eye subpath beyond z0 for some t >= 2.
+    for (const Strategy& st : strategies.strategies) {
+      max_light_ = std::max(max_light_, st.s.hi == Range::kOpen ? kMaxVertices : st.s.hi);
+      max_eye_ = std::max(max_eye_, st.t.hi == Range::kOpen ? kMaxVertices : st.t.hi);
+    }
+    if (max_light_ < 2) max_light_ = 0;
+    // runs_mask_[n] bit s2: the profile runs (s2, n - s2); t2 = 0 only when light paths can hit the lens.
+    for (std::size_t n = 0; n < runs_mask_.size(); ++n)
+      for (int s2 = 0; s2 <= static_cast<int>(n); ++s2)
+        if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
+          runs_mask_[n] |= std::uint64_t{1} << s2;
+    has_mirror_ = table_.runs(ConnectorKind::kMirror) && !rs.mirrors.empty();
+    has_connectors_ = table_.runs(ConnectorKind::kDistantProjection) || table_.runs(ConnectorKind::kOrthoProjection) || has_mirror_;
+    mirror_shape_.assign(rs.material_of_shape.size(), 0);
+    for (const PlanarMirror& m : rs.mirrors) mirror_shape_[static_cast<std::size_t>(m.shape)] = 1;
+    eye0_runs_ = (runs_mask_[1] >> 1) & 1;
+    all_runs_ = !has_connectors_ && !general_mis;  // the per-sample sums below know plain joins only
+    for (std::size_t n = 1; n < runs_mask_.size(); ++n) {
+      const std::uint64_t below = (std::uint64_t{1} << n) - 1;  // s2 < n: t2 >= 1
+      all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
+    }
+    for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
+    sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
+    for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
+    max_light_ = std::min(max_light_, max_bounces_ + 1);
+    max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
+  }
+
+  // A weighted contribution on its way to record(): with its shadow ray pending, or none needed.
+  struct Pending {
+    PathKey key = 0;
+    vec3 c{0.0f};
+    int strategy = 0, batch = 0;
+    int technique = 0;       // Technique::code(): the strategy at this (s, chain, t), for the histogram
+    bool splat = false;      // to raster point (rx, ry); else to the sample's own pixel, column px
+    bool connector = false;  // counted in the connector's statistics
+    float rx = 0.0f, ry = 0.0f;
+    int px = 0;
+    // Segments that must all be clear: this lane's and the segments - 1 before it in the batch
+    // (the mirror connector tests two). 0 marks a lane whose contribution sits on a later lane.
+    int segments = 1;
+  };
+
+  struct Thread {
+    Histogram hist;
+    // The current row's camera contributions, pixel by pixel; flushed to the image at the row's
+    // end (finish_row()), after the row's last shadow rays.
+    std::vector<ClassImages::PixelSum> row;
+    std::array<Vertex, kMaxVertices> eye, light;
+    std::uint64_t rays = 0;
+    std::vector<ConnectorStats> connectors;  // indexed by profile strategy (only connectors' are used)
+    PathIds ids;
+    JoinResult join{};  // the join being made (joins build into it; estimate() consumes it)
+    std::vector<Vertex> path{};         // a whole path x0 … xk for path_weight()
+    std::vector<double> rel{}, eye_density{};  // path_weight()'s density ratios and remapped ef
+    // The subpaths' letters packed (set by prepare_joins()): light_mask has c0 c1 of y0, then
+    // bit i + 1 for y_i's letter; eye_masks[t] has the eye subpath's last t + 1 letters (z(t-1)
+    // … z0 and z0's spatial letter) as they sit after c(s) in any connection with t eye vertices.
+    PathKey light_mask = 0;
+    std::array<PathKey, kMaxVertices + 1> eye_masks{};
+    ClassImages* images = nullptr;  // the shared image that splats go to
+    ClassImages::SplatBuffer splats = ClassImages::SplatBuffer();  // they go through this; render() flushes it at the end
+    std::array<double, kMaxVertices> light_ratio{}, eye_ratio{};  // set by prepare_joins()
+    // With every strategy run (all_runs_), the MIS sums over each subpath's fixed part, from its
+    // start to vertex j (set by prepare_joins()): light_acc[j] = Σ_{i <= j, strategy (i, ·)
+    // samples the letters} Π_{m=i..j} light_ratio[m]², and eye_acc likewise.
+    std::array<double, kMaxVertices> light_acc{}, eye_acc{};
+    // 1 / (remapped forward density) of each vertex (set by prepare_joins()): a weight multiplies
+    // by it rather than dividing on its critical path.
+    std::array<double, kMaxVertices> light_inv_fwd{}, eye_inv_fwd{};
+    int ns = 0, nt = 0;        // the current subpaths' lengths
+    int px = 0;                // the current sample's column
+    bool joins_ready = false;  // prepare_joins() runs on the sample's first recorded contribution
+    // Shadow rays queued by connect(), traced when the batch is full and when a row ends
+    // (finish_row()); pending[lane] is what lane's ray decides on. A row is one thread's work
+    // from start to end, so which rays share a packet does not depend on the thread count.
+    OcclusionBatch shadow = OcclusionBatch();
+    std::array<Pending, OcclusionBatch::kCapacity> pending{};
+    // The sample in progress (pass, row), and the first non-finite contribution this thread
+    // recorded, for the warning that names it (render() keeps the earliest over the threads).
+    std::uint64_t pass = 0;
+    int py = 0;
+    std::optional<NonfiniteSample> first_nonfinite{};
+  };
+
+  // A vertex's density ratio in the MIS sums, a Dirac's densities (stored as 0) counting as 1.
+  // Branch-free (0 + 1 is exact): Dirac vertices come and go along a path unpredictably.
+  static double remap(float f) { return static_cast<double>(f) + static_cast<double>(f == 0.0f); }
+  static double ratio(const Vertex& v) { return remap(v.pdf_rev) / remap(v.pdf_fwd); }
+  static double inv_fwd(const Vertex& v) { return 1.0 / remap(v.pdf_fwd); }
+  // Per sample, before its first recorded contribution: the letter masks, and each vertex's
+  // ratio of reverse to forward density (a join changes only the two nearest each end).
+  void prepare_joins(Thread& th, int ns, int nt) const {
+    for (int i = 0; i < ns; ++i) {
+      th.light_ratio[static_cast<std::size_t>(i)] = ratio(th.light[static_cast<std::size_t>(i)]);
+      th.light_inv_fwd[static_cast<std::size_t>(i)] = inv_fwd(th.light[static_cast<std::size_t>(i)]);
+    }
+    for (int i = 0; i < nt; ++i) {
+      th.eye_ratio[static_cast<std::size_t>(i)] = ratio(th.eye[static_cast<std::size_t>(i)]);
+      th.eye_inv_fwd[static_cast<std::size_t>(i)] = inv_fwd(th.eye[static_cast<std::size_t>(i)]);
+    }
+    th.joins_ready = true;
+    th.light_mask = 0;
+    if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
+    for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
+    th.eye_masks[0] = letter_bit(th.eye[0].pos_letter, 0);
+    for (int t = 1; t <= nt; ++t)
+      th.eye_masks[static_cast<std::size_t>(t)] =
+          (th.eye_masks[static_cast<std::size_t>(t - 1)] << 1) | letter_bit(th.eye[static_cast<std::size_t>(t - 1)].letter, 0);
+    if (!all_runs_) return;
+    // Strategy (i, ·) on the light side joins at y(i-1) and y_i: letters c_i and c_(i+1), bits i
+    // and i + 1 of light_mask. On the eye side strategy (·, j) joins at z_j and z(j-1): letters
+    // z_j's and z(j-1)'s (z0's spatial letter for j = 0, which also needs the lens).
+    double acc = 0.0;
+    for (int j = 0; j < ns; ++j) {
+      const double r = th.light_ratio[static_cast<std::size_t>(j)];
+      acc = r * r * (static_cast<double>(((th.light_mask >> j) & 3) == 0) + acc);
+      th.light_acc[static_cast<std::size_t>(j)] = acc;
+    }
+    acc = 0.0;
+    for (int j = 0; j < nt; ++j) {
+      const char before = j > 0 ? th.eye[static_cast<std::size_t>(j - 1)].letter : th.eye[0].pos_letter;
+      const bool runs = th.eye[static_cast<std::size_t>(j)].letter == 'D' && before == 'D' && (j > 0 || eye0_runs_);
+      const double r = th.eye_ratio[static_cast<std::size_t>(j)];
+      acc = r * r * (static_cast<double>(runs) + acc);
+      th.eye_acc[static_cast<std::size_t>(j)] = acc;
+    }
+  }
+  // The packed full-path string of connection (s, t), as full_path() spells it.
+  // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
+  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
+    PathKey m = 0;
+    if (s > 0) {
+      m = th.light_mask & (bit(s + 1) - 1);
+      if (s == 1 && t != 1 && sampled) m = letter_bit(sampled->pos_letter, 0) | letter_bit(sampled->letter, 1);
+    }
+    if (t > 0) m |= th.eye_masks[static_cast<std::size_t>(t)] << (s + 1);
+    m &= ~(bit(s) | bit(s + 1));  // the join letters
+    return m | static_cast<PathKey>(s + t + 2) << kLengthShift;
+  }
+
+  // The profile's strategy that runs the plain join (s, DD, t), or -1.
+  int strategy(int s, int t) const { return table_.plain(s, t); }
+
+  // One sample: pixel (px, py), pass `pass`. Its camera contributions collect in th.row (the
+  // caller flushes them with finish_row()); light-tracing splats go through th.splats.
+  void sample(Thread& th, int px, int py, std::uint64_t pass) const;
+  // After a row's samples: traces the shadow rays still queued, records what they let through,
+  // and adds the row's camera contributions to row y of the image.
+  void finish_row(Thread& th, ClassImages& images, int y) const {
+    trace_shadows(th);
+    // All the row's words are requested before the first is added to: the adds are atomic, and an
+    // atomic add to a line not in cache waits for it, one line after another.
+    for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].prefetch(images, static_cast<int>(x), y);
+    for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].flush(images, static_cast<int>(x), y);
+  }
+
+ private:
+  friend struct IntegratorTestAccess;  // tests/trace/mis_test.cpp: checks the MIS weights on re-split paths
+  // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
+  // Densities as the MIS ratios keep them: a Dirac part's is stored as 0.
+  static float finite_part(float pdf, bool delta) { return delta ? 0.0f : pdf; }
+  // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w.
+  float sensor_pdf_dir(const Vertex& v, const vec3& w) const {
+    const RayPdf p = pdf_ray(cam_.params, v.p, w);
+    return finite_part(p.dir, p.delta_dir);
+  }
+  // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
+  float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
+    const RayPdf p = pdf_ray(l.params, SurfacePoint{v.p, v.n, l.pdf_pos}, w);
+    return finite_part(p.dir, p.delta_dir);
+  }
+  // A light chosen uniformly by u, and a point on it drawn from u2 (area lights; the others
+  // ignore the point).
+  std::size_t pick_light(float u) const {
+    return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(u * static_cast<float>(rs_.lights.size())));
+  }
+  // *error: the point's rounding-error bound (SurfaceSample::error), which offsets rays leaving it.
+  SurfacePoint sample_point(const RenderLight& l, glm::vec2 u2, vec3* error) const {
+    *error = aperture_error(l);
+    if (!l.is_area()) return {};
+    const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, u2);
+    *error = ss.error;
+    return {ss.position, ss.normal, l.pdf_pos};
+  }
+  // The error bound of a distant light's aperture points (zero for other lights): the aperture is
+  // no shape, but it may coincide with one (a window pane).
+  static vec3 aperture_error(const RenderLight& l) {
+    const auto* d = std::get_if<DistantLightParams>(&l.params);
+    return d ? parallelogram_error(d->corner, d->edge1, d->edge2) : vec3(0.0f);
+  }
+  // Where a point or spot light is (the integrator picks an area light's points itself).
+  static vec3 light_position(const LightParams& l) {
+    if (const auto* p = std::get_if<PointLightParams>(&l)) return p->position;
+    if (const auto* p = std::get_if<SpotLightParams>(&l)) return p->position;
+    return vec3(0.0f);
+  }
+  // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
+  void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
+    const float w = static_cast<float>(cam_.width), h = static_cast<float>(cam_.height);
+    *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
+    *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
+  }
+
+  // --- densities used by MIS ---
+  // Solid-angle density at `v` of sampling the unit direction `wn`, given the unit direction
+  // `wp` to v's other neighbour (null when it has none: a surface then has no density).
+  float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
+    switch (v.kind) {
+      case Kind::kCamera: return sensor_pdf_dir(v, wn);
+      case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
+      case Kind::kSurface:
+        return wp ? bsdf::pdf(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)], *wp, wn, v.ns, v.n) : 0.0f;
+      case Kind::kLens: return 0.0f;
+    }
+    return 0.0f;
+  }
+  // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
+  float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const {
+    const vec3 d = next.p - v.p;
+    const float d2 = glm::dot(d, d);
+    if (d2 == 0.0f) return 0.0f;
+    const vec3 wn = d / std::sqrt(d2);
+    const vec3 wp = prev ? glm::normalize(prev->p - v.p) : vec3(0.0f);
+    return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
+  }
+  // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
+  float pdf_light_origin(const Vertex& v) const {
+    const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
+    return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
+  }
+
+  // --- subpaths ---
+  template <TransportMode mode>  // a template: the walk's tests of its direction are not branches
+  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
+                  float pdf_dir, int max_vertices) const;
+  int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
+  int light_subpath(Thread& th, Sampler& rng) const;
+
+  // --- connections ---
+  // The five kinds of connection, one instantiation of connect() each, so that the kind is not a
+  // branch taken anew (and mispredicted) on every call.
+  enum class Connection {
+    kEmitter,  // s = 0: the eye subpath's last vertex lies on an area light
+    kLens,     // t = 0: the light subpath's last vertex lies on the lens
+    kSplat,    // t = 1: a light vertex joined to a fresh sensor sample
+    kNee,      // s = 1: an eye vertex joined to a fresh light sample
+    kJoin,     // s, t >= 2: a shadow ray between two subpath vertices
+    kDistant,  // distant-projection (0, DSD, t): an eye vertex joined to a distant light's aperture
+    kOrtho,    // ortho-projection (s, DSD, 0): a light vertex joined to an orthographic film
+  };
+  // The profile's strategy running a projection connector with this many eye (distant: its chain
+  // is c0 c1 c2, so (0, DSD, t)) or light (ortho: (s, DSD, 0)) vertices, or -1.
+  int distant_of(int t) const { return table_.at(0, ConnectorKind::kDistantProjection, t); }
+  int ortho_of(int s) const { return table_.at(s, ConnectorKind::kOrthoProjection, 0); }
+  // Density of the far end of a parallel beam per unit area there, relative to the near end's:
+  // points x and y on one line along w, with unit normals (zero: no surface), map areas as
+  // dA_x |cos θ_x| = dA_y |cos θ_y|.
+  static float parallel_jacobian(const Vertex& far, const Vertex& near, const vec3& w) {
+    const float c = abs_cos(near, w);
+    return c > 0.0f ? abs_cos(far, w) / c : 0.0f;
+  }
+  template <Connection C>
+  void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
+  // The mirror connector (s, DSD, t), s, t >= 1: y(s-1) (a fresh light sample for s = 1) joined to
+  // z(t-1) (a fresh sensor sample for t = 1) across each planar mirror by the image method.
+  void connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const;
+  int mirror_of(int s, int t) const { return table_.at(s, ConnectorKind::kMirror, t); }
+  // --- MIS over whole paths, for profiles with the mirror connector ---
+  // Puts the path x0 … xk of a contribution into th.path: s light vertices (fresh_light for y0 when
+  // given), `middle` when given (the mirror vertex), t eye vertices (fresh_eye for z0 when given).
+  void gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* middle, const Vertex* fresh_eye) const;
+  // Whether the path of connection (s, t) with letters `key` could also be sampled by the mirror
+  // connector (then every strategy weighs it with path_weight()).
+  bool mirror_can_sample(const Thread& th, int s, int t, PathKey key) const;
+  // The power-heuristic weight of strategy `self` (kNone: split s; kMirror: mirror vertex x_s)
+  // for the path in th.path with letters `key`, from every vertex's two area densities.
+  float path_weight(Thread& th, PathKey key, ConnectorKind self, int s) const;
+  // The power-heuristic weight of a plain or projection join (s, t) with letters `key` (a fresh
+  // endpoint `sampled` standing for z0 when t = 1, else for y0 when s = 1), from the subpaths'
+  // stored densities and the join's own (`join`: what the join computed; null: recompute it).
+  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const JoinDensity* join = nullptr,
+                   ConnectorKind self = ConnectorKind::kNone) const;
+  // The estimator's one consumer of joins: weighs th.join by MIS over every strategy of the
+  // profile, then records it, or queues its segments and records it once all are found clear.
+  void estimate(Thread& th, int batch) const;
+  // The full-path letters of the path made by s light and t eye vertices (with `sampled`
+  // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
+  // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
+  void full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const;
+  void record(Thread& th, const Pending& r) const;
+  void trace_shadows(Thread& th) const;
+
+  const RenderScene& rs_;
+  const RenderSensor& cam_;
+  const StrategySet& strategies_;
+  const RenderOptions& o_;
+  const Classifier* classifier_;
+  int max_bounces_ = 16;
+  static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;
+  StrategyTable table_;  // which strategy runs each (s, chain, t)
+  bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
+  bool has_mirror_ = false;      // a mirror strategy runs and the scene has a planar mirror
+  std::vector<std::uint8_t> mirror_shape_;  // the shape is a planar mirror
+  // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
+  // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
+  static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
+  std::array<std::uint64_t, 64> runs_mask_{};
+  // The profile runs every (s, t) with t >= 1 (full BDPT), and (s, 0) for all s or none
+  // (eye0_runs_): which strategies sample a path then depends on its letters alone, so the MIS
+  // sums over each subpath's fixed part are computed once per sample (prepare_joins()).
+  bool all_runs_ = false;
+  bool eye0_runs_ = false;
+  std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
+  std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
+  std::vector<std::string> light_pairs_;  // each light's letters c0 c1
+  int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
+  int max_eye_ = 1;    // longest eye subpath any strategy uses
+  float light_pick_ = 0.0f;
+  bool lens_hits_ = false;
+};
+
+}  // namespace pathex::tracer

@@ -1,0 +1,66 @@
+// One join's result (DESIGN §4, §7): what every strategy hands the estimator, whether it is a
+// plain join (s, DD, t) or a connector (s, DSD, t).
+//
+// A join takes the two subpaths (or fresh endpoint samples) and builds the rest of a full path:
+// the vertices it needs (a fresh light or sensor sample, a projected aperture or film point, a
+// mirror vertex), the path's letters, its contribution before weighting, the straight segments that
+// must all be unoccluded for it to count (none when the last edge was traced, one for a shadow ray,
+// two across a mirror), and what MIS needs of its own density. The estimator
+// (Integrator::estimate()) weighs it and queues its segments in one place, whichever join made it.
+#pragma once
+
+#include <array>
+
+#include "reach/profile.h"
+#include "trace/accel/path_ids.h"
+#include "trace/bsdf.h"
+#include "trace/vertex.h"
+
+namespace pathex::tracer {
+
+// What MIS needs of a join's own density, as the join computed it: the unit direction w from the
+// light end to the eye end and their squared distance, and the BSDF densities at each end that the
+// join's BSDF evaluation gave for free. The MIS routine recomputes only the densities at the two
+// ends (Veach's ratios); the subpaths keep the rest as the walks stored them.
+struct JoinDensity {
+  vec3 w{0.0f};
+  float d2 = 0.0f;
+  bsdf::JoinPdfs at_qs;  // at the light end, wo = its wo, wi = w
+  bsdf::JoinPdfs at_pt;  // at the eye end, wo = its wo, wi = -w
+};
+
+// A straight segment from `from` to `to` that must be unoccluded (rays leave each end offset by its
+// rounding-error bound).
+struct Segment {
+  const Vertex* from = nullptr;
+  const Vertex* to = nullptr;
+};
+
+struct JoinResult {
+  // The strategy: its chain (kNone for the plain join), the light and eye subpath vertices it
+  // joins (a connector's on either side of its chain), and the strategy table's index of it.
+  ConnectorKind chain = ConnectorKind::kNone;
+  int s = 0, t = 0;
+  int strategy = -1;
+  accel::PathKey letters = 0;       // the full path's letters, packed
+  vec3 contribution{0.0f};          // before the MIS weight
+  // The vertices it built: one standing for y0 (a fresh light sample, an aperture point), one for
+  // z0 (a fresh sensor sample, a film point), one between the subpaths (a mirror vertex).
+  Vertex light0{}, eye0{}, middle{};
+  bool has_light0 = false, has_eye0 = false, has_middle = false;
+  // The segments to test, all of which must be clear (the first num_segments).
+  std::array<Segment, 2> segments{};
+  int num_segments = 0;
+  // Its density for MIS: the join's direction and end densities (has_density: the join has two
+  // ends; an eye vertex on a light, s = 0, and a light vertex on the lens, t = 0, have one).
+  JoinDensity density{};
+  bool has_density = false;
+  // Where it lands: a splat to raster point (rx, ry), else the sample's own pixel.
+  bool splat = false;
+  float rx = 0.0f, ry = 0.0f;
+
+  // The fresh endpoint standing in for y0 or z0 (z0 first), as the plain-join MIS routine takes it.
+  const Vertex* fresh() const { return has_eye0 ? &eye0 : has_light0 ? &light0 : nullptr; }
+};
+
+}  // namespace pathex::tracer

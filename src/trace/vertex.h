@@ -1,0 +1,53 @@
+// A vertex of a subpath as the tracer keeps it (DESIGN §7): where it is, how it was sampled (its
+// letter and its two area densities), and the throughput that reached it.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+namespace pathex::tracer {
+
+using glm::vec3;
+inline constexpr int kMaxVertices = 64;  // per subpath; max_bounces is clamped so paths fit
+
+enum class Kind : std::uint8_t { kCamera, kLight, kSurface, kLens };
+
+struct Vertex {
+  Kind kind = Kind::kSurface;
+  char letter = 'D';     // scattering letter: surface c_i; light c1 (direction); sensor c(k+1)
+  char pos_letter = 'D'; // lights c0 and sensors c(k+2)
+  bool finite = true;    // can be a join end: not a surface, or a surface with a finite BSDF part
+  vec3 p{0.0f};
+  vec3 n{0.0f};          // geometric normal (unit); zero for points (point, spot, pinhole, laser)
+  vec3 err{0.0f};        // bound on p's rounding error (Hit::error): how far a ray leaving p is offset
+  vec3 ns{0.0f};         // shading normal
+  vec3 beta{1.0f};       // throughput up to and including this vertex
+  vec3 wo{0.0f};         // unit direction to the vertex before it on its subpath (zero for the first)
+  float d2_wo = 0.0f;    // squared distance to that vertex
+  float pdf_fwd = 0.0f;  // area density of sampling this vertex in its subpath's direction
+  float pdf_rev = 0.0f;  // area density of sampling it from the other direction
+  int shape = -1;        // surfaces and area-light points
+  int light = -1;        // light vertices
+  // Without short-circuits: which components are zero follows the scene's orientation, which no
+  // branch predictor guesses (this test was an eighth of the tracer's mispredicted branches).
+  bool has_normal() const { return (n.x != 0.0f) | (n.y != 0.0f) | (n.z != 0.0f); }
+};
+
+// Sets v.wo and v.d2_wo from its predecessor's position.
+inline void link(Vertex& v, const Vertex& pred) {
+  const vec3 e = pred.p - v.p;
+  v.d2_wo = glm::dot(e, e);
+  v.wo = v.d2_wo > 0.0f ? e / std::sqrt(v.d2_wo) : vec3(0.0f);
+}
+
+// |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
+inline float abs_cos(const Vertex& v, const vec3& w) {
+  // Arithmetic, not a choice (which compiled to a branch that mispredicted at every point vertex):
+  // a point's n is zero, so its |cos| term is 0 and the added 1 is the whole value.
+  return std::fabs(glm::dot(v.n, w)) + static_cast<float>(!v.has_normal());
+}
+
+}  // namespace pathex::tracer
