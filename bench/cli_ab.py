@@ -11,13 +11,15 @@ Prints samples per CPU-second for each side and the median of the per-round rati
 """
 import argparse
 import os
+import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 
 
-def cpu_run(cmd):
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+def cpu_run(cmd, cwd):
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd)
     _, status, usage = os.wait4(proc.pid, 0)
     err = proc.stderr.read().decode()
     proc.stderr.close()
@@ -34,19 +36,29 @@ def main():
     ap.add_argument("--renderer", default="bdpt")
     ap.add_argument("--spp", type=int, default=32)
     ap.add_argument("--rounds", type=int, default=9)
+    ap.add_argument("--b-arg", action="append", default=[],
+                    help="an extra argument for binary B only (repeatable), e.g. --b-arg=--sampler --b-arg=independent "
+                         "when A predates the option and its default")
     args = ap.parse_args()
-    tail = (["trace"] + ([args.scene] if args.scene else []) +
+    tail = (["trace"] + ([os.path.abspath(args.scene)] if args.scene else []) +
             ["--renderer", args.renderer, "--spp", str(args.spp), "--threads", "1", "--no-images", "--quiet", "--json"])
     samples = 64 * 64 * args.spp if args.scene is None else None
+    # Each binary writes its outputs (pathex-out/) in a folder of its own: pathex refuses to replace
+    # outputs another version wrote.
+    work = tempfile.mkdtemp(prefix="cli_ab-")
+    dirs = {name: os.path.join(work, name) for name in ("a", "b")}
+    for d in dirs.values():
+        os.mkdir(d)
     ratios, ta, tb = [], [], []
     for r in range(args.rounds):
         order = [("a", args.a), ("b", args.b)] if r % 2 == 0 else [("b", args.b), ("a", args.a)]
         t = {}
         for name, binary in order:
-            t[name] = cpu_run([binary] + tail)
+            t[name] = cpu_run([os.path.abspath(binary)] + tail + (args.b_arg if name == "b" else []), dirs[name])
         ta.append(t["a"])
         tb.append(t["b"])
         ratios.append(t["a"] / t["b"])
+    shutil.rmtree(work)
     med_a, med_b = statistics.median(ta), statistics.median(tb)
     rate = (lambda t: f"{samples / t / 1e6:.3f} M samples/CPU-s") if samples else (lambda t: f"{t:.3f} CPU-s")
     print(f"{args.renderer}, {args.spp} spp, {args.rounds} interleaved rounds")

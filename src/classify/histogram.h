@@ -25,7 +25,7 @@
 // that an interrupted render still spreads what it has over every batch — so that every batch
 // covers the whole image and the batch estimates X_b = S_b / n_b are independent and identically
 // distributed, whatever the strategy (splats from light tracing land anywhere, which rules out a
-// per-pixel variance). batch_of_pass() below is the other possible dealing, contiguous ranges.
+// per-pixel variance).
 // With N = Σ n_b and X̄ = Σ S_b / N, the standard error of X̄ is estimated by
 //
 //     stderr² = Σ_b (S_b − n_b X̄)² / (N² − Σ_b n_b²),
@@ -127,12 +127,6 @@ inline bool is_zero(const ExactRgb& c) { return c[0] == 0 && c[1] == 0 && c[2] =
 // "0", or the signed hexadecimal integer "0x1f…" / "-0x1f…" (the raw fixed-point value), and back.
 std::string exact_to_string(ExactSum s);
 std::optional<ExactSum> exact_from_string(std::string_view s);
-
-// The batch of the pass-th sample of every pixel when each pixel takes spp samples: contiguous
-// ranges of passes, as equal as possible (spp < B leaves some batches empty, which is allowed).
-inline int batch_of_pass(std::uint64_t pass, std::uint64_t spp, int num_batches) {
-  return static_cast<int>(pass * static_cast<std::uint64_t>(num_batches) / spp);
-}
 
 // --- the accumulator ---
 

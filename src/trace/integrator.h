@@ -32,9 +32,8 @@ static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms pa
 class Integrator {
  public:
   // `general_mis` (for tests) turns off the per-sample MIS sums, leaving the general recurrence.
-  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, const Classifier* cl,
-             bool general_mis = false)
-      : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), classifier_(cl), table_(strategies.strategies) {
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, bool general_mis = false)
+      : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), table_(strategies.strategies) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
     lens_hits_ = cam_.type == SensorType::kLens;
@@ -70,7 +69,8 @@ class Integrator {
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
 
-  // A weighted contribution on its way to record(): with its shadow ray pending, or none needed.
+  // A weighted JoinResult on its way to record() (estimate() makes it): with its segments queued
+  // for visibility, or none needed.
   struct Pending {
     PathKey key = 0;
     vec3 c{0.0f};
@@ -172,7 +172,7 @@ class Integrator {
   }
   // The packed full-path string of connection (s, t), as full_path() spells it.
   // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
-  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
+  [[gnu::always_inline]] PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
     PathKey m = 0;
     if (s > 0) {
       m = th.light_mask & (bit(s + 1) - 1);
@@ -275,8 +275,11 @@ class Integrator {
   }
 
   // --- subpaths ---
+  // Forced inline, as connect() below: each instantiation has one caller, and as out-of-line calls
+  // (the class is shared with the tests, so its members are not local to render.cpp) they cost
+  // about 2 % of pt-nee's instructions.
   template <TransportMode mode>  // a template: the walk's tests of its direction are not branches
-  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
+  [[gnu::always_inline]] inline int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
                   float pdf_dir, int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
   int light_subpath(Thread& th, Sampler& rng) const;
@@ -305,7 +308,7 @@ class Integrator {
     return c > 0.0f ? abs_cos(far, w) / c : 0.0f;
   }
   template <Connection C>
-  void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
+  [[gnu::always_inline]] inline void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
   // The mirror connector (s, DSD, t), s, t >= 1: y(s-1) (a fresh light sample for s = 1) joined to
   // z(t-1) (a fresh sensor sample for t = 1) across each planar mirror by the image method.
   void connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const;
@@ -339,7 +342,6 @@ class Integrator {
   const RenderSensor& cam_;
   const StrategySet& strategies_;
   const RenderOptions& o_;
-  const Classifier* classifier_;
   int max_bounces_ = 16;
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;
   StrategyTable table_;  // which strategy runs each (s, chain, t)

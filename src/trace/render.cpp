@@ -902,7 +902,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
                    o.images ? ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes)
                             : ClassImages(0, 0, nullptr, {}),
                    layout.strategies};
-  Integrator integrator(*rs, *strategies, o, classifier);
+  Integrator integrator(*rs, *strategies, o);
   const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
   tbb::enumerable_thread_specific<Integrator::Thread> locals(

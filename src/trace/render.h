@@ -14,8 +14,11 @@
 // never by huge numbers. The mirror connector (s, DSD, t), s, t >= 1, joins y(s-1) and z(t-1)
 // across a planar mirror by the image method (trace/joins/mirror.h); in its profiles a path it
 // could also sample is weighed over whole-path densities. Profiles naming the manifold connector
-// are refused by name. Shadow rays are queued per thread and traced sixteen at a time as one Embree packet
-// (OcclusionBatch); a contribution is recorded once its segment is found clear.
+// are refused by name. Every join, plain or connector, returns one JoinResult (trace/joins/join.h)
+// that the estimator weighs and queues in one place; the strategy running each (s, chain, t) comes
+// from one StrategyTable (trace/strategy_table.h) built from the profile. Shadow rays are queued per thread and traced sixteen at a time as one Embree packet
+// (OcclusionBatch); a contribution is recorded once all its segments (one for a shadow ray, two across
+// a mirror) are found clear.
 //
 // Determinism: every random number is a function of (seed, pixel, pass, dimension), and all
 // sums are exact (classify/histogram.h), so results are bit-identical whatever the thread count.

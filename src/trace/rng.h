@@ -88,8 +88,10 @@ class Sampler {
         key_(stream_key(seed, pixel, kind == SamplerKind::kSobol ? sample >> 32 : sample)),
         reversed_index_(sobol::reverse_bits(static_cast<std::uint32_t>(sample))) {}
 
-  float get1d() { return at(dim_++); }
-  glm::vec2 get2d() {
+  // Forced inline: a walk draws a few numbers per vertex, and the call (and the test of kind_ in a
+  // function the compiler will not inline) cost as much as the independent stream's hashing.
+  [[gnu::always_inline]] float get1d() { return at(dim_++); }
+  [[gnu::always_inline]] glm::vec2 get2d() {
     if (kind_ == SamplerKind::kIndependent) {
       const float a = get1d();
       return {a, get1d()};
@@ -99,7 +101,7 @@ class Sampler {
     return {sobol::to_unit_float(p[0]), sobol::to_unit_float(p[1])};
   }
   // The number get1d() would draw at an absolute dimension, without moving the cursor.
-  float at(std::uint64_t dim) const {
+  [[gnu::always_inline]] float at(std::uint64_t dim) const {
     if (kind_ == SamplerKind::kIndependent) return bits_to_unit_float(stream_bits(key_, dim));
     return sobol::to_unit_float(sobol::point1(reversed_index_, sobol_seeds(dim, /*pair=*/false)));
   }

@@ -109,11 +109,11 @@ struct Seeds {
 // computed with three bit reversals instead of seven (dimension0 is a reversal, and a nested
 // scramble is a reversal on each side of laine_karras); `reversed_index` is reverse_bits(index),
 // the same for every dimension of a sample. Test Sobol.PointsAreTheScrambledSequence.
-constexpr std::uint32_t point1(std::uint32_t reversed_index, const Seeds& s) {
+[[gnu::always_inline]] constexpr std::uint32_t point1(std::uint32_t reversed_index, const Seeds& s) {
   const std::uint32_t i = reverse_bits(laine_karras(reversed_index, s.shuffle));
   return reverse_bits(laine_karras(i, s.x));
 }
-constexpr std::array<std::uint32_t, 2> point2(std::uint32_t reversed_index, const Seeds& s) {
+[[gnu::always_inline]] constexpr std::array<std::uint32_t, 2> point2(std::uint32_t reversed_index, const Seeds& s) {
   const std::uint32_t i = reverse_bits(laine_karras(reversed_index, s.shuffle));
   return {reverse_bits(laine_karras(i, s.x)), reverse_bits(laine_karras(dimension1_reversed(i), s.y))};
 }

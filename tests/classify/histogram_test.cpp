@@ -482,16 +482,6 @@ TEST(HistogramReport, RefusesSumsThatMayHaveOverflowed) {
   EXPECT_EQ(r.error().code, ErrorCode::kLimit);
 }
 
-TEST(Histogram, BatchOfPassCoversContiguousRanges) {
-  std::vector<int> counts(32, 0);
-  for (std::uint64_t pass = 0; pass < 100; ++pass) ++counts[static_cast<std::size_t>(batch_of_pass(pass, 100, 32))];
-  EXPECT_EQ(*std::min_element(counts.begin(), counts.end()), 3);
-  EXPECT_EQ(*std::max_element(counts.begin(), counts.end()), 4);
-  EXPECT_EQ(batch_of_pass(0, 100, 32), 0);
-  EXPECT_EQ(batch_of_pass(99, 100, 32), 31);
-  EXPECT_EQ(batch_of_pass(3, 4, 32), 24) << "fewer passes than batches leaves gaps";
-}
-
 TEST(Histogram, RecordsClassSetsWhenGivenAClassifier) {
   Classes classes({{"point", "LS.*E"}, {"area", "LD.*E"}});
   Histogram h(HistogramLayout{}, &*classes.classifier);

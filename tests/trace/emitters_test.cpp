@@ -451,7 +451,7 @@ TEST(ThinLens, NormalisedFocusedAndMeasuresTheClosedForm) {
         r->origin + r->direction * (kLightDistance / glm::dot(r->direction, cam.forward));
     if (!meet) meet = at_focus;
     EXPECT_NEAR(glm::length(at_focus - *meet), 0.0f, 2e-5f);
-    glm::vec2 back;
+    glm::vec2 back{-1.0f};  // importance() sets it where it returns nonzero importance
     EXPECT_GT(importance(cam, r->origin, r->direction, &back).x, 0.0f);
     EXPECT_NEAR(glm::length(back - raster), 0.0f, 1e-5f);
     // A light subpath arriving along the reversed ray hits the lens where the ray left it.

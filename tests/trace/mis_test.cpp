@@ -177,8 +177,8 @@ std::vector<MisCheck> check_mis_weights(const Scene& scene, const Profile& profi
   o.max_bounces = std::min(8, profile.max_bounces.value_or(8));
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
-  const Integrator integrator(rs, strategies, o, nullptr);
-  const Integrator recurrence(rs, strategies, o, nullptr, /*general_mis=*/true);
+  const Integrator integrator(rs, strategies, o);
+  const Integrator recurrence(rs, strategies, o, /*general_mis=*/true);
   Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
   th.images = &images;
   th.connectors.resize(strategies.strategies.size());
