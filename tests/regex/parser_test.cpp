@@ -13,7 +13,10 @@
 
 #include "classify/pathclass.h"
 #include "core/error.h"
+#include "core/limits.h"
+#include "core/stack.h"
 #include "regex/ast.h"
+#include "regex/lpe.h"
 #include "regex/parser.h"
 
 namespace pathex {
@@ -169,6 +172,53 @@ TEST(ParserLimits, HostileNestingFailsWithALocatedErrorNotACrash) {
   std::string alts = "S";
   for (int i = 0; i < 50000; ++i) alts += "|D";
   ASSERT_TRUE(parse(alts, Limits{}).ok());
+}
+
+// The ceiling of --max-depth is safe: every recursive routine over the tree (parse, print, dump,
+// reverse, the Thompson construction with nested & and ~, the LPE parser) runs the tallest trees
+// the ceiling lets through, and the inputs it stops, on a quarter of the command line's stack
+// (core/stack.h). In a build whose frames grow so that the ceiling no longer has that margin
+// (the sanitized build's are ten times a release build's), this test dies of a stack overflow.
+TEST(ParserLimits, TheDepthCeilingRunsOnAQuarterOfTheCommandLineStack) {
+  Limits l;
+  l.max_depth = kMaxDepthCeiling;
+  const int n = kMaxDepthCeiling;
+  const std::vector<std::string> tallest = {
+      "L" + std::string(n - 3, '(') + "S" + std::string(n - 3, ')') + "DDDE",  // groups: tree height n
+      "L(" + std::string(n - 4, '~') + "S)DDDE",                               // complements
+      "L(" + std::string(n - 4, '(') + "S" + std::string(n - 4, ')') + std::string(n - 4, '*') + ")DE",
+      [n] {  // intersections, each nested in the next: ((S&S)&S)&…
+        std::string e = "S";
+        for (int i = 0; i < n / 2 - 2; ++i) e = "(" + e + "&S)";
+        return "L" + e + "DE";
+      }()};
+  const std::vector<std::string> too_tall = {std::string(10000, '(') + "S", "S" + std::string(100000, '*'),
+                                             std::string(100000, '~') + "S"};
+  bool ran = false;
+  ASSERT_TRUE(run_on_stack(kCommandLineStackBytes / 4, [&] {
+    for (const std::string& expr : tallest) {
+      const Result<Regex> r = parse(expr, l);
+      ASSERT_TRUE(r.ok()) << expr.substr(0, 40) << ": " << r.error().render();
+      EXPECT_EQ(parse(to_string(*r), l).expect("the printed tree").nodes.size(), r->nodes.size()) << expr.substr(0, 40);
+      EXPECT_FALSE(dump(*r).empty());
+      EXPECT_EQ(dump(reversed(reversed(*r))), dump(*r));
+      ClassOptions options;
+      options.limits = l;
+      const Result<PathClass> c = compile_class(expr, options);
+      ASSERT_TRUE(c.ok()) << expr.substr(0, 40) << ": " << c.error().render();
+    }
+    for (const std::string& expr : too_tall) {
+      const Result<Regex> r = parse(expr, l);
+      ASSERT_FALSE(r.ok());
+      EXPECT_EQ(r.error().code, ErrorCode::kLimit);
+    }
+    // LPEs nest the same way, in their own parser.
+    const std::string lpe = "C" + std::string(n - 3, '(') + "D" + std::string(n - 3, ')') + "L";
+    EXPECT_TRUE(parse_lpe(lpe, {LightType::kArea}, {SensorType::kPinhole}, l).ok());
+    EXPECT_FALSE(parse_lpe("C" + std::string(10000, '(') + "D", {LightType::kArea}, {SensorType::kPinhole}, l).ok());
+    ran = true;
+  }));
+  EXPECT_TRUE(ran);
 }
 
 // --- names ---

@@ -1,16 +1,21 @@
 // pathex-mpi: the pathex command line inside an MPI job. `mpirun -n N pathex-mpi trace …` renders
 // one image across the N ranks (mpi_cluster.cpp) and writes the outputs of one process on rank 0;
-// every other command runs as in pathex, on every rank.
+// every other command runs as in pathex, on every rank. As in pathex, the whole of it runs on a
+// thread with an explicit stack (core/stack.h); MPI is initialised on that thread too, so that it
+// is the thread MPI_THREAD_FUNNELED names.
 #include <mpi.h>
 
 #include <cstdio>
 
 #include "cli/common.h"
 #include "cli/mpi/mpi_cluster.h"
+#include "core/stack.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_mpi_command_line(int argc, char** argv) {
   int provided = 0;
-  // Only the main thread calls MPI (the TBB workers never do).
+  // Only this thread calls MPI (the TBB workers never do).
   if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
     std::fprintf(stderr, "pathex: error: MPI_Init failed\n");
     return pathex::cli::kExitBadInput;
@@ -23,5 +28,16 @@ int main(int argc, char** argv) {
     pathex::cli::set_cluster(nullptr);
   }
   MPI_Finalize();
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int code = pathex::cli::kExitBadInput;
+  if (!pathex::run_on_stack(pathex::kCommandLineStackBytes, [&] { code = run_mpi_command_line(argc, argv); })) {
+    std::fprintf(stderr, "pathex: error: cannot start the command line's thread (a %zu MiB stack)\n",
+                 pathex::kCommandLineStackBytes >> 20);
+  }
   return code;
 }
