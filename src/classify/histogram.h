@@ -353,6 +353,9 @@ struct ClassEstimate {
   Estimate estimate;
   double share = 0;  // class luminance / total luminance (0 when the total is 0)
   std::vector<TechniqueEstimate> strategies;  // the techniques of its paths, summed by technique
+  // False for a class the render did not estimate (pathex trace --only asked for other classes):
+  // its estimate is unknown, never 0, and histogram.json says "not rendered".
+  bool rendered = true;
 };
 
 struct PathEstimate {
@@ -364,6 +367,9 @@ struct PathEstimate {
 
 struct HistogramReport {
   RunInfo run;
+  // The requested classes' names when only they were rendered (pathex trace --only): then `total`
+  // is the sum over their paths, not the image's.
+  std::vector<std::string> only;
   std::uint64_t nonfinite_samples = 0;
   Estimate total;
   std::vector<ClassEstimate> classes;  // in classifier order

@@ -239,4 +239,9 @@ Result<const PathClass*> ClassTable::add(const std::string& name, std::string_vi
   return static_cast<const PathClass*>(user_.back().get());
 }
 
+void ClassTable::set_render(const PathClass* c, bool render) {
+  for (auto& u : user_)
+    if (u.get() == c) u->render = render;
+}
+
 }  // namespace pathex

@@ -51,6 +51,7 @@ struct PathClass {
   Regex light_ast;          // a tree of the class's language read light-first: ast, reversed if eye_first;
                             // what `$name` stands for in later expressions
   Dfa dfa;                  // minimal DFA of the class: full paths, ∩ U
+  bool render = false;      // a class file's "render": true (only such classes are rendered)
 };
 
 class ClassTable;
@@ -69,6 +70,8 @@ class ClassTable {
   Result<const PathClass*> add(const std::string& name, std::string_view text, const ClassOptions& options,
                                std::string description = "");
   const PathClass* find(std::string_view name) const;
+  // Marks a class of this table as requested ("render": true in its class file).
+  void set_render(const PathClass* c, bool render);
   // The classes added by the user, in order (built-ins excluded).
   const std::vector<std::unique_ptr<PathClass>>& user_classes() const { return user_; }
   // Built-ins in their documented order.

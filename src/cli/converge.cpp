@@ -280,12 +280,13 @@ Result<bool> load_reference_file(const std::string& file, int width, int height,
     if (!h) return h.error();
     for (ClassRow& row : *rows) {
       if (row.name == "total") {
+        if (!h->report.only.empty()) continue;  // an --only render's total is not the image's
         row.reference = h->report.total.luminance;
         row.reference_stderr = std::isfinite(h->report.total.std_error) ? h->report.total.std_error : 0.0;
         continue;
       }
       for (const ClassEstimate& c : h->report.classes)
-        if (c.name == row.name) {
+        if (c.name == row.name && c.rendered) {  // a class that was not rendered has no value
           row.reference = c.estimate.luminance;
           row.reference_stderr = std::isfinite(c.estimate.std_error) ? c.estimate.std_error : 0.0;
         }

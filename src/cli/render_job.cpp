@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <tbb/task_group.h>
 
+#include "automata/ops.h"
 #include "core/version.h"
 #include "io/atomic_file.h"
 #include "io/class_file.h"
@@ -36,6 +37,35 @@ Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string&
   } else {
     for (const auto& c : ClassTable::builtins().builtin_classes())
       if (c->name != "all") out->classes.push_back(c.get());
+  }
+  // --- the requested classes: "render": true entries, then --only (DESIGN §11) ---
+  for (const PathClass* c : out->classes)
+    if (c->render) out->requested.push_back(c);
+  for (std::size_t i = 0; i < identity.only.size(); ++i) {
+    const std::string& expr = identity.only[i];
+    const PathClass* same = nullptr;
+    for (const PathClass* c : out->classes)
+      if (!expr.empty() && expr[0] == '$' && c->name == expr.substr(1)) same = c;
+    if (same == nullptr) {
+      Result<const PathClass*> added = out->table.add("only-" + std::to_string(i + 1), expr, copts);
+      if (!added) {
+        Error e = added.error();
+        e.message = "--only '" + expr + "': " + e.message;
+        return e;
+      }
+      same = *added;
+      out->classes.push_back(same);
+    }
+    if (std::find(out->requested.begin(), out->requested.end(), same) == out->requested.end()) out->requested.push_back(same);
+  }
+  out->estimated.assign(out->classes.size(), 1);
+  if (!out->requested.empty()) {
+    Dfa r = dfa_empty();
+    for (const PathClass* c : out->requested) r = dfa_union(r, c->dfa);
+    const Dfa paths = dfa_intersect(ends_universe(copts.ends), dfa_universe_bounded(identity.max_bounces));
+    for (std::size_t i = 0; i < out->classes.size(); ++i)
+      out->estimated[i] = is_subset(dfa_intersect(out->classes[i]->dfa, paths), r) ? 1 : 0;
+    out->requested_language = std::move(r);
   }
   Result<Classifier> classifier = Classifier::build(out->classes, limits);
   if (!classifier) return classifier.error();
@@ -75,7 +105,8 @@ namespace {
 
 // Everything but the shard file: histogram.json, the images, run.json.
 Result<WrittenReport> write_report_and_images(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                              const RenderClasses& classes, const std::vector<ConnectorStats>& connectors) {
+                                              const RenderClasses& classes, const std::vector<ConnectorStats>& connectors,
+                                              const std::vector<PrunedStrategy>& not_run) {
   const RenderIdentity& id = header.identity;
   RunInfo info;
   info.scene = id.scene;
@@ -88,7 +119,14 @@ Result<WrittenReport> write_report_and_images(const std::string& dir, const Shar
   if (!rep) return rep.error();
 
   WrittenReport out{std::move(*rep), {}};
+  for (std::size_t i = 0; i < out.report.classes.size() && i < classes.estimated.size(); ++i)
+    out.report.classes[i].rendered = classes.estimated[i] != 0;
   nlohmann::ordered_json doc = to_json(out.report);
+  if (!classes.requested.empty()) {  // pathex trace --only, "render": the classes whose paths were estimated
+    nlohmann::ordered_json only = nlohmann::ordered_json::array();
+    for (const PathClass* c : classes.requested) only.push_back({{"name", c->name}, {"expr", c->text}});
+    doc["only"] = std::move(only);
+  }
   if (!connectors.empty()) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
     for (const ConnectorStats& c : connectors)
@@ -103,7 +141,13 @@ Result<WrittenReport> write_report_and_images(const std::string& dir, const Shar
   if (Result<bool> w = write_file_atomic(dir + "/histogram.json", out.json_text); !w) return w.error();
   if (id.images) {
     const std::uint64_t spp = header.passes.count();
-    const std::vector<ImageLayer> layers = sums.images.layers(spp ? 1.0 / static_cast<double>(spp) : 0.0);
+    std::vector<ImageLayer> layers = sums.images.layers(spp ? 1.0 / static_cast<double>(spp) : 0.0);
+    // A class that was not rendered has no image (its layer holds at most the requested part of it).
+    std::erase_if(layers, [&](const ImageLayer& l) {
+      for (std::size_t i = 0; i < classes.classes.size(); ++i)
+        if (classes.classes[i]->name == l.name) return classes.estimated[i] == 0;
+      return false;
+    });
     if (Result<bool> w = write_exr(dir + "/classes.exr", layers); !w) return w.error();
     if (Result<bool> w = write_previews(dir, layers); !w) return w.error();
   }
@@ -114,6 +158,16 @@ Result<WrittenReport> write_report_and_images(const std::string& dir, const Shar
   run["passes"] = header.passes.to_string();
   run["cpu_s"] = header.run.cpu_s;
   run["efficiency"] = efficiency_json(out.report.total, header.run.cpu_s);
+  if (!not_run.empty()) {  // what this run did not simulate (a merge does not know: it has no scene)
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const PrunedStrategy& p : not_run) {
+      nlohmann::ordered_json e = {{"strategy", p.strategy}, {"profile", p.was}};
+      e["runs"] = p.now.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(p.now);
+      e["reason"] = p.reason;
+      list.push_back(std::move(e));
+    }
+    run["pruned"] = std::move(list);
+  }
   if (Result<bool> w = write_file_atomic(dir + "/run.json", run.dump(2) + "\n"); !w) return w.error();
   return out;
 }
@@ -121,14 +175,15 @@ Result<WrittenReport> write_report_and_images(const std::string& dir, const Shar
 }  // namespace
 
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors) {
+                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors,
+                                           const std::vector<PrunedStrategy>& not_run) {
   // The shard file, the largest output and independent of the others, is encoded and written on
   // another core while the report and the images are made and written on this one (both read the
   // sums only). The bytes do not depend on it.
   std::optional<Result<bool>> shard;
   tbb::task_group group;
   group.run([&] { shard.emplace(write_file_atomic(dir + "/" + kRenderShardName, encode_shard(header, sums.histogram, sums.images))); });
-  Result<WrittenReport> rest = write_report_and_images(dir, header, sums, classes, connectors);
+  Result<WrittenReport> rest = write_report_and_images(dir, header, sums, classes, connectors, not_run);
   group.wait();
   if (!rest) return rest.error();
   if (!*shard) return shard->error();

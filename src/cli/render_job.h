@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,19 +18,27 @@
 #include "core/limits.h"
 #include "core/pass_set.h"
 #include "io/shard.h"
+#include "reach/prune.h"
 #include "trace/render.h"
 
 namespace pathex::cli {
 
-// The classes of a render, compiled: the class file's entries (or the built-ins but $all).
+// The classes of a render, compiled: the class file's entries (or the built-ins but $all), then
+// each --only expression that is not one of them by name ($name), as class "only-N".
 struct RenderClasses {
   ClassTable table;
   std::vector<const PathClass*> classes;
   std::unique_ptr<Classifier> classifier;
   std::vector<ClassInfo> infos;
+  // The requested classes (identity.only and the class file's "render": true entries); empty: all.
+  std::vector<const PathClass*> requested;
+  std::optional<Dfa> requested_language;  // their union; unset: every path
+  // Per class: whether it is estimated, i.e. all its paths (with the render's ends and bound) are
+  // requested. The others are reported "not rendered".
+  std::vector<std::uint8_t> estimated;
 };
 // Compiles `text` (a class file's contents, read from `filename`; both "" for the built-in
-// classes) against the end types of `identity` (lights, sensor).
+// classes) and identity.only against the end types of `identity` (lights, sensor).
 Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string& text, const std::string& filename,
                                                               const RenderIdentity& identity, const Limits& limits);
 
@@ -52,8 +61,13 @@ struct WrittenReport {
 // histogram.json also lists what each connector did ("connectors": [{strategy, connector,
 // attempts, successes, failures {outside, occluded, no_transport}}] in the profile's order;
 // absent when the profile has none).
+// With requested classes, histogram.json lists them ("only": [{name, expr}]) and marks every class
+// not contained in them "rendered": false; the EXR and PNGs have no layer for a class that was not
+// rendered. run.json's "pruned" lists the strategies the checker did not run or narrowed
+// ([{strategy, profile, runs (null: not run), reason}]; reach/prune.h).
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors = {});
+                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors = {},
+                                           const std::vector<PrunedStrategy>& not_run = {});
 
 // Where the MPI ranks of a render into `dir` keep their own shard files until rank 0 has written
 // the outputs: the folder "<dir>.ranks" beside it (the output folder holds only its set).

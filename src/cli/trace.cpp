@@ -28,6 +28,9 @@
 #include "io/profile_json.h"
 #include "scene/scene_hash.h"
 #include "scene/universe.h"
+#include "automata/ops.h"
+#include "reach/prune.h"
+#include "trace/prune.h"
 #include "trace/render.h"
 
 namespace pathex::cli {
@@ -41,6 +44,7 @@ struct TraceArgs {
   std::string scene;
   std::string renderer = "bdpt";
   std::string classes_file;
+  std::vector<std::string> only;  // --only: the requested classes (DESIGN §11)
   std::string out = "pathex-out";
   std::uint64_t spp = 16;
   std::uint64_t seed = 1;
@@ -165,6 +169,7 @@ Result<bool> load_fresh(const TraceArgs& a, Job* job) {
     class_text = std::move(*text);
     id.classes_file = std::filesystem::absolute(a.classes_file).lexically_normal().string();
   }
+  id.only = a.only;
   Result<std::unique_ptr<RenderClasses>> classes =
       compile_render_classes(class_text, a.classes_file.empty() ? "" : a.classes_file, id, a.limits);
   if (!classes) return classes.error();
@@ -244,9 +249,45 @@ int run(const TraceArgs& a) {
   if (a.missed && (!a.shard.empty() || !a.resume.empty() || ranks > 1))
     return report(make_error(ErrorCode::kUsage, "--missed measures a whole render in one process: it cannot be given with "
                                                 "--shard, --resume or MPI"));
+  if (a.missed && !id.only.empty())
+    return report(make_error(ErrorCode::kUsage, "--missed measures what the whole render misses: it cannot be given with --only"));
+
+  // --- DESIGN §11: run only the strategies that can sample a requested path of this scene ---
+  const Dfa universe = scene_universe(scene_types(*job.scene));
+  Result<ProfilePruning> pruning =
+      prune_profile(*job.profile, id.max_bounces, universe, job.classes->requested_language, a.limits);
+  if (!pruning) return report(pruning.error());
+  if (pruning->samples_nothing() && job.classes->requested.empty()) {
+    // Nothing of the scene can be sampled at all: render as asked (a black image, and the warning
+    // about the lights it cannot reach), running the profile whole as before.
+    pruning->profile = *job.profile;
+    pruning->changes.clear();
+  }
+  if (pruning->samples_nothing()) {
+    std::cout << "nothing to render: no strategy of " << id.renderer << " samples a path of "
+              << (id.only.empty() ? "this scene" : "the requested classes in this scene") << " ("
+              << describe(scene_types(*job.scene)) << ")\n";
+    for (const PathClass* c : job.classes->requested)
+      if (is_empty(dfa_intersect(dfa_intersect(c->dfa, universe), bounded_universe(id.max_bounces))))
+        std::cout << "  " << c->text << " has no path in this scene\n";
+    for (const PrunedStrategy& p : pruning->changes) std::cout << "  " << p.strategy << " " << p.was << ": " << p.reason << "\n";
+    return kExitNo;
+  }
+  std::vector<std::string> runs;
+  for (const Strategy& st : pruning->profile.strategies) runs.push_back(st.name);
+  if (a.resume.empty()) job.header.identity.strategies = runs;  // the histogram is laid out for these
+  else if (runs != id.strategies)
+    return report(make_error(ErrorCode::kUsage, "the strategies " + a.resume + " was rendered with are not the ones this pathex runs for it"));
+  std::optional<RequestedPaths> only;
+  if (!job.classes->requested.empty()) {
+    Result<RequestedPaths> r = RequestedPaths::make(job.classes->requested, a.limits);
+    if (!r) return report(r.error());
+    only.emplace(std::move(*r));
+  }
+
   // Connector statistics (histogram.json "connectors") are per process and not yet kept in shard
   // files, so a render that is split or resumed must not use a connector.
-  for (const Strategy& st : job.profile->strategies)
+  for (const Strategy& st : pruning->profile.strategies)
     if (st.connector != ConnectorKind::kNone && (!a.shard.empty() || !a.resume.empty() || ranks > 1))
       return report(make_error(ErrorCode::kUsage, "the " + job.profile->name + " profile uses the " + to_string(st.connector) +
                                                       " connector, whose statistics are not merged yet: --shard, --resume and MPI runs need a profile without connectors"));
@@ -262,7 +303,6 @@ int run(const TraceArgs& a) {
   // 0 prints both; the other ranks skip the compilation).
   ReachCache cache(a.limits);
   const CompiledProfile* compiled = nullptr;
-  const Dfa universe = scene_universe(scene_types(*job.scene));
   if (rank == 0) {
     Result<const CompiledProfile*> cp = cache.compiled(id.renderer_source, id.max_bounces);
     if (!cp) return report(cp.error());
@@ -282,6 +322,7 @@ int run(const TraceArgs& a) {
   ro.rr_depth = id.rr_depth;
   ro.rr_threshold = static_cast<float>(id.rr_threshold);
   ro.batches = id.batches;
+  ro.only = only ? &*only : nullptr;
   // Without image outputs the render keeps the histogram alone (the same histogram).
   ro.images = id.images;
   if (ro.images)
@@ -304,7 +345,7 @@ int run(const TraceArgs& a) {
     const RenderWatch watch(rank == 0 && !a.quiet, a.time_limit);
     ro.progress = watch.progress();
     ro.cancel = stopped = watch.cancel();
-    return render(*job.scene, *job.profile, job.classes->classifier.get(), ro);
+    return render(*job.scene, pruning->profile, job.classes->classifier.get(), ro);
   }();
   const double cpu_s = process_cpu_seconds() - cpu_start;
   if (!out) return report(out.error());
@@ -367,7 +408,7 @@ int run(const TraceArgs& a) {
   if (rank == 0) {
     const SignalShield shield;
     Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
-      Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, out->connectors);
+      Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, out->connectors, pruning->changes);
       if (!r) return r.error();
       written = std::move(*r);
       if (missed)  // what pathex bias writes to bias.json, without images
@@ -408,12 +449,25 @@ int run(const TraceArgs& a) {
     std::cout << " (passes " << header.passes.to_string() << " of " << job.header.spp << ")";
   std::cout << ", " << std::fixed << std::setprecision(2) << out->time_s << " s" << (complete ? "" : " (interrupted)")
             << ", non-finite samples " << rep->nonfinite_samples << "\n";
-  std::cout << "image mean luminance " << absolute(rep->total) << "\n"
-            << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n";
+  if (!job.classes->requested.empty()) {
+    std::cout << "rendered only";
+    for (const PathClass* c : job.classes->requested) std::cout << " " << c->name << " (" << c->text << ")";
+    std::cout << "\nluminance of those paths " << absolute(rep->total) << "\n"
+              << "(shares are of the requested paths' total; luminances are absolute, comparable between renderers)\n";
+  } else {
+    std::cout << "image mean luminance " << absolute(rep->total) << "\n"
+              << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n";
+  }
+  for (const PrunedStrategy& p : pruning->changes)
+    std::cout << (p.now.empty() ? "not run: " : "narrowed: ") << p.strategy << " " << p.was << (p.now.empty() ? "" : " to " + p.now) << ": " << p.reason << "\n";
   if (missed) std::cout << "this renderer " << missed_line(*missed).substr(missed->renderer.size() + 1) << "\n";
   std::cout << "\n";
   for (std::size_t i = 0; i < rep->classes.size(); ++i) {
     const ClassEstimate& c = rep->classes[i];
+    if (!c.rendered) {
+      std::cout << c.name << ": not rendered\n";
+      continue;
+    }
     Result<QueryResult> q = query(*classes[i], *compiled, qo);
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
@@ -464,6 +518,9 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--renderer", args->renderer, "Renderer profile: built-in name or file")->capture_default_str();
   sub->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 24));
   sub->add_option("--classes", args->classes_file, "Class file; default: the built-in classes");
+  sub->add_option("--only", args->only,
+                  "Estimate only the paths of this class (an expression; repeatable): other strategies and subpaths are not "
+                  "simulated, and classes outside it are reported as not rendered");
   sub->add_option("--seed", args->seed, "Random seed (0 to 2^64 - 1)")->capture_default_str()->check(non_negative());
   sub->add_option("--threads", args->threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
   sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices (k - 1); default: the profile's bound, else 16")
@@ -505,7 +562,7 @@ Command add_trace(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   add_limit_options(sub, &args->limits);
   return {sub, [args, sub] {
-            for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
+            for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
                                   "--resolution", "--max-paths", "--sampler", "--rr-depth", "--rr-threshold"})
               if (sub->count(o) > 0) args->settings_given.push_back(o);
             return run(*args);

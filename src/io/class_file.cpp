@@ -36,9 +36,9 @@ Result<bool> load_class_file(const std::string& text, const std::string& filenam
     const auto& entry = classes[i];
     if (!entry.is_object()) return reader.fail(ptr, "expected an object with \"name\" and \"expr\"");
     for (const auto& [key, value] : entry.items()) {
-      if (key != "name" && key != "expr" && key != "notation" && key != "description")
+      if (key != "name" && key != "expr" && key != "notation" && key != "description" && key != "render")
         return reader.fail(ptr + "/" + pointer_token(key),
-                          "unknown key '" + key + "', expected one of name, expr, notation, description");
+                          "unknown key '" + key + "', expected one of name, expr, notation, description, render");
     }
     if (!entry.contains("name") || !entry.at("name").is_string())
       return reader.fail(ptr + "/name", "expected a string class name");
@@ -59,14 +59,19 @@ Result<bool> load_class_file(const std::string& text, const std::string& filenam
     opts.notation = Notation::kFull;
     if (entry.contains("notation")) {
       const auto& n = entry.at("notation");
-      const auto parsed = n.is_string() ? notation_from_string(n.get<std::string>()) : std::nullopt;
-      if (!parsed) return reader.fail(ptr + "/notation", "expected \"full\", \"heckbert\" or \"lpe\"");
-      opts.notation = *parsed;
+      const auto notation = n.is_string() ? notation_from_string(n.get<std::string>()) : std::nullopt;
+      if (!notation) return reader.fail(ptr + "/notation", "expected \"full\", \"heckbert\" or \"lpe\"");
+      opts.notation = *notation;
     }
     std::string description;
     if (entry.contains("description")) {
       if (!entry.at("description").is_string()) return reader.fail(ptr + "/description", "expected a string");
       description = entry.at("description").get<std::string>();
+    }
+    bool render = false;
+    if (entry.contains("render")) {
+      if (!entry.at("render").is_boolean()) return reader.fail(ptr + "/render", "expected true or false");
+      render = entry.at("render").get<bool>();
     }
     Result<const PathClass*> added = table->add(name, entry.at("expr").get<std::string>(), opts, description);
     if (!added) {
@@ -74,6 +79,7 @@ Result<bool> load_class_file(const std::string& text, const std::string& filenam
       e.where = filename + ":" + ptr + (e.code == ErrorCode::kBadValue ? "/name" : "/expr");
       return e;
     }
+    table->set_render(*added, render);
   }
   return true;
 }

@@ -4,6 +4,9 @@
 //                {"name": "glass", "expr": "$caustic & L.*SS.*E"},
 //                {"name": "mirror-classic", "expr": "LSDE", "notation": "heckbert"}]}
 //
+// "render": true on entries makes `pathex trace` and `converge` estimate only those classes (as
+// --only does; DESIGN §11): the other classes are reported "not rendered".
+//
 // Entries are compiled in order; each may refer to the built-ins and to the entries before it.
 // Errors name the file and the JSON pointer of the offending value.
 #pragma once

@@ -190,6 +190,12 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
     json j = json::object();
     j["name"] = c.name;
     j["expr"] = c.expr;
+    if (!c.rendered) {  // pathex trace --only asked for other classes: no estimate, never a 0
+      j["rendered"] = false;
+      j["note"] = "not rendered: only the requested classes were estimated (--only, \"render\")";
+      classes.push_back(std::move(j));
+      continue;
+    }
     put_estimate(j, c.estimate);
     j["share"] = c.share;
     j["strategies"] = techniques_json(c.strategies);
@@ -355,6 +361,8 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
   if (doc.contains("distinct_paths")) r.distinct_paths = rd.uint(doc, "", "distinct_paths");
   if (doc.contains("max_paths") && !doc["max_paths"].is_null()) r.max_paths = rd.uint(doc, "", "max_paths");
   if (const json* t = rd.field(doc, "", "total")) r.total = rd.estimate(*t, "/total", /*samples_required=*/false);
+  if (doc.contains("only") && doc["only"].is_array())  // pathex trace --only
+    for (std::size_t i = 0; i < doc["only"].size(); ++i) r.only.push_back(rd.str(doc["only"][i], "/only/" + std::to_string(i), "name"));
   if (const json* classes = rd.array(doc, "", "classes")) {
     for (std::size_t i = 0; i < classes->size() && !rd.failed(); ++i) {
       const json& cj = (*classes)[i];
@@ -362,6 +370,11 @@ Result<HistogramFile> histogram_from_json(const json& doc, const std::string& fi
       ClassEstimate c;
       c.name = rd.str(cj, cp, "name");
       c.expr = rd.str(cj, cp, "expr");
+      if (cj.contains("rendered")) c.rendered = rd.boolean(cj, cp, "rendered");
+      if (!c.rendered) {
+        r.classes.push_back(std::move(c));
+        continue;
+      }
       c.estimate = rd.estimate(cj, cp, /*samples_required=*/true);
       c.share = rd.number(cj, cp, "share");
       c.strategies = rd.techniques(cj, cp, "strategies");

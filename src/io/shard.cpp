@@ -266,6 +266,7 @@ json identity_json(const RenderIdentity& id) {
   j["scene"] = {{"name", id.scene}, {"file", id.scene_file}, {"hash", id.scene_hash}};
   j["renderer"] = {{"name", id.renderer}, {"source", id.renderer_source}, {"hash", id.renderer_hash}};
   j["classes"] = {{"file", id.classes_file}, {"text", id.classes_text}, {"hash", id.classes_hash}};
+  if (!id.only.empty()) j["classes"]["only"] = id.only;  // absent when every class is rendered
   j["ends"] = {{"lights", id.lights}, {"sensor", id.sensor}};
   j["seed"] = id.seed;
   j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"rr_depth", id.rr_depth},
@@ -368,7 +369,15 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   };
   strings3("scene", {{{"name", &id.scene}, {"file", &id.scene_file}, {"hash", &id.scene_hash}}});
   strings3("renderer", {{{"name", &id.renderer}, {"source", &id.renderer_source}, {"hash", &id.renderer_hash}}});
-  strings3("classes", {{{"file", &id.classes_file}, {"text", &id.classes_text}, {"hash", &id.classes_hash}}});
+  nlohmann::json classes = j.at("classes");
+  if (classes.is_object() && classes.contains("only")) {  // --only's classes, when given
+    id.only = rd.strings(classes, "/classes", "only");
+    classes.erase("only");
+  }
+  if (rd.object(classes, "/classes", {"file", "text", "hash"}))
+    for (const auto& [name, out] : {std::pair{"file", &id.classes_file}, std::pair{"text", &id.classes_text},
+                                    std::pair{"hash", &id.classes_hash}})
+      *out = rd.str(classes, "/classes", name);
   if (rd.object(j.at("ends"), "/ends", {"lights", "sensor"})) {
     id.lights = rd.strings(j.at("ends"), "/ends", "lights");
     id.sensor = rd.str(j.at("ends"), "/ends", "sensor");
@@ -428,6 +437,14 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
       return (i.classes_file.empty() ? std::string("the built-in classes") : i.classes_file) + ", hash " + i.classes_hash;
     };
     return differ("another class file", name(a), name(b));
+  }
+  if (a.only != b.only) {
+    const auto list = [](const std::vector<std::string>& v) {
+      std::string out;
+      for (const std::string& e : v) out += (out.empty() ? "" : " ") + std::string("--only '") + e + "'";
+      return out.empty() ? std::string("every class") : out;
+    };
+    return differ("other requested classes", list(a.only), list(b.only));
   }
   const auto option = [&](const char* name, long long x, long long y) -> std::optional<std::string> {
     if (x == y) return std::nullopt;

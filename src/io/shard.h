@@ -83,6 +83,7 @@ struct RenderIdentity {
   std::string classes_file;  // absolute; "" for the built-in classes
   std::string classes_text;  // the class file's text; "" for the built-in classes
   std::string classes_hash;
+  std::vector<std::string> only;    // pathex trace --only: the requested classes' expressions, in order
   std::vector<std::string> lights;  // the scene's light types ("area", …)
   std::string sensor;               // and sensor type
   std::uint64_t seed = 1;

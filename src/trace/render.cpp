@@ -30,6 +30,7 @@
 #include "trace/bsdf.h"
 #include "trace/frame.h"
 #include "trace/integrator.h"
+#include "trace/prune.h"
 #include "trace/render_scene.h"
 #include "trace/rng.h"
 #include "trace/strategy_table.h"
@@ -81,7 +82,8 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   float eta2 = 1.0f;  // the product of η² over the refractions so far (radiance walks)
   // `beta` passed in the first vertex already includes the first direction's weight: the caller
   // stores it in path[count - 1].beta and we continue from there.
-  while (count < max_vertices) {
+  SubpathPrefix live(o_.only, mode == TransportMode::kImportance, path[0].pos_letter, path[0].letter);  // trace/prune.h
+  while (count < max_vertices && live.alive()) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
     const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, HitDetail::kNoUv);  // zero for points: no offset
@@ -154,6 +156,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     o = v.p;
     d = bs->wi;
     if (!std::isfinite(beta.x + beta.y + beta.z)) break;
+    live.extend(v.letter);  // --only: a subpath no requested class can complete stops (DESIGN §11)
   }
   return count;
 }
@@ -576,6 +579,7 @@ void Integrator::estimate(Thread& th, int batch) const {
   const JoinResult& jr = th.join;
   // The MIS weight over every strategy of the profile that samples this path: over whole-path
   // densities when the mirror connector is one of them, else by the join-local recurrence.
+  if (o_.only != nullptr && !o_.only->records(jr.letters)) return;  // --only: not requested, no weight, no shadow ray
   float weight = 0.0f;
   if (jr.chain == ConnectorKind::kMirror || (has_mirror_ && mirror_can_sample(th, jr.s, jr.t, jr.letters))) {
     gather(th, jr.s, jr.t, jr.has_light0 ? &jr.light0 : nullptr, jr.has_middle ? &jr.middle : nullptr,

@@ -43,6 +43,8 @@
 
 namespace pathex {
 
+class RequestedPaths;  // trace/prune.h
+
 // Passes a pixel takes back to back (the last chunk may be shorter). Progress is reported, and a
 // cancelled render stops, after whole chunks, so every finished pass covers the whole image.
 inline constexpr std::uint64_t kPassesPerChunk = 4;
@@ -68,6 +70,10 @@ struct RenderOptions {
   // histogram, which is the same either way, and RenderOutput::images is empty (0 × 0): no
   // per-pixel sums, no splat buffers, none of the image's memory traffic.
   bool images = true;
+  // pathex trace --only (trace/prune.h): only paths in these classes are recorded, and a subpath
+  // stops once none of them can be completed from it. Null: every path. Hand the tracer the profile
+  // reduced by prune_profile() (reach/prune.h) too, so that no strategy runs for nothing.
+  const RequestedPaths* only = nullptr;
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;  // called from one thread
   const std::atomic<bool>* cancel = nullptr;  // set to stop early; the result is marked incomplete
 };

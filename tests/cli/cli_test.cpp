@@ -311,7 +311,7 @@ TEST(CliClassFile, ErrorsNameTheFileAndPointer) {
   const CliRun key = pathex({"explain", "--classes", bad_key.string(), "LDE"});
   EXPECT_EQ(key.code, 2);
   EXPECT_EQ(key.err, "pathex: error: " + bad_key.string() +
-                         ":/classes/0/exp: unknown key 'exp', expected one of name, expr, notation, description\n");
+                         ":/classes/0/exp: unknown key 'exp', expected one of name, expr, notation, description, render\n");
 }
 
 TEST(CliClassFile, TwentyHasTwentyClassesThatAllCompile) {

@@ -1,0 +1,93 @@
+#!/usr/bin/env python3
+"""Efficiency gain of rendering one class alone (pathex trace --only, issue 14), interleaved.
+
+    python3 bench/only_gain.py build/pathex --rounds 5
+
+For each case (scene, renderer, class), each round runs the full render (every strategy, every
+path, the class measured as one class of the render) and the --only render of that class alone,
+in an order that alternates between rounds, each with the round's seed, one thread, no images.
+The efficiency of a render on the class is 1 / (σ² T): σ the class's standard error (batch means,
+histogram.json) and T the process's CPU seconds (user + system, os.wait4: start-up, checker,
+rendering, writing). Printed per case: per round the gain (efficiency of --only over the full
+render's) and the median over rounds, with the median CPU seconds of each side.
+
+With --baseline OLD it also measures the cost of the hooks when nothing is pruned: a render whose
+profile the checker leaves whole (the Cornell box with pt), OLD (pathex before issue 14) against
+the given binary, interleaved: the median ratio of CPU seconds.
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cli_ab import cpu_run  # noqa: E402  (the one CPU-time runner)
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCENES = os.path.join(ROOT, "samples", "scenes")
+# (label, scene, renderer, class expression, spp, resolution)
+CASES = [
+    ("caustic of point-glass", "point-glass.json", "bdpt", "$caustic", 64, "128x128"),
+    ("$direct on the Cornell box", "cornell.json", "bdpt", "$direct", 16, "128x128"),
+    ("L.{8,}E on the Cornell box", "cornell.json", "bdpt", "L.{8,}E", 16, "128x128"),
+]
+
+
+def render(binary, scene, renderer, classes, spp, resolution, seed, out, only):
+    cmd = [binary, "trace", os.path.join(SCENES, scene), "--renderer", renderer, "--classes", classes, "--spp", str(spp),
+           "--resolution", resolution, "--seed", str(seed), "--threads", "1", "--no-images", "--quiet", "--out", out]
+    if only:
+        cmd += ["--only", "$target"]
+    t = cpu_run(cmd)
+    with open(os.path.join(out, "histogram.json")) as f:
+        doc = json.load(f)
+    c = next(c for c in doc["classes"] if c["name"] == "target")
+    return c["luminance"], c["stderr"], t
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("binary")
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--baseline", help="pathex before issue 14, for the cost when nothing is pruned")
+    args = ap.parse_args()
+    tmp = tempfile.mkdtemp(prefix="pathex-only-")
+    for label, scene, renderer, expr, spp, res in CASES:
+        classes = os.path.join(tmp, "classes.json")
+        with open(classes, "w") as f:
+            json.dump({"classes": [{"name": "target", "expr": expr}]}, f)
+        gains, tf, to = [], [], []
+        for r in range(args.rounds):
+            seed = 100 + r
+            sides = [False, True] if r % 2 == 0 else [True, False]
+            got = {}
+            for only in sides:
+                got[only] = render(args.binary, scene, renderer, classes, spp, res, seed, os.path.join(tmp, "out"), only)
+            (lf, sf, cf), (lo, so, co) = got[False], got[True]
+            gain = (sf * sf * cf) / (so * so * co)
+            gains.append(gain)
+            tf.append(cf)
+            to.append(co)
+            print(f"  {label}, round {r}: full {lf:.5f} ± {sf:.5f} in {cf:.2f} s, only {lo:.5f} ± {so:.5f} in {co:.2f} s,"
+                  f" gain {gain:.2f}x", flush=True)
+        print(f"{label} ({renderer}, {spp} spp, {res}): gain in 1/(sigma^2 T) median {statistics.median(gains):.2f}x"
+              f" (range {min(gains):.2f}-{max(gains):.2f}); CPU s full {statistics.median(tf):.2f}, only {statistics.median(to):.2f}",
+              flush=True)
+    if args.baseline:
+        ratios = []
+        for r in range(args.rounds):
+            cmd = ["trace", os.path.join(SCENES, "cornell.json"), "--renderer", "pt", "--spp", "64", "--resolution", "128x128",
+                   "--threads", "1", "--no-images", "--quiet", "--out", os.path.join(tmp, "out")]
+            order = [args.baseline, args.binary] if r % 2 == 0 else [args.binary, args.baseline]
+            t = {b: cpu_run([b] + cmd) for b in order}
+            ratios.append(t[args.binary] / t[args.baseline])
+            print(f"  nothing pruned, round {r}: old {t[args.baseline]:.3f} s, new {t[args.binary]:.3f} s", flush=True)
+        print(f"nothing pruned (Cornell box, pt, 64 spp, 128x128): new / old CPU s median {statistics.median(ratios):.3f}"
+              f" (range {min(ratios):.3f}-{max(ratios):.3f})")
+
+
+if __name__ == "__main__":
+    main()

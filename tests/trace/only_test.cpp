@@ -1,0 +1,334 @@
+// Rendering only what is asked (DESIGN §11, issue 14): strategy pruning by the checker, --only
+// renders against the same class taken from a full render, dead-state termination against the
+// classifier, and "not rendered" in pathex trace's outputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <regex>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "automata/ops.h"
+#include "classify/classifier.h"
+#include "classify/pathclass.h"
+#include "io/profile_json.h"
+#include "reach/prune.h"
+#include "scene/scene.h"
+#include "scene/universe.h"
+#include "trace/prune.h"
+#include "trace/render.h"
+
+namespace pathex {
+namespace {
+
+const std::string kScenes = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/";
+
+Scene scene_at(const std::string& name, int size) {
+  Scene s = load_scene_file(kScenes + name).expect("a sample scene");
+  s.camera.width = size;
+  s.camera.height = size;
+  return s;
+}
+
+ClassOptions options_for(const Scene& scene) {
+  const SceneTypes types = scene_types(scene);
+  ClassOptions o;
+  o.ends.lights.assign(types.lights.begin(), types.lights.end());
+  o.ends.sensors = {types.sensor};
+  return o;
+}
+
+// The classes of `exprs`, compiled for the scene's ends, kept alive for the test.
+std::vector<const PathClass*> classes_for(const Scene& scene, const std::vector<std::string>& exprs) {
+  static std::vector<std::unique_ptr<PathClass>> keep;
+  std::vector<const PathClass*> out;
+  for (const std::string& e : exprs) {
+    keep.push_back(std::make_unique<PathClass>(compile_class(e, options_for(scene)).expect("a test class")));
+    keep.back()->name = e;
+    out.push_back(keep.back().get());
+  }
+  return out;
+}
+
+ProfilePruning prune(const Scene& scene, const std::string& renderer, const std::vector<const PathClass*>& requested,
+                     int max_bounces) {
+  const Profile p = resolve_profile(renderer, Limits{}).expect("a built-in profile");
+  std::optional<Dfa> r;
+  if (!requested.empty()) {
+    r = dfa_empty();
+    for (const PathClass* c : requested) r = dfa_union(*r, c->dfa);
+  }
+  return prune_profile(p, max_bounces, scene_universe(scene_types(scene)), r, Limits{}).expect("pruning");
+}
+
+const PrunedStrategy* change_of(const ProfilePruning& p, const std::string& strategy) {
+  for (const PrunedStrategy& c : p.changes)
+    if (c.strategy == strategy) return &c;
+  return nullptr;
+}
+
+TEST(Pruning, TheIssuesExamples) {
+  // Only point lights: emitter hits are never tested.
+  const Scene point = scene_at("point-plane.json", 8);
+  const ProfilePruning pt_nee = prune(point, "pt-nee", {}, 8);
+  const PrunedStrategy* hit = change_of(pt_nee, "emitter-hit");
+  ASSERT_NE(hit, nullptr);
+  EXPECT_EQ(hit->now, "");
+  EXPECT_EQ(pt_nee.profile.strategies.size(), 1u);
+  EXPECT_EQ(pt_nee.profile.strategies[0].name, "nee");
+  // bdpt keeps every s but 0 (the eye subpath hitting a light).
+  const ProfilePruning bdpt = prune(point, "bdpt", {}, 8);
+  ASSERT_EQ(bdpt.profile.strategies.size(), 1u);
+  EXPECT_EQ(bdpt.profile.strategies[0].s.lo, 1);
+  // An orthographic sensor: no light tracing.
+  const Scene ortho = scene_at("mirror-ortho.json", 8);
+  const ProfilePruning lt = prune(ortho, "lt", {}, 8);
+  const PrunedStrategy* splat = change_of(lt, "light-splat");
+  ASSERT_NE(splat, nullptr);
+  EXPECT_EQ(splat->now, "");
+  EXPECT_EQ(prune(ortho, "bdpt", {}, 8).profile.strategies.at(0).t.lo, 2);
+  // Caustics in a scene without a specular material: nothing runs.
+  EXPECT_TRUE(prune(point, "bdpt", classes_for(point, {"$caustic"}), 8).samples_nothing());
+  EXPECT_TRUE(prune(point, "pt-nee", classes_for(point, {"$caustic"}), 8).samples_nothing());
+  // A class every strategy meets prunes nothing on a scene that has every end and material.
+  const Scene cornell = scene_at("cornell.json", 8);
+  EXPECT_TRUE(prune(cornell, "pt", {}, 8).changes.empty());
+  // NEE cannot sample a caustic (its light-side join letters are DD right after the light).
+  const ProfilePruning caustic = prune(cornell, "pt-nee", classes_for(cornell, {"$caustic"}), 8);
+  ASSERT_NE(change_of(caustic, "nee"), nullptr);
+  EXPECT_EQ(change_of(caustic, "nee")->now, "");
+}
+
+// "bdpt (2, DD, 1)" -> {"bdpt", 2, 1}
+struct TechniqueName {
+  std::string strategy;
+  int s = 0, t = 0;
+};
+TechniqueName parse_technique(const std::string& name) {
+  static const std::regex re(R"(^(.*) \((\d+), [^,]+, (\d+)\)$)");
+  std::smatch m;
+  EXPECT_TRUE(std::regex_match(name, m, re)) << name;
+  return {m[1], std::stoi(m[2]), std::stoi(m[3])};
+}
+
+// A strategy the checker prunes (or a subpath length it narrows away) contributes nothing to a full
+// render of the whole profile: over every sample scene and every built-in profile the tracer runs.
+TEST(Pruning, APrunedStrategyNeverContributes) {
+  constexpr int kBounces = 6;
+  int scenes = 0, pruned_seen = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kScenes)) {
+    if (entry.path().extension() != ".json") continue;
+    const Scene scene = scene_at(entry.path().filename().string(), 12);
+    ++scenes;
+    for (const Profile& profile : builtin_profiles(Limits{}).expect("the built-in profiles")) {
+      if (!runnable_strategies(profile).ok()) continue;  // the manifold connector
+      const ProfilePruning p = prune(scene, profile.name, {}, kBounces);
+      if (p.changes.empty()) continue;
+      ++pruned_seen;
+      RenderOptions o;
+      o.spp = 2;
+      o.max_bounces = kBounces;
+      o.images = false;
+      o.threads = 1;
+      const RenderOutput out = render(scene, profile, nullptr, o).expect("a render");
+      const HistogramReport rep = make_report(out.histogram, RunInfo{}, nullptr, {}).expect("a report");
+      for (const PathEstimate& path : rep.paths)
+        for (const TechniqueEstimate& te : path.strategies) {
+          const TechniqueName t = parse_technique(te.name);
+          const Strategy* kept = nullptr;
+          for (const Strategy& st : p.profile.strategies)
+            if (st.name == t.strategy) kept = &st;
+          const bool runs = kept != nullptr && kept->s.contains(t.s) && kept->t.contains(t.t);
+          EXPECT_TRUE(runs || te.samples == 0) << entry.path().filename() << " " << profile.name << ": " << te.name
+                                               << " contributed to " << path.path << " though the checker prunes it";
+        }
+    }
+  }
+  EXPECT_GE(scenes, 9);
+  EXPECT_GE(pruned_seen, 10);  // the assertion above ran on many pruned profiles
+}
+
+struct ClassValue {
+  double luminance = 0, std_error = 0;
+};
+
+// The luminance of class `expr` in a render of `scene` by `renderer`: the full profile with every
+// path recorded, or (only) the pruned profile recording only that class.
+ClassValue render_class(const Scene& scene, const std::string& renderer, const std::string& expr, bool only,
+                        std::uint64_t seed, std::uint64_t spp, int max_bounces) {
+  const std::vector<const PathClass*> classes = classes_for(scene, {expr});
+  const Classifier cl = Classifier::build(classes, Limits{}).expect("a classifier");
+  RenderOptions o;
+  o.spp = spp;
+  o.seed = seed;
+  o.max_bounces = max_bounces;
+  o.images = false;
+  const Profile full = resolve_profile(renderer, Limits{}).expect("a profile");
+  std::optional<RequestedPaths> requested;
+  ProfilePruning p = prune(scene, renderer, classes, max_bounces);
+  if (only) {
+    requested.emplace(RequestedPaths::make(classes, Limits{}).expect("requested paths"));
+    o.only = &*requested;
+  }
+  const RenderOutput out = render(scene, only ? p.profile : full, &cl, o).expect("a render");
+  const HistogramReport rep = make_report(out.histogram, RunInfo{}, &cl, {{expr, expr}}).expect("a report");
+  return {rep.classes.at(0).estimate.luminance, rep.classes.at(0).estimate.std_error};
+}
+
+// An --only render of one class agrees with the class taken from a full render within 3σ
+// (independent seeds; batch-means standard errors).
+TEST(Only, AgreesWithTheClassOfAFullRender) {
+  struct Case {
+    std::string scene, renderer, expr;
+  };
+  const std::vector<Case> cases = {
+      {"point-glass.json", "bdpt", "$caustic"},       {"point-glass.json", "pt-nee", "$direct"},
+      {"cornell.json", "bdpt", "$direct"},            {"cornell.json", "pt-nee", "$caustic"},
+      {"cornell.json", "bdpt", "L.{8,}E"},            {"point-mirror-caustic.json", "bdpt", "$caustic"},
+      {"closed-sphere-point.json", "pt-nee", "L.{6}E"}, {"mirror-ortho.json", "bdpt", "$direct"},
+  };
+  for (const Case& c : cases) {
+    const Scene scene = scene_at(c.scene, 16);
+    const ClassValue full = render_class(scene, c.renderer, c.expr, false, 11, 32, 10);
+    const ClassValue only = render_class(scene, c.renderer, c.expr, true, 12, 32, 10);
+    const double sigma = std::sqrt(full.std_error * full.std_error + only.std_error * only.std_error);
+    EXPECT_GT(full.luminance, 0.0) << c.scene << " " << c.expr;
+    EXPECT_LE(std::fabs(full.luminance - only.luminance), 3.0 * sigma + 1e-12)
+        << c.scene << " " << c.renderer << " " << c.expr << ": full " << full.luminance << " ± " << full.std_error
+        << ", only " << only.luminance << " ± " << only.std_error;
+  }
+}
+
+// A subpath stops exactly when its prefix (light side, read forward) or suffix (eye side, read
+// backward) is dead for the requested classes: then no full path through it is requested. Checked
+// on random full paths against the classifier, both ways (an alive prefix of a requested path is
+// never cut).
+TEST(DeadState, AStoppedSubpathCouldNotHaveContributed) {
+  const Scene cornell = scene_at("cornell.json", 8);
+  // Which sides can die: a caustic (L..S+D.*..E) is decided near the light, any suffix completes
+  // it; every string extends to a member of L.{8,}E; a direct path is short on both sides.
+  struct Case {
+    std::string expr;
+    bool light_dies, eye_dies;
+  };
+  for (const Case& c : std::vector<Case>{{"$caustic", true, false}, {"L.{8,}E", false, false}, {"$direct", true, true},
+                                         {"L..S.*E & L.*S..E", true, true}}) {
+    const std::string& expr = c.expr;
+    const std::vector<const PathClass*> classes = classes_for(cornell, {expr});
+    const RequestedPaths only = RequestedPaths::make(classes, Limits{}).expect("requested paths");
+    const Classifier& cl = only.classifier();
+    std::mt19937_64 rng(5);
+    int dead_light = 0, dead_eye = 0, requested = 0;
+    for (int n = 0; n < 20000; ++n) {
+      // L c0 … c(k+2) E with random letters (valid or not: the automata answer for any string).
+      const int letters = 4 + static_cast<int>(rng() % 12);
+      std::string path = "L";
+      for (int i = 0; i < letters; ++i) path += (rng() % 3 == 0) ? 'S' : 'D';
+      path += 'E';
+      const bool in = !cl.members(cl.classify(path)).empty();
+      EXPECT_EQ(in, only.records(accel::pack(path))) << path;
+      requested += in ? 1 : 0;
+      SubpathPrefix light(&only, true, path[1], path[2]);
+      bool dead = !light.alive();
+      for (std::size_t i = 3; i + 1 < path.size() && !dead; ++i) {
+        light.extend(path[i]);
+        dead = !light.alive();
+      }
+      if (dead) {
+        ++dead_light;
+        EXPECT_FALSE(in) << expr << ": the light subpath of " << path << " was stopped";
+      }
+      SubpathPrefix eye(&only, false, path[path.size() - 2], path[path.size() - 3]);
+      dead = !eye.alive();
+      for (std::size_t i = path.size() - 4; i >= 1 && !dead; --i) {
+        eye.extend(path[i]);
+        dead = !eye.alive();
+      }
+      if (dead) {
+        ++dead_eye;
+        EXPECT_FALSE(in) << expr << ": the eye subpath of " << path << " was stopped";
+      }
+    }
+    EXPECT_GT(requested, 0) << expr;
+    EXPECT_EQ(dead_light > 0, c.light_dies) << expr << ": " << dead_light << " light subpaths stopped";
+    EXPECT_EQ(dead_eye > 0, c.eye_dies) << expr << ": " << dead_eye << " eye subpaths stopped";
+  }
+  // Without requested classes nothing is dead.
+  SubpathPrefix all(nullptr, true, 'S', 'D');
+  all.extend('S');
+  EXPECT_TRUE(all.alive());
+}
+
+std::string run(const std::string& args, int* status) {
+  std::string out;
+  FILE* p = popen((std::string(PATHEX_BINARY) + " " + args + " 2>&1").c_str(), "r");
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) out += buf;
+  *status = WEXITSTATUS(pclose(p));
+  return out;
+}
+
+TEST(Only, ClassesNotAskedForAreReportedNotRendered) {
+  const std::string dir = ::testing::TempDir() + "/only-not-rendered";
+  int status = 0;
+  const std::string table = run("trace " + kScenes + "point-glass.json --spp 2 --resolution 16x16 --quiet --out " + dir +
+                                    " --only '$caustic'",
+                                &status);
+  EXPECT_EQ(status, 0) << table;
+  EXPECT_NE(table.find("\ndirect: not rendered\n"), std::string::npos) << table;
+  EXPECT_NE(table.find("\ncaustic: 100.0 % of the image"), std::string::npos) << table;
+  EXPECT_NE(table.find("rendered only caustic (L..S+D.*..E)"), std::string::npos) << table;
+  std::ifstream in(dir + "/histogram.json");
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  ASSERT_EQ(doc.at("only").size(), 1u);
+  EXPECT_EQ(doc.at("only")[0].at("name"), "caustic");
+  for (const nlohmann::json& c : doc.at("classes")) {
+    const bool caustic = c.at("name") == "caustic";
+    EXPECT_EQ(c.contains("luminance"), caustic) << c.dump();
+    EXPECT_EQ(c.value("rendered", true), caustic) << c.dump();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/direct.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/caustic.png"));
+  // An expression that is no class of the render becomes one ("only-1"), estimated.
+  const std::string json = run("trace " + kScenes + "point-glass.json --spp 2 --resolution 8x8 --quiet --json --out " + dir +
+                                   " --only 'L.{8,}E'",
+                               &status);
+  EXPECT_EQ(status, 0) << json;
+  const nlohmann::json doc2 = nlohmann::json::parse(json);
+  EXPECT_EQ(doc2.at("classes").back().at("name"), "only-1");
+  EXPECT_TRUE(doc2.at("classes").back().contains("luminance"));
+  // "render": true in a class file is the same request.
+  const std::string file = ::testing::TempDir() + "/only-classes.json";
+  std::ofstream(file) << R"({"classes": [{"name": "glass", "expr": "$caustic", "render": true},)"
+                      << R"( {"name": "short", "expr": "L.{4,5}E"}, {"name": "long", "expr": "L..S+D.*..E & L.{9,}E"}]})";
+  const std::string listed = run("trace " + kScenes + "point-glass.json --spp 2 --resolution 8x8 --quiet --json --out " + dir +
+                                     " --classes " + file,
+                                 &status);
+  EXPECT_EQ(status, 0) << listed;
+  const nlohmann::json doc3 = nlohmann::json::parse(listed);
+  ASSERT_EQ(doc3.at("classes").size(), 3u);
+  EXPECT_TRUE(doc3.at("classes")[0].contains("luminance"));
+  EXPECT_EQ(doc3.at("classes")[1].value("rendered", true), false);  // not within the caustics
+  EXPECT_TRUE(doc3.at("classes")[2].contains("luminance"));          // within the caustics: estimated
+  // Caustics of a scene without a specular material: nothing runs, and the output says why.
+  const std::string none = run("trace " + kScenes + "point-plane.json --spp 2 --quiet --out " + dir + "-none --only '$caustic'", &status);
+  EXPECT_EQ(status, 1) << none;
+  EXPECT_NE(none.find("nothing to render: no strategy of bdpt samples a path of the requested classes in this scene "
+                      "(lights point; sensor pinhole; materials D)"),
+            std::string::npos)
+      << none;
+  EXPECT_NE(none.find("L..S+D.*..E has no path in this scene"), std::string::npos) << none;
+  EXPECT_FALSE(std::filesystem::exists(dir + "-none/histogram.json"));
+  // A bad expression is a located usage error.
+  const std::string bad = run("trace " + kScenes + "point-glass.json --spp 1 --quiet --out " + dir + " --only 'L(('", &status);
+  EXPECT_EQ(status, 2) << bad;
+  EXPECT_NE(bad.find("--only 'L(('"), std::string::npos) << bad;
+}
+
+}  // namespace
+}  // namespace pathex
