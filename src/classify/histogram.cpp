@@ -45,6 +45,8 @@ std::optional<ExactSum> exact_from_string(std::string_view s) {
 
 // --- the accumulator ---
 
+const Histogram::Cell Histogram::kEmptyCell{};
+
 Histogram::Histogram(HistogramLayout layout, const Classifier* classifier)
     : layout_(std::move(layout)),
       classifier_(classifier),
@@ -59,7 +61,6 @@ Histogram::PathId Histogram::intern(std::string_view path) {
   paths_.emplace_back(path);
   ids_.emplace(paths_.back(), id);
   sets_.push_back(classifier_ != nullptr ? classifier_->classify(path) : 0);
-  for (std::vector<Cell>& row : cells_) row.emplace_back();
   first_row_.push_back(-1);
   return id;
 }
@@ -104,12 +105,13 @@ void Histogram::add_exact(PathId id, int batch, int strategy, const ExactRgb& c)
   if (strategy != kNoStrategy) {
     const int r = technique_row(id, strategy);
     ++rows_[static_cast<std::size_t>(r)].contributions;
-    row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(r)] += luminance_exact(c);
+    row_sum_of(r, batch) += luminance_exact(c);
   }
   add_magnitude_of(c);
 }
 
 void Histogram::add_cell(PathId id, int batch, const ExactRgb& sum, std::uint64_t contributions) {
+  if (contributions == 0 && is_zero(sum)) return;  // leaves an unused batch unused
   Cell& cell = cell_of(id, batch);
   add_to(cell.sum, sum);
   cell.contributions += contributions;
@@ -123,7 +125,6 @@ int Histogram::technique_row(PathId id, int technique) {
   }
   const int r = static_cast<int>(rows_.size());
   rows_.push_back(TechniqueRow{id, technique, 0, -1});
-  for (std::vector<ExactSum>& sums : row_sums_) sums.push_back(0);
   (last < 0 ? first_row_[static_cast<std::size_t>(id)] : rows_[static_cast<std::size_t>(last)].next) = r;
   return r;
 }
@@ -139,7 +140,8 @@ void Histogram::add_technique(PathId id, int technique, std::uint64_t contributi
   const int r = technique_row(id, technique);
   rows_[static_cast<std::size_t>(r)].contributions += contributions;
   if (batch_sums == nullptr) return;
-  for (std::size_t b = 0; b < row_sums_.size(); ++b) row_sums_[b][static_cast<std::size_t>(r)] += batch_sums[b];
+  for (int b = 0; b < num_batches(); ++b)
+    if (batch_sums[b] != 0) row_sum_of(r, b) += batch_sums[b];
 }
 
 std::string Technique::name(const HistogramLayout& layout) const {
@@ -164,6 +166,7 @@ Result<bool> Histogram::merge(const Histogram& other) {
   for (PathId o = 0; o < other.num_paths(); ++o) {
     const PathId id = intern(other.path(o));
     for (int b = 0; b < layout_.num_batches; ++b) {
+      if (!other.batch_in_use(b)) continue;
       const Cell& src = other.cell(o, b);
       add_cell(id, b, src.sum, src.contributions);
     }
@@ -176,6 +179,24 @@ Result<bool> Histogram::merge(const Histogram& other) {
   for (std::size_t b = 0; b < batch_samples_.size(); ++b) batch_samples_[b] += other.batch_samples_[b];
   nonfinite_ += other.nonfinite_;
   add_magnitude(other.magnitude_);
+  return true;
+}
+
+Result<bool> Histogram::merge(Histogram&& other) {
+  if (!paths_.empty() || !rows_.empty() || !(other.layout_ == layout_) || other.classifier_ != classifier_)
+    return merge(static_cast<const Histogram&>(other));
+  // Nothing here yet: the sums are other's, moved; the counts add to what this one has.
+  ids_ = std::move(other.ids_);
+  paths_ = std::move(other.paths_);
+  sets_ = std::move(other.sets_);
+  cells_ = std::move(other.cells_);
+  first_row_ = std::move(other.first_row_);
+  rows_ = std::move(other.rows_);
+  row_sums_ = std::move(other.row_sums_);
+  for (std::size_t b = 0; b < batch_samples_.size(); ++b) batch_samples_[b] += other.batch_samples_[b];
+  nonfinite_ += other.nonfinite_;
+  add_magnitude(other.magnitude_);
+  other = Histogram(layout_, classifier_);
   return true;
 }
 

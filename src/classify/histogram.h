@@ -33,9 +33,13 @@
 // which is unbiased for independent samples and reduces to the textbook Σ (X_b − X̄)² / (B(B−1))
 // when the batches are equal. It needs at least two batches holding samples; otherwise it is NaN.
 //
-// Memory: per distinct path string, B cells of 64 bytes, and per technique that sampled it a row
-// of B × 16 bytes (about 2 KiB + 0.5 KiB per technique for B = 32). A Histogram has one writer; each worker thread owns one (a
-// "shard") and the shards are merged at the end.
+// Memory: per distinct path string and per batch that holds a contribution of any path, a cell of
+// 64 bytes, and per technique that sampled it 16 bytes per such batch (about 2 KiB + 0.5 KiB per
+// technique for B = 32 batches in use). A batch's cells and row sums are laid out the first time
+// something is added to it: a render of fewer passes than B fills only as many batches (the
+// default 16 spp half of them, a one-pass shard one), and the others cost nothing, neither memory
+// nor the page faults and copies that first touching it took. A Histogram has one writer; each
+// worker thread owns one (a "shard") and the shards are merged at the end.
 #pragma once
 
 #include <array>
@@ -223,7 +227,7 @@ class Histogram {
     Cell& cell = cell_of(id, batch);
     add_to(cell.sum, c);
     ++cell.contributions;
-    row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(row)] += luminance_exact(c);
+    row_sum_of(row, batch) += luminance_exact(c);
     add_magnitude_of(c);
   }
   // The row of (path, technique code), added on first sight.
@@ -236,17 +240,24 @@ class Histogram {
   // Adds everything `other` holds. Exact and order-independent. Fails (kUsage) if the layouts
   // differ.
   Result<bool> merge(const Histogram& other);
+  // The same, taking `other`'s paths, cells and rows as they are when this histogram has none yet
+  // (a render's first worker histogram): the same sums, without copying them. `other` is left empty.
+  Result<bool> merge(Histogram&& other);
 
   // --- the exact state (for reports and serialisation) ---
   const Cell& cell(PathId id, int batch) const {
-    return cells_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(id)];
+    const std::vector<Cell>& cells = cells_[static_cast<std::size_t>(batch)];
+    return static_cast<std::size_t>(id) < cells.size() ? cells[static_cast<std::size_t>(id)] : kEmptyCell;
   }
   // The path's first technique row (-1: none); follow TechniqueRow::next for the others.
   int first_row(PathId id) const { return first_row_[static_cast<std::size_t>(id)]; }
   const TechniqueRow& row(int r) const { return rows_[static_cast<std::size_t>(r)]; }
   ExactSum row_sum(int r, int batch) const {
-    return row_sums_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(r)];
+    const std::vector<ExactSum>& sums = row_sums_[static_cast<std::size_t>(batch)];
+    return static_cast<std::size_t>(r) < sums.size() ? sums[static_cast<std::size_t>(r)] : ExactSum{0};
   }
+  // Whether anything was ever added to the batch's cells or row sums (the others are all zero).
+  bool batch_in_use(int batch) const { return !cells_[static_cast<std::size_t>(batch)].empty(); }
   int num_rows() const { return static_cast<int>(rows_.size()); }
   // The path's rows ordered by technique code (the order serialised forms use).
   std::vector<int> sorted_rows(PathId id) const;
@@ -272,8 +283,17 @@ class Histogram {
     using is_transparent = void;
     std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
   };
+  static const Cell kEmptyCell;  // what cell() reads in a batch not laid out that far
+  // A batch's cells (and row sums) reach the paths (rows) seen so far when first written to.
   Cell& cell_of(PathId id, int batch) {
-    return cells_[static_cast<std::size_t>(batch)][static_cast<std::size_t>(id)];
+    std::vector<Cell>& cells = cells_[static_cast<std::size_t>(batch)];
+    if (static_cast<std::size_t>(id) >= cells.size()) cells.resize(paths_.size());
+    return cells[static_cast<std::size_t>(id)];
+  }
+  ExactSum& row_sum_of(int r, int batch) {
+    std::vector<ExactSum>& sums = row_sums_[static_cast<std::size_t>(batch)];
+    if (static_cast<std::size_t>(r) >= sums.size()) sums.resize(rows_.size(), 0);
+    return sums[static_cast<std::size_t>(r)];
   }
 
   HistogramLayout layout_;
@@ -282,7 +302,8 @@ class Histogram {
   std::vector<std::string> paths_;
   std::vector<std::uint32_t> sets_;
   // Batch-major, [batch][id]: a render's passes go to batches round-robin, so the cells it adds
-  // to at a time are a few batches' rows, not a line of every path's B cells.
+  // to at a time are a few batches' rows, not a line of every path's B cells. A batch's row is
+  // empty until written to and then at most num_paths() long (cell() reads past its end as zero).
   std::vector<std::vector<Cell>> cells_;
   // Each |channel| < 2^114, so the sum of three cannot wrap before saturating.
   void add_magnitude_of(const ExactRgb& c) {
@@ -292,7 +313,8 @@ class Histogram {
   }
   std::vector<int> first_row_;           // per path
   std::vector<TechniqueRow> rows_;
-  // Batch-major like cells_, [batch][row]: the rows a render adds to at a time are one batch's.
+  // Batch-major like cells_, [batch][row]: the rows a render adds to at a time are one batch's;
+  // laid out on first write like cells_.
   std::vector<std::vector<ExactSum>> row_sums_;
   std::vector<std::uint64_t> batch_samples_;
   std::uint64_t nonfinite_ = 0;

@@ -942,7 +942,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   for (Integrator::Thread& th : locals) {
     th.splats.flush(out.images);
     th.ids.flush(th.hist);
-    Result<bool> m = out.histogram.merge(th.hist);
+    Result<bool> m = out.histogram.merge(std::move(th.hist));  // the first thread's moved, not copied
     if (!m) return m.error();
     out.rays += th.rays;
     if (th.first_nonfinite && (!out.first_nonfinite || th.first_nonfinite->order() < out.first_nonfinite->order()))
