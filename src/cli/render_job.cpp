@@ -182,7 +182,7 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
   // sums only). The bytes do not depend on it.
   std::optional<Result<bool>> shard;
   tbb::task_group group;
-  group.run([&] { shard.emplace(write_file_atomic(dir + "/" + kRenderShardName, encode_shard(header, sums.histogram, sums.images))); });
+  group.run([&] { shard.emplace(write_shard(dir + "/" + kRenderShardName, header, sums.histogram, sums.images)); });
   Result<WrittenReport> rest = write_report_and_images(dir, header, sums, classes, connectors, not_run);
   group.wait();
   if (!rest) return rest.error();

@@ -387,7 +387,7 @@ int run(const TraceArgs& a) {
     const std::string mine = rank_shard_path(job.out, rank);
     std::error_code ec;
     std::filesystem::create_directories(ranks_folder(job.out), ec);
-    if (Result<bool> w = write_file_atomic(mine, encode_shard(header, sums.histogram, sums.images)); !w) return report(w.error());
+    if (Result<bool> w = write_shard(mine, header, sums.histogram, sums.images); !w) return report(w.error());
     if (stopped->load())
       std::fprintf(stderr, "pathex: rank %d stopped after %s of its passes; they are kept in %s ('pathex trace --resume %s' finishes the render)\n",
                    rank, out->passes_done.to_string().c_str(), mine.c_str(), job.out.c_str());

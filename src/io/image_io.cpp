@@ -1,6 +1,6 @@
-// OpenEXR and PNG encoding in memory (so that write_file_atomic can place the file whole), EXR
-// reading, and the preview tone mapping. OpenEXR reports errors by exceptions; they are caught
-// here and turned into Error values naming the file.
+// OpenEXR and PNG encoding (the EXR straight into its file, the PNGs in memory; either placed
+// whole by io/atomic_file.h), EXR reading, and the preview tone mapping. OpenEXR reports errors
+// by exceptions; they are caught here and turned into Error values naming the file.
 #include "io/image_io.h"
 
 #include <algorithm>
@@ -58,6 +58,30 @@ class MemoryOStream : public Imf::OStream {
   std::size_t pos_ = 0;
 };
 
+// An OpenEXR output stream into an AtomicFile, written as it is encoded (OpenEXR seeks back once,
+// to fill in the table of line offsets).
+class FileOStream : public Imf::OStream {
+ public:
+  explicit FileOStream(AtomicFile* file) : Imf::OStream("<file>"), file_(file) {}
+  void write(const char c[], int n) override {
+    const std::string_view bytes(c, static_cast<std::size_t>(n));
+    if (pos_ == file_->size()) {
+      file_->append(bytes);
+    } else {
+      const std::uint64_t inside = std::min<std::uint64_t>(bytes.size(), file_->size() - pos_);
+      file_->write_at(pos_, bytes.substr(0, static_cast<std::size_t>(inside)));
+      file_->append(bytes.substr(static_cast<std::size_t>(inside)));
+    }
+    pos_ += bytes.size();
+  }
+  uint64_t tellp() override { return pos_; }
+  void seekp(uint64_t pos) override { pos_ = pos; }
+
+ private:
+  AtomicFile* file_;
+  std::uint64_t pos_ = 0;
+};
+
 Result<bool> check_layers(const std::vector<ImageLayer>& layers) {
   if (layers.empty()) return make_error(ErrorCode::kUsage, "no image layers to write");
   const int w = layers[0].image.width, h = layers[0].image.height;
@@ -88,7 +112,10 @@ std::uint64_t render_memory_estimate(int width, int height, int layers) {
 
 // --- OpenEXR ---
 
-Result<std::string> encode_exr(const std::vector<ImageLayer>& layers, const ExrOptions& options) {
+namespace {
+
+// The file into `out` (MemoryOStream or FileOStream).
+Result<bool> encode_exr_into(Imf::OStream& out, const std::vector<ImageLayer>& layers, const ExrOptions& options) {
   if (Result<bool> ok = check_layers(layers); !ok) return ok.error();
   const int w = layers[0].image.width, h = layers[0].image.height;
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
@@ -119,28 +146,39 @@ Result<std::string> encode_exr(const std::vector<ImageLayer>& layers, const ExrO
                                       x_stride * static_cast<std::size_t>(w)));
       }
     }
-    // At most the raw pixels (RLE grows a run-free line by one byte in 128) and the header.
-    MemoryOStream out(layers.size() * pixels * 3 * size * 130 / 128 + 65536);
     {
       // Blocks of scan lines compressed on every core (the bytes do not depend on it).
       Imf::OutputFile file(out, header, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
       file.setFrameBuffer(frame);
       file.writePixels(h);
     }  // the destructor completes the file (line offset table)
-    return out.take();
+    return true;
   } catch (const std::exception& ex) {
     return make_error(ErrorCode::kBadFile, std::string("OpenEXR could not encode the image: ") + ex.what());
   }
 }
 
+}  // namespace
+
+Result<std::string> encode_exr(const std::vector<ImageLayer>& layers, const ExrOptions& options) {
+  // At most the raw pixels (RLE grows a run-free line by one byte in 128) and the header.
+  const std::size_t raw = layers.empty() ? 0 : layers.size() * layers[0].image.rgb.size() * (options.half ? 2 : 4);
+  MemoryOStream out(raw * 130 / 128 + 65536);
+  if (Result<bool> r = encode_exr_into(out, layers, options); !r) return r.error();
+  return out.take();
+}
+
 Result<bool> write_exr(const std::string& path, const std::vector<ImageLayer>& layers, const ExrOptions& options) {
-  Result<std::string> bytes = encode_exr(layers, options);
-  if (!bytes) {
-    Error e = bytes.error();
+  // Straight into the file: a memory copy of it would be as large as the layers.
+  AtomicFile file(path);
+  if (!file.ok()) return file.commit();  // the error
+  FileOStream out(&file);
+  if (Result<bool> r = encode_exr_into(out, layers, options); !r) {
+    Error e = r.error();
     e.where = path;
     return e;
   }
-  return write_file_atomic(path, *bytes);
+  return file.commit();
 }
 
 Result<ExrChannels> read_exr(const std::string& path) {

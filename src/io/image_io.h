@@ -1,8 +1,9 @@
 // Image outputs of `pathex trace`: one multi-layer OpenEXR file (a layer per class plus "total",
 // channels "<layer>.R", "<layer>.G", "<layer>.B") and an 8-bit sRGB PNG preview per layer.
 //
-// Every writer encodes in memory and hands the bytes to write_file_atomic (io/atomic_file.h), so
-// an output file is written whole or not at all (DESIGN §12). Errors are values naming the path.
+// Every writer goes through io/atomic_file.h (the EXR streamed into its file as it is encoded, a
+// PNG's bytes handed over whole), so an output file is written whole or not at all (DESIGN §12).
+// Errors are values naming the path.
 //
 // Previews share one exposure, chosen so that the 99th percentile of the total's luminance maps
 // to 1 (preview_exposure), so class previews are comparable with the total and with each other;

@@ -17,7 +17,8 @@
 //   12      4     H: header length in bytes
 //   16      H     header: a JSON object (UTF-8), keys below
 //   16+H    8     N: body length in bytes
-//   24+H    N     body: the exact sums, encoded as below, compressed as one zstd frame (level 1)
+//   24+H    N     body: the exact sums, encoded as below, compressed as one zstd frame (any level;
+//                 pathex writes its fast level -3)
 //   24+H+N  4     CRC-32 (ISO-HDLC, zlib's crc32) of every byte before it
 //
 // A file whose length is not 28 + H + N is truncated (or has trailing bytes); a CRC mismatch
@@ -121,6 +122,10 @@ struct ShardHeader {
 
 // The file's bytes. `histogram` and `images` hold the sums of exactly `header.passes`.
 std::string encode_shard(const ShardHeader& header, const Histogram& histogram, const ClassImages& images);
+// The same bytes written to `path` as they are encoded (whole or not at all: io/atomic_file.h),
+// without holding the file in memory.
+Result<bool> write_shard(const std::string& path, const ShardHeader& header, const Histogram& histogram,
+                         const ClassImages& images);
 
 // A shard file checked (length, CRC) and its header parsed; the body is decoded by add_shard_sums.
 struct ShardFile {
