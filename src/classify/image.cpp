@@ -61,6 +61,7 @@ ClassImages::ClassImages(int width, int height, const Classifier* classifier, co
     for (std::size_t layer : layers) slots_of_layer_[layer].push_back(slot);
   }
   for (auto& slots : slots_of_layer_) std::sort(slots.begin(), slots.end());
+  allocation_ = std::make_unique<std::mutex>();
   planes_ = std::make_unique<std::atomic<TileDirectory*>[]>(num_slots_);
   for (std::size_t slot = 0; slot < num_slots_; ++slot) planes_[slot].store(nullptr, std::memory_order_relaxed);
 }
@@ -74,7 +75,9 @@ ClassImages::ClassImages(ClassImages&& other) noexcept
       slots_of_layer_(std::move(other.slots_of_layer_)),
       slot_of_set_(std::move(other.slot_of_set_)),
       num_slots_(other.num_slots_),
-      planes_(std::move(other.planes_)) {
+      planes_(std::move(other.planes_)),
+      tiles_(std::move(other.tiles_)),
+      allocation_(std::move(other.allocation_)) {
   other.num_slots_ = 0;
 }
 
@@ -88,6 +91,8 @@ ClassImages& ClassImages::operator=(ClassImages&& other) noexcept {
     slot_of_set_ = std::move(other.slot_of_set_);
     num_slots_ = other.num_slots_;
     planes_ = std::move(other.planes_);
+    tiles_ = std::move(other.tiles_);
+    allocation_ = std::move(other.allocation_);
     other.num_slots_ = 0;
   }
   return *this;
@@ -98,34 +103,28 @@ void ClassImages::release() {
   for (std::size_t slot = 0; slot < num_slots_; ++slot) {
     TileDirectory* dir = planes_[slot].load(std::memory_order_relaxed);
     if (dir == nullptr) continue;
-    for (std::size_t t = 0; t < num_tiles(); ++t) delete[] dir[t].load(std::memory_order_relaxed);
-    delete[] dir;
+    delete[] dir;  // its tiles are the arena's
   }
   planes_.reset();
+  tiles_ = ZeroedArena();
 }
 
 std::uint64_t* ClassImages::tile(std::size_t slot, std::size_t tile) {
-  // Both levels are allocated on first use; a thread that loses the race to install one frees
-  // its own and uses the winner's.
+  if (const TileDirectory* dir = planes_[slot].load(std::memory_order_acquire))
+    if (std::uint64_t* words = dir[tile].load(std::memory_order_acquire)) return words;
+  // The first touch of the plane or the tile: both are made under the lock, once (the adds
+  // themselves stay lock-free); the tile comes zeroed from the arena.
+  const std::lock_guard<std::mutex> hold(*allocation_);
   TileDirectory* dir = planes_[slot].load(std::memory_order_acquire);
   if (dir == nullptr) {
-    auto* fresh = new TileDirectory[num_tiles()];
-    for (std::size_t t = 0; t < num_tiles(); ++t) fresh[t].store(nullptr, std::memory_order_relaxed);
-    if (planes_[slot].compare_exchange_strong(dir, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) {
-      dir = fresh;
-    } else {
-      delete[] fresh;
-    }
+    dir = new TileDirectory[num_tiles()];
+    for (std::size_t t = 0; t < num_tiles(); ++t) dir[t].store(nullptr, std::memory_order_relaxed);
+    planes_[slot].store(dir, std::memory_order_release);
   }
-  std::atomic<std::uint64_t*>& entry = dir[tile];
-  std::uint64_t* words = entry.load(std::memory_order_acquire);
+  std::uint64_t* words = dir[tile].load(std::memory_order_acquire);
   if (words == nullptr) {
-    auto* fresh = new std::uint64_t[kTileWords]();
-    if (entry.compare_exchange_strong(words, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) {
-      words = fresh;
-    } else {
-      delete[] fresh;
-    }
+    words = static_cast<std::uint64_t*>(tiles_.allocate(kTileWords * sizeof(std::uint64_t)));
+    dir[tile].store(words, std::memory_order_release);
   }
   return words;
 }

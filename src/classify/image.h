@@ -7,9 +7,10 @@
 // whatever the number of class layers; a layer is the sum of the planes of the sets that contain
 // its class (the total: of all planes), formed only when read. Sets with the same layers share a
 // plane (without class layers there is one plane, the total's). Planes are allocated in 8 × 8-pixel
-// tiles, each the first time a contribution lands in it, so memory is 48 bytes per pixel per
-// combination of layers, counted only over the tiles where that combination occurs (rare
-// combinations, and there are hundreds with twenty overlapping classes, cost a few tiles).
+// tiles (carved from a ZeroedArena, core/zeroed_arena.h), each the first time a contribution lands
+// in it, so memory is 48 bytes per pixel per combination of layers, counted only over the tiles
+// where that combination occurs (rare combinations, and there are hundreds with twenty
+// overlapping classes, cost a few tiles).
 //
 // Any thread may add to any pixel at any time — camera samples to their own pixel, light-tracing
 // splats anywhere — without locks and without per-thread copies of the frame: each channel is a
@@ -30,12 +31,14 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include "classify/classifier.h"
 #include "classify/histogram.h"
 #include "core/error.h"
+#include "core/zeroed_arena.h"
 
 namespace pathex {
 
@@ -201,6 +204,8 @@ class ClassImages {
   std::vector<std::size_t> slot_of_set_;                  // class set -> its plane's slot
   std::size_t num_slots_ = 0;                             // distinct layer lists among the sets
   std::unique_ptr<std::atomic<TileDirectory*>[]> planes_;  // per slot, null until first used
+  ZeroedArena tiles_;                                      // every tile's words
+  std::unique_ptr<std::mutex> allocation_;                 // held while a directory or tile is made
 };
 
 }  // namespace pathex
