@@ -182,24 +182,6 @@ Result<bool> Histogram::merge(const Histogram& other) {
   return true;
 }
 
-Result<bool> Histogram::merge(Histogram&& other) {
-  if (!paths_.empty() || !rows_.empty() || !(other.layout_ == layout_) || other.classifier_ != classifier_)
-    return merge(static_cast<const Histogram&>(other));
-  // Nothing here yet: the sums are other's, moved; the counts add to what this one has.
-  ids_ = std::move(other.ids_);
-  paths_ = std::move(other.paths_);
-  sets_ = std::move(other.sets_);
-  cells_ = std::move(other.cells_);
-  first_row_ = std::move(other.first_row_);
-  rows_ = std::move(other.rows_);
-  row_sums_ = std::move(other.row_sums_);
-  for (std::size_t b = 0; b < batch_samples_.size(); ++b) batch_samples_[b] += other.batch_samples_[b];
-  nonfinite_ += other.nonfinite_;
-  add_magnitude(other.magnitude_);
-  other = Histogram(layout_, classifier_);
-  return true;
-}
-
 // --- statistics ---
 
 Estimate batch_means(const std::vector<ExactRgb>& batch_sums, const std::vector<std::uint64_t>& batch_samples,

@@ -292,6 +292,32 @@ TEST(AtomicWrite, ReplacesTheFileWholeAndLeavesNoTemporary) {
   EXPECT_EQ(dir.entries(), std::set<std::string>{"histogram.json"});
 }
 
+// Streamed: pieces larger and smaller than its buffer, and a patch over bytes both in the file
+// and still in the buffer, give the bytes of one write.
+TEST(AtomicWrite, AStreamedFileHasTheBytesOfOneWrite) {
+  TempDir dir;
+  const std::string path = dir.file("render.shard");
+  std::string expected = std::string(3 << 20, 'a') + "0123456789" + std::string(1000, 'b');
+  {
+    AtomicFile file(path);
+    ASSERT_TRUE(file.ok());
+    file.append(std::string_view(expected).substr(0, 3 << 20));
+    file.append("0123456789");
+    file.append(std::string(1000, 'b'));
+    EXPECT_EQ(file.size(), expected.size());
+    file.write_at((3 << 20) - 2, "XXXX");  // two bytes written to the file, two still buffered
+    expected.replace((3 << 20) - 2, 4, "XXXX");
+    ASSERT_TRUE(file.commit());
+  }
+  EXPECT_EQ(read_bytes(path), expected);
+  EXPECT_EQ(dir.entries(), std::set<std::string>{"render.shard"});
+  {
+    AtomicFile abandoned(dir.file("other.shard"));
+    abandoned.append("never committed");
+  }
+  EXPECT_EQ(dir.entries(), std::set<std::string>{"render.shard"});
+}
+
 TEST(AtomicWrite, AMissingDirectoryIsAnErrorNamingThePath) {
   TempDir dir;
   const std::string path = dir.file("no/such/dir/histogram.json");
