@@ -53,14 +53,6 @@ Result<Range> narrowed(const Strategy& st, bool on_s, std::optional<int> max_bou
   return Range{lo, hi >= last - 1 ? r.hi : hi};
 }
 
-// The language of one join (s, DD, t) of `owner`.
-Result<Dfa> join_language(const Strategy& owner, Join j, int max_bounces, const Limits& limits) {
-  Strategy one = owner;
-  one.s = Range{j.s, j.s};
-  one.t = Range{j.t, j.t};
-  return strategy_language(one, max_bounces, limits);
-}
-
 // Rays to extend a subpath from its first vertex to `vertices` vertices (cover_cost()).
 double subpath_rays(int vertices) {
   double r = 0.0;
@@ -112,21 +104,37 @@ Result<CoverSelection> select_cover(const Profile& pruned, int max_bounces, cons
   std::vector<std::size_t> owner;
   std::vector<Dfa> lang;
   std::map<std::pair<int, int>, bool> seen;
+  // A join's wanted paths are the wanted paths of its length whose join sits after s letters: one
+  // language per length and one per (strategy, s), rather than one per join.
+  std::vector<Dfa> wanted_of_length(static_cast<std::size_t>(letters) + 1, dfa_empty());
+  for (int n = 4; n <= letters; ++n)
+    wanted_of_length[static_cast<std::size_t>(n)] = dfa_intersect(
+        wanted, n == 4 ? dfa_universe_bounded(0) : dfa_difference(dfa_universe_bounded(n - 4), dfa_universe_bounded(n - 5)));
   for (std::size_t i = 0; i < pruned.strategies.size(); ++i) {
     const Strategy& st = pruned.strategies[i];
     if (st.connector != ConnectorKind::kNone) continue;
-    for (int s = 0; s + 2 <= letters; ++s)
+    for (int s = 0; s + 2 <= letters; ++s) {
+      if (!st.s.contains(s)) continue;
+      std::optional<Dfa> after_s;  // the strategy's language with s letters before its join
       for (int t = 0; s + t + 2 <= letters; ++t) {
-        if (!st.s.contains(s) || !st.t.contains(t) || seen[{s, t}]) continue;
+        if (!st.t.contains(t) || seen[{s, t}]) continue;
         seen[{s, t}] = true;
-        Result<Dfa> l = join_language(st, Join{s, t}, max_bounces, limits);
-        if (!l) return l.error();
-        Dfa mine = dfa_intersect(*l, wanted);
+        const Dfa& w = wanted_of_length[static_cast<std::size_t>(s + t + 2)];
+        if (is_empty(w)) continue;
+        if (!after_s) {
+          Strategy one = st;
+          one.s = Range{s, s};
+          Result<Dfa> l = strategy_language(one, max_bounces, limits);
+          if (!l) return l.error();
+          after_s = std::move(*l);
+        }
+        Dfa mine = dfa_intersect(*after_s, w);
         if (is_empty(mine)) continue;
         x.push_back(Join{s, t});
         owner.push_back(i);
         lang.push_back(std::move(mine));
       }
+    }
   }
   // Hits (s = 0: an eye subpath that happens to reach an area light; t = 0: a light subpath that
   // reaches the lens) cost no ray, but sample by chance: for a small light or lens they are the
@@ -163,28 +171,54 @@ Result<CoverSelection> select_cover(const Profile& pruned, int max_bounces, cons
   for (const auto& [t, members] : columns) families.push_back(members);
   std::vector<Dfa> family_lang;
   for (const std::vector<int>& f : families) family_lang.push_back(union_of(f));
-  std::vector<int> all;
-  for (std::size_t m = 0; m < x.size(); ++m)
-    if (!is_hit(m)) all.push_back(static_cast<int>(m));
-  std::vector<std::vector<int>> candidates{all};
+  out.full_cost = cover_cost(x);
+  // Only a candidate under the budget is worth it; adding joins never lowers the cost, so a family
+  // over it is skipped before any language operation.
+  const double budget = kCoverAt * out.full_cost;
+  const auto within = [&](const std::vector<int>& c) { return cover_cost(joins_of(c)) <= budget; };
+  std::vector<std::vector<int>> candidates;
+  // What each family misses, and its shortest missed path: a pair covers only if each family
+  // samples the other's, a test on one string before the language operation.
+  std::vector<Dfa> missed;
+  std::vector<std::string> missed_one;
   for (std::size_t f = 0; f < families.size(); ++f) {
-    const Dfa missed = dfa_difference(need, family_lang[f]);
-    std::vector<int> c = families[f];
-    if (!is_empty(missed))
-      for (std::size_t m = 0; m < x.size(); ++m)
-        if (!is_hit(m) && std::find(c.begin(), c.end(), static_cast<int>(m)) == c.end() &&
-            !is_empty(dfa_intersect(lang[m], missed)))
-          c.push_back(static_cast<int>(m));
-    candidates.push_back(std::move(c));
-    for (std::size_t g = f + 1; g < families.size(); ++g)
-      if (is_subset(need, dfa_union(family_lang[f], family_lang[g]))) {
-        std::vector<int> pair = families[f];
-        for (int m : families[g])
-          if (std::find(pair.begin(), pair.end(), m) == pair.end()) pair.push_back(m);
-        candidates.push_back(std::move(pair));
-      }
+    missed.push_back(dfa_difference(need, family_lang[f]));
+    missed_one.push_back(shortest_member(missed.back()).value_or(""));
+    if (missed_one.back().empty() && within(families[f])) candidates.push_back(families[f]);
   }
+  for (std::size_t f = 0; f < families.size(); ++f)
+    for (std::size_t g = f + 1; g < families.size(); ++g) {
+      if (missed_one[f].empty() || missed_one[g].empty()) continue;  // one alone covers: the pair costs more
+      if (!family_lang[g].accepts(missed_one[f]) || !family_lang[f].accepts(missed_one[g])) continue;
+      std::vector<int> pair = families[f];
+      for (int m : families[g])
+        if (std::find(pair.begin(), pair.end(), m) == pair.end()) pair.push_back(m);
+      if (within(pair) && is_empty(dfa_intersect(missed[f], missed[g]))) candidates.push_back(std::move(pair));
+    }
+  // Completions, the cheapest families first, each only while it can still beat the best so far.
+  double bound = budget;
+  for (const std::vector<int>& c : candidates) bound = std::min(bound, cover_cost(joins_of(c)));
+  std::vector<std::size_t> by_cost(families.size());
+  for (std::size_t f = 0; f < families.size(); ++f) by_cost[f] = f;
+  std::stable_sort(by_cost.begin(), by_cost.end(), [&](std::size_t a, std::size_t b) {
+    return cover_cost(joins_of(families[a])) < cover_cost(joins_of(families[b]));
+  });
+  for (std::size_t f : by_cost) {
+    if (missed_one[f].empty()) continue;
+    std::vector<int> c = families[f];
+    const auto cheap = [&] { return cover_cost(joins_of(c)) <= bound; };
+    for (std::size_t m = 0; m < x.size() && cheap(); ++m)
+      if (!is_hit(m) && std::find(c.begin(), c.end(), static_cast<int>(m)) == c.end() &&
+          !is_empty(dfa_intersect(lang[m], missed[f])))
+        c.push_back(static_cast<int>(m));
+    if (!cheap()) continue;
+    bound = cover_cost(joins_of(c));
+    candidates.push_back(std::move(c));
+  }
+  // None under the budget: every join runs (the exact pruning).
   std::vector<int> best;
+  if (candidates.empty())
+    for (std::size_t m = 0; m < x.size(); ++m) best.push_back(static_cast<int>(m));
   double best_cost = 0.0;
   for (const std::vector<int>& c : candidates) {
     if (c.empty()) continue;
@@ -199,14 +233,14 @@ Result<CoverSelection> select_cover(const Profile& pruned, int max_bounces, cons
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     return join_rays(x[static_cast<std::size_t>(a)]) > join_rays(x[static_cast<std::size_t>(b)]);
   });
-  for (int m : order) {
+  for (int m : candidates.empty() ? std::vector<int>{} : order) {
     std::vector<int> rest;
     for (int k : best)
       if (k != m) rest.push_back(k);
     if (!rest.empty() && is_subset(need, union_of(rest)) && cover_cost(joins_of(rest)) <= cover_cost(joins_of(best)))
       best = std::move(rest);
   }
-  best.insert(best.end(), hits.begin(), hits.end());
+  if (!candidates.empty()) best.insert(best.end(), hits.begin(), hits.end());
   std::sort(best.begin(), best.end(), [&](int a, int b) {
     const Join& ja = x[static_cast<std::size_t>(a)];
     const Join& jb = x[static_cast<std::size_t>(b)];
@@ -216,7 +250,6 @@ Result<CoverSelection> select_cover(const Profile& pruned, int max_bounces, cons
   });
   out.kept = joins_of(best);
   out.cost = cover_cost(out.kept);
-  out.full_cost = cover_cost(x);
   // Group each strategy's kept joins into (s, DD, t range)s: one per s and run of consecutive t.
   for (std::size_t k = 0; k < best.size();) {
     const std::size_t m = static_cast<std::size_t>(best[k]);
@@ -290,7 +323,7 @@ Result<ProfilePruning> prune_profile(const Profile& p, std::optional<int> max_bo
   // --- the cheapest cover of the requested paths ---
   Result<CoverSelection> cover = select_cover(out.profile, *max_bounces, universe, *requested, limits);
   if (!cover) return cover.error();
-  if (cover->cost >= cover->full_cost) return out;
+  if (cover->cost > kCoverAt * cover->full_cost) return out;
   char figures[160];
   std::snprintf(figures, sizeof figures, "%zu joins, %.2f rays a sample against %.2f (cost model: reach/prune.h)",
                 cover->kept.size(), cover->cost, cover->full_cost);

@@ -66,7 +66,14 @@ Result<ProfilePruning> prune_profile(const Profile& p, std::optional<int> max_bo
 // (ties: fewer joins, then rows before columns, smaller s first: camera-side sampling, whose
 // contributions stay in their pixel), with joins the rest covers dropped, the most expensive
 // first. Takes well under a second for max_bounces 16.
+//
+// A cover is used only when it costs at most kCoverAt of every join's rays: a subset that is not
+// full BDPT takes the tracer's general MIS routine (dearer per join than full BDPT's per-sample
+// sums), and the variance per sample may rise; below a 4/3 saving the exact pruning, which samples
+// the requested paths exactly as the full render does, is kept. Candidates over that budget are
+// skipped before any language operation (adding joins never lowers the cost).
 inline constexpr double kGoOn = 0.8;
+inline constexpr double kCoverAt = 0.75;
 
 struct Join {
   int s = 0, t = 0;
@@ -79,7 +86,7 @@ struct CoverSelection {
   Profile profile;           // the connector strategies and the kept joins, grouped into (s, DD, t range) strategies
   std::vector<std::vector<Strategy>> per_strategy;  // [i]: what runs of the pruned profile's strategy i
   std::vector<Join> kept;    // the kept joins
-  double cost = 0.0;         // cover_cost(kept)
+  double cost = 0.0;         // cover_cost(kept); every join (the fallback) when no candidate is within kCoverAt
   double full_cost = 0.0;    // cover_cost of every join the pruned profile runs that samples a requested path
 };
 
