@@ -36,6 +36,10 @@ CASES = [
     ("caustic of point-glass", "point-glass.json", "bdpt", "$caustic", 64, "128x128"),
     ("$direct on the Cornell box", "cornell.json", "bdpt", "$direct", 16, "128x128"),
     ("L.{8,}E on the Cornell box", "cornell.json", "bdpt", "L.{8,}E", 16, "128x128"),
+    # Classes the cover reduces (reach/prune.h): caustics seen on a diffuse surface (light tracing
+    # alone samples them), long all-diffuse paths (NEE alone).
+    ("caustic on a diffuse surface, point-glass", "point-glass.json", "bdpt", "L..S+D.*DDSE", 64, "128x128"),
+    ("LD{7,}SE on the Cornell box", "cornell.json", "bdpt", "LD{7,}SE", 16, "128x128"),
 ]
 
 

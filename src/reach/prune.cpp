@@ -263,7 +263,12 @@ Result<CoverSelection> select_cover(const Profile& pruned, int max_bounces, cons
       hi = x[n].t;
     }
     g.t = Range{x[m].t, hi};
-    out.per_strategy[owner[m]].push_back(g);
+    // Consecutive s with the same t range make one strategy (light tracing: (4..17, DD, 1)).
+    std::vector<Strategy>& mine = out.per_strategy[owner[m]];
+    if (!mine.empty() && mine.back().t.lo == g.t.lo && mine.back().t.hi == g.t.hi && mine.back().s.hi + 1 == g.s.lo)
+      mine.back().s.hi = g.s.hi;
+    else
+      mine.push_back(g);
     k = next;
   }
   for (std::size_t i = 0; i < pruned.strategies.size(); ++i) {
