@@ -60,9 +60,12 @@ def main():
     ap.add_argument("binary")
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--baseline", help="pathex before issue 14, for the cost when nothing is pruned")
+    ap.add_argument("--case", action="append", default=[], help="only the cases whose label holds this (repeatable)")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="pathex-only-")
     for label, scene, renderer, expr, spp, res in CASES:
+        if args.case and not any(c in label for c in args.case):
+            continue
         classes = os.path.join(tmp, "classes.json")
         with open(classes, "w") as f:
             json.dump({"classes": [{"name": "target", "expr": expr}]}, f)
