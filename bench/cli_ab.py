@@ -18,7 +18,7 @@ import sys
 import tempfile
 
 
-def cpu_run(cmd, cwd):
+def cpu_run(cmd, cwd=None):
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd)
     _, status, usage = os.wait4(proc.pid, 0)
     err = proc.stderr.read().decode()

@@ -114,7 +114,14 @@ inline Rgb to_double(const ExactRgb& s) { return {to_double(s[0]), to_double(s[1
 // The Rec. 709 luminance of a contribution already on the grid, rounded to the grid: a function of
 // the contribution alone (what the per-technique sums add, see Histogram::TechniqueRow).
 inline ExactSum luminance_exact(const ExactRgb& c) {
-  const auto v = [&](std::size_t i) { return static_cast<double>(static_cast<SignedExactSum>(c[i])); };
+  // The same double as the 128-bit conversion (both round the same integer to nearest), through
+  // the 64-bit one when the value fits, as most contributions do (|c| < 0.5): the 128-bit one is a
+  // library call (__floattidf), three per recorded contribution.
+  const auto v = [&](std::size_t i) {
+    const auto s = static_cast<SignedExactSum>(c[i]);
+    const auto low = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[i]));
+    return static_cast<SignedExactSum>(low) == s ? static_cast<double>(low) : static_cast<double>(s);
+  };
   return round_to_fixed(0.2126 * v(0) + 0.7152 * v(1) + 0.0722 * v(2));
 }
 inline void add_to(ExactRgb& acc, const ExactRgb& c) {

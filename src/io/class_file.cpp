@@ -59,9 +59,9 @@ Result<bool> load_class_file(const std::string& text, const std::string& filenam
     opts.notation = Notation::kFull;
     if (entry.contains("notation")) {
       const auto& n = entry.at("notation");
-      const auto notation = n.is_string() ? notation_from_string(n.get<std::string>()) : std::nullopt;
-      if (!notation) return reader.fail(ptr + "/notation", "expected \"full\", \"heckbert\" or \"lpe\"");
-      opts.notation = *notation;
+      const auto chosen = n.is_string() ? notation_from_string(n.get<std::string>()) : std::nullopt;
+      if (!chosen) return reader.fail(ptr + "/notation", "expected \"full\", \"heckbert\" or \"lpe\"");
+      opts.notation = *chosen;
     }
     std::string description;
     if (entry.contains("description")) {

@@ -22,6 +22,7 @@
 #include "trace/render.h"
 #include "trace/render_scene.h"
 #include "trace/rng.h"
+#include "trace/scene_features.h"
 #include "trace/strategy_table.h"
 #include "trace/vertex.h"
 
@@ -68,6 +69,7 @@ class Integrator {
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
     sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
     for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
+    features_ = rs.features;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
@@ -282,7 +284,9 @@ class Integrator {
   // Forced inline, as connect() below: each instantiation has one caller, and as out-of-line calls
   // (the class is shared with the tests, so its members are not local to render.cpp) they cost
   // about 2 % of pt-nee's instructions.
-  template <TransportMode mode>  // a template: the walk's tests of its direction are not branches
+  // A template on the direction: the walk's tests of its direction are not branches. What the
+  // scene cannot have (features_, trace/scene_features.h) it skips.
+  template <TransportMode mode>
   [[gnu::always_inline]] inline int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
                   float pdf_dir, int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
@@ -395,6 +399,7 @@ class Integrator {
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;
   bool lens_hits_ = false;
+  SceneFeatures features_;  // what the scene's materials can do: the walk skips the rest
 };
 
 }  // namespace pathex::tracer

@@ -56,6 +56,9 @@ namespace tracer {
 namespace {
 // Passes go to batches round-robin: every batch covers the whole image, passes are i.i.d., and
 // an interrupted render still spreads what it has over all batches (so its error is defined).
+// Paths a thread's histogram has room for before it first regrows (address space only).
+constexpr std::size_t kReservedPaths = std::size_t{1} << 14;
+
 int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % static_cast<std::uint64_t>(batches)); }
 
 // Random-number dimensions (trace/rng.h): each stage of a sample draws from its own block, so that
@@ -137,14 +140,16 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     beta *= bs->weight * bsdf::shading_normal_correction(wo, bs->wi, v.ns, v.n, mode);
     // A Dirac's densities stay symbolic: 0 here, remapped to 1 in the MIS ratios, and every
     // strategy that would join at this vertex is excluded by its letter S.
-    pdf_dir = bs->is_delta ? 0.0f : bs->pdf;
-    const float pdf_rev_dir = bs->is_delta ? 0.0f : bs->pdf_rev;
+    // (Without a specular material no lobe is a Dirac: the test is skipped.)
+    const bool delta = features_.specular && bs->is_delta;
+    pdf_dir = delta ? 0.0f : bs->pdf;
+    const float pdf_rev_dir = delta ? 0.0f : bs->pdf_rev;
     prev.pdf_rev = pdf_rev_dir * abs_cos(prev, d) * inv_d2;
     // --- Russian roulette, never mislabelling: the vertices so far stay valid prefixes ---
     // From vertex rr_depth on, a walk whose throughput relative to its start (a refraction's
     // radiance scaling 1/η² undone, so that entering glass is no loss) is below rr_threshold
     // survives with probability throughput / threshold, and a survivor carries the threshold.
-    if (mode == TransportMode::kRadiance) eta2 *= bs->eta * bs->eta;
+    if (mode == TransportMode::kRadiance && features_.transmission) eta2 *= bs->eta * bs->eta;  // else η = 1
     if (count >= o_.rr_depth && o_.rr_threshold > 0.0f) {
       const float u_rr = rng.get1d();  // drawn at every vertex, so the dimensions stay aligned
       const float survive = max_component(beta) * eta2 / (beta_start * o_.rr_threshold);
@@ -937,6 +942,13 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
         Integrator::Thread th{Histogram(layout, classifier),
                               std::vector<ClassImages::PixelSum>(static_cast<std::size_t>(out.images.width()), ClassImages::PixelSum(out.images)),
                               {}, {}, 0, {}, {}, {}};
+        // Room for many paths and technique rows at once: the histogram keeps each of its batches'
+        // cells and row sums in a row of its own, and a render finds new paths to the end (the
+        // rare long ones), so regrowing moved every row into fresh pages, again and again (a
+        // quarter of pt-nee's CPU time on the embedded Cornell box at 128 spp went to the copies
+        // and their page faults). Address space only: pages are touched as paths arrive.
+        th.hist.reserve_paths(tracer::kReservedPaths);
+        th.hist.reserve_rows(2 * tracer::kReservedPaths);
         th.images = &out.images;
         th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
         th.connectors.resize(strategies->strategies.size());
@@ -966,14 +978,27 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   }
   out.spp_done = out.passes_done.count();
   out.complete = out.passes_done == todo;
+  // The threads' histograms are summed into the first of them, which then takes the place of
+  // the output's (holding only the sample counts so far): one fewer copy of every path, and of
+  // its classification. Ids are local to a histogram, so which thread comes first does not show.
+  std::optional<Histogram> summed;
   for (Integrator::Thread& th : locals) {
     th.splats.flush(out.images);
     th.ids.flush(th.hist);
-    Result<bool> m = out.histogram.merge(th.hist);
-    if (!m) return m.error();
+    if (!summed) {
+      summed.emplace(std::move(th.hist));
+    } else {
+      Result<bool> m = summed->merge(th.hist);
+      if (!m) return m.error();
+    }
     out.rays += th.rays;
     if (th.first_nonfinite && (!out.first_nonfinite || th.first_nonfinite->order() < out.first_nonfinite->order()))
       out.first_nonfinite = th.first_nonfinite;
+  }
+  if (summed) {
+    Result<bool> m = summed->merge(out.histogram);  // the sample counts of every batch
+    if (!m) return m.error();
+    out.histogram = std::move(*summed);
   }
   // Connector statistics, in the profile's order (integer sums: the same for every thread count).
   for (std::size_t i = 0; i < strategies->strategies.size(); ++i) {

@@ -34,6 +34,7 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     rs.light_of_shape[i] = static_cast<int>(rs.lights.size());
     rs.lights.push_back(l);
   }
+  rs.features = scene_features(rs.material_of_shape);
   for (const Light& light : scene.lights) {
     RenderLight l;
     if (const auto* p = std::get_if<PointLight>(&light)) {

@@ -23,6 +23,7 @@
 #include "trace/embree_scene.h"
 #include "trace/emitters.h"
 #include "trace/joins/mirror.h"
+#include "trace/scene_features.h"
 
 namespace pathex {
 
@@ -55,6 +56,7 @@ struct RenderScene {
   std::vector<RenderLight> lights;
   std::vector<PlanarMirror> mirrors;         // quads of a pure mirror material (the mirror connector's)
   RenderSensor camera;
+  SceneFeatures features;                    // what the shapes' materials can do (trace/scene_features.h)
 };
 
 Result<RenderScene> make_render_scene(const Scene& scene);

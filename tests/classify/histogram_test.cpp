@@ -64,6 +64,28 @@ TEST(ExactSum, FastRoundingMatchesNearbyint) {
   for (double y : ys) ASSERT_EQ(round_to_fixed(y), reference(y)) << std::hexfloat << y;
 }
 
+// luminance_exact() converts through 64 bits when a value fits: the same doubles as the 128-bit
+// conversion, hence the same luminance, on both sides of the boundary and for wide values.
+TEST(ExactSum, LuminanceMatchesThe128BitConversion) {
+  const auto reference = [](const ExactRgb& c) {
+    const auto v = [&](std::size_t i) { return static_cast<double>(static_cast<SignedExactSum>(c[i])); };
+    return round_to_fixed(0.2126 * v(0) + 0.7152 * v(1) + 0.0722 * v(2));
+  };
+  const SignedExactSum edge = SignedExactSum{1} << 63;
+  std::vector<SignedExactSum> vs = {0, 1, -1, edge - 1, edge, -edge, -edge - 1, edge + 1, edge * 3 + 12345,
+                                    -(edge * 5) - 7, (SignedExactSum{1} << 100) + 1, -(SignedExactSum{1} << 100) - 1};
+  Rng rng{11};
+  for (int i = 0; i < 100000; ++i) {
+    const ExactSum r = (static_cast<ExactSum>(rng.next()) << 64) | rng.next();
+    const auto v = static_cast<SignedExactSum>(r >> (rng.next() % 128));  // of every width
+    vs.push_back(rng.next() % 2 ? v : static_cast<SignedExactSum>(ExactSum{0} - static_cast<ExactSum>(v)));  // no signed overflow
+  }
+  for (std::size_t i = 0; i + 2 < vs.size(); ++i) {
+    const ExactRgb c{static_cast<ExactSum>(vs[i]), static_cast<ExactSum>(vs[i + 1]), static_cast<ExactSum>(vs[i + 2])};
+    ASSERT_EQ(luminance_exact(c), reference(c)) << i;
+  }
+}
+
 TEST(ExactSum, TextRoundTrip) {
   const ExactSum top = static_cast<ExactSum>(1) << 127;
   for (ExactSum v : {ExactSum{0}, ExactSum{1}, ExactSum{0} - 1, static_cast<ExactSum>(0x1f) << 70, top - 1, top})
