@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -134,6 +135,95 @@ TEST(ManifoldWalk, TenInterfacesSolveAndStayFinite) {
   EXPECT_GT(w.dw_db, 0.0);
 }
 
+// The walk against brute force: the irradiance a point light at height 2.4 casts through a glass
+// sphere (centre height 0.9, radius 0.5, index 1.5) onto the floor at radius r, per unit intensity.
+// Brute force: rays uniform in the cone of the sphere, refracted twice with their Fresnel
+// transmittance, binned in an annulus around r. The walk: every distinct chain found from 3000
+// seeds (straight rays from the floor point into the sphere, refracted through it), summed, each
+// |dω_a/dA_b| times its transmittance. Near the axis three chains reach a point (rays from the far
+// side cross it), further out one.
+TEST(ManifoldWalk, SumOverChainsIsTheBruteForceIrradiance) {
+  const dvec3 a(0, 2.4, 0), c(0, 0.9, 0);
+  const double r = 0.5, n = 1.5;
+  const ShapeGeometry sphere = SphereShape{{0.0f, 0.9f, 0.0f}, 0.5f};
+  const auto fresnel = [](double cos_i, double eta) {  // eta = η_t / η_i, cos_i > 0
+    const double s2 = (1 - cos_i * cos_i) / (eta * eta);
+    if (s2 >= 1) return 1.0;
+    const double ct = std::sqrt(1 - s2), rs = (cos_i - eta * ct) / (cos_i + eta * ct), rp = (eta * cos_i - ct) / (eta * cos_i + ct);
+    return 0.5 * (rs * rs + rp * rp);
+  };
+  const auto refract = [](dvec3 d, dvec3 nrm, double eta, dvec3* out) {  // nrm against d, eta = η_i / η_t
+    const double ci = -glm::dot(d, nrm), s2 = eta * eta * (1 - ci * ci);
+    if (s2 >= 1) return false;
+    *out = glm::normalize(eta * d + (eta * ci - std::sqrt(1 - s2)) * nrm);
+    return true;
+  };
+  const auto hit = [&](dvec3 o, dvec3 d, bool inside) {
+    const dvec3 oc = o - c;
+    const double b = glm::dot(oc, d), disc = std::max(b * b - (glm::dot(oc, oc) - r * r), 0.0);
+    return inside ? -b + std::sqrt(disc) : -b - std::sqrt(disc);
+  };
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> uni(0, 1);
+  // A direction uniform in the cone from `from` around the sphere.
+  const auto cone = [&](dvec3 from) {
+    const dvec3 axis = glm::normalize(c - from);
+    const double cos_max = std::sqrt(1 - r * r / glm::dot(c - from, c - from));
+    const double z = 1 - uni(rng) * (1 - cos_max), phi = 2 * M_PI * uni(rng), s = std::sqrt(1 - z * z);
+    dvec3 t1, t2;
+    tangent_frame(axis, &t1, &t2);
+    return glm::normalize(s * std::cos(phi) * t1 + s * std::sin(phi) * t2 + z * axis);
+  };
+  const double radii[] = {0.05, 0.2};
+  const double dr = 0.005;
+  double sums[2] = {0, 0};
+  long counts[2] = {0, 0};
+  const long rays = 2000000;
+  const double cos_max = std::sqrt(1 - r * r / glm::dot(c - a, c - a)), omega = 2 * M_PI * (1 - cos_max);
+  for (long i = 0; i < rays; ++i) {
+    const dvec3 d = cone(a);
+    const dvec3 p1 = a + hit(a, d, false) * d, n1 = (p1 - c) / r;
+    dvec3 d2, d3;
+    if (!refract(d, n1, 1 / n, &d2)) continue;
+    const dvec3 p2 = p1 + hit(p1, d2, true) * d2, n2 = (p2 - c) / r;
+    if (!refract(d2, -n2, n, &d3) || d3.y >= 0) continue;
+    const dvec3 floor = p2 + (-p2.y / d3.y) * d3;
+    const double at = std::hypot(floor.x, floor.z);
+    for (int k = 0; k < 2; ++k)
+      if (std::fabs(at - radii[k]) < dr) {
+        sums[k] += (1 - fresnel(-glm::dot(d, n1), n)) * (1 - fresnel(glm::dot(d2, n2), 1 / n));
+        ++counts[k];
+      }
+  }
+  for (int k = 0; k < 2; ++k) {
+    const double area = M_PI * (std::pow(radii[k] + dr, 2) - std::pow(radii[k] - dr, 2));
+    const double brute = sums[k] * omega / static_cast<double>(rays) / area;
+    const dvec3 b(radii[k], 0, 0);
+    std::vector<std::vector<ChainVertex>> found;
+    double walk = 0.0;
+    for (int seed = 0; seed < 3000; ++seed) {
+      const dvec3 d = cone(b);
+      const dvec3 q1 = b + hit(b, d, false) * d;
+      dvec3 e;
+      if (!refract(d, (q1 - c) / r, 1 / n, &e)) continue;
+      const dvec3 q2 = q1 + hit(q1, e, true) * e;
+      std::vector<ChainVertex> x{on(sphere, q2, true), on(sphere, q1, false)};
+      const ManifoldWalk w = solve_chain(x, a, b, dvec3(0, 1, 0), 8.5, ManifoldOptions{});
+      if (w.failure != ManifoldFailure::kNone) continue;
+      bool seen = false;
+      for (const auto& y : found) seen = seen || glm::length(y[0].p - x[0].p) < 1e-4;
+      if (seen) continue;
+      found.push_back(x);
+      const double c0 = glm::dot(glm::normalize(a - x[0].p), (x[0].p - c) / r);
+      const double c1 = glm::dot(glm::normalize(x[0].p - x[1].p), (x[1].p - c) / r);
+      walk += w.dw_db * (1 - fresnel(c0, n)) * (1 - fresnel(std::fabs(c1), 1 / n));
+    }
+    EXPECT_EQ(found.size(), k == 0 ? 3u : 1u) << "radius " << radii[k];
+    // The brute force's error: a count's relative σ is 1 / √count (the weights vary little).
+    EXPECT_NEAR(walk, brute, 4.0 * brute / std::sqrt(static_cast<double>(counts[k])) + 1e-3 * brute) << "radius " << radii[k];
+  }
+}
+
 HistogramReport render_point_glass(const std::string& renderer, std::uint64_t spp, std::vector<ConnectorStats>* stats = nullptr) {
   Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/point-glass.json").expect("the sample");
   scene.camera.width = scene.camera.height = 24;
@@ -158,6 +248,10 @@ const PathEstimate* find(const HistogramReport& r, const std::string& path) {
 
 // The caustic under the sphere, seen directly: light tracing and bdpt sample it by splatting,
 // pt-nee+manifold by the walk. The caustic seen through the sphere only the walk reaches.
+// Known: the render's manifold estimate of the caustic has come out low in every run (README "The
+// manifold connector": 0.012-0.017 against light tracing's 0.0247 at 16 spp; heavy tails or a
+// bias, not settled), while the walk itself matches brute force (SumOverChainsIsTheBruteForce-
+// Irradiance); its σ is large, so the 4σ check below is weak.
 TEST(ManifoldRender, PointGlassCausticAgreesWithLightTracingAndBdpt) {
   std::vector<ConnectorStats> stats;
   const HistogramReport mf = render_point_glass("pt-nee+manifold", 64, &stats);

@@ -151,6 +151,7 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
   const double h = 1e-7 * std::max(scene_size, 1e-30);  // the difference step
   std::vector<double> j, jb;
   bool solved = false;
+  int polish = 0;
   for (w.iterations = 0; w.iterations <= o.max_iterations; ++w.iterations) {
     const Frames f = frames_of(x);
     const std::optional<std::vector<double>> c = constraints(x, a, b, f);
@@ -159,12 +160,20 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
       return w;
     }
     const double err = largest(*c);
-    if (err < o.threshold) {
+    // Solved below the threshold; up to three more steps polish it (Newton converges
+    // quadratically there), so that the same solution found from two seeds compares equal.
+    const bool within = err < o.threshold;
+    if (within && (err < 1e-4 * o.threshold || polish == 3)) {
       solved = true;
       break;
     }
-    if (w.iterations == o.max_iterations) break;
+    polish += within ? 1 : 0;
+    if (w.iterations == o.max_iterations) {
+      solved = within;
+      break;
+    }
     if (!jacobian(x, a, b, f, h, &j, nullptr, nullptr, nullptr)) {
+      if (within) { solved = true; break; }
       w.failure = ManifoldFailure::kNoSolution;
       return w;
     }
@@ -193,6 +202,7 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
       }
     }
     if (!moved) {
+      if (within) { solved = true; break; }  // as good as rounding allows
       w.failure = ManifoldFailure::kNoSolution;
       return w;
     }

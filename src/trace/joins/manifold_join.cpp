@@ -166,7 +166,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   }
   const int m = static_cast<int>(chain.size());
   // Trials until a fresh seed finds the same chain: their number K has E[K] = 1 / p(chain).
-  const double same = 1e-4 * scene_size_;
+  const double same = 1e-5 * scene_size_;
   std::vector<ChainVertex> other;
   int trials = 1;
   for (; trials < o_.manifold.max_trials; ++trials) {
