@@ -45,7 +45,9 @@
 #include "io/input_file.h"
 #include "io/output_set.h"
 #include "io/profile_json.h"
+#include "reach/prune.h"
 #include "scene/universe.h"
+#include "trace/prune.h"
 #include "trace/render.h"
 
 namespace pathex::cli {
@@ -64,6 +66,7 @@ struct ConvergeArgs {
   int threads = 0;
   std::optional<int> max_bounces;
   std::string resolution;
+  std::vector<std::string> only;  // --only: the requested classes (DESIGN §11), as pathex trace's
   std::string out = "pathex-converge";
   bool json = false;
   bool quiet = false;
@@ -160,6 +163,7 @@ struct RungSetup {
   const Classifier* classifier = nullptr;
   int threads = 0;
   std::optional<int> max_bounces;  // unset: each profile's own bound, else 16 (as trace)
+  const RequestedPaths* only = nullptr;  // --only: record these paths alone
 };
 
 struct ClassMeasure {
@@ -196,6 +200,7 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   ro.seed = seed;
   ro.threads = setup.threads;
   ro.max_bounces = setup.max_bounces;
+  ro.only = setup.only;
   for (int i = 0; i < setup.classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
   ro.cancel = &g_stop;
   g_stop.store(g_interrupted.load());
@@ -438,6 +443,11 @@ int run(const ConvergeArgs& a) {
   RenderIdentity ends;
   for (LightType l : types.lights) ends.lights.push_back(to_string(l));
   ends.sensor = to_string(types.sensor);
+  ends.only = a.only;
+  ends.max_bounces = a.max_bounces.value_or(16);
+  // With --only the scene's closed form (a total and its classes) is not the measure: the
+  // reference is --reference FILE or a reference run of the requested classes.
+  const bool closed_form = scene->reference.has_value() && a.only.empty();
   std::string class_text;
   if (!a.classes_file.empty()) {
     Result<std::string> text = read_input_file(a.classes_file, a.limits.max_file_bytes);
@@ -448,7 +458,7 @@ int run(const ConvergeArgs& a) {
   if (!listed) return report(listed.error());
   std::vector<std::unique_ptr<PathClass>> owned;
   std::vector<const PathClass*> classes = (*listed)->classes;
-  if (a.classes_file.empty() && scene->reference) {
+  if (a.classes_file.empty() && closed_form) {
     ClassOptions copts;
     copts.limits = a.limits;
     copts.ends.lights.assign(types.lights.begin(), types.lights.end());
@@ -469,12 +479,44 @@ int run(const ConvergeArgs& a) {
       classes.push_back(owned.back().get());
     }
   }
+  // --- --only: the requested classes are measured, the others listed as not rendered ---
+  std::vector<const PathClass*> not_rendered;
+  std::optional<RequestedPaths> only;
+  std::string requested_text;
+  if (!a.only.empty()) {
+    std::vector<const PathClass*> estimated;
+    for (std::size_t i = 0; i < classes.size(); ++i) ((*listed)->estimated[i] ? estimated : not_rendered).push_back(classes[i]);
+    classes = std::move(estimated);
+    for (const PathClass* c : (*listed)->requested) requested_text += (requested_text.empty() ? "" : " | ") + c->text;
+    Result<RequestedPaths> r = RequestedPaths::make((*listed)->requested, a.limits);
+    if (!r) return report(r.error());
+    only.emplace(std::move(*r));
+    // Each renderer runs the strategies and joins that sample the requested paths (reach/prune.h).
+    const Dfa universe = scene_universe(types);
+    for (Profile* p : [&] {
+           std::vector<Profile*> all;
+           for (Profile& q : profiles) all.push_back(&q);
+           all.push_back(&*ref_profile);
+           return all;
+         }()) {
+      const int bounces = a.max_bounces.value_or(p->max_bounces.value_or(16));
+      Result<ProfilePruning> pruned = prune_profile(*p, bounces, universe, (*listed)->requested_language, a.limits);
+      if (!pruned) return report(pruned.error());
+      if (pruned->samples_nothing()) {
+        std::cout << "nothing to render: no strategy of " << p->name << " samples a path of the requested classes in this scene ("
+                  << describe(types) << ")\n";
+        return kExitNo;
+      }
+      p->strategies = std::move(pruned->profile.strategies);
+    }
+  }
   Result<Classifier> classifier = Classifier::build(classes, a.limits);
   if (!classifier) return report(classifier.error());
-  std::vector<ClassRow> rows{{"total", "$all", std::nullopt, 0.0, std::nullopt}};
+  // Row 0 is every path measured: the scene's total, or with --only the requested paths' total.
+  std::vector<ClassRow> rows{{only ? "requested" : "total", only ? requested_text : "$all", std::nullopt, 0.0, std::nullopt}};
   for (const PathClass* c : classes) rows.push_back({c->name, c->text, std::nullopt, 0.0, std::nullopt});
 
-  RungSetup setup{&*scene, &*classifier, a.threads, a.max_bounces};
+  RungSetup setup{&*scene, &*classifier, a.threads, a.max_bounces, only ? &*only : nullptr};
   const int width = scene->camera.width, height = scene->camera.height;
   const std::uint64_t base_seed = a.seed;
   std::signal(SIGINT, on_interrupt);
@@ -488,7 +530,7 @@ int run(const ConvergeArgs& a) {
     if (Result<bool> r = load_reference_file(a.reference, width, height, &rows); !r) return report(r.error());
     ref.kind = "file";
     ref.source = a.reference;
-  } else if (scene->reference) {
+  } else if (closed_form) {
     for (ClassRow& row : rows)
       for (const ReferenceClass& rc : scene->reference->classes)
         if (rc.name == row.name) {
@@ -613,6 +655,15 @@ int run(const ConvergeArgs& a) {
   doc["ranks"] = cluster != nullptr ? cluster->size() : 1;  // MPI ranks, each with `threads`
   doc["max_bounces"] = a.max_bounces ? nlohmann::ordered_json(*a.max_bounces) : nlohmann::ordered_json(nullptr);
   doc["resolution"] = {width, height};
+  if (only) {  // --only: what was estimated, and what was not
+    nlohmann::ordered_json jo = nlohmann::ordered_json::array(), jn = nlohmann::ordered_json::array();
+    for (std::size_t i = 1; i < rows.size(); ++i) jo.push_back({{"name", rows[i].name}, {"expr", rows[i].expr}});
+    for (const PathClass* c : not_rendered)
+      jn.push_back({{"name", c->name}, {"expr", c->text}, {"rendered", false},
+                    {"note", "not rendered: only the requested classes were estimated (--only)"}});
+    doc["only"] = jo;
+    doc["not_rendered"] = jn;
+  }
   nlohmann::ordered_json jref = {{"kind", ref.kind}, {"source", ref.source}};
   if (ref.kind == "run") jref["run"] = ref.run;
   nlohmann::ordered_json jrefc = nlohmann::ordered_json::array();
@@ -721,6 +772,12 @@ int run(const ConvergeArgs& a) {
   // --- the table ---
   std::cout << "scene " << a.scene << ", reference: " << ref.kind << " (" << ref.source << ")"
             << (complete ? "" : "; interrupted: the finished rungs only") << "\n";
+  if (only) {
+    std::cout << "rendered only";
+    for (std::size_t i = 1; i < rows.size(); ++i) std::cout << (i > 1 ? "," : "") << " " << rows[i].name << " (" << rows[i].expr << ")";
+    std::cout << "\n";
+    for (const PathClass* c : not_rendered) std::cout << c->name << ": not rendered\n";
+  }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     std::cout << "\nclass " << rows[i].name << " " << rows[i].expr << ": reference "
               << (rows[i].reference ? fmt(*rows[i].reference, "%.6g") : std::string("none (no errors measured)"));
@@ -782,6 +839,10 @@ Command add_converge(CLI::App& app) {
   sub->add_option("--threads", args->threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
   sub->add_option("--max-bounces", args->max_bounces, "Largest number of interior vertices; default: each profile's bound, else 16")->check(CLI::Range(0, 1000));
   sub->add_option("--resolution", args->resolution, "Image size WIDTHxHEIGHT; default: the scene's")->type_name("WxH");
+  sub->add_option("--only", args->only,
+                  "Measure only the paths of this class (an expression or $name; repeatable), as pathex trace --only: the "
+                  "other classes are reported as not rendered")
+      ->type_name("EXPR");
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
   sub->add_flag("--json", args->json, "Print converge.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress lines");

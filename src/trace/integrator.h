@@ -43,12 +43,14 @@ class Integrator {
     for (int s = 0; s < 2 * kMaxVertices; ++s) any_t0 = any_t0 || table_.plain(s, 0) >= 0;
     lens_hits_ = lens_hits_ && any_t0;
     // Subpaths are only as long as a strategy can use: s = 1 and t = 1 take fresh samples, so a
-    // light subpath is traced only for some s >= 2 and an eye subpath beyond z0 for some t >= 2.
+    // light subpath is traced only for some s >= 2 (or for its first vertex, for (1, DD, 1)) and an
+    // eye subpath beyond z0 for some t >= 2.
     for (const Strategy& st : strategies.strategies) {
       max_light_ = std::max(max_light_, st.s.hi == Range::kOpen ? kMaxVertices : st.s.hi);
       max_eye_ = std::max(max_eye_, st.t.hi == Range::kOpen ? kMaxVertices : st.t.hi);
     }
-    if (max_light_ < 2) max_light_ = 0;
+    // (A light splat from y0, the join (1, DD, 1), uses the light subpath's first vertex.)
+    if (max_light_ < 2 && table_.plain(1, 1) < 0) max_light_ = 0;
     // runs_mask_[n] bit s2: the profile runs (s2, n - s2); t2 = 0 only when light paths can hit the lens.
     for (std::size_t n = 0; n < runs_mask_.size(); ++n)
       for (int s2 = 0; s2 <= static_cast<int>(n); ++s2)

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,42 @@ TEST(Converge, ReferenceRunIsWrittenAndReadBack) {
   EXPECT_EQ(j.at("reference").at("kind"), "file");
   EXPECT_EQ(j.at("reference").at("classes").at(0).at("per_pixel"), true);
   EXPECT_FALSE(j.at("renderers").at(0).at("classes").at(0).at("rungs").at(0).at("rms_pixel_error").is_null());
+}
+
+// --only measures the requested classes alone (as pathex trace --only): the table and
+// converge.json name them, list every other class as not rendered, and the estimate is the closed
+// form of those paths (two bounces in the closed sphere: rho^2 I / (pi r^2)), within 3 sigma.
+TEST(Converge, OnlyMeasuresTheRequestedClassesAndListsTheOthersNotRendered) {
+  const std::string dir = out_dir("only");
+  CliRun r = run_pathex("converge samples/scenes/closed-sphere-point.json --renderer bdpt --renderer pt-nee --only 'L.{6}E' "
+                        "--spp 4,16 --resolution 8x8 --quiet --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\nrendered only only-1 (L.{6}E)\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\ndirect: not rendered\n"), std::string::npos) << r.out;
+  std::ifstream in(dir + "/converge.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j.at("only").size(), 1u);
+  EXPECT_EQ(j.at("only")[0].at("name"), "only-1");
+  std::vector<std::string> skipped;
+  for (const auto& c : j.at("not_rendered")) {
+    EXPECT_EQ(c.at("rendered"), false);
+    skipped.push_back(c.at("name"));
+  }
+  EXPECT_EQ(skipped, (std::vector<std::string>{"local", "emission", "direct", "indirect", "caustic"}));
+  const double expected = 0.25 / M_PI;
+  for (const auto& renderer : j.at("renderers")) {
+    std::vector<std::string> names;
+    for (const auto& c : renderer.at("classes")) names.push_back(c.at("name"));
+    EXPECT_EQ(names, (std::vector<std::string>{"requested", "only-1"}));  // the requested total, then the class
+    const auto& last = renderer.at("classes").at(1).at("rungs").back();
+    EXPECT_LE(std::fabs(last.at("estimate").get<double>() - expected), 3.0 * last.at("stderr").get<double>() + 1e-6 * expected)
+        << renderer.at("name") << " " << last.dump();
+  }
+  // A class the scene cannot have: nothing runs, and it says why.
+  r = run_pathex("converge samples/scenes/closed-sphere-point.json --renderer bdpt --only '$caustic' --spp 4 --resolution 8x8 "
+                 "--quiet --out " + out_dir("only-none"));
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.out.find("nothing to render: no strategy of bdpt samples a path of the requested classes"), std::string::npos) << r.out;
 }
 
 TEST(Converge, RefusalsExitTwo) {

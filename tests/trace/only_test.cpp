@@ -191,6 +191,15 @@ TEST(Only, AgreesWithTheClassOfAFullRender) {
       {"cornell.json", "bdpt", "$direct"},            {"cornell.json", "pt-nee", "$caustic"},
       {"cornell.json", "bdpt", "L.{8,}E"},            {"point-mirror-caustic.json", "bdpt", "$caustic"},
       {"closed-sphere-point.json", "pt-nee", "L.{6}E"}, {"mirror-ortho.json", "bdpt", "$direct"},
+      // The cover selected for --only (reach/prune.h) on every sample scene, several classes.
+      {"point-glass.json", "bdpt", "L.{8,}E"},        {"point-glass.json", "bdpt", "$direct"},
+      {"cornell.json", "bdpt", "$caustic"},           {"cornell.json", "bdpt", "L.*S.*E"},
+      {"closed-sphere-point.json", "bdpt", "L.{7,}E"}, {"closed-sphere-emitting.json", "bdpt", "L.{7,}E"},
+      {"closed-sphere-emitting.json", "bdpt", "$direct"}, {"point-plane.json", "bdpt", "$direct"},
+      {"point-plane.json", "bdpt", "L.*E"},        {"point-mirror-caustic.json", "bdpt", "L.*E"},
+      {"mirror-ortho.json", "bdpt", "L.*S.*E"},        {"laser.json", "bdpt", "L.{6,}E"},
+      {"spotmeter-caustic.json", "bdpt", "L.*E"}, {"sun-window.json", "pt-nee+distant", "$direct"},
+      {"sun-window.json", "bdpt", "L.{7,}E"},
   };
   for (const Case& c : cases) {
     const Scene scene = scene_at(c.scene, 16);
@@ -202,6 +211,89 @@ TEST(Only, AgreesWithTheClassOfAFullRender) {
         << c.scene << " " << c.renderer << " " << c.expr << ": full " << full.luminance << " ± " << full.std_error
         << ", only " << only.luminance << " ± " << only.std_error;
   }
+}
+
+Dfa union_of(const std::vector<const PathClass*>& classes) {
+  Dfa u = dfa_empty();
+  for (const PathClass* c : classes) u = dfa_union(u, c->dfa);
+  return u;
+}
+
+// The cover --only runs (reach/prune.h) samples every requested path the whole profile samples:
+// checked with the automata (covers()) and, independently of them, against the definition of a
+// strategy (strategy_samples()) on the requested paths up to 11 letters, for every sample scene,
+// two profiles and four classes.
+TEST(Cover, TheSelectedCoverSamplesEveryRequestedPath) {
+  constexpr int kBounces = 5;
+  int reduced = 0, paths = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kScenes)) {
+    if (entry.path().extension() != ".json") continue;
+    const Scene scene = scene_at(entry.path().filename().string(), 8);
+    const Dfa universe = scene_universe(scene_types(scene));
+    for (const std::string renderer : {"bdpt", "pt-nee"})
+      for (const std::string expr : {"$caustic", "$direct", "L.{7,}E", "L.*S.*E"}) {
+        const std::vector<const PathClass*> classes = classes_for(scene, {expr});
+        const ProfilePruning p = prune(scene, renderer, classes, kBounces);
+        if (p.samples_nothing()) continue;
+        const std::string what = entry.path().filename().string() + " " + renderer + " " + expr;
+        const Profile full = resolve_profile(renderer, Limits{}).expect("a profile");
+        const Dfa requested = union_of(classes);
+        EXPECT_TRUE(covers(p.profile, full, kBounces, universe, requested, Limits{}).expect("a cover check")) << what;
+        const Dfa sampled = reachable_language(full, kBounces, Limits{}).expect("the profile's language");
+        for (const std::string& path : enumerate_members(dfa_intersect(dfa_intersect(universe, requested), sampled), 11, 400)) {
+          bool any = false;
+          for (const Strategy& st : p.profile.strategies) any = any || strategy_samples(st, path, kBounces);
+          EXPECT_TRUE(any) << what << ": " << path << " is sampled by " << renderer << " but by none of the cover";
+          ++paths;
+        }
+        for (const PrunedStrategy& c : p.changes) reduced += c.reason.find("cheapest cover") != std::string::npos ? 1 : 0;
+      }
+  }
+  EXPECT_GE(reduced, 10);  // the check above ran on many reduced profiles
+  EXPECT_GE(paths, 1000);
+}
+
+// covers() rejects a subset that misses a requested path, and the path it misses is one the
+// subset's strategies do not sample by their definition.
+TEST(Cover, ASubsetThatMissesARequestedPathIsRejected) {
+  constexpr int kBounces = 8;
+  const Profile full = resolve_profile("bdpt", Limits{}).expect("bdpt");
+  ASSERT_EQ(full.strategies.size(), 1u);
+  const auto with = [&](Range s, Range t) {
+    Profile p = full;
+    p.strategies[0].s = s;
+    p.strategies[0].t = t;
+    return p;
+  };
+  const auto missed = [&](const Profile& kept, const Scene& scene, const std::string& expr) {
+    const Dfa universe = scene_universe(scene_types(scene));
+    const Dfa requested = union_of(classes_for(scene, {expr}));
+    const bool ok = covers(kept, full, kBounces, universe, requested, Limits{}).expect("a cover check");
+    const Dfa wanted = dfa_intersect(dfa_intersect(universe, requested), reachable_language(full, kBounces, Limits{}).expect("R"));
+    const std::optional<std::string> w = shortest_member(dfa_difference(wanted, reachable_language(kept, kBounces, Limits{}).expect("K")));
+    EXPECT_EQ(ok, !w.has_value()) << expr;
+    if (w) {
+      EXPECT_TRUE(strategy_samples(full.strategies[0], *w, kBounces)) << *w;
+      for (const Strategy& st : kept.strategies) EXPECT_FALSE(strategy_samples(st, *w, kBounces)) << *w;
+    }
+    return w.value_or("");
+  };
+  const Range any{0, Range::kOpen};
+  // Light tracing alone misses the caustics of point-glass seen through the glass or a mirror
+  // (a specular vertex before the pinhole); with the joins t >= 3 it covers them.
+  const Scene glass = scene_at("point-glass.json", 8);
+  const Profile lt = with(any, Range{1, 1});
+  EXPECT_NE(missed(lt, glass, "$caustic"), "");
+  Profile lt_and_eye = lt;
+  lt_and_eye.strategies.push_back(with(any, Range{3, Range::kOpen}).strategies[0]);
+  EXPECT_EQ(missed(lt_and_eye, glass, "$caustic"), "");
+  // Next-event estimation alone misses the long paths of the Cornell box whose light first meets
+  // a specular surface (L D D S …).
+  const Scene cornell = scene_at("cornell.json", 8);
+  const std::string w = missed(with(Range{1, 1}, any), cornell, "L.{8,}E");
+  EXPECT_EQ(w.substr(0, 4), "LDDS");
+  // In a closed diffuse sphere lit by a point light it samples every path alone.
+  EXPECT_EQ(missed(with(Range{1, 1}, any), scene_at("closed-sphere-point.json", 8), "L.{7,}E"), "");
 }
 
 // A subpath stops exactly when its prefix (light side, read forward) or suffix (eye side, read
