@@ -129,12 +129,26 @@ Result<WrittenReport> write_report_and_images(const std::string& dir, const Shar
   }
   if (!connectors.empty()) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const ConnectorStats& c : connectors)
-      list.push_back({{"strategy", c.strategy},
-                      {"connector", c.connector},
-                      {"attempts", c.attempts},
-                      {"successes", c.successes},
-                      {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}});
+    for (const ConnectorStats& c : connectors) {
+      nlohmann::ordered_json entry = {{"strategy", c.strategy},
+                                      {"connector", c.connector},
+                                      {"attempts", c.attempts},
+                                      {"successes", c.successes},
+                                      {"failures", {{"outside", c.outside}, {"occluded", c.occluded}, {"no_transport", c.no_transport}}}};
+      if (c.connector == "manifold") {  // the Newton walk's own reasons (trace/joins/manifold.h)
+        nlohmann::ordered_json& f = entry["failures"];
+        f.erase("outside");
+        f["no_solution"] = c.no_solution;
+        f["singular"] = c.singular;
+        f["wrong_type"] = c.wrong_type;
+        f["too_short"] = c.too_short;
+        f["iteration_limit"] = c.iteration_limit;
+        entry["walks"] = c.walks;
+        entry["mean_iterations"] = c.walks > 0 ? nlohmann::ordered_json(static_cast<double>(c.iterations) / static_cast<double>(c.walks))
+                                               : nlohmann::ordered_json(nullptr);
+      }
+      list.push_back(std::move(entry));
+    }
     doc["connectors"] = std::move(list);
   }
   out.json_text = doc.dump(2) + "\n";

@@ -484,6 +484,12 @@ int run(const TraceArgs& a) {
       std::cout << "  " << std::left << std::setw(width) << c.strategy << std::right << std::setw(10) << c.attempts
                 << std::setw(11) << c.successes << std::setw(10) << c.outside << std::setw(10) << c.occluded
                 << std::setw(14) << c.no_transport << "   (" << c.connector << ")\n";
+    for (const ConnectorStats& c : out->connectors)
+      if (c.connector == "manifold")
+        std::cout << "  " << c.strategy << " (manifold): no solution " << c.no_solution << ", singular " << c.singular
+                  << ", wrong type " << c.wrong_type << ", too short " << c.too_short << ", iteration limit "
+                  << c.iteration_limit << "; mean Newton iterations "
+                  << (c.walks > 0 ? static_cast<double>(c.iterations) / static_cast<double>(c.walks) : 0.0) << "\n";
   }
   std::cout << "\nmost important paths\n";
   for (std::size_t i = 0; i < rep->paths.size() && static_cast<int>(i) < a.top_paths; ++i) {

@@ -38,6 +38,7 @@
 
 #include "core/error.h"
 #include "scene/scene.h"
+#include "trace/differential.h"
 
 namespace pathex {
 
@@ -195,6 +196,13 @@ class EmbreeScene {
   SurfaceSample sample_shape(int shape, glm::vec2 u) const;
   // The unit geometric normal of a shape at a point on it (`primitive`: the triangle of a mesh).
   glm::vec3 normal_at(int shape, int primitive, const glm::vec3& p) const;
+  // A shape's geometry as the scene gives it.
+  const ShapeGeometry& shape_geometry(int shape) const { return source_->shapes[static_cast<std::size_t>(shape)].geometry; }
+  // A hit's position and normal derivatives (trace/differential.h), computed only when asked: the
+  // manifold connector's walk along surfaces needs them, the hot loop's hits do not.
+  SurfaceDerivatives derivatives(const Hit& h) const {
+    return surface_derivatives(shape_geometry(h.shape), h.primitive, glm::dvec3(h.position));
+  }
 
   RTCScene handle() const { return scene_.get(); }
   std::size_t triangle_count() const { return triangles_; }

@@ -18,6 +18,7 @@
 #include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/joins/join.h"
+#include "trace/joins/manifold.h"
 #include "trace/render.h"
 #include "trace/render_scene.h"
 #include "trace/rng.h"
@@ -56,7 +57,9 @@ class Integrator {
         if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
           runs_mask_[n] |= std::uint64_t{1} << s2;
     has_mirror_ = table_.runs(ConnectorKind::kMirror) && !rs.mirrors.empty();
-    has_connectors_ = table_.runs(ConnectorKind::kDistantProjection) || table_.runs(ConnectorKind::kOrthoProjection) || has_mirror_;
+    init_manifold();
+    has_connectors_ = table_.runs(ConnectorKind::kDistantProjection) || table_.runs(ConnectorKind::kOrthoProjection) || has_mirror_ ||
+                      has_manifold_;
     mirror_shape_.assign(rs.material_of_shape.size(), 0);
     for (const PlanarMirror& m : rs.mirrors) mirror_shape_[static_cast<std::size_t>(m.shape)] = 1;
     eye0_runs_ = (runs_mask_[1] >> 1) & 1;
@@ -99,6 +102,7 @@ class Integrator {
     std::vector<ConnectorStats> connectors;  // indexed by profile strategy (only connectors' are used)
     PathIds ids;
     JoinResult join{};  // the join being made (joins build into it; estimate() consumes it)
+    std::vector<ChainVertex> manifold_chain{};  // the manifold connector's chain being solved
     std::vector<Vertex> path{};         // a whole path x0 … xk for path_weight()
     std::vector<double> rel{}, eye_density{};  // path_weight()'s density ratios and remapped ef
     // The subpaths' letters packed (set by prepare_joins()): light_mask has c0 c1 of y0, then
@@ -319,10 +323,30 @@ class Integrator {
   // z(t-1) (a fresh sensor sample for t = 1) across each planar mirror by the image method.
   void connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const;
   int mirror_of(int s, int t) const { return table_.at(s, ConnectorKind::kMirror, t); }
-  // --- MIS over whole paths, for profiles with the mirror connector ---
+  // A connector's light end for s = 1: a fresh light sample in th.join.light0 from random-number
+  // block `block` (one per t), or null when the light picked has a Dirac direction (no D end).
+  const Vertex* fresh_light_end(Thread& th, Sampler& rng, int t, std::uint64_t block) const;
+  // The manifold connector (s, DS+D, t), s >= 1, t >= 2 (trace/joins/manifold.h): y(s-1) (a
+  // fresh light sample for s = 1) joined to z(t-1) across a chain of smooth glass by specular
+  // manifold sampling. Defined in trace/joins/manifold_join.cpp.
+  void connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const;
+  int manifold_of(int s, int t) const { return table_.at(s, ConnectorKind::kManifold, t); }
+  // A seed chain from eye end b: the ray from b towards a specular shape drawn uniformly (a point
+  // on its area, or a direction in the cone of a sphere), followed through every specular surface
+  // it meets (a mirror reflects; glass reflects with the Fresnel probability, else refracts) until
+  // it leaves them; its hits, light side first. Random numbers from counter-based `stream`.
+  ManifoldFailure seed_chain(const Vertex& b, std::uint64_t stream, std::uint64_t* drawn, std::vector<ChainVertex>& chain) const;
+  void init_manifold();
+  // Whether the manifold connector (s, DS^mD, ·) could build the chain x_s … x(s+m-1) of th.path
+  // (letters `key`): the profile runs it there, its eye end is a surface, and every chain vertex is
+  // a reflection or refraction on smooth glass or a reflection on a mirror.
+  bool manifold_at(const Thread& th, PathKey key, int s, int m) const;
+  // --- MIS over whole paths, for profiles with the mirror or the manifold connector ---
   // Puts the path x0 … xk of a contribution into th.path: s light vertices (fresh_light for y0 when
-  // given), `middle` when given (the mirror vertex), t eye vertices (fresh_eye for z0 when given).
-  void gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* middle, const Vertex* fresh_eye) const;
+  // given), the `chain_length` vertices of `chain` (the mirror vertex, the manifold's chain), t eye
+  // vertices (fresh_eye for z0 when given).
+  void gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* chain, int chain_length,
+              const Vertex* fresh_eye) const;
   // Whether the path of connection (s, t) with letters `key` could also be sampled by the mirror
   // connector (then every strategy weighs it with path_weight()).
   bool mirror_can_sample(const Thread& th, int s, int t, PathKey key) const;
@@ -353,6 +377,13 @@ class Integrator {
   StrategyTable table_;  // which strategy runs each (s, chain, t)
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
   bool has_mirror_ = false;      // a mirror strategy runs and the scene has a planar mirror
+  bool has_manifold_ = false;    // a manifold strategy runs and the scene has smooth glass
+  // The manifold's specular surfaces, per shape: the index of a pure smooth dielectric, else 0; the
+  // reflectance of a mirror (a mixture's mirror components, weighed), else 0.
+  std::vector<float> glass_ior_;
+  std::vector<vec3> mirror_reflectance_;
+  std::vector<int> specular_shapes_;  // the shapes with either (the manifold's seeds aim at points on them)
+  double scene_size_ = 1.0;       // the scene's bounding-box diagonal (the manifold's shortest segment scales with it)
   std::vector<std::uint8_t> mirror_shape_;  // the shape is a planar mirror
   // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
   // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).

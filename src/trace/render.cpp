@@ -42,11 +42,11 @@ namespace pathex {
 Result<StrategySet> runnable_strategies(const Profile& profile) {
   StrategySet set;
   for (const Strategy& st : profile.strategies) {
-    if (st.connector == ConnectorKind::kManifold)
-      return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' uses the connector '" + to_string(st.connector) +
-                                               "' (strategy '" + st.name +
-                                               "'), which the tracer does not run yet; it runs plain joins (s, DD, t) and the "
-                                               "mirror, distant-projection and ortho-projection connectors");
+    // The manifold connector's seed leaves a surface vertex of the eye subpath (trace/joins/manifold.h).
+    if (st.connector == ConnectorKind::kManifold && st.t.contains(1))
+      return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' runs the manifold connector with t = 1 (strategy '" +
+                                               st.name + "'), which the tracer does not run: its eye end must be a surface "
+                                               "vertex of the eye subpath, t >= 2");
     set.strategies.push_back(st);
   }
   return set;
@@ -565,7 +565,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   const bool fresh = C == Connection::kSplat || C == Connection::kNee || kind != ConnectorKind::kNone;
   jr.has_eye0 = fresh && fresh_eye;
   jr.has_light0 = fresh && !fresh_eye;
-  jr.has_middle = false;
+  jr.chain_length = 0;
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   jr.letters = path_key(th, s, t, fresh ? &sampled : nullptr) | chain_s;
   jr.contribution = contrib;
@@ -586,8 +586,10 @@ void Integrator::estimate(Thread& th, int batch) const {
   // densities when the mirror connector is one of them, else by the join-local recurrence.
   if (o_.only != nullptr && !o_.only->records(jr.letters)) return;  // --only: not requested, no weight, no shadow ray
   float weight = 0.0f;
-  if (jr.chain == ConnectorKind::kMirror || (has_mirror_ && mirror_can_sample(th, jr.s, jr.t, jr.letters))) {
-    gather(th, jr.s, jr.t, jr.has_light0 ? &jr.light0 : nullptr, jr.has_middle ? &jr.middle : nullptr,
+  // With the manifold connector every path is weighed over whole paths (which chains it could
+  // build depends on the path's vertices, not on the join's).
+  if (has_manifold_ || jr.chain == ConnectorKind::kMirror || (has_mirror_ && mirror_can_sample(th, jr.s, jr.t, jr.letters))) {
+    gather(th, jr.s, jr.t, jr.has_light0 ? &jr.light0 : nullptr, jr.chain_length > 0 ? jr.chain_vertices.data() : nullptr, jr.chain_length,
            jr.has_eye0 ? &jr.eye0 : nullptr);
     weight = path_weight(th, jr.letters, jr.chain, jr.s);
   } else {
@@ -628,31 +630,9 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
   // block per s, after the seven blocks of connect()'s kinds.
   constexpr std::uint64_t kLightBlock = 7, kEyeBlock = 8;
   // --- the light end a: y(s-1), or a fresh light sample ---
-  const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
-  const RenderLight* light = nullptr;
-  if (a) {
-    if (a->kind != Kind::kSurface || !a->finite) return;
-  } else {
-    if (rs_.lights.empty()) return;
-    rng.set_dimension(kJoinDims + (kLightBlock * kMaxRuns + static_cast<std::uint64_t>(t)) * kDimsPerJoin);
-    const std::size_t li = pick_light(rng.get1d());
-    light = &rs_.lights[li];
-    const glm::vec2 up = rng.get2d();
-    if (light_pairs_[li][1] != 'D') return;  // a Dirac direction (distant, laser): no D end
-    Vertex& y0 = th.join.light0;
-    y0 = Vertex{};
-    y0.kind = Kind::kLight;
-    y0.light = static_cast<int>(li);
-    y0.pos_letter = light_pairs_[li][0];
-    y0.letter = 'D';
-    const SurfacePoint x = sample_point(*light, up, &y0.err);
-    y0.p = light->is_area() ? x.position : light_position(light->params);
-    y0.n = light->is_area() ? x.normal : vec3(0.0f);
-    y0.ns = y0.n;
-    y0.pdf_fwd = light_pick_ * light->pdf_pos;
-    y0.beta = spatial_emission(light->params) / (light_pick_ * (light->pdf_pos > 0.0f ? light->pdf_pos : 1.0f));
-    a = &y0;
-  }
+  const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, kLightBlock);
+  if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
+  const RenderLight* light = s == 1 ? &rs_.lights[static_cast<std::size_t>(a->light)] : nullptr;
   // --- the eye end b: z(t-1), or (t = 1) a fresh sensor sample drawn per mirror ---
   const Vertex* b = t >= 2 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
   glm::vec2 u_lens{0.0f};
@@ -712,7 +692,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
       continue;
     }
     JoinResult& jr = th.join;
-    Vertex& m = jr.middle;
+    Vertex& m = jr.chain_vertices[0];
     m = Vertex{};
     m.kind = Kind::kSurface;
     m.letter = 'S';
@@ -729,7 +709,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     jr.contribution = contrib;
     jr.has_light0 = s == 1;
     jr.has_eye0 = t == 1;
-    jr.has_middle = true;
+    jr.chain_length = 1;
     jr.segments = {Segment{a, &m}, Segment{&m, b}};  // both must be clear
     jr.num_segments = 2;
     jr.has_density = false;  // MIS over whole paths recomputes every density
@@ -740,10 +720,33 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
   }
 }
 
-void Integrator::gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* middle, const Vertex* fresh_eye) const {
+const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, std::uint64_t block) const {
+  if (rs_.lights.empty()) return nullptr;
+  rng.set_dimension(kJoinDims + (block * kMaxRuns + static_cast<std::uint64_t>(t)) * kDimsPerJoin);
+  const std::size_t li = pick_light(rng.get1d());
+  const RenderLight& light = rs_.lights[li];
+  const glm::vec2 up = rng.get2d();
+  if (light_pairs_[li][1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
+  Vertex& y0 = th.join.light0;
+  y0 = Vertex{};
+  y0.kind = Kind::kLight;
+  y0.light = static_cast<int>(li);
+  y0.pos_letter = light_pairs_[li][0];
+  y0.letter = 'D';
+  const SurfacePoint x = sample_point(light, up, &y0.err);
+  y0.p = light.is_area() ? x.position : light_position(light.params);
+  y0.n = light.is_area() ? x.normal : vec3(0.0f);
+  y0.ns = y0.n;
+  y0.pdf_fwd = light_pick_ * light.pdf_pos;
+  y0.beta = spatial_emission(light.params) / (light_pick_ * (light.pdf_pos > 0.0f ? light.pdf_pos : 1.0f));
+  return &y0;
+}
+
+void Integrator::gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* chain, int chain_length,
+                        const Vertex* fresh_eye) const {
   th.path.clear();
   for (int i = 0; i < s; ++i) th.path.push_back(i == 0 && fresh_light ? *fresh_light : th.light[static_cast<std::size_t>(i)]);
-  if (middle) th.path.push_back(*middle);
+  for (int i = 0; i < chain_length; ++i) th.path.push_back(chain[i]);
   for (int j = t - 1; j >= 0; --j) th.path.push_back(j == 0 && fresh_eye ? *fresh_eye : th.eye[static_cast<std::size_t>(j)]);
   Vertex& x0 = th.path.front();
   if (s == 0) {  // an eye vertex on an area light starts the path
@@ -798,6 +801,19 @@ float Integrator::path_weight(Thread& th, PathKey key, ConnectorKind self, int s
   }
   const double light_pos = rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
   const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };
+  // The number of S vertices from x_i on (letters c(i+1) …), and the density of a chain
+  // connector whose chain is x_i … x(i+m-1): the light walk's up to x(i-1), the eye walk's from
+  // x(i+m) on, the chain's own vertices omitted (they are constructed, as the mirror's vertex).
+  const auto s_run = [&](int i) {
+    int m = 0;
+    while (i + m <= k - 1 && letter_s(i + m + 1)) ++m;
+    return m;
+  };
+  const auto chain_density = [&](int i, int m) {
+    double r = rel[static_cast<std::size_t>(i)];
+    for (int v = i; v < i + m; ++v) r /= e[static_cast<std::size_t>(v)];
+    return r;
+  };
   const auto mirror_at = [&](int m) {
     return m >= 1 && m <= k - 1 && dsd_at(m) && mirror_of(m, k - m) >= 0 && x[static_cast<std::size_t>(m)].kind == Kind::kSurface &&
            mirror_shape_[static_cast<std::size_t>(x[static_cast<std::size_t>(m)].shape)];
@@ -808,7 +824,7 @@ float Integrator::path_weight(Thread& th, PathKey key, ConnectorKind self, int s
     case ConnectorKind::kDistantProjection: own = rel[1] / light_pos; break;
     case ConnectorKind::kOrthoProjection: own = rel[static_cast<std::size_t>(n - 1)] / cam_.pdf_pos; break;
     case ConnectorKind::kMirror: own = rel[static_cast<std::size_t>(s)] / e[static_cast<std::size_t>(s)]; break;
-    case ConnectorKind::kManifold: break;  // not run (runnable_strategies() refuses it)
+    case ConnectorKind::kManifold: own = chain_density(s, s_run(s)); break;
   }
   double sum = 0.0;
   const auto add = [&](double p) {
@@ -823,6 +839,12 @@ float Integrator::path_weight(Thread& th, PathKey key, ConnectorKind self, int s
   if (n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f) add(rel[static_cast<std::size_t>(n - 1)] / cam_.pdf_pos);
   for (int m = 1; m <= k - 1; ++m)
     if (mirror_at(m)) add(rel[static_cast<std::size_t>(m)] / e[static_cast<std::size_t>(m)]);
+  // The manifold's chains: every maximal run of S vertices x_i … x(i+m-1) between two D vertices.
+  if (has_manifold_)
+    for (int i = 1; i <= k - 1; ++i) {
+      const int m = s_run(i);
+      if (m > 0 && !letter_s(i) && manifold_at(th, key, i, m)) add(chain_density(i, m));
+    }
   return sum > 0.0 && std::isfinite(sum) ? static_cast<float>(1.0 / sum) : 0.0f;
 }
 
@@ -883,6 +905,11 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
     for (int t = 1; t <= nt; ++t)
       for (int s = 1; s <= std::min(s_max, max_bounces_ + 1 - t); ++s)
         if (mirror_of(s, t) >= 0) connect_mirror(th, rng, s, t, batch);
+  // The manifold connector's eye end is a surface vertex z(t-1), t >= 2.
+  if (has_manifold_)
+    for (int t = 2; t <= nt; ++t)
+      for (int s = 1; s <= std::min(s_max, max_bounces_ + 1 - t); ++s)
+        if (manifold_of(s, t) >= 0) connect_manifold(th, rng, s, t, batch);
 }
 
 
@@ -985,6 +1012,13 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
       total.outside += c.outside;
       total.occluded += c.occluded;
       total.no_transport += c.no_transport;
+      total.no_solution += c.no_solution;
+      total.singular += c.singular;
+      total.wrong_type += c.wrong_type;
+      total.too_short += c.too_short;
+      total.iteration_limit += c.iteration_limit;
+      total.walks += c.walks;
+      total.iterations += c.iterations;
     }
     out.connectors.push_back(total);
   }

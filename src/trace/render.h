@@ -13,8 +13,9 @@
 // strategies whose language contains it have nonzero density, so deltas are handled by letters,
 // never by huge numbers. The mirror connector (s, DSD, t), s, t >= 1, joins y(s-1) and z(t-1)
 // across a planar mirror by the image method (trace/joins/mirror.h); in its profiles a path it
-// could also sample is weighed over whole-path densities. Profiles naming the manifold connector
-// are refused by name. Every join, plain or connector, returns one JoinResult (trace/joins/join.h)
+// could also sample is weighed over whole-path densities. The manifold connector (s, DS+D, t),
+// s >= 1, t >= 2, joins y(s-1) and z(t-1) across a chain of smooth glass by a Newton walk
+// (trace/joins/manifold.h); in its profiles every path is weighed over whole-path densities. Every join, plain or connector, returns one JoinResult (trace/joins/join.h)
 // that the estimator weighs and queues in one place; the strategy running each (s, chain, t) comes
 // from one StrategyTable (trace/strategy_table.h) built from the profile. Shadow rays are queued per thread and traced sixteen at a time as one Embree packet
 // (OcclusionBatch); a contribution is recorded once all its segments (one for a shadow ray, two across
@@ -39,6 +40,7 @@
 #include "core/pass_set.h"
 #include "reach/profile.h"
 #include "scene/scene.h"
+#include "trace/joins/manifold.h"
 #include "trace/rng.h"
 
 namespace pathex {
@@ -74,6 +76,7 @@ struct RenderOptions {
   // stops once none of them can be completed from it. Null: every path. Hand the tracer the profile
   // reduced by prune_profile() (reach/prune.h) too, so that no strategy runs for nothing.
   const RequestedPaths* only = nullptr;
+  ManifoldOptions manifold{};          // pathex trace --manifold-*: the manifold connector's limits
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;  // called from one thread
   const std::atomic<bool>* cancel = nullptr;  // set to stop early; the result is marked incomplete
 };
@@ -82,12 +85,17 @@ struct RenderOptions {
 // contribution is recorded) or fails for one reason.
 struct ConnectorStats {
   std::string strategy;            // the profile's name for the strategy
-  std::string connector;           // "mirror", "distant-projection", "ortho-projection"
+  std::string connector;           // "mirror", "distant-projection", "ortho-projection", "manifold"
   std::uint64_t attempts = 0;      // joins tried (one per eye or light vertex where it may stand)
   std::uint64_t successes = 0;     // contributions recorded
   std::uint64_t outside = 0;       // the projection missed the aperture (or the film); off the mirror
   std::uint64_t occluded = 0;      // a segment it built was blocked (any of them)
   std::uint64_t no_transport = 0;  // built, but the BSDF or emission towards it is zero
+  // The manifold connector's own failures (trace/joins/manifold.h, ManifoldFailure; zero for the
+  // others): its seed blocked or a built segment blocked count as `occluded`.
+  std::uint64_t no_solution = 0, singular = 0, wrong_type = 0, too_short = 0, iteration_limit = 0;
+  std::uint64_t walks = 0;       // chains handed to the Newton solver
+  std::uint64_t iterations = 0;  // Newton iterations over all of them (mean: iterations / walks)
 };
 
 // Where a render's first non-finite contribution arose (they are bugs: DESIGN §7). "First" is by
@@ -116,7 +124,8 @@ struct RenderOutput {
 };
 
 // The strategies of a profile the tracer runs: plain joins and the mirror and projection
-// connectors. runnable_strategies() names the first connector the tracer does not run (manifold).
+// connectors, and the manifold connector with its eye end on a surface (t >= 2); runnable_strategies()
+// refuses a profile with a manifold strategy at t = 1 by name.
 // The tracer looks them up by (s, chain, t) in a StrategyTable (trace/strategy_table.h).
 struct StrategySet {
   std::vector<Strategy> strategies;

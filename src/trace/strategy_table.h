@@ -2,7 +2,7 @@
 //
 // A strategy of a profile joins s letters' worth of light subpath to t letters' worth of eye
 // subpath by a chain: the plain join DD (ConnectorKind::kNone) or a connector's DSD (mirror,
-// distant projection, ortho projection). The tracer asks, for every join it could make, which
+// distant projection, ortho projection) or the manifold's DS+D. The tracer asks, for every join it could make, which
 // strategy of the profile runs it; the answer is an index into the strategy list the table was
 // built from, or -1. Build it from a reduced strategy list (a pruned profile) and the tracer runs
 // only those strategies: nothing else in the tracer knows which strategies exist.
@@ -22,11 +22,10 @@ class StrategyTable {
   static constexpr int kMaxSide = 128;
 
   StrategyTable() : slots_(kChains * kMaxSide * kMaxSide, -1) {}
-  // The first strategy in `strategies` whose chain, s range and t range contain each key. A
-  // strategy with a connector the table does not key (manifold) is not entered.
+  // The first strategy in `strategies` whose chain, s range and t range contain each key.
   explicit StrategyTable(const std::vector<Strategy>& strategies) : StrategyTable() {
     for (const ConnectorKind chain : {ConnectorKind::kNone, ConnectorKind::kMirror, ConnectorKind::kDistantProjection,
-                                      ConnectorKind::kOrthoProjection})
+                                      ConnectorKind::kOrthoProjection, ConnectorKind::kManifold})
       for (int s = 0; s < kMaxSide; ++s)
         for (int t = 0; t < kMaxSide; ++t)
           for (std::size_t i = 0; i < strategies.size(); ++i) {
@@ -55,11 +54,11 @@ class StrategyTable {
   }
 
  private:
-  static constexpr std::size_t kChains = 4;  // kNone, kMirror, kDistantProjection, kOrthoProjection
+  static constexpr std::size_t kChains = 5;  // kNone, kMirror, kDistantProjection, kOrthoProjection, kManifold
   static std::size_t index(int s, ConnectorKind chain, int t) {
     return (static_cast<std::size_t>(chain) * kMaxSide + static_cast<std::size_t>(s)) * kMaxSide + static_cast<std::size_t>(t);
   }
-  static_assert(static_cast<std::size_t>(ConnectorKind::kOrthoProjection) + 1 == kChains, "one slot block per keyed chain");
+  static_assert(static_cast<std::size_t>(ConnectorKind::kManifold) + 1 == kChains, "one slot block per keyed chain");
   std::vector<std::int16_t> slots_;  // [chain][s][t]
 };
 

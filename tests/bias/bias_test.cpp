@@ -251,16 +251,16 @@ TEST(Bias, RealIntegratorsOnEverySampleScene) {
 TEST(Bias, ReferenceIsBdptPlusTheConnectorsTheSceneNeeds) {
   const BiasOptions o;
   const Profile pt = profile("pt");
-  // The Cornell box's mirror sphere puts interior S letters in its universe: the mirror connector
-  // joins the reference.
-  EXPECT_EQ(choose_reference("", load(sample("cornell.json")), pt, o).expect("a reference").name, "bdpt+mirror");
+  // The Cornell box's mirror sphere puts interior S letters in its universe: the mirror and the
+  // manifold connectors join the reference.
+  EXPECT_EQ(choose_reference("", load(sample("cornell.json")), pt, o).expect("a reference").name, "bdpt+mirror+manifold");
   EXPECT_EQ(choose_reference("", load(sample("point-plane.json")), pt, o).expect("a reference").name, "bdpt");
   const Profile sun = choose_reference("", load(sample("sun-window.json")), pt, o).expect("a reference");
   EXPECT_EQ(sun.name, "bdpt+distant-projection");
   ASSERT_EQ(sun.strategies.size(), 2u);
   EXPECT_EQ(sun.strategies[1].describe(), "(0, DSD, 2..) via distant-projection");
   EXPECT_EQ(choose_reference("", load(sample("mirror-ortho.json")), pt, o).expect("a reference").name,
-            "bdpt+mirror+ortho-projection");
+            "bdpt+mirror+ortho-projection+manifold");
 }
 
 TEST(Bias, TheReferenceRendersDeeperThanTheRenderersBound) {

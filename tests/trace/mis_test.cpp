@@ -50,8 +50,31 @@ struct IntegratorTestAccess {
   }
   // The same weight by the general routine over the whole path's densities.
   static float general_weight(const Integrator& in, Integrator::Thread& th, int s, int t) {
-    in.gather(th, s, t, nullptr, nullptr, nullptr);
+    in.gather(th, s, t, nullptr, nullptr, 0, nullptr);
     return in.path_weight(th, in.path_key(th, s, t, nullptr), ConnectorKind::kNone, s);
+  }
+  // For the path of plain connection (s, t) (gathered into th.path): the weights that path_weight()
+  // gives it as each strategy that could sample it, the plain joins (s2, DD, ·) whose letters are
+  // D and the manifold's chains, each computed as its own strategy. *chains: how many manifold
+  // chains could build it. Must sum to 1.
+  static double whole_path_weight_sum(const Integrator& in, Integrator::Thread& th, int s, int t, int* chains) {
+    in.gather(th, s, t, nullptr, nullptr, 0, nullptr);
+    const PathKey key = in.path_key(th, s, t, nullptr);
+    const int k = static_cast<int>(th.path.size()) - 1, n = k + 1;
+    double sum = 0.0;
+    *chains = 0;
+    for (int s2 = 0; s2 <= n; ++s2)
+      if (((in.runs_mask_[static_cast<std::size_t>(n)] >> s2) & 1) && packed_is_d(key, s2) && packed_is_d(key, s2 + 1))
+        sum += in.path_weight(th, key, ConnectorKind::kNone, s2);
+    for (int i = 1; i <= k - 1; ++i) {
+      int m = 0;
+      while (i + m <= k - 1 && !packed_is_d(key, i + m + 1)) ++m;
+      if (m > 0 && in.manifold_at(th, key, i, m)) {
+        ++*chains;
+        sum += in.path_weight(th, key, ConnectorKind::kManifold, i);
+      }
+    }
+    return sum;
   }
   // Whether (s, t) joins two vertices that can be joined (s = 0: an eye vertex on an area light;
   // t = 0: a light vertex on the lens; otherwise two surfaces with finite parts).
@@ -235,6 +258,47 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
   }
   EXPECT_GT(checked, 2000u);
   EXPECT_GE(by_length.size(), 5u);  // paths of many lengths
+}
+
+// Where bdpt's light tracing (and its other joins) and the manifold connector both sample a path,
+// the whole-path weights of all of them sum to 1: random paths of the glass-sphere scene formed by
+// every plain join of bdpt+manifold's subpaths, those a manifold chain could build among them.
+TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
+  const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/point-glass.json").expect("the sample");
+  const Profile profile = parse_profile(R"({"name": "bdpt+manifold", "strategies": [
+      {"name": "bdpt", "s": "0..", "chain": "DD", "t": "0.."},
+      {"name": "manifold", "s": "1..", "chain": "DS+D", "t": "2..", "connector": "manifold"}]})",
+                                        "bdpt+manifold.json", Limits{})
+                              .expect("a valid profile");
+  const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
+  const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
+  RenderOptions o;
+  o.seed = 5;
+  o.max_bounces = 8;
+  HistogramLayout layout;
+  ClassImages images(1, 1, nullptr, {});
+  const Integrator integrator(rs, strategies, o);
+  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
+  th.images = &images;
+  th.connectors.resize(strategies.strategies.size());
+  using A = IntegratorTestAccess;
+  int checked = 0, shared = 0;
+  for (int i = 0; i < 10000; ++i) {
+    Sampler rng(5, static_cast<std::uint64_t>(i), 0);
+    int ns = 0;
+    const int nt = A::trace_subpaths(integrator, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
+    for (int t = 0; t <= nt; ++t)
+      for (int s = 0; s <= ns; ++s) {
+        if (s == 1 || t == 1 || s + t < 2 || s + t - 2 > *o.max_bounces || !A::joinable(integrator, th, s, t)) continue;
+        int chains = 0;
+        const double sum = A::whole_path_weight_sum(integrator, th, s, t, &chains);
+        ++checked;
+        if (chains > 0) ++shared;
+        EXPECT_NEAR(sum, 1.0, 1e-4) << A::label(integrator, th, s, t) << " (s=" << s << ", t=" << t << ")";
+      }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_GT(shared, 50);  // paths that the manifold and the plain joins both sample
 }
 
 }  // namespace

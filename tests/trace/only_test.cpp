@@ -126,7 +126,7 @@ TEST(Pruning, APrunedStrategyNeverContributes) {
     const Scene scene = scene_at(entry.path().filename().string(), 12);
     ++scenes;
     for (const Profile& profile : builtin_profiles(Limits{}).expect("the built-in profiles")) {
-      if (!runnable_strategies(profile).ok()) continue;  // the manifold connector
+      if (!runnable_strategies(profile).ok()) continue;
       const ProfilePruning p = prune(scene, profile.name, {}, kBounces);
       if (p.changes.empty()) continue;
       ++pruned_seen;

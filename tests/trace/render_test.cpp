@@ -536,14 +536,18 @@ TEST(Labels, PointLightWithPinholeOnlyProducesSDprefixAndDSsuffix) {
 }
 
 TEST(Profiles, ConnectorsTheTracerDoesNotRunAreRefusedByName) {
-  Result<Profile> p = resolve_profile("pt-nee+manifold", Limits{});
-  ASSERT_TRUE(p.ok());
+  // The manifold connector's eye end is a surface vertex of the eye subpath: t = 1 is refused.
+  Result<Profile> p = parse_profile(R"({"name": "lt+manifold", "strategies": [
+      {"name": "splat-manifold", "s": "1..", "chain": "DS+D", "t": "1..", "connector": "manifold"}]})",
+                                    "lt+manifold.json", Limits{});
+  ASSERT_TRUE(p.ok()) << p.error().render();
   Result<StrategySet> s = runnable_strategies(*p);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().message,
-            "renderer 'pt-nee+manifold' uses the connector 'manifold' (strategy 'manifold-nee'), which the tracer does not run "
-            "yet; it runs plain joins (s, DD, t) and the mirror, distant-projection and ortho-projection connectors");
-  for (const char* name : {"pt-nee+distant", "bdpt+ortho", "bdpt+mirror", "pt-nee+mirror", "pbrt-v4-path", "pbrt-v4-bdpt", "mitsuba3-path"})
+            "renderer 'lt+manifold' runs the manifold connector with t = 1 (strategy 'splat-manifold'), which the tracer does "
+            "not run: its eye end must be a surface vertex of the eye subpath, t >= 2");
+  for (const char* name : {"pt-nee+distant", "bdpt+ortho", "bdpt+mirror", "pt-nee+mirror", "pt-nee+manifold", "pbrt-v4-path",
+                           "pbrt-v4-bdpt", "mitsuba3-path"})
     EXPECT_TRUE(runnable_strategies(resolve_profile(name, Limits{}).expect("a test input")).ok()) << name;
 }
 

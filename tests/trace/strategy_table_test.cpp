@@ -30,6 +30,17 @@ TEST(StrategyTable, KeysPlainJoinsAndConnectorsApart) {
   EXPECT_EQ(table.at(1, ConnectorKind::kManifold, 1), -1);
 }
 
+TEST(StrategyTable, ManifoldChainsAreKeyedByTheirEnds) {
+  const Profile p = profile("pt-nee+manifold");  // emitter-hit, nee, manifold-nee (1, DS+D, 2..)
+  const StrategyTable table(p.strategies);
+  EXPECT_EQ(table.at(1, ConnectorKind::kManifold, 2), 2);
+  EXPECT_EQ(table.at(1, ConnectorKind::kManifold, 9), 2);
+  EXPECT_EQ(table.at(1, ConnectorKind::kManifold, 1), -1);
+  EXPECT_EQ(table.at(2, ConnectorKind::kManifold, 2), -1);
+  EXPECT_TRUE(table.runs(ConnectorKind::kManifold));
+  EXPECT_FALSE(table.runs(ConnectorKind::kMirror));
+}
+
 TEST(StrategyTable, ProjectionConnectorsSitAtThePathsEnds) {
   const Profile p = profile("pt-nee+distant");  // emitter-hit (0, DD, 2..), nee (1, DD, 2..), (0, DSD, 2..)
   const StrategyTable table(p.strategies);

@@ -18,6 +18,10 @@
 
 namespace pathex::tracer {
 
+// The most interior vertices a connector builds between its two ends (the manifold connector's
+// specular chain): its kMaxChain + 1 segments fill at most one shadow-ray packet.
+inline constexpr int kMaxChain = 15;
+
 // What MIS needs of a join's own density, as the join computed it: the unit direction w from the
 // light end to the eye end and their squared distance, and the BSDF densities at each end that the
 // join's BSDF evaluation gave for free. The MIS routine recomputes only the densities at the two
@@ -45,11 +49,15 @@ struct JoinResult {
   accel::PathKey letters = 0;       // the full path's letters, packed
   vec3 contribution{0.0f};          // before the MIS weight
   // The vertices it built: one standing for y0 (a fresh light sample, an aperture point), one for
-  // z0 (a fresh sensor sample, a film point), one between the subpaths (a mirror vertex).
-  Vertex light0{}, eye0{}, middle{};
-  bool has_light0 = false, has_eye0 = false, has_middle = false;
+  // z0 (a fresh sensor sample, a film point), and the chain between the subpaths in light-to-eye
+  // order (a mirror vertex; the manifold connector's specular vertices): the first chain_length of
+  // chain_vertices.
+  Vertex light0{}, eye0{};
+  std::array<Vertex, kMaxChain> chain_vertices{};
+  bool has_light0 = false, has_eye0 = false;
+  int chain_length = 0;
   // The segments to test, all of which must be clear (the first num_segments).
-  std::array<Segment, 2> segments{};
+  std::array<Segment, kMaxChain + 1> segments{};
   int num_segments = 0;
   // Its density for MIS: the join's direction and end densities (has_density: the join has two
   // ends; an eye vertex on a light, s = 0, and a light vertex on the lens, t = 0, have one).

@@ -1,0 +1,243 @@
+// The manifold connector in the integrator (trace/joins/manifold.h for the walk): the seed, the
+// contribution through the solved chain, and which paths it could build (for MIS).
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "trace/frame.h"
+#include "trace/integrator.h"
+#include "trace/joins/manifold.h"
+
+namespace pathex::tracer {
+namespace {
+bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+}  // namespace
+
+void Integrator::init_manifold() {
+  glass_ior_.assign(rs_.material_of_shape.size(), 0.0f);
+  mirror_reflectance_.assign(rs_.material_of_shape.size(), vec3(0.0f));
+  specular_shapes_.clear();
+  for (std::size_t i = 0; i < rs_.material_of_shape.size(); ++i) {
+    if (rs_.light_of_shape[i] >= 0) continue;
+    const Material& m = *rs_.material_of_shape[i];
+    if (const auto* d = std::get_if<Dielectric>(&m); d && d->ior > 0.0f && d->ior != 1.0f) glass_ior_[i] = d->ior;
+    // A mirror, or a mixture's mirror components (each weighed by its weight).
+    if (const auto* r = std::get_if<Mirror>(&m)) mirror_reflectance_[i] = r->reflectance;
+    if (const auto* mix = std::get_if<Mixture>(&m))
+      for (const Mixture::Component& c : mix->components)
+        if (const auto* r = std::get_if<Mirror>(&c.material); r && std::isfinite(c.weight) && c.weight > 0.0f)
+          mirror_reflectance_[i] += c.weight * r->reflectance;
+    if (glass_ior_[i] > 0.0f || !is_black(mirror_reflectance_[i])) specular_shapes_.push_back(static_cast<int>(i));
+  }
+  has_manifold_ = !specular_shapes_.empty() && table_.runs(ConnectorKind::kManifold);
+  RTCBounds b;
+  rtcGetSceneBounds(rs_.geometry->handle(), &b);
+  const double dx = static_cast<double>(b.upper_x) - b.lower_x, dy = static_cast<double>(b.upper_y) - b.lower_y,
+               dz = static_cast<double>(b.upper_z) - b.lower_z;
+  const double size = std::sqrt(dx * dx + dy * dy + dz * dz);
+  scene_size_ = std::isfinite(size) && size > 0.0 ? size : 1.0;
+}
+
+bool Integrator::manifold_at(const Thread& th, PathKey key, int i, int m) const {
+  const std::vector<Vertex>& x = th.path;
+  const int k = static_cast<int>(x.size()) - 1;
+  const int t = k + 1 - i - m;  // letters after the chain
+  if (i < 1 || m < 1 || m > kMaxChain || t < 2 || manifold_of(i, t) < 0) return false;
+  if (!packed_is_d(key, i) || !packed_is_d(key, i + m + 1)) return false;
+  const Vertex& a = x[static_cast<std::size_t>(i - 1)];
+  const Vertex& b = x[static_cast<std::size_t>(i + m)];
+  if (b.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(b.shape)]) return false;
+  if (i >= 2 && (a.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(a.shape)])) return false;
+  for (int v = i; v < i + m; ++v) {
+    const Vertex& c = x[static_cast<std::size_t>(v)];
+    if (c.kind != Kind::kSurface) return false;
+    const std::size_t shape = static_cast<std::size_t>(c.shape);
+    const float before = glm::dot(x[static_cast<std::size_t>(v - 1)].p - c.p, c.n);
+    const float after = glm::dot(x[static_cast<std::size_t>(v + 1)].p - c.p, c.n);
+    // Glass reflects or refracts; a mirror (or a mixture's mirror part) reflects.
+    if (glass_ior_[shape] == 0.0f && (is_black(mirror_reflectance_[shape]) || !(before * after > 0.0f))) return false;
+  }
+  return true;
+}
+
+
+ManifoldFailure Integrator::seed_chain(const Vertex& b, std::uint64_t stream, std::uint64_t* drawn, std::vector<ChainVertex>& chain) const {
+  const auto u = [&] { return bits_to_unit_float(stream_bits(stream, (*drawn)++)); };
+  chain.clear();
+  const float u_shape = u();
+  const glm::vec2 u_point(u(), u());
+  const std::size_t pick = std::min(specular_shapes_.size() - 1, static_cast<std::size_t>(u_shape * static_cast<float>(specular_shapes_.size())));
+  const int shape = specular_shapes_[pick];
+  vec3 o = b.p, no = b.n, eo = b.err;
+  vec3 d;
+  const auto* sphere = std::get_if<SphereShape>(&rs_.geometry->shape_geometry(shape));
+  const vec3 to_centre = sphere ? sphere->center - b.p : vec3(0.0f);
+  const float d2 = glm::dot(to_centre, to_centre);
+  if (sphere && d2 > sphere->radius * sphere->radius) {
+    // A sphere seen from outside: a direction uniform in the cone it subtends, so every seed meets it.
+    const float cos_max = std::sqrt(std::max(0.0f, 1.0f - sphere->radius * sphere->radius / d2));
+    d = Frame::from_normal(to_centre / std::sqrt(d2)).to_world(sample_uniform_cone(u_point, cos_max));
+  } else {  // otherwise towards a point uniform on the shape's area
+    d = rs_.geometry->sample_shape(shape, u_point).position - b.p;
+    if (!(glm::dot(d, d) > 0.0f)) return ManifoldFailure::kNoSolution;
+  }
+  d = glm::normalize(d);
+  for (;;) {
+    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, no, eo, HitDetail::kNoUv);
+    if (!hit) break;
+    const float ior = glass_ior_[static_cast<std::size_t>(hit->shape)];
+    const bool mirror = !is_black(mirror_reflectance_[static_cast<std::size_t>(hit->shape)]);
+    if (ior == 0.0f && !mirror) {
+      if (chain.empty()) return ManifoldFailure::kOccluded;  // something opaque between b and the specular surfaces
+      break;
+    }
+    if (static_cast<int>(chain.size()) == kMaxChain) return ManifoldFailure::kNoSolution;
+    // Follow the surface as light would: a mirror reflects; glass reflects with the Fresnel
+    // probability (always under total internal reflection), else refracts.
+    const float cos_o = -glm::dot(d, hit->normal);
+    const bool reflect = mirror || u() < bsdf::fresnel_dielectric(cos_o, ior);
+    const double outside = 1.0, inside = ior > 0.0f ? static_cast<double>(ior) : 1.0;  // b's side: where the ray came from
+    const double eye_side = cos_o > 0.0f ? outside : inside;
+    chain.push_back({&rs_.geometry->shape_geometry(hit->shape), hit->shape, hit->primitive, inside,
+                     reflect ? eye_side : (cos_o > 0.0f ? inside : outside), eye_side, reflect, glm::dvec3(hit->position)});
+    const vec3 n_side = cos_o > 0.0f ? hit->normal : -hit->normal;  // towards where d came from
+    if (reflect) {
+      d = glm::normalize(d + 2.0f * std::fabs(cos_o) * n_side);
+    } else {
+      const float eta = cos_o > 0.0f ? 1.0f / ior : ior;  // η_from / η_to
+      const float sin2_t = eta * eta * std::max(0.0f, 1.0f - cos_o * cos_o);
+      if (sin2_t >= 1.0f) return ManifoldFailure::kNoSolution;  // (Fresnel gave 1: not reached)
+      d = glm::normalize(eta * d + (eta * std::fabs(cos_o) - std::sqrt(1.0f - sin2_t)) * n_side);
+    }
+    o = hit->position;
+    no = hit->normal;
+    eo = hit->error;
+  }
+  if (chain.empty()) return ManifoldFailure::kNoSolution;
+  std::reverse(chain.begin(), chain.end());  // light side first
+  return ManifoldFailure::kNone;
+}
+
+void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const {
+  const int strategy_index = manifold_of(s, t);
+  ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
+  constexpr std::uint64_t kLightBlock = 9;  // after connect()'s seven blocks and the mirror's two
+  const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
+  if (b->kind != Kind::kSurface || !b->finite) return;
+  const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, kLightBlock);
+  if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
+  // --- specular manifold sampling: a random seed chain, solved; then the inverse probability of
+  //     that solution, estimated by the number of fresh seeds it takes to find it again ---
+  ++stats.attempts;
+  // The seeds draw from their own counter-based stream (an unbounded count of numbers per join).
+  const std::uint64_t stream = stream_key(rng.key(), th.pass, 0x6d616e69666f6c64ULL + static_cast<std::uint64_t>(s) * kMaxRuns +
+                                                               static_cast<std::uint64_t>(t));
+  std::uint64_t drawn = 0;
+  const glm::dvec3 pa(a->p), pb(b->p), nb(b->n);
+  const auto trial = [&](std::vector<ChainVertex>& chain) -> ManifoldWalk {
+    ManifoldWalk w;
+    const ManifoldFailure seed = seed_chain(*b, stream, &drawn, chain);
+    if (seed != ManifoldFailure::kNone) {
+      w.failure = seed;
+      return w;
+    }
+    const int m = static_cast<int>(chain.size());
+    if (s + m + t - 2 > max_bounces_) {  // longer than the render's bound on interior vertices
+      w.failure = ManifoldFailure::kNoSolution;
+      return w;
+    }
+    ++stats.walks;
+    w = solve_chain(chain, pa, pb, nb, scene_size_, o_.manifold);
+    stats.iterations += static_cast<std::uint64_t>(w.iterations);
+    return w;
+  };
+  std::vector<ChainVertex>& chain = th.manifold_chain;
+  const ManifoldWalk walk = trial(chain);
+  switch (walk.failure) {
+    case ManifoldFailure::kNone: break;
+    case ManifoldFailure::kNoSolution: ++stats.no_solution; return;
+    case ManifoldFailure::kOccluded: ++stats.occluded; return;
+    case ManifoldFailure::kSingular: ++stats.singular; return;
+    case ManifoldFailure::kWrongType: ++stats.wrong_type; return;
+    case ManifoldFailure::kTooShort: ++stats.too_short; return;
+    case ManifoldFailure::kIterationLimit: ++stats.iteration_limit; return;
+  }
+  const int m = static_cast<int>(chain.size());
+  // Trials until a fresh seed finds the same chain: their number K has E[K] = 1 / p(chain).
+  const double same = 1e-5 * scene_size_;
+  std::vector<ChainVertex> other;
+  int trials = 1;
+  for (; trials < o_.manifold.max_trials; ++trials) {
+    other.clear();
+    const ManifoldWalk w = trial(other);
+    if (w.failure != ManifoldFailure::kNone || static_cast<int>(other.size()) != m) continue;
+    bool equal = true;
+    for (std::size_t i = 0; i < chain.size() && equal; ++i)
+      equal = other[i].id == chain[i].id && other[i].reflect == chain[i].reflect && glm::length(other[i].p - chain[i].p) < same;
+    if (equal) break;
+  }
+  // --- the chain's vertices and its contribution ---
+  JoinResult& jr = th.join;
+  vec3 transmit(1.0f);  // the share of flux the chain passes: tint (1 - F) or tint F for glass, R for a mirror
+  for (int i = 0; i < m; ++i) {
+    const ChainVertex& c = chain[static_cast<std::size_t>(i)];
+    Vertex& v = jr.chain_vertices[static_cast<std::size_t>(i)];
+    v = Vertex{};
+    v.kind = Kind::kSurface;
+    v.letter = 'S';
+    v.p = vec3(c.p);
+    v.n = vec3(surface_derivatives(*c.shape, c.primitive, c.p).n);
+    v.ns = v.n;
+    v.finite = false;
+    // Rounding of the solved point: its float position and the surface's own test, as a hit's bound.
+    v.err = error_gamma(16) * (glm::abs(v.p) + vec3(static_cast<float>(scene_size_)));
+    v.shape = c.id;
+    const glm::dvec3 prev = i == 0 ? glm::dvec3(a->p) : chain[static_cast<std::size_t>(i - 1)].p;
+    const float cos_prev = static_cast<float>(glm::dot(glm::normalize(prev - c.p), glm::dvec3(v.n)));
+    if (const auto* glass = std::get_if<Dielectric>(rs_.material_of_shape[static_cast<std::size_t>(c.id)])) {
+      const float f = bsdf::fresnel_dielectric(cos_prev, glass->ior);
+      transmit *= glass->tint * (c.reflect ? f : 1.0f - f);
+    } else {
+      transmit *= mirror_reflectance_[static_cast<std::size_t>(c.id)];
+    }
+  }
+  const vec3 w_a = glm::normalize(jr.chain_vertices[0].p - a->p);
+  const vec3 w_b = glm::normalize(jr.chain_vertices[static_cast<std::size_t>(m - 1)].p - b->p);
+  // f at a towards the chain: the light's directional emission (a's beta holds the spatial part), or the BSDF.
+  const vec3 fa = s == 1 ? vec3(directional_emission(rs_.lights[static_cast<std::size_t>(a->light)].params, a->n, w_a))
+                         : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, w_a, a->ns, a->n);
+  const vec3 fb = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(b->shape)], b->wo, w_b, b->ns, b->n);
+  // Flux leaving a into dω lands on dA_b = dω / |dω_a/dA_b|: the generalized geometry term.
+  const vec3 contrib = a->beta * fa * abs_cos(*a, w_a) * transmit * fb * b->beta *
+                       static_cast<float>(walk.dw_db * static_cast<double>(trials));
+  if (is_black(contrib)) {
+    ++stats.no_transport;
+    return;
+  }
+  if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
+  // The letters: a's c(s) = D, the chain's c(s+1) … c(s+m) = S, b's c(s+m+1) = D.
+  const PathKey light_part = s == 1 ? letter_bit(a->pos_letter, 0) : th.light_mask & (bit(s) - 1);
+  PathKey key = light_part | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + m + 1)) & ~bit(s + m + 1)) |
+                static_cast<PathKey>(s + t + m + 2) << kLengthShift;
+  for (int i = 1; i <= m; ++i) key |= bit(s + i);
+  jr.chain = ConnectorKind::kManifold;
+  jr.s = s;
+  jr.t = t;
+  jr.strategy = strategy_index;
+  jr.letters = key;
+  jr.contribution = contrib;
+  jr.has_light0 = s == 1;
+  jr.has_eye0 = false;
+  jr.chain_length = m;
+  jr.segments[0] = Segment{a, &jr.chain_vertices[0]};
+  for (int i = 1; i < m; ++i) jr.segments[static_cast<std::size_t>(i)] = Segment{&jr.chain_vertices[static_cast<std::size_t>(i - 1)], &jr.chain_vertices[static_cast<std::size_t>(i)]};
+  jr.segments[static_cast<std::size_t>(m)] = Segment{&jr.chain_vertices[static_cast<std::size_t>(m - 1)], b};
+  jr.num_segments = m + 1;  // all must be clear
+  jr.has_density = false;    // MIS over whole paths recomputes every density
+  jr.splat = false;
+  estimate(th, batch);
+}
+
+}  // namespace pathex::tracer
