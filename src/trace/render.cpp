@@ -701,15 +701,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     m.ns = mirror.normal;
     m.err = mirror.error;
     m.shape = mirror.shape;
-    jr.chain = ConnectorKind::kMirror;
-    jr.s = s;
-    jr.t = t;
-    jr.strategy = strategy_index;
-    jr.letters = key;
-    jr.contribution = contrib;
-    jr.has_light0 = s == 1;
-    jr.has_eye0 = t == 1;
-    jr.chain_length = 1;
+    jr.set_connector(ConnectorKind::kMirror, s, t, strategy_index, key, contrib, 1);
     jr.segments = {Segment{a, &m}, Segment{&m, b}};  // both must be clear
     jr.num_segments = 2;
     jr.has_density = false;  // MIS over whole paths recomputes every density
@@ -1005,21 +997,7 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
     const Strategy& st = strategies->strategies[i];
     if (st.connector == ConnectorKind::kNone) continue;
     ConnectorStats total{st.name, to_string(st.connector)};
-    for (const Integrator::Thread& th : locals) {
-      const ConnectorStats& c = th.connectors[i];
-      total.attempts += c.attempts;
-      total.successes += c.successes;
-      total.outside += c.outside;
-      total.occluded += c.occluded;
-      total.no_transport += c.no_transport;
-      total.no_solution += c.no_solution;
-      total.singular += c.singular;
-      total.wrong_type += c.wrong_type;
-      total.too_short += c.too_short;
-      total.iteration_limit += c.iteration_limit;
-      total.walks += c.walks;
-      total.iterations += c.iterations;
-    }
+    for (const Integrator::Thread& th : locals) total += th.connectors[i];
     out.connectors.push_back(total);
   }
   out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -96,6 +96,23 @@ struct ConnectorStats {
   std::uint64_t no_solution = 0, singular = 0, wrong_type = 0, too_short = 0, iteration_limit = 0;
   std::uint64_t walks = 0;       // chains handed to the Newton solver
   std::uint64_t iterations = 0;  // Newton iterations over all of them (mean: iterations / walks)
+
+  // Adds another thread's counts (the names stay this one's).
+  ConnectorStats& operator+=(const ConnectorStats& o) {
+    attempts += o.attempts;
+    successes += o.successes;
+    outside += o.outside;
+    occluded += o.occluded;
+    no_transport += o.no_transport;
+    no_solution += o.no_solution;
+    singular += o.singular;
+    wrong_type += o.wrong_type;
+    too_short += o.too_short;
+    iteration_limit += o.iteration_limit;
+    walks += o.walks;
+    iterations += o.iterations;
+    return *this;
+  }
 };
 
 // Where a render's first non-finite contribution arose (they are bugs: DESIGN §7). "First" is by

@@ -67,6 +67,22 @@ struct JoinResult {
   bool splat = false;
   float rx = 0.0f, ry = 0.0f;
 
+  // What a connector that builds chain_vertices (mirror, manifold) records once it has a
+  // contribution: its strategy (s, chain, t) and the path's letters. At s = 1 (t = 1) the connector
+  // stands on a fresh light (sensor) sample, light0 (eye0).
+  void set_connector(ConnectorKind kind, int light_s, int eye_t, int strategy_index, accel::PathKey key,
+                     vec3 c, int length) {
+    chain = kind;
+    s = light_s;
+    t = eye_t;
+    strategy = strategy_index;
+    letters = key;
+    contribution = c;
+    has_light0 = light_s == 1;
+    has_eye0 = eye_t == 1;
+    chain_length = length;
+  }
+
   // The fresh endpoint standing in for y0 or z0 (z0 first), as the plain-join MIS routine takes it.
   const Vertex* fresh() const { return has_eye0 ? &eye0 : has_light0 ? &light0 : nullptr; }
 };

@@ -222,15 +222,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   PathKey key = light_part | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + m + 1)) & ~bit(s + m + 1)) |
                 static_cast<PathKey>(s + t + m + 2) << kLengthShift;
   for (int i = 1; i <= m; ++i) key |= bit(s + i);
-  jr.chain = ConnectorKind::kManifold;
-  jr.s = s;
-  jr.t = t;
-  jr.strategy = strategy_index;
-  jr.letters = key;
-  jr.contribution = contrib;
-  jr.has_light0 = s == 1;
-  jr.has_eye0 = false;
-  jr.chain_length = m;
+  jr.set_connector(ConnectorKind::kManifold, s, t, strategy_index, key, contrib, m);  // b is a surface vertex: t >= 2, no eye0
   jr.segments[0] = Segment{a, &jr.chain_vertices[0]};
   for (int i = 1; i < m; ++i) jr.segments[static_cast<std::size_t>(i)] = Segment{&jr.chain_vertices[static_cast<std::size_t>(i - 1)], &jr.chain_vertices[static_cast<std::size_t>(i)]};
   jr.segments[static_cast<std::size_t>(m)] = Segment{&jr.chain_vertices[static_cast<std::size_t>(m - 1)], b};
