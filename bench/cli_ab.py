@@ -39,6 +39,9 @@ def main():
     ap.add_argument("--b-arg", action="append", default=[],
                     help="an extra argument for binary B only (repeatable), e.g. --b-arg=--sampler --b-arg=independent "
                          "when A predates the option and its default")
+    ap.add_argument("--a-arg", action="append", default=[],
+                    help="an extra argument for binary A only (repeatable), e.g. to compare two samplers or two builds "
+                         "with the same non-default option")
     args = ap.parse_args()
     tail = (["trace"] + ([os.path.abspath(args.scene)] if args.scene else []) +
             ["--renderer", args.renderer, "--spp", str(args.spp), "--threads", "1", "--no-images", "--quiet", "--json"])
@@ -54,7 +57,7 @@ def main():
         order = [("a", args.a), ("b", args.b)] if r % 2 == 0 else [("b", args.b), ("a", args.a)]
         t = {}
         for name, binary in order:
-            t[name] = cpu_run([os.path.abspath(binary)] + tail + (args.b_arg if name == "b" else []), dirs[name])
+            t[name] = cpu_run([os.path.abspath(binary)] + tail + (args.b_arg if name == "b" else args.a_arg), dirs[name])
         ta.append(t["a"])
         tb.append(t["b"])
         ratios.append(t["a"] / t["b"])

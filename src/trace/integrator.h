@@ -224,8 +224,11 @@ class Integrator {
   }
   // A light chosen uniformly by u, and a point on it drawn from u2 (area lights; the others
   // ignore the point).
+  // (u n lies in [0, n), far below 2^63: the signed conversion is exact and, unlike the unsigned
+  // one, a single instruction.)
   std::size_t pick_light(float u) const {
-    return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(u * static_cast<float>(rs_.lights.size())));
+    const auto i = static_cast<std::int64_t>(u * static_cast<float>(rs_.lights.size()));
+    return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(i));
   }
   // *error: the point's rounding-error bound (SurfaceSample::error), which offsets rays leaving it.
   SurfacePoint sample_point(const RenderLight& l, glm::vec2 u2, vec3* error) const {

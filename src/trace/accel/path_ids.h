@@ -56,13 +56,7 @@ class PathIds {
         ++slot.contributions;
         return slot.ids;
       }
-      if (slot.key == 0) {
-        const Histogram::PathId id = hist.intern(unpack(key));
-        slot = {key, technique, {id, hist.technique_row(id, technique)}, 1};
-        const Ids ids = slot.ids;
-        if (2 * ++used_ > slots_.size()) grow();
-        return ids;
-      }
+      if (slot.key == 0) return insert(hist, slot, key, technique);
     }
   }
   // Adds the contributions counted since the last flush to the histogram's technique rows.
@@ -81,9 +75,19 @@ class PathIds {
     Ids ids;
     std::uint64_t contributions = 0;  // nonzero contributions of the pair since the last flush
   };
+  // A pair's first sight, out of line: the lookup above stays small enough to inline.
+  [[gnu::noinline]] Ids insert(Histogram& hist, Slot& slot, PathKey key, int technique) {
+    const Histogram::PathId id = hist.intern(unpack(key));
+    slot = {key, technique, {id, hist.technique_row(id, technique)}, 1};
+    const Ids ids = slot.ids;
+    if (2 * ++used_ > slots_.size()) grow();
+    return ids;
+  }
+  // One finaliser over the three words, each spread by its own odd multiplier first (ids do not
+  // depend on the hash: they are given in order of first sight).
   static std::size_t hash(PathKey key, int technique) {
-    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) ^
-                                          mix64(static_cast<std::uint64_t>(key >> 64) ^ static_cast<std::uint64_t>(technique))));
+    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) + static_cast<std::uint64_t>(key >> 64) * kGoldenGamma +
+                                          static_cast<std::uint64_t>(technique) * 0xd6e8feb86659fd93ULL));
   }
   void grow() {
     std::vector<Slot> old(slots_.size() * 2);
