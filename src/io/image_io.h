@@ -24,9 +24,9 @@ namespace pathex {
 
 // What the images of a render of `width` x `height` pixels with `layers` layers (the total and one
 // per class) take at their peak, which is while they are written: the render's exact sums (48
-// bytes per pixel per plane, counted as one plane per layer: ClassImages), the layers as floats
-// (12 bytes per pixel each) and, kept as a margin since the EXR is streamed into its file, twice
-// the floats again (what the EXR's bytes took in memory before). pathex trace compares it with
+// bytes per pixel per plane, counted as one plane per layer: ClassImages) and, kept as a margin
+// since the EXR and the previews are now written band by band (write_image_files), the layers as
+// floats (12 bytes per pixel each) and twice that again (what the EXR's bytes took in memory before). pathex trace compares it with
 // --max-memory before rendering. Measured peaks stay below it (README "Limits").
 std::uint64_t render_memory_estimate(int width, int height, int layers);
 
