@@ -9,6 +9,7 @@
 #include <cstring>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <set>
@@ -301,23 +302,30 @@ namespace {
 // `n` values times exposure, sRGB-encoded, clamped, rounded to 8 bits, into `out`.
 void tonemap_srgb8_into(const float* in, std::size_t n, double exposure, std::uint8_t* out) {
   const std::array<double, 255>& thresholds = srgb8_thresholds();
-  // A first guess per 1/4096 of [0, 1] (the curve's steepest slope, 12.92 · 255 codes per unit,
-  // moves less than one code per bucket), then the thresholds themselves decide: the code is
-  // exactly the number of thresholds at or below v, as a search would give, at two comparisons.
+  // Per 1/4096 of [0, 1]: the code at the bucket's start (the number of thresholds at or below it)
+  // and the next threshold. The thresholds are at least 1 / (12.92 · 255) = 1/3295 apart (the
+  // curve's steepest slope), more than a bucket, so at most one lies inside a bucket and one
+  // comparison decides: exactly the number of thresholds at or below v, as a search would give,
+  // without the data-dependent branches of a search (which mispredicted on noisy layers).
   constexpr int kBuckets = 4096;
-  static const std::array<std::uint8_t, kBuckets + 1> guess = [&] {
-    std::array<std::uint8_t, kBuckets + 1> g{};
-    for (int b = 0; b <= kBuckets; ++b)
-      g[static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(
+  struct Bucket {
+    double next;  // the first threshold above the bucket's start; +inf past code 255
+    unsigned code;
+  };
+  static const std::array<Bucket, kBuckets + 1> buckets = [&] {
+    std::array<Bucket, kBuckets + 1> g{};
+    for (int b = 0; b <= kBuckets; ++b) {
+      const auto code = static_cast<unsigned>(
           std::upper_bound(thresholds.begin(), thresholds.end(), static_cast<double>(b) / kBuckets) - thresholds.begin());
+      g[static_cast<std::size_t>(b)] = {code < 255 ? thresholds[code] : std::numeric_limits<double>::infinity(), code};
+    }
     return g;
   }();
   for (std::size_t i = 0; i < n; ++i) {
     double v = in[i] * exposure;
     v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0;  // NaN and ±inf never reach a finished image
-    unsigned code = guess[static_cast<std::size_t>(v * kBuckets)];
-    while (code > 0 && v < thresholds[code - 1]) --code;
-    while (code < 255 && v >= thresholds[code]) ++code;
+    const Bucket& b = buckets[static_cast<std::size_t>(v * kBuckets)];
+    const unsigned code = b.code + (v >= b.next ? 1u : 0u);
     out[i] = static_cast<std::uint8_t>(code);
   }
 }
