@@ -195,31 +195,45 @@ ImageLayer ClassImages::layer(int layer, double scale) const {
   out.name = names_[static_cast<std::size_t>(layer)];
   out.image.width = width_;
   out.image.height = height_;
-  out.image.rgb.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 3, 0.0f);
+  out.image.rgb.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 3);
+  layer_rows(layer, scale, 0, height_, out.image.rgb.data());
+  return out;
+}
+
+void ClassImages::layer_rows(int layer, double scale, int y0, int rows, float* out) const {
+  const int y1 = std::min(y0 + rows, height_);
+  const std::size_t row_floats = static_cast<std::size_t>(width_) * 3;
   // Tile by tile: the exact sums of the layer's planes in the tile (most planes touch few tiles:
   // a pixel-by-pixel search of every plane cost seconds at 512 x 512 with twenty layers), then
-  // its floats. Tiles no plane touched stay zero.
+  // its floats. Pixels of tiles no plane touched are zero.
   const std::vector<std::size_t>& slots = slots_of_layer_[static_cast<std::size_t>(layer)];
   std::array<ExactSum, kTileWords / 2> sums;
-  for (std::size_t t = 0; t < num_tiles(); ++t) {
-    bool any = false;
-    for (std::size_t slot : slots) {
-      const std::uint64_t* w = tile_words(slot, t);
-      if (w == nullptr) continue;
-      if (!any) sums.fill(0);
-      any = true;
-      for (std::size_t i = 0; i < sums.size(); ++i) sums[i] += load(w + 2 * i);
-    }
-    if (!any) continue;
-    const int x0 = static_cast<int>(t % tiles_x()) * kTile, y0 = static_cast<int>(t / tiles_x()) * kTile;
-    for (int y = y0; y < std::min(y0 + kTile, height_); ++y)
-      for (int x = x0; x < std::min(x0 + kTile, width_); ++x) {
-        const ExactSum* src = &sums[in_tile_index(x, y) / 2];
-        float* dst = &out.image.rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)) * 3];
-        for (std::size_t ch = 0; ch < 3; ++ch) dst[ch] = static_cast<float>(to_double(src[ch]) * scale);
+  for (int ty = y0 / kTile; ty * kTile < y1; ++ty) {
+    const int row_lo = std::max(ty * kTile, y0), row_hi = std::min(ty * kTile + kTile, y1);
+    for (std::size_t tx = 0; tx < tiles_x(); ++tx) {
+      const std::size_t t = static_cast<std::size_t>(ty) * tiles_x() + tx;
+      const int x0 = static_cast<int>(tx) * kTile, x1 = std::min(x0 + kTile, width_);
+      bool any = false;
+      for (std::size_t slot : slots) {
+        const std::uint64_t* w = tile_words(slot, t);
+        if (w == nullptr) continue;
+        if (!any) sums.fill(0);
+        any = true;
+        for (std::size_t i = 0; i < sums.size(); ++i) sums[i] += load(w + 2 * i);
       }
+      for (int y = row_lo; y < row_hi; ++y) {
+        float* dst = out + static_cast<std::size_t>(y - y0) * row_floats + static_cast<std::size_t>(x0) * 3;
+        if (!any) {
+          std::fill(dst, dst + static_cast<std::size_t>(x1 - x0) * 3, 0.0f);
+          continue;
+        }
+        for (int x = x0; x < x1; ++x, dst += 3) {
+          const ExactSum* src = &sums[in_tile_index(x, y) / 2];
+          for (std::size_t ch = 0; ch < 3; ++ch) dst[ch] = static_cast<float>(to_double(src[ch]) * scale);
+        }
+      }
+    }
   }
-  return out;
 }
 
 std::vector<ImageLayer> ClassImages::layers(double scale) const {

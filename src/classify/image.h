@@ -91,6 +91,10 @@ class ClassImages {
   ExactRgb sum(int layer, int x, int y) const;
   // The layer as floats, each pixel's sum times `scale` (1 / spp for the pixel's mean).
   ImageLayer layer(int layer, double scale) const;
+  // Rows [y0, y0 + rows) of the layer as floats (as layer() has them) into `out`, rows × width × 3
+  // floats: writers that go a band of rows at a time never hold the whole layer. Fastest with y0 a
+  // multiple of kTile (a tile's planes are summed once per call that covers it).
+  void layer_rows(int layer, double scale, int y0, int rows, float* out) const;
   std::vector<ImageLayer> layers(double scale) const;  // every layer, in parallel
   std::size_t memory_bytes() const;
 

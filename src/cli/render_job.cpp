@@ -103,10 +103,10 @@ static nlohmann::ordered_json efficiency_json(const Estimate& total, double cpu_
 
 namespace {
 
-// Everything but the shard file: histogram.json, the images, run.json.
-Result<WrittenReport> write_report_and_images(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                              const RenderClasses& classes, const std::vector<ConnectorStats>& connectors,
-                                              const std::vector<PrunedStrategy>& not_run) {
+// histogram.json and run.json (which reads the report's total).
+Result<WrittenReport> write_report(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
+                                   const RenderClasses& classes, const std::vector<ConnectorStats>& connectors,
+                                   const std::vector<PrunedStrategy>& not_run) {
   const RenderIdentity& id = header.identity;
   RunInfo info;
   info.scene = id.scene;
@@ -153,18 +153,6 @@ Result<WrittenReport> write_report_and_images(const std::string& dir, const Shar
   }
   out.json_text = doc.dump(2) + "\n";
   if (Result<bool> w = write_file_atomic(dir + "/histogram.json", out.json_text); !w) return w.error();
-  if (id.images) {
-    const std::uint64_t spp = header.passes.count();
-    std::vector<ImageLayer> layers = sums.images.layers(spp ? 1.0 / static_cast<double>(spp) : 0.0);
-    // A class that was not rendered has no image (its layer holds at most the requested part of it).
-    std::erase_if(layers, [&](const ImageLayer& l) {
-      for (std::size_t i = 0; i < classes.classes.size(); ++i)
-        if (classes.classes[i]->name == l.name) return classes.estimated[i] == 0;
-      return false;
-    });
-    if (Result<bool> w = write_exr(dir + "/classes.exr", layers); !w) return w.error();
-    if (Result<bool> w = write_previews(dir, layers); !w) return w.error();
-  }
   nlohmann::ordered_json run = nlohmann::ordered_json::object();
   run["time_s"] = header.run.time_s;
   run["threads"] = header.run.threads;
@@ -186,22 +174,56 @@ Result<WrittenReport> write_report_and_images(const std::string& dir, const Shar
   return out;
 }
 
+// The layers of the rendered classes (and the total), a band of rows at a time from the exact sums.
+class RenderBands final : public LayerBands {
+ public:
+  RenderBands(const ClassImages& images, const RenderClasses& classes, double scale) : images_(images), scale_(scale) {
+    for (int l = 0; l < images.num_layers(); ++l) {
+      // A class that was not rendered has no image (its layer holds at most the requested part of it).
+      bool rendered = true;
+      for (std::size_t i = 0; i < classes.classes.size(); ++i)
+        if (classes.classes[i]->name == images.layer_name(l)) rendered = classes.estimated[i] != 0;
+      if (rendered) layers_.push_back(l);
+    }
+  }
+  int width() const override { return images_.width(); }
+  int height() const override { return images_.height(); }
+  std::size_t num_layers() const override { return layers_.size(); }
+  const std::string& name(std::size_t layer) const override { return images_.layer_name(layers_[layer]); }
+  void fill(std::size_t layer, int y0, int rows, float* out) const override { images_.layer_rows(layers_[layer], scale_, y0, rows, out); }
+
+ private:
+  const ClassImages& images_;
+  double scale_;
+  std::vector<int> layers_;
+};
+
+// classes.exr and the PNG previews.
+Result<bool> write_images(const std::string& dir, const ShardHeader& header, const RenderSums& sums, const RenderClasses& classes) {
+  const std::uint64_t spp = header.passes.count();
+  const RenderBands bands(sums.images, classes, spp ? 1.0 / static_cast<double>(spp) : 0.0);
+  return write_image_files(bands, ImageFiles{dir + "/classes.exr", {}, dir});
+}
+
 }  // namespace
 
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
                                            const RenderClasses& classes, const std::vector<ConnectorStats>& connectors,
                                            const std::vector<PrunedStrategy>& not_run) {
-  // The shard file, the largest output and independent of the others, is encoded and written on
-  // another core while the report and the images are made and written on this one (both read the
-  // sums only). The bytes do not depend on it.
-  std::optional<Result<bool>> shard;
+  // The files are independent and read the sums only: the shard file (the largest), the report
+  // and the images are made and written as concurrent tasks, so the wall time is the longest of
+  // them rather than their sum. The bytes do not depend on it; the first failure in the order
+  // report, images, shard is the one returned.
+  std::optional<Result<bool>> shard, images;
   tbb::task_group group;
   group.run([&] { shard.emplace(write_shard(dir + "/" + kRenderShardName, header, sums.histogram, sums.images)); });
-  Result<WrittenReport> rest = write_report_and_images(dir, header, sums, classes, connectors, not_run);
+  if (header.identity.images) group.run([&] { images.emplace(write_images(dir, header, sums, classes)); });
+  Result<WrittenReport> report = write_report(dir, header, sums, classes, connectors, not_run);
   group.wait();
-  if (!rest) return rest.error();
+  if (!report) return report.error();
+  if (images && !*images) return images->error();
   if (!*shard) return shard->error();
-  return rest;
+  return report;
 }
 
 std::string ranks_folder(const std::string& dir) {

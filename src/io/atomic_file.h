@@ -23,7 +23,7 @@ class AtomicFile {
   // Creates the temporary beside `path`; ok() says whether that worked.
   explicit AtomicFile(std::string path);
   ~AtomicFile();  // removes the temporary unless committed
-  // Appended bytes wait in a buffer of up to 1 MiB; larger pieces are written at once.
+  // Appended bytes wait in a buffer of up to 256 KiB; larger pieces are written at once.
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 

@@ -8,6 +8,9 @@
 #include <cstdio>
 #include <cstring>
 #include <array>
+#include <cstdint>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <set>
 #include <thread>
@@ -22,6 +25,7 @@
 #include <png.h>
 #include <zlib.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include "io/atomic_file.h"
 
@@ -34,32 +38,6 @@ Error file_error(const std::string& path, std::string message) {
   return e;
 }
 
-// An OpenEXR output stream into a string.
-class MemoryOStream : public Imf::OStream {
- public:
-  // `capacity`: the bytes expected, allocated once (the file is written in small pieces).
-  explicit MemoryOStream(std::size_t capacity) : Imf::OStream("<memory>") { bytes_.reserve(capacity); }
-  void write(const char c[], int n) override {
-    const auto count = static_cast<std::size_t>(n);
-    if (pos_ == bytes_.size()) {
-      bytes_.append(c, count);
-    } else {
-      if (pos_ + count > bytes_.size()) bytes_.resize(pos_ + count);
-      std::memcpy(bytes_.data() + pos_, c, count);
-    }
-    pos_ += count;
-  }
-  uint64_t tellp() override { return pos_; }
-  void seekp(uint64_t pos) override { pos_ = static_cast<std::size_t>(pos); }
-  std::string take() { return std::move(bytes_); }
-
- private:
-  std::string bytes_;
-  std::size_t pos_ = 0;
-};
-
-// An OpenEXR output stream into an AtomicFile, written as it is encoded (OpenEXR seeks back once,
-// to fill in the table of line offsets).
 class FileOStream : public Imf::OStream {
  public:
   explicit FileOStream(AtomicFile* file) : Imf::OStream("<file>"), file_(file) {}
@@ -114,71 +92,104 @@ std::uint64_t render_memory_estimate(int width, int height, int layers) {
 
 namespace {
 
-// The file into `out` (MemoryOStream or FileOStream).
-Result<bool> encode_exr_into(Imf::OStream& out, const std::vector<ImageLayer>& layers, const ExrOptions& options) {
-  if (Result<bool> ok = check_layers(layers); !ok) return ok.error();
-  const int w = layers[0].image.width, h = layers[0].image.height;
-  const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  const Imf::PixelType type = options.half ? Imf::HALF : Imf::FLOAT;
-  const std::size_t size = options.half ? sizeof(half) : sizeof(float);
-  try {
-    Imf::Header header(w, h);
-    // RLE: the render's float noise barely compresses, the class layers' empty regions do; ZIP
-    // level 1 took six to eight times the CPU for files two thirds the size (bench/README.md).
-    header.compression() = Imf::RLE_COMPRESSION;
-    // Half channels need their own buffers; float channels point straight into the layers.
-    std::vector<std::vector<half>> halves;
-    Imf::FrameBuffer frame;
-    static const char* const kChannel[3] = {"R", "G", "B"};
-    for (const ImageLayer& l : layers) {
-      const char* base = reinterpret_cast<const char*>(l.image.rgb.data());
-      std::size_t x_stride = 3 * sizeof(float);
-      if (options.half) {
-        halves.emplace_back(pixels * 3);
-        for (std::size_t i = 0; i < pixels * 3; ++i) halves.back()[i] = half(l.image.rgb[i]);
-        base = reinterpret_cast<const char*>(halves.back().data());
-        x_stride = 3 * sizeof(half);
-      }
-      for (std::size_t c = 0; c < 3; ++c) {
-        const std::string name = l.name + "." + kChannel[c];
-        header.channels().insert(name, Imf::Channel(type));
-        frame.insert(name, Imf::Slice(type, const_cast<char*>(base + c * size), x_stride,
-                                      x_stride * static_cast<std::size_t>(w)));
-      }
-    }
-    {
-      // Blocks of scan lines compressed on every core (the bytes do not depend on it).
-      Imf::OutputFile file(out, header, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
-      file.setFrameBuffer(frame);
-      file.writePixels(h);
-    }  // the destructor completes the file (line offset table)
-    return true;
-  } catch (const std::exception& ex) {
-    return make_error(ErrorCode::kBadFile, std::string("OpenEXR could not encode the image: ") + ex.what());
+// An EXR file written a band of scan lines at a time into an AtomicFile (the slices of each band
+// point into its buffers; OpenEXR encodes blocks of lines on every core, and the bytes do not
+// depend on it). RLE: the render's float noise barely compresses, the class layers' empty regions
+// do; ZIP level 1 took six to eight times the CPU for files two thirds the size (bench/README.md).
+class ExrStream {
+ public:
+  ExrStream(AtomicFile* file, const LayerBands& bands, const ExrOptions& options) : out_(file), bands_(bands), options_(options) {}
+
+  Result<bool> open() {
+    return guarded([&] {
+      Imf::Header header(bands_.width(), bands_.height());
+      header.compression() = Imf::RLE_COMPRESSION;
+      static const char* const kChannel[3] = {"R", "G", "B"};
+      for (std::size_t l = 0; l < bands_.num_layers(); ++l)
+        for (const char* c : kChannel) header.channels().insert(bands_.name(l) + "." + c, Imf::Channel(type()));
+      file_ = std::make_unique<Imf::OutputFile>(out_, header, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+    });
   }
-}
+
+  // Rows [y0, y0 + rows), band[l] holding layer l's (rows × width × 3 floats).
+  Result<bool> write(int y0, int rows, const std::vector<std::vector<float>>& band) {
+    return guarded([&] {
+      const std::size_t w = static_cast<std::size_t>(bands_.width()), size = options_.half ? sizeof(half) : sizeof(float);
+      const std::size_t x_stride = 3 * size, y_stride = x_stride * w;
+      if (options_.half) halves_.resize(band.size());
+      Imf::FrameBuffer frame;
+      static const char* const kChannel[3] = {"R", "G", "B"};
+      for (std::size_t l = 0; l < band.size(); ++l) {
+        const char* data = reinterpret_cast<const char*>(band[l].data());
+        if (options_.half) {  // half channels need their own buffers
+          const std::size_t n = static_cast<std::size_t>(rows) * w * 3;
+          halves_[l].resize(n);
+          for (std::size_t i = 0; i < n; ++i) halves_[l][i] = half(band[l][i]);
+          data = reinterpret_cast<const char*>(halves_[l].data());
+        }
+        // OpenEXR addresses pixel (x, y) at base + x * x_stride + y * y_stride: the band's first
+        // row is line y0.
+        const std::uintptr_t base = reinterpret_cast<std::uintptr_t>(data) - static_cast<std::uintptr_t>(y0) * y_stride;
+        for (std::size_t c = 0; c < 3; ++c)
+          frame.insert(bands_.name(l) + "." + kChannel[c],
+                       Imf::Slice(type(), reinterpret_cast<char*>(base + c * size), x_stride, y_stride));
+      }
+      file_->setFrameBuffer(frame);
+      file_->writePixels(rows);
+    });
+  }
+
+  // Completes the file (the table of line offsets).
+  Result<bool> close() {
+    return guarded([&] { file_.reset(); });
+  }
+
+ private:
+  Imf::PixelType type() const { return options_.half ? Imf::HALF : Imf::FLOAT; }
+  template <typename F>
+  Result<bool> guarded(F&& f) {
+    try {
+      f();
+      return true;
+    } catch (const std::exception& ex) {
+      return make_error(ErrorCode::kBadFile, std::string("OpenEXR could not encode the image: ") + ex.what());
+    }
+  }
+
+  FileOStream out_;
+  const LayerBands& bands_;
+  ExrOptions options_;
+  std::unique_ptr<Imf::OutputFile> file_;
+  std::vector<std::vector<half>> halves_;
+};
+
+// Whole layers (write_exr, write_previews) as bands.
+class VectorBands final : public LayerBands {
+ public:
+  explicit VectorBands(const std::vector<ImageLayer>& layers) : layers_(layers) {}
+  int width() const override { return layers_[0].image.width; }
+  int height() const override { return layers_[0].image.height; }
+  std::size_t num_layers() const override { return layers_.size(); }
+  const std::string& name(std::size_t layer) const override { return layers_[layer].name; }
+  void fill(std::size_t layer, int y0, int rows, float* out) const override {
+    const std::size_t row = static_cast<std::size_t>(width()) * 3;
+    const float* src = layers_[layer].image.rgb.data() + static_cast<std::size_t>(y0) * row;
+    std::copy(src, src + static_cast<std::size_t>(rows) * row, out);
+  }
+
+ private:
+  const std::vector<ImageLayer>& layers_;
+};
 
 }  // namespace
 
-Result<std::string> encode_exr(const std::vector<ImageLayer>& layers, const ExrOptions& options) {
-  // At most the raw pixels (RLE grows a run-free line by one byte in 128) and the header.
-  const std::size_t raw = layers.empty() ? 0 : layers.size() * layers[0].image.rgb.size() * (options.half ? 2 : 4);
-  MemoryOStream out(raw * 130 / 128 + 65536);
-  if (Result<bool> r = encode_exr_into(out, layers, options); !r) return r.error();
-  return out.take();
-}
-
 Result<bool> write_exr(const std::string& path, const std::vector<ImageLayer>& layers, const ExrOptions& options) {
-  // Straight into the file: a memory copy of it would be as large as the layers.
-  AtomicFile file(path);
-  if (!file.ok()) return file.commit();  // the error
-  FileOStream out(&file);
-  if (Result<bool> r = encode_exr_into(out, layers, options); !r) {
-    Error e = r.error();
+  if (Result<bool> ok = check_layers(layers); !ok) {
+    Error e = ok.error();
     e.where = path;
     return e;
   }
-  return file.commit();
+  return write_image_files(VectorBands(layers), ImageFiles{path, options, ""});
 }
 
 Result<ExrChannels> read_exr(const std::string& path) {
@@ -229,14 +240,10 @@ Result<std::vector<ImageLayer>> read_exr_layers(const std::string& path) {
 
 // --- PNG previews ---
 
-double preview_exposure(const RgbImage& total) {
-  const std::size_t pixels = total.rgb.size() / 3;
-  std::vector<double> lum;
-  lum.reserve(pixels);
-  for (std::size_t i = 0; i < pixels; ++i) {
-    const double l = luminance({total.rgb[3 * i], total.rgb[3 * i + 1], total.rgb[3 * i + 2]});
-    lum.push_back(std::isfinite(l) ? l : 0.0);
-  }
+namespace {
+
+// 1 / (the 99th percentile, nearest rank, of the luminances); else 1 / the largest; else 1.
+double exposure_of(std::vector<double> lum) {
   if (lum.empty()) return 1;
   // Nearest rank: the smallest value with at least 99 % of the pixels at or below it.
   const std::size_t rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(lum.size()))) - 1;
@@ -245,6 +252,23 @@ double preview_exposure(const RgbImage& total) {
   if (p99 > 0) return 1 / p99;
   const double top = *std::max_element(lum.begin(), lum.end());
   return top > 0 ? 1 / top : 1;
+}
+
+// The luminances of `pixels` RGB float pixels, non-finite ones as 0, appended to `lum`.
+void append_luminances(const float* rgb, std::size_t pixels, std::vector<double>* lum) {
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const double l = luminance({rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]});
+    lum->push_back(std::isfinite(l) ? l : 0.0);
+  }
+}
+
+}  // namespace
+
+double preview_exposure(const RgbImage& total) {
+  std::vector<double> lum;
+  lum.reserve(total.rgb.size() / 3);
+  append_luminances(total.rgb.data(), total.rgb.size() / 3, &lum);
+  return exposure_of(std::move(lum));
 }
 
 namespace {
@@ -273,35 +297,52 @@ const std::array<double, 255>& srgb8_thresholds() {
 
 }  // namespace
 
-std::vector<std::uint8_t> tonemap_srgb8(const RgbImage& image, double exposure) {
+namespace {
+
+// `n` values times exposure, sRGB-encoded, clamped, rounded to 8 bits, into `out`.
+void tonemap_srgb8_into(const float* in, std::size_t n, double exposure, std::uint8_t* out) {
   const std::array<double, 255>& thresholds = srgb8_thresholds();
-  // A first guess per 1/4096 of [0, 1] (the curve's steepest slope, 12.92 · 255 codes per unit,
-  // moves less than one code per bucket), then the thresholds themselves decide: the code is
-  // exactly the number of thresholds at or below v, as a search would give, at two comparisons.
+  // Per 1/4096 of [0, 1]: the code at the bucket's start (the number of thresholds at or below it)
+  // and the next threshold. The thresholds are at least 1 / (12.92 · 255) = 1/3295 apart (the
+  // curve's steepest slope), more than a bucket, so at most one lies inside a bucket and one
+  // comparison decides: exactly the number of thresholds at or below v, as a search would give,
+  // without the data-dependent branches of a search (which mispredicted on noisy layers).
   constexpr int kBuckets = 4096;
-  static const std::array<std::uint8_t, kBuckets + 1> guess = [&] {
-    std::array<std::uint8_t, kBuckets + 1> g{};
-    for (int b = 0; b <= kBuckets; ++b)
-      g[static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(
+  struct Bucket {
+    double next;  // the first threshold above the bucket's start; +inf past code 255
+    unsigned code;
+  };
+  static const std::array<Bucket, kBuckets + 1> buckets = [&] {
+    std::array<Bucket, kBuckets + 1> g{};
+    for (int b = 0; b <= kBuckets; ++b) {
+      const auto code = static_cast<unsigned>(
           std::upper_bound(thresholds.begin(), thresholds.end(), static_cast<double>(b) / kBuckets) - thresholds.begin());
+      g[static_cast<std::size_t>(b)] = {code < 255 ? thresholds[code] : std::numeric_limits<double>::infinity(), code};
+    }
     return g;
   }();
-  std::vector<std::uint8_t> out(image.rgb.size());
-  for (std::size_t i = 0; i < image.rgb.size(); ++i) {
-    double v = image.rgb[i] * exposure;
+  for (std::size_t i = 0; i < n; ++i) {
+    double v = in[i] * exposure;
     v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0;  // NaN and ±inf never reach a finished image
-    unsigned code = guess[static_cast<std::size_t>(v * kBuckets)];
-    while (code > 0 && v < thresholds[code - 1]) --code;
-    while (code < 255 && v >= thresholds[code]) ++code;
+    const Bucket& b = buckets[static_cast<std::size_t>(v * kBuckets)];
+    const unsigned code = b.code + (v >= b.next ? 1u : 0u);
     out[i] = static_cast<std::uint8_t>(code);
   }
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> tonemap_srgb8(const RgbImage& image, double exposure) {
+  std::vector<std::uint8_t> out(image.rgb.size());
+  tonemap_srgb8_into(image.rgb.data(), image.rgb.size(), exposure, out.data());
   return out;
 }
 
 namespace {
 
 // libpng's low-level writer into a string. libpng reports errors by longjmp, so the calls live in
-// a function with no C++ object to unwind; the message is kept in `message`.
+// functions with no C++ object to unwind (each sets its own return point); the message is kept in
+// `message`.
 struct PngSink {
   std::string* bytes;
   char message[160];
@@ -318,7 +359,7 @@ void png_fail(png_structp png, png_const_charp message) {
 }
 void png_ignore_warning(png_structp, png_const_charp) {}
 
-bool png_write_rows(png_structp png, png_infop info, int width, int height, const std::uint8_t* rgb8) {
+bool png_begin(png_structp png, png_infop info, int width, int height) {
   if (setjmp(png_jmpbuf(png))) return false;
   png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -328,11 +369,52 @@ bool png_write_rows(png_structp png, png_infop info, int width, int height, cons
   png_set_compression_strategy(png, Z_RLE);
   png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
   png_write_info(png, info);
-  const std::size_t row = static_cast<std::size_t>(width) * 3;
-  for (int y = 0; y < height; ++y) png_write_row(png, rgb8 + static_cast<std::size_t>(y) * row);
+  return true;
+}
+bool png_rows(png_structp png, const std::uint8_t* rgb8, int rows, std::size_t row_bytes) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  for (int y = 0; y < rows; ++y) png_write_row(png, rgb8 + static_cast<std::size_t>(y) * row_bytes);
+  return true;
+}
+bool png_end(png_structp png, png_infop info) {
+  if (setjmp(png_jmpbuf(png))) return false;
   png_write_end(png, info);
   return true;
 }
+
+// An 8-bit RGB PNG encoded a band of rows at a time into a string.
+class PngStream {
+ public:
+  PngStream() = default;
+  PngStream(const PngStream&) = delete;
+  PngStream& operator=(const PngStream&) = delete;
+  ~PngStream() { png_destroy_write_struct(&png_, &info_); }
+
+  Result<bool> begin(int width, int height) {
+    width_ = width;
+    bytes_.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3 / 2);
+    png_ = png_create_write_struct(PNG_LIBPNG_VER_STRING, &sink_, png_fail, png_ignore_warning);
+    info_ = png_ != nullptr ? png_create_info_struct(png_) : nullptr;
+    if (info_ == nullptr) return make_error(ErrorCode::kBadFile, "libpng could not encode the image: out of memory");
+    png_set_write_fn(png_, &sink_, png_append, png_no_flush);
+    return check(png_begin(png_, info_, width, height));
+  }
+  Result<bool> rows(const std::uint8_t* rgb8, int rows) { return check(png_rows(png_, rgb8, rows, static_cast<std::size_t>(width_) * 3)); }
+  Result<bool> end() { return check(png_end(png_, info_)); }
+  const std::string& bytes() const { return bytes_; }
+  std::string take() { return std::move(bytes_); }
+
+ private:
+  Result<bool> check(bool ok) {
+    if (ok) return true;
+    return make_error(ErrorCode::kBadFile, std::string("libpng could not encode the image: ") + sink_.message);
+  }
+  std::string bytes_;
+  PngSink sink_{&bytes_, {}};
+  png_structp png_ = nullptr;
+  png_infop info_ = nullptr;
+  int width_ = 0;
+};
 
 }  // namespace
 
@@ -340,20 +422,11 @@ Result<std::string> encode_png(int width, int height, const std::vector<std::uin
   if (width <= 0 || height <= 0 ||
       rgb8.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3)
     return make_error(ErrorCode::kUsage, "the PNG pixels do not match its size");
-  std::string bytes;
-  bytes.reserve(rgb8.size() / 2);
-  PngSink sink{&bytes, {}};
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &sink, png_fail, png_ignore_warning);
-  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-  if (info == nullptr) {
-    png_destroy_write_struct(&png, nullptr);
-    return make_error(ErrorCode::kBadFile, "libpng could not encode the image: out of memory");
-  }
-  png_set_write_fn(png, &sink, png_append, png_no_flush);
-  const bool ok = png_write_rows(png, info, width, height, rgb8.data());
-  png_destroy_write_struct(&png, &info);
-  if (!ok) return make_error(ErrorCode::kBadFile, std::string("libpng could not encode the image: ") + sink.message);
-  return bytes;
+  PngStream png;
+  if (Result<bool> r = png.begin(width, height); !r) return r.error();
+  if (Result<bool> r = png.rows(rgb8.data(), height); !r) return r.error();
+  if (Result<bool> r = png.end(); !r) return r.error();
+  return png.take();
 }
 
 Result<bool> write_png(const std::string& path, const RgbImage& image, double exposure) {
@@ -372,17 +445,102 @@ Result<bool> write_previews(const std::string& dir, const std::vector<ImageLayer
     e.where = dir;
     return e;
   }
-  auto total = std::find_if(layers.begin(), layers.end(), [](const ImageLayer& l) { return l.name == "total"; });
-  const double exposure = preview_exposure((total != layers.end() ? *total : layers[0]).image);
-  // Encoded and written in parallel (a file's flush to disk waits beside the others' encoding);
-  // the first failure in layer order is the one reported.
-  std::vector<std::optional<Result<bool>>> written(layers.size());
-  tbb::parallel_for(std::size_t{0}, layers.size(), [&](std::size_t i) {
-    const std::string path = (dir.empty() ? std::string(".") : dir) + "/" + layers[i].name + ".png";
-    written[i].emplace(write_png(path, layers[i].image, exposure));
+  return write_image_files(VectorBands(layers), ImageFiles{"", {}, dir.empty() ? std::string(".") : dir});
+}
+
+// --- an image's files a band of rows at a time ---
+
+Result<bool> write_image_files(const LayerBands& bands, const ImageFiles& files) {
+  const std::size_t n = bands.num_layers();
+  const int w = bands.width(), h = bands.height();
+  const std::size_t band_floats = static_cast<std::size_t>(kBandRows) * static_cast<std::size_t>(w) * 3;
+  const auto located = [](Error e, const std::string& where) {
+    e.where = where;
+    return e;
+  };
+  {
+    std::set<std::string> names;
+    for (std::size_t l = 0; l < n; ++l)
+      if (bands.name(l).empty() || !names.insert(bands.name(l)).second)
+        return located(make_error(ErrorCode::kUsage, "the image layers' names are not distinct and nonempty"),
+                       files.exr.empty() ? files.previews : files.exr);
+    if (n == 0 || w <= 0 || h <= 0)
+      return located(make_error(ErrorCode::kUsage, "cannot write an empty image"), files.exr.empty() ? files.previews : files.exr);
+  }
+  const bool previews = !files.previews.empty();
+  const auto png_path = [&](std::size_t l) { return files.previews + "/" + bands.name(l) + ".png"; };
+
+  // --- the previews' exposure: a first pass over the total's bands ---
+  double exposure = 1;
+  if (previews) {
+    std::size_t total = 0;
+    for (std::size_t l = 0; l < n; ++l)
+      if (bands.name(l) == "total") {
+        total = l;
+        break;
+      }
+    std::vector<double> lum;
+    lum.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    std::vector<float> band(band_floats);
+    for (int y0 = 0; y0 < h; y0 += kBandRows) {
+      const int rows = std::min(kBandRows, h - y0);
+      bands.fill(total, y0, rows, band.data());
+      append_luminances(band.data(), static_cast<std::size_t>(rows) * static_cast<std::size_t>(w), &lum);
+    }
+    exposure = exposure_of(std::move(lum));
+  }
+
+  // --- the files, band by band ---
+  std::optional<AtomicFile> exr_file;
+  std::optional<ExrStream> exr;
+  std::optional<Error> exr_error;
+  if (!files.exr.empty()) {
+    exr_file.emplace(files.exr);
+    if (!exr_file->ok()) return exr_file->commit();  // the error
+    exr.emplace(&*exr_file, bands, files.exr_options);
+    if (Result<bool> r = exr->open(); !r) return located(r.error(), files.exr);
+  }
+  std::vector<PngStream> pngs(previews ? n : 0);
+  std::vector<std::optional<Error>> png_errors(pngs.size());
+  for (std::size_t l = 0; l < pngs.size(); ++l)
+    if (Result<bool> r = pngs[l].begin(w, h); !r) png_errors[l] = located(r.error(), png_path(l));
+  std::vector<std::vector<float>> band(n, std::vector<float>(band_floats));
+  std::vector<std::vector<std::uint8_t>> rgb8(pngs.size(), std::vector<std::uint8_t>(band_floats));
+  for (int y0 = 0; y0 < h; y0 += kBandRows) {
+    const int rows = std::min(kBandRows, h - y0);
+    const std::size_t values = static_cast<std::size_t>(rows) * static_cast<std::size_t>(w) * 3;
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t l) { bands.fill(l, y0, rows, band[l].data()); });
+    tbb::task_group group;
+    if (exr && !exr_error)
+      group.run([&] {
+        if (Result<bool> r = exr->write(y0, rows, band); !r) exr_error = located(r.error(), files.exr);
+      });
+    tbb::parallel_for(std::size_t{0}, pngs.size(), [&](std::size_t l) {
+      if (png_errors[l]) return;
+      tonemap_srgb8_into(band[l].data(), values, exposure, rgb8[l].data());
+      if (Result<bool> r = pngs[l].rows(rgb8[l].data(), rows); !r) png_errors[l] = located(r.error(), png_path(l));
+    });
+    group.wait();
+  }
+  // --- completed and put in place: the EXR beside the previews (each file's flush to disk waits
+  // beside the others') ---
+  std::optional<Result<bool>> exr_done;
+  tbb::task_group group;
+  if (exr && !exr_error)
+    group.run([&] {
+      if (Result<bool> r = exr->close(); !r) exr_error = located(r.error(), files.exr);
+      else exr_done.emplace(exr_file->commit());
+    });
+  tbb::parallel_for(std::size_t{0}, pngs.size(), [&](std::size_t l) {
+    if (png_errors[l]) return;
+    if (Result<bool> r = pngs[l].end(); !r) png_errors[l] = located(r.error(), png_path(l));
+    else if (Result<bool> wr = write_file_atomic(png_path(l), pngs[l].bytes()); !wr) png_errors[l] = wr.error();
   });
-  for (std::optional<Result<bool>>& w : written)
-    if (!*w) return std::move(*w);
+  group.wait();
+  if (exr_error) return *exr_error;
+  if (exr_done && !*exr_done) return std::move(*exr_done);
+  for (const std::optional<Error>& e : png_errors)
+    if (e) return *e;
   return true;
 }
 

@@ -24,9 +24,9 @@ namespace pathex {
 
 // What the images of a render of `width` x `height` pixels with `layers` layers (the total and one
 // per class) take at their peak, which is while they are written: the render's exact sums (48
-// bytes per pixel per plane, counted as one plane per layer: ClassImages), the layers as floats
-// (12 bytes per pixel each) and, kept as a margin since the EXR is streamed into its file, twice
-// the floats again (what the EXR's bytes took in memory before). pathex trace compares it with
+// bytes per pixel per plane, counted as one plane per layer: ClassImages) and, kept as a margin
+// since the EXR and the previews are now written band by band (write_image_files), the layers as
+// floats (12 bytes per pixel each) and twice that again (what the EXR's bytes took in memory before). pathex trace compares it with
 // --max-memory before rendering. Measured peaks stay below it (README "Limits").
 std::uint64_t render_memory_estimate(int width, int height, int layers);
 
@@ -36,8 +36,7 @@ struct ExrOptions {
   bool half = false;  // 16-bit half channels instead of 32-bit float (values above 65504 become inf)
 };
 
-// The EXR file's bytes. All layers must have the same nonzero size and distinct, nonempty names.
-Result<std::string> encode_exr(const std::vector<ImageLayer>& layers, const ExrOptions& options = {});
+// All layers must have the same nonzero size and distinct, nonempty names.
 Result<bool> write_exr(const std::string& path, const std::vector<ImageLayer>& layers, const ExrOptions& options = {});
 
 // Every channel of a scanline or tiled EXR file, as floats, row-major from the top of the data
@@ -50,6 +49,37 @@ struct ExrChannels {
 Result<ExrChannels> read_exr(const std::string& path);
 // The layers of a file written by write_exr: every "<layer>.R/.G/.B" triple, by layer name.
 Result<std::vector<ImageLayer>> read_exr_layers(const std::string& path);
+
+// --- an image's files a band of rows at a time ---
+
+// The layers of an image, made a band of rows at a time when a writer asks for them, so that
+// writing the EXR and the previews never holds every layer as floats (a 512 x 512 render with
+// twenty class layers: 66 MB, whose first touches cost more than encoding them on the
+// development VM, bench/README.md).
+class LayerBands {
+ public:
+  virtual ~LayerBands() = default;
+  virtual int width() const = 0;
+  virtual int height() const = 0;
+  virtual std::size_t num_layers() const = 0;
+  virtual const std::string& name(std::size_t layer) const = 0;
+  // Rows [y0, y0 + rows) of a layer, rows × width × 3 floats (RGB, row-major), into `out`. Called
+  // from several threads at once, with y0 a multiple of kBandRows.
+  virtual void fill(std::size_t layer, int y0, int rows, float* out) const = 0;
+};
+inline constexpr int kBandRows = 16;
+
+struct ImageFiles {
+  std::string exr;       // the EXR file of every layer; empty: none
+  ExrOptions exr_options;
+  std::string previews;  // the folder of the PNG previews, <layer>.png each; empty: none
+};
+// Writes `files` from `bands`: the EXR and every preview encoded band by band, the layers of a
+// band made in parallel and the EXR and the PNGs encoded side by side. The previews' exposure is
+// that of the layer named "total" (else the first), from a first pass over its bands. The bytes
+// are those of the whole-image writers. Errors name the file; the first in the order EXR,
+// previews by layer is returned.
+Result<bool> write_image_files(const LayerBands& bands, const ImageFiles& files);
 
 // --- PNG previews ---
 

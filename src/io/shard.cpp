@@ -153,7 +153,9 @@ class Writer {
   std::uint32_t crc() const { return crc_; }    // their CRC-32
 
  private:
-  static constexpr std::size_t kWindow = std::size_t{1} << 20;
+  // zstd's block (ZSTD_CStreamInSize()): a larger window only costs fresh pages (a 1 MiB one was
+  // 5 % of a small render's per-run cost, bench/README.md).
+  static constexpr std::size_t kWindow = std::size_t{1} << 17;
   void room(std::size_t n) {
     if (window_.size() - used_ < n) compress(ZSTD_e_continue);
   }

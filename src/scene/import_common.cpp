@@ -6,12 +6,15 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <utility>
+#include <variant>
 
-#include <assimp/Importer.hpp>
+#include <assimp/cimport.h>
 #include <assimp/mesh.h>
 #include <assimp/scene.h>
+#include <dlfcn.h>
 
 namespace pathex::import {
 
@@ -125,14 +128,49 @@ bool is_similarity(const glm::mat4& m, float* scale) {
 
 // --- PLY meshes through assimp ---
 
+namespace {
+
+// libassimp is loaded when a PLY mesh is read, not linked: with the libraries it pulls in (draco,
+// minizip) its mapping and relocation took about 40 % of every pathex process's start-up page
+// faults (`pathex --version` 25 -> 15 ms CPU, bench/README.md), and only imported scenes with PLY
+// meshes use it. Its C interface is looked up by name (PATHEX_ASSIMP_SONAME: the build's library).
+struct AssimpApi {
+  decltype(&::aiImportFile) import_file;
+  decltype(&::aiReleaseImport) release_import;
+  decltype(&::aiGetErrorString) error_string;
+};
+
+// The loaded library's functions, or the reason it could not be loaded.
+const std::variant<AssimpApi, std::string>& assimp_library() {
+  static const std::variant<AssimpApi, std::string> api = []() -> std::variant<AssimpApi, std::string> {
+    void* lib = ::dlopen(PATHEX_ASSIMP_SONAME, RTLD_NOW | RTLD_LOCAL);  // never closed: the process keeps it
+    if (lib == nullptr) return std::string("cannot load " PATHEX_ASSIMP_SONAME " (") + ::dlerror() + ")";
+    AssimpApi a{};
+    a.import_file = reinterpret_cast<decltype(a.import_file)>(::dlsym(lib, "aiImportFile"));
+    a.release_import = reinterpret_cast<decltype(a.release_import)>(::dlsym(lib, "aiReleaseImport"));
+    a.error_string = reinterpret_cast<decltype(a.error_string)>(::dlsym(lib, "aiGetErrorString"));
+    if (a.import_file == nullptr || a.release_import == nullptr || a.error_string == nullptr)
+      return std::string(PATHEX_ASSIMP_SONAME " lacks a function of assimp's C interface");
+    return a;
+  }();
+  return api;
+}
+
+}  // namespace
+
 Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext != ".ply") return located(at, "the mesh '" + path + "' is not a .ply file");
-  Assimp::Importer importer;
+  const std::variant<AssimpApi, std::string>& loaded = assimp_library();
+  if (const std::string* why = std::get_if<std::string>(&loaded))
+    return located(at, "cannot read the PLY mesh '" + path + "': " + *why);
+  const AssimpApi& assimp = std::get<AssimpApi>(loaded);
   // No post-processing: the faces arrive as written, so quads can be checked before splitting.
-  const aiScene* scene = importer.ReadFile(path, 0);
-  if (scene == nullptr) return located(at, "cannot read the PLY mesh '" + path + "': " + importer.GetErrorString());
+  const std::unique_ptr<const aiScene, decltype(assimp.release_import)> imported(assimp.import_file(path.c_str(), 0),
+                                                                                assimp.release_import);
+  const aiScene* scene = imported.get();
+  if (scene == nullptr) return located(at, "cannot read the PLY mesh '" + path + "': " + assimp.error_string());
   MeshShape mesh;
   mesh.file = path;
   for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
