@@ -143,6 +143,8 @@ Result<WrittenReport> write_report(const std::string& dir, const ShardHeader& he
         f["wrong_type"] = c.wrong_type;
         f["too_short"] = c.too_short;
         f["iteration_limit"] = c.iteration_limit;
+        entry["repeats"] = c.repeats;
+        entry["truncated"] = c.truncated;
         entry["walks"] = c.walks;
         entry["mean_iterations"] = c.walks > 0 ? nlohmann::ordered_json(static_cast<double>(c.iterations) / static_cast<double>(c.walks))
                                                : nlohmann::ordered_json(nullptr);

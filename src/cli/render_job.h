@@ -59,7 +59,7 @@ struct WrittenReport {
   std::string json_text;
 };
 // histogram.json also lists what each connector did ("connectors": [{strategy, connector,
-// attempts, successes, failures {outside, occluded, no_transport; the manifold's no_solution, singular, wrong_type, too_short, iteration_limit instead of outside}, and for the manifold walks and mean_iterations}] in the profile's order;
+// attempts, successes, failures {outside, occluded, no_transport; the manifold's no_solution, singular, wrong_type, too_short, iteration_limit instead of outside}, and for the manifold repeats, truncated, walks and mean_iterations}] in the profile's order;
 // absent when the profile has none).
 // With requested classes, histogram.json lists them ("only": [{name, expr}]) and marks every class
 // not contained in them "rendered": false; the EXR and PNGs have no layer for a class that was not

@@ -488,7 +488,8 @@ int run(const TraceArgs& a) {
       if (c.connector == "manifold")
         std::cout << "  " << c.strategy << " (manifold): no solution " << c.no_solution << ", singular " << c.singular
                   << ", wrong type " << c.wrong_type << ", too short " << c.too_short << ", iteration limit "
-                  << c.iteration_limit << "; mean Newton iterations "
+                  << c.iteration_limit << "; repeats " << c.repeats << ", truncated " << c.truncated
+                  << "; mean Newton iterations "
                   << (c.walks > 0 ? static_cast<double>(c.iterations) / static_cast<double>(c.walks) : 0.0) << "\n";
   }
   std::cout << "\nmost important paths\n";

@@ -102,7 +102,8 @@ class Integrator {
     std::vector<ConnectorStats> connectors;  // indexed by profile strategy (only connectors' are used)
     PathIds ids;
     JoinResult join{};  // the join being made (joins build into it; estimate() consumes it)
-    std::vector<ChainVertex> manifold_chain{};  // the manifold connector's chain being solved
+    std::vector<ChainVertex> manifold_seed{};       // the manifold connector's chain being solved
+    std::vector<ManifoldSolution> manifold_found{};  // and the distinct chains its first batch found
     std::vector<Vertex> path{};         // a whole path x0 … xk for path_weight()
     std::vector<double> rel{}, eye_density{};  // path_weight()'s density ratios and remapped ef
     // The subpaths' letters packed (set by prepare_joins()): light_mask has c0 c1 of y0, then
@@ -333,12 +334,17 @@ class Integrator {
   // fresh light sample for s = 1) joined to z(t-1) across a chain of smooth glass by specular
   // manifold sampling. Defined in trace/joins/manifold_join.cpp.
   void connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const;
+  // One chain's contribution between a and b, its |dω_a/dA_b| times its inverse probability `weight`.
+  void emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a, const Vertex& b,
+                     const std::vector<ChainVertex>& chain, double weight) const;
   int manifold_of(int s, int t) const { return table_.at(s, ConnectorKind::kManifold, t); }
-  // A seed chain from eye end b: the ray from b towards a specular shape drawn uniformly (a point
-  // on its area, or a direction in the cone of a sphere), followed through every specular surface
-  // it meets (a mirror reflects; glass reflects with the Fresnel probability, else refracts) until
-  // it leaves them; its hits, light side first. Random numbers from counter-based `stream`.
-  ManifoldFailure seed_chain(const Vertex& b, std::uint64_t stream, std::uint64_t* drawn, std::vector<ChainVertex>& chain) const;
+  // A seed chain from end `from` (the light end a when from_light, else the eye end b): the ray
+  // towards a specular shape (drawn by seed_cdf_; a point on its area, or a direction in the cone
+  // of a sphere), followed through every specular surface it meets (a mirror reflects; glass
+  // reflects with the Fresnel probability, else refracts) until it leaves them; its hits, light
+  // side first. Random numbers from counter-based `stream`.
+  ManifoldFailure seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
+                             std::vector<ChainVertex>& chain) const;
   void init_manifold();
   // Whether the manifold connector (s, DS^mD, ·) could build the chain x_s … x(s+m-1) of th.path
   // (letters `key`): the profile runs it there, its eye end is a surface, and every chain vertex is
@@ -386,6 +392,7 @@ class Integrator {
   std::vector<float> glass_ior_;
   std::vector<vec3> mirror_reflectance_;
   std::vector<int> specular_shapes_;  // the shapes with either (the manifold's seeds aim at points on them)
+  std::vector<float> seed_cdf_;       // the seeds' choice among them (cumulative, last 1)
   double scene_size_ = 1.0;       // the scene's bounding-box diagonal (the manifold's shortest segment scales with it)
   std::vector<std::uint8_t> mirror_shape_;  // the shape is a planar mirror
   // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the

@@ -96,6 +96,8 @@ struct ConnectorStats {
   std::uint64_t no_solution = 0, singular = 0, wrong_type = 0, too_short = 0, iteration_limit = 0;
   std::uint64_t walks = 0;       // chains handed to the Newton solver
   std::uint64_t iterations = 0;  // Newton iterations over all of them (mean: iterations / walks)
+  std::uint64_t repeats = 0;     // seeds of a first batch that solved to a chain already found in it
+  std::uint64_t truncated = 0;   // chains not found again within max_trials seeds (their weight is low)
 
   // Adds another thread's counts (the names stay this one's).
   ConnectorStats& operator+=(const ConnectorStats& o) {
@@ -111,6 +113,8 @@ struct ConnectorStats {
     iteration_limit += o.iteration_limit;
     walks += o.walks;
     iterations += o.iterations;
+    repeats += o.repeats;
+    truncated += o.truncated;
     return *this;
   }
 };

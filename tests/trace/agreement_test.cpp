@@ -78,10 +78,6 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
         if (!(p.estimate.luminance > 0.01 * reference.total.luminance) || !checker.reachable.accepts(p.path)) continue;
         auto it = found.find(p.path);
         ASSERT_NE(it, found.end()) << where << ": bdpt finds " << p.path << " but the profile never samples it";
-        // pt-nee+manifold's estimate of the glass caustic has come out low in every run (heavy tails
-        // or a bias; README "The manifold connector"): it must find every string, its value is not
-        // compared here.
-        if (name == "pt-nee+manifold") continue;
         const double sigma = std::hypot(p.estimate.std_error, it->second->estimate.std_error);
         EXPECT_LE(std::fabs(p.estimate.luminance - it->second->estimate.luminance), 4.0 * sigma + 1e-9)
             << where << ": " << p.path << " bdpt " << p.estimate.luminance << " ± " << p.estimate.std_error << ", "

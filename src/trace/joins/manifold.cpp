@@ -211,12 +211,13 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     w.failure = ManifoldFailure::kIterationLimit;
     return w;
   }
-  // --- the solution's type: a refraction's neighbours on opposite sides, a reflection's on one ---
+  // --- the solution's type: a refraction's neighbours on opposite sides, a reflection's on one,
+  //     the light's on the seed's side ---
   for (std::size_t i = 0; i < m; ++i) {
     const dvec3 nrm = surface_derivatives(*x[i].shape, x[i].primitive, x[i].p).n;
     const dvec3 prev = i == 0 ? a : x[i - 1].p, next = i + 1 == m ? b : x[i + 1].p;
-    const double sides = glm::dot(prev - x[i].p, nrm) * glm::dot(next - x[i].p, nrm);
-    if (x[i].reflect ? !(sides > 0.0) : !(sides < 0.0)) {
+    const double light = glm::dot(prev - x[i].p, nrm), sides = light * glm::dot(next - x[i].p, nrm);
+    if ((x[i].reflect ? !(sides > 0.0) : !(sides < 0.0)) || light * x[i].light_side < 0.0) {
       w.failure = ManifoldFailure::kWrongType;
       return w;
     }

@@ -1,13 +1,12 @@
-// The `manifold` connector's walk (DESIGN §4): a chain D S…S D through smooth dielectric surfaces,
-// joined by solving for the specular vertices between two fixed ends. This is manifold next-event
-// estimation (Hanika, Droske and Fascione 2015, "Manifold Next Event Estimation"; Cycles' MNEE),
-// on the half-vector constraints of manifold exploration (Jakob and Marschner 2012):
+// The `manifold` connector's walk (DESIGN §4): a chain D S…S D through smooth glass and mirrors,
+// joined by solving for the specular vertices between two fixed ends, on the half-vector
+// constraints of manifold exploration (Jakob and Marschner 2012):
 //
-//  - the seed: a straight line from the eye end b towards the light end a; every smooth dielectric
-//    surface it crosses becomes one specular vertex (a refraction), anything else blocks it;
+//  - the seed (trace/joins/manifold_join.cpp): a ray from either end towards a specular shape,
+//    followed through the specular surfaces it meets; every hit becomes one specular vertex whose
+//    type (reflection or refraction) and indices on either side stay fixed;
 //  - Newton's method on the constraints: at each vertex, the generalized half vector
-//    h = η_i w_i + η_o w_o (w_i, w_o unit towards the neighbours, η the index on each one's side
-//    as the seed crossed it)
+//    h = η_i w_i + η_o w_o (w_i, w_o unit towards the neighbours, η the index on each one's side)
 //    must lie along the surface normal; its tangential part is the constraint, two numbers per
 //    vertex. The Jacobian is by central differences in double precision along each vertex's
 //    tangent frame (trace/differential.h); steps that do not reduce the largest constraint are
@@ -17,9 +16,11 @@
 //    chain carries to b per unit intensity at a is |dω_a / dA_b| (implicit function theorem:
 //    dX/db = -(∂C/∂X)⁻¹ ∂C/∂b). Without a chain it is |cos_b| / d², the plain geometry term.
 //
-// The estimator is biased (Hanika et al.'s MNEE): one deterministic seed finds at most one of the
-// chains joining a and b, and solutions the solver rejects (near-singular Jacobian, at the
-// caustic's folds) are missed. README "The manifold connector" gives the bias measured.
+// The estimator is specular manifold sampling (Zeltner, Georgiev and Jakob 2020) over batches of
+// seeds: every distinct chain a first batch finds is weighed by the number of fresh batches it
+// takes to find it again, whose mean is the inverse of the probability that a batch finds it;
+// unbiased but for the chains still not found after max_trials seeds (counted). README "The
+// manifold connector" gives the figures.
 #pragma once
 
 #include <cstdint>
@@ -37,7 +38,8 @@ struct ManifoldOptions {
   double threshold = 1e-5;         // largest |tangential half vector| accepted as solved (SMS: 1e-5)
   double min_segment = 1e-3;       // shortest segment, as a fraction of the scene's size (Cycles: 1e-3)
   double singular = 1e-7;          // smallest |pivot| / largest |pivot| of the constraint Jacobian
-  int max_trials = 100;            // seeds tried to find a solution again (its inverse probability)
+  int seeds = 4;                   // seeds per batch: the first batch's distinct chains are the join's contributions
+  int max_trials = 2000;           // seeds spent finding them again (their inverse probability), at most
 };
 
 // Why a walk failed; kNone when it succeeded.
@@ -62,12 +64,23 @@ struct ChainVertex {
   double eta_light = 1.0, eta_eye = 1.5;
   bool reflect = false;  // a reflection (both neighbours on one side; η equal), else a refraction
   glm::dvec3 p{0.0};
+  // The side of the light-side neighbour, fixed by the seed: +1 on the normal's side, -1 behind
+  // it, 0 unchecked. Without it a reflection on a mirror sphere also "solves" at a point that
+  // sees neither neighbour (the half vector along -n).
+  int light_side = 0;
 };
 
 struct ManifoldWalk {
   ManifoldFailure failure = ManifoldFailure::kNone;
   int iterations = 0;   // Newton iterations taken
   double dw_db = 0.0;   // |dω_a / dA_b|: solid angle at a per unit area at b through the chain
+};
+
+// A distinct chain a join's first batch of seeds found, and the batch that found it again (0: none yet).
+struct ManifoldSolution {
+  std::vector<ChainVertex> chain;
+  double dw_db = 0.0;
+  int batches = 0;
 };
 
 // Solves the chain between a and b (b on a surface of unit normal nb) in place from its seed

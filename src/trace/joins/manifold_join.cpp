@@ -31,6 +31,16 @@ void Integrator::init_manifold() {
           mirror_reflectance_[i] += c.weight * r->reflectance;
     if (glass_ior_[i] > 0.0f || !is_black(mirror_reflectance_[i])) specular_shapes_.push_back(static_cast<int>(i));
   }
+  // Seeds pick a shape by the share of flux it passes on: 1 for glass (reflected plus
+  // transmitted), a mirror's (or a mixture's mirror parts') mean reflectance, at most 1.
+  seed_cdf_.clear();
+  float total = 0.0f;
+  for (const int shape : specular_shapes_) {
+    const vec3 r = mirror_reflectance_[static_cast<std::size_t>(shape)];
+    total += glass_ior_[static_cast<std::size_t>(shape)] > 0.0f ? 1.0f : std::clamp((r.x + r.y + r.z) / 3.0f, 1e-3f, 1.0f);
+    seed_cdf_.push_back(total);
+  }
+  for (float& c : seed_cdf_) c /= total;
   has_manifold_ = !specular_shapes_.empty() && table_.runs(ConnectorKind::kManifold);
   RTCBounds b;
   rtcGetSceneBounds(rs_.geometry->handle(), &b);
@@ -63,24 +73,25 @@ bool Integrator::manifold_at(const Thread& th, PathKey key, int i, int m) const 
 }
 
 
-ManifoldFailure Integrator::seed_chain(const Vertex& b, std::uint64_t stream, std::uint64_t* drawn, std::vector<ChainVertex>& chain) const {
+ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
+                                       std::vector<ChainVertex>& chain) const {
   const auto u = [&] { return bits_to_unit_float(stream_bits(stream, (*drawn)++)); };
   chain.clear();
   const float u_shape = u();
   const glm::vec2 u_point(u(), u());
-  const std::size_t pick = std::min(specular_shapes_.size() - 1, static_cast<std::size_t>(u_shape * static_cast<float>(specular_shapes_.size())));
+  const std::size_t pick = static_cast<std::size_t>(std::upper_bound(seed_cdf_.begin(), seed_cdf_.end() - 1, u_shape) - seed_cdf_.begin());
   const int shape = specular_shapes_[pick];
-  vec3 o = b.p, no = b.n, eo = b.err;
+  vec3 o = from.p, no = from.n, eo = from.err;
   vec3 d;
   const auto* sphere = std::get_if<SphereShape>(&rs_.geometry->shape_geometry(shape));
-  const vec3 to_centre = sphere ? sphere->center - b.p : vec3(0.0f);
+  const vec3 to_centre = sphere ? sphere->center - from.p : vec3(0.0f);
   const float d2 = glm::dot(to_centre, to_centre);
   if (sphere && d2 > sphere->radius * sphere->radius) {
     // A sphere seen from outside: a direction uniform in the cone it subtends, so every seed meets it.
     const float cos_max = std::sqrt(std::max(0.0f, 1.0f - sphere->radius * sphere->radius / d2));
     d = Frame::from_normal(to_centre / std::sqrt(d2)).to_world(sample_uniform_cone(u_point, cos_max));
   } else {  // otherwise towards a point uniform on the shape's area
-    d = rs_.geometry->sample_shape(shape, u_point).position - b.p;
+    d = rs_.geometry->sample_shape(shape, u_point).position - from.p;
     if (!(glm::dot(d, d) > 0.0f)) return ManifoldFailure::kNoSolution;
   }
   d = glm::normalize(d);
@@ -90,7 +101,7 @@ ManifoldFailure Integrator::seed_chain(const Vertex& b, std::uint64_t stream, st
     const float ior = glass_ior_[static_cast<std::size_t>(hit->shape)];
     const bool mirror = !is_black(mirror_reflectance_[static_cast<std::size_t>(hit->shape)]);
     if (ior == 0.0f && !mirror) {
-      if (chain.empty()) return ManifoldFailure::kOccluded;  // something opaque between b and the specular surfaces
+      if (chain.empty()) return ManifoldFailure::kOccluded;  // something opaque between the end and the specular surfaces
       break;
     }
     if (static_cast<int>(chain.size()) == kMaxChain) return ManifoldFailure::kNoSolution;
@@ -98,10 +109,12 @@ ManifoldFailure Integrator::seed_chain(const Vertex& b, std::uint64_t stream, st
     // probability (always under total internal reflection), else refracts.
     const float cos_o = -glm::dot(d, hit->normal);
     const bool reflect = mirror || u() < bsdf::fresnel_dielectric(cos_o, ior);
-    const double outside = 1.0, inside = ior > 0.0f ? static_cast<double>(ior) : 1.0;  // b's side: where the ray came from
-    const double eye_side = cos_o > 0.0f ? outside : inside;
-    chain.push_back({&rs_.geometry->shape_geometry(hit->shape), hit->shape, hit->primitive, inside,
-                     reflect ? eye_side : (cos_o > 0.0f ? inside : outside), eye_side, reflect, glm::dvec3(hit->position)});
+    const double outside = 1.0, inside = ior > 0.0f ? static_cast<double>(ior) : 1.0;
+    const double came = cos_o > 0.0f ? outside : inside;                    // the index where the ray came from
+    const double goes = reflect ? came : (cos_o > 0.0f ? inside : outside);  // and where it goes on
+    const int came_side = cos_o > 0.0f ? 1 : -1, goes_side = reflect ? came_side : -came_side;
+    chain.push_back({&rs_.geometry->shape_geometry(hit->shape), hit->shape, hit->primitive, inside, from_light ? came : goes,
+                     from_light ? goes : came, reflect, glm::dvec3(hit->position), from_light ? came_side : goes_side});
     const vec3 n_side = cos_o > 0.0f ? hit->normal : -hit->normal;  // towards where d came from
     if (reflect) {
       d = glm::normalize(d + 2.0f * std::fabs(cos_o) * n_side);
@@ -116,7 +129,7 @@ ManifoldFailure Integrator::seed_chain(const Vertex& b, std::uint64_t stream, st
     eo = hit->error;
   }
   if (chain.empty()) return ManifoldFailure::kNoSolution;
-  std::reverse(chain.begin(), chain.end());  // light side first
+  if (!from_light) std::reverse(chain.begin(), chain.end());  // light side first
   return ManifoldFailure::kNone;
 }
 
@@ -128,23 +141,18 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   if (b->kind != Kind::kSurface || !b->finite) return;
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, kLightBlock);
   if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
-  // --- specular manifold sampling: a random seed chain, solved; then the inverse probability of
-  //     that solution, estimated by the number of fresh seeds it takes to find it again ---
-  ++stats.attempts;
   // The seeds draw from their own counter-based stream (an unbounded count of numbers per join).
   const std::uint64_t stream = stream_key(rng.key(), th.pass, 0x6d616e69666f6c64ULL + static_cast<std::uint64_t>(s) * kMaxRuns +
                                                                static_cast<std::uint64_t>(t));
   std::uint64_t drawn = 0;
   const glm::dvec3 pa(a->p), pb(b->p), nb(b->n);
+  // One seed, from either end with probability 1/2, solved.
   const auto trial = [&](std::vector<ChainVertex>& chain) -> ManifoldWalk {
     ManifoldWalk w;
-    const ManifoldFailure seed = seed_chain(*b, stream, &drawn, chain);
-    if (seed != ManifoldFailure::kNone) {
-      w.failure = seed;
-      return w;
-    }
-    const int m = static_cast<int>(chain.size());
-    if (s + m + t - 2 > max_bounces_) {  // longer than the render's bound on interior vertices
+    const bool from_light = bits_to_unit_float(stream_bits(stream, drawn++)) < 0.5f;
+    w.failure = seed_chain(from_light ? *a : *b, from_light, stream, &drawn, chain);
+    if (w.failure != ManifoldFailure::kNone) return w;
+    if (s + static_cast<int>(chain.size()) + t - 2 > max_bounces_) {  // longer than the render's bound on interior vertices
       w.failure = ManifoldFailure::kNoSolution;
       return w;
     }
@@ -153,31 +161,67 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
     stats.iterations += static_cast<std::uint64_t>(w.iterations);
     return w;
   };
-  std::vector<ChainVertex>& chain = th.manifold_chain;
-  const ManifoldWalk walk = trial(chain);
-  switch (walk.failure) {
-    case ManifoldFailure::kNone: break;
-    case ManifoldFailure::kNoSolution: ++stats.no_solution; return;
-    case ManifoldFailure::kOccluded: ++stats.occluded; return;
-    case ManifoldFailure::kSingular: ++stats.singular; return;
-    case ManifoldFailure::kWrongType: ++stats.wrong_type; return;
-    case ManifoldFailure::kTooShort: ++stats.too_short; return;
-    case ManifoldFailure::kIterationLimit: ++stats.iteration_limit; return;
+  std::vector<ManifoldSolution>& found = th.manifold_found;
+  std::vector<ChainVertex>& seed = th.manifold_seed;
+  const double same = 1e-5 * scene_size_;  // solutions are polished (solve_chain), so one found twice compares equal
+  const auto index_of = [&](const std::vector<ChainVertex>& x) -> int {
+    for (std::size_t k = 0; k < found.size(); ++k) {
+      const std::vector<ChainVertex>& y = found[k].chain;
+      bool equal = y.size() == x.size();
+      for (std::size_t i = 0; i < x.size() && equal; ++i)
+        equal = x[i].id == y[i].id && x[i].reflect == y[i].reflect && glm::length(x[i].p - y[i].p) < same;
+      if (equal) return static_cast<int>(k);
+    }
+    return -1;
+  };
+  // --- the first batch: `seeds` seeds, each an attempt; the distinct chains they solve to ---
+  const int per_batch = std::max(1, o_.manifold.seeds);
+  found.clear();
+  for (int j = 0; j < per_batch; ++j) {
+    ++stats.attempts;
+    const ManifoldWalk w = trial(seed);
+    switch (w.failure) {
+      case ManifoldFailure::kNone: break;
+      case ManifoldFailure::kNoSolution: ++stats.no_solution; continue;
+      case ManifoldFailure::kOccluded: ++stats.occluded; continue;
+      case ManifoldFailure::kSingular: ++stats.singular; continue;
+      case ManifoldFailure::kWrongType: ++stats.wrong_type; continue;
+      case ManifoldFailure::kTooShort: ++stats.too_short; continue;
+      case ManifoldFailure::kIterationLimit: ++stats.iteration_limit; continue;
+    }
+    if (index_of(seed) >= 0) {
+      ++stats.repeats;
+      continue;
+    }
+    found.push_back({seed, w.dw_db, 0});
   }
+  // --- each chain's inverse probability of being found by a batch: the number of fresh batches
+  //     until one finds it again (geometric, E[K] = 1 / P(a batch finds it)); the batches are
+  //     shared, and run until every chain is found again or max_trials seeds are spent ---
+  std::size_t left = found.size();
+  int batches = 0;
+  while (left > 0 && (batches + 1) * per_batch <= o_.manifold.max_trials) {
+    ++batches;
+    for (int j = 0; j < per_batch; ++j) {
+      if (trial(seed).failure != ManifoldFailure::kNone) continue;
+      const int k = index_of(seed);
+      if (k >= 0 && found[static_cast<std::size_t>(k)].batches == 0) {
+        found[static_cast<std::size_t>(k)].batches = batches;
+        --left;
+      }
+    }
+  }
+  stats.truncated += left;  // weighed by the batches run, an underestimate of their inverse probability
+  for (const ManifoldSolution& x : found)
+    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : batches));
+}
+
+void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a_end, const Vertex& b_end,
+                               const std::vector<ChainVertex>& chain, double weight) const {
+  const Vertex* a = &a_end;
+  const Vertex* b = &b_end;
+  ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
   const int m = static_cast<int>(chain.size());
-  // Trials until a fresh seed finds the same chain: their number K has E[K] = 1 / p(chain).
-  const double same = 1e-5 * scene_size_;
-  std::vector<ChainVertex> other;
-  int trials = 1;
-  for (; trials < o_.manifold.max_trials; ++trials) {
-    other.clear();
-    const ManifoldWalk w = trial(other);
-    if (w.failure != ManifoldFailure::kNone || static_cast<int>(other.size()) != m) continue;
-    bool equal = true;
-    for (std::size_t i = 0; i < chain.size() && equal; ++i)
-      equal = other[i].id == chain[i].id && other[i].reflect == chain[i].reflect && glm::length(other[i].p - chain[i].p) < same;
-    if (equal) break;
-  }
   // --- the chain's vertices and its contribution ---
   JoinResult& jr = th.join;
   vec3 transmit(1.0f);  // the share of flux the chain passes: tint (1 - F) or tint F for glass, R for a mirror
@@ -209,9 +253,10 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   const vec3 fa = s == 1 ? vec3(directional_emission(rs_.lights[static_cast<std::size_t>(a->light)].params, a->n, w_a))
                          : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, w_a, a->ns, a->n);
   const vec3 fb = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(b->shape)], b->wo, w_b, b->ns, b->n);
-  // Flux leaving a into dω lands on dA_b = dω / |dω_a/dA_b|: the generalized geometry term.
+  // Flux leaving a into dω lands on dA_b = dω / |dω_a/dA_b|: the generalized geometry term, here
+  // times the chain's estimated inverse probability (`weight`).
   const vec3 contrib = a->beta * fa * abs_cos(*a, w_a) * transmit * fb * b->beta *
-                       static_cast<float>(walk.dw_db * static_cast<double>(trials));
+                       static_cast<float>(weight);
   if (is_black(contrib)) {
     ++stats.no_transport;
     return;
