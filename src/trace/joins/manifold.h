@@ -38,6 +38,7 @@ struct ManifoldOptions {
   double min_segment = 1e-3;       // shortest segment, as a fraction of the scene's size (Cycles: 1e-3)
   double singular = 1e-7;          // smallest |pivot| / largest |pivot| of the constraint Jacobian
   int max_trials = 100;            // seeds tried to find a solution again (its inverse probability)
+  bool operator==(const ManifoldOptions&) const = default;
 };
 
 // Why a walk failed; kNone when it succeeded.
