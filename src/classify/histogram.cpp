@@ -144,11 +144,18 @@ void Histogram::add_technique(PathId id, int technique, std::uint64_t contributi
     if (batch_sums[b] != 0) row_sum_of(r, b) += batch_sums[b];
 }
 
-std::string Technique::name(const HistogramLayout& layout) const {
+std::string Technique::chain(std::string_view path) const {
+  if (!connector) return "DD";
+  const std::size_t before = 1 + static_cast<std::size_t>(s), after = 1 + static_cast<std::size_t>(t);
+  if (path.size() < before + after + 3) return "DS+D";
+  return std::string(path.substr(before, path.size() - before - after));
+}
+
+std::string Technique::name(const HistogramLayout& layout, const std::string& chain) const {
   const std::string base = static_cast<std::size_t>(strategy) < layout.strategies.size()
                                ? layout.strategies[static_cast<std::size_t>(strategy)]
                                : "strategy " + std::to_string(strategy);
-  return base + " (" + std::to_string(s) + ", " + (connector ? "DSD" : "DD") + ", " + std::to_string(t) + ")";
+  return base + " (" + std::to_string(s) + ", " + chain + ", " + std::to_string(t) + ")";
 }
 
 void Histogram::add_magnitude(ExactSum m) { magnitude_ = add_saturating(magnitude_, std::min(m, kMagnitudeCap), kMagnitudeCap); }
@@ -238,12 +245,14 @@ struct TechniqueSums {
   std::vector<ExactSum> sums;  // per batch
   std::uint64_t contributions = 0;
 };
-using TechniqueTable = std::map<int, TechniqueSums>;  // by Technique::code()
+// By Technique::code(), then the chain joined (a connector's chain has the path's length).
+using TechniqueTable = std::map<std::pair<int, std::string>, TechniqueSums>;
 
 void add_rows(const Histogram& h, Histogram::PathId p, TechniqueTable* table) {
   const std::size_t B = static_cast<std::size_t>(h.num_batches());
   for (int r = h.first_row(p); r >= 0; r = h.row(r).next) {
-    TechniqueSums& t = (*table)[h.row(r).technique];
+    const int code = h.row(r).technique;
+    TechniqueSums& t = (*table)[{code, Technique::from_code(code).chain(h.path(p))}];
     t.sums.resize(B, 0);
     for (std::size_t b = 0; b < B; ++b) t.sums[b] += h.row_sum(r, static_cast<int>(b));
     t.contributions += h.row(r).contributions;
@@ -255,7 +264,7 @@ void add_rows(const Histogram& h, Histogram::PathId p, TechniqueTable* table) {
 std::vector<TechniqueEstimate> technique_estimates(const HistogramLayout& layout, const TechniqueTable& table,
                                                    const std::vector<std::uint64_t>& n) {
   std::vector<ExactSum> whole(n.size(), 0);
-  for (const auto& [code, t] : table)
+  for (const auto& [key, t] : table)
     for (std::size_t b = 0; b < whole.size(); ++b) whole[b] += t.sums[b];
   ExactSum total = 0;
   for (ExactSum s : whole) total += s;
@@ -268,11 +277,11 @@ std::vector<TechniqueEstimate> technique_estimates(const HistogramLayout& layout
     nonempty += n[b] != 0 ? 1 : 0;
   }
   std::vector<TechniqueEstimate> out;
-  for (const auto& [code, t] : table) {
+  for (const auto& [key, t] : table) {
     ExactSum sum = 0;
     for (ExactSum s : t.sums) sum += s;
     TechniqueEstimate te;
-    te.name = Technique::from_code(code).name(layout);
+    te.name = Technique::from_code(key.first).name(layout, key.second);
     te.share = lum != 0 ? to_double(sum) / lum : 0.0;
     te.samples = t.contributions;
     if (nonempty >= 2 && variance > 0) {

@@ -163,8 +163,12 @@ struct Technique {
   static Technique from_code(int code) {
     return {(code >> 17) & 0xfff, (code >> 9) & 0xff, (code >> 1) & 0xff, (code & 1) != 0};
   }
-  // "bdpt (2, DD, 1)", "mirror (1, DSD, 1)": the strategy's name in the layout and (s, chain, t).
-  std::string name(const HistogramLayout& layout) const;
+  // The chain it joined on `path`: DD for a plain join; for a connector the path's letters between
+  // the s before it and the t after it (DESIGN §4: the strategy's language is
+  // L [SD]{s} chain [SD]{t} E), such as DSSD; DS+D when the path is too short to hold one.
+  std::string chain(std::string_view path) const;
+  // "bdpt (2, DD, 1)", "manifold (1, DSSD, 4)": the strategy's name in the layout, then (s, chain, t).
+  std::string name(const HistogramLayout& layout, const std::string& chain) const;
 };
 
 class Histogram {

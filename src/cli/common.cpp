@@ -1,6 +1,8 @@
 #include "cli/common.h"
 
+#include <cmath>
 #include <iostream>
+#include <sstream>
 
 #include "classify/notation_hint.h"
 #include "io/class_file.h"
@@ -17,6 +19,54 @@ const CLI::Validator& non_negative() {
       },
       /*validator_desc=*/"", /*validator_name=*/"non-negative");
   return v;
+}
+
+namespace {
+
+// A finite number in the interval from lo to hi, each end included or not; CLI11's Range lets NaN
+// through (every comparison with it is false).
+CLI::Validator real_in(double lo, bool lo_open, double hi, bool hi_open) {
+  std::ostringstream range;
+  range << (lo_open ? "(" : "[") << lo << ", " << hi << (hi_open ? ")" : "]");
+  const std::string text = range.str();
+  return CLI::Validator(
+      [=](std::string& value) -> std::string {
+        std::istringstream in(value);
+        double x = 0;
+        in >> x;
+        const bool whole = !in.fail() && (in >> std::ws).eof();
+        if (whole && std::isfinite(x) && (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi)) return "";
+        return "expected a number in " + text + ", got '" + value + "'";
+      },
+      /*validator_desc=*/"FLOAT in " + text, /*validator_name=*/"real in " + text);
+}
+
+}  // namespace
+
+void add_manifold_options(CLI::App* app, ManifoldOptions* o) {
+  const std::vector<std::string>& name = manifold_option_names();
+  const char* group = "Manifold connector";
+  app->add_option(name[0], o->max_iterations, "Newton iterations of one walk before it fails (iteration_limit)")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(1, 10000))->group(group);
+  app->add_option(name[1], o->threshold, "Largest constraint (tangential generalized half vector) of a solved chain")
+      ->capture_default_str()->check(real_in(0, true, 1, true))->group(group);
+  app->add_option(name[2], o->min_segment,
+                  "Shortest segment of a solution, as a fraction of the scene's bounding-box diagonal (too_short)")
+      ->capture_default_str()->check(real_in(0, false, 1, true))->group(group);
+  app->add_option(name[3], o->singular, "Smallest |pivot| / largest |pivot| of the constraint Jacobian (singular)")
+      ->capture_default_str()->check(real_in(0, false, 1, true))->group(group);
+  app->add_option(name[4], o->max_trials,
+                  "Seeds spent finding a join's chains again, their inverse-probability estimate (a cap: a chain not found again by then is counted as truncated)")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(1, 100000))->group(group);
+  app->add_option(name[5], o->seeds, "Seeds per batch: the first batch's distinct chains are a join's contributions")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(1, 64))->group(group);
+}
+
+const std::vector<std::string>& manifold_option_names() {
+  static const std::vector<std::string> names = {"--manifold-iterations", "--manifold-threshold", "--manifold-min-segment",
+                                                 "--manifold-singular", "--manifold-trials",
+                                                 "--manifold-seeds"};
+  return names;
 }
 
 void add_limit_options(CLI::App* app, Limits* limits) {

@@ -12,6 +12,7 @@
 #include "classify/pathclass.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "trace/joins/manifold.h"
 
 namespace pathex::cli {
 
@@ -34,6 +35,12 @@ void add_limit_options(CLI::App* app, Limits* limits);
 // Refuses a value with a minus sign: CLI11 reads "-1" into an unsigned option as 2^64 - 1.
 const CLI::Validator& non_negative();
 void add_notation_options(CLI::App* app, NotationOptions* n);
+// The manifold connector's limits (trace/joins/manifold.h), group "Manifold connector", each with
+// its default and its range: --manifold-iterations, --manifold-threshold, --manifold-min-segment,
+// --manifold-singular, --manifold-trials.
+void add_manifold_options(CLI::App* app, ManifoldOptions* o);
+// The names of those options, in that order (for commands that refuse them in some modes).
+const std::vector<std::string>& manifold_option_names();
 // `--light point area` reads `area` as an expression, because --light takes one comma-separated
 // list. Returns the message for such a command line (a type name right after the value of --light
 // or --sensor), else nothing.

@@ -53,6 +53,7 @@ struct TraceArgs {
   SamplerKind sampler = RenderOptions{}.sampler;  // the defaults of these three: RenderOptions'
   int rr_depth = RenderOptions{}.rr_depth;
   float rr_threshold = RenderOptions{}.rr_threshold;
+  ManifoldOptions manifold = RenderOptions{}.manifold;
   std::string resolution;  // "WxH"; empty: the scene's
   std::uint64_t max_paths = 1000;
   int top_paths = 8;
@@ -160,6 +161,10 @@ Result<bool> load_fresh(const TraceArgs& a, Job* job) {
   id.width = scene->camera.width;
   id.height = scene->camera.height;
   id.max_paths = a.max_paths;
+  // The manifold's limits are part of the render only where its connector runs.
+  if (std::any_of(profile->strategies.begin(), profile->strategies.end(),
+                  [](const Strategy& st) { return st.connector == ConnectorKind::kManifold; }))
+    id.manifold = a.manifold;
   for (const Strategy& st : runnable->strategies) id.strategies.push_back(st.name);
 
   std::string class_text;
@@ -321,6 +326,7 @@ int run(const TraceArgs& a) {
   ro.sampler = id.sampler == "sobol" ? SamplerKind::kSobol : SamplerKind::kIndependent;
   ro.rr_depth = id.rr_depth;
   ro.rr_threshold = static_cast<float>(id.rr_threshold);
+  ro.manifold = id.manifold.value_or(ManifoldOptions{});
   ro.batches = id.batches;
   ro.only = only ? &*only : nullptr;
   // Without image outputs the render keeps the histogram alone (the same histogram).
@@ -567,10 +573,13 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--resume", args->resume, "Continue the interrupted render in this folder to its requested spp (settings come from the folder)");
   sub->add_option("--time", args->time_limit, "Stop after this many seconds (at the end of a chunk of passes); --resume continues")
       ->check(CLI::PositiveNumber);
+  add_manifold_options(sub, &args->manifold);
   add_limit_options(sub, &args->limits);
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
                                   "--resolution", "--max-paths", "--sampler", "--rr-depth", "--rr-threshold"})
+              if (sub->count(o) > 0) args->settings_given.push_back(o);
+            for (const std::string& o : manifold_option_names())
               if (sub->count(o) > 0) args->settings_given.push_back(o);
             return run(*args);
           }};

@@ -318,6 +318,12 @@ json identity_json(const RenderIdentity& id) {
                   {"rr_threshold", id.rr_threshold}, {"batches", id.batches},
                   {"width", id.width},           {"height", id.height},     {"images", id.images},
                   {"max_paths", id.max_paths}};
+  if (const std::optional<ManifoldOptions>& m = id.manifold)
+    j["options"]["manifold"] = {{"max_iterations", m->max_iterations}, {"threshold", m->threshold},
+                                {"min_segment", m->min_segment},       {"singular", m->singular},
+                                {"max_trials", m->max_trials},             {"seeds", m->seeds}};
+  else
+    j["options"]["manifold"] = nullptr;
   j["strategies"] = id.strategies;
   return j;
 }
@@ -431,7 +437,7 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   h.spp = rd.uint(j, "", "spp");
   const nlohmann::json& o = j.at("options");
   if (rd.object(o, "/options", {"max_bounces", "sampler", "rr_depth", "rr_threshold", "batches", "width", "height", "images",
-                                "max_paths"})) {
+                                "max_paths", "manifold"})) {
     id.max_bounces = rd.small(o, "/options", "max_bounces");
     id.sampler = rd.str(o, "/options", "sampler");
     id.rr_depth = rd.small(o, "/options", "rr_depth");
@@ -441,6 +447,19 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
     id.height = rd.small(o, "/options", "height");
     id.images = rd.boolean(o, "/options", "images");
     id.max_paths = rd.uint(o, "/options", "max_paths");
+    if (!o.contains("manifold")) rd.fail("/options/manifold", "missing manifold (null, or the manifold connector's limits)");
+    else if (const nlohmann::json& m = o.at("manifold"); !m.is_null() &&
+        rd.object(m, "/options/manifold", {"max_iterations", "threshold", "min_segment", "singular", "max_trials", "seeds"})) {
+      const char* mp = "/options/manifold";
+      ManifoldOptions limits;
+      limits.max_iterations = rd.small(m, mp, "max_iterations");
+      limits.threshold = rd.number(m, mp, "threshold");
+      limits.min_segment = rd.number(m, mp, "min_segment");
+      limits.singular = rd.number(m, mp, "singular");
+      limits.max_trials = rd.small(m, mp, "max_trials");
+      limits.seeds = rd.small(m, mp, "seeds");
+      id.manifold = limits;
+    }
   }
   if (!rd.error && (id.batches < 1 || id.batches > 1000000)) rd.fail("/options/batches", "expected 1 to 1000000 batches");
   id.strategies = rd.strings(j, "", "strategies");
@@ -507,6 +526,21 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
   if (a.images != b.images)
     return differ("another image setting", a.images ? "images" : "--no-images", b.images ? "images" : "--no-images");
   if (auto d = option("--max-paths", static_cast<long long>(a.max_paths), static_cast<long long>(b.max_paths))) return d;
+  if (a.manifold && b.manifold) {  // both run the manifold connector (the profile hashes agree)
+    const ManifoldOptions &x = *a.manifold, &y = *b.manifold;
+    const auto real = [&](const char* name, double u, double v) -> std::optional<std::string> {
+      if (u == v) return std::nullopt;
+      return differ(std::string("another ") + name, JsonReader::fmt(u), JsonReader::fmt(v));
+    };
+    if (auto d = option("--manifold-iterations", x.max_iterations, y.max_iterations)) return d;
+    if (auto d = real("--manifold-threshold", x.threshold, y.threshold)) return d;
+    if (auto d = real("--manifold-min-segment", x.min_segment, y.min_segment)) return d;
+    if (auto d = real("--manifold-singular", x.singular, y.singular)) return d;
+    if (auto d = option("--manifold-trials", x.max_trials, y.max_trials)) return d;
+    if (auto d = option("--manifold-seeds", x.seeds, y.seeds)) return d;
+  } else if (a.manifold.has_value() != b.manifold.has_value()) {
+    return std::optional<std::string>("another manifold setting (one runs the manifold connector, the other does not)");
+  }
   // Derived from what the hashes cover; different only in a hand-made file.
   if (a.strategies != b.strategies || a.lights != b.lights || a.sensor != b.sensor || a.classes_text != b.classes_text)
     return std::optional<std::string>("another render description (strategies, end types or class text)");

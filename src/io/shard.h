@@ -29,7 +29,8 @@
 // absolute file), hash}, "classes" {file (absolute, "" for the built-in classes), text (the class
 // file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
-// {max_bounces, sampler, rr_depth, rr_threshold, batches, width, height, images, max_paths}, "strategies" [names], "share" and
+// {max_bounces, sampler, rr_depth, rr_threshold, batches, width, height, images, max_paths, manifold (null, or the
+// manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials})}, "strategies" [names], "share" and
 // "passes" (each [[first, last), …]: the passes the run was asked for, and those whose sums this
 // file holds), "run" {time_s, threads, rays}.
 //
@@ -64,6 +65,7 @@
 #include "classify/image.h"
 #include "core/error.h"
 #include "core/pass_set.h"
+#include "trace/joins/manifold.h"
 
 namespace pathex {
 
@@ -96,6 +98,9 @@ struct RenderIdentity {
   int width = 0, height = 0;  // the camera's resolution (the scene's, or --resolution's)
   bool images = true;
   std::uint64_t max_paths = 1000;  // rows of histogram.json's path table (--max-paths)
+  // The manifold connector's limits (pathex trace --manifold-*), when the profile runs it; unset
+  // otherwise (they change nothing then).
+  std::optional<ManifoldOptions> manifold;
   std::vector<std::string> strategies;  // the histogram's strategy names
   bool operator==(const RenderIdentity&) const = default;
 };

@@ -21,7 +21,7 @@ Histogram render(int paths) {
     const std::string path = "L" + std::string(static_cast<std::size_t>(4 + i), 'D') + "E";
     for (int b = 0; b < 4; ++b) {
       const double v = (i + 1) * (1.0 + 0.01 * b) + 1e-7 * i;
-      EXPECT_TRUE(h.add(h.intern(path), b, (i + b) % 2, {v, 0.5 * v, 0.25 * v}));
+      EXPECT_TRUE(h.add(h.intern(path), b, Technique{(i + b) % 2, 1, 3, false}.code(), {v, 0.5 * v, 0.25 * v}));
     }
   }
   for (int b = 0; b < 4; ++b) h.add_samples(b, 100);
@@ -49,7 +49,7 @@ TEST(MaxPaths, TheRestIsSummedExactlyIntoOneOtherRow) {
     const std::string path = i < 7 ? "LSSSSE" : "L" + std::string(static_cast<std::size_t>(4 + i), 'D') + "E";
     for (int b = 0; b < 4; ++b) {
       const double v = (i + 1) * (1.0 + 0.01 * b) + 1e-7 * i;
-      ASSERT_TRUE(merged.add(merged.intern(path), b, (i + b) % 2, {v, 0.5 * v, 0.25 * v}));
+      ASSERT_TRUE(merged.add(merged.intern(path), b, Technique{(i + b) % 2, 1, 3, false}.code(), {v, 0.5 * v, 0.25 * v}));
     }
   }
   for (int b = 0; b < 4; ++b) merged.add_samples(b, 100);

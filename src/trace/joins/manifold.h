@@ -40,6 +40,7 @@ struct ManifoldOptions {
   double singular = 1e-7;          // smallest |pivot| / largest |pivot| of the constraint Jacobian
   int seeds = 4;                   // seeds per batch: the first batch's distinct chains are the join's contributions
   int max_trials = 2000;           // seeds spent finding them again (their inverse probability), at most
+  bool operator==(const ManifoldOptions&) const = default;
 };
 
 // Why a walk failed; kNone when it succeeded.

@@ -213,7 +213,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   }
   stats.truncated += left;  // weighed by the batches run, an underestimate of their inverse probability
   for (const ManifoldSolution& x : found)
-    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : batches));
+    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)));
 }
 
 void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a_end, const Vertex& b_end,

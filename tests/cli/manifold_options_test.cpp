@@ -1,0 +1,162 @@
+// pathex trace --manifold-*: the manifold connector's limits as options. Their defaults are the
+// library's (ManifoldOptions) and --help states them; a bad value is one message and exit 2; they
+// reach the walk; and where the connector runs they are part of the render, so renders with other
+// limits are not merged and --resume does not take them.
+#include <gtest/gtest.h>
+
+#include "support/cli_run.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+#include "trace/joins/manifold.h"
+
+namespace {
+
+using pathex::test::CliRun;
+
+CliRun run(const std::string& args) { return pathex::test::run_pathex(args); }
+
+std::string out_dir(const std::string& name) {
+  const std::string d =
+      (std::filesystem::temp_directory_path() / ("pathex-manifold-opt-" + std::to_string(::getpid()) + "-" + name)).string();
+  std::filesystem::remove_all(d);
+  return d;
+}
+
+const std::string kScene = "samples/scenes/point-glass.json";
+
+// The manifold connector's row of histogram.json's "connectors".
+nlohmann::json manifold_stats(const std::string& args) {
+  const std::string dir = out_dir("stats");
+  const CliRun r = run("trace " + kScene + " --renderer pt-nee+manifold --spp 2 --resolution 16x16 --no-images --quiet --json --out " +
+                       dir + " " + args);
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  const nlohmann::json h = nlohmann::json::parse(r.out);
+  for (const auto& c : h["connectors"])
+    if (c["connector"] == "manifold") return c;
+  ADD_FAILURE() << "no manifold connector in " << r.out;
+  return {};
+}
+
+// The JSON header of DIR/render.shard (io/shard.h: magic, version, header length, header).
+nlohmann::json shard_header(const std::string& dir) {
+  std::ifstream in(dir + "/render.shard", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() < 16) return {};
+  std::uint32_t n = 0;
+  for (int i = 3; i >= 0; --i) n = (n << 8) | static_cast<unsigned char>(bytes[12 + static_cast<std::size_t>(i)]);
+  return nlohmann::json::parse(bytes.substr(16, n));
+}
+
+TEST(ManifoldOptions, HelpStatesTheLibraryDefaults) {
+  const CliRun r = run("trace --help");
+  ASSERT_EQ(r.code, 0);
+  const pathex::ManifoldOptions d;
+  EXPECT_EQ(d.max_iterations, 64);  // what the README states
+  EXPECT_EQ(d.max_trials, 2000);
+  EXPECT_EQ(d.seeds, 4);
+  for (const std::string line : {"--manifold-iterations INT:INT in [1 - 10000]=64", "--manifold-threshold FLOAT:FLOAT in (0, 1)=1e-05",
+                                 "--manifold-min-segment FLOAT:FLOAT in [0, 1)=0.001",
+                                 "--manifold-singular FLOAT:FLOAT in [0, 1)=1e-07", "--manifold-trials INT:INT in [1 - 100000]=2000",
+                                 "--manifold-seeds INT:INT in [1 - 64]=4"})
+    EXPECT_NE(r.out.find("  " + line + "\n"), std::string::npos) << line << "\n" << r.out;
+}
+
+TEST(ManifoldOptions, BadValuesAreOneMessageAndExitTwo) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--manifold-iterations 0", "--manifold-iterations: Value 0 not in range 1 to 10000"},
+      {"--manifold-iterations -3", "--manifold-iterations: expected a non-negative integer, got '-3'"},
+      {"--manifold-threshold 0", "--manifold-threshold: expected a number in (0, 1), got '0'"},
+      {"--manifold-threshold nan", "--manifold-threshold: expected a number in (0, 1), got 'nan'"},
+      {"--manifold-threshold 1e-3x", "--manifold-threshold: expected a number in (0, 1), got '1e-3x'"},
+      {"--manifold-min-segment 1", "--manifold-min-segment: expected a number in [0, 1), got '1'"},
+      {"--manifold-singular -0.1", "--manifold-singular: expected a number in [0, 1), got '-0.1'"},
+      {"--manifold-singular inf", "--manifold-singular: expected a number in [0, 1), got 'inf'"},
+      {"--manifold-trials 100001", "--manifold-trials: Value 100001 not in range 1 to 100000"},
+      {"--manifold-seeds 0", "--manifold-seeds: Value 0 not in range 1 to 64"},
+  };
+  for (const auto& [args, message] : cases) {
+    const CliRun r = run("trace " + kScene + " --renderer pt-nee+manifold --spp 1 --out " + out_dir("bad") + " " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.err, message + "\nRun with --help for more information.\n") << args;
+  }
+}
+
+// Each limit reaches the walk: at its extreme every walk fails for the reason it governs.
+TEST(ManifoldOptions, TheLimitsReachTheWalk) {
+  const nlohmann::json d = manifold_stats("");
+  ASSERT_GT(d["successes"].get<long>(), 0);
+
+  const nlohmann::json one = manifold_stats("--manifold-iterations 1");
+  EXPECT_GT(one["failures"]["iteration_limit"].get<long>(), d["failures"]["iteration_limit"].get<long>());
+  EXPECT_LE(one["mean_iterations"].get<double>(), 1.0);
+
+  const nlohmann::json shortest = manifold_stats("--manifold-min-segment 0.99");  // every segment is shorter
+  EXPECT_EQ(shortest["successes"], 0);
+  EXPECT_GT(shortest["failures"]["too_short"].get<long>(), d["failures"]["too_short"].get<long>());
+
+  const nlohmann::json singular = manifold_stats("--manifold-singular 0.99");
+  EXPECT_GT(singular["failures"]["singular"].get<long>(), 0);
+  EXPECT_LT(singular["successes"].get<long>(), d["successes"].get<long>());
+
+  // One seed to find the chains again: their inverse probability is capped, so fewer walks than the default.
+  const nlohmann::json trials = manifold_stats("--manifold-trials 1");
+  EXPECT_LT(trials["walks"].get<long>(), d["walks"].get<long>());
+  EXPECT_GT(trials["truncated"].get<long>(), d["truncated"].get<long>());
+
+  // One seed per batch: a quarter of the default's first-batch seeds.
+  const nlohmann::json seeds = manifold_stats("--manifold-seeds 1");
+  EXPECT_EQ(seeds["attempts"].get<long>() * 4, d["attempts"].get<long>());
+}
+
+TEST(ManifoldOptions, MergeRefusesRendersWithOtherLimits) {
+  const std::string a = out_dir("a"), b = out_dir("b"), m = out_dir("m");
+  const std::string common = "trace " + kScene + " --renderer pt-nee+manifold --spp 1 --resolution 8x8 --no-images --quiet --out ";
+  ASSERT_EQ(run(common + a).code, 0);
+  ASSERT_EQ(run(common + b + " --manifold-iterations 20").code, 0);
+  const CliRun r = run("merge " + a + " " + b + " --out " + m);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "pathex: error: " + b + "/render.shard and " + a +
+                       "/render.shard are not of one render: another --manifold-iterations (20 against 64)\n");
+  // A real number is named with the shortest text that reads back the same.
+  const std::string c = out_dir("c");
+  ASSERT_EQ(run(common + c + " --manifold-threshold 0.0001").code, 0);
+  const CliRun t = run("merge " + a + " " + c + " --out " + m);
+  EXPECT_EQ(t.code, 2);
+  EXPECT_NE(t.err.find("are not of one render: another --manifold-threshold (0.0001 against 1e-05)\n"), std::string::npos) << t.err;
+  // Where no manifold connector runs, the limits change nothing and are not part of the render.
+  const std::string s0 = out_dir("s0"), s1 = out_dir("s1");
+  const std::string bdpt = "trace " + kScene + " --renderer bdpt --spp 2 --resolution 8x8 --no-images --quiet --out ";
+  ASSERT_EQ(run(bdpt + s0 + " --shard 0/2").code, 0);
+  ASSERT_EQ(run(bdpt + s1 + " --shard 1/2 --manifold-iterations 20").code, 0);
+  const CliRun ok = run("merge " + s0 + " " + s1 + " --quiet --out " + m);
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  // The shard header records the limits of a render that runs the connector, and null otherwise.
+  EXPECT_EQ(shard_header(b)["options"]["manifold"],
+            nlohmann::json::parse(R"({"max_iterations": 20, "threshold": 1e-05, "min_segment": 0.001, "singular": 1e-07,
+                                     "max_trials": 2000, "seeds": 4})"));
+  EXPECT_TRUE(shard_header(s1)["options"]["manifold"].is_null());
+  for (const std::string& dir : {a, b, c, s0, s1, m}) std::filesystem::remove_all(dir);
+}
+
+TEST(ManifoldOptions, ResumeTakesTheLimitsFromTheFolder) {
+  const std::string a = out_dir("resume");
+  ASSERT_EQ(run("trace " + kScene + " --renderer bdpt --spp 1 --resolution 8x8 --no-images --quiet --out " + a).code, 0);
+  for (const std::string o : {"--manifold-iterations 8", "--manifold-threshold 0.001", "--manifold-min-segment 0",
+                               "--manifold-singular 0", "--manifold-trials 3", "--manifold-seeds 2"}) {
+    const CliRun r = run("trace --resume " + a + " " + o);
+    EXPECT_EQ(r.code, 2) << o;
+    EXPECT_EQ(r.err, "pathex: error: --resume takes the render's settings from " + a + "; " + o.substr(0, o.find(' ')) +
+                         " cannot be given with it\n");
+  }
+  std::filesystem::remove_all(a);
+}
+
+}  // namespace

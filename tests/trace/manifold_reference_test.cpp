@@ -1,0 +1,78 @@
+// The caustic seen through the glass sphere (LSDSSDSSDSE), which only the manifold connector
+// samples under a point light, against a reference from an estimator that shares nothing with
+// the walk: plain path tracing of the same scene with a spherical lamp of the point light's
+// intensity in its place, extrapolated to a lamp of radius 0 (bench/manifold_reference.py; the
+// figures and command are in tests/trace/scenes/point-glass-through.reference.json and
+// bench/README.md).
+#include <gtest/gtest.h>
+
+#include "support/cli_run.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "classify/histogram.h"
+
+namespace {
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+// Fixed seed, 128 spp (a few seconds): the manifold's estimate of the class and the reference
+// agree within 4 combined standard errors.
+TEST(ManifoldReference, SeenThroughCausticAgreesWithTheShrinkingLampReference) {
+  const std::string scene = "tests/trace/scenes/point-glass-through.json";
+  const nlohmann::json ref = read_json(std::string(PATHEX_SOURCE_DIR) + "/tests/trace/scenes/point-glass-through.reference.json");
+  ASSERT_EQ(ref["class"], "LSDSSDSSDSE");
+  const double l0 = ref["reference"]["luminance"].get<double>();
+  const double s0 = ref["reference"]["stderr"].get<double>();
+  ASSERT_GT(l0, 0.0);
+  ASSERT_GT(s0, 0.0);
+
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("pathex-manifold-ref-" + std::to_string(::getpid()))).string();
+  std::filesystem::remove_all(dir);
+  const pathex::test::CliRun r = pathex::test::run_pathex("trace " + scene +
+                                                          " --renderer pt-nee+manifold --only LSDSSDSSDSE --spp 128 "
+                                                          "--seed 1 --no-images --quiet --json --out " + dir);
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json h = nlohmann::json::parse(r.out);
+  EXPECT_EQ(h["nonfinite_samples"], 0);
+  const nlohmann::json& c = h["classes"].back();
+  ASSERT_EQ(c["expr"], "LSDSSDSSDSE");
+  const double l = c["luminance"].get<double>(), s = c["stderr"].get<double>();
+  ASSERT_TRUE(std::isfinite(l) && std::isfinite(s));
+  ASSERT_GT(l, 0.0);
+  ASSERT_GT(s, 0.0);
+  const double combined = std::sqrt(s * s + s0 * s0);
+  EXPECT_LE(std::abs(l - l0), 4 * combined) << "pt-nee+manifold " << l << " ± " << s << ", reference " << l0 << " ± " << s0;
+  // Every sample of the class is the manifold joining the light to the floor through the sphere:
+  // the chain c1…c4 = DSSD, its label the chain itself.
+  ASSERT_EQ(c["strategies"].size(), 1u) << c["strategies"].dump();
+  EXPECT_TRUE(c["strategies"].contains("manifold-nee (1, DSSD, 4)")) << c["strategies"].dump();
+}
+
+// A technique's label shows the chain it joined on the path: the path's letters between s and t.
+TEST(TechniqueLabel, ShowsTheChainJoined) {
+  using pathex::Technique;
+  EXPECT_EQ((Technique{0, 1, 4, true}.chain("LSDSSDSSDSE")), "DSSD");   // manifold, through the sphere twice
+  EXPECT_EQ((Technique{0, 1, 2, true}.chain("LSDSSDDSE")), "DSSD");     // manifold, the caustic seen directly
+  EXPECT_EQ((Technique{0, 1, 2, true}.chain("LSDSSSSDDSE")), "DSSSSD"); // a chain of four interfaces
+  EXPECT_EQ((Technique{0, 1, 2, true}.chain("LSDSDDSE")), "DSD");       // the planar mirror
+  EXPECT_EQ((Technique{0, 0, 2, true}.chain("LDSDDSE")), "DSD");        // distant-projection, c0…c2
+  EXPECT_EQ((Technique{0, 1, 0, true}.chain("LSDSDE")), "DSD");         // ortho-projection, ck…c(k+2)
+  EXPECT_EQ((Technique{0, 1, 4, true}.chain("LSDSE")), "DS+D");         // too short for (1, ·, 4)
+  EXPECT_EQ((Technique{0, 2, 3, false}.chain("LSDDDDSE")), "DD");       // a plain join's chain is DD
+  const pathex::HistogramLayout layout{2, {"manifold-nee"}};
+  EXPECT_EQ((Technique{0, 1, 4, true}.name(layout, "DSSD")), "manifold-nee (1, DSSD, 4)");
+}
+
+}  // namespace
