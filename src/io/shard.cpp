@@ -325,6 +325,9 @@ json identity_json(const RenderIdentity& id) {
   else
     j["options"]["manifold"] = nullptr;
   j["strategies"] = id.strategies;
+  json connectors = json::array();
+  for (const ConnectorStrategy& c : id.connectors) connectors.push_back({{"strategy", c.strategy}, {"connector", c.connector}});
+  j["connectors"] = std::move(connectors);
   return j;
 }
 
@@ -405,11 +408,11 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   HeaderFields rd(path);
   ShardHeader h;
   RenderIdentity& id = h.identity;
-  if (!rd.object(j, "", {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "spp",
-                         "share", "passes", "run"}))
+  if (!rd.object(j, "", {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "connectors",
+                         "spp", "share", "passes", "run"}))
     return *rd.error;
-  for (const char* key : {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "spp",
-                          "share", "passes", "run"})
+  for (const char* key : {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "connectors",
+                          "spp", "share", "passes", "run"})
     if (!j.contains(key)) return rd.fail(std::string("/") + key, std::string("missing ") + key), *rd.error;
   id.pathex = rd.str(j, "", "pathex");
   // Objects of three strings: {name, file, hash} and the like.
@@ -463,6 +466,15 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   }
   if (!rd.error && (id.batches < 1 || id.batches > 1000000)) rd.fail("/options/batches", "expected 1 to 1000000 batches");
   id.strategies = rd.strings(j, "", "strategies");
+  if (const nlohmann::json& c = j.at("connectors"); !c.is_array()) {
+    rd.fail("/connectors", "expected an array of {strategy, connector}, found " + JsonReader::kind(c));
+  } else {
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const std::string ptr = "/connectors/" + std::to_string(i);
+      if (!rd.object(c[i], ptr, {"strategy", "connector"})) break;
+      id.connectors.push_back({rd.str(c[i], ptr, "strategy"), rd.str(c[i], ptr, "connector")});
+    }
+  }
   h.share = rd.passes(j, "share");
   h.passes = rd.passes(j, "passes");
   const nlohmann::json& r = j.at("run");
@@ -542,8 +554,9 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
     return std::optional<std::string>("another manifold setting (one runs the manifold connector, the other does not)");
   }
   // Derived from what the hashes cover; different only in a hand-made file.
-  if (a.strategies != b.strategies || a.lights != b.lights || a.sensor != b.sensor || a.classes_text != b.classes_text)
-    return std::optional<std::string>("another render description (strategies, end types or class text)");
+  if (a.strategies != b.strategies || a.connectors != b.connectors || a.lights != b.lights || a.sensor != b.sensor ||
+      a.classes_text != b.classes_text)
+    return std::optional<std::string>("another render description (strategies, connectors, end types or class text)");
   return std::nullopt;
 }
 
@@ -551,7 +564,9 @@ namespace {
 
 // The file into `sink`, in order but for N, written over its placeholder at the end; the CRC-32 of
 // the whole is that of the prefix combined with the body's, which the Writer kept.
-void encode_shard_into(Sink& sink, const ShardHeader& header, const Histogram& h, const ClassImages& images) {
+void encode_shard_into(Sink& sink, const ShardHeader& header, const RenderSums& state) {
+  const Histogram& h = state.histogram;
+  const ClassImages& images = state.images;
   json hj = identity_json(header.identity);
   hj["spp"] = header.spp;
   const auto passes_json = [](const PassSet& set) {
@@ -634,6 +649,10 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const Histogram& h
       if (mask >> k & 1)
         for (std::size_t c = 0; c < 6; c += 2) w.split(words[6 * k + c], words[6 * k + c + 1]);
   }
+  // --- connector statistics ---
+  w.u(state.connectors.size());
+  for (const ConnectorStats& c : state.connectors)
+    for (const std::uint64_t* count : ConnectorStats::counts_of(c)) w.u(*count);
   w.finish();
   std::string n;
   put_le<std::uint64_t>(n, w.size());
@@ -648,17 +667,17 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const Histogram& h
 
 }  // namespace
 
-std::string encode_shard(const ShardHeader& header, const Histogram& h, const ClassImages& images) {
+std::string encode_shard(const ShardHeader& header, const RenderSums& sums) {
   std::string out;
   StringSink sink(&out);
-  encode_shard_into(sink, header, h, images);
+  encode_shard_into(sink, header, sums);
   return out;
 }
 
-Result<bool> write_shard(const std::string& path, const ShardHeader& header, const Histogram& h, const ClassImages& images) {
+Result<bool> write_shard(const std::string& path, const ShardHeader& header, const RenderSums& sums) {
   AtomicFile file(path);
   FileSink sink(&file);
-  if (file.ok()) encode_shard_into(sink, header, h, images);
+  if (file.ok()) encode_shard_into(sink, header, sums);
   return file.commit();
 }
 
@@ -712,10 +731,20 @@ Result<ShardFile> read_shard(const std::string& path, std::string buffer) {
   return parse_shard(std::move(bytes), path);
 }
 
-Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* images, std::size_t files) {
+Result<bool> add_shard_sums(const ShardFile& f, RenderSums* state, std::size_t files) {
   const RenderIdentity& id = f.header.identity;
+  Histogram* h = &state->histogram;
+  ClassImages* images = &state->images;
   if (h->num_batches() != id.batches || h->layout().strategies != id.strategies)
     return file_error(f.path, "the shard's histogram layout (batches, strategies) is not the merge's");
+  const auto same_connectors = [&] {
+    if (state->connectors.size() != id.connectors.size()) return false;
+    for (std::size_t i = 0; i < id.connectors.size(); ++i)
+      if (state->connectors[i].strategy != id.connectors[i].strategy || state->connectors[i].connector != id.connectors[i].connector)
+        return false;
+    return true;
+  };
+  if (!same_connectors()) return file_error(f.path, "the shard's connector strategies are not the merge's");
   Reader r(f.bytes.data() + f.body_offset, f.body_size);
   const auto bad = [&](const std::string& what) { return file_error(f.path, "malformed shard body: " + what); };
   // --- histogram ---
@@ -795,7 +824,20 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
     if (r.failed()) return bad("the image section ends early");
     images->add_tile(static_cast<std::size_t>(p), static_cast<std::size_t>(t), words.data());
   }
-  if (!r.at_end()) return bad("bytes after the image section");
+  // --- connector statistics ---
+  const std::uint64_t connectors = r.u();
+  if (r.failed()) return bad("the connector section ends early");
+  if (connectors != state->connectors.size())
+    return bad("it counts " + std::to_string(connectors) + " connector strategies; its header names " +
+               std::to_string(state->connectors.size()));
+  std::array<std::uint64_t, ConnectorStats::kCounts> counts;
+  for (ConnectorStats& c : state->connectors) {
+    for (std::uint64_t& n : counts) n = r.u();
+    if (r.failed()) return bad("the connector section ends early");
+    const auto to = ConnectorStats::counts_of(c);
+    for (std::size_t i = 0; i < counts.size(); ++i) *to[i] += counts[i];
+  }
+  if (!r.at_end()) return bad("bytes after the connector section");
   return true;
 }
 
