@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -267,9 +268,22 @@ Result<std::vector<std::string>> render_folder_shards(const std::string& dir) {
 Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits) {
   std::optional<CombinedRender> out;
   std::vector<std::pair<std::string, PassSet>> seen;  // each file's passes, for naming an overlap
-  std::string buffer;  // the previous file's bytes, whose pages are mapped already
-  for (const std::string& path : paths) {
-    Result<ShardFile> file = read_shard(path, std::move(buffer));
+  // The next file is read and checked (its CRC-32 over every byte) on another thread while this
+  // one is added. Each read goes into the bytes of the file added before the one in hand, whose
+  // pages are mapped already (a merge of 16 files of 11 MB spent 0.45 s of CPU faulting in fresh
+  // ones). Errors are still reported in the order of the files.
+  std::string spare;
+  const auto read_ahead = [&](std::size_t i) {
+    return std::async(std::launch::async, [path = paths[i], buffer = std::move(spare)]() mutable {
+      return read_shard(path, std::move(buffer));
+    });
+  };
+  std::future<Result<ShardFile>> next;
+  if (!paths.empty()) next = read_ahead(0);
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const std::string& path = paths[i];
+    Result<ShardFile> file = next.get();
+    if (i + 1 < paths.size()) next = read_ahead(i + 1);
     if (!file) return file.error();
     const ShardHeader& h = file->header;
     if (h.identity.pathex != pathex_version())
@@ -307,7 +321,7 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
     header.run.rays += h.run.rays;
     header.run.cpu_s += h.run.cpu_s;
     seen.emplace_back(path, h.passes);
-    buffer = std::move(file->bytes);
+    spare = std::move(file->bytes);
   }
   if (!out) return make_error(ErrorCode::kUsage, "no shard files to combine");
   return std::move(*out);

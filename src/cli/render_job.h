@@ -81,7 +81,7 @@ struct CombinedRender {
   std::unique_ptr<RenderClasses> classes;
   RenderSums sums;
 };
-// Reads the files one at a time (one file's bytes in memory at once). Refuses damaged files
+// Reads the files in order, the next while one is added (two files' bytes in memory at once). Refuses damaged files
 // (kBadFile), files of another pathex build than this one, and (kUsage, naming both files) files
 // of different renders (identity_difference) or holding the same pass twice (naming the passes).
 Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits);

@@ -9,7 +9,8 @@
 //
 // File layout, version 5 (all integers little-endian; version 1 had the body uncompressed, version
 // 2 per-strategy sums in place of the technique rows, version 3 every batch of every cell and row
-// and every pixel of a stored tile as varints, version 4 no connector statistics):
+// and every pixel of a stored tile as varints, version 4 one zstd frame for the whole body and no
+// connector statistics):
 //
 //   offset  size  what
 //   0       8     magic "PXSHARD\n"
@@ -17,7 +18,7 @@
 //   12      4     H: header length in bytes
 //   16      H     header: a JSON object (UTF-8), keys below
 //   16+H    8     N: body length in bytes
-//   24+H    N     body: the exact sums, encoded as below, compressed as one zstd frame (any level;
+//   24+H    N     body: an index, then the exact sums encoded as below in zstd frames (any level;
 //                 pathex writes its fast level -3)
 //   24+H+N  4     CRC-32 (ISO-HDLC, zlib's crc32) of every byte before it
 //
@@ -36,9 +37,15 @@
 // "passes" (each [[first, last), …]: the passes the run was asked for, and those whose sums this
 // file holds), "run" {time_s, threads, rays}.
 //
-// Body, in this order. `u` is an unsigned LEB128 varint; `x` is a 128-bit fixed-point sum
+// Body. First its index, uncompressed: 4 bytes K, the number of image frames; (K + 2) × 8 bytes,
+// the compressed size of each frame in order (the histogram frame, the K image frames, the
+// connector frame), which fill the rest of the body; K × 8 bytes, each image frame's first tile
+// key (plane × tiles per plane + tile), increasing: a frame's tiles have keys from its first key
+// to below the next frame's (the last: below planes × tiles), so frames hold disjoint tiles and
+// are decoded at once, on every core, with the histogram frame. Then the frames, each one zstd
+// frame of the encoding below. `u` is an unsigned LEB128 varint; `x` is a 128-bit fixed-point sum
 // zigzag-encoded ((v << 1) ^ (v >> 127), arithmetic shift) as an unsigned LEB128 varint, so zero
-// is one byte and a typical sum (64 fraction bits) nine or ten. The body is decoded as it is
+// is one byte and a typical sum (64 fraction bits) nine or ten. A frame is decoded as it is
 // decompressed, a window of 1 MiB at a time, so a file cannot make pathex allocate more than its
 // sums take; a path string is at most 512 KiB.
 //   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P, u number of
@@ -50,13 +57,13 @@
 //              the batch's distance after the previous one listed minus one (the first: its
 //              index), so that batches come in order and below B (B from the header); a shard
 //              of one pass holds one batch per cell list.
-//   images:    u planes, u tiles per plane, u number of stored tiles T; then per tile, by plane
-//              then tile: u plane, u tile, 8 bytes: the mask of its 8 × 8 pixels (bit i: pixel i
+//   images:    (each image frame; pathex writes 512 stored tiles a frame) u planes, u tiles per
+//              plane, u number of stored tiles T in the frame; then per tile, by key: u plane, u tile, 8 bytes: the mask of its 8 × 8 pixels (bit i: pixel i
 //              of the tile, row-major) with a nonzero sum; per pixel of the mask, per channel, the
 //              sum's low 64-bit word as 8 raw bytes, then its high word as the zigzag varint of a
 //              signed 64-bit integer (one byte for sums below 64: most). Tiles with nothing in
 //              them are not stored. Raw words decode with a load where a varint took ten steps.
-//   connectors: u number of connector strategies C (the header's "connectors"), then per connector,
+//   connectors: (the last frame) u number of connector strategies C (the header's "connectors"), then per connector,
 //              in the header's order, 14 × u: the counts of histogram.json's "connectors" (exact
 //              integer sums over samples): attempts, successes, outside, occluded, no_transport,
 //              no_solution, singular, wrong_type, too_short, iteration_limit, walks (chains handed

@@ -124,6 +124,38 @@ TEST(ShardFile, RoundTripsTheExactSums) {
   EXPECT_EQ(sums.connectors[0].iterations, std::uint64_t{1} << 61);
 }
 
+// A larger image is stored in several frames (512 tiles each), decoded at once: every tile's sums
+// come back, and frames whose key ranges are not increasing (so that two could add to one tile)
+// are refused.
+TEST(ShardFile, ImageFramesRoundTripAndMustNotOverlap) {
+  Fixture f;
+  const int w = 200, h = 200;  // 625 tiles of 8 x 8: two frames
+  RenderSums sums{Histogram(f.histogram.layout()), ClassImages(w, h, nullptr, {}), {{"b", "mirror"}}};
+  for (int y = 0; y < h; y += 3)
+    for (int x = 0; x < w; x += 5) sums.images.add(x, y, 0, *to_exact({0.5 + x, -0.25 * y, 1e-9}));
+  const std::string bytes = encode_shard(f.header, sums);
+  Result<ShardFile> file = parse_shard(bytes, "x.shard");
+  ASSERT_TRUE(file) << file.error().render();
+  const std::size_t body = file->body_offset;
+  ASSERT_EQ(static_cast<unsigned char>(bytes[body]), 2u);  // K, little-endian
+  RenderSums into{Histogram(f.histogram.layout()), ClassImages(w, h, nullptr, {}), {{"b", "mirror"}}};
+  ASSERT_TRUE(add_shard_sums(*file, &into)) << add_shard_sums(*file, &into).error().render();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) ASSERT_EQ(into.images.sum(0, x, y), sums.images.sum(0, x, y)) << x << " " << y;
+  // The second frame's first key set to the first's (the CRC made right again).
+  std::string bad = bytes;
+  const std::size_t keys = body + 4 + 8 * 4;
+  bad.replace(keys + 8, 8, bad.substr(keys, 8));
+  const auto crc = static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(bad.data()), static_cast<uInt>(bad.size() - 4)));
+  for (std::size_t i = 0; i < 4; ++i) bad[bad.size() - 4 + i] = static_cast<char>((crc >> (8 * i)) & 0xff);
+  Result<ShardFile> overlapping = parse_shard(bad, "y.shard");
+  ASSERT_TRUE(overlapping) << overlapping.error().render();
+  RenderSums again{Histogram(f.histogram.layout()), ClassImages(w, h, nullptr, {}), {{"b", "mirror"}}};
+  Result<bool> r = add_shard_sums(*overlapping, &again);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().render(), "y.shard: malformed shard body: its image frames' keys are not increasing");
+}
+
 // The connector statistics are laid out by the header's "connectors": sums laid out for others,
 // or a body that counts other connectors than its header names, are refused.
 TEST(ShardFile, ConnectorStatisticsOfAnotherLayoutAreRefused) {
