@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,7 @@ struct Case {
   bool connector = false;  // the profile runs a connector on this scene: its statistics merge too
   std::string options = "";  // more options of the render
 };
+void PrintTo(const Case& c, std::ostream* os) { *os << c.scene << " " << c.renderer << c.options; }
 
 // A render's connector statistics, which must be nonzero for their merge to test anything.
 void expect_connector_work(const std::string& d, const std::string& what) {
