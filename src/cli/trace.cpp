@@ -10,6 +10,8 @@
 #include <sstream>
 #include <thread>
 
+#include <tbb/global_control.h>
+
 #include "cli/bias_common.h"
 #include "cli/common.h"
 #include "cli/estimate_text.h"
@@ -413,6 +415,10 @@ int run(const TraceArgs& a) {
   std::optional<Error> failure;
   if (rank == 0) {
     const SignalShield shield;
+    // --threads bounds the writing too: one thread writes the files one after the other, with no
+    // worker thread started (and spinning) for a render that asked for one.
+    std::optional<tbb::global_control> limit;
+    if (a.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(a.threads));
     Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
       Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, out->connectors, pruning->changes);
       if (!r) return r.error();
@@ -440,7 +446,7 @@ int run(const TraceArgs& a) {
   const bool complete = rep->run.complete;
   if (a.json) {
     std::cout << written->json_text;
-    return complete ? kExitOk : kExitNo;
+    return finish_command(complete ? kExitOk : kExitNo);
   }
 
   // --- the table: classes with the checker's verdict, then the most important exact paths ---
@@ -512,7 +518,7 @@ int run(const TraceArgs& a) {
   if (!complete)
     std::cout << "interrupted: 'pathex trace --resume " << job.out << "' renders the missing passes "
               << job.header.share.minus(header.passes).to_string() << "\n";
-  return complete ? kExitOk : kExitNo;
+  return finish_command(complete ? kExitOk : kExitNo);
 }
 
 }  // namespace
