@@ -247,6 +247,11 @@ double process_cpu_seconds() {
 }
 
 int run(const TraceArgs& a) {
+  // --threads bounds the whole command, not only the render's loop: Embree's BVH build before it
+  // and the concurrent writing after it would otherwise start TBB worker threads (which spin
+  // while they wait) for a render that asked for one thread.
+  std::optional<tbb::global_control> limit;
+  if (a.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(a.threads));
   Job job;
   if (Result<bool> r = a.resume.empty() ? load_fresh(a, &job) : load_resumed(a, &job); !r) return report(r.error());
   const RenderIdentity& id = job.header.identity;
@@ -415,10 +420,6 @@ int run(const TraceArgs& a) {
   std::optional<Error> failure;
   if (rank == 0) {
     const SignalShield shield;
-    // --threads bounds the writing too: one thread writes the files one after the other, with no
-    // worker thread started (and spinning) for a render that asked for one.
-    std::optional<tbb::global_control> limit;
-    if (a.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(a.threads));
     Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
       Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, out->connectors, pruning->changes);
       if (!r) return r.error();
