@@ -180,9 +180,10 @@ def main():
                               f"{statistics.median(x[1] for x in rs):>12.4g}{statistics.median(x[2] for x in rs):>12.4g}"
                               f"{statistics.median(eff):>12.4g}{statistics.median(eff_off):>12.4g}"
                               f"   {fmt_range(ratio):<26}{fmt_range(ratio_off)}", flush=True)
-                    print(f"  {'variant':<14}{'efficiency 1/(mean MSE x median CPU s), variant / old, 95 % bootstrap: whole':<76}off")
+                    print("  efficiency 1 / (mean MSE x median CPU s), variant / old, 95 % bootstrap interval:")
+                    print(f"  {'variant':<14}{'whole / old':<26}off / old")
                     for label, _, _ in variants[1:]:
-                        print(f"  {label:<14}{mean_ratio(base, runs[label], 1):<76}{mean_ratio(base, runs[label], 2)}",
+                        print(f"  {label:<14}{mean_ratio(base, runs[label], 1):<26}{mean_ratio(base, runs[label], 2)}",
                               flush=True)
     if args.json_out:
         with open(args.json_out, "w") as f:
