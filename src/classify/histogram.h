@@ -293,16 +293,22 @@ class Histogram {
   };
   static const Cell kEmptyCell;  // what cell() reads in a batch not laid out that far
   // A batch's cells (and row sums) reach the paths (rows) seen so far when first written to.
+  // The extension is out of line: the callers run once per contribution, the extension once per
+  // new path or row in a batch.
   Cell& cell_of(PathId id, int batch) {
     std::vector<Cell>& cells = cells_[static_cast<std::size_t>(batch)];
-    if (static_cast<std::size_t>(id) >= cells.size()) cells.resize(paths_.size());
+    if (static_cast<std::size_t>(id) >= cells.size()) [[unlikely]]
+      extend_cells(batch);
     return cells[static_cast<std::size_t>(id)];
   }
   ExactSum& row_sum_of(int r, int batch) {
     std::vector<ExactSum>& sums = row_sums_[static_cast<std::size_t>(batch)];
-    if (static_cast<std::size_t>(r) >= sums.size()) sums.resize(rows_.size(), 0);
+    if (static_cast<std::size_t>(r) >= sums.size()) [[unlikely]]
+      extend_row_sums(batch);
     return sums[static_cast<std::size_t>(r)];
   }
+  [[gnu::noinline]] void extend_cells(int batch) { cells_[static_cast<std::size_t>(batch)].resize(paths_.size()); }
+  [[gnu::noinline]] void extend_row_sums(int batch) { row_sums_[static_cast<std::size_t>(batch)].resize(rows_.size(), 0); }
 
   HistogramLayout layout_;
   const Classifier* classifier_ = nullptr;

@@ -375,6 +375,9 @@ class Integrator {
   // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
   void full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const;
   void record(Thread& th, const Pending& r) const;
+  // A contribution that is not finite (a bug: counted, and the first one kept for the warning).
+  // Out of line and cold, so that record()'s code stays small.
+  [[gnu::cold, gnu::noinline]] void record_nonfinite(Thread& th, const Pending& r) const;
   void trace_shadows(Thread& th) const;
 
   const RenderScene& rs_;

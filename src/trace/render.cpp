@@ -399,10 +399,7 @@ void Integrator::record(Thread& th, const Pending& r) const {
   const Rgb rgb{r.c.x, r.c.y, r.c.z};
   ExactRgb e;
   if (!to_exact(rgb, &e)) {
-    th.hist.add_nonfinite();
-    if (!th.first_nonfinite)
-      th.first_nonfinite = NonfiniteSample{strategies_.strategies[static_cast<std::size_t>(r.strategy)].name, unpack(r.key),
-                                           th.pass, r.px, th.py};
+    record_nonfinite(th, r);
     return;
   }
   if (is_zero(e)) return;
@@ -412,6 +409,13 @@ void Integrator::record(Thread& th, const Pending& r) const {
   const std::uint32_t set = th.hist.class_set(id);
   if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, e);
   else th.row[static_cast<std::size_t>(r.px)].add(set, e);
+}
+
+void Integrator::record_nonfinite(Thread& th, const Pending& r) const {
+  th.hist.add_nonfinite();
+  if (!th.first_nonfinite)
+    th.first_nonfinite = NonfiniteSample{strategies_.strategies[static_cast<std::size_t>(r.strategy)].name, unpack(r.key),
+                                         th.pass, r.px, th.py};
 }
 
 template <Integrator::Connection C>

@@ -40,68 +40,113 @@ inline PathKey pack(const std::string& letters) {  // "L c0 … E"
 
 // Per-thread map from (packed string, technique) to the histogram's path id and technique row,
 // so that recording a contribution hashes three words instead of a string and walks no list;
-// Histogram::intern() and technique_row() run once per new pair and thread. The contributions
-// of each pair are counted here, in the slot just read, and handed to the histogram by flush().
-class PathIds {
+// Histogram::intern() runs once per new string and thread, technique_row() once per new pair. The
+// contributions of each pair are counted here, in the slot just read, and handed to the histogram
+// by flush().
+//
+// Layout, for the hot lookup: a slot is 32 bytes (two per cache line; the key as two words, the
+// count in 32 bits, handed over before it can wrap), and the strings seen so far have a table of
+// their own, read only when a pair is new, so that a string's second technique does not unpack it
+// and hash it as a string again. (FlushAt is the count at which a slot hands its contributions
+// over before its 32 bits wrap; a test lowers it.)
+template <std::uint32_t FlushAt = 0xffffffffu>
+class BasicPathIds {
  public:
   struct Ids {
     Histogram::PathId path = -1;
     int row = -1;  // Histogram::technique_row() of the technique
   };
   Ids get(Histogram& hist, PathKey key, int technique) {
+    const std::uint64_t lo = static_cast<std::uint64_t>(key), hi = static_cast<std::uint64_t>(key >> 64);
     const std::size_t mask = slots_.size() - 1;
-    for (std::size_t i = hash(key, technique) & mask;; i = (i + 1) & mask) {
+    for (std::size_t i = hash(lo, hi, technique) & mask;; i = (i + 1) & mask) {
       Slot& slot = slots_[i];
-      if (slot.key == key && slot.technique == technique) {
-        ++slot.contributions;
+      if (slot.lo == lo && slot.hi == hi && slot.technique == technique) {
+        if (++slot.contributions >= FlushAt) [[unlikely]]
+          hand_over(hist, slot);
         return slot.ids;
       }
-      if (slot.key == 0) return insert(hist, slot, key, technique);
+      if (slot.hi == 0) return insert(hist, slot, key, technique);
     }
   }
   // Adds the contributions counted since the last flush to the histogram's technique rows.
   void flush(Histogram& hist) {
     for (Slot& slot : slots_)
-      if (slot.key != 0 && slot.contributions != 0) {
-        hist.add_technique(slot.ids.path, slot.technique, slot.contributions, nullptr);
-        slot.contributions = 0;
-      }
+      if (slot.hi != 0 && slot.contributions != 0) hand_over(hist, slot);
   }
 
  private:
   struct Slot {
-    PathKey key = 0;  // 0: empty (a real key has a nonzero length)
+    std::uint64_t lo = 0, hi = 0;  // the key's words; hi == 0: empty (a real key's length byte is nonzero)
     int technique = 0;
     Ids ids;
-    std::uint64_t contributions = 0;  // nonzero contributions of the pair since the last flush
+    std::uint32_t contributions = 0;  // nonzero contributions of the pair since they were last handed over
   };
+  static_assert(sizeof(Slot) == 32, "two slots per cache line");
+  struct PathSlot {
+    PathKey key = 0;  // 0: empty
+    Histogram::PathId id = -1;
+  };
+
+  [[gnu::noinline]] static void hand_over(Histogram& hist, Slot& slot) {
+    hist.add_technique(slot.ids.path, slot.technique, slot.contributions, nullptr);
+    slot.contributions = 0;
+  }
   // A pair's first sight, out of line: the lookup above stays small enough to inline.
   [[gnu::noinline]] Ids insert(Histogram& hist, Slot& slot, PathKey key, int technique) {
-    const Histogram::PathId id = hist.intern(unpack(key));
-    slot = {key, technique, {id, hist.technique_row(id, technique)}, 1};
+    const Histogram::PathId id = path_id(hist, key);
+    slot = {static_cast<std::uint64_t>(key), static_cast<std::uint64_t>(key >> 64), technique, {id, hist.technique_row(id, technique)}, 1};
     const Ids ids = slot.ids;
     if (2 * ++used_ > slots_.size()) grow();
     return ids;
   }
+  // The histogram's id of the string, interned on its first sight in this thread.
+  Histogram::PathId path_id(Histogram& hist, PathKey key) {
+    const std::uint64_t lo = static_cast<std::uint64_t>(key), hi = static_cast<std::uint64_t>(key >> 64);
+    const std::size_t mask = paths_.size() - 1;
+    for (std::size_t i = hash(lo, hi, -1) & mask;; i = (i + 1) & mask) {
+      PathSlot& p = paths_[i];
+      if (p.key == key) return p.id;
+      if (p.key == 0) {
+        p = {key, hist.intern(unpack(key))};
+        const Histogram::PathId id = p.id;
+        if (2 * ++paths_used_ > paths_.size()) grow_paths();
+        return id;
+      }
+    }
+  }
   // One finaliser over the three words, each spread by its own odd multiplier first (ids do not
   // depend on the hash: they are given in order of first sight).
-  static std::size_t hash(PathKey key, int technique) {
-    return static_cast<std::size_t>(mix64(static_cast<std::uint64_t>(key) + static_cast<std::uint64_t>(key >> 64) * kGoldenGamma +
-                                          static_cast<std::uint64_t>(technique) * 0xd6e8feb86659fd93ULL));
+  static std::size_t hash(std::uint64_t lo, std::uint64_t hi, int technique) {
+    return static_cast<std::size_t>(mix64(lo + hi * kGoldenGamma + static_cast<std::uint64_t>(technique) * 0xd6e8feb86659fd93ULL));
   }
   void grow() {
     std::vector<Slot> old(slots_.size() * 2);
     old.swap(slots_);
     const std::size_t mask = slots_.size() - 1;
     for (const Slot& slot : old) {
-      if (slot.key == 0) continue;
-      std::size_t i = hash(slot.key, slot.technique) & mask;
-      while (slots_[i].key != 0) i = (i + 1) & mask;
+      if (slot.hi == 0) continue;
+      std::size_t i = hash(slot.lo, slot.hi, slot.technique) & mask;
+      while (slots_[i].hi != 0) i = (i + 1) & mask;
       slots_[i] = slot;
+    }
+  }
+  void grow_paths() {
+    std::vector<PathSlot> old(paths_.size() * 2);
+    old.swap(paths_);
+    const std::size_t mask = paths_.size() - 1;
+    for (const PathSlot& p : old) {
+      if (p.key == 0) continue;
+      std::size_t i = hash(static_cast<std::uint64_t>(p.key), static_cast<std::uint64_t>(p.key >> 64), -1) & mask;
+      while (paths_[i].key != 0) i = (i + 1) & mask;
+      paths_[i] = p;
     }
   }
   std::vector<Slot> slots_ = std::vector<Slot>(256);
   std::size_t used_ = 0;
+  std::vector<PathSlot> paths_ = std::vector<PathSlot>(256);
+  std::size_t paths_used_ = 0;
 };
+using PathIds = BasicPathIds<>;
 
 }  // namespace pathex::accel
