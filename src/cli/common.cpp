@@ -1,6 +1,9 @@
 #include "cli/common.h"
 
+#include <atomic>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 
@@ -158,6 +161,20 @@ Result<PathClass> compile_cli_expression(const std::string& expr, const Notation
 void print_notation_hint(const std::string& expr, const PathClass& pc, const ClassOptions& options,
                          const ClassTable* table) {
   if (std::optional<std::string> h = heckbert_hint(expr, pc, options, table)) std::cerr << "pathex: hint: " << *h << "\n";
+}
+
+namespace {
+std::atomic<bool> fast_exit_allowed{false};
+}  // namespace
+
+void allow_fast_exit() { fast_exit_allowed.store(true); }
+
+int finish_command(int code) {
+  if (!fast_exit_allowed.load()) return code;
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  std::_Exit(code);
 }
 
 int report(const Error& e) {

@@ -64,6 +64,15 @@ int report(const Error& e);
 // Parses the command line, runs the subcommand and returns the exit code (cli/app.cpp).
 int run_command_line(int argc, char** argv);
 
+// Ending the process without freeing (a compiler's -disable-free): a command that has written,
+// synced and renamed all its outputs calls finish_command(code), which flushes stdout and stderr
+// and ends the process at once when the process allows it, so that a render's tables and images
+// are not freed page by page (munmap's TLB flushes) just before the kernel drops the address
+// space anyway; otherwise it returns code. Only the pathex binary's main allows it: tests run
+// commands in-process, and pathex-mpi must finalise MPI.
+void allow_fast_exit();
+int finish_command(int code);
+
 // Registration of each subcommand (one file each).
 Command add_explain(CLI::App& app);
 Command add_match(CLI::App& app);

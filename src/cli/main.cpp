@@ -7,6 +7,7 @@
 
 int main(int argc, char** argv) {
   int code = pathex::cli::kExitBadInput;
+  pathex::cli::allow_fast_exit();  // a command that has written its outputs may end without freeing
   if (!pathex::run_on_stack(pathex::kCommandLineStackBytes,
                             [&] { code = pathex::cli::run_command_line(argc, argv); })) {
     std::fprintf(stderr, "pathex: error: cannot start the command line's thread (a %zu MiB stack)\n",

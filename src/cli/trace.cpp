@@ -10,6 +10,8 @@
 #include <sstream>
 #include <thread>
 
+#include <tbb/global_control.h>
+
 #include "cli/bias_common.h"
 #include "cli/common.h"
 #include "cli/estimate_text.h"
@@ -245,6 +247,11 @@ double process_cpu_seconds() {
 }
 
 int run(const TraceArgs& a) {
+  // --threads bounds the whole command, not only the render's loop: Embree's BVH build before it
+  // and the concurrent writing after it would otherwise start TBB worker threads (which spin
+  // while they wait) for a render that asked for one thread.
+  std::optional<tbb::global_control> limit;
+  if (a.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(a.threads));
   Job job;
   if (Result<bool> r = a.resume.empty() ? load_fresh(a, &job) : load_resumed(a, &job); !r) return report(r.error());
   const RenderIdentity& id = job.header.identity;
@@ -440,7 +447,7 @@ int run(const TraceArgs& a) {
   const bool complete = rep->run.complete;
   if (a.json) {
     std::cout << written->json_text;
-    return complete ? kExitOk : kExitNo;
+    return finish_command(complete ? kExitOk : kExitNo);
   }
 
   // --- the table: classes with the checker's verdict, then the most important exact paths ---
@@ -512,7 +519,7 @@ int run(const TraceArgs& a) {
   if (!complete)
     std::cout << "interrupted: 'pathex trace --resume " << job.out << "' renders the missing passes "
               << job.header.share.minus(header.passes).to_string() << "\n";
-  return complete ? kExitOk : kExitNo;
+  return finish_command(complete ? kExitOk : kExitNo);
 }
 
 }  // namespace

@@ -12,12 +12,23 @@ namespace {
 
 // Whether `st` with its s (or t) range set to exactly `v` samples a path of `target`. With s
 // fixed the language reads deterministically from L; with only t fixed its determinisation would
-// remember the last t letters (2^t states), so then each s of the range is tried with it.
+// remember the last t letters (2^t states), so then each s of the range is tried with it, except
+// for a small t, whose one language over the whole s range is cheap (the language of an s range
+// is the union of its values' languages, so the answer is the same).
+constexpr int kWholeRangeMaxT = 4;
+
 Result<bool> samples_at(const Strategy& st, bool on_s, int v, int top, std::optional<int> max_bounces, const Dfa& target,
                         const Limits& limits) {
   Strategy one = st;
   (on_s ? one.s : one.t) = Range{v, v};
   const int s_last = st.s.hi == Range::kOpen ? top : std::min(st.s.hi, top);
+  if (!on_s && v <= kWholeRangeMaxT) {
+    if (st.s.lo > s_last) return false;
+    one.s = Range{st.s.lo, s_last};
+    Result<Dfa> l = strategy_language(one, max_bounces, limits);
+    if (!l) return l.error();
+    return !is_empty(dfa_intersect(*l, target));
+  }
   for (int s = on_s ? v : st.s.lo; s <= (on_s ? v : s_last); ++s) {
     one.s = Range{s, s};
     Result<Dfa> l = strategy_language(one, max_bounces, limits);
