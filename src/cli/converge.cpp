@@ -228,11 +228,12 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   r.seed = seed;
   r.cpu_s = r.own_cpu_s = cpu1 - cpu0;
   if (cluster != nullptr) {
-    RenderSums sums{std::move(out->histogram), std::move(out->images)};
+    RenderSums sums{std::move(out->histogram), std::move(out->images), std::move(out->connectors)};
     ShardRun run{out->time_s, ro.threads, out->rays, r.cpu_s};
     if (Result<bool> red = cluster->reduce(&sums, &out->passes_done, &run); !red) return red.error();
     out->histogram = std::move(sums.histogram);
     out->images = std::move(sums.images);
+    out->connectors = std::move(sums.connectors);
     out->spp_done = out->passes_done.count();  // on rank 0, every rank's
     r.cpu_s = run.cpu_s;
     wall1 = std::chrono::steady_clock::now();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -81,9 +82,12 @@ RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& class
   std::vector<int> layers;
   if (identity.images)
     for (int i = 0; i < classes.classifier->num_classes(); ++i) layers.push_back(i);
+  std::vector<ConnectorStats> connectors;
+  for (const ConnectorStrategy& c : identity.connectors) connectors.push_back({c.strategy, c.connector});
   return {Histogram(layout, classes.classifier.get()),
           identity.images ? ClassImages(identity.width, identity.height, classes.classifier.get(), layers)
-                          : ClassImages(0, 0, nullptr, {})};
+                          : ClassImages(0, 0, nullptr, {}),
+          std::move(connectors)};
 }
 
 // run.json's "efficiency": Veach's efficiency of the image-mean estimate, 1 / (relative variance ×
@@ -105,9 +109,9 @@ namespace {
 
 // histogram.json and run.json (which reads the report's total).
 Result<WrittenReport> write_report(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                   const RenderClasses& classes, const std::vector<ConnectorStats>& connectors,
-                                   const std::vector<PrunedStrategy>& not_run) {
+                                   const RenderClasses& classes, const std::vector<PrunedStrategy>& not_run) {
   const RenderIdentity& id = header.identity;
+  const std::vector<ConnectorStats>& connectors = sums.connectors;
   RunInfo info;
   info.scene = id.scene;
   info.renderer = id.renderer;
@@ -210,17 +214,16 @@ Result<bool> write_images(const std::string& dir, const ShardHeader& header, con
 }  // namespace
 
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors,
-                                           const std::vector<PrunedStrategy>& not_run) {
+                                           const RenderClasses& classes, const std::vector<PrunedStrategy>& not_run) {
   // The files are independent and read the sums only: the shard file (the largest), the report
   // and the images are made and written as concurrent tasks, so the wall time is the longest of
   // them rather than their sum. The bytes do not depend on it; the first failure in the order
   // report, images, shard is the one returned.
   std::optional<Result<bool>> shard, images;
   tbb::task_group group;
-  group.run([&] { shard.emplace(write_shard(dir + "/" + kRenderShardName, header, sums.histogram, sums.images)); });
+  group.run([&] { shard.emplace(write_shard(dir + "/" + kRenderShardName, header, sums)); });
   if (header.identity.images) group.run([&] { images.emplace(write_images(dir, header, sums, classes)); });
-  Result<WrittenReport> report = write_report(dir, header, sums, classes, connectors, not_run);
+  Result<WrittenReport> report = write_report(dir, header, sums, classes, not_run);
   group.wait();
   if (!report) return report.error();
   if (images && !*images) return images->error();
@@ -265,9 +268,22 @@ Result<std::vector<std::string>> render_folder_shards(const std::string& dir) {
 Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits) {
   std::optional<CombinedRender> out;
   std::vector<std::pair<std::string, PassSet>> seen;  // each file's passes, for naming an overlap
-  std::string buffer;  // the previous file's bytes, whose pages are mapped already
-  for (const std::string& path : paths) {
-    Result<ShardFile> file = read_shard(path, std::move(buffer));
+  // The next file is read and checked (its CRC-32 over every byte) on another thread while this
+  // one is added. Each read goes into the bytes of the file added before the one in hand, whose
+  // pages are mapped already (a merge of 16 files of 11 MB spent 0.45 s of CPU faulting in fresh
+  // ones). Errors are still reported in the order of the files.
+  std::string spare;
+  const auto read_ahead = [&](std::size_t i) {
+    return std::async(std::launch::async, [path = paths[i], buffer = std::move(spare)]() mutable {
+      return read_shard(path, std::move(buffer));
+    });
+  };
+  std::future<Result<ShardFile>> next;
+  if (!paths.empty()) next = read_ahead(0);
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const std::string& path = paths[i];
+    Result<ShardFile> file = next.get();
+    if (i + 1 < paths.size()) next = read_ahead(i + 1);
     if (!file) return file.error();
     const ShardHeader& h = file->header;
     if (h.identity.pathex != pathex_version())
@@ -295,7 +311,7 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
                                                    ": the renders to merge must hold disjoint passes");
     }
     const std::size_t files_left = paths.size() - seen.size();  // this one included
-    if (Result<bool> r = add_shard_sums(*file, &out->sums.histogram, &out->sums.images, files_left); !r) return r.error();
+    if (Result<bool> r = add_shard_sums(*file, &out->sums, files_left); !r) return r.error();
     ShardHeader& header = out->header;
     header.spp = std::max(header.spp, h.spp);
     header.share.add(h.share);
@@ -305,7 +321,7 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
     header.run.rays += h.run.rays;
     header.run.cpu_s += h.run.cpu_s;
     seen.emplace_back(path, h.passes);
-    buffer = std::move(file->bytes);
+    spare = std::move(file->bytes);
   }
   if (!out) return make_error(ErrorCode::kUsage, "no shard files to combine");
   return std::move(*out);

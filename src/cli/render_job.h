@@ -42,12 +42,8 @@ struct RenderClasses {
 Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string& text, const std::string& filename,
                                                               const RenderIdentity& identity, const Limits& limits);
 
-// A render's exact state: what a shard file holds.
-struct RenderSums {
-  Histogram histogram;
-  ClassImages images;
-};
-// Empty sums laid out for `identity` and `classes`: every class gets an image layer.
+// Empty sums (RenderSums, io/shard.h) laid out for `identity` and `classes`: every class gets an
+// image layer, every connector strategy of the identity its statistics.
 RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& classes);
 
 // The render folder's outputs: histogram.json, classes.exr and the PNGs (unless the identity has
@@ -58,7 +54,7 @@ struct WrittenReport {
   HistogramReport report;
   std::string json_text;
 };
-// histogram.json also lists what each connector did ("connectors": [{strategy, connector,
+// histogram.json also lists what each connector did (sums.connectors; "connectors": [{strategy, connector,
 // attempts, successes, failures {outside, occluded, no_transport; the manifold's no_solution, singular, wrong_type, too_short, iteration_limit instead of outside}, and for the manifold repeats, truncated, walks and mean_iterations}] in the profile's order;
 // absent when the profile has none).
 // With requested classes, histogram.json lists them ("only": [{name, expr}]) and marks every class
@@ -66,8 +62,7 @@ struct WrittenReport {
 // rendered. run.json's "pruned" lists the strategies the checker did not run or narrowed
 // ([{strategy, profile, runs (null: not run), reason}]; reach/prune.h).
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                           const RenderClasses& classes, const std::vector<ConnectorStats>& connectors = {},
-                                           const std::vector<PrunedStrategy>& not_run = {});
+                                           const RenderClasses& classes, const std::vector<PrunedStrategy>& not_run = {});
 
 // Where the MPI ranks of a render into `dir` keep their own shard files until rank 0 has written
 // the outputs: the folder "<dir>.ranks" beside it (the output folder holds only its set).
@@ -86,7 +81,7 @@ struct CombinedRender {
   std::unique_ptr<RenderClasses> classes;
   RenderSums sums;
 };
-// Reads the files one at a time (one file's bytes in memory at once). Refuses damaged files
+// Reads the files in order, the next while one is added (two files' bytes in memory at once). Refuses damaged files
 // (kBadFile), files of another pathex build than this one, and (kUsage, naming both files) files
 // of different renders (identity_difference) or holding the same pass twice (naming the passes).
 Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits);

@@ -286,10 +286,17 @@ int run(const TraceArgs& a) {
     return kExitNo;
   }
   std::vector<std::string> runs;
-  for (const Strategy& st : pruning->profile.strategies) runs.push_back(st.name);
-  if (a.resume.empty()) job.header.identity.strategies = runs;  // the histogram is laid out for these
-  else if (runs != id.strategies)
+  std::vector<ConnectorStrategy> connectors;
+  for (const Strategy& st : pruning->profile.strategies) {
+    runs.push_back(st.name);
+    if (st.connector != ConnectorKind::kNone) connectors.push_back({st.name, to_string(st.connector)});
+  }
+  if (a.resume.empty()) {  // the histogram and the connector statistics are laid out for these
+    job.header.identity.strategies = runs;
+    job.header.identity.connectors = connectors;
+  } else if (runs != id.strategies || connectors != id.connectors) {
     return report(make_error(ErrorCode::kUsage, "the strategies " + a.resume + " was rendered with are not the ones this pathex runs for it"));
+  }
   std::optional<RequestedPaths> only;
   if (!job.classes->requested.empty()) {
     Result<RequestedPaths> r = RequestedPaths::make(job.classes->requested, a.limits);
@@ -297,12 +304,6 @@ int run(const TraceArgs& a) {
     only.emplace(std::move(*r));
   }
 
-  // Connector statistics (histogram.json "connectors") are per process and not yet kept in shard
-  // files, so a render that is split or resumed must not use a connector.
-  for (const Strategy& st : pruning->profile.strategies)
-    if (st.connector != ConnectorKind::kNone && (!a.shard.empty() || !a.resume.empty() || ranks > 1))
-      return report(make_error(ErrorCode::kUsage, "the " + job.profile->name + " profile uses the " + to_string(st.connector) +
-                                                      " connector, whose statistics are not merged yet: --shard, --resume and MPI runs need a profile without connectors"));
   // The output folder is checked before the render, not after it.
   std::optional<OutputSet> out_set;
   if (rank == 0) {
@@ -389,7 +390,7 @@ int run(const TraceArgs& a) {
     missed = std::move(b->report);
   }
 
-  RenderSums sums{std::move(out->histogram), std::move(out->images)};
+  RenderSums sums{std::move(out->histogram), std::move(out->images), std::move(out->connectors)};
   ShardHeader header = job.header;
   header.passes = out->passes_done;
   header.run = {out->time_s, ro.threads > 0 ? ro.threads : static_cast<int>(std::thread::hardware_concurrency()), out->rays,
@@ -400,7 +401,7 @@ int run(const TraceArgs& a) {
     const std::string mine = rank_shard_path(job.out, rank);
     std::error_code ec;
     std::filesystem::create_directories(ranks_folder(job.out), ec);
-    if (Result<bool> w = write_shard(mine, header, sums.histogram, sums.images); !w) return report(w.error());
+    if (Result<bool> w = write_shard(mine, header, sums); !w) return report(w.error());
     if (stopped->load())
       std::fprintf(stderr, "pathex: rank %d stopped after %s of its passes; they are kept in %s ('pathex trace --resume %s' finishes the render)\n",
                    rank, out->passes_done.to_string().c_str(), mine.c_str(), job.out.c_str());
@@ -409,6 +410,7 @@ int run(const TraceArgs& a) {
   if (job.resumed) {
     if (Result<bool> m = sums.histogram.merge(job.resumed->sums.histogram); !m) return report(m.error());
     if (Result<bool> m = sums.images.merge(job.resumed->sums.images); !m) return report(m.error());
+    for (std::size_t i = 0; i < sums.connectors.size(); ++i) sums.connectors[i] += job.resumed->sums.connectors[i];
     header.passes.add(job.resumed->header.passes);
     header.run.time_s += job.resumed->header.run.time_s;
     header.run.rays += job.resumed->header.run.rays;
@@ -421,7 +423,7 @@ int run(const TraceArgs& a) {
   if (rank == 0) {
     const SignalShield shield;
     Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
-      Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, out->connectors, pruning->changes);
+      Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, pruning->changes);
       if (!r) return r.error();
       written = std::move(*r);
       if (missed)  // what pathex bias writes to bias.json, without images
@@ -488,16 +490,16 @@ int run(const TraceArgs& a) {
               << absolute(c.estimate) << "\n";
     if (!c.strategies.empty()) std::cout << "  from " << techniques_text(c.strategies, 3) << "\n";
   }
-  if (!out->connectors.empty()) {
+  if (!sums.connectors.empty()) {  // the render's: with the resumed and the other ranks' passes
     int width = 10;
-    for (const ConnectorStats& c : out->connectors) width = std::max(width, static_cast<int>(c.strategy.size()));
+    for (const ConnectorStats& c : sums.connectors) width = std::max(width, static_cast<int>(c.strategy.size()));
     std::cout << "\n" << std::left << std::setw(width + 2) << "connectors" << std::right
               << "  attempts  successes   outside  occluded  no transport\n";
-    for (const ConnectorStats& c : out->connectors)
+    for (const ConnectorStats& c : sums.connectors)
       std::cout << "  " << std::left << std::setw(width) << c.strategy << std::right << std::setw(10) << c.attempts
                 << std::setw(11) << c.successes << std::setw(10) << c.outside << std::setw(10) << c.occluded
                 << std::setw(14) << c.no_transport << "   (" << c.connector << ")\n";
-    for (const ConnectorStats& c : out->connectors)
+    for (const ConnectorStats& c : sums.connectors)
       if (c.connector == "manifold")
         std::cout << "  " << c.strategy << " (manifold): no solution " << c.no_solution << ", singular " << c.singular
                   << ", wrong type " << c.wrong_type << ", too short " << c.too_short << ", iteration limit "

@@ -15,6 +15,8 @@
 #include <string_view>
 
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include "io/atomic_file.h"
 #include "io/json_reader.h"
@@ -35,6 +37,11 @@ constexpr std::uint64_t kMaxReservedInAll = std::uint64_t{1} << 19;  // for all 
 // A tile's pixels (ClassImages: six words each, the low and high word of R, G and B).
 constexpr std::size_t kTilePixels = ClassImages::kTile * ClassImages::kTile;
 static_assert(kTilePixels == 64 && ClassImages::kTileWords == 6 * kTilePixels);
+// Stored tiles per image frame: about 1 to 1.7 MB of body each (the merged 512 × 512 twenty-class
+// render has 60 such frames), so that a file's frames decode on every core.
+constexpr std::size_t kTilesPerFrame = 512;
+// The body's index: K, the K + 2 frames' sizes and the K image frames' first keys.
+constexpr std::size_t body_index_bytes(std::size_t image_frames) { return 4 + 8 * (image_frames + 2) + 8 * image_frames; }
 
 std::uint32_t crc32_of(const char* data, std::size_t n) {
   return static_cast<std::uint32_t>(
@@ -145,9 +152,12 @@ class Writer {
       at += n;
     }
   }
-  // Compresses what is left and ends the frame.
-  void finish() {
+  // Compresses what is left and ends the frame; what follows starts another. Its compressed size.
+  std::uint64_t end_frame() {
     compress(ZSTD_e_end);
+    const std::uint64_t n = size_ - frame_start_;
+    frame_start_ = size_;
+    return n;
   }
   std::uint64_t size() const { return size_; }  // compressed bytes so far
   std::uint32_t crc() const { return crc_; }    // their CRC-32
@@ -179,7 +189,7 @@ class Writer {
   std::vector<char> window_;
   std::vector<char> compressed_;  // one output block of the stream, reused
   std::size_t used_ = 0;
-  std::uint64_t size_ = 0;
+  std::uint64_t size_ = 0, frame_start_ = 0;
   std::uint32_t crc_ = 0;
 };
 
@@ -325,6 +335,9 @@ json identity_json(const RenderIdentity& id) {
   else
     j["options"]["manifold"] = nullptr;
   j["strategies"] = id.strategies;
+  json connectors = json::array();
+  for (const ConnectorStrategy& c : id.connectors) connectors.push_back({{"strategy", c.strategy}, {"connector", c.connector}});
+  j["connectors"] = std::move(connectors);
   return j;
 }
 
@@ -405,11 +418,11 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   HeaderFields rd(path);
   ShardHeader h;
   RenderIdentity& id = h.identity;
-  if (!rd.object(j, "", {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "spp",
-                         "share", "passes", "run"}))
+  if (!rd.object(j, "", {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "connectors",
+                         "spp", "share", "passes", "run"}))
     return *rd.error;
-  for (const char* key : {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "spp",
-                          "share", "passes", "run"})
+  for (const char* key : {"pathex", "scene", "renderer", "classes", "ends", "seed", "options", "strategies", "connectors",
+                          "spp", "share", "passes", "run"})
     if (!j.contains(key)) return rd.fail(std::string("/") + key, std::string("missing ") + key), *rd.error;
   id.pathex = rd.str(j, "", "pathex");
   // Objects of three strings: {name, file, hash} and the like.
@@ -463,6 +476,15 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   }
   if (!rd.error && (id.batches < 1 || id.batches > 1000000)) rd.fail("/options/batches", "expected 1 to 1000000 batches");
   id.strategies = rd.strings(j, "", "strategies");
+  if (const nlohmann::json& c = j.at("connectors"); !c.is_array()) {
+    rd.fail("/connectors", "expected an array of {strategy, connector}, found " + JsonReader::kind(c));
+  } else {
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const std::string ptr = "/connectors/" + std::to_string(i);
+      if (!rd.object(c[i], ptr, {"strategy", "connector"})) break;
+      id.connectors.push_back({rd.str(c[i], ptr, "strategy"), rd.str(c[i], ptr, "connector")});
+    }
+  }
   h.share = rd.passes(j, "share");
   h.passes = rd.passes(j, "passes");
   const nlohmann::json& r = j.at("run");
@@ -542,16 +564,20 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
     return std::optional<std::string>("another manifold setting (one runs the manifold connector, the other does not)");
   }
   // Derived from what the hashes cover; different only in a hand-made file.
-  if (a.strategies != b.strategies || a.lights != b.lights || a.sensor != b.sensor || a.classes_text != b.classes_text)
-    return std::optional<std::string>("another render description (strategies, end types or class text)");
+  if (a.strategies != b.strategies || a.connectors != b.connectors || a.lights != b.lights || a.sensor != b.sensor ||
+      a.classes_text != b.classes_text)
+    return std::optional<std::string>("another render description (strategies, connectors, end types or class text)");
   return std::nullopt;
 }
 
 namespace {
 
-// The file into `sink`, in order but for N, written over its placeholder at the end; the CRC-32 of
-// the whole is that of the prefix combined with the body's, which the Writer kept.
-void encode_shard_into(Sink& sink, const ShardHeader& header, const Histogram& h, const ClassImages& images) {
+// The file into `sink`, in order but for N and the body's index, written over their placeholders
+// at the end; the CRC-32 of the whole is that of the prefix and the index combined with the
+// frames', which the Writer kept.
+void encode_shard_into(Sink& sink, const ShardHeader& header, const RenderSums& state) {
+  const Histogram& h = state.histogram;
+  const ClassImages& images = state.images;
   json hj = identity_json(header.identity);
   hj["spp"] = header.spp;
   const auto passes_json = [](const PassSet& set) {
@@ -565,12 +591,25 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const Histogram& h
                {"cpu_s", header.run.cpu_s}};
   const std::string head = hj.dump(1) + "\n";
 
+  // The stored tiles (any nonzero word), in key order, and the image frames they fall into.
+  const std::size_t planes = images.num_planes(), tiles = images.num_tiles();
+  std::vector<std::pair<std::size_t, std::size_t>> stored;
+  for (std::size_t p = 0; p < planes; ++p)
+    for (std::size_t t = 0; t < tiles; ++t)
+      if (const std::uint64_t* words = images.tile_words(p, t);
+          words != nullptr && std::any_of(words, words + ClassImages::kTileWords, [](std::uint64_t v) { return v != 0; }))
+        stored.emplace_back(p, t);
+  const std::size_t frames = (stored.size() + kTilesPerFrame - 1) / kTilesPerFrame;
+
   std::string prefix(kMagic, sizeof kMagic);
   put_le<std::uint32_t>(prefix, kShardFormatVersion);
   put_le<std::uint32_t>(prefix, static_cast<std::uint32_t>(head.size()));
   prefix += head;
   put_le<std::uint64_t>(prefix, 0);  // N, once the body is written
   sink.append(prefix);
+  std::string index(body_index_bytes(frames), '\0');  // written again once the frames' sizes are known
+  sink.append(index);
+  std::vector<std::uint64_t> sizes;
   Writer w(&sink);
   // --- histogram ---
   for (int b = 0; b < h.num_batches(); ++b) w.u(h.batch_samples(b));
@@ -611,36 +650,47 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const Histogram& h
       }
     }
   }
-  // --- images ---
-  const std::size_t planes = images.num_planes(), tiles = images.num_tiles();
-  std::vector<std::pair<std::size_t, std::size_t>> stored;
-  for (std::size_t p = 0; p < planes; ++p)
-    for (std::size_t t = 0; t < tiles; ++t)
-      if (const std::uint64_t* words = images.tile_words(p, t);
-          words != nullptr && std::any_of(words, words + ClassImages::kTileWords, [](std::uint64_t v) { return v != 0; }))
-        stored.emplace_back(p, t);
-  w.u(planes);
-  w.u(tiles);
-  w.u(stored.size());
-  for (const auto& [p, t] : stored) {
-    w.u(p);
-    w.u(t);
-    const std::uint64_t* words = images.tile_words(p, t);
-    std::uint64_t mask = 0;  // the tile's pixels with a nonzero sum
-    for (std::size_t k = 0; k < kTilePixels; ++k)
-      if (std::any_of(words + 6 * k, words + 6 * k + 6, [](std::uint64_t v) { return v != 0; })) mask |= std::uint64_t{1} << k;
-    w.raw64(mask);
-    for (std::size_t k = 0; k < kTilePixels; ++k)
-      if (mask >> k & 1)
-        for (std::size_t c = 0; c < 6; c += 2) w.split(words[6 * k + c], words[6 * k + c + 1]);
+  sizes.push_back(w.end_frame());
+  // --- images, kTilesPerFrame stored tiles a frame ---
+  std::vector<std::uint64_t> first_keys;
+  for (std::size_t f = 0; f < frames; ++f) {
+    const std::size_t begin = f * kTilesPerFrame, end = std::min(stored.size(), begin + kTilesPerFrame);
+    first_keys.push_back(stored[begin].first * tiles + stored[begin].second);
+    w.u(planes);
+    w.u(tiles);
+    w.u(end - begin);
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto [p, t] = stored[i];
+      w.u(p);
+      w.u(t);
+      const std::uint64_t* words = images.tile_words(p, t);
+      std::uint64_t mask = 0;  // the tile's pixels with a nonzero sum
+      for (std::size_t k = 0; k < kTilePixels; ++k)
+        if (std::any_of(words + 6 * k, words + 6 * k + 6, [](std::uint64_t v) { return v != 0; })) mask |= std::uint64_t{1} << k;
+      w.raw64(mask);
+      for (std::size_t k = 0; k < kTilePixels; ++k)
+        if (mask >> k & 1)
+          for (std::size_t c = 0; c < 6; c += 2) w.split(words[6 * k + c], words[6 * k + c + 1]);
+    }
+    sizes.push_back(w.end_frame());
   }
-  w.finish();
+  // --- connector statistics ---
+  w.u(state.connectors.size());
+  for (const ConnectorStats& c : state.connectors)
+    for (const std::uint64_t* count : ConnectorStats::counts_of(c)) w.u(*count);
+  sizes.push_back(w.end_frame());
+
+  index.clear();
+  put_le<std::uint32_t>(index, static_cast<std::uint32_t>(frames));
+  for (std::uint64_t n : sizes) put_le<std::uint64_t>(index, n);
+  for (std::uint64_t k : first_keys) put_le<std::uint64_t>(index, k);
+  sink.write_at(prefix.size(), index);
   std::string n;
-  put_le<std::uint64_t>(n, w.size());
+  put_le<std::uint64_t>(n, index.size() + w.size());
   prefix.replace(prefix.size() - 8, 8, n);
   sink.write_at(prefix.size() - 8, n);
   const auto crc = static_cast<std::uint32_t>(
-      crc32_combine(crc32_of(prefix.data(), prefix.size()), w.crc(), static_cast<z_off_t>(w.size())));
+      crc32_combine(crc32_of((prefix + index).data(), prefix.size() + index.size()), w.crc(), static_cast<z_off_t>(w.size())));
   std::string tail;
   put_le<std::uint32_t>(tail, crc);
   sink.append(tail);
@@ -648,17 +698,17 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const Histogram& h
 
 }  // namespace
 
-std::string encode_shard(const ShardHeader& header, const Histogram& h, const ClassImages& images) {
+std::string encode_shard(const ShardHeader& header, const RenderSums& sums) {
   std::string out;
   StringSink sink(&out);
-  encode_shard_into(sink, header, h, images);
+  encode_shard_into(sink, header, sums);
   return out;
 }
 
-Result<bool> write_shard(const std::string& path, const ShardHeader& header, const Histogram& h, const ClassImages& images) {
+Result<bool> write_shard(const std::string& path, const ShardHeader& header, const RenderSums& sums) {
   AtomicFile file(path);
   FileSink sink(&file);
-  if (file.ok()) encode_shard_into(sink, header, h, images);
+  if (file.ok()) encode_shard_into(sink, header, sums);
   return file.commit();
 }
 
@@ -706,19 +756,26 @@ Result<ShardFile> read_shard(const std::string& path, std::string buffer) {
   if (!in) return file_error(path, "cannot open the shard file");
   const std::streamoff size = in.tellg();
   std::string bytes = std::move(buffer);
-  bytes.resize(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)));
+  const auto n = static_cast<std::size_t>(std::max<std::streamoff>(size, 0));
+  if (n > bytes.capacity()) {
+    // Room for files a little larger than this one too (the shards of a render differ in size by
+    // a fraction of a percent), so that the buffer passed on to read the next is not reallocated
+    // into fresh pages; the old contents are not copied.
+    bytes.clear();
+    bytes.reserve(n + n / 16);
+  }
+  bytes.resize(n);
   in.seekg(0);
   if (size < 0 || !in.read(bytes.data(), size)) return file_error(path, "cannot read the shard file");
   return parse_shard(std::move(bytes), path);
 }
 
-Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* images, std::size_t files) {
-  const RenderIdentity& id = f.header.identity;
-  if (h->num_batches() != id.batches || h->layout().strategies != id.strategies)
-    return file_error(f.path, "the shard's histogram layout (batches, strategies) is not the merge's");
-  Reader r(f.bytes.data() + f.body_offset, f.body_size);
-  const auto bad = [&](const std::string& what) { return file_error(f.path, "malformed shard body: " + what); };
-  // --- histogram ---
+namespace {
+
+using BadBody = std::optional<std::string>;  // what is wrong with a frame, if anything
+
+// The histogram frame, added to `h`.
+BadBody add_histogram(Reader& r, Histogram* h, std::size_t files) {
   const int B = h->num_batches(), S = h->num_strategies();
   std::vector<ExactSum> technique_sums(static_cast<std::size_t>(B));
   for (int b = 0; b < B; ++b) h->add_samples(b, r.u());
@@ -746,43 +803,50 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
   for (std::uint64_t i = 0; i < paths && !r.failed(); ++i) {
     const std::string_view path = r.text();
     if (r.failed()) break;
-    const Histogram::PathId id_ = h->intern(path);
+    const Histogram::PathId id = h->intern(path);
     const std::uint64_t cells = r.u();
-    if (cells > static_cast<std::uint64_t>(B)) return bad("path \"" + std::string(path) + "\" holds more cells than batches");
+    if (cells > static_cast<std::uint64_t>(B)) return "path \"" + std::string(path) + "\" holds more cells than batches";
     std::uint64_t b1 = 0;  // one past the previous held batch
     for (std::uint64_t k = 0; k < cells && !r.failed(); ++k) {
-      if (!next_batch(b1)) return bad("a cell of path \"" + std::string(path) + "\" is past the last batch");
+      if (!next_batch(b1)) return "a cell of path \"" + std::string(path) + "\" is past the last batch";
       const std::uint64_t n = r.u();
-      h->add_cell(id_, static_cast<int>(b1 - 1), r.rgb(), n);
+      h->add_cell(id, static_cast<int>(b1 - 1), r.rgb(), n);
     }
     const std::uint64_t rows = r.u();
     for (std::uint64_t k = 0; k < rows && !r.failed(); ++k) {
       const std::uint64_t code = r.u(), n = r.u(), sums = r.u();
-      if (sums > static_cast<std::uint64_t>(B)) return bad("a technique of path \"" + std::string(path) + "\" holds more sums than batches");
+      if (sums > static_cast<std::uint64_t>(B)) return "a technique of path \"" + std::string(path) + "\" holds more sums than batches";
       std::fill(technique_sums.begin(), technique_sums.end(), ExactSum{0});
       b1 = 0;
       for (std::uint64_t j = 0; j < sums && !r.failed(); ++j) {
-        if (!next_batch(b1)) return bad("a technique sum of path \"" + std::string(path) + "\" is past the last batch");
+        if (!next_batch(b1)) return "a technique sum of path \"" + std::string(path) + "\" is past the last batch";
         technique_sums[static_cast<std::size_t>(b1 - 1)] = r.x();
       }
       if (r.failed()) break;
       if (code >= (std::uint64_t{1} << 29) || Technique::from_code(static_cast<int>(code)).strategy >= S)
-        return bad("a technique of path \"" + std::string(path) + "\" names no strategy of the render");
-      h->add_technique(id_, static_cast<int>(code), n, technique_sums.data());
+        return "a technique of path \"" + std::string(path) + "\" names no strategy of the render";
+      h->add_technique(id, static_cast<int>(code), n, technique_sums.data());
     }
   }
-  if (r.failed()) return bad("the histogram ends early");
-  // --- images ---
+  if (r.failed()) return "the histogram ends early";
+  if (!r.at_end()) return "bytes after the histogram";
+  return std::nullopt;
+}
+
+// An image frame, added to `images`: its tiles' keys (plane × tiles + tile) are increasing and in
+// [first, end), which the index keeps apart from every other frame's, so that frames add at once.
+BadBody add_image_frame(Reader& r, ClassImages* images, std::uint64_t first, std::uint64_t end) {
   const std::uint64_t planes = r.u(), tiles = r.u(), stored = r.u();
-  if (r.failed()) return bad("the image section ends early");
-  if (stored > 0 && (planes != images->num_planes() || tiles != images->num_tiles()))
-    return bad("its images have " + std::to_string(planes) + " planes of " + std::to_string(tiles) +
-               " tiles; the merge's have " + std::to_string(images->num_planes()) + " of " +
-               std::to_string(images->num_tiles()));
+  if (r.failed()) return "an image frame ends early";
+  if (planes != images->num_planes() || tiles != images->num_tiles())
+    return "its images have " + std::to_string(planes) + " planes of " + std::to_string(tiles) + " tiles; the merge's have " +
+           std::to_string(images->num_planes()) + " of " + std::to_string(images->num_tiles());
   std::array<std::uint64_t, ClassImages::kTileWords> words;
-  for (std::uint64_t i = 0; i < stored; ++i) {
+  for (std::uint64_t i = 0, next = first; i < stored; ++i) {
     const std::uint64_t p = r.u(), t = r.u();
-    if (r.failed() || p >= planes || t >= tiles) return bad("a stored tile is out of range");
+    if (r.failed() || p >= planes || t >= tiles || p * tiles + t < next || p * tiles + t >= end)
+      return "a stored tile is out of its frame's range or order";
+    next = p * tiles + t + 1;
     const std::uint64_t mask = r.raw64();
     for (std::size_t k = 0; k < kTilePixels; ++k) {
       std::uint64_t* px = words.data() + 6 * k;
@@ -792,10 +856,87 @@ Result<bool> add_shard_sums(const ShardFile& f, Histogram* h, ClassImages* image
         std::fill(px, px + 6, std::uint64_t{0});
       }
     }
-    if (r.failed()) return bad("the image section ends early");
+    if (r.failed()) return "an image frame ends early";
     images->add_tile(static_cast<std::size_t>(p), static_cast<std::size_t>(t), words.data());
   }
-  if (!r.at_end()) return bad("bytes after the image section");
+  if (!r.at_end()) return "bytes after an image frame's tiles";
+  return std::nullopt;
+}
+
+// The connector frame, added to `connectors`.
+BadBody add_connector_counts(Reader& r, std::vector<ConnectorStats>* connectors) {
+  const std::uint64_t n = r.u();
+  if (r.failed()) return "the connector section ends early";
+  if (n != connectors->size())
+    return "it counts " + std::to_string(n) + " connector strategies; its header names " + std::to_string(connectors->size());
+  std::array<std::uint64_t, ConnectorStats::kCounts> counts;
+  for (ConnectorStats& c : *connectors) {
+    for (std::uint64_t& k : counts) k = r.u();
+    if (r.failed()) return "the connector section ends early";
+    const auto to = ConnectorStats::counts_of(c);
+    for (std::size_t i = 0; i < counts.size(); ++i) *to[i] += counts[i];
+  }
+  if (!r.at_end()) return "bytes after the connector section";
+  return std::nullopt;
+}
+
+}  // namespace
+
+Result<bool> add_shard_sums(const ShardFile& f, RenderSums* state, std::size_t files) {
+  const RenderIdentity& id = f.header.identity;
+  Histogram* h = &state->histogram;
+  ClassImages* images = &state->images;
+  if (h->num_batches() != id.batches || h->layout().strategies != id.strategies)
+    return file_error(f.path, "the shard's histogram layout (batches, strategies) is not the merge's");
+  const auto same_connectors = [&] {
+    if (state->connectors.size() != id.connectors.size()) return false;
+    for (std::size_t i = 0; i < id.connectors.size(); ++i)
+      if (state->connectors[i].strategy != id.connectors[i].strategy || state->connectors[i].connector != id.connectors[i].connector)
+        return false;
+    return true;
+  };
+  if (!same_connectors()) return file_error(f.path, "the shard's connector strategies are not the merge's");
+  const auto bad = [&](const std::string& what) { return file_error(f.path, "malformed shard body: " + what); };
+  // --- the index: every frame's place, and the image frames' key ranges ---
+  const std::size_t at = f.body_offset, size = f.body_size;
+  if (size < 4) return bad("no index");
+  const std::uint64_t frames = get_le<std::uint32_t>(f.bytes, at);
+  if (body_index_bytes(frames) > size) return bad("its index is longer than the body");
+  const std::uint64_t key_end = static_cast<std::uint64_t>(images->num_planes()) * images->num_tiles();
+  std::vector<std::uint64_t> starts, keys;  // each frame's offset in the file; each image frame's first key
+  std::uint64_t offset = at + body_index_bytes(frames);
+  for (std::uint64_t i = 0; i < frames + 2; ++i) {
+    starts.push_back(offset);
+    const std::uint64_t n = get_le<std::uint64_t>(f.bytes, at + 4 + 8 * i);
+    if (n > at + size - offset) return bad("its frames are longer than the body");
+    offset += n;
+  }
+  if (offset != at + size) return bad("bytes after its last frame");
+  starts.push_back(offset);
+  for (std::uint64_t i = 0; i < frames; ++i) {
+    keys.push_back(get_le<std::uint64_t>(f.bytes, at + 4 + 8 * (frames + 2) + 8 * i));
+    if (keys.back() >= key_end || (i > 0 && keys.back() <= keys[i - 1])) return bad("its image frames' keys are not increasing");
+  }
+  keys.push_back(key_end);
+  const auto frame = [&](std::size_t i) { return Reader(f.bytes.data() + starts[i], starts[i + 1] - starts[i]); };
+  // --- the histogram, and the image frames at once (on other threads: disjoint tiles) ---
+  BadBody histogram_error;
+  std::vector<BadBody> image_errors(frames);
+  tbb::task_group group;
+  group.run([&] {
+    Reader r = frame(0);
+    histogram_error = add_histogram(r, h, files);
+  });
+  tbb::parallel_for(std::size_t{0}, static_cast<std::size_t>(frames), [&](std::size_t i) {
+    Reader r = frame(1 + i);
+    image_errors[i] = add_image_frame(r, images, keys[i], keys[i + 1]);
+  });
+  group.wait();
+  if (histogram_error) return bad(*histogram_error);
+  for (const BadBody& e : image_errors)
+    if (e) return bad(*e);
+  Reader r = frame(frames + 1);
+  if (BadBody e = add_connector_counts(r, &state->connectors)) return bad(*e);
   return true;
 }
 

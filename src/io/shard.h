@@ -7,17 +7,18 @@
 // exact integer sums (classify/histogram.h, classify/image.h), which add. A shard file holds those
 // sums, not the floats of the outputs.
 //
-// File layout, version 4 (all integers little-endian; version 1 had the body uncompressed, version
+// File layout, version 5 (all integers little-endian; version 1 had the body uncompressed, version
 // 2 per-strategy sums in place of the technique rows, version 3 every batch of every cell and row
-// and every pixel of a stored tile as varints):
+// and every pixel of a stored tile as varints, version 4 one zstd frame for the whole body and no
+// connector statistics):
 //
 //   offset  size  what
 //   0       8     magic "PXSHARD\n"
-//   8       4     format version (4)
+//   8       4     format version (5)
 //   12      4     H: header length in bytes
 //   16      H     header: a JSON object (UTF-8), keys below
 //   16+H    8     N: body length in bytes
-//   24+H    N     body: the exact sums, encoded as below, compressed as one zstd frame (any level;
+//   24+H    N     body: an index, then the exact sums encoded as below in zstd frames (any level;
 //                 pathex writes its fast level -3)
 //   24+H+N  4     CRC-32 (ISO-HDLC, zlib's crc32) of every byte before it
 //
@@ -30,13 +31,21 @@
 // file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
 // {max_bounces, sampler, rr_depth, rr_threshold, batches, width, height, images, max_paths, manifold (null, or the
-// manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials})}, "strategies" [names], "share" and
+// manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds})}, "strategies" [names],
+// "connectors" [{strategy, connector}] (the strategies that run a connector, in the profile's order,
+// with the connector's name: "mirror", "distant-projection", "ortho-projection", "manifold"), "share" and
 // "passes" (each [[first, last), …]: the passes the run was asked for, and those whose sums this
 // file holds), "run" {time_s, threads, rays}.
 //
-// Body, in this order. `u` is an unsigned LEB128 varint; `x` is a 128-bit fixed-point sum
+// Body. First its index, uncompressed: 4 bytes K, the number of image frames; (K + 2) × 8 bytes,
+// the compressed size of each frame in order (the histogram frame, the K image frames, the
+// connector frame), which fill the rest of the body; K × 8 bytes, each image frame's first tile
+// key (plane × tiles per plane + tile), increasing: a frame's tiles have keys from its first key
+// to below the next frame's (the last: below planes × tiles), so frames hold disjoint tiles and
+// are decoded at once, on every core, with the histogram frame. Then the frames, each one zstd
+// frame of the encoding below. `u` is an unsigned LEB128 varint; `x` is a 128-bit fixed-point sum
 // zigzag-encoded ((v << 1) ^ (v >> 127), arithmetic shift) as an unsigned LEB128 varint, so zero
-// is one byte and a typical sum (64 fraction bits) nine or ten. The body is decoded as it is
+// is one byte and a typical sum (64 fraction bits) nine or ten. A frame is decoded as it is
 // decompressed, a window of 1 MiB at a time, so a file cannot make pathex allocate more than its
 // sums take; a path string is at most 512 KiB.
 //   histogram: B × u batch samples, u non-finite count, x magnitude, u number of paths P, u number of
@@ -48,12 +57,18 @@
 //              the batch's distance after the previous one listed minus one (the first: its
 //              index), so that batches come in order and below B (B from the header); a shard
 //              of one pass holds one batch per cell list.
-//   images:    u planes, u tiles per plane, u number of stored tiles T; then per tile, by plane
-//              then tile: u plane, u tile, 8 bytes: the mask of its 8 × 8 pixels (bit i: pixel i
+//   images:    (each image frame; pathex writes 512 stored tiles a frame) u planes, u tiles per
+//              plane, u number of stored tiles T in the frame; then per tile, by key: u plane, u tile, 8 bytes: the mask of its 8 × 8 pixels (bit i: pixel i
 //              of the tile, row-major) with a nonzero sum; per pixel of the mask, per channel, the
 //              sum's low 64-bit word as 8 raw bytes, then its high word as the zigzag varint of a
 //              signed 64-bit integer (one byte for sums below 64: most). Tiles with nothing in
 //              them are not stored. Raw words decode with a load where a varint took ten steps.
+//   connectors: (the last frame) u number of connector strategies C (the header's "connectors"), then per connector,
+//              in the header's order, 14 × u: the counts of histogram.json's "connectors" (exact
+//              integer sums over samples): attempts, successes, outside, occluded, no_transport,
+//              no_solution, singular, wrong_type, too_short, iteration_limit, walks (chains handed
+//              to the Newton solver), iterations (their Newton iterations in all), repeats, truncated
+//              (ConnectorStats::counts_of's order, trace/render.h).
 #pragma once
 
 #include <cstdint>
@@ -66,10 +81,18 @@
 #include "core/error.h"
 #include "core/pass_set.h"
 #include "trace/joins/manifold.h"
+#include "trace/render.h"
 
 namespace pathex {
 
-inline constexpr std::uint32_t kShardFormatVersion = 4;
+// A strategy of the render that runs a connector (histogram.json "connectors": strategy, connector).
+struct ConnectorStrategy {
+  std::string strategy;   // the profile's name for it (one of RenderIdentity::strategies)
+  std::string connector;  // to_string(ConnectorKind): "mirror", "distant-projection", …
+  bool operator==(const ConnectorStrategy&) const = default;
+};
+
+inline constexpr std::uint32_t kShardFormatVersion = 5;
 inline constexpr const char* kShardExtension = ".shard";
 
 // What must agree for two renders to merge: all but the names and files (the same scene, profile
@@ -102,6 +125,7 @@ struct RenderIdentity {
   // otherwise (they change nothing then).
   std::optional<ManifoldOptions> manifold;
   std::vector<std::string> strategies;  // the histogram's strategy names
+  std::vector<ConnectorStrategy> connectors;  // those of them that run a connector, in order
   bool operator==(const RenderIdentity&) const = default;
 };
 
@@ -125,12 +149,19 @@ struct ShardHeader {
   ShardRun run;
 };
 
-// The file's bytes. `histogram` and `images` hold the sums of exactly `header.passes`.
-std::string encode_shard(const ShardHeader& header, const Histogram& histogram, const ClassImages& images);
+// A render's exact state, what a shard file holds: every field a sum over the passes it took.
+struct RenderSums {
+  Histogram histogram;
+  ClassImages images;
+  std::vector<ConnectorStats> connectors;  // one per RenderIdentity::connectors, in its order
+};
+
+// The file's bytes. `sums` hold the sums of exactly `header.passes`; their connector statistics
+// are those of header.identity.connectors.
+std::string encode_shard(const ShardHeader& header, const RenderSums& sums);
 // The same bytes written to `path` as they are encoded (whole or not at all: io/atomic_file.h),
 // without holding the file in memory.
-Result<bool> write_shard(const std::string& path, const ShardHeader& header, const Histogram& histogram,
-                         const ClassImages& images);
+Result<bool> write_shard(const std::string& path, const ShardHeader& header, const RenderSums& sums);
 
 // A shard file checked (length, CRC) and its header parsed; the body is decoded by add_shard_sums.
 struct ShardFile {
@@ -147,12 +178,12 @@ Result<ShardFile> parse_shard(std::string bytes, const std::string& path);
 // mapped: a merge of 16 files of 11 MB spent 0.45 s of CPU faulting in fresh ones).
 Result<ShardFile> read_shard(const std::string& path, std::string buffer = {});
 
-// Adds the file's sums to `histogram` and `images`, which must have the file's layout: the
-// histogram's batches and strategies, the images' size and planes (built from the same classes).
+// Adds the file's sums to `sums`, which must have the file's layout: the histogram's batches and
+// strategies, the images' size and planes (built from the same classes), the connectors' names.
 // `files`: how many files of the same render the caller will add in all (this one included): the
 // histogram makes room ahead for that many times this file's paths and rows (address space
 // only, capped; pages are touched by the paths that come), so that adding the others does not
 // move its batch rows again and again.
-Result<bool> add_shard_sums(const ShardFile& file, Histogram* histogram, ClassImages* images, std::size_t files = 1);
+Result<bool> add_shard_sums(const ShardFile& file, RenderSums* sums, std::size_t files = 1);
 
 }  // namespace pathex

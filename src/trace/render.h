@@ -25,12 +25,14 @@
 // sums are exact (classify/histogram.h), so results are bit-identical whatever the thread count.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "classify/classifier.h"
@@ -99,22 +101,20 @@ struct ConnectorStats {
   std::uint64_t repeats = 0;     // seeds of a first batch that solved to a chain already found in it
   std::uint64_t truncated = 0;   // chains not found again within max_trials seeds (their weight is low)
 
-  // Adds another thread's counts (the names stay this one's).
+  // The counts, in a fixed order (the shard file's, io/shard.h, and the MPI reduction's). Each is
+  // a sum over samples, and a sample's counts depend on (seed, pixel, pass) alone, so the counts
+  // of a render are those of its threads, shards, resumed parts or MPI ranks added.
+  static constexpr std::size_t kCounts = 14;
+  template <class Self>  // ConnectorStats or const ConnectorStats
+  static std::array<decltype(&std::declval<Self&>().attempts), kCounts> counts_of(Self& s) {
+    return {&s.attempts,  &s.successes,  &s.outside,  &s.occluded,        &s.no_transport, &s.no_solution, &s.singular,
+            &s.wrong_type, &s.too_short, &s.iteration_limit, &s.walks, &s.iterations,   &s.repeats,     &s.truncated};
+  }
+  // Adds another thread's (or shard's) counts; the names stay this one's.
   ConnectorStats& operator+=(const ConnectorStats& o) {
-    attempts += o.attempts;
-    successes += o.successes;
-    outside += o.outside;
-    occluded += o.occluded;
-    no_transport += o.no_transport;
-    no_solution += o.no_solution;
-    singular += o.singular;
-    wrong_type += o.wrong_type;
-    too_short += o.too_short;
-    iteration_limit += o.iteration_limit;
-    walks += o.walks;
-    iterations += o.iterations;
-    repeats += o.repeats;
-    truncated += o.truncated;
+    const auto to = counts_of(*this);
+    const auto from = counts_of(o);
+    for (std::size_t i = 0; i < kCounts; ++i) *to[i] += *from[i];
     return *this;
   }
 };

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -46,16 +47,39 @@ nlohmann::json histogram(const std::string& d) { return nlohmann::json::parse(re
 struct Case {
   std::string scene;
   std::string renderer;
+  bool connector = false;  // the profile runs a connector on this scene: its statistics merge too
+  std::string options = "";  // more options of the render
 };
+void PrintTo(const Case& c, std::ostream* os) { *os << c.scene << " " << c.renderer << c.options; }
+
+// A render's connector statistics, which must be nonzero for their merge to test anything.
+void expect_connector_work(const std::string& d, const std::string& what) {
+  const nlohmann::json h = histogram(d);
+  ASSERT_TRUE(h.contains("connectors")) << what;
+  ASSERT_FALSE(h["connectors"].empty()) << what;
+  for (const auto& c : h["connectors"]) {
+    EXPECT_GT(c["attempts"].get<std::uint64_t>(), 0u) << what << " " << c.dump();
+    EXPECT_GT(c["successes"].get<std::uint64_t>(), 0u) << what << " " << c.dump();
+  }
+}
+
+// The connector table of `pathex trace`'s terminal output (from its "connectors" line to the
+// blank line after it): the render's statistics, whatever parts it was rendered in.
+std::string connector_table(const std::string& out) {
+  const std::size_t at = out.find("\nconnectors ");
+  if (at == std::string::npos) return "(no connector table)";
+  return out.substr(at, out.find("\n\n", at + 1) - at);
+}
 
 class ShardsMerge : public testing::TestWithParam<Case> {};
 
 TEST_P(ShardsMerge, IntoTheBytesOfOneRender) {
   const Case& c = GetParam();
-  const std::string args = "trace samples/scenes/" + c.scene + ".json --renderer " + c.renderer + " --spp 7 --seed 3 --quiet";
+  const std::string args = "trace samples/scenes/" + c.scene + ".json --renderer " + c.renderer + " --spp 7 --seed 3 --quiet" + c.options;
   const std::string single = dir("single");
   const CliRun s = run_pathex(args + " --out " + single);
   ASSERT_EQ(s.code, 0) << s.err;
+  if (c.connector) expect_connector_work(single, c.scene + " " + c.renderer);
   for (int n : {1, 2, 3, 7}) {
     std::string shards;
     for (int i = 0; i < n; ++i) {
@@ -80,13 +104,19 @@ std::vector<Case> cases() {
   for (const char* scene : {"closed-sphere-emitting", "closed-sphere-point", "cornell", "laser", "mirror-ortho", "point-glass",
                             "point-mirror-caustic", "point-plane", "spotmeter-caustic", "sun-window"})
     for (const char* renderer : {"bdpt", "pt-nee"}) out.push_back({scene, renderer});
+  // Every connector, and a real integrator's profile that uses one (histogram.json "connectors").
+  out.push_back({"point-mirror-caustic", "pt-nee+mirror", true});
+  out.push_back({"mirror-ortho", "bdpt+ortho", true});
+  out.push_back({"sun-window", "pt-nee+distant", true});
+  out.push_back({"sun-window", "pbrt-v4-path", true});
+  out.push_back({"point-glass", "pt-nee+manifold", true, " --resolution 24x24"});  // the manifold walks: 4x the cost per pixel
   return out;
 }
 
 INSTANTIATE_TEST_SUITE_P(SampleScenes, ShardsMerge, testing::ValuesIn(cases()), [](const auto& test) {
   std::string name = test.param.scene + "_" + test.param.renderer;
   for (char& ch : name)
-    if (ch == '-') ch = '_';
+    if (ch == '-' || ch == '+') ch = '_';
   return name;
 });
 
@@ -111,6 +141,22 @@ TEST(Resume, AnInterruptedRenderResumedIsTheUninterruptedRender) {
   ASSERT_EQ(rest.code, 0) << rest.err;
   expect_same_outputs(full, cut, "resumed");
   EXPECT_EQ(histogram(cut)["complete"], true);
+}
+
+// The connector statistics (histogram.json and the terminal table) are the whole render's too.
+TEST(Resume, ARenderWithAConnectorResumedIsTheUninterruptedRender) {
+  const std::string args = "trace samples/scenes/point-glass.json --renderer pt-nee+manifold --spp 12 --resolution 24x24";
+  const std::string full = dir("full"), cut = dir("cut");
+  const CliRun whole = run_pathex(args + " --out " + full);
+  ASSERT_EQ(whole.code, 0) << whole.err;
+  expect_connector_work(full, "uninterrupted");
+  ASSERT_EQ(run_pathex(args + " --quiet --time 0.000001 --out " + cut).code, 1);
+  EXPECT_EQ(histogram(cut)["spp"], 4);
+  const CliRun rest = run_pathex("trace --resume " + cut + " --threads 1");
+  ASSERT_EQ(rest.code, 0) << rest.err;
+  expect_same_outputs(full, cut, "resumed with a connector");
+  EXPECT_EQ(connector_table(rest.out), connector_table(whole.out));
+  EXPECT_NE(connector_table(whole.out).find("(manifold): no solution "), std::string::npos) << whole.out;
 }
 
 // Also: the resolution and the path table's bound come back from the folder.
@@ -231,6 +277,17 @@ TEST_F(MergeRefuses, AnotherPathexVersion) {
   expect_refusal(a_ + " " + b_, shard(b_) + " was rendered by another pathex version (0.0.1 (elsewhere) against " + mine + ")");
 }
 
+// A render's connector strategies follow from its profile and scene (both hashed), so only a
+// hand-made file has others; its statistics could not be added to the merge's.
+TEST_F(MergeRefuses, AnotherConnectorLayout) {
+  nlohmann::ordered_json j = read_header(shard(b_)).json;
+  ASSERT_TRUE(j["connectors"].empty());
+  j["connectors"] = {{{"strategy", j["strategies"][0]}, {"connector", "mirror"}}};
+  write_header(shard(b_), j);
+  expect_refusal(a_ + " " + b_, shard(b_) + " and " + shard(a_) +
+                                    " are not of one render: another render description (strategies, connectors, end types or class text)");
+}
+
 TEST_F(MergeRefuses, OverlappingPasses) {
   const std::string c = dir("c");
   ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/4 --quiet --out " + c).code, 0);  // passes 2-3, also in a
@@ -309,6 +366,20 @@ TEST(Mpi, ThreeRanksWriteTheBytesOfOneProcess) {
   for (const auto& e : fs::directory_iterator(ranks))
     if (e.path().extension() == ".shard") shards.push_back(e.path().filename().string());
   EXPECT_EQ(shards, std::vector<std::string>{"render.shard"});
+}
+
+// The ranks' connector statistics are reduced too: histogram.json and rank 0's table.
+TEST(Mpi, ThreeRanksWithAConnectorWriteTheBytesOfOneProcess) {
+  if (std::string(PATHEX_MPI_BINARY).empty()) GTEST_SKIP() << "pathex-mpi is not built (MPI was not found at configure time)";
+  const std::string args = " trace samples/scenes/point-glass.json --renderer pt-nee+manifold --resolution 24x24 --spp 9 --out ";
+  const std::string single = dir("single"), ranks = dir("ranks");
+  const CliRun one = run_pathex(args + single);
+  ASSERT_EQ(one.code, 0) << one.err;
+  expect_connector_work(single, "one process");
+  const CliRun r = run_mpirun("-n 3 " + pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks + " --threads 1");
+  ASSERT_EQ(r.code, 0) << r.out;
+  expect_same_outputs(single, ranks, "3 MPI ranks with a connector");
+  EXPECT_EQ(connector_table(r.out), connector_table(one.out));
 }
 
 TEST(Mpi, ADyingRankFailsTheRunAndTheOthersWorkIsKept) {

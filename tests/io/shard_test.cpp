@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <utility>
+
 #include <nlohmann/json.hpp>
 
 #include "core/pass_set.h"
@@ -49,60 +51,141 @@ struct Fixture {
   Fixture() {
     header.identity.pathex = "test";
     header.identity.strategies = {"a", "b"};
+    header.identity.connectors = {{"b", "mirror"}};
     header.identity.batches = 3;
     header.spp = 8;
     header.share = PassSet::range(0, 8);
     header.passes = PassSet::range(0, 4);
-    HistogramLayout layout{3, {"a", "b"}};
-    histogram = Histogram(layout);
-    const Histogram::PathId p = histogram.intern("LDDDSE"), q = histogram.intern("LSDDSE");
-    histogram.add(p, 0, Technique{0, 2, 2}.code(), {1.0, 2.0, 3.0});
-    histogram.add(p, 1, Technique{1, 1, 2, true}.code(), {4.0, 2.0, 3.0});
-    histogram.add(q, 2, Technique{1, 3, 1}.code(), {-0.5, 1e10, 1e-19});  // negative, large and tiny sums
-    histogram.add_samples(0, 5);
-    histogram.add_nonfinite(2);
-    images.add(3, 9, 0, *to_exact({0.25, 0.5, -1.0}));
+    Histogram& h = sums.histogram;
+    const Histogram::PathId p = h.intern("LDDDSE"), q = h.intern("LSDDSE");
+    h.add(p, 0, Technique{0, 2, 2}.code(), {1.0, 2.0, 3.0});
+    h.add(p, 1, Technique{1, 1, 2, true}.code(), {4.0, 2.0, 3.0});
+    h.add(q, 2, Technique{1, 3, 1}.code(), {-0.5, 1e10, 1e-19});  // negative, large and tiny sums
+    h.add_samples(0, 5);
+    h.add_nonfinite(2);
+    sums.images.add(3, 9, 0, *to_exact({0.25, 0.5, -1.0}));
+    ConnectorStats mirror{"b", "mirror"};
+    const auto counts = ConnectorStats::counts_of(mirror);
+    for (std::size_t i = 0; i < counts.size(); ++i) *counts[i] = 3 * i + 1;
+    mirror.iterations = std::uint64_t{1} << 60;  // a count needs all its bits
+    sums.connectors = {mirror};
+  }
+  // Empty sums laid out as these.
+  RenderSums empty() const {
+    std::vector<ConnectorStats> c;
+    for (const ConnectorStrategy& n : header.identity.connectors) c.push_back({n.strategy, n.connector});
+    return {Histogram(sums.histogram.layout()), ClassImages(10, 10, nullptr, {}), c};
   }
   ShardHeader header;
-  Histogram histogram;
-  ClassImages images{10, 10, nullptr, {}};
+  RenderSums sums{Histogram(HistogramLayout{3, {"a", "b"}}), ClassImages(10, 10, nullptr, {}), {}};
+  const Histogram& histogram = sums.histogram;
+  const ClassImages& images = sums.images;
 };
 
 TEST(ShardFile, RoundTripsTheExactSums) {
   Fixture f;
-  const std::string bytes = encode_shard(f.header, f.histogram, f.images);
+  const std::string bytes = encode_shard(f.header, f.sums);
   Result<ShardFile> file = parse_shard(bytes, "x.shard");
   ASSERT_TRUE(file) << file.error().render();
   EXPECT_EQ(file->header.passes, f.header.passes);
   EXPECT_EQ(file->header.identity, f.header.identity);
-  Histogram h(f.histogram.layout());
-  ClassImages im(10, 10, nullptr, {});
-  ASSERT_TRUE(add_shard_sums(*file, &h, &im));
+  RenderSums sums = f.empty();
+  ASSERT_TRUE(add_shard_sums(*file, &sums));
+  // Twice: the sums add, the connector counts too.
+  ASSERT_TRUE(add_shard_sums(*file, &sums));
+  const Histogram& h = sums.histogram;
+  const ClassImages& im = sums.images;
   ASSERT_EQ(h.num_paths(), 2);
   for (int p = 0; p < 2; ++p) {
     const Histogram::PathId id = *h.find(f.histogram.path(p));
     for (int b = 0; b < 3; ++b) {
-      EXPECT_EQ(h.cell(id, b).sum, f.histogram.cell(p, b).sum);
-      EXPECT_EQ(h.cell(id, b).contributions, f.histogram.cell(p, b).contributions);
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(h.cell(id, b).sum[c], 2 * f.histogram.cell(p, b).sum[c]);
+      EXPECT_EQ(h.cell(id, b).contributions, 2 * f.histogram.cell(p, b).contributions);
     }
     const std::vector<int> got = h.sorted_rows(id), want = f.histogram.sorted_rows(p);
     ASSERT_EQ(got.size(), want.size());
     for (std::size_t i = 0; i < got.size(); ++i) {
       EXPECT_EQ(h.row(got[i]).technique, f.histogram.row(want[i]).technique);
-      EXPECT_EQ(h.row(got[i]).contributions, f.histogram.row(want[i]).contributions);
-      for (int b = 0; b < 3; ++b) EXPECT_EQ(h.row_sum(got[i], b), f.histogram.row_sum(want[i], b));
+      EXPECT_EQ(h.row(got[i]).contributions, 2 * f.histogram.row(want[i]).contributions);
+      for (int b = 0; b < 3; ++b) EXPECT_EQ(h.row_sum(got[i], b), 2 * f.histogram.row_sum(want[i], b));
     }
   }
-  EXPECT_EQ(h.batch_samples(0), 5u);
-  EXPECT_EQ(h.nonfinite(), 2u);
-  EXPECT_EQ(h.magnitude(), f.histogram.magnitude());
-  EXPECT_EQ(im.sum(0, 3, 9), f.images.sum(0, 3, 9));
+  EXPECT_EQ(h.batch_samples(0), 10u);
+  EXPECT_EQ(h.nonfinite(), 4u);
+  const ExactRgb one = f.images.sum(0, 3, 9);
+  EXPECT_EQ(im.sum(0, 3, 9), (ExactRgb{2 * one[0], 2 * one[1], 2 * one[2]}));
   EXPECT_EQ(im.sum(0, 4, 9), ExactRgb{});
+  ASSERT_EQ(sums.connectors.size(), 1u);
+  EXPECT_EQ(sums.connectors[0].strategy, "b");
+  EXPECT_EQ(sums.connectors[0].connector, "mirror");
+  const auto got = ConnectorStats::counts_of(std::as_const(sums.connectors[0]));
+  const auto want = ConnectorStats::counts_of(f.sums.connectors[0]);
+  for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(*got[i], 2 * *want[i]) << i;
+  EXPECT_EQ(sums.connectors[0].iterations, std::uint64_t{1} << 61);
+}
+
+// A larger image is stored in several frames (512 tiles each), decoded at once: every tile's sums
+// come back, and frames whose key ranges are not increasing (so that two could add to one tile)
+// are refused.
+TEST(ShardFile, ImageFramesRoundTripAndMustNotOverlap) {
+  Fixture f;
+  const int w = 200, h = 200;  // 625 tiles of 8 x 8: two frames
+  RenderSums sums{Histogram(f.histogram.layout()), ClassImages(w, h, nullptr, {}), {{"b", "mirror"}}};
+  for (int y = 0; y < h; y += 3)
+    for (int x = 0; x < w; x += 5) sums.images.add(x, y, 0, *to_exact({0.5 + x, -0.25 * y, 1e-9}));
+  const std::string bytes = encode_shard(f.header, sums);
+  Result<ShardFile> file = parse_shard(bytes, "x.shard");
+  ASSERT_TRUE(file) << file.error().render();
+  const std::size_t body = file->body_offset;
+  ASSERT_EQ(static_cast<unsigned char>(bytes[body]), 2u);  // K, little-endian
+  RenderSums into{Histogram(f.histogram.layout()), ClassImages(w, h, nullptr, {}), {{"b", "mirror"}}};
+  ASSERT_TRUE(add_shard_sums(*file, &into)) << add_shard_sums(*file, &into).error().render();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) ASSERT_EQ(into.images.sum(0, x, y), sums.images.sum(0, x, y)) << x << " " << y;
+  // The second frame's first key set to the first's (the CRC made right again).
+  std::string bad = bytes;
+  const std::size_t keys = body + 4 + 8 * 4;
+  bad.replace(keys + 8, 8, bad.substr(keys, 8));
+  const auto crc = static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(bad.data()), static_cast<uInt>(bad.size() - 4)));
+  for (std::size_t i = 0; i < 4; ++i) bad[bad.size() - 4 + i] = static_cast<char>((crc >> (8 * i)) & 0xff);
+  Result<ShardFile> overlapping = parse_shard(bad, "y.shard");
+  ASSERT_TRUE(overlapping) << overlapping.error().render();
+  RenderSums again{Histogram(f.histogram.layout()), ClassImages(w, h, nullptr, {}), {{"b", "mirror"}}};
+  Result<bool> r = add_shard_sums(*overlapping, &again);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().render(), "y.shard: malformed shard body: its image frames' keys are not increasing");
+}
+
+// The connector statistics are laid out by the header's "connectors": sums laid out for others,
+// or a body that counts other connectors than its header names, are refused.
+TEST(ShardFile, ConnectorStatisticsOfAnotherLayoutAreRefused) {
+  Fixture f;
+  Result<ShardFile> file = parse_shard(encode_shard(f.header, f.sums), "x.shard");
+  ASSERT_TRUE(file) << file.error().render();
+  RenderSums other = f.empty();
+  other.connectors[0].connector = "manifold";
+  Result<bool> r = add_shard_sums(*file, &other);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().render(), "x.shard: the shard's connector strategies are not the merge's");
+  other = f.empty();
+  other.connectors.clear();
+  r = add_shard_sums(*file, &other);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().render(), "x.shard: the shard's connector strategies are not the merge's");
+  // A (hand-made) file whose body counts no connector where its header names one.
+  RenderSums none = f.empty();
+  none.connectors.clear();
+  Result<ShardFile> bad = parse_shard(encode_shard(f.header, none), "y.shard");
+  ASSERT_TRUE(bad) << bad.error().render();
+  RenderSums into = f.empty();
+  r = add_shard_sums(*bad, &into);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().render(), "y.shard: malformed shard body: it counts 0 connector strategies; its header names 1");
 }
 
 TEST(ShardFile, EveryTruncationAndEveryFlippedByteIsRefused) {
   Fixture f;
-  const std::string bytes = encode_shard(f.header, f.histogram, f.images);
+  const std::string bytes = encode_shard(f.header, f.sums);
   for (std::size_t n = 0; n < bytes.size(); ++n) {
     Result<ShardFile> file = parse_shard(bytes.substr(0, n), "x.shard");
     ASSERT_FALSE(file) << n;
@@ -121,7 +204,7 @@ TEST(ShardFile, EveryTruncationAndEveryFlippedByteIsRefused) {
   EXPECT_EQ(message("hello, world, not a shard"), "not a pathex shard file (it does not begin with \"PXSHARD\")");
   std::string v2 = bytes;
   v2[8] = 2;  // version 2 had per-strategy sums, not per-technique rows
-  EXPECT_EQ(message(v2), "shard file format version 2; this pathex reads version 4");
+  EXPECT_EQ(message(v2), "shard file format version 2; this pathex reads version 5");
   EXPECT_EQ(message(bytes + "x"), "corrupted shard file: 1 bytes after its checksum");
 }
 
@@ -141,7 +224,7 @@ std::string with_header(const std::string& bytes, const std::string& head) {
 // The header goes through the one JSON reader: a wrong value is refused at its JSON pointer.
 TEST(ShardFile, HeaderErrorsNameTheFileAndThePointer) {
   Fixture f;
-  const std::string bytes = encode_shard(f.header, f.histogram, f.images);
+  const std::string bytes = encode_shard(f.header, f.sums);
   std::uint32_t h = 0;
   for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
   const nlohmann::ordered_json head = nlohmann::ordered_json::parse(bytes.substr(16, h));

@@ -14,6 +14,7 @@
 //              gathered on rank 0;
 //   images     the union of the (plane, tile) pairs some rank touched (a bitwise-or reduction),
 //              then those tiles' words, in blocks of at most 4096 tiles (12 MiB);
+//   connectors the connector statistics' counts (ConnectorStats::counts_of), 64-bit sums;
 //   passes     gathered on rank 0 as [first, last) pairs.
 // Rank 0 contributes zeros and adds the reduced sums of the others into its own accumulators.
 #include <mpi.h>
@@ -274,6 +275,23 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
     if (rank_ == 0)
       for (std::size_t k = 0; k < n; ++k)
         im.add_tile(cells[at + k] / tiles, cells[at + k] % tiles, block.data() + k * ClassImages::kTileWords);
+  }
+
+  // --- the connector statistics: the same strategies on every rank, their counts summed ---
+  std::vector<Word> counts, total(sums->connectors.size() * ConnectorStats::kCounts);
+  for (const ConnectorStats& c : sums->connectors)
+    for (const std::uint64_t* n : ConnectorStats::counts_of(c)) counts.push_back(*n);
+  if (!counts.empty()) {
+    if (Result<bool> r = check(MPI_Reduce(counts.data(), total.data(), static_cast<int>(counts.size()), MPI_UINT64_T, MPI_SUM, 0,
+                                          MPI_COMM_WORLD),
+                               "reduce");
+        !r)
+      return r;
+    if (rank_ == 0)
+      for (std::size_t i = 0; i < sums->connectors.size(); ++i) {
+        const auto to = ConnectorStats::counts_of(sums->connectors[i]);
+        for (std::size_t k = 0; k < ConnectorStats::kCounts; ++k) *to[k] = total[i * ConnectorStats::kCounts + k];
+      }
   }
 
   // --- passes and run figures ---
