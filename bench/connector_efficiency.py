@@ -14,6 +14,12 @@ renderer's median efficiency over the first one's (DESIGN §8: Veach's efficienc
         --renderer pt-nee+mirror --renderer bdpt --renderer lt --spp 64 --rounds 5
 
 The last line says how many times more efficient the first renderer is than the best of the others.
+With --baseline OLD/pathex every renderer also runs with that binary, in the same rounds (labelled
+`@baseline`), and each line compares the renderer with its baseline; --only renders the class
+alone (`--only CLASS`) instead of taking it from a full render (`--classes`).
+
+    python3 bench/connector_efficiency.py build/pathex samples/scenes/point-glass.json LSDSSDDSE \
+        --renderer pt-nee+manifold --baseline /work/old-8eebe78/build/pathex --only --spp 16 --rounds 5
 """
 import argparse
 import json
@@ -43,30 +49,42 @@ def main():
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--max-bounces", type=int, default=8)
+    ap.add_argument("--baseline", help="another pathex binary: every renderer also runs with it")
+    ap.add_argument("--only", action="store_true", help="render with --only CLASS (default: the class of a full render)")
     args = ap.parse_args()
+    # (label, binary, renderer) per run
+    runs = [(r, args.pathex, r) for r in args.renderer]
+    if args.baseline:
+        runs = [x for r in args.renderer for x in ((r, args.pathex, r), (r + " @baseline", args.baseline, r))]
     with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
         json.dump({"classes": [{"name": "c", "expr": args.path_class}]}, f)
         classes = f.name
-    results = {r: [] for r in args.renderer}
+    results = {label: [] for label, _, _ in runs}
+    select = ["--only", args.path_class] if args.only else ["--classes", classes]
     try:
         for rnd in range(args.rounds):
-            order = args.renderer[rnd % len(args.renderer):] + args.renderer[:rnd % len(args.renderer)]
-            for r in order:
-                doc, cpu = run([args.pathex, "trace", args.scene, "--renderer", r, "--spp", str(args.spp), "--classes",
-                                classes, "--seed", str(rnd + 1), "--threads", "1", "--max-bounces", str(args.max_bounces),
-                                "--no-images", "--quiet", "--json"])
-                c = doc["classes"][0]
+            order = runs[rnd % len(runs):] + runs[:rnd % len(runs)]
+            for label, binary, r in order:
+                with tempfile.TemporaryDirectory() as out:  # each binary writes its own folder
+                    doc, cpu = run([binary, "trace", args.scene, "--renderer", r, "--spp", str(args.spp), *select,
+                                    "--seed", str(rnd + 1), "--threads", "1", "--max-bounces", str(args.max_bounces),
+                                    "--no-images", "--quiet", "--json", "--out", os.path.join(out, "o")])
+                c = [c for c in doc["classes"] if c["expr"] == args.path_class or c.get("name") == "c"][0]
                 se = c["stderr"]
-                results[r].append((c["luminance"], se, cpu, 1.0 / (se * se * cpu) if se else float("inf")))
+                results[label].append((c["luminance"], se, cpu, 1.0 / (se * se * cpu) if se else float("inf")))
     finally:
         os.unlink(classes)
     print(f"class {args.path_class} in {args.scene}, {args.spp} spp, {args.rounds} interleaved rounds, 1 thread")
     ref = statistics.median(x[3] for x in results[args.renderer[0]])
-    for r in args.renderer:
-        med = lambda i: statistics.median(x[i] for x in results[r])
+    for label, _, r in runs:
+        med = lambda i: statistics.median(x[i] for x in results[label])
         eff = med(3)
-        print(f"  {r:16s} estimate {med(0):.6g} ± {med(1):.3g}  CPU {med(2):.3f} s  efficiency {eff:.4g}"
+        print(f"  {label:16s} estimate {med(0):.6g} ± {med(1):.3g}  CPU {med(2):.3f} s  efficiency {eff:.4g}"
               f"  ({eff / ref:.3g} × {args.renderer[0]})")
+        if label.endswith(" @baseline"):
+            ratios = [n[3] / b[3] for n, b in zip(results[r], results[label])]
+            print(f"  {r} against its baseline: {statistics.median(ratios):.3g} × (median of the rounds' ratios, "
+                  f"{min(ratios):.3g}–{max(ratios):.3g})")
     if len(args.renderer) > 1:
         best = max(args.renderer[1:], key=lambda r: statistics.median(x[3] for x in results[r]))
         best_eff = statistics.median(x[3] for x in results[best])

@@ -338,6 +338,8 @@ class Integrator {
   void emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a, const Vertex& b,
                      const std::vector<ChainVertex>& chain, double weight) const;
   int manifold_of(int s, int t) const { return table_.at(s, ConnectorKind::kManifold, t); }
+  // The letters of the path a chain of m specular vertices between a (c(s), y(s-1)) and z(t-1) makes.
+  PathKey manifold_key(Thread& th, const Vertex& a, int s, int t, int m) const;
   // A seed chain from end `from` (the light end a when from_light, else the eye end b): the ray
   // towards a specular shape (drawn by seed_cdf_; a point on its area, or a direction in the cone
   // of a sphere), followed through every specular surface it meets (a mirror reflects; glass

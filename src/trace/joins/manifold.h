@@ -52,6 +52,7 @@ enum class ManifoldFailure : std::uint8_t {
   kWrongType,       // the solution reflects where the seed refracted, or the reverse
   kTooShort,        // a segment is shorter than min_segment of the scene's size
   kIterationLimit,  // not solved within max_iterations
+  kUnrequested,     // (the connector's, before solving) under --only, the chain's path is in no requested class
 };
 
 // One specular vertex of a chain: its surface and where it is.

@@ -9,6 +9,7 @@
 #include "trace/frame.h"
 #include "trace/integrator.h"
 #include "trace/joins/manifold.h"
+#include "trace/prune.h"
 
 namespace pathex::tracer {
 namespace {
@@ -156,6 +157,12 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
       w.failure = ManifoldFailure::kNoSolution;
       return w;
     }
+    // --only: a chain whose path is in no requested class is not solved (its seed still counts
+    // in the batches, so the requested chains' inverse probabilities are unchanged).
+    if (o_.only != nullptr && !o_.only->records(manifold_key(th, *a, s, t, static_cast<int>(chain.size())))) {
+      w.failure = ManifoldFailure::kUnrequested;
+      return w;
+    }
     ++stats.walks;
     w = solve_chain(chain, pa, pb, nb, scene_size_, o_.manifold);
     stats.iterations += static_cast<std::uint64_t>(w.iterations);
@@ -188,6 +195,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
       case ManifoldFailure::kWrongType: ++stats.wrong_type; continue;
       case ManifoldFailure::kTooShort: ++stats.too_short; continue;
       case ManifoldFailure::kIterationLimit: ++stats.iteration_limit; continue;
+      case ManifoldFailure::kUnrequested: ++stats.no_transport; continue;  // no light to the classes rendered
     }
     if (index_of(seed) >= 0) {
       ++stats.repeats;
@@ -214,6 +222,16 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   stats.truncated += left;  // weighed by the batches run, an underestimate of their inverse probability
   for (const ManifoldSolution& x : found)
     emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)));
+}
+
+PathKey Integrator::manifold_key(Thread& th, const Vertex& a, int s, int t, int m) const {
+  if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
+  // The letters: a's c(s) = D, the chain's c(s+1) … c(s+m) = S, b's c(s+m+1) = D.
+  const PathKey light_part = s == 1 ? letter_bit(a.pos_letter, 0) : th.light_mask & (bit(s) - 1);
+  PathKey key = light_part | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + m + 1)) & ~bit(s + m + 1)) |
+                static_cast<PathKey>(s + t + m + 2) << kLengthShift;
+  for (int i = 1; i <= m; ++i) key |= bit(s + i);
+  return key;
 }
 
 void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a_end, const Vertex& b_end,
@@ -261,12 +279,7 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     ++stats.no_transport;
     return;
   }
-  if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
-  // The letters: a's c(s) = D, the chain's c(s+1) … c(s+m) = S, b's c(s+m+1) = D.
-  const PathKey light_part = s == 1 ? letter_bit(a->pos_letter, 0) : th.light_mask & (bit(s) - 1);
-  PathKey key = light_part | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + m + 1)) & ~bit(s + m + 1)) |
-                static_cast<PathKey>(s + t + m + 2) << kLengthShift;
-  for (int i = 1; i <= m; ++i) key |= bit(s + i);
+  const PathKey key = manifold_key(th, *a, s, t, m);
   jr.set_connector(ConnectorKind::kManifold, s, t, strategy_index, key, contrib, m);  // b is a surface vertex: t >= 2, no eye0
   jr.segments[0] = Segment{a, &jr.chain_vertices[0]};
   for (int i = 1; i < m; ++i) jr.segments[static_cast<std::size_t>(i)] = Segment{&jr.chain_vertices[static_cast<std::size_t>(i - 1)], &jr.chain_vertices[static_cast<std::size_t>(i)]};
