@@ -94,6 +94,22 @@ inline std::optional<BsdfSample> sample(const Material& m, const glm::vec3& wo, 
                                         const glm::vec3& ng, float u_component, glm::vec2 u,
                                         TransportMode mode);
 
+// Which of sample()'s numbers a material reads: the component number (a mixture's pick, a
+// dielectric's choice between reflection and refraction) and the direction pair (every finite
+// lobe). sample() returns the same, bit for bit, whatever the unread numbers are
+// (Bsdf.SampleIgnoresTheNumbersItDoesNotRead), so a tracer need not compute them
+// (Sampler::get1d_if, trace/rng.h).
+struct NumbersRead {
+  bool component = true;
+  bool direction = true;
+};
+inline NumbersRead numbers_read(const Material& m) {
+  if (std::holds_alternative<Diffuse>(m) || std::holds_alternative<Glossy>(m)) return {false, true};
+  if (std::holds_alternative<Mirror>(m)) return {false, false};
+  if (std::holds_alternative<Dielectric>(m)) return {true, false};
+  return {true, true};  // a mixture
+}
+
 namespace detail {
 // Lambert needs no local frame: only the sides of the two directions (the tests reflection
 // in bsdf.cpp makes, on the same dot products, so both paths agree bit for bit) and |cos θi|.

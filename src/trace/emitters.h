@@ -302,6 +302,7 @@ glm::vec3 spatial_emission(const LightParams& l);
 float directional_emission(const LightParams& l, const glm::vec3& n, const glm::vec3& w);
 
 // Sensors. `raster` ∈ [0,1)² as above; u_lens is read by the thin lens only.
+inline bool reads_lens_numbers(const SensorParams& s) { return std::holds_alternative<ThinLensParams>(s); }
 std::optional<EndpointRay> sample_ray(const SensorParams& s, glm::vec2 raster, glm::vec2 u_lens);
 // Densities of the ray leaving `origin` (a point of the sensor) in `direction`.
 RayPdf pdf_ray(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction);

@@ -227,12 +227,15 @@ class Integrator {
   // ignore the point).
   // (u n lies in [0, n), far below 2^63: the signed conversion is exact and, unlike the unsigned
   // one, a single instruction.)
-  std::size_t pick_light(float u) const {
+  // (A lone light's pick and a non-area light's point read no number: Sampler::get1d_if.)
+  std::size_t pick_light(Sampler& rng) const {
+    const float u = rng.get1d_if(rs_.lights.size() > 1);
     const auto i = static_cast<std::int64_t>(u * static_cast<float>(rs_.lights.size()));
     return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(i));
   }
   // *error: the point's rounding-error bound (SurfaceSample::error), which offsets rays leaving it.
-  SurfacePoint sample_point(const RenderLight& l, glm::vec2 u2, vec3* error) const {
+  SurfacePoint sample_point(const RenderLight& l, Sampler& rng, vec3* error) const {
+    const glm::vec2 u2 = rng.get2d_if(l.is_area());
     *error = aperture_error(l);
     if (!l.is_area()) return {};
     const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, u2);

@@ -132,8 +132,9 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // --- scatter ---
     const Material& m = *rs_.material_of_shape[static_cast<std::size_t>(v.shape)];
     const vec3 wo = -d;
-    const float u_comp = rng.get1d();
-    const glm::vec2 u = rng.get2d();
+    const bsdf::NumbersRead reads = bsdf::numbers_read(m);  // the others are not computed
+    const float u_comp = rng.get1d_if(reads.component);
+    const glm::vec2 u = rng.get2d_if(reads.direction);
     const std::optional<BsdfSample> bs = bsdf::sample(m, wo, v.ns, v.n, u_comp, u, mode);
     if (!bs || is_black(bs->weight) || bs->pdf <= 0.0f) break;
     v.letter = letter_char(bs->letter);
@@ -151,8 +152,8 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // survives with probability throughput / threshold, and a survivor carries the threshold.
     if (mode == TransportMode::kRadiance && features_.transmission) eta2 *= bs->eta * bs->eta;  // else η = 1
     if (count >= o_.rr_depth && o_.rr_threshold > 0.0f) {
-      const float u_rr = rng.get1d();  // drawn at every vertex, so the dimensions stay aligned
       const float survive = max_component(beta) * eta2 / (beta_start * o_.rr_threshold);
+      const float u_rr = rng.get1d_if(survive < 1.0f);  // its dimension taken at every vertex, so the dimensions stay aligned
       if (survive < 1.0f) {
         if (u_rr >= survive) break;
         beta *= 1.0f / survive;
@@ -174,7 +175,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   z0.letter = sensor_pair_[0];
   z0.pos_letter = sensor_pair_[1];
   const glm::vec2 uf = rng.get2d();
-  const glm::vec2 ul = rng.get2d();
+  const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(cam_.params));
   const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(cam_.width),
                          (static_cast<float>(py) + uf.y) / static_cast<float>(cam_.height)};
   const std::optional<EndpointRay> r = sample_ray(cam_.params, raster, ul);
@@ -193,7 +194,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
 
 int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
-  const std::size_t li = pick_light(rng.get1d());
+  const std::size_t li = pick_light(rng);
   const RenderLight& l = rs_.lights[li];
   Vertex& y0 = th.light[0];
   y0 = Vertex{};
@@ -201,7 +202,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   y0.light = static_cast<int>(li);
   y0.pos_letter = light_pairs_[li][0];
   y0.letter = light_pairs_[li][1];
-  const SurfacePoint x = sample_point(l, rng.get2d(), &y0.err);
+  const SurfacePoint x = sample_point(l, rng, &y0.err);
   const std::optional<EndpointRay> r = sample_ray(l.params, x, rng.get2d());
   y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
@@ -467,7 +468,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     std::optional<EndpointConnection> c;
     if constexpr (C == Connection::kSplat) {
       if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no DD join
-      c = connect_finite(cam_.params, rng.get2d(), qs->p);
+      c = connect_finite(cam_.params, rng.get2d_if(reads_lens_numbers(cam_.params)), qs->p);
       if (!c) return;
     } else {
       const auto* film = std::get_if<OrthographicParams>(&cam_.params);
@@ -505,14 +506,13 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     // --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
     //     for distant-projection, the aperture point on the line through pt against the light ---
     if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
-    const std::size_t li = pick_light(rng.get1d());
+    const std::size_t li = pick_light(rng);
     const RenderLight& l = rs_.lights[li];
     std::optional<EndpointConnection> c;
     vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
     if constexpr (C == Connection::kNee) {
-      const glm::vec2 up = rng.get2d();
       if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
-      c = pathex::connect(l.params, sample_point(l, up, &err), pt->p);
+      c = pathex::connect(l.params, sample_point(l, rng, &err), pt->p);
       if (!c) return;
     } else {
       if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
@@ -645,7 +645,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
   } else {
     if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no D end
     rng.set_dimension(kJoinDims + (kEyeBlock * kMaxRuns + static_cast<std::uint64_t>(s)) * kDimsPerJoin);
-    u_lens = rng.get2d();
+    u_lens = rng.get2d_if(reads_lens_numbers(cam_.params));
   }
   if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
   // The letters: y(s-1)'s c(s) = D, the mirror's c(s+1) = S, z(t-1)'s c(s+2) = D.
@@ -719,9 +719,8 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
 const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, std::uint64_t block) const {
   if (rs_.lights.empty()) return nullptr;
   rng.set_dimension(kJoinDims + (block * kMaxRuns + static_cast<std::uint64_t>(t)) * kDimsPerJoin);
-  const std::size_t li = pick_light(rng.get1d());
+  const std::size_t li = pick_light(rng);
   const RenderLight& light = rs_.lights[li];
-  const glm::vec2 up = rng.get2d();
   if (light_pairs_[li][1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
   Vertex& y0 = th.join.light0;
   y0 = Vertex{};
@@ -729,7 +728,7 @@ const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, std::
   y0.light = static_cast<int>(li);
   y0.pos_letter = light_pairs_[li][0];
   y0.letter = 'D';
-  const SurfacePoint x = sample_point(light, up, &y0.err);
+  const SurfacePoint x = sample_point(light, rng, &y0.err);
   y0.p = light.is_area() ? x.position : light_position(light.params);
   y0.n = light.is_area() ? x.normal : vec3(0.0f);
   y0.ns = y0.n;
