@@ -15,6 +15,8 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -834,6 +836,49 @@ TEST(ShadingNormalCorrection, IsVeachsAdjointFactor) {
   EXPECT_FLOAT_EQ(bsdf::shading_normal_correction(wo, wi, ns, ng, TransportMode::kImportance),
                   expected);
   EXPECT_NE(expected, 1.0f);
+}
+
+// --- the numbers sample() reads ---
+
+// The tracer computes only the numbers numbers_read() names (Sampler::get1d_if): every other
+// number must leave sample() unchanged, bit for bit, and the names must not be more than it reads
+// (a Lambert vertex's component number, a mirror's direction, a dielectric's direction).
+TEST(Bsdf, SampleIgnoresTheNumbersItDoesNotRead) {
+  const std::vector<std::pair<Material, bsdf::NumbersRead>> kinds = {
+      {Diffuse{glm::vec3(0.7f)}, {false, true}},
+      {Mirror{glm::vec3(0.9f)}, {false, false}},
+      {Dielectric{1.5f, glm::vec3(1.0f)}, {true, false}},
+      {Glossy{glm::vec3(0.8f), 0.3f}, {false, true}},
+      {mixture({{0.5f, Diffuse{glm::vec3(1.0f)}}, {0.5f, Mirror{glm::vec3(1.0f)}}}), {true, true}}};
+  auto same = [](const std::optional<BsdfSample>& a, const std::optional<BsdfSample>& b) {
+    if (a.has_value() != b.has_value()) return false;
+    return !a || (a->wi == b->wi && a->f == b->f && a->pdf == b->pdf && a->pdf_rev == b->pdf_rev &&
+                  a->weight == b->weight && a->eta == b->eta && a->letter == b->letter &&
+                  a->is_delta == b->is_delta && a->lobe == b->lobe && a->component == b->component);
+  };
+  for (const auto& [m, expected] : kinds) {
+    const bsdf::NumbersRead reads = bsdf::numbers_read(m);
+    EXPECT_EQ(reads.component, expected.component) << m.index();
+    EXPECT_EQ(reads.direction, expected.direction) << m.index();
+    int component_matters = 0, direction_matters = 0;
+    for (int i = 0; i < 2000; ++i) {
+      Sampler s(21, static_cast<std::uint64_t>(m.index()), static_cast<std::uint64_t>(i));
+      const glm::vec3 wo = sample_uniform_sphere(s.get2d());  // either side: glass is entered from both
+      const float uc = s.get1d(), uc2 = s.get1d();
+      const glm::vec2 u = s.get2d(), u2 = s.get2d();
+      for (const TransportMode mode : {TransportMode::kRadiance, TransportMode::kImportance}) {
+        const auto base = bsdf::sample(m, wo, kUp, kUp, uc, u, mode);
+        // The unread numbers replaced: the same sample.
+        ASSERT_TRUE(same(base, bsdf::sample(m, wo, kUp, kUp, reads.component ? uc : uc2, reads.direction ? u : u2, mode)))
+            << "material " << m.index() << ", sample " << i;
+        // The read ones replaced: a different sample, sometimes.
+        component_matters += !same(base, bsdf::sample(m, wo, kUp, kUp, uc2, u, mode));
+        direction_matters += !same(base, bsdf::sample(m, wo, kUp, kUp, uc, u2, mode));
+      }
+    }
+    EXPECT_EQ(component_matters > 0, expected.component) << m.index();
+    EXPECT_EQ(direction_matters > 0, expected.direction) << m.index();
+  }
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -544,6 +545,30 @@ TEST(Grazing, JoinsStayFiniteAtCosOneInAMillion) {
   spot.axis = glm::vec3(0.0f, 0.0f, -1.0f);
   EXPECT_FALSE(connect(spot, glm::vec3(1.8f, 0.0f, -1.0f))) << "61° off the axis, cone of 60°";
   EXPECT_TRUE(connect(spot, glm::vec3(1.7f, 0.0f, -1.0f))) << "59.5° off the axis";
+}
+
+// The tracer computes a sensor's lens numbers only where reads_lens_numbers() says they are read
+// (Sampler::get2d_if): a pinhole's rays and joins are the same for any, a thin lens's are not.
+TEST(Sensors, LensNumbersAreReadByTheThinLensOnly) {
+  ThinLensParams lens;
+  lens.lens_radius = 0.2f;
+  lens.focus_distance = kLightDistance;
+  const std::vector<SensorParams> sensors = {PinholeParams{}, lens, OrthographicParams{}};
+  for (const SensorParams& cam : sensors) {
+    int differs = 0;
+    for (int i = 0; i < 200; ++i) {
+      Sampler s(23, static_cast<std::uint64_t>(cam.index()), static_cast<std::uint64_t>(i));
+      const glm::vec2 raster = s.get2d(), u = s.get2d(), u2 = s.get2d();
+      const glm::vec3 ref(0.3f * (raster.x - 0.5f), 0.3f * (raster.y - 0.5f), -2.0f);  // in front of the sensors
+      const auto a = sample_ray(cam, raster, u), b = sample_ray(cam, raster, u2);
+      ASSERT_EQ(a.has_value(), b.has_value());
+      if (a) differs += a->origin != b->origin || a->direction != b->direction || a->weight != b->weight;
+      const auto c = connect_finite(cam, u, ref), d = connect_finite(cam, u2, ref);
+      ASSERT_EQ(c.has_value(), d.has_value());
+      if (c) differs += c->position != d->position || c->wi != d->wi || c->weight != d->weight;
+    }
+    EXPECT_EQ(differs > 0, reads_lens_numbers(cam)) << "sensor " << cam.index();
+  }
 }
 
 }  // namespace

@@ -200,5 +200,26 @@ TEST(SobolSampler, DifferentPairsOfAPixelAreUncorrelated) {
   }
 }
 
+// get1d_if / get2d_if: the number get1d / get2d would draw when read, 0 when not, and the cursor
+// moved the same either way, so every later number is unchanged (for both samplers).
+TEST(Sampler, ConditionalDrawsMoveTheCursorLikeDraws) {
+  for (const SamplerKind kind : {SamplerKind::kIndependent, SamplerKind::kSobol}) {
+    Sampler a(3, 77, 5, kind), b(3, 77, 5, kind), c(3, 77, 5, kind);
+    const float a1 = a.get1d();
+    const glm::vec2 a2 = a.get2d();
+    EXPECT_EQ(b.get1d_if(true), a1);
+    EXPECT_EQ(b.get2d_if(true), a2);
+    EXPECT_EQ(c.get1d_if(false), 0.0f);
+    EXPECT_EQ(c.get2d_if(false), glm::vec2(0.0f));
+    EXPECT_EQ(a.dimension(), 3u);
+    EXPECT_EQ(b.dimension(), 3u);
+    EXPECT_EQ(c.dimension(), 3u);
+    const glm::vec2 next = a.get2d();
+    EXPECT_EQ(b.get2d(), next);
+    EXPECT_EQ(c.get2d(), next);
+    EXPECT_EQ(a.at2d(3), next);
+  }
+}
+
 }  // namespace
 }  // namespace pathex
