@@ -89,6 +89,10 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   while (count < max_vertices && live.alive()) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
+    // The direction numbers of the vertex this ray finds (dimensions 1 and 2 of its block), drawn
+    // before the ray is traced: they do not depend on the hit, and so their computation overlaps
+    // the intersection instead of delaying the scattering (Sampler::at2d_now).
+    const glm::vec2 u_dir = rng.at2d_now(rng.dimension() + 1);
     const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, HitDetail::kNoUv);  // zero for points: no offset
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
@@ -134,7 +138,8 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     const vec3 wo = -d;
     const bsdf::NumbersRead reads = bsdf::numbers_read(m);  // the others are not computed
     const float u_comp = rng.get1d_if(reads.component);
-    const glm::vec2 u = rng.get2d_if(reads.direction);
+    const glm::vec2 u = reads.direction ? u_dir : glm::vec2(0.0f);
+    rng.skip(2);
     const std::optional<BsdfSample> bs = bsdf::sample(m, wo, v.ns, v.n, u_comp, u, mode);
     if (!bs || is_black(bs->weight) || bs->pdf <= 0.0f) break;
     v.letter = letter_char(bs->letter);
