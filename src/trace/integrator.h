@@ -299,7 +299,8 @@ class Integrator {
   [[gnu::always_inline]] inline int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
                   float pdf_dir, int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
-  int light_subpath(Thread& th, Sampler& rng) const;
+  // u_ray: the numbers of the light's first direction (Sampler::at2d_now at kLightRayDim).
+  int light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const;
 
   // --- connections ---
   // The five kinds of connection, one instantiation of connect() each, so that the kind is not a

@@ -67,6 +67,8 @@ int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % s
 constexpr std::uint64_t kEyeDims = 0;
 constexpr std::uint64_t kLightDims = 1024;
 constexpr std::uint64_t kJoinDims = 2048;
+// The light subpath's first direction, after the light's pick (1) and point (2).
+constexpr std::uint64_t kLightRayDim = kLightDims + 3;
 constexpr std::uint64_t kDimsPerJoin = 4;
 static_assert(4 + 4 * 64 <= kLightDims - kEyeDims, "a subpath's numbers fit its block");
 
@@ -197,7 +199,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   return n;
 }
 
-int Integrator::light_subpath(Thread& th, Sampler& rng) const {
+int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
   const std::size_t li = pick_light(rng);
   const RenderLight& l = rs_.lights[li];
@@ -208,7 +210,8 @@ int Integrator::light_subpath(Thread& th, Sampler& rng) const {
   y0.pos_letter = light_pairs_[li][0];
   y0.letter = light_pairs_[li][1];
   const SurfacePoint x = sample_point(l, rng, &y0.err);
-  const std::optional<EndpointRay> r = sample_ray(l.params, x, rng.get2d());
+  rng.skip(2);  // u_ray, drawn in advance
+  const std::optional<EndpointRay> r = sample_ray(l.params, x, u_ray);
   y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
     y0.p = x.position;
@@ -866,13 +869,18 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
   Sampler rng(o_.seed, pixel, pass, o_.sampler);
   rng.set_dimension(kEyeDims);
+  // The light's first direction, computed before the eye subpath is traced: a Sobol point's chain
+  // of dependent multiplies then overlaps the eye subpath's work instead of delaying the light
+  // subpath's first ray (Sampler::at2d_now).
+  const bool light_walk = !rs_.lights.empty() && max_light_ > 0;  // as light_subpath() tests
+  const glm::vec2 u_light_ray = light_walk ? rng.at2d_now(kLightRayDim) : glm::vec2(0.0f);
   const int batch = batch_of(pass, o_.batches);
   th.px = px;
   th.py = py;
   th.pass = pass;
   const int nt = eye_subpath(th, rng, px, py);
   rng.set_dimension(kLightDims);
-  const int ns = light_subpath(th, rng);
+  const int ns = light_subpath(th, rng, u_light_ray);
   th.ns = ns;
   th.nt = nt;
   th.joins_ready = false;

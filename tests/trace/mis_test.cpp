@@ -27,7 +27,9 @@ struct IntegratorTestAccess {
   // One sample's eye and light subpaths, as render() traces them.
   static int trace_subpaths(const Integrator& in, Integrator::Thread& th, Sampler& rng, int px, int py, int* ns) {
     const int nt = in.eye_subpath(th, rng, px, py);
-    *ns = in.light_subpath(th, rng);
+    // The light's first direction, drawn in advance as render() draws it: after the light's pick
+    // and point (render.cpp's kLightRayDim).
+    *ns = in.light_subpath(th, rng, rng.at2d(rng.dimension() + 3));
     th.ns = *ns;
     th.nt = nt;
     in.prepare_joins(th, *ns, nt);

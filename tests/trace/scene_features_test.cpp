@@ -20,7 +20,10 @@ namespace pathex::tracer {
 // The test's access to the integrator's subpaths (as tests/trace/mis_test.cpp's).
 struct IntegratorTestAccess {
   static int eye(const Integrator& in, Integrator::Thread& th, Sampler& rng, int px, int py) { return in.eye_subpath(th, rng, px, py); }
-  static int light(const Integrator& in, Integrator::Thread& th, Sampler& rng) { return in.light_subpath(th, rng); }
+  // The light's first direction drawn in advance, after its pick and point (render.cpp's kLightRayDim).
+  static int light(const Integrator& in, Integrator::Thread& th, Sampler& rng) {
+    return in.light_subpath(th, rng, rng.at2d(rng.dimension() + 3));
+  }
 };
 
 namespace {
