@@ -20,8 +20,8 @@
 //   passes     gathered on rank 0 as [first, last) pairs.
 // Rank 0 contributes zeros and, after the last collective (so that the others wait asleep in
 // count_failures while it works), adds the reduced histogram sums into its own accumulators.
-// Only the held sums travel: at 2,048 spp of the Cornell box (42 k paths, 138 k rows, B = 32) 28 MB
-// instead of the 92 MB of dense cells and rows (bench/README.md, "MPI, fifth session").
+// Only the held sums travel: at 2,048 spp of the Cornell box (42 k paths, 138 k rows, B = 32) 30.5 MB
+// per rank instead of 92.5 MB with dense rows (bench/README.md, "MPI's fixed cost").
 #include <mpi.h>
 
 #include <algorithm>
