@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/json_reader.h"
+#include "io/json_text.h"
 
 namespace pathex {
 namespace {
@@ -223,7 +224,7 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
 }
 
 std::string histogram_json_text(const HistogramReport& report, const Histogram* raw) {
-  return to_json(report, raw).dump(2) + "\n";
+  return json_text(to_json(report, raw));
 }
 
 json raw_to_json(const Histogram& h) {

@@ -120,6 +120,20 @@ INSTANTIATE_TEST_SUITE_P(SampleScenes, ShardsMerge, testing::ValuesIn(cases()), 
   return name;
 });
 
+// A finished render keeps its sums (render.shard), so it can be extended: a 4-spp render and the
+// second half of an 8-spp split merge into the 8-spp render (why complete runs write the file).
+TEST(Merge, AFinishedRenderExtendedByTheNextPassesIsTheLongerRender) {
+  const std::string args = "trace samples/scenes/cornell.json --resolution 24x16 --quiet";
+  const std::string first = dir("first"), next = dir("next"), merged = dir("merged"), single = dir("single");
+  ASSERT_EQ(run_pathex(args + " --spp 4 --out " + first).code, 0);
+  ASSERT_EQ(run_pathex(args + " --spp 8 --shard 1/2 --out " + next).code, 0);
+  const CliRun m = run_pathex("merge " + first + " " + next + " --quiet --out " + merged);
+  ASSERT_EQ(m.code, 0) << m.err;
+  ASSERT_EQ(run_pathex(args + " --spp 8 --out " + single).code, 0);
+  expect_same_outputs(single, merged, "a 4-spp render extended to 8");
+  EXPECT_EQ(histogram(merged)["spp"], 8);
+}
+
 // --- resume ---
 
 TEST(Resume, AnInterruptedRenderResumedIsTheUninterruptedRender) {
