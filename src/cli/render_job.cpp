@@ -15,7 +15,6 @@
 #include "io/class_file.h"
 #include "io/histogram_json.h"
 #include "io/image_io.h"
-#include "io/json_text.h"
 
 namespace pathex::cli {
 
@@ -158,7 +157,7 @@ Result<WrittenReport> write_report(const std::string& dir, const ShardHeader& he
     }
     doc["connectors"] = std::move(list);
   }
-  out.json_text = json_text(doc);
+  out.json_text = doc.dump(2) + "\n";
   if (Result<bool> w = write_file_atomic(dir + "/histogram.json", out.json_text); !w) return w.error();
   nlohmann::ordered_json run = nlohmann::ordered_json::object();
   run["time_s"] = header.run.time_s;

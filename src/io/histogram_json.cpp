@@ -8,7 +8,6 @@
 #include <nlohmann/json.hpp>
 
 #include "io/json_reader.h"
-#include "io/json_text.h"
 
 namespace pathex {
 namespace {
@@ -224,7 +223,7 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
 }
 
 std::string histogram_json_text(const HistogramReport& report, const Histogram* raw) {
-  return json_text(to_json(report, raw));
+  return to_json(report, raw).dump(2) + "\n";
 }
 
 json raw_to_json(const Histogram& h) {

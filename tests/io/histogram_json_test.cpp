@@ -2,12 +2,10 @@
 // accumulator (merging parsed shard outputs equals the whole render), and errors that name the
 // JSON pointer of the offending value.
 #include "io/histogram_json.h"
-#include "io/json_text.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -231,38 +229,6 @@ TEST(HistogramJson, RawErrorsNameTheJsonPointer) {
     EXPECT_EQ(r.error().where, c.where);
     EXPECT_EQ(r.error().message, c.message);
   }
-}
-
-// json_text is dump(2) and a newline, byte for byte: on a written report with its raw section
-// (hexadecimal strings, nested arrays, floats, null standard errors) and on a document that
-// reaches every branch of the fast writer and of its hand-over to nlohmann.
-TEST(JsonText, IsDumpWithTwoSpacesAndANewline) {
-  Fixture f;
-  const Histogram h = shard(0, 40);
-  const json doc = to_json(f.report(h), &h);
-  EXPECT_EQ(json_text(doc), doc.dump(2) + "\n");
-  EXPECT_EQ(histogram_json_text(f.report(h), &h), doc.dump(2) + "\n");
-
-  json edge = json::object();
-  edge["empty object"] = json::object();
-  edge["empty array"] = json::array();
-  edge["nested"] = json::array({json::object(), json::array(), json::array({json::object({{"a", json::array()}})})});
-  edge["quote \" and backslash \\"] = "tab\tnewline\ncontrol\x01 del\x7f";
-  edge["utf-8 \xc3\xa9"] = "\xe2\x88\x9e and \xf0\x9f\x98\x80";
-  edge["ints"] = json::array({0, -1, std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::uint64_t>::max()});
-  edge["floats"] = json::array({0.0, -0.0, 1.0, -2.5, 0.1, 1e-300, 4.9e-324, 1e21, 123456789012345678.0, 1e15, 1e16,
-                                0.0001, 0.00001, std::numeric_limits<double>::max()});
-  edge["not finite"] = json::array({std::nan(""), std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()});
-  edge["null, bools"] = json::array({nullptr, true, false});
-  edge["binary"] = json::binary({1, 2, 3});
-  EXPECT_EQ(json_text(edge), edge.dump(2) + "\n");
-  EXPECT_EQ(json_text(json::object()), "{}\n");
-  EXPECT_EQ(json_text(json(3)), "3\n");
-
-  // Invalid UTF-8 is refused as dump() refuses it (nlohmann's type_error 316).
-  const json bad = json::object({{"path", std::string("L\xff")}});
-  EXPECT_THROW(bad.dump(2), nlohmann::json::type_error);
-  EXPECT_THROW(json_text(bad), nlohmann::json::type_error);
 }
 
 }  // namespace
