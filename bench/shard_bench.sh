@@ -10,6 +10,9 @@
 #            every process; per pair the wall speedup (target >= 1.8x), the CPU efficiency and the
 #            speedup the CPU times predict on an idle machine; their medians, and how busy the
 #            machine was. Skipped without build/pathex-mpi.
+#            SPP (default 256) sets the render's spp. With OLD_MPI=path/to/another/pathex-mpi, each
+#            round also runs that build's 2 ranks right after this build's, against the same
+#            one-process time (its wall speedup and CPU efficiency per round, and their medians).
 #            With OLD=path/to/another/pathex, `merge` also renders that build's shards and times its
 #            merges alternately with this build's (ratios within one run).
 # Usage: bash bench/shard_bench.sh [merge|size|mpi|all] (default all). Scratch: $TMPDIR/pathex-shard-bench.
@@ -107,7 +110,7 @@ if [ "$what" = mpi ] || [ "$what" = all ]; then
     # slower rank's CPU + the 2-rank run's start-up and reduction, measured as its wall time
     # minus its slower rank's wall time).
     args=(trace samples/scenes/cornell.json --spp "${SPP:-256}" --threads 1 --quiet)
-    speedups=(); efficiencies=(); idle_speedups=()
+    speedups=(); efficiencies=(); idle_speedups=(); old_speedups=(); old_efficiencies=()
     cpu_idle() { awk '/^cpu /{print $5 + $6, $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9}' /proc/stat; }
     read -r idle0 all0 < <(cpu_idle)
     for r in $(seq 1 "$rounds"); do
@@ -132,11 +135,29 @@ if [ "$what" = mpi ] || [ "$what" = all ]; then
       idle_speedups+=("$(echo "$cpu1 / ($slow_cpu + $overhead)" | bc -l)")
       printf 'round %d: 1 process %.2f s wall %.2f s CPU; 2 ranks %.2f s wall, ranks %.2f + %.2f s CPU, mpirun start-up and exit %.2f s; wall speedup %.3f, CPU efficiency %.3f, idle-machine speedup %.3f\n' \
         "$r" "$one" "$cpu1" "$two" "$cpu_a" "$cpu_b" "$overhead" "${speedups[-1]}" "${efficiencies[-1]}" "${idle_speedups[-1]}"
+      if [ -n "${OLD_MPI:-}" ]; then
+        t3=$(now)
+        mpirun --oversubscribe --allow-run-as-root -n 2 sh -c \
+          '/usr/bin/time -f "%e %U %S" -o "$0.$OMPI_COMM_WORLD_RANK" "$@"' "$work/old.time" "$OLD_MPI" "${args[@]}" --out "$work/old" > /dev/null
+        t4=$(now)
+        cmp -s "$work/one/histogram.json" "$work/old/histogram.json" && same="identical outputs" || same="outputs differ"
+        read -r _ u_a s_a < "$work/old.time.0"
+        read -r _ u_b s_b < "$work/old.time.1"
+        old_two=$(echo "$t4 - $t3" | bc -l)
+        old_speedups+=("$(echo "$one / $old_two" | bc -l)")
+        old_efficiencies+=("$(echo "$cpu1 / ($u_a + $s_a + $u_b + $s_b)" | bc -l)")
+        printf '  %s: 2 ranks %.2f s wall, ranks %.2f + %.2f s CPU; wall speedup %.3f, CPU efficiency %.3f (%s)\n' "$OLD_MPI" "$old_two" \
+          "$(echo "$u_a + $s_a" | bc -l)" "$(echo "$u_b + $s_b" | bc -l)" "${old_speedups[-1]}" "${old_efficiencies[-1]}" "$same"
+      fi
     done
     read -r idle1 all1 < <(cpu_idle)
     busy=$(echo "100 * (1 - ($idle1 - $idle0) / ($all1 - $all0))" | bc -l)
     printf 'mpi 2 ranks x 1 thread against 1 process x 1 thread (medians of %d rounds): wall speedup %.3f, CPU efficiency %.3f, idle-machine speedup %.3f (machine %.0f %% busy during the runs, load average %s)\n' \
       "$rounds" "$(printf '%s\n' "${speedups[@]}" | median)" "$(printf '%s\n' "${efficiencies[@]}" | median)" \
       "$(printf '%s\n' "${idle_speedups[@]}" | median)" "$busy" "$(cut -d' ' -f1-3 /proc/loadavg)"
+    if [ -n "${OLD_MPI:-}" ]; then
+      printf '  %s (alternating with it): wall speedup %.3f, CPU efficiency %.3f (medians)\n' "$OLD_MPI" \
+        "$(printf '%s\n' "${old_speedups[@]}" | median)" "$(printf '%s\n' "${old_efficiencies[@]}" | median)"
+    fi
   fi
 fi

@@ -282,6 +282,11 @@ class Histogram {
   // Adds `contributions` to the row of (path, technique) and, when `batch_sums` is not null, its
   // B per-batch luminance sums.
   void add_technique(PathId id, int technique, std::uint64_t contributions, const ExactSum* batch_sums);
+  // Adds `sum` to row `r`'s luminance sum in `batch` (a row of technique_row()): for readers that
+  // restore the row sums batch by batch (the MPI reduction, cli/mpi/).
+  void add_row_sum(int r, int batch, ExactSum sum) {
+    if (sum != 0) row_sum_of(r, batch) += sum;
+  }
   void add_magnitude(ExactSum m);
 
  private:

@@ -69,7 +69,8 @@ int run_command_line(int argc, char** argv);
 // and ends the process at once when the process allows it, so that a render's tables and images
 // are not freed page by page (munmap's TLB flushes) just before the kernel drops the address
 // space anyway; otherwise it returns code. Only the pathex binary's main allows it: tests run
-// commands in-process, and pathex-mpi must finalise MPI.
+// commands in-process, and pathex-mpi must finalise MPI. Under AddressSanitizer it always returns, so
+// that LeakSanitizer's check at exit runs on the pathex binary too.
 void allow_fast_exit();
 int finish_command(int code);
 

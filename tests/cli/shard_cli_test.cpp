@@ -120,6 +120,20 @@ INSTANTIATE_TEST_SUITE_P(SampleScenes, ShardsMerge, testing::ValuesIn(cases()), 
   return name;
 });
 
+// A finished render keeps its sums (render.shard), so it can be extended: a 4-spp render and the
+// second half of an 8-spp split merge into the 8-spp render (why complete runs write the file).
+TEST(Merge, AFinishedRenderExtendedByTheNextPassesIsTheLongerRender) {
+  const std::string args = "trace samples/scenes/cornell.json --resolution 24x16 --quiet";
+  const std::string first = dir("first"), next = dir("next"), merged = dir("merged"), single = dir("single");
+  ASSERT_EQ(run_pathex(args + " --spp 4 --out " + first).code, 0);
+  ASSERT_EQ(run_pathex(args + " --spp 8 --shard 1/2 --out " + next).code, 0);
+  const CliRun m = run_pathex("merge " + first + " " + next + " --quiet --out " + merged);
+  ASSERT_EQ(m.code, 0) << m.err;
+  ASSERT_EQ(run_pathex(args + " --spp 8 --out " + single).code, 0);
+  expect_same_outputs(single, merged, "a 4-spp render extended to 8");
+  EXPECT_EQ(histogram(merged)["spp"], 8);
+}
+
 // --- resume ---
 
 TEST(Resume, AnInterruptedRenderResumedIsTheUninterruptedRender) {
@@ -367,6 +381,33 @@ TEST(Mpi, ThreeRanksWriteTheBytesOfOneProcess) {
     if (e.path().extension() == ".shard") shards.push_back(e.path().filename().string());
   EXPECT_EQ(shards, std::vector<std::string>{"render.shard"});
 }
+
+// The reduction sends only the sums some rank holds (one bit per batch cell, row sum and image
+// tile, or-reduced first). Twenty classes on the Cornell box at 3 spp leave most batches empty,
+// six class layers empty (no point, distant or lens paths) and one nearly so (specular-only, a
+// single sample), and with 2 or 3 ranks many paths, rows and tiles are held by one rank alone.
+class MpiSparse : public ::testing::TestWithParam<int> {};
+TEST_P(MpiSparse, RanksWriteTheBytesOfOneProcess) {
+  if (std::string(PATHEX_MPI_BINARY).empty()) GTEST_SKIP() << "pathex-mpi is not built (MPI was not found at configure time)";
+  const std::string n = std::to_string(GetParam());
+  const std::string args =
+      " trace samples/scenes/cornell.json --classes samples/classes/twenty.json --resolution 40x40 --spp 3 --quiet --out ";
+  const std::string single = dir("single"), ranks = dir("ranks-" + n);
+  ASSERT_EQ(run_pathex(args + single).code, 0);
+  std::vector<std::string> empty, sparse;
+  const nlohmann::json classes = histogram(single)["classes"];
+  for (const auto& c : classes) {
+    if (c["samples"] == 0) empty.push_back(c["name"]);
+    if (c["samples"] == 1) sparse.push_back(c["name"]);
+  }
+  EXPECT_EQ(empty, (std::vector<std::string>{"caustic-hard", "from-point", "from-distant", "to-lens", "to-ortho", "not-local"}));
+  EXPECT_EQ(sparse, std::vector<std::string>{"specular-only"});
+  const CliRun r = run_mpirun("-n " + n + " " + pathex::test::shell_quote(PATHEX_MPI_BINARY) + args + ranks + " --threads 1");
+  ASSERT_EQ(r.code, 0) << r.out;
+  expect_same_outputs(single, ranks, n + " MPI ranks, twenty classes");
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, MpiSparse, ::testing::Values(2, 3),
+                         [](const ::testing::TestParamInfo<int>& p) { return std::to_string(p.param) + "ranks"; });
 
 // The ranks' connector statistics are reduced too: histogram.json and rank 0's table.
 TEST(Mpi, ThreeRanksWithAConnectorWriteTheBytesOfOneProcess) {

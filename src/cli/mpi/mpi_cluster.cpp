@@ -7,23 +7,30 @@
 // What is reduced, in this order:
 //   paths      the union of the ranks' path strings (gathered on rank 0, sorted, broadcast), so that
 //              every rank lays its histogram out in the same order;
-//   histogram  the union of the (path, batch) cells and the paths' strategy sums that are nonzero
-//              on some rank (a bitwise-or reduction), then those: per cell the sums and the
-//              contribution count, per path the strategy sums; per batch the sample counts and
-//              the non-finite count: one 128-bit sum each; the magnitude bound (saturating)
-//              gathered on rank 0;
-//   images     the union of the (plane, tile) pairs some rank touched (a bitwise-or reduction),
-//              then those tiles' words, in blocks of at most 4096 tiles (12 MiB);
+//   rows       the union of the (path, technique) rows as (index of the path above, technique code)
+//              pairs, gathered on rank 0, sorted and broadcast the same way;
+//   flags      one bit per (batch, path) cell, per (batch, row) luminance sum and per (image plane,
+//              tile), set where this rank holds something nonzero: one bitwise-or reduction;
+//   histogram  the held cells' RGB sums and the held row sums (128-bit sums, batch-major as the
+//              histogram keeps them), then in one 64-bit reduction the held cells' and every
+//              row's contribution counts, the batches' sample counts and the non-finite count;
+//              the magnitude bound (saturating) gathered on rank 0;
+//   images     the held tiles' words, in blocks of at most 4096 tiles (12 MiB);
 //   connectors the connector statistics' counts (ConnectorStats::counts_of), 64-bit sums;
 //   passes     gathered on rank 0 as [first, last) pairs.
-// Rank 0 contributes zeros and adds the reduced sums of the others into its own accumulators.
+// Rank 0 contributes zeros and, after the last collective (so that the others wait asleep in
+// count_failures while it works), adds the reduced histogram sums into its own accumulators.
+// Only the held sums travel: at 2,048 spp of the Cornell box (42 k paths, 138 k rows, B = 32) 30.5 MB
+// per rank instead of 92.5 MB with dense rows (bench/README.md, "MPI's fixed cost").
 #include <mpi.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "cli/mpi/mpi_cluster.h"
@@ -114,180 +121,181 @@ Result<bool> MpiCluster::or_all(const std::vector<unsigned char>& flags, std::ve
   return true;
 }
 
+template <typename T>
+Result<bool> MpiCluster::gather_to_root(const std::vector<T>& mine, MPI_Datatype type, std::vector<T>* all) {
+  const int my_count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_)), offsets(static_cast<std::size_t>(size_));
+  if (Result<bool> r = check(MPI_Gather(&my_count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD), "gather"); !r) return r;
+  all->clear();
+  if (rank_ == 0) {
+    int total = 0;
+    for (int i = 0; i < size_; ++i) offsets[static_cast<std::size_t>(i)] = total, total += counts[static_cast<std::size_t>(i)];
+    all->resize(static_cast<std::size_t>(total));
+  }
+  return check(MPI_Gatherv(mine.data(), my_count, type, all->data(), counts.data(), offsets.data(), type, 0, MPI_COMM_WORLD), "gather");
+}
+
+template <typename T>
+Result<bool> MpiCluster::broadcast(std::vector<T>* v, MPI_Datatype type) {
+  std::uint64_t n = v->size();
+  if (Result<bool> r = check(MPI_Bcast(&n, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD), "broadcast"); !r) return r;
+  v->resize(n);
+  return check(MPI_Bcast(v->data(), static_cast<int>(n), type, 0, MPI_COMM_WORLD), "broadcast");
+}
+
 Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run) {
   if (Result<bool> r = wait_for_all("barrier before the reduction"); !r) return r;
   Histogram& h = sums->histogram;
-  // --- the union of the path strings and of the (path, technique) rows ("path\tcode"), on every rank ---
-  std::string mine;
-  for (int p = 0; p < h.num_paths(); ++p) {
-    mine += h.path(p) + "\n";
-    for (int r = h.first_row(p); r >= 0; r = h.row(r).next) mine += h.path(p) + "\t" + std::to_string(h.row(r).technique) + "\n";
-  }
-  const int my_size = static_cast<int>(mine.size());
-  std::vector<int> sizes(static_cast<std::size_t>(size_)), offsets(static_cast<std::size_t>(size_));
-  if (Result<bool> r = check(MPI_Gather(&my_size, 1, MPI_INT, sizes.data(), 1, MPI_INT, 0, MPI_COMM_WORLD), "gather"); !r) return r;
-  std::string all;
-  if (rank_ == 0) {
-    int total = 0;
-    for (int i = 0; i < size_; ++i) offsets[static_cast<std::size_t>(i)] = total, total += sizes[static_cast<std::size_t>(i)];
-    all.resize(static_cast<std::size_t>(total));
-  }
-  if (Result<bool> r = check(MPI_Gatherv(mine.data(), my_size, MPI_CHAR, all.data(), sizes.data(), offsets.data(), MPI_CHAR, 0,
-                                         MPI_COMM_WORLD),
-                             "gather");
-      !r)
-    return r;
-  std::vector<std::string> paths;
-  std::string joined;
-  if (rank_ == 0) {
+  const bool root = rank_ == 0;
+
+  // --- the union of the path strings, sorted, on every rank ---
+  std::vector<char> mine, all;
+  for (int p = 0; p < h.num_paths(); ++p) mine.insert(mine.end(), h.path(p).begin(), h.path(p).end()), mine.push_back('\n');
+  if (Result<bool> r = gather_to_root(mine, MPI_CHAR, &all); !r) return r;
+  std::vector<std::string_view> paths;
+  std::vector<char> joined;
+  if (root) {
     for (std::size_t at = 0; at < all.size();) {
-      const std::size_t nl = all.find('\n', at);
-      paths.push_back(all.substr(at, nl - at));
+      const std::size_t nl = static_cast<std::size_t>(std::find(all.begin() + static_cast<std::ptrdiff_t>(at), all.end(), '\n') - all.begin());
+      paths.emplace_back(all.data() + at, nl - at);
       at = nl + 1;
     }
     std::sort(paths.begin(), paths.end());
     paths.erase(std::unique(paths.begin(), paths.end()), paths.end());
-    for (const std::string& p : paths) joined += p + "\n";
+    for (std::string_view p : paths) joined.insert(joined.end(), p.begin(), p.end()), joined.push_back('\n');
   }
-  std::uint64_t joined_size = joined.size();
-  if (Result<bool> r = check(MPI_Bcast(&joined_size, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD), "broadcast"); !r) return r;
-  joined.resize(joined_size);
-  if (Result<bool> r = check(MPI_Bcast(joined.data(), static_cast<int>(joined_size), MPI_CHAR, 0, MPI_COMM_WORLD), "broadcast"); !r)
-    return r;
-  if (rank_ != 0)
-    for (std::size_t at = 0; at < joined.size();) {
-      const std::size_t nl = joined.find('\n', at);
-      paths.push_back(joined.substr(at, nl - at));
-      at = nl + 1;
-    }
-
-  // --- the histogram's sums: only the cells some rank holds ---
-  // Most of a path's B batch cells are empty (a rare path lands in few batches), so the ranks
-  // first agree on which cells are nonzero on any rank (a bitwise-or reduction of one byte each)
-  // and then reduce those alone: 2.4 MB instead of 28 MB for the 13,302 paths of the Cornell box
-  // at 128 spp (bench/README.md, "MPI"). A path line has B cells of 8 words (RGB sums and the
-  // contribution count); a (path, technique) row line has one cell of 2B + 2 words (its B
-  // per-batch luminance sums and its contribution count) in its first column.
-  const int B = h.num_batches();
-  const std::size_t columns = std::max<std::size_t>(static_cast<std::size_t>(B), 1);
-  const std::size_t path_cell = 8, row_cell = 2 * static_cast<std::size_t>(B) + 2;
-  // A row line's path and technique.
-  const auto split = [](const std::string& line, std::size_t tab) {
-    return std::pair<std::string, int>(line.substr(0, tab), std::stoi(line.substr(tab + 1)));
-  };
-  std::vector<Histogram::PathId> ids(paths.size(), -1);
-  std::vector<int> rows(paths.size(), -1);  // a row line's row here, -1 if this rank has none
-  std::vector<char> is_row(paths.size(), 0);
-  std::vector<unsigned char> held(paths.size() * columns, 0), any_held(held.size(), 0);
-  for (std::size_t i = 0; i < paths.size(); ++i) {
-    if (const std::size_t tab = paths[i].find('\t'); tab != std::string::npos) {
-      is_row[i] = 1;
-      const auto [p, code] = split(paths[i], tab);
-      const std::optional<Histogram::PathId> id = h.find(p);
-      for (int r = id ? h.first_row(*id) : -1; r >= 0 && rows[i] < 0; r = h.row(r).next)
-        if (h.row(r).technique == code) rows[i] = r;
-      held[i * columns] = rows[i] >= 0 ? 1 : 0;
-      continue;
-    }
-    const std::optional<Histogram::PathId> id = h.find(paths[i]);
-    if (!id) continue;
-    ids[i] = *id;
-    for (int b = 0; b < B; ++b) {
-      const Histogram::Cell& cell = h.cell(*id, b);
-      held[i * columns + static_cast<std::size_t>(b)] = cell.contributions != 0 || !is_zero(cell.sum);
-    }
+  if (Result<bool> r = broadcast(&joined, MPI_CHAR); !r) return r;
+  paths.clear();
+  for (std::size_t at = 0; at < joined.size();) {
+    const std::size_t nl = static_cast<std::size_t>(std::find(joined.begin() + static_cast<std::ptrdiff_t>(at), joined.end(), '\n') - joined.begin());
+    paths.emplace_back(joined.data() + at, nl - at);
+    at = nl + 1;
   }
-  if (Result<bool> r = or_all(held, &any_held); !r) return r;
-  std::size_t n_words = 2 * (static_cast<std::size_t>(B) + 1);  // batch sample counts, non-finite count
-  for (std::size_t i = 0; i < any_held.size(); ++i)
-    if (any_held[i] != 0) n_words += is_row[i / columns] != 0 ? row_cell : path_cell;
-  std::vector<Word> words(n_words, 0);
-  Word* w = words.data();
+  std::vector<Histogram::PathId> ids(paths.size(), -1);  // this rank's id of each path, -1: none
   for (std::size_t i = 0; i < paths.size(); ++i)
-    for (std::size_t c = 0; c < columns; ++c) {
-      if (any_held[i * columns + c] == 0) continue;
-      if (is_row[i] != 0) {
-        if (rows[i] >= 0) {  // else zeros
-          for (int b = 0; b < B; ++b) put(w + 2 * static_cast<std::size_t>(b), h.row_sum(rows[i], b));
-          put(w + 2 * static_cast<std::size_t>(B), h.row(rows[i]).contributions);
+    if (const std::optional<Histogram::PathId> id = h.find(paths[i])) ids[i] = *id;
+
+  // --- the union of the (path, technique) rows, as (path's index above, technique code) pairs ---
+  std::vector<int> my_rows, union_rows;
+  for (std::size_t i = 0; i < paths.size(); ++i)
+    if (ids[i] >= 0)
+      for (int r = h.first_row(ids[i]); r >= 0; r = h.row(r).next) my_rows.push_back(static_cast<int>(i)), my_rows.push_back(h.row(r).technique);
+  if (Result<bool> r = gather_to_root(my_rows, MPI_INT, &union_rows); !r) return r;
+  if (root) {
+    std::vector<std::pair<int, int>> pairs;
+    for (std::size_t k = 0; k + 1 < union_rows.size(); k += 2) pairs.emplace_back(union_rows[k], union_rows[k + 1]);
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    union_rows.clear();
+    for (const auto& [i, code] : pairs) union_rows.push_back(i), union_rows.push_back(code);
+  }
+  if (Result<bool> r = broadcast(&union_rows, MPI_INT); !r) return r;
+  const std::size_t num_rows = union_rows.size() / 2;
+  std::vector<int> rows(num_rows, -1);  // this rank's row of each, -1: none
+  for (std::size_t k = 0; k < num_rows; ++k)
+    if (const Histogram::PathId id = ids[static_cast<std::size_t>(union_rows[2 * k])]; id >= 0)
+      for (int r = h.first_row(id); r >= 0 && rows[k] < 0; r = h.row(r).next)
+        if (h.row(r).technique == union_rows[2 * k + 1]) rows[k] = r;
+
+  // --- which sums are nonzero on some rank: one bit per (batch, path) cell, per (batch, row) sum
+  // and per (image plane, tile), or-reduced. Most of a path's or a row's B batches are empty (a
+  // rare path lands in few batches), so the sums reduced below are a fraction of the dense ones.
+  // Batch-major, as the histogram keeps them: a batch's cells and row sums are one array each ---
+  const auto B = static_cast<std::size_t>(h.num_batches());
+  const std::size_t P = paths.size();
+  ClassImages& im = sums->images;
+  const std::size_t planes = im.num_planes(), tiles = im.num_tiles();
+  const std::size_t cell_bits = B * P, row_bits = B * num_rows, n_bits = cell_bits + row_bits + planes * tiles;
+  std::vector<unsigned char> held((n_bits + 7) / 8, 0), any_held(held.size(), 0);
+  const auto set_bit = [&](std::size_t i) { held[i >> 3] |= static_cast<unsigned char>(1u << (i & 7)); };
+  const auto is_held = [&](std::size_t i) { return ((any_held[i >> 3] >> (i & 7)) & 1) != 0; };
+  for (std::size_t b = 0; b < B; ++b) {
+    for (std::size_t i = 0; i < P; ++i)
+      if (ids[i] >= 0)
+        if (const Histogram::Cell& cell = h.cell(ids[i], static_cast<int>(b)); cell.contributions != 0 || !is_zero(cell.sum))
+          set_bit(b * P + i);
+    for (std::size_t k = 0; k < num_rows; ++k)
+      if (rows[k] >= 0 && h.row_sum(rows[k], static_cast<int>(b)) != 0) set_bit(cell_bits + b * num_rows + k);
+  }
+  for (std::size_t p = 0; p < planes; ++p)
+    for (std::size_t t = 0; t < tiles; ++t)
+      if (im.tile_words(p, t) != nullptr) set_bit(cell_bits + row_bits + p * tiles + t);
+  if (Result<bool> r = or_all(held, &any_held); !r) return r;
+
+  // --- the histogram's sums, in the order of the bits: 128-bit words for the held cells' RGB sums
+  // and the held row sums; 64-bit counts (their own type, summed by MPI_SUM modulo 2^64 like the
+  // accumulator's) for the held cells' contributions, every row's contributions, the batches'
+  // samples and the non-finite count. Rank 0 contributes zeros and adds the others' sums into its
+  // own accumulators ---
+  std::size_t held_cells = 0, held_row_sums = 0;
+  for (std::size_t i = 0; i < cell_bits; ++i) held_cells += is_held(i) ? 1 : 0;
+  for (std::size_t i = cell_bits; i < cell_bits + row_bits; ++i) held_row_sums += is_held(i) ? 1 : 0;
+  std::vector<Word> words(6 * held_cells + 2 * held_row_sums, 0), counts(held_cells + num_rows + B + 1, 0);
+  if (!root) {
+    Word* w = words.data();
+    Word* n = counts.data();
+    for (std::size_t b = 0; b < B; ++b) {
+      for (std::size_t i = 0; i < P; ++i) {
+        if (!is_held(b * P + i)) continue;
+        if (ids[i] >= 0) {  // else zeros
+          const Histogram::Cell& cell = h.cell(ids[i], static_cast<int>(b));
+          put(w, cell.sum[0]), put(w + 2, cell.sum[1]), put(w + 4, cell.sum[2]), *n = cell.contributions;
         }
-        w += row_cell;
-        continue;
+        w += 6, ++n;
       }
-      if (held[i * columns + c] != 0) {  // else zeros
-        const Histogram::Cell& cell = h.cell(ids[i], static_cast<int>(c));
-        put(w, cell.sum[0]), put(w + 2, cell.sum[1]), put(w + 4, cell.sum[2]), put(w + 6, cell.contributions);
+      for (std::size_t k = 0; k < num_rows; ++k) {
+        if (!is_held(cell_bits + b * num_rows + k)) continue;
+        if (rows[k] >= 0) put(w, h.row_sum(rows[k], static_cast<int>(b)));
+        w += 2;
       }
-      w += path_cell;
     }
-  for (int b = 0; b < B; ++b, w += 2) put(w, h.batch_samples(b));
-  put(w, h.nonfinite());
+    for (std::size_t k = 0; k < num_rows; ++k, ++n)
+      if (rows[k] >= 0) *n = h.row(rows[k]).contributions;
+    for (std::size_t b = 0; b < B; ++b) *n++ = h.batch_samples(static_cast<int>(b));
+    *n = h.nonfinite();
+  }
   if (Result<bool> r = sum_to_root(&words); !r) return r;
+  std::vector<Word> count_sums(root ? counts.size() : 0);
+  if (Result<bool> r = check(MPI_Reduce(counts.data(), count_sums.data(), static_cast<int>(counts.size()), MPI_UINT64_T, MPI_SUM, 0,
+                                        MPI_COMM_WORLD),
+                             "reduce");
+      !r)
+    return r;
   std::vector<Word> magnitudes(2 * static_cast<std::size_t>(size_));
   const Word my_magnitude[2] = {static_cast<Word>(h.magnitude()), static_cast<Word>(h.magnitude() >> 64)};
   if (Result<bool> r = check(MPI_Gather(my_magnitude, 2, MPI_UINT64_T, magnitudes.data(), 2, MPI_UINT64_T, 0, MPI_COMM_WORLD), "gather");
       !r)
     return r;
-  if (rank_ == 0) {
-    const Word* r = words.data();
-    std::vector<ExactSum> row_sums(static_cast<std::size_t>(B));
-    for (std::size_t i = 0; i < paths.size(); ++i) {
-      if (is_row[i] != 0) {
-        if (any_held[i * columns] == 0) continue;
-        const auto [p, code] = split(paths[i], paths[i].find('\t'));
-        for (int b = 0; b < B; ++b, r += 2) row_sums[static_cast<std::size_t>(b)] = get(r);
-        h.add_technique(h.intern(p), code, static_cast<std::uint64_t>(get(r)), row_sums.data());
-        r += 2;
-        continue;
-      }
-      // Every path of the union, held or not: a path string with no nonzero sum is still one of the
-      // render's distinct paths.
-      const Histogram::PathId id = ids[i] >= 0 ? ids[i] : h.intern(paths[i]);
-      for (std::size_t c = 0; c < columns; ++c) {
-        if (any_held[i * columns + c] == 0) continue;
-        h.add_cell(id, static_cast<int>(c), {get(r), get(r + 2), get(r + 4)}, static_cast<std::uint64_t>(get(r + 6)));
-        r += 8;
-      }
-    }
-    for (int b = 0; b < B; ++b, r += 2) h.add_samples(b, static_cast<std::uint64_t>(get(r)));
-    h.add_nonfinite(static_cast<std::uint64_t>(get(r)));
-    for (int i = 1; i < size_; ++i) h.add_magnitude(get(&magnitudes[2 * static_cast<std::size_t>(i)]));
-  }
 
   // --- the images: the tiles any rank touched, in blocks ---
-  ClassImages& im = sums->images;
-  const std::size_t planes = im.num_planes(), tiles = im.num_tiles();
-  std::vector<unsigned char> touched(planes * tiles), any(planes * tiles);
-  for (std::size_t p = 0; p < planes; ++p)
-    for (std::size_t t = 0; t < tiles; ++t) touched[p * tiles + t] = im.tile_words(p, t) != nullptr ? 1 : 0;
-  if (Result<bool> r = or_all(touched, &any); !r) return r;
-  std::vector<std::size_t> cells;
-  for (std::size_t i = 0; i < any.size(); ++i)
-    if (any[i] != 0) cells.push_back(i);
+  std::vector<std::size_t> touched;
+  for (std::size_t i = 0; i < planes * tiles; ++i)
+    if (is_held(cell_bits + row_bits + i)) touched.push_back(i);
   constexpr std::size_t kTilesPerBlock = 4096;
-  for (std::size_t at = 0; at < cells.size(); at += kTilesPerBlock) {
-    const std::size_t n = std::min(kTilesPerBlock, cells.size() - at);
+  for (std::size_t at = 0; at < touched.size(); at += kTilesPerBlock) {
+    const std::size_t n = std::min(kTilesPerBlock, touched.size() - at);
     std::vector<Word> block(n * ClassImages::kTileWords, 0);
-    for (std::size_t k = 0; k < n; ++k)
-      if (const Word* src = im.tile_words(cells[at + k] / tiles, cells[at + k] % tiles))
-        std::memcpy(block.data() + k * ClassImages::kTileWords, src, ClassImages::kTileWords * sizeof(Word));
-    if (Result<bool> r = sum_to_root(&block); !r) return r;
-    if (rank_ == 0)
+    if (!root)
       for (std::size_t k = 0; k < n; ++k)
-        im.add_tile(cells[at + k] / tiles, cells[at + k] % tiles, block.data() + k * ClassImages::kTileWords);
+        if (const Word* src = im.tile_words(touched[at + k] / tiles, touched[at + k] % tiles))
+          std::memcpy(block.data() + k * ClassImages::kTileWords, src, ClassImages::kTileWords * sizeof(Word));
+    if (Result<bool> r = sum_to_root(&block); !r) return r;
+    if (root)
+      for (std::size_t k = 0; k < n; ++k)
+        im.add_tile(touched[at + k] / tiles, touched[at + k] % tiles, block.data() + k * ClassImages::kTileWords);
   }
 
   // --- the connector statistics: the same strategies on every rank, their counts summed ---
-  std::vector<Word> counts, total(sums->connectors.size() * ConnectorStats::kCounts);
+  std::vector<Word> connector_counts, total(sums->connectors.size() * ConnectorStats::kCounts);
   for (const ConnectorStats& c : sums->connectors)
-    for (const std::uint64_t* n : ConnectorStats::counts_of(c)) counts.push_back(*n);
-  if (!counts.empty()) {
-    if (Result<bool> r = check(MPI_Reduce(counts.data(), total.data(), static_cast<int>(counts.size()), MPI_UINT64_T, MPI_SUM, 0,
-                                          MPI_COMM_WORLD),
+    for (const std::uint64_t* n : ConnectorStats::counts_of(c)) connector_counts.push_back(*n);
+  if (!connector_counts.empty()) {
+    if (Result<bool> r = check(MPI_Reduce(connector_counts.data(), total.data(), static_cast<int>(connector_counts.size()), MPI_UINT64_T,
+                                          MPI_SUM, 0, MPI_COMM_WORLD),
                                "reduce");
         !r)
       return r;
-    if (rank_ == 0)
+    if (root)
       for (std::size_t i = 0; i < sums->connectors.size(); ++i) {
         const auto to = ConnectorStats::counts_of(sums->connectors[i]);
         for (std::size_t k = 0; k < ConnectorStats::kCounts; ++k) *to[k] = total[i * ConnectorStats::kCounts + k];
@@ -295,21 +303,9 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
   }
 
   // --- passes and run figures ---
-  std::vector<Word> ranges;
+  std::vector<Word> ranges, all_ranges;
   for (const PassRange& r : passes->ranges()) ranges.push_back(r.first), ranges.push_back(r.last);
-  const int my_count = static_cast<int>(ranges.size());
-  if (Result<bool> r = check(MPI_Gather(&my_count, 1, MPI_INT, sizes.data(), 1, MPI_INT, 0, MPI_COMM_WORLD), "gather"); !r) return r;
-  std::vector<Word> all_ranges;
-  if (rank_ == 0) {
-    int total = 0;
-    for (int i = 0; i < size_; ++i) offsets[static_cast<std::size_t>(i)] = total, total += sizes[static_cast<std::size_t>(i)];
-    all_ranges.resize(static_cast<std::size_t>(total));
-  }
-  if (Result<bool> r = check(MPI_Gatherv(ranges.data(), my_count, MPI_UINT64_T, all_ranges.data(), sizes.data(), offsets.data(),
-                                         MPI_UINT64_T, 0, MPI_COMM_WORLD),
-                             "gather");
-      !r)
-    return r;
+  if (Result<bool> r = gather_to_root(ranges, MPI_UINT64_T, &all_ranges); !r) return r;
   for (std::size_t i = 0; i + 1 < all_ranges.size(); i += 2) passes->add(all_ranges[i], all_ranges[i + 1]);
   double time_max = 0;
   std::uint64_t rays = 0;
@@ -319,7 +315,34 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
   if (Result<bool> r = check(MPI_Reduce(&run->threads, &threads, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
   double cpu_sum = 0.0;
   if (Result<bool> r = check(MPI_Reduce(&run->cpu_s, &cpu_sum, 1, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD), "reduce"); !r) return r;
-  if (rank_ == 0) *run = {time_max, threads, rays, cpu_sum};
+  if (!root) return true;
+  *run = {time_max, threads, rays, cpu_sum};
+
+  // --- rank 0 adds the others' histogram sums into its own (after the last collective, so that
+  // the other ranks wait for it asleep, in count_failures, not polling in a collective) ---
+  // Every path of the union, held or not: a path string with no nonzero sum is still one of the
+  // render's distinct paths; and every row of the union, with its contributions.
+  h.reserve_paths(P);
+  h.reserve_rows(num_rows);
+  for (std::size_t i = 0; i < P; ++i)
+    if (ids[i] < 0) ids[i] = h.intern(paths[i]);
+  const Word* n = count_sums.data() + held_cells;
+  for (std::size_t k = 0; k < num_rows; ++k, ++n) {
+    const Histogram::PathId id = ids[static_cast<std::size_t>(union_rows[2 * k])];
+    h.add_technique(id, union_rows[2 * k + 1], *n, nullptr);
+    rows[k] = h.technique_row(id, union_rows[2 * k + 1]);
+  }
+  const Word* w = words.data();
+  const Word* c = count_sums.data();
+  for (std::size_t b = 0; b < B; ++b) {
+    for (std::size_t i = 0; i < P; ++i)
+      if (is_held(b * P + i)) h.add_cell(ids[i], static_cast<int>(b), {get(w), get(w + 2), get(w + 4)}, *c++), w += 6;
+    for (std::size_t k = 0; k < num_rows; ++k)
+      if (is_held(cell_bits + b * num_rows + k)) h.add_row_sum(rows[k], static_cast<int>(b), get(w)), w += 2;
+  }
+  for (std::size_t b = 0; b < B; ++b) h.add_samples(static_cast<int>(b), *n++);
+  h.add_nonfinite(*n);
+  for (int i = 1; i < size_; ++i) h.add_magnitude(get(&magnitudes[2 * static_cast<std::size_t>(i)]));
   return true;
 }
 

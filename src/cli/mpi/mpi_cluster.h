@@ -29,6 +29,12 @@ class MpiCluster final : public Cluster {
   Result<bool> wait_for_all(const char* what);
   // `any`[i] = the bitwise or of every rank's `flags`[i] (both of one size on every rank).
   Result<bool> or_all(const std::vector<unsigned char>& flags, std::vector<unsigned char>* any);
+  // `all` = every rank's `mine` one after the other, in rank order, on rank 0 (others: emptied).
+  template <typename T>
+  Result<bool> gather_to_root(const std::vector<T>& mine, MPI_Datatype type, std::vector<T>* all);
+  // Rank 0's `v` on every rank.
+  template <typename T>
+  Result<bool> broadcast(std::vector<T>* v, MPI_Datatype type);
   // 128-bit sums of `words` (pairs of low, high words) over the ranks, on rank 0 (others: emptied).
   Result<bool> sum_to_root(std::vector<std::uint64_t>* words);
 
