@@ -5,9 +5,11 @@ Runs `pathex trace SCENE --renderer R --spp N --threads 1 --no-images --quiet --
 binary in turn, ROUNDS times, alternating which goes first, and measures each process's CPU time
 (user + system, from os.wait4), so that time the shared host gives to other work is not counted.
 Prints samples per CPU-second for each side and the median of the per-round ratios B / A (above
-1: B is faster).
+1: B is faster). More than one B may be given: every round then runs them all, in an order that
+rotates from round to round, and each is compared with A (--b-arg goes to every B).
 
     python3 bench/cli_ab.py OLD/pathex build/pathex --renderer pt-nee --spp 32 --rounds 9
+    python3 bench/cli_ab.py OLD/pathex MAIN/pathex build/pathex --renderer bdpt --spp 32 --rounds 15
 """
 import argparse
 import os
@@ -31,7 +33,7 @@ def cpu_run(cmd, cwd=None):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("a", help="binary A (the baseline)")
-    ap.add_argument("b", help="binary B (the change)")
+    ap.add_argument("b", nargs="+", help="binary B (the change), or several")
     ap.add_argument("--scene", default=None, help="scene file (default: the embedded Cornell box)")
     ap.add_argument("--renderer", default="bdpt")
     ap.add_argument("--spp", type=int, default=32)
@@ -49,25 +51,27 @@ def main():
     # Each binary writes its outputs (pathex-out/) in a folder of its own: pathex refuses to replace
     # outputs another version wrote.
     work = tempfile.mkdtemp(prefix="cli_ab-")
-    dirs = {name: os.path.join(work, name) for name in ("a", "b")}
+    sides = [("a", args.a)] + [(f"b{i}", b) for i, b in enumerate(args.b)]
+    dirs = {name: os.path.join(work, name) for name, _ in sides}
     for d in dirs.values():
         os.mkdir(d)
-    ratios, ta, tb = [], [], []
+    times = {name: [] for name, _ in sides}
     for r in range(args.rounds):
-        order = [("a", args.a), ("b", args.b)] if r % 2 == 0 else [("b", args.b), ("a", args.a)]
-        t = {}
+        # Two sides alternate which goes first; more rotate, so that each takes every place in turn.
+        k = r % len(sides)
+        order = sides[k:] + sides[:k] if len(sides) > 2 else (sides if r % 2 == 0 else sides[::-1])
         for name, binary in order:
-            t[name] = cpu_run([os.path.abspath(binary)] + tail + (args.b_arg if name == "b" else args.a_arg), dirs[name])
-        ta.append(t["a"])
-        tb.append(t["b"])
-        ratios.append(t["a"] / t["b"])
+            times[name].append(cpu_run([os.path.abspath(binary)] + tail + (args.a_arg if name == "a" else args.b_arg),
+                                       dirs[name]))
     shutil.rmtree(work)
-    med_a, med_b = statistics.median(ta), statistics.median(tb)
     rate = (lambda t: f"{samples / t / 1e6:.3f} M samples/CPU-s") if samples else (lambda t: f"{t:.3f} CPU-s")
     print(f"{args.renderer}, {args.spp} spp, {args.rounds} interleaved rounds")
-    print(f"  A {args.a}: median {rate(med_a)}")
-    print(f"  B {args.b}: median {rate(med_b)}")
-    print(f"  speed B / A: median {statistics.median(ratios):.4f} (rounds: {' '.join(f'{x:.3f}' for x in ratios)})")
+    print(f"  A {args.a}: median {rate(statistics.median(times['a']))}")
+    for name, binary in sides[1:]:
+        ratios = [a / b for a, b in zip(times["a"], times[name])]
+        label = "B" if len(sides) == 2 else f"B{name[1:]}"
+        print(f"  {label} {binary}: median {rate(statistics.median(times[name]))}")
+        print(f"  speed {label} / A: median {statistics.median(ratios):.4f} (rounds: {' '.join(f'{x:.3f}' for x in ratios)})")
 
 
 if __name__ == "__main__":
