@@ -161,8 +161,8 @@ glm::vec2 quad_uv(const QuadShape& q, const vec3& p) {
 // b0 p0 + b1 p1 + b2 p2: three products and two sums per component, and barycentrics whose sum
 // is 1 only up to rounding (pbrt-v4 bounds the same interpolation by gamma(7)); and Embree's test.
 vec3 triangle_point(const vec3& p0, const vec3& p1, const vec3& p2, float b0, float b1, float b2, vec3* error) {
-  const vec3 span = glm::abs(p1 - p0) + glm::abs(p2 - p0);
-  *error = error_gamma(7) * (glm::abs(b0 * p0) + glm::abs(b1 * p1) + glm::abs(b2 * p2)) +
+  const vec3 span = abs3(p1 - p0) + abs3(p2 - p0);
+  *error = error_gamma(7) * (abs3(b0 * p0) + abs3(b1 * p1) + abs3(b2 * p2)) +
            primitive_test_error(std::max(span.x, std::max(span.y, span.z)));
   return b0 * p0 + b1 * p1 + b2 * p2;
 }
@@ -170,7 +170,7 @@ vec3 triangle_point(const vec3& p0, const vec3& p1, const vec3& p2, float b0, fl
 // centre + radius n with n unit up to rounding: the reprojection and the sum (pbrt-v4: gamma(5)
 // for the reprojection in object space, plus the move to world space).
 vec3 sphere_error(const SphereShape& s, const vec3& n) {
-  return error_gamma(8) * (glm::abs(s.center) + s.radius * glm::abs(n));
+  return error_gamma(8) * (abs3(s.center) + s.radius * abs3(n));
 }
 
 // A point of the disk's plane within the radius: a projection or a frame's rotation, and a sum.

@@ -67,6 +67,11 @@ struct SurfaceSample {
   glm::vec3 error{0.0f};   // as Hit::error
 };
 
+// |v| per component. Not glm::abs, whose x >= 0 ? x : -x (which keeps -0) compiles to a branch per
+// component; here the sign bits are cleared (the bounds below and the offsets add such terms, where
+// -0 and +0 are the same).
+inline glm::vec3 abs3(const glm::vec3& v) { return {std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}; }
+
 // gamma(n) = n u / (1 - n u) with u = 2^-24, the unit roundoff of float: the bound on the
 // relative error of n successive float operations (pbrt-v4's gamma()).
 constexpr float error_gamma(int n) {
@@ -155,9 +160,13 @@ class EmbreeScene {
   // the tracer casts takes one or two.
   static glm::vec3 offset(const glm::vec3& p, const glm::vec3& n, const glm::vec3& e, const glm::vec3& d) {
     // A zero normal or error (a point: lights, pinholes) offsets by exactly zero, without a branch
-    // whose outcome would follow which ends of a connection are points.
-    const float dist = glm::dot(glm::abs(n), e);
-    const glm::vec3 off = (glm::dot(n, d) >= 0.0f ? dist : -dist) * n;
+    // whose outcome would follow which ends of a connection are points. No branches on signs
+    // either (glm::abs and a choice of ±dist compiled to four, mispredicted as often as the
+    // scene's normals and the rays' directions change sign): abs3(), and the side's sign put into
+    // dist's sign bit (dist >= 0, so this is -dist exactly when d points below the surface).
+    const float dist = glm::dot(abs3(n), e);
+    const std::uint32_t below = glm::dot(n, d) >= 0.0f ? 0u : 0x80000000u;
+    const glm::vec3 off = std::bit_cast<float>(std::bit_cast<std::uint32_t>(dist) ^ below) * n;
     return away(p + off, off);
   }
   // Each component of x moved to the next float towards the sign of dir's (kept when dir's is
