@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -68,6 +69,12 @@ class Integrator {
       const std::uint64_t below = (std::uint64_t{1} << n) - 1;  // s2 < n: t2 >= 1
       all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
     }
+    // The general recurrence reads the subpaths' stored ratios only beyond the two vertices nearest
+    // each end of a join, that is for another strategy at least 3 splits away from the join's own.
+    int spread = 0;
+    for (const std::uint64_t m : runs_mask_)
+      if (m != 0) spread = std::max(spread, (63 - std::countl_zero(m)) - std::countr_zero(m));
+    stored_ratios_ = all_runs_ || has_connectors_ || general_mis || spread >= 3;
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
     sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
     for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
@@ -142,8 +149,11 @@ class Integrator {
   static double ratio(const Vertex& v) { return remap(v.pdf_rev) / remap(v.pdf_fwd); }
   static double inv_fwd(const Vertex& v) { return 1.0 / remap(v.pdf_fwd); }
   // Per sample, before its first recorded contribution: the letter masks, and each vertex's
-  // ratio of reverse to forward density (a join changes only the two nearest each end).
+  // ratio of reverse to forward density (a join changes only the two nearest each end) when a
+  // weight can read them (stored_ratios_; pt-nee's never do).
   void prepare_joins(Thread& th, int ns, int nt) const {
+    set_masks(th, ns, nt);
+    if (!stored_ratios_) return;
     for (int i = 0; i < ns; ++i) {
       th.light_ratio[static_cast<std::size_t>(i)] = ratio(th.light[static_cast<std::size_t>(i)]);
       th.light_inv_fwd[static_cast<std::size_t>(i)] = inv_fwd(th.light[static_cast<std::size_t>(i)]);
@@ -152,14 +162,6 @@ class Integrator {
       th.eye_ratio[static_cast<std::size_t>(i)] = ratio(th.eye[static_cast<std::size_t>(i)]);
       th.eye_inv_fwd[static_cast<std::size_t>(i)] = inv_fwd(th.eye[static_cast<std::size_t>(i)]);
     }
-    th.joins_ready = true;
-    th.light_mask = 0;
-    if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
-    for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
-    th.eye_masks[0] = letter_bit(th.eye[0].pos_letter, 0);
-    for (int t = 1; t <= nt; ++t)
-      th.eye_masks[static_cast<std::size_t>(t)] =
-          (th.eye_masks[static_cast<std::size_t>(t - 1)] << 1) | letter_bit(th.eye[static_cast<std::size_t>(t - 1)].letter, 0);
     if (!all_runs_) return;
     // Strategy (i, ·) on the light side joins at y(i-1) and y_i: letters c_i and c_(i+1), bits i
     // and i + 1 of light_mask. On the eye side strategy (·, j) joins at z_j and z(j-1): letters
@@ -178,6 +180,17 @@ class Integrator {
       acc = r * r * (static_cast<double>(runs) + acc);
       th.eye_acc[static_cast<std::size_t>(j)] = acc;
     }
+  }
+  // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key().
+  void set_masks(Thread& th, int ns, int nt) const {
+    th.joins_ready = true;
+    th.light_mask = 0;
+    if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
+    for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
+    th.eye_masks[0] = letter_bit(th.eye[0].pos_letter, 0);
+    for (int t = 1; t <= nt; ++t)
+      th.eye_masks[static_cast<std::size_t>(t)] =
+          (th.eye_masks[static_cast<std::size_t>(t - 1)] << 1) | letter_bit(th.eye[static_cast<std::size_t>(t - 1)].letter, 0);
   }
   // The packed full-path string of connection (s, t), as full_path() spells it.
   // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
@@ -413,6 +426,9 @@ class Integrator {
   // sums over each subpath's fixed part are computed once per sample (prepare_joins()).
   bool all_runs_ = false;
   bool eye0_runs_ = false;
+  // A weight may read the ratios prepare_joins() stores (else it skips them): some n has two
+  // strategies 3 or more splits apart, or the sums above or a connector's weights need them.
+  bool stored_ratios_ = true;
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
   std::vector<std::string> light_pairs_;  // each light's letters c0 c1
