@@ -431,6 +431,15 @@ template <Integrator::Connection C>
 void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) const {
   constexpr bool by_light = C == Connection::kSplat || C == Connection::kOrtho || C == Connection::kLens;
   rng.set_dimension(kJoinDims + (static_cast<std::uint64_t>(C) * kMaxRuns + static_cast<std::uint64_t>(by_light ? s : t)) * kDimsPerJoin);
+  // s = 0: the eye subpath's last vertex must lie on an area light, which most do not; tested
+  // before the join is set up.
+  [[maybe_unused]] int hit_light = -1;
+  if constexpr (C == Connection::kEmitter) {
+    const Vertex& z = th.eye[static_cast<std::size_t>(t - 1)];
+    if (z.kind != Kind::kSurface) return;
+    hit_light = rs_.light_of_shape[static_cast<std::size_t>(z.shape)];
+    if (hit_light < 0) return;
+  }
   constexpr ConnectorKind kind = C == Connection::kDistant ? ConnectorKind::kDistantProjection : C == Connection::kOrtho ? ConnectorKind::kOrthoProjection : ConnectorKind::kNone;
   const int strategy_index = C == Connection::kDistant ? distant_of(t) : C == Connection::kOrtho ? ortho_of(s) : strategy(s, t);
   ConnectorStats* stats = kind != ConnectorKind::kNone ? &th.connectors[static_cast<std::size_t>(strategy_index)] : nullptr;
@@ -454,11 +463,8 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
   bool joined = false;  // `join` describes this connection (every case but s = 0 and t = 0)
   std::array<const Vertex*, 2> ends{};  // the shadow ray's ends, in the order visible() takes them
   if constexpr (C == Connection::kEmitter) {
-    // --- eye path hits an area light ---
-    if (pt->kind != Kind::kSurface) return;
-    const int li = rs_.light_of_shape[static_cast<std::size_t>(pt->shape)];
-    if (li < 0) return;
-    const LightParams& l = rs_.lights[static_cast<std::size_t>(li)].params;
+    // --- eye path hits an area light (hit_light, above) ---
+    const LightParams& l = rs_.lights[static_cast<std::size_t>(hit_light)].params;
     contrib = pt->beta * spatial_emission(l) * directional_emission(l, pt->n, pt->wo);
   } else if constexpr (C == Connection::kLens) {
     // --- light path hits the lens ---
