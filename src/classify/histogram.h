@@ -113,7 +113,13 @@ inline bool to_exact(const Rgb& c, ExactRgb* out) {
   for (std::size_t i = 0; i < 3; ++i) (*out)[i] = round_to_fixed(c[i] * 0x1p64);
   return true;
 }
-inline double to_double(ExactSum s) { return static_cast<double>(static_cast<SignedExactSum>(s)) * 0x1p-64; }
+// A sum that fits 64 bits converts in one instruction instead of libgcc's 128-bit routine; both
+// round to nearest, so the double is the same.
+inline double to_double(ExactSum s) {
+  const auto v = static_cast<SignedExactSum>(s);
+  if (const auto low = static_cast<std::int64_t>(v); low == v) return static_cast<double>(low) * 0x1p-64;
+  return static_cast<double>(v) * 0x1p-64;
+}
 inline Rgb to_double(const ExactRgb& s) { return {to_double(s[0]), to_double(s[1]), to_double(s[2])}; }
 // The Rec. 709 luminance of a contribution already on the grid, rounded to the grid: a function of
 // the contribution alone (what the per-technique sums add, see Histogram::TechniqueRow).

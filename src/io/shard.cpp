@@ -130,10 +130,11 @@ class Writer {
     x(c[1]);
     x(c[2]);
   }
-  // Eight bytes, little-endian.
+  // Eight bytes, little-endian (the machine's order, asserted above).
   void raw64(std::uint64_t v) {
     room(8);
-    for (int i = 0; i < 8; ++i) window_[used_++] = static_cast<char>((v >> (8 * i)) & 0xff);
+    std::memcpy(window_.data() + used_, &v, 8);
+    used_ += 8;
   }
   // A pixel's channel sum: the low word raw, the high word as a zigzag varint of its signed
   // value (one byte below 2^70 in magnitude, i.e. a sum below 64 on the pixel's grid).
