@@ -16,6 +16,7 @@
 #include "classify/pathclass.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/pass_deal.h"
 #include "core/pass_set.h"
 #include "io/shard.h"
 #include "reach/prune.h"
@@ -97,6 +98,11 @@ class Cluster {
   virtual ~Cluster() = default;
   virtual int rank() const = 0;
   virtual int size() const = 0;
+  // This rank's side of the deal of `todo` in chunks of `chunk` passes among the ranks
+  // (core/pass_deal.h): every rank makes one and renders the chunks it is handed until none is
+  // left (or it stops). Not collective; while it lives, this rank makes no other call on the
+  // cluster, and destroying it waits until every rank has left the deal.
+  virtual std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk) = 0;
   // Collective: adds every rank's sums, passes and run figures into rank 0's, exactly. The other
   // ranks' arguments are left unspecified. Fails naming a rank that did not take part.
   virtual Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run) = 0;

@@ -323,11 +323,18 @@ int run(const TraceArgs& a) {
     warn_unreachable_lights(*job.scene, *job.profile, *compiled, universe, id.max_bounces, a.limits);
   }
 
-  // --- render this process's part of the passes still missing ---
+  // --- render the passes still missing: all of them, or under MPI the chunks of them that the
+  // ranks' shared deal hands this rank (whoever is free takes the next, core/pass_deal.h) ---
   const PassSet todo = job.header.share.minus(job.header.passes);
   RenderOptions ro;
   ro.spp = job.header.spp;
-  ro.passes = todo.part(static_cast<std::uint64_t>(rank), static_cast<std::uint64_t>(ranks));
+  std::unique_ptr<PassDealer> dealer;
+  if (cluster != nullptr) {
+    dealer = cluster->deal(todo, kPassesPerChunk);
+    ro.dealer = dealer.get();
+  } else {
+    ro.passes = todo;
+  }
   ro.seed = id.seed;
   ro.threads = a.threads;
   ro.max_bounces = id.max_bounces;
@@ -405,6 +412,7 @@ int run(const TraceArgs& a) {
     if (stopped->load())
       std::fprintf(stderr, "pathex: rank %d stopped after %s of its passes; they are kept in %s ('pathex trace --resume %s' finishes the render)\n",
                    rank, out->passes_done.to_string().c_str(), mine.c_str(), job.out.c_str());
+    dealer.reset();  // the deal ends once every rank has left it (after its shard is safe)
     if (Result<bool> r = cluster->reduce(&sums, &header.passes, &header.run); !r) return report(r.error());
   }
   if (job.resumed) {
