@@ -1,5 +1,5 @@
-// Pass sets, their deal (core/pass_deal.h) and the shard file format (io/shard.h): exact round trips of the sums, and every
-// damaged file refused with its own message.
+// Pass sets, their deal (core/pass_deal.h) and the shard file format (io/shard.h): exact round
+// trips of the sums, and every damaged file refused with its own message.
 #include <gtest/gtest.h>
 #include <zlib.h>
 
