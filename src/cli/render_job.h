@@ -5,6 +5,7 @@
 // exactly the bytes of one uninterrupted process.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -92,7 +93,8 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
 namespace pathex::cli {
 
 // The processes one render is split across: one by default; pathex-mpi installs its MPI ranks
-// (cli/mpi/) before running the command line. Each rank renders a part of the run's passes.
+// (cli/mpi/) before running the command line. Each rank renders the chunks of the run's passes
+// that their shared deal hands it.
 class Cluster {
  public:
   virtual ~Cluster() = default;
@@ -104,8 +106,11 @@ class Cluster {
   // cluster, and destroying it waits until every rank has left the deal.
   virtual std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk) = 0;
   // Collective: adds every rank's sums, passes and run figures into rank 0's, exactly. The other
-  // ranks' arguments are left unspecified. Fails naming a rank that did not take part.
-  virtual Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run) = 0;
+  // ranks' arguments are left unspecified (their sums are only read). Rank 0 calls `before_changing`
+  // (when set) before it first changes `*sums`: until then others may read them (write them to a
+  // file from another thread). Fails naming a rank that did not take part.
+  virtual Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run,
+                              const std::function<void()>& before_changing = {}) = 0;
   // Collective: the number of ranks whose `ok` is false, on every rank (0 when all succeeded).
   virtual int count_failures(bool ok) = 0;
 };

@@ -150,7 +150,7 @@ Result<bool> MpiCluster::broadcast(std::vector<T>* v, MPI_Datatype type) {
   return check(MPI_Bcast(v->data(), static_cast<int>(n), type, 0, MPI_COMM_WORLD), "broadcast");
 }
 
-Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run) {
+Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run, const std::function<void()>& before_changing) {
   if (Result<bool> r = wait_for_all("barrier before the reduction"); !r) return r;
   Histogram& h = sums->histogram;
   const bool root = rank_ == 0;
@@ -274,7 +274,9 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
       !r)
     return r;
 
-  // --- the images: the tiles any rank touched, in blocks ---
+  // --- the images: the tiles any rank touched, in blocks (rank 0 adds each block as it comes:
+  // the first change to its sums) ---
+  if (root && before_changing) before_changing();
   std::vector<std::size_t> touched;
   for (std::size_t i = 0; i < planes * tiles; ++i)
     if (is_held(cell_bits + row_bits + i)) touched.push_back(i);

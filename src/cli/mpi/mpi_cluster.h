@@ -3,6 +3,7 @@
 
 #include <mpi.h>
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -20,7 +21,7 @@ class MpiCluster final : public Cluster {
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk) override;
-  Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run) override;
+  Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run, const std::function<void()>& before_changing) override;
   int count_failures(bool ok) override;
 
  private:
