@@ -187,9 +187,10 @@ struct RungResult {
 
 // Renders one rung: `profile` at `budget` with `seed`. A time budget stops the render after the
 // chunk in progress when the time is up; Ctrl-C (g_interrupted) stops it and marks it interrupted.
-// Under MPI every rank calls it for every rung (it is collective): the ranks deal the rung's passes
-// among themselves (Cluster::deal: whoever is free takes the next chunk), and only rank 0's result
-// holds the rung's measures (the others' `classes` are empty). A rung interrupted on any rank is interrupted on all.
+// Under MPI every rank calls it for every rung (it is collective): the ranks deal the rung's
+// passes among themselves (Cluster::deal: whoever is free takes the next chunk), and only rank 0's
+// result holds the rung's measures (the others' `classes` are empty). A rung interrupted on any
+// rank is interrupted on all.
 Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, const Budget& budget, std::uint64_t seed,
                             const std::vector<ClassRow>& rows) {
   Cluster* cluster = current_cluster();
