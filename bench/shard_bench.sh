@@ -106,9 +106,11 @@ if [ "$what" = mpi ] || [ "$what" = all ]; then
   else
     # Wall time (including process start) and CPU time (user + sys) of each process: the CPU
     # figures say what the split costs whatever the load: efficiency = CPU of one process / CPU
-    # of both ranks, and the speedup two idle cores would give = CPU of one process / (the
-    # slower rank's CPU + the 2-rank run's start-up and reduction, measured as its wall time
-    # minus its slower rank's wall time).
+    # of both ranks, and the speedup two idle cores would give = CPU of one process / (half the
+    # ranks' CPU + the 2-rank run's start-up and exit, measured as its wall time minus its slower
+    # rank's wall time). Half: the ranks deal the passes as they go (src/cli/mpi/mpi_deal.h), so
+    # on two equal idle cores each would do half the work; under load the faster rank takes more
+    # passes and the ranks' CPU times differ. (Before the dynamic deal, the slower rank's CPU.)
     args=(trace samples/scenes/cornell.json --spp "${SPP:-256}" --threads 1 --quiet)
     speedups=(); efficiencies=(); idle_speedups=(); old_speedups=(); old_efficiencies=()
     cpu_idle() { awk '/^cpu /{print $5 + $6, $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9}' /proc/stat; }
@@ -127,14 +129,13 @@ if [ "$what" = mpi ] || [ "$what" = all ]; then
       read -r w_b u_b s_b < "$work/rank.time.1"
       one=$(echo "$t1 - $t0" | bc -l); two=$(echo "$t2 - $t1" | bc -l)
       cpu1=$(echo "$u1 + $s1" | bc -l); cpu_a=$(echo "$u_a + $s_a" | bc -l); cpu_b=$(echo "$u_b + $s_b" | bc -l)
-      slow_cpu=$(echo "if ($cpu_a > $cpu_b) $cpu_a else $cpu_b" | bc -l)
       slow_wall=$(echo "if ($w_a > $w_b) $w_a else $w_b" | bc -l)
       overhead=$(echo "$two - $slow_wall" | bc -l)
       speedups+=("$(echo "$one / $two" | bc -l)")
       efficiencies+=("$(echo "$cpu1 / ($cpu_a + $cpu_b)" | bc -l)")
-      idle_speedups+=("$(echo "$cpu1 / ($slow_cpu + $overhead)" | bc -l)")
-      printf 'round %d: 1 process %.2f s wall %.2f s CPU; 2 ranks %.2f s wall, ranks %.2f + %.2f s CPU, mpirun start-up and exit %.2f s; wall speedup %.3f, CPU efficiency %.3f, idle-machine speedup %.3f\n' \
-        "$r" "$one" "$cpu1" "$two" "$cpu_a" "$cpu_b" "$overhead" "${speedups[-1]}" "${efficiencies[-1]}" "${idle_speedups[-1]}"
+      idle_speedups+=("$(echo "$cpu1 / (($cpu_a + $cpu_b) / 2 + $overhead)" | bc -l)")
+      printf 'round %d: 1 process %.2f s wall %.2f s CPU; 2 ranks %.2f s wall, ranks %.2f + %.2f s CPU, mpirun start-up and exit %.2f s; wall speedup %.3f, CPU efficiency %.3f, idle-machine speedup %.3f (load %s)\n' \
+        "$r" "$one" "$cpu1" "$two" "$cpu_a" "$cpu_b" "$overhead" "${speedups[-1]}" "${efficiencies[-1]}" "${idle_speedups[-1]}" "$(cut -d' ' -f1 /proc/loadavg)"
       if [ -n "${OLD_MPI:-}" ]; then
         t3=$(now)
         mpirun --oversubscribe --allow-run-as-root -n 2 sh -c \

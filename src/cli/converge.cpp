@@ -9,10 +9,10 @@
 // Rendering goes through the tracer's library entry point, render(), one call per rung
 // (run_rung below): the ladder is a plain loop over independent rungs, each a function of its
 // renderer, budget and seed. Under MPI (`mpirun -n N pathex-mpi converge …`) every rung is split
-// like `pathex trace`: each rank renders its part of the rung's passes, the exact sums are added on
-// rank 0 (Cluster::reduce), which measures the rung from the same sums as one process, so every
-// estimate, stderr and error is the same number; its CPU time is the ranks' sum, its wall time
-// rank 0's. Rank 0 alone shows progress, prints and writes.
+// like `pathex trace`: the ranks deal the rung's passes as they go (Cluster::deal), the exact sums
+// are added on rank 0 (Cluster::reduce), which measures the rung from the same sums as one process,
+// so every estimate, stderr and error is the same number; its CPU time is the ranks' sum, its wall
+// time rank 0's. Rank 0 alone shows progress, prints and writes.
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -187,16 +187,20 @@ struct RungResult {
 
 // Renders one rung: `profile` at `budget` with `seed`. A time budget stops the render after the
 // chunk in progress when the time is up; Ctrl-C (g_interrupted) stops it and marks it interrupted.
-// Under MPI every rank calls it for every rung (it is collective): each renders part(rank, ranks)
-// of the passes, and only rank 0's result holds the rung's measures (the others' `classes` are
-// empty). A rung interrupted on any rank is interrupted on all.
+// Under MPI every rank calls it for every rung (it is collective): the ranks deal the rung's
+// passes among themselves (Cluster::deal: whoever is free takes the next chunk), and only rank 0's
+// result holds the rung's measures (the others' `classes` are empty). A rung interrupted on any
+// rank is interrupted on all.
 Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, const Budget& budget, std::uint64_t seed,
                             const std::vector<ClassRow>& rows) {
   Cluster* cluster = current_cluster();
   RenderOptions ro;
   ro.spp = budget.spp ? budget.spp : (std::uint64_t{1} << 24);
-  if (cluster != nullptr)
-    ro.passes = PassSet::range(0, ro.spp).part(static_cast<std::uint64_t>(cluster->rank()), static_cast<std::uint64_t>(cluster->size()));
+  std::unique_ptr<PassDealer> dealer;  // under MPI, the ranks' shared deal of the rung's passes
+  if (cluster != nullptr) {
+    dealer = cluster->deal(PassSet::range(0, ro.spp), kPassesPerChunk);
+    ro.dealer = dealer.get();
+  }
   ro.seed = seed;
   ro.threads = setup.threads;
   ro.max_bounces = setup.max_bounces;
@@ -222,6 +226,7 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
     timer.request_stop();
     timer.join();
   }
+  dealer.reset();  // every rank has left the deal: the cluster is free for the reduction
   if (!out) return out.error();
   RungResult r;
   r.budget = budget;

@@ -5,6 +5,7 @@
 // exactly the bytes of one uninterrupted process.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +17,7 @@
 #include "classify/pathclass.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/pass_deal.h"
 #include "core/pass_set.h"
 #include "io/shard.h"
 #include "reach/prune.h"
@@ -91,15 +93,24 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
 namespace pathex::cli {
 
 // The processes one render is split across: one by default; pathex-mpi installs its MPI ranks
-// (cli/mpi/) before running the command line. Each rank renders a part of the run's passes.
+// (cli/mpi/) before running the command line. Each rank renders the chunks of the run's passes
+// that their shared deal hands it.
 class Cluster {
  public:
   virtual ~Cluster() = default;
   virtual int rank() const = 0;
   virtual int size() const = 0;
+  // This rank's side of the deal of `todo` in chunks of `chunk` passes among the ranks
+  // (core/pass_deal.h): every rank makes one and renders the chunks it is handed until none is
+  // left (or it stops). Not collective; while it lives, this rank makes no other call on the
+  // cluster, and destroying it waits until every rank has left the deal.
+  virtual std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk) = 0;
   // Collective: adds every rank's sums, passes and run figures into rank 0's, exactly. The other
-  // ranks' arguments are left unspecified. Fails naming a rank that did not take part.
-  virtual Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run) = 0;
+  // ranks' arguments are left unspecified (their sums are only read). Rank 0 calls `before_changing`
+  // (when set) before it first changes `*sums`: until then others may read them (write them to a
+  // file from another thread). Fails naming a rank that did not take part.
+  virtual Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run,
+                              const std::function<void()>& before_changing = {}) = 0;
   // Collective: the number of ranks whose `ok` is false, on every rank (0 when all succeeded).
   virtual int count_failures(bool ok) = 0;
 };

@@ -323,11 +323,18 @@ int run(const TraceArgs& a) {
     warn_unreachable_lights(*job.scene, *job.profile, *compiled, universe, id.max_bounces, a.limits);
   }
 
-  // --- render this process's part of the passes still missing ---
+  // --- render the passes still missing: all of them, or under MPI the chunks of them that the
+  // ranks' shared deal hands this rank (whoever is free takes the next, core/pass_deal.h) ---
   const PassSet todo = job.header.share.minus(job.header.passes);
   RenderOptions ro;
   ro.spp = job.header.spp;
-  ro.passes = todo.part(static_cast<std::uint64_t>(rank), static_cast<std::uint64_t>(ranks));
+  std::unique_ptr<PassDealer> dealer;
+  if (cluster != nullptr) {
+    dealer = cluster->deal(todo, kPassesPerChunk);
+    ro.dealer = dealer.get();
+  } else {
+    ro.passes = todo;
+  }
   ro.seed = id.seed;
   ro.threads = a.threads;
   ro.max_bounces = id.max_bounces;
@@ -396,16 +403,29 @@ int run(const TraceArgs& a) {
   header.run = {out->time_s, ro.threads > 0 ? ro.threads : static_cast<int>(std::thread::hardware_concurrency()), out->rays,
                 cpu_s};
 
-  // --- MPI: keep this rank's work in a shard file, then sum every rank's into rank 0's ---
+  // --- MPI: keep this rank's work in a shard file, written while every rank's sums are added
+  // into rank 0's (the reduction reads the sums; rank 0 waits for the file before it changes
+  // them). Signals wait for the file: a rank that dies makes mpirun stop the others ---
   if (cluster != nullptr) {
     const std::string mine = rank_shard_path(job.out, rank);
     std::error_code ec;
     std::filesystem::create_directories(ranks_folder(job.out), ec);
-    if (Result<bool> w = write_shard(mine, header, sums); !w) return report(w.error());
+    std::optional<Result<bool>> kept;
+    std::thread keeper([&, h = header] {
+      const SignalShield shield;
+      kept.emplace(write_shard(mine, h, sums));
+    });
+    const auto kept_now = [&] {
+      if (keeper.joinable()) keeper.join();
+    };
+    dealer.reset();  // the deal ends once every rank has left it
+    Result<bool> reduced = cluster->reduce(&sums, &header.passes, &header.run, kept_now);
+    kept_now();
+    if (!*kept) return report(kept->error());
     if (stopped->load())
       std::fprintf(stderr, "pathex: rank %d stopped after %s of its passes; they are kept in %s ('pathex trace --resume %s' finishes the render)\n",
                    rank, out->passes_done.to_string().c_str(), mine.c_str(), job.out.c_str());
-    if (Result<bool> r = cluster->reduce(&sums, &header.passes, &header.run); !r) return report(r.error());
+    if (!reduced) return report(reduced.error());
   }
   if (job.resumed) {
     if (Result<bool> m = sums.histogram.merge(job.resumed->sums.histogram); !m) return report(m.error());

@@ -29,6 +29,15 @@ PassSet PassSet::part(std::uint64_t index, std::uint64_t count) const {
 
 void PassSet::add(std::uint64_t first, std::uint64_t last) {
   if (first >= last) return;
+  // After every range (a render's chunks come in order): appended or joined in constant time.
+  if (ranges_.empty() || ranges_.back().last < first) {
+    ranges_.push_back({first, last});
+    return;
+  }
+  if (ranges_.back().last == first) {
+    ranges_.back().last = last;
+    return;
+  }
   std::vector<PassRange> out;
   out.reserve(ranges_.size() + 1);
   PassRange fresh{first, last};

@@ -973,11 +973,18 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
   const auto start = std::chrono::steady_clock::now();
   // Passes run in chunks: a pixel takes a chunk's passes back to back, so that its camera
   // contributions reach the shared image once per chunk (and its part of the scene stays in
-  // cache); cancelling stops on a whole chunk, so every finished pass covers the whole image.
-  const PassSet todo = o.passes.value_or(PassSet::range(0, o.spp));
-  for (const PassRange& chunk : todo.chunks(kPassesPerChunk)) {
-    if (o.cancel && o.cancel->load()) break;
-    const std::uint64_t first = chunk.first, end = chunk.last;
+  // cache); cancelling stops on a whole chunk, so every finished pass covers the whole image. The
+  // chunks come from a deal (core/pass_deal.h): this render's passes in order, or an MPI job's.
+  ChunkDeal own(o.passes.value_or(PassSet::range(0, o.spp)), kPassesPerChunk);
+  PassDealer& deal = o.dealer != nullptr ? *o.dealer : own;
+  bool dealt_all = false;
+  while (!(o.cancel && o.cancel->load())) {
+    const std::optional<PassRange> chunk = deal.next();
+    if (!chunk) {
+      dealt_all = true;
+      break;
+    }
+    const std::uint64_t first = chunk->first, end = chunk->last;
     tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& rows) {
       Integrator::Thread& th = locals.local();
       for (int y = rows.begin(); y < rows.end(); ++y) {
@@ -988,10 +995,10 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
     });
     for (std::uint64_t p = first; p < end; ++p) out.histogram.add_samples(tracer::batch_of(p, o.batches), pixels);
     out.passes_done.add(first, end);
-    if (o.progress) o.progress(out.passes_done.count() * pixels, todo.count() * pixels);
+    if (o.progress) o.progress(deal.dealt() * pixels, deal.total() * pixels);
   }
   out.spp_done = out.passes_done.count();
-  out.complete = out.passes_done == todo;
+  out.complete = dealt_all;
   // The threads' histograms are summed into the first of them, which then takes the place of
   // the output's (holding only the sample counts so far): one fewer copy of every path, and of
   // its classification. Ids are local to a histogram, so which thread comes first does not show.

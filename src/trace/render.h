@@ -39,6 +39,7 @@
 #include "classify/histogram.h"
 #include "classify/image.h"
 #include "core/error.h"
+#include "core/pass_deal.h"
 #include "core/pass_set.h"
 #include "reach/profile.h"
 #include "scene/scene.h"
@@ -58,6 +59,9 @@ struct RenderOptions {
   // The passes to take (a shard's share, what a resumed render still lacks); unset: [0, spp).
   // The outputs of renders of disjoint pass sets add up exactly to the render of their union.
   std::optional<PassSet> passes;
+  // Where the chunks come from instead (then `passes` is ignored): a deal shared with other
+  // processes (core/pass_deal.h), of which this render takes the chunks it is handed.
+  PassDealer* dealer = nullptr;
   std::uint64_t seed = 1;
   int threads = 0;                     // 0: all cores
   std::optional<int> max_bounces;      // interior vertices, k - 1; unset: the profile's bound, else 16
@@ -79,7 +83,9 @@ struct RenderOptions {
   // reduced by prune_profile() (reach/prune.h) too, so that no strategy runs for nothing.
   const RequestedPaths* only = nullptr;
   ManifoldOptions manifold{};          // pathex trace --manifold-*: the manifold connector's limits
-  std::function<void(std::uint64_t done, std::uint64_t total)> progress;  // called from one thread
+  // Called from one thread after each chunk: samples done of the total (with a dealer, the passes
+  // it has dealt to every taker).
+  std::function<void(std::uint64_t done, std::uint64_t total)> progress;
   const std::atomic<bool>* cancel = nullptr;  // set to stop early; the result is marked incomplete
 };
 

@@ -409,6 +409,37 @@ TEST_P(MpiSparse, RanksWriteTheBytesOfOneProcess) {
 INSTANTIATE_TEST_SUITE_P(Ranks, MpiSparse, ::testing::Values(2, 3),
                          [](const ::testing::TestParamInfo<int>& p) { return std::to_string(p.param) + "ranks"; });
 
+// The ranks share a deal of the passes (src/cli/mpi/mpi_deal.h): whoever is free takes the next
+// chunk, so a rank's passes can be any set, and which set does not change a byte. The test's shim
+// (support/mpi_deal_shim.cpp) holds ranks back: the last rank asks for its first chunk only once
+// rank 0 has written its rank file, after the deal is done, so it renders nothing; with 3 ranks,
+// rank 1 also asks 20 ms late for every chunk, so it takes fewer chunks than rank 0, scattered
+// among rank 0's (where, varies from run to run).
+#ifndef PATHEX_MPI_DEAL_SHIM
+#define PATHEX_MPI_DEAL_SHIM ""
+#endif
+class MpiUnevenDeal : public ::testing::TestWithParam<int> {};
+TEST_P(MpiUnevenDeal, RanksWriteTheBytesOfOneProcess) {
+  if (std::string(PATHEX_MPI_BINARY).empty()) GTEST_SKIP() << "pathex-mpi is not built (MPI was not found at configure time)";
+  const int n = GetParam();
+  const std::string args =
+      " trace samples/scenes/cornell.json --classes samples/classes/twenty.json --resolution 40x40 --spp 64 --quiet --threads 1 --out ";
+  const std::string single = dir("single"), ranks = dir("uneven-" + std::to_string(n));
+  fs::remove_all(ranks + ".ranks");
+  ASSERT_EQ(run_pathex(args + single).code, 0);
+  using pathex::test::shell_quote;
+  const std::string preload =
+      "LD_PRELOAD=" + shell_quote(PATHEX_MPI_DEAL_SHIM) + " ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:verify_asan_link_order=0\"";
+  std::string cases = std::to_string(n - 1) + ") export " + preload + " PATHEX_DEAL_AWAIT=" + shell_quote(ranks + ".ranks/rank-0.shard") + ";; ";
+  if (n == 3) cases += "1) export " + preload + " PATHEX_DEAL_SLEEP_MS=20;; ";
+  const std::string body = "case \"$OMPI_COMM_WORLD_RANK\" in " + cases + "esac; exec " + shell_quote(PATHEX_MPI_BINARY) + args + ranks;
+  const CliRun r = run_mpirun("-n " + std::to_string(n) + " sh -c " + shell_quote(body));
+  ASSERT_EQ(r.code, 0) << r.out;
+  expect_same_outputs(single, ranks, std::to_string(n) + " MPI ranks dealt unevenly");
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, MpiUnevenDeal, ::testing::Values(2, 3),
+                         [](const ::testing::TestParamInfo<int>& p) { return std::to_string(p.param) + "ranks"; });
+
 // The ranks' connector statistics are reduced too: histogram.json and rank 0's table.
 TEST(Mpi, ThreeRanksWithAConnectorWriteTheBytesOfOneProcess) {
   if (std::string(PATHEX_MPI_BINARY).empty()) GTEST_SKIP() << "pathex-mpi is not built (MPI was not found at configure time)";

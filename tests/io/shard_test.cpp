@@ -1,12 +1,16 @@
-// Pass sets and the shard file format (io/shard.h): exact round trips of the sums, and every
-// damaged file refused with its own message.
+// Pass sets, their deal (core/pass_deal.h) and the shard file format (io/shard.h): exact round
+// trips of the sums, and every damaged file refused with its own message.
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <optional>
+#include <thread>
 #include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "core/pass_deal.h"
 #include "core/pass_set.h"
 #include "io/shard.h"
 
@@ -31,6 +35,46 @@ TEST(PassSet, PartsAreDisjointCoverTheSetAndDifferByAtMostOne) {
   }
   EXPECT_EQ(set.part(1, 3).to_string(), "5-9, 20");
   EXPECT_EQ(PassSet::range(0, 8).part(1, 2).to_string(), "4-7");
+}
+
+// A deal hands out the set's chunks in order (PassSet::chunks), each once, then none; `dealt`
+// counts the passes handed out.
+TEST(ChunkDeal, DealsTheChunksInOrderThenNone) {
+  PassSet set = PassSet::range(0, 10);
+  set.add(20, 27);
+  ChunkDeal deal(set, 4);
+  EXPECT_EQ(deal.total(), 17u);
+  EXPECT_EQ(deal.dealt(), 0u);
+  std::vector<PassRange> got;
+  std::vector<std::uint64_t> dealt;
+  while (const std::optional<PassRange> c = deal.next()) got.push_back(*c), dealt.push_back(deal.dealt());
+  EXPECT_EQ(got, set.chunks(4));
+  EXPECT_EQ(dealt, (std::vector<std::uint64_t>{4, 8, 10, 14, 17}));
+  EXPECT_FALSE(deal.next());
+  EXPECT_EQ(deal.dealt(), 17u);
+  ChunkDeal none(PassSet(), 4);
+  EXPECT_FALSE(none.next());
+  EXPECT_EQ(none.total(), 0u);
+}
+
+// Threads taking from one deal (MPI rank 0's render and its thread serving the other ranks)
+// together get every pass once.
+TEST(ChunkDeal, ThreadsTakingTogetherGetEveryPassOnce) {
+  ChunkDeal deal(PassSet::range(0, 3000), 3);
+  std::vector<PassSet> taken(4);
+  {
+    std::vector<std::jthread> takers;
+    for (PassSet& mine : taken)
+      takers.emplace_back([&deal, &mine] {
+        while (const std::optional<PassRange> c = deal.next()) mine.add(c->first, c->last);
+      });
+  }
+  PassSet all;
+  for (const PassSet& mine : taken) {
+    EXPECT_TRUE(all.intersect(mine).empty());
+    all.add(mine);
+  }
+  EXPECT_EQ(all, PassSet::range(0, 3000));
 }
 
 TEST(PassSet, SetOperationsAndText) {

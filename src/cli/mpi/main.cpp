@@ -1,8 +1,9 @@
 // pathex-mpi: the pathex command line inside an MPI job. `mpirun -n N pathex-mpi trace …` renders
 // one image across the N ranks (mpi_cluster.cpp) and writes the outputs of one process on rank 0;
 // every other command runs as in pathex, on every rank. As in pathex, the whole of it runs on a
-// thread with an explicit stack (core/stack.h); MPI is initialised on that thread too, so that it
-// is the thread MPI_THREAD_FUNNELED names.
+// thread with an explicit stack (core/stack.h); MPI is initialised on that thread too. Only it calls
+// MPI, except on rank 0 while the ranks deal the passes, when a thread of the deal does
+// (mpi_deal.h): MPI_THREAD_SERIALIZED.
 #include <mpi.h>
 
 #include <cstdio>
@@ -15,8 +16,8 @@ namespace {
 
 int run_mpi_command_line(int argc, char** argv) {
   int provided = 0;
-  // Only this thread calls MPI (the TBB workers never do).
-  if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
+  // One thread at a time calls MPI (the TBB workers never do).
+  if (MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS) {
     std::fprintf(stderr, "pathex: error: MPI_Init failed\n");
     return pathex::cli::kExitBadInput;
   }

@@ -1,6 +1,6 @@
 // pathex-mpi: the pathex command line with `trace` split across MPI ranks (built when CMake finds
-// MPI, e.g. Debian's OpenMPI). Each rank renders its part of the passes with TBB inside; the
-// exact integer sums are then added on rank 0 by MPI reductions (a user operation adding 128-bit
+// MPI, e.g. Debian's OpenMPI). Each rank renders, with TBB inside, the chunks of passes that the
+// ranks' shared deal hands it (mpi_deal.h: whoever is free takes the next chunk); the exact integer sums are then added on rank 0 by MPI reductions (a user operation adding 128-bit
 // integers, which is associative and commutative, so the result does not depend on the order MPI
 // combines ranks in), and rank 0 writes the outputs: the same bytes as one process.
 //
@@ -29,11 +29,11 @@
 #include <cstring>
 #include <string>
 #include <string_view>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "cli/mpi/mpi_cluster.h"
+#include "cli/mpi/mpi_deal.h"
 
 namespace pathex::cli {
 namespace {
@@ -63,6 +63,10 @@ MpiCluster::MpiCluster() {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &size_);
   MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  int level = MPI_THREAD_SINGLE;
+  MPI_Query_thread(&level);
+  serialized_ = level >= MPI_THREAD_SERIALIZED;
+  MPI_Comm_dup(MPI_COMM_WORLD, &deal_comm_);  // inherits MPI_ERRORS_RETURN
   MPI_Type_contiguous(2, MPI_UINT64_T, &u128_);
   MPI_Type_commit(&u128_);
   MPI_Op_create(&add_u128, /*commute=*/1, &add_);
@@ -71,6 +75,14 @@ MpiCluster::MpiCluster() {
 MpiCluster::~MpiCluster() {
   MPI_Op_free(&add_);
   MPI_Type_free(&u128_);
+  MPI_Comm_free(&deal_comm_);
+}
+
+std::unique_ptr<PassDealer> MpiCluster::deal(const PassSet& todo, std::uint64_t chunk) {
+  if (!serialized_)  // rank 0 could not serve the others from a thread: a static share each
+    return std::make_unique<ChunkDeal>(todo.part(static_cast<std::uint64_t>(rank_), static_cast<std::uint64_t>(size_)), chunk);
+  if (rank_ == 0) return std::make_unique<RootDeal>(todo, chunk, deal_comm_, size_);
+  return std::make_unique<RemoteDeal>(todo.count(), deal_comm_, rank_);
 }
 
 Result<bool> MpiCluster::check(int code, const char* what) const {
@@ -84,15 +96,10 @@ Result<bool> MpiCluster::check(int code, const char* what) const {
 Result<bool> MpiCluster::wait_for_all(const char* what) {
   MPI_Request request{};
   if (Result<bool> r = check(MPI_Ibarrier(MPI_COMM_WORLD, &request), what); !r) return r;
-  // Polls every 0.25 ms at first, backing off to every 8 ms: a wake-up costs some 30 µs of CPU
-  // here (a virtual machine), and a rank that waits seconds for a slower one polled 1000 times a
-  // second (38 ms of CPU in a 128-spp run of the Cornell box); the added latency is at most 8 ms.
-  for (std::chrono::microseconds pause(250);; pause = std::min(2 * pause, std::chrono::microseconds(8000))) {
-    int done = 0;
-    if (Result<bool> r = check(MPI_Test(&request, &done, MPI_STATUS_IGNORE), what); !r) return r;
-    if (done != 0) return true;
-    std::this_thread::sleep_for(pause);
-  }
+  // Backing off to every 8 ms: a wake-up costs some 30 µs of CPU here (a virtual machine), and a
+  // rank that waits seconds for a slower one polled 1000 times a second (38 ms of CPU in a 128-spp
+  // run of the Cornell box); the added latency is at most 8 ms.
+  return check(wait_sleeping(&request, MPI_STATUS_IGNORE, std::chrono::microseconds(8000)), what);
 }
 
 Result<bool> MpiCluster::sum_to_root(std::vector<Word>* words) {
@@ -143,7 +150,7 @@ Result<bool> MpiCluster::broadcast(std::vector<T>* v, MPI_Datatype type) {
   return check(MPI_Bcast(v->data(), static_cast<int>(n), type, 0, MPI_COMM_WORLD), "broadcast");
 }
 
-Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run) {
+Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run, const std::function<void()>& before_changing) {
   if (Result<bool> r = wait_for_all("barrier before the reduction"); !r) return r;
   Histogram& h = sums->histogram;
   const bool root = rank_ == 0;
@@ -267,7 +274,9 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
       !r)
     return r;
 
-  // --- the images: the tiles any rank touched, in blocks ---
+  // --- the images: the tiles any rank touched, in blocks (rank 0 adds each block as it comes:
+  // the first change to its sums) ---
+  if (root && before_changing) before_changing();
   std::vector<std::size_t> touched;
   for (std::size_t i = 0; i < planes * tiles; ++i)
     if (is_held(cell_bits + row_bits + i)) touched.push_back(i);

@@ -3,6 +3,8 @@
 
 #include <mpi.h>
 
+#include <functional>
+#include <memory>
 #include <vector>
 
 #include "cli/render_job.h"
@@ -18,14 +20,15 @@ class MpiCluster final : public Cluster {
 
   int rank() const override { return rank_; }
   int size() const override { return size_; }
-  Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run) override;
+  std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk) override;
+  Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run, const std::function<void()>& before_changing) override;
   int count_failures(bool ok) override;
 
  private:
   Result<bool> check(int code, const char* what) const;
-  // Returns once every rank has called it, sleeping (not spinning) while it waits: OpenMPI's
-  // blocking collectives poll at full speed, so a rank done first would take a core from the
-  // ranks still rendering, and every rank one from rank 0 writing the outputs.
+  // Returns once every rank has called it, sleeping (not spinning) while it waits (wait_sleeping,
+  // mpi_deal.h): OpenMPI's blocking collectives poll at full speed, so a rank done first would take
+  // a core from the ranks still rendering, and every rank one from rank 0 writing the outputs.
   Result<bool> wait_for_all(const char* what);
   // `any`[i] = the bitwise or of every rank's `flags`[i] (both of one size on every rank).
   Result<bool> or_all(const std::vector<unsigned char>& flags, std::vector<unsigned char>* any);
@@ -39,6 +42,8 @@ class MpiCluster final : public Cluster {
   Result<bool> sum_to_root(std::vector<std::uint64_t>* words);
 
   int rank_ = 0, size_ = 1;
+  bool serialized_ = false;         // MPI_THREAD_SERIALIZED provided: the deal is shared (mpi_deal.h)
+  MPI_Comm deal_comm_ = MPI_COMM_NULL;  // the deal's messages
   MPI_Datatype u128_{};
   MPI_Op add_{};
 };
