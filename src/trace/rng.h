@@ -70,9 +70,7 @@ inline constexpr float kOneMinusEpsilon = 1.0f - 0x1p-24f;  // the largest float
 // (trace/sobol.h): each pair of dimensions drawn with get2d() is stratified over a pixel's passes
 // (the first 2^k passes put one point in every elementary interval of area 2^-k), each number on
 // its own still uniform and independent across dimension pairs. Both are functions of (seed,
-// pixel, pass, dimension) alone. With `sobol` the tracer still draws the light subpath's vertices
-// after the first, and the splats' sensor numbers, from the independent stream
-// (trace/render.cpp, Integrator::sample, which says why).
+// pixel, pass, dimension) alone.
 enum class SamplerKind : std::uint8_t { kIndependent, kSobol };
 constexpr const char* to_string(SamplerKind k) { return k == SamplerKind::kSobol ? "sobol" : "independent"; }
 
