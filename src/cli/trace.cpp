@@ -422,6 +422,9 @@ int run(const TraceArgs& a) {
     Result<bool> reduced = cluster->reduce(&sums, &header.passes, &header.run, kept_now);
     kept_now();
     if (!*kept) return report(kept->error());
+    // Every rank's file is whole before rank 0 writes the outputs: a rank that dies before this
+    // point leaves rank files that --resume completes, never outputs beside them.
+    cluster->count_failures(true);
     if (stopped->load())
       std::fprintf(stderr, "pathex: rank %d stopped after %s of its passes; they are kept in %s ('pathex trace --resume %s' finishes the render)\n",
                    rank, out->passes_done.to_string().c_str(), mine.c_str(), job.out.c_str());
