@@ -6,31 +6,12 @@
 //   sleeps PATHEX_DEAL_SLEEP_MS milliseconds every time (a rank that asks that much more slowly),
 // then sends. Used by tests/cli/shard_cli_test.cpp (MpiUnevenDeal).
 #include <mpi.h>
-#include <sys/stat.h>
 
 #include <cstdlib>
-#include <ctime>
-#include <string>
+
+#include "await_files.h"
 
 namespace {
-
-void pause_ms(long ms) {
-  const timespec t{ms / 1000, (ms % 1000) * 1'000'000};
-  ::nanosleep(&t, nullptr);
-}
-
-void await_files() {
-  const char* list = std::getenv("PATHEX_DEAL_AWAIT");
-  if (list == nullptr) return;
-  std::string rest = list;
-  while (!rest.empty()) {
-    const std::size_t colon = rest.find(':');
-    const std::string file = rest.substr(0, colon);
-    rest = colon == std::string::npos ? "" : rest.substr(colon + 1);
-    struct stat st {};
-    while (!file.empty() && ::stat(file.c_str(), &st) != 0) pause_ms(10);
-  }
-}
 
 bool g_awaited = false;
 
@@ -38,9 +19,9 @@ bool g_awaited = false;
 
 extern "C" int MPI_Send(const void* buf, int count, MPI_Datatype type, int dest, int tag, MPI_Comm comm) {
   if (!g_awaited) {
-    await_files();
+    pathex_test::await_files("PATHEX_DEAL_AWAIT");
     g_awaited = true;
   }
-  if (const char* ms = std::getenv("PATHEX_DEAL_SLEEP_MS")) pause_ms(std::atol(ms));
+  if (const char* ms = std::getenv("PATHEX_DEAL_SLEEP_MS")) pathex_test::pause_ms(std::atol(ms));
   return PMPI_Send(buf, count, type, dest, tag, comm);
 }

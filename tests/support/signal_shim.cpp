@@ -25,6 +25,8 @@
 #include <ctime>
 #include <string>
 
+#include "await_files.h"
+
 namespace {
 
 std::atomic<long> g_calls{0};
@@ -36,27 +38,12 @@ bool watched(const char* path) {
   return path != nullptr && (dir == nullptr || std::strstr(path, dir) != nullptr);
 }
 
-// Waits until every file of PATHEX_SHIM_AWAIT exists, polling (stat is not intercepted).
-void await_files() {
-  const char* list = env("PATHEX_SHIM_AWAIT");
-  if (list == nullptr) return;
-  std::string rest = list;
-  while (!rest.empty()) {
-    const std::size_t colon = rest.find(':');
-    const std::string file = rest.substr(0, colon);
-    rest = colon == std::string::npos ? "" : rest.substr(colon + 1);
-    struct stat st {};
-    const timespec pause{0, 10'000'000};
-    while (!file.empty() && ::stat(file.c_str(), &st) != 0) ::nanosleep(&pause, nullptr);
-  }
-}
-
 void count(bool counts) {
   if (!counts) return;
   const long n = ++g_calls;
   const char* at = env("PATHEX_SHIM_AT");
   if (at == nullptr || std::atol(at) != n) return;
-  await_files();
+  pathex_test::await_files("PATHEX_SHIM_AWAIT");
   const char* sig = env("PATHEX_SHIM_SIGNAL");
   ::raise(sig ? std::atoi(sig) : SIGTERM);
 }
