@@ -16,6 +16,7 @@
 #include "classify/classifier.h"
 #include "classify/histogram.h"
 #include "classify/image.h"
+#include "trace/accel/nee_mis.h"
 #include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/joins/join.h"
@@ -75,6 +76,7 @@ class Integrator {
     for (const std::uint64_t m : runs_mask_)
       if (m != 0) spread = std::max(spread, (63 - std::countl_zero(m)) - std::countr_zero(m));
     stored_ratios_ = all_runs_ || has_connectors_ || general_mis || spread >= 3;
+    nee_mis_ = !has_connectors_ && !has_manifold_ && !general_mis && accel::nee_mis_applies(runs_mask_);
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
     sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
     for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
@@ -144,8 +146,7 @@ class Integrator {
   };
 
   // A vertex's density ratio in the MIS sums, a Dirac's densities (stored as 0) counting as 1.
-  // Branch-free (0 + 1 is exact): Dirac vertices come and go along a path unpredictably.
-  static double remap(float f) { return static_cast<double>(f) + static_cast<double>(f == 0.0f); }
+  static double remap(float f) { return remap_density(f); }
   static double ratio(const Vertex& v) { return remap(v.pdf_rev) / remap(v.pdf_fwd); }
   static double inv_fwd(const Vertex& v) { return 1.0 / remap(v.pdf_fwd); }
   // Per sample, before its first recorded contribution: the letter masks, and each vertex's
@@ -386,6 +387,27 @@ class Integrator {
   // stored densities and the join's own (`join`: what the join computed; null: recompute it).
   float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const JoinDensity* join = nullptr,
                    ConnectorKind self = ConnectorKind::kNone) const;
+  // mis_weight() for nee_mis_ profiles and t >= 2, by the fast path (trace/accel/nee_mis.h): 1
+  // when the other strategy cannot sample the letters, else its density of the point on the light
+  // against this one's.
+  float nee_mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const JoinDensity* join) const {
+    // As mis_weight() tests it: the other strategy, (0, t + 1) or (1, t - 1), runs, and its join
+    // letters are D.
+    const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));
+    if (((runs_mask_[static_cast<std::size_t>(s + t)] & d_pairs) >> (1 - s) & 1) == 0) return 1.0f;
+    const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
+    if (s == 0) return accel::emitter_hit_weight(pt, pdf_light_origin(pt));
+    const Vertex& y0 = sampled ? *sampled : th.light[0];
+    JoinDensity own;
+    if (join == nullptr) {  // as mis_weight() recomputes it
+      const vec3 e = pt.p - y0.p;
+      own.d2 = glm::dot(e, e);
+      own.w = own.d2 > 0.0f ? e * (1.0f / std::sqrt(own.d2)) : vec3(0.0f);
+      join = &own;
+    }
+    const float dir = join->at_pt.known ? join->at_pt.to_wi : pdf_dir(pt, &pt.wo, -join->w);
+    return accel::nee_weight(y0, dir, join->w, join->d2);
+  }
   // The estimator's one consumer of joins: weighs th.join by MIS over every strategy of the
   // profile, then records it, or queues its segments and records it once all are found clear.
   void estimate(Thread& th, int batch) const;
@@ -429,6 +451,9 @@ class Integrator {
   // A weight may read the ratios prepare_joins() stores (else it skips them): some n has two
   // strategies 3 or more splits apart, or the sums above or a connector's weights need them.
   bool stored_ratios_ = true;
+  // The profile's plain joins are the emitter hit and next-event estimation alone, and no connector
+  // runs: the estimator weighs joins with t >= 2 by the fast path (nee_mis_weight()).
+  bool nee_mis_ = false;
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
   std::vector<std::string> light_pairs_;  // each light's letters c0 c1

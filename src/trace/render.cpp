@@ -610,6 +610,8 @@ void Integrator::estimate(Thread& th, int batch) const {
     gather(th, jr.s, jr.t, jr.has_light0 ? &jr.light0 : nullptr, jr.chain_length > 0 ? jr.chain_vertices.data() : nullptr, jr.chain_length,
            jr.has_eye0 ? &jr.eye0 : nullptr);
     weight = path_weight(th, jr.letters, jr.chain, jr.s);
+  } else if (nee_mis_ && jr.t >= 2) {  // pt-nee's two strategies (trace/accel/nee_mis.h)
+    weight = nee_mis_weight(th, jr.s, jr.t, jr.fresh(), jr.letters, jr.has_density ? &jr.density : nullptr);
   } else {
     weight = mis_weight(th, jr.s, jr.t, jr.fresh(), jr.letters, jr.has_density ? &jr.density : nullptr, jr.chain);
   }

@@ -43,6 +43,10 @@ inline void link(Vertex& v, const Vertex& pred) {
   v.wo = v.d2_wo > 0.0f ? e / std::sqrt(v.d2_wo) : vec3(0.0f);
 }
 
+// A vertex's density as the MIS ratios use it, a Dirac's densities (stored as 0) counting as 1.
+// Branch-free (0 + 1 is exact): Dirac vertices come and go along a path unpredictably.
+inline double remap_density(float f) { return static_cast<double>(f) + static_cast<double>(f == 0.0f); }
+
 // |cos| at `v` towards `w` (1 for vertices without a surface, such as point lights).
 inline float abs_cos(const Vertex& v, const vec3& w) {
   // Arithmetic, not a choice (which compiled to a branch that mispredicted at every point vertex):

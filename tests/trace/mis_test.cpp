@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -24,6 +26,7 @@ namespace pathex::tracer {
 
 // The test's access to the integrator's internals: drives its subpaths and joins by hand.
 struct IntegratorTestAccess {
+  using Thread = Integrator::Thread;
   // One sample's eye and light subpaths, as render() traces them.
   static int trace_subpaths(const Integrator& in, Integrator::Thread& th, Sampler& rng, int px, int py, int* ns) {
     const int nt = in.eye_subpath(th, rng, px, py);
@@ -78,6 +81,42 @@ struct IntegratorTestAccess {
     }
     return sum;
   }
+  // Next-event estimation (1, t) from eye vertex z(t-1), as connect() joins it: a light picked and
+  // a point on it drawn from `rng` into *y0, the join's density into *join. False when there is
+  // no DD join (no light, a Dirac light, z(t-1) not a finite surface).
+  static bool nee_join(const Integrator& in, const Thread& th, int t, Sampler& rng, Vertex* y0, JoinDensity* join) {
+    const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
+    if (pt.kind != Kind::kSurface || !pt.finite || in.rs_.lights.empty()) return false;
+    const std::size_t li = in.pick_light(rng);
+    const RenderLight& l = in.rs_.lights[li];
+    if (in.light_pairs_[li][1] != 'D') return false;
+    vec3 err{0.0f};
+    const std::optional<EndpointConnection> c = pathex::connect(l.params, in.sample_point(l, rng, &err), pt.p);
+    if (!c) return false;
+    *y0 = Vertex{};
+    y0->kind = Kind::kLight;
+    y0->light = static_cast<int>(li);
+    y0->pos_letter = in.light_pairs_[li][0];
+    y0->letter = 'D';
+    y0->p = c->position;
+    y0->n = c->normal;
+    y0->ns = y0->n;
+    y0->err = err;
+    y0->pdf_fwd = in.light_pick_ * l.pdf_pos;
+    *join = JoinDensity{};
+    bsdf::eval(*in.rs_.material_of_shape[static_cast<std::size_t>(pt.shape)], pt.wo, c->wi, pt.ns, pt.n, &join->at_pt);
+    join->w = -c->wi;
+    join->d2 = c->distance * c->distance;
+    return true;
+  }
+  // The weight of connection (s, t) of the current subpaths (a fresh light point `y0` for s = 1)
+  // with the join's density `join` (null: recomputed), and the letters it records.
+  // As the estimator chooses: the fast path when the integrator takes it (t >= 2 here).
+  static float weight_of(const Integrator& in, const Thread& th, int s, int t, const Vertex* y0, const JoinDensity* join) {
+    const PathKey key = in.path_key(th, s, t, y0);
+    return in.nee_mis_ ? in.nee_mis_weight(th, s, t, y0, key, join) : in.mis_weight(th, s, t, y0, key, join);
+  }
+  static bool takes_nee_fast_path(const Integrator& in) { return in.nee_mis_; }
   // Whether (s, t) joins two vertices that can be joined (s = 0: an eye vertex on an area light;
   // t = 0: a light vertex on the lens; otherwise two surfaces with finite parts).
   static bool joinable(const Integrator& in, const Integrator::Thread& th, int s, int t) {
@@ -93,7 +132,6 @@ struct IntegratorTestAccess {
   // every strategy (s', t') with s' + t' = s + t that the profile runs and whose join letters are
   // D (and the projection connectors where the letters are DSD), of the MIS weight it computes
   // when it samples the same vertices. Must be 1.
-  using Thread = Integrator::Thread;
   static float weight_sum(const Integrator& in, Thread& th, int s, int t) {
     // The full path in light-to-eye order, from the two subpaths as connected by (s, t).
     const int k = s + t - 1;
@@ -260,6 +298,77 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
   }
   EXPECT_GT(checked, 2000u);
   EXPECT_GE(by_length.size(), 5u);  // paths of many lengths
+}
+
+// pt-nee's fast path (trace/accel/nee_mis.h) is a special case of the general MIS routine: on
+// random paths of every sample scene, the weights of its emitter hits (0, t) and of its next-event
+// estimation (1, t) from fresh light points equal, bit for bit, those of the join-local recurrence
+// (an integrator built with general_mis, which takes no fast path), with the join's densities as
+// connect() computes them and recomputed. Fixed seed; every profile the fast path applies to.
+TEST(Mis, NeeFastPathEqualsTheGeneralRoutine) {
+  const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes";
+  using A = IntegratorTestAccess;
+  int scenes = 0, nee_weighed = 0, hits_weighed = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".json") continue;
+    const Scene scene = load_scene_file(entry.path().string()).expect("a sample scene");
+    ++scenes;
+    for (const char* renderer : {"pt-nee", "pt", "pbrt-v4-path", "mitsuba3-path"}) {
+      const Profile profile = resolve_profile(renderer, Limits{}).expect("a built-in profile");
+      const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
+      const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
+      RenderOptions o;
+      o.seed = 17;
+      o.max_bounces = std::min(8, profile.max_bounces.value_or(8));
+      HistogramLayout layout;
+      ClassImages images(1, 1, nullptr, {});
+      const Integrator fast(rs, strategies, o);
+      const Integrator general(rs, strategies, o, /*general_mis=*/true);
+      ASSERT_FALSE(A::takes_nee_fast_path(general));
+      // pt-nee and pt always; pbrt-v4-path and mitsuba3-path where their distant connector cannot run.
+      if (std::string(renderer) == "pt-nee" || std::string(renderer) == "pt") {
+        EXPECT_TRUE(A::takes_nee_fast_path(fast)) << renderer;
+      }
+      if (!A::takes_nee_fast_path(fast)) continue;
+      Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
+      th.images = &images;
+      th.connectors.resize(strategies.strategies.size());
+      const StrategyTable table(strategies.strategies);
+      for (int i = 0; i < 400; ++i) {
+        Sampler rng(17, static_cast<std::uint64_t>(i), 0);
+        int ns = 0;
+        const int nt = A::trace_subpaths(fast, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
+        for (int t = 2; t <= nt && t - 2 <= *o.max_bounces; ++t) {
+          const auto where = [&](int s) {
+            return entry.path().filename().string() + " " + renderer + " " + A::label(fast, th, s, t) + " (s=" + std::to_string(s) +
+                   ", t=" + std::to_string(t) + ", sample " + std::to_string(i) + ")";
+          };
+          if (table.plain(0, t) >= 0 && A::joinable(fast, th, 0, t)) {
+            const float w = A::weight_of(fast, th, 0, t, nullptr, nullptr);
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(w), std::bit_cast<std::uint32_t>(A::weight_of(general, th, 0, t, nullptr, nullptr)))
+                << where(0);
+            if (w < 1.0f) ++hits_weighed;
+          }
+          Vertex y0;
+          JoinDensity join;
+          Sampler light_rng(17, static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(t));
+          if (t + 1 - 2 <= *o.max_bounces && table.plain(1, t) >= 0 && A::nee_join(fast, th, t, light_rng, &y0, &join)) {
+            const float w = A::weight_of(fast, th, 1, t, &y0, &join);
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(w), std::bit_cast<std::uint32_t>(A::weight_of(general, th, 1, t, &y0, &join)))
+                << where(1);
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(A::weight_of(fast, th, 1, t, &y0, nullptr)),
+                      std::bit_cast<std::uint32_t>(A::weight_of(general, th, 1, t, &y0, nullptr)))
+                << where(1) << ", the join's density recomputed";
+            if (w < 1.0f) ++nee_weighed;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GE(scenes, 10);
+  // Paths that both strategies sample (a weight below 1), not only the trivial ones.
+  EXPECT_GT(nee_weighed, 1000);
+  EXPECT_GT(hits_weighed, 300);
 }
 
 // Where bdpt's light tracing (and its other joins) and the manifold connector both sample a path,
