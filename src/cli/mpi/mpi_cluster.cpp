@@ -23,10 +23,14 @@
 // Only the held sums travel: at 2,048 spp of the Cornell box (42 k paths, 138 k rows, B = 32) 30.5 MB
 // per rank instead of 92.5 MB with dense rows (bench/README.md, "MPI's fixed cost").
 #include <mpi.h>
+#include <sys/mman.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
+#include <new>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -56,6 +60,62 @@ void put(Word* w, ExactSum x) {
   w[1] = static_cast<Word>(x >> 64);
 }
 ExactSum get(const Word* w) { return (static_cast<ExactSum>(w[1]) << 64) | static_cast<ExactSum>(w[0]); }
+
+// A bit set over [0, n), 64 bits a word.
+struct Bits {
+  explicit Bits(std::size_t n) : words((n + 63) / 64, 0) {}
+  void set(std::size_t i) { words[i >> 6] |= Word{1} << (i & 63); }
+  // The set bits in [begin, end), in increasing order.
+  template <typename F>
+  void for_each(std::size_t begin, std::size_t end, F&& f) const {
+    for (std::size_t k = begin >> 6; begin < end && k <= (end - 1) >> 6; ++k) {
+      Word x = words[k];
+      if (k == begin >> 6) x &= ~Word{0} << (begin & 63);
+      if (k == (end - 1) >> 6 && (end & 63) != 0) x &= ~Word{0} >> (64 - (end & 63));
+      for (; x != 0; x &= x - 1) f((k << 6) + static_cast<std::size_t>(std::countr_zero(x)));
+    }
+  }
+  std::size_t count(std::size_t begin, std::size_t end) const {
+    std::size_t n = 0;
+    for_each(begin, end, [&](std::size_t) { ++n; });
+    return n;
+  }
+  std::vector<Word> words;
+};
+
+// Words that start as zeros without being written: fresh pages from the kernel, already zero, so
+// they are touched once, by whoever fills them (the reduction's tens of megabytes: written once
+// instead of zeroed and then written). Large blocks ask for transparent huge pages: a page fault
+// per 2 MiB instead of per 4 KiB (on this project's virtual machines a fault costs some 30 µs, and
+// 30 MB of 4 KiB pages took a tenth of a second; bench/README.md, "issue 16, sixth session").
+class ZeroedWords {
+ public:
+  explicit ZeroedWords(std::size_t n) : n_(n), bytes_(std::max<std::size_t>(n, 1) * sizeof(Word)) {
+    if (bytes_ >= kMapped) {
+      void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (p == MAP_FAILED) throw std::bad_alloc();
+      ::madvise(p, bytes_, MADV_HUGEPAGE);  // advice: without it (or refused), 4 KiB pages
+      p_ = static_cast<Word*>(p);
+    } else {
+      p_ = static_cast<Word*>(std::calloc(bytes_, 1));
+      if (p_ == nullptr) throw std::bad_alloc();
+    }
+  }
+  ~ZeroedWords() {
+    if (bytes_ >= kMapped) ::munmap(p_, bytes_);
+    else std::free(p_);
+  }
+  ZeroedWords(const ZeroedWords&) = delete;
+  ZeroedWords& operator=(const ZeroedWords&) = delete;
+  Word* data() { return p_; }
+  const Word* data() const { return p_; }
+  std::size_t size() const { return n_; }
+
+ private:
+  static constexpr std::size_t kMapped = std::size_t{4} << 20;
+  std::size_t n_, bytes_;
+  Word* p_ = nullptr;
+};
 
 }  // namespace
 
@@ -102,26 +162,25 @@ Result<bool> MpiCluster::wait_for_all(const char* what) {
   return check(wait_sleeping(&request, MPI_STATUS_IGNORE, std::chrono::microseconds(8000)), what);
 }
 
-Result<bool> MpiCluster::sum_to_root(std::vector<Word>* words) {
-  if (rank_ == 0) std::fill(words->begin(), words->end(), 0);  // rank 0 adds the others' into its own
-  std::vector<Word> out(rank_ == 0 ? words->size() : 0);
-  const std::size_t pairs = words->size() / 2;
+Result<bool> MpiCluster::sum_to_root(Word* words, std::size_t size) {
+  // Rank 0's own words are zeros (it adds the others' into its own sums afterwards): in place, the
+  // result replaces them.
+  const std::size_t pairs = size / 2;
   constexpr std::size_t kBlock = std::size_t{1} << 20;  // pairs per call, within MPI's int counts
   for (std::size_t at = 0; at < pairs; at += kBlock) {
     const int n = static_cast<int>(std::min(kBlock, pairs - at));
-    Result<bool> r = check(MPI_Reduce(words->data() + 2 * at, rank_ == 0 ? out.data() + 2 * at : nullptr, n, u128_, add_, 0,
-                                      MPI_COMM_WORLD),
+    Word* block = words + 2 * at;
+    Result<bool> r = check(MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : block, rank_ == 0 ? block : nullptr, n, u128_, add_, 0, MPI_COMM_WORLD),
                            "reduce");
     if (!r) return r;
   }
-  words->swap(out);
   return true;
 }
 
-Result<bool> MpiCluster::or_all(const std::vector<unsigned char>& flags, std::vector<unsigned char>* any) {
+Result<bool> MpiCluster::or_all(const std::vector<Word>& flags, std::vector<Word>* any) {
   for (std::size_t at = 0; at < flags.size(); at += std::size_t{1} << 30) {
     const int n = static_cast<int>(std::min(flags.size() - at, std::size_t{1} << 30));
-    if (Result<bool> r = check(MPI_Allreduce(flags.data() + at, any->data() + at, n, MPI_UNSIGNED_CHAR, MPI_BOR, MPI_COMM_WORLD), "reduce");
+    if (Result<bool> r = check(MPI_Allreduce(flags.data() + at, any->data() + at, n, MPI_UINT64_T, MPI_BOR, MPI_COMM_WORLD), "reduce");
         !r)
       return r;
   }
@@ -207,61 +266,66 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
   // --- which sums are nonzero on some rank: one bit per (batch, path) cell, per (batch, row) sum
   // and per (image plane, tile), or-reduced. Most of a path's or a row's B batches are empty (a
   // rare path lands in few batches), so the sums reduced below are a fraction of the dense ones.
-  // Batch-major, as the histogram keeps them: a batch's cells and row sums are one array each ---
+  // Batch-major, as the histogram keeps them: a batch's cells and row sums are one array each,
+  // read here in this rank's order (each rank sets the bits of its own nonzero sums at their
+  // places in the union: a batch's bits fit in cache, its sums are read in memory order) ---
   const auto B = static_cast<std::size_t>(h.num_batches());
   const std::size_t P = paths.size();
   ClassImages& im = sums->images;
   const std::size_t planes = im.num_planes(), tiles = im.num_tiles();
   const std::size_t cell_bits = B * P, row_bits = B * num_rows, n_bits = cell_bits + row_bits + planes * tiles;
-  std::vector<unsigned char> held((n_bits + 7) / 8, 0), any_held(held.size(), 0);
-  const auto set_bit = [&](std::size_t i) { held[i >> 3] |= static_cast<unsigned char>(1u << (i & 7)); };
-  const auto is_held = [&](std::size_t i) { return ((any_held[i >> 3] >> (i & 7)) & 1) != 0; };
-  for (std::size_t b = 0; b < B; ++b) {
+  Bits held(n_bits), any_held(n_bits);
+  {
+    std::vector<std::size_t> place(static_cast<std::size_t>(h.num_paths())), row_place(static_cast<std::size_t>(h.num_rows()));
     for (std::size_t i = 0; i < P; ++i)
-      if (ids[i] >= 0)
-        if (const Histogram::Cell& cell = h.cell(ids[i], static_cast<int>(b)); cell.contributions != 0 || !is_zero(cell.sum))
-          set_bit(b * P + i);
+      if (ids[i] >= 0) place[static_cast<std::size_t>(ids[i])] = i;
     for (std::size_t k = 0; k < num_rows; ++k)
-      if (rows[k] >= 0 && h.row_sum(rows[k], static_cast<int>(b)) != 0) set_bit(cell_bits + b * num_rows + k);
+      if (rows[k] >= 0) row_place[static_cast<std::size_t>(rows[k])] = k;
+    for (std::size_t b = 0; b < B; ++b) {
+      for (std::size_t j = 0; h.batch_in_use(static_cast<int>(b)) && j < place.size(); ++j)
+        if (const Histogram::Cell& cell = h.cell(static_cast<Histogram::PathId>(j), static_cast<int>(b));
+            cell.contributions != 0 || !is_zero(cell.sum))
+          held.set(b * P + place[j]);
+      for (std::size_t r = 0; r < row_place.size(); ++r)
+        if (h.row_sum(static_cast<int>(r), static_cast<int>(b)) != 0) held.set(cell_bits + b * num_rows + row_place[r]);
+    }
   }
   for (std::size_t p = 0; p < planes; ++p)
     for (std::size_t t = 0; t < tiles; ++t)
-      if (im.tile_words(p, t) != nullptr) set_bit(cell_bits + row_bits + p * tiles + t);
-  if (Result<bool> r = or_all(held, &any_held); !r) return r;
+      if (im.tile_words(p, t) != nullptr) held.set(cell_bits + row_bits + p * tiles + t);
+  if (Result<bool> r = or_all(held.words, &any_held.words); !r) return r;
 
   // --- the histogram's sums, in the order of the bits: 128-bit words for the held cells' RGB sums
   // and the held row sums; 64-bit counts (their own type, summed by MPI_SUM modulo 2^64 like the
   // accumulator's) for the held cells' contributions, every row's contributions, the batches'
   // samples and the non-finite count. Rank 0 contributes zeros and adds the others' sums into its
   // own accumulators ---
-  std::size_t held_cells = 0, held_row_sums = 0;
-  for (std::size_t i = 0; i < cell_bits; ++i) held_cells += is_held(i) ? 1 : 0;
-  for (std::size_t i = cell_bits; i < cell_bits + row_bits; ++i) held_row_sums += is_held(i) ? 1 : 0;
-  std::vector<Word> words(6 * held_cells + 2 * held_row_sums, 0), counts(held_cells + num_rows + B + 1, 0);
+  const std::size_t held_cells = any_held.count(0, cell_bits), held_row_sums = any_held.count(cell_bits, cell_bits + row_bits);
+  ZeroedWords words(6 * held_cells + 2 * held_row_sums);  // zeros where this rank holds nothing
+  std::vector<Word> counts(held_cells + num_rows + B + 1, 0);
   if (!root) {
     Word* w = words.data();
     Word* n = counts.data();
     for (std::size_t b = 0; b < B; ++b) {
-      for (std::size_t i = 0; i < P; ++i) {
-        if (!is_held(b * P + i)) continue;
-        if (ids[i] >= 0) {  // else zeros
-          const Histogram::Cell& cell = h.cell(ids[i], static_cast<int>(b));
+      any_held.for_each(b * P, (b + 1) * P, [&](std::size_t bit) {
+        if (const Histogram::PathId id = ids[bit - b * P]; id >= 0) {
+          const Histogram::Cell& cell = h.cell(id, static_cast<int>(b));
           put(w, cell.sum[0]), put(w + 2, cell.sum[1]), put(w + 4, cell.sum[2]), *n = cell.contributions;
         }
         w += 6, ++n;
-      }
-      for (std::size_t k = 0; k < num_rows; ++k) {
-        if (!is_held(cell_bits + b * num_rows + k)) continue;
-        if (rows[k] >= 0) put(w, h.row_sum(rows[k], static_cast<int>(b)));
+      });
+      const std::size_t at = cell_bits + b * num_rows;
+      any_held.for_each(at, at + num_rows, [&](std::size_t bit) {
+        if (const int r = rows[bit - at]; r >= 0) put(w, h.row_sum(r, static_cast<int>(b)));
         w += 2;
-      }
+      });
     }
     for (std::size_t k = 0; k < num_rows; ++k, ++n)
       if (rows[k] >= 0) *n = h.row(rows[k]).contributions;
     for (std::size_t b = 0; b < B; ++b) *n++ = h.batch_samples(static_cast<int>(b));
     *n = h.nonfinite();
   }
-  if (Result<bool> r = sum_to_root(&words); !r) return r;
+  if (Result<bool> r = sum_to_root(words.data(), words.size()); !r) return r;
   std::vector<Word> count_sums(root ? counts.size() : 0);
   if (Result<bool> r = check(MPI_Reduce(counts.data(), count_sums.data(), static_cast<int>(counts.size()), MPI_UINT64_T, MPI_SUM, 0,
                                         MPI_COMM_WORLD),
@@ -278,8 +342,7 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
   // the first change to its sums) ---
   if (root && before_changing) before_changing();
   std::vector<std::size_t> touched;
-  for (std::size_t i = 0; i < planes * tiles; ++i)
-    if (is_held(cell_bits + row_bits + i)) touched.push_back(i);
+  any_held.for_each(cell_bits + row_bits, n_bits, [&](std::size_t bit) { touched.push_back(bit - cell_bits - row_bits); });
   constexpr std::size_t kTilesPerBlock = 4096;
   for (std::size_t at = 0; at < touched.size(); at += kTilesPerBlock) {
     const std::size_t n = std::min(kTilesPerBlock, touched.size() - at);
@@ -288,7 +351,7 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
       for (std::size_t k = 0; k < n; ++k)
         if (const Word* src = im.tile_words(touched[at + k] / tiles, touched[at + k] % tiles))
           std::memcpy(block.data() + k * ClassImages::kTileWords, src, ClassImages::kTileWords * sizeof(Word));
-    if (Result<bool> r = sum_to_root(&block); !r) return r;
+    if (Result<bool> r = sum_to_root(block.data(), block.size()); !r) return r;
     if (root)
       for (std::size_t k = 0; k < n; ++k)
         im.add_tile(touched[at + k] / tiles, touched[at + k] % tiles, block.data() + k * ClassImages::kTileWords);
@@ -344,10 +407,11 @@ Result<bool> MpiCluster::reduce(RenderSums* sums, PassSet* passes, ShardRun* run
   const Word* w = words.data();
   const Word* c = count_sums.data();
   for (std::size_t b = 0; b < B; ++b) {
-    for (std::size_t i = 0; i < P; ++i)
-      if (is_held(b * P + i)) h.add_cell(ids[i], static_cast<int>(b), {get(w), get(w + 2), get(w + 4)}, *c++), w += 6;
-    for (std::size_t k = 0; k < num_rows; ++k)
-      if (is_held(cell_bits + b * num_rows + k)) h.add_row_sum(rows[k], static_cast<int>(b), get(w)), w += 2;
+    any_held.for_each(b * P, (b + 1) * P, [&](std::size_t bit) {
+      h.add_cell(ids[bit - b * P], static_cast<int>(b), {get(w), get(w + 2), get(w + 4)}, *c++), w += 6;
+    });
+    const std::size_t at = cell_bits + b * num_rows;
+    any_held.for_each(at, at + num_rows, [&](std::size_t bit) { h.add_row_sum(rows[bit - at], static_cast<int>(b), get(w)), w += 2; });
   }
   for (std::size_t b = 0; b < B; ++b) h.add_samples(static_cast<int>(b), *n++);
   h.add_nonfinite(*n);

@@ -31,15 +31,16 @@ class MpiCluster final : public Cluster {
   // a core from the ranks still rendering, and every rank one from rank 0 writing the outputs.
   Result<bool> wait_for_all(const char* what);
   // `any`[i] = the bitwise or of every rank's `flags`[i] (both of one size on every rank).
-  Result<bool> or_all(const std::vector<unsigned char>& flags, std::vector<unsigned char>* any);
+  Result<bool> or_all(const std::vector<std::uint64_t>& flags, std::vector<std::uint64_t>* any);
   // `all` = every rank's `mine` one after the other, in rank order, on rank 0 (others: emptied).
   template <typename T>
   Result<bool> gather_to_root(const std::vector<T>& mine, MPI_Datatype type, std::vector<T>* all);
   // Rank 0's `v` on every rank.
   template <typename T>
   Result<bool> broadcast(std::vector<T>* v, MPI_Datatype type);
-  // 128-bit sums of `words` (pairs of low, high words) over the ranks, on rank 0 (others: emptied).
-  Result<bool> sum_to_root(std::vector<std::uint64_t>* words);
+  // The 128-bit sums of `size` words (pairs of low, high words) over the ranks, into rank 0's
+  // `words`, which must hold zeros (the others' are left as they were).
+  Result<bool> sum_to_root(std::uint64_t* words, std::size_t size);
 
   int rank_ = 0, size_ = 1;
   bool serialized_ = false;         // MPI_THREAD_SERIALIZED provided: the deal is shared (mpi_deal.h)
