@@ -483,13 +483,16 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     report.classes.push_back(std::move(ce));
   }
   if (listed < order.size()) {
-    std::vector<ExactRgb> other_sums(B, ExactRgb{});
-    std::uint64_t other_count = 0;
-    for (std::size_t i = listed; i < order.size(); ++i) {
+    // The total less the listed rows (integer sums: exactly the sum of the other rows' cells,
+    // without reading the cells of every path again, in an order scattered over memory).
+    std::vector<ExactRgb> other_sums = total_sums;
+    std::uint64_t other_count = total_count;
+    for (std::size_t i = 0; i < listed; ++i) {
       const Histogram::PathId p = order[i];
       for (int b = 0; b < nb; ++b) {
-        add_to(other_sums[static_cast<std::size_t>(b)], h.cell(p, b).sum);
-        other_count += h.cell(p, b).contributions;
+        const Histogram::Cell& c = h.cell(p, b);
+        for (std::size_t ch = 0; ch < 3; ++ch) other_sums[static_cast<std::size_t>(b)][ch] -= c.sum[ch];
+        other_count -= c.contributions;
       }
     }
     PathEstimate pe;
