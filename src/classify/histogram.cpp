@@ -282,7 +282,8 @@ class TechniqueTables {
     }
   }
 
-  // Row r adds into table `table`'s entry of its key. Rows are added in order (r never decreases).
+  // Row r adds into table `table`'s entry of its key. Rows are added in order (r never decreases),
+  // a row's tables one after the other.
   void add(int r, std::size_t table) {
     const int key = key_of_row_[static_cast<std::size_t>(r)];
     std::vector<int>& slots = slots_[table];
@@ -296,21 +297,22 @@ class TechniqueTables {
     add_to_entry(r, new_entry(key_of_row_[static_cast<std::size_t>(r)], table));
   }
 
-  // The sums, batch by batch (a batch nothing was added to holds zeros only).
+  // The sums, batch by batch (a batch nothing was added to holds zeros only), along the row sums:
+  // a row adds its sum to its entries where the sum is not zero.
   void sum() {
     const std::size_t B = static_cast<std::size_t>(h_.num_batches()), E = entry_key_.size();
+    const std::size_t rows = static_cast<std::size_t>(h_.num_rows());
+    std::vector<std::size_t> first(rows + 1, 0);  // row r's entries: dests_[first[r], first[r + 1])
+    for (const Dest& d : dests_) ++first[static_cast<std::size_t>(d.row) + 1];
+    for (std::size_t r = 0; r < rows; ++r) first[r + 1] += first[r];
     sums_.assign(B * E, 0);
     for (std::size_t b = 0; b < B; ++b) {
       if (!h_.batch_in_use(static_cast<int>(b))) continue;
       ExactSum* out = sums_.data() + b * E;
-      int last = -1;
-      ExactSum s = 0;
-      for (const Dest& d : dests_) {
-        if (d.row != last) {
-          last = d.row;
-          s = h_.row_sum(d.row, static_cast<int>(b));
-        }
-        out[static_cast<std::size_t>(d.entry)] += s;
+      for (std::size_t r = 0; r < rows; ++r) {
+        const ExactSum s = h_.row_sum(static_cast<int>(r), static_cast<int>(b));
+        if (s == 0) continue;
+        for (std::size_t i = first[r]; i < first[r + 1]; ++i) out[static_cast<std::size_t>(dests_[i].entry)] += s;
       }
     }
   }
