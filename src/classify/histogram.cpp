@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <unordered_map>
 
 namespace pathex {
 
@@ -240,71 +241,156 @@ std::vector<double> batch_deviations(const std::vector<ExactSum>& sums, const st
   return d;
 }
 
-// The exact luminance sums of one technique within a path, a class or the "other" row.
-struct TechniqueSums {
-  std::vector<ExactSum> sums;  // per batch
-  std::uint64_t contributions = 0;
+// The techniques of a report's tables (each class, each listed path, "other"), keyed by
+// Technique::code() and the chain joined (a connector's chain has the path's length), and their
+// exact luminance sums. A row of the histogram adds into the entries of its key in the tables of
+// its path's classes and in its path's own table (or "other"). The sums are added batch by batch
+// along the histogram's batch-major row sums, in one pass: looking each row's 32 batch sums up
+// for every table it belongs to was most of a 256 x 256, 16-spp report's CPU time (bench/README.md,
+// issue 19). Integer sums: the order of the additions does not change them.
+struct TechniqueKey {
+  int code;
+  std::string chain;
+  bool operator<(const TechniqueKey& o) const { return code != o.code ? code < o.code : chain < o.chain; }
 };
-// By Technique::code(), then the chain joined (a connector's chain has the path's length).
-using TechniqueTable = std::map<std::pair<int, std::string>, TechniqueSums>;
 
-void add_rows(const Histogram& h, Histogram::PathId p, TechniqueTable* table) {
-  const std::size_t B = static_cast<std::size_t>(h.num_batches());
-  for (int r = h.first_row(p); r >= 0; r = h.row(r).next) {
-    const int code = h.row(r).technique;
-    TechniqueSums& t = (*table)[{code, Technique::from_code(code).chain(h.path(p))}];
-    t.sums.resize(B, 0);
-    for (std::size_t b = 0; b < B; ++b) t.sums[b] += h.row_sum(r, static_cast<int>(b));
-    t.contributions += h.row(r).contributions;
-  }
-}
+class TechniqueTables {
+ public:
+  TechniqueTables(const Histogram& h, std::size_t tables) : h_(h), slots_(tables), entries_(tables) {}
 
-// Each technique's share of the whole (the sum of the table's techniques), its samples and its
-// part of the whole's batch-means variance (TechniqueEstimate), all from luminance sums.
-std::vector<TechniqueEstimate> technique_estimates(const HistogramLayout& layout, const TechniqueTable& table,
-                                                   const std::vector<std::uint64_t>& n) {
-  std::vector<ExactSum> whole(n.size(), 0);
-  for (const auto& [key, t] : table)
-    for (std::size_t b = 0; b < whole.size(); ++b) whole[b] += t.sums[b];
-  ExactSum total = 0;
-  for (ExactSum s : whole) total += s;
-  const double lum = to_double(total);
-  const std::vector<double> dw = batch_deviations(whole, n);
-  double variance = 0;
-  int nonempty = 0;
-  for (std::size_t b = 0; b < dw.size(); ++b) {
-    variance += dw[b] * dw[b];
-    nonempty += n[b] != 0 ? 1 : 0;
-  }
-  std::vector<TechniqueEstimate> out;
-  for (const auto& [key, t] : table) {
-    ExactSum sum = 0;
-    for (ExactSum s : t.sums) sum += s;
-    TechniqueEstimate te;
-    te.name = Technique::from_code(key.first).name(layout, key.second);
-    te.share = lum != 0 ? to_double(sum) / lum : 0.0;
-    te.samples = t.contributions;
-    if (nonempty >= 2 && variance > 0) {
-      const std::vector<double> dt = batch_deviations(t.sums, n);
-      double covariance = 0;
-      for (std::size_t b = 0; b < dt.size(); ++b) covariance += dt[b] * dw[b];
-      te.variance_share = covariance / variance;
+  // The key of each row, interned: ids dense from 0 (a plain join's chain is DD, a connector's
+  // the path's letters between its ends).
+  void intern_rows() {
+    std::unordered_map<int, int> plain;
+    std::map<TechniqueKey, int> connector;
+    key_of_row_.resize(static_cast<std::size_t>(h_.num_rows()));
+    for (int r = 0; r < h_.num_rows(); ++r) {
+      const int code = h_.row(r).technique;
+      const Technique t = Technique::from_code(code);
+      int id;
+      if (!t.connector) {
+        const auto [it, added] = plain.try_emplace(code, static_cast<int>(keys_.size()));
+        if (added) keys_.push_back({code, t.chain(h_.path(h_.row(r).path))});
+        id = it->second;
+      } else {
+        TechniqueKey k{code, t.chain(h_.path(h_.row(r).path))};
+        const auto [it, added] = connector.try_emplace(k, static_cast<int>(keys_.size()));
+        if (added) keys_.push_back(std::move(k));
+        id = it->second;
+      }
+      key_of_row_[static_cast<std::size_t>(r)] = id;
     }
-    out.push_back(std::move(te));
   }
-  return out;
-}
 
-// One row of the path table: the estimate of `sums` (per batch) and what each technique adds.
-PathEstimate path_estimate(const Histogram& h, std::string name, const std::vector<ExactRgb>& sums,
-                           const std::vector<std::uint64_t>& batch_samples, std::uint64_t contributions,
-                           const TechniqueTable& techniques) {
-  PathEstimate pe;
-  pe.path = std::move(name);
-  pe.estimate = batch_means(sums, batch_samples, contributions);
-  pe.strategies = technique_estimates(h.layout(), techniques, batch_samples);
-  return pe;
-}
+  // Row r adds into table `table`'s entry of its key. Rows are added in order (r never decreases),
+  // a row's tables one after the other.
+  void add(int r, std::size_t table) {
+    const int key = key_of_row_[static_cast<std::size_t>(r)];
+    std::vector<int>& slots = slots_[table];
+    if (slots.empty()) slots.assign(keys_.size(), -1);
+    int& e = slots[static_cast<std::size_t>(key)];
+    if (e < 0) e = new_entry(key, table);
+    add_to_entry(r, e);
+  }
+  // The same for a table whose rows all have distinct keys (one path's rows): no key is looked up.
+  void add_distinct(int r, std::size_t table) {
+    add_to_entry(r, new_entry(key_of_row_[static_cast<std::size_t>(r)], table));
+  }
+
+  // The sums, batch by batch (a batch nothing was added to holds zeros only), along the row sums:
+  // a row adds its sum to its entries where the sum is not zero.
+  void sum() {
+    const std::size_t B = static_cast<std::size_t>(h_.num_batches()), E = entry_key_.size();
+    const std::size_t rows = static_cast<std::size_t>(h_.num_rows());
+    std::vector<std::size_t> first(rows + 1, 0);  // row r's entries: dests_[first[r], first[r + 1])
+    for (const Dest& d : dests_) ++first[static_cast<std::size_t>(d.row) + 1];
+    for (std::size_t r = 0; r < rows; ++r) first[r + 1] += first[r];
+    sums_.assign(B * E, 0);
+    for (std::size_t b = 0; b < B; ++b) {
+      if (!h_.batch_in_use(static_cast<int>(b))) continue;
+      ExactSum* out = sums_.data() + b * E;
+      for (std::size_t r = 0; r < rows; ++r) {
+        const ExactSum s = h_.row_sum(static_cast<int>(r), static_cast<int>(b));
+        if (s == 0) continue;
+        for (std::size_t i = first[r]; i < first[r + 1]; ++i) out[static_cast<std::size_t>(dests_[i].entry)] += s;
+      }
+    }
+  }
+
+  // Each technique's share of the table's whole, its samples and its part of the whole's
+  // batch-means variance (TechniqueEstimate), from luminance sums, in the order of the keys.
+  std::vector<TechniqueEstimate> estimates(std::size_t table, const std::vector<std::uint64_t>& n) const {
+    const std::size_t B = n.size(), E = entry_key_.size();
+    std::vector<int> entries = entries_[table];
+    std::sort(entries.begin(), entries.end(), [&](int a, int b) {
+      return keys_[static_cast<std::size_t>(entry_key_[static_cast<std::size_t>(a)])] <
+             keys_[static_cast<std::size_t>(entry_key_[static_cast<std::size_t>(b)])];
+    });
+    const auto batch_sums = [&](int e) {
+      std::vector<ExactSum> v(B);
+      for (std::size_t b = 0; b < B; ++b) v[b] = sums_[b * E + static_cast<std::size_t>(e)];
+      return v;
+    };
+    std::vector<ExactSum> whole(B, 0);
+    for (int e : entries)
+      for (std::size_t b = 0; b < B; ++b) whole[b] += sums_[b * E + static_cast<std::size_t>(e)];
+    ExactSum total = 0;
+    for (ExactSum s : whole) total += s;
+    const double lum = to_double(total);
+    const std::vector<double> dw = batch_deviations(whole, n);
+    double variance = 0;
+    int nonempty = 0;
+    for (std::size_t b = 0; b < dw.size(); ++b) {
+      variance += dw[b] * dw[b];
+      nonempty += n[b] != 0 ? 1 : 0;
+    }
+    std::vector<TechniqueEstimate> out;
+    out.reserve(entries.size());
+    for (int e : entries) {
+      const std::vector<ExactSum> sums = batch_sums(e);
+      ExactSum sum = 0;
+      for (ExactSum s : sums) sum += s;
+      const TechniqueKey& key = keys_[static_cast<std::size_t>(entry_key_[static_cast<std::size_t>(e)])];
+      TechniqueEstimate te;
+      te.name = Technique::from_code(key.code).name(h_.layout(), key.chain);
+      te.share = lum != 0 ? to_double(sum) / lum : 0.0;
+      te.samples = contributions_[static_cast<std::size_t>(e)];
+      if (nonempty >= 2 && variance > 0) {
+        const std::vector<double> dt = batch_deviations(sums, n);
+        double covariance = 0;
+        for (std::size_t b = 0; b < dt.size(); ++b) covariance += dt[b] * dw[b];
+        te.variance_share = covariance / variance;
+      }
+      out.push_back(std::move(te));
+    }
+    return out;
+  }
+
+ private:
+  struct Dest {
+    int row, entry;
+  };
+  int new_entry(int key, std::size_t table) {
+    const int e = static_cast<int>(entry_key_.size());
+    entry_key_.push_back(key);
+    contributions_.push_back(0);
+    entries_[table].push_back(e);
+    return e;
+  }
+  void add_to_entry(int r, int e) {
+    dests_.push_back({r, e});
+    contributions_[static_cast<std::size_t>(e)] += h_.row(r).contributions;
+  }
+  const Histogram& h_;
+  std::vector<TechniqueKey> keys_;
+  std::vector<int> key_of_row_;
+  std::vector<std::vector<int>> slots_;    // per table: the entry of each key, -1 for none (add())
+  std::vector<std::vector<int>> entries_;  // per table: its entries
+  std::vector<int> entry_key_;
+  std::vector<std::uint64_t> contributions_;
+  std::vector<Dest> dests_;
+  std::vector<ExactSum> sums_;  // batch-major: sums_[b * entries + e]
+};
 
 }  // namespace
 
@@ -329,7 +415,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   std::uint64_t total_count = 0;
   std::vector<std::vector<ExactRgb>> class_sums(classes.size(), std::vector<ExactRgb>(B, ExactRgb{}));
   std::vector<std::uint64_t> class_counts(classes.size(), 0);
-  std::vector<TechniqueTable> class_techniques(classes.size());
+  std::vector<std::uint32_t> path_set(classes.empty() ? 0 : static_cast<std::size_t>(h.num_paths()));
   std::vector<ExactRgb> path_sums(B);
 
   for (Histogram::PathId p = 0; p < h.num_paths(); ++p) {
@@ -345,11 +431,12 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     }
     total_count += count;
     if (!classes.empty()) {
-      for (int k : classifier->members(classifier->classify(h.path(p)))) {
+      const std::uint32_t set = classifier->classify(h.path(p));
+      path_set[static_cast<std::size_t>(p)] = set;
+      for (int k : classifier->members(set)) {
         const std::size_t ks = static_cast<std::size_t>(k);
         for (std::size_t b = 0; b < B; ++b) add_to(class_sums[ks][b], path_sums[b]);
         class_counts[ks] += count;
-        add_rows(h, p, &class_techniques[ks]);
       }
     }
     // The row's techniques are worked out below, for the rows listed only.
@@ -360,15 +447,6 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   }
   report.distinct_paths = report.paths.size();
   report.total = batch_means(total_sums, n, total_count);
-  for (std::size_t k = 0; k < classes.size(); ++k) {
-    ClassEstimate ce;
-    ce.name = classes[k].name;
-    ce.expr = classes[k].expr;
-    ce.estimate = batch_means(class_sums[k], n, class_counts[k]);
-    ce.share = report.total.luminance != 0 ? ce.estimate.luminance / report.total.luminance : 0.0;
-    ce.strategies = technique_estimates(h.layout(), class_techniques[k], n);
-    report.classes.push_back(std::move(ce));
-  }
   // Rows by luminance, largest first. report.paths[i] is still path id i here, which is what
   // lets the rows past max_paths be summed from the exact cells.
   std::vector<Histogram::PathId> order(report.paths.size());
@@ -381,28 +459,56 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   });
   report.max_paths = max_paths;
   const std::size_t listed = max_paths ? std::min<std::size_t>(order.size(), *max_paths) : order.size();
+
+  // --- the technique tables: one per class, one per listed row, then "other" ---
+  const std::size_t other_table = classes.size() + listed;
+  TechniqueTables tables(h, other_table + 1);
+  tables.intern_rows();
+  std::vector<std::size_t> own_table(order.size(), other_table);
+  for (std::size_t i = 0; i < listed; ++i) own_table[static_cast<std::size_t>(order[i])] = classes.size() + i;
+  for (int r = 0; r < h.num_rows(); ++r) {  // in the order of the row sums
+    const std::size_t p = static_cast<std::size_t>(h.row(r).path);
+    if (!classes.empty())
+      for (int k : classifier->members(path_set[p])) tables.add(r, static_cast<std::size_t>(k));
+    if (own_table[p] == other_table) tables.add(r, other_table);
+    else tables.add_distinct(r, own_table[p]);
+  }
+  tables.sum();
+
+  for (std::size_t k = 0; k < classes.size(); ++k) {
+    ClassEstimate ce;
+    ce.name = classes[k].name;
+    ce.expr = classes[k].expr;
+    ce.estimate = batch_means(class_sums[k], n, class_counts[k]);
+    ce.share = report.total.luminance != 0 ? ce.estimate.luminance / report.total.luminance : 0.0;
+    ce.strategies = tables.estimates(k, n);
+    report.classes.push_back(std::move(ce));
+  }
   if (listed < order.size()) {
-    std::vector<ExactRgb> other_sums(B, ExactRgb{});
-    TechniqueTable other_techniques;
-    std::uint64_t other_count = 0;
-    for (std::size_t i = listed; i < order.size(); ++i) {
+    // The total less the listed rows (integer sums: exactly the sum of the other rows' cells,
+    // without reading the cells of every path again, in an order scattered over memory).
+    std::vector<ExactRgb> other_sums = total_sums;
+    std::uint64_t other_count = total_count;
+    for (std::size_t i = 0; i < listed; ++i) {
       const Histogram::PathId p = order[i];
       for (int b = 0; b < nb; ++b) {
-        add_to(other_sums[static_cast<std::size_t>(b)], h.cell(p, b).sum);
-        other_count += h.cell(p, b).contributions;
+        const Histogram::Cell& c = h.cell(p, b);
+        for (std::size_t ch = 0; ch < 3; ++ch) other_sums[static_cast<std::size_t>(b)][ch] -= c.sum[ch];
+        other_count -= c.contributions;
       }
-      add_rows(h, p, &other_techniques);
     }
-    report.other = path_estimate(h, "other", other_sums, n, other_count, other_techniques);
+    PathEstimate pe;
+    pe.path = "other";
+    pe.estimate = batch_means(other_sums, n, other_count);
+    pe.strategies = tables.estimates(other_table, n);
+    report.other = std::move(pe);
     report.other_paths = order.size() - listed;
   }
   std::vector<PathEstimate> rows;
   rows.reserve(listed);
   for (std::size_t i = 0; i < listed; ++i) {
     rows.push_back(std::move(report.paths[order[i]]));
-    TechniqueTable techniques;
-    add_rows(h, order[i], &techniques);
-    rows.back().strategies = technique_estimates(h.layout(), techniques, n);
+    rows.back().strategies = tables.estimates(classes.size() + i, n);
   }
   report.paths = std::move(rows);
   return report;

@@ -176,16 +176,22 @@ Result<bool> OutputSet::write(const std::function<Result<bool>(const std::string
     fs::remove_all(staging, ignored);
     return e;
   };
-  if (Result<bool> w = write_files(staging); !w) return abandon(w.error());
+  {
+    // The files are flushed to disk together, once all are written (io/atomic_file.h).
+    const DeferredSync together(staging);
+    if (Result<bool> w = write_files(staging); !w) return abandon(w.error());
 
-  // --- the manifest: every file staged ---
-  std::vector<std::string> names;
-  for (fs::directory_iterator it(staging, ec), end; !ec && it != end; it.increment(ec)) names.push_back(it->path().filename().string());
-  if (ec) return abandon(out_error(dir_, "cannot list the staging folder: " + ec.message()));
-  std::sort(names.begin(), names.end());
-  std::string manifest = "# pathex output set: the files pathex wrote here. A new run replaces exactly these.\n";
-  for (const std::string& n : names) manifest += n + "\n";
-  if (Result<bool> w = write_file_atomic(staging + "/" + kManifestName, manifest); !w) return abandon(w.error());
+    // --- the manifest: every file staged ---
+    std::vector<std::string> names;
+    for (fs::directory_iterator it(staging, ec), end; !ec && it != end; it.increment(ec)) names.push_back(it->path().filename().string());
+    if (ec) return abandon(out_error(dir_, "cannot list the staging folder: " + ec.message()));
+    std::sort(names.begin(), names.end());
+    std::string manifest = "# pathex output set: the files pathex wrote here. A new run replaces exactly these.\n";
+    for (const std::string& n : names) manifest += n + "\n";
+    if (Result<bool> w = write_file_atomic(staging + "/" + kManifestName, manifest); !w) return abandon(w.error());
+    names.push_back(kManifestName);
+    if (Result<bool> s = sync_files(staging, names); !s) return abandon(s.error());
+  }
   sync_dir(staging);
 
   // --- in place, in one step ---
