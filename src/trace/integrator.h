@@ -313,8 +313,7 @@ class Integrator {
                   float pdf_dir, int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
   // u_ray: the numbers of the light's first direction (Sampler::at2d_now at kLightRayDim).
-  // `rng` draws the light's pick, point and first direction; `walk_rng` the walk from there.
-  int light_subpath(Thread& th, Sampler& rng, Sampler& walk_rng, glm::vec2 u_ray) const;
+  int light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const;
 
   // --- connections ---
   // The five kinds of connection, one instantiation of connect() each, so that the kind is not a

@@ -199,7 +199,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   return n;
 }
 
-int Integrator::light_subpath(Thread& th, Sampler& rng, Sampler& walk_rng, glm::vec2 u_ray) const {
+int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
   const std::size_t li = pick_light(rng);
   const RenderLight& l = rs_.lights[li];
@@ -228,8 +228,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, Sampler& walk_rng, glm::
   if (is_black(beta1)) return 1;
   const vec3 saved = y0.beta;
   th.light[0].beta = beta1;
-  walk_rng.set_dimension(rng.dimension());
-  const int n = random_walk<TransportMode::kImportance>(th, walk_rng, th.light, 1, y0.p, r->direction,
+  const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, r->direction,
                                                         finite_part(r->pdf.dir, r->pdf.delta_dir), max_light_);
   th.light[0].beta = saved;
   // A Dirac direction from a finite-area origin (a distant light's aperture) is a parallel beam:
@@ -646,8 +645,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
   const int strategy_index = mirror_of(s, t);
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
   // Random numbers: a fresh light sample's from one block per t, a fresh sensor sample's from one
-  // block per s, after the seven blocks of connect()'s kinds; `rng` is the light side's stream for
-  // t = 1 (a splat), the eye side's otherwise (sample()).
+  // block per s, after the seven blocks of connect()'s kinds.
   constexpr std::uint64_t kLightBlock = 7, kEyeBlock = 8;
   // --- the light end a: y(s-1), or a fresh light sample ---
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, kLightBlock);
@@ -875,20 +873,7 @@ void Integrator::trace_shadows(Thread& th) const {
 
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
-  // Two streams of numbers, both functions of (seed, pixel, pass, dimension), so renders stay
-  // bit-identical across threads and shards. `rng`, the sampler asked for, draws the eye side
-  // (the eye subpath and the strategies with t >= 2, whose contributions land on this pixel) and
-  // the light subpath's first vertex (the light's pick, point and first direction). `light_rng`,
-  // independent numbers whatever the sampler (with `sobol`, the second stream, whose key is its
-  // own: Sampler::second_stream), draws the light subpath's later vertices and the splats' sensor
-  // numbers (t <= 1). The two never draw the same dimension of one sample. Measured with `sobol` (bench/README.md, issue 19's fifth
-  // session): stratifying the first light direction lowers the error (point-plane.json bdpt
-  // −7 % MSE, the Cornell box's whole image −7 %), the later light vertices' Sobol numbers lower
-  // nothing measurable and cost ~2 % of bdpt's time; the eye side's numbers past the first
-  // vertices still pay for themselves (Cornell box bdpt with independent numbers from the eye
-  // subpath's second surface vertex on: +25 % MSE).
   Sampler rng(o_.seed, pixel, pass, o_.sampler);
-  Sampler light_rng = o_.sampler == SamplerKind::kIndependent ? rng : Sampler::second_stream(o_.seed, pixel, pass);
   rng.set_dimension(kEyeDims);
   // The light's first direction, computed before the eye subpath is traced: a Sobol point's chain
   // of dependent multiplies then overlaps the eye subpath's work instead of delaying the light
@@ -901,7 +886,7 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   th.pass = pass;
   const int nt = eye_subpath(th, rng, px, py);
   rng.set_dimension(kLightDims);
-  const int ns = light_subpath(th, rng, light_rng, u_light_ray);
+  const int ns = light_subpath(th, rng, u_light_ray);
   th.ns = ns;
   th.nt = nt;
   th.joins_ready = false;
@@ -912,12 +897,12 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   // can be a lens vertex; it forms the t = 0 connection and no other.
   const bool lens_end = ns >= 2 && th.light[static_cast<std::size_t>(ns - 1)].kind == Kind::kLens;
   if (lens_end && lens_hits_ && ns - 2 <= max_bounces_ && strategy(ns, 0) >= 0)
-    connect<Connection::kLens>(th, light_rng, ns, 0, batch);
+    connect<Connection::kLens>(th, rng, ns, 0, batch);
   // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
   const int s_max = (rs_.lights.empty() ? ns : std::max(ns, 1)) - (lens_end ? 1 : 0);
   if (nt >= 1)
     for (int s = 1; s <= std::min(s_max, max_bounces_ + 1); ++s)
-      if (strategy(s, 1) >= 0) connect<Connection::kSplat>(th, light_rng, s, 1, batch);
+      if (strategy(s, 1) >= 0) connect<Connection::kSplat>(th, rng, s, 1, batch);
   for (int t = 2; t <= nt; ++t) {
     const int s_hi = std::min(s_max, max_bounces_ + 2 - t);
     if (s_hi >= 0 && strategy(0, t) >= 0) connect<Connection::kEmitter>(th, rng, 0, t, batch);
@@ -928,12 +913,12 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   }
   if (has_connectors_ && nt >= 1)
     for (int s = 1; s <= std::min(ns - (lens_end ? 1 : 0), max_bounces_ + 1); ++s)
-      if (ortho_of(s) >= 0) connect<Connection::kOrtho>(th, light_rng, s, 1, batch);
+      if (ortho_of(s) >= 0) connect<Connection::kOrtho>(th, rng, s, 1, batch);
   // The mirror connector's path has s + t + 1 vertices: s + t - 1 interior ones.
   if (has_mirror_)
     for (int t = 1; t <= nt; ++t)
       for (int s = 1; s <= std::min(s_max, max_bounces_ + 1 - t); ++s)
-        if (mirror_of(s, t) >= 0) connect_mirror(th, t == 1 ? light_rng : rng, s, t, batch);
+        if (mirror_of(s, t) >= 0) connect_mirror(th, rng, s, t, batch);
   // The manifold connector's eye end is a surface vertex z(t-1), t >= 2.
   if (has_manifold_)
     for (int t = 2; t <= nt; ++t)

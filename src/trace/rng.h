@@ -70,9 +70,7 @@ inline constexpr float kOneMinusEpsilon = 1.0f - 0x1p-24f;  // the largest float
 // (trace/sobol.h): each pair of dimensions drawn with get2d() is stratified over a pixel's passes
 // (the first 2^k passes put one point in every elementary interval of area 2^-k), each number on
 // its own still uniform and independent across dimension pairs. Both are functions of (seed,
-// pixel, pass, dimension) alone. With `sobol` the tracer still draws the light subpath's vertices
-// after the first, and the splats' sensor numbers, from an independent stream with its own key
-// (Sampler::second_stream; trace/render.cpp, Integrator::sample, says why).
+// pixel, pass, dimension) alone.
 enum class SamplerKind : std::uint8_t { kIndependent, kSobol };
 constexpr const char* to_string(SamplerKind k) { return k == SamplerKind::kSobol ? "sobol" : "independent"; }
 
@@ -89,19 +87,6 @@ class Sampler {
         // new scrambled sequence.
         key_(stream_key(seed, pixel, kind == SamplerKind::kSobol ? sample >> 32 : sample)),
         reversed_index_(sobol::reverse_bits(static_cast<std::uint32_t>(sample))) {}
-
-  // A sample's second stream: independent numbers whatever the first stream's kind, under a key
-  // of their own. The tracer draws a light walk's later numbers from it under `sobol`
-  // (trace/render.cpp, Integrator::sample). Its key is the independent stream's salted and mixed
-  // again: unsalted, pass 0's key would be the Sobol sampler's key (stream_key(seed, pixel, 0)),
-  // whose hash of dimension d is the seed that scrambles Sobol dimension d, so a number of one
-  // stream would be bits of the other's at the same dimension. Test Sampler.SecondStreamHasItsOwnKey.
-  static Sampler second_stream(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample) {
-    Sampler s(seed, pixel, sample, SamplerKind::kIndependent);
-    s.key_ = mix64(s.key_ ^ kSecondStreamSalt);
-    return s;
-  }
-  static constexpr std::uint64_t kSecondStreamSalt = 0xb7e151628aed2a6bULL;  // digits of e
 
   // Forced inline: a walk draws a few numbers per vertex, and the call (and the test of kind_ in a
   // function the compiler will not inline) cost as much as the independent stream's hashing.

@@ -29,7 +29,7 @@ struct IntegratorTestAccess {
     const int nt = in.eye_subpath(th, rng, px, py);
     // The light's first direction, drawn in advance as render() draws it: after the light's pick
     // and point (render.cpp's kLightRayDim).
-    *ns = in.light_subpath(th, rng, rng, rng.at2d(rng.dimension() + 3));
+    *ns = in.light_subpath(th, rng, rng.at2d(rng.dimension() + 3));
     th.ns = *ns;
     th.nt = nt;
     in.prepare_joins(th, *ns, nt);

@@ -221,35 +221,5 @@ TEST(Sampler, ConditionalDrawsMoveTheCursorLikeDraws) {
   }
 }
 
-// The second stream (Sampler::second_stream, the light walk's numbers under `sobol`) has keys of
-// its own. Without the salt, pass 0's independent key is the Sobol sampler's key of the same pixel
-// (asserted first: the collision the salt removes), whose hash of dimension d scrambles Sobol
-// dimension d, so a number of one stream would be bits of the other's at the same dimension.
-TEST(Sampler, SecondStreamHasItsOwnKey) {
-  EXPECT_EQ(Sampler(9, 123, 0, SamplerKind::kIndependent).key(), Sampler(9, 123, 40, SamplerKind::kSobol).key());
-  std::set<std::uint64_t> first, second;
-  for (std::uint64_t seed = 0; seed < 2; ++seed)
-    for (std::uint64_t p = 0; p < 128; ++p)
-      for (std::uint64_t pass = 0; pass < 128; ++pass) {
-        first.insert(Sampler(seed, p, pass, SamplerKind::kIndependent).key());
-        first.insert(Sampler(seed, p, pass, SamplerKind::kSobol).key());
-        const Sampler s = Sampler::second_stream(seed, p, pass);
-        EXPECT_EQ(s.kind(), SamplerKind::kIndependent);
-        second.insert(s.key());
-      }
-  EXPECT_EQ(second.size(), 2u * 128u * 128u);  // no two samples share a second stream
-  for (std::uint64_t k : second) ASSERT_EQ(first.count(k), 0u) << "a second-stream key is a first stream's";
-  // A pure function of (seed, pixel, pass, dimension), like the first stream, and not its numbers.
-  Sampler a = Sampler::second_stream(4, 55, 0), b = Sampler::second_stream(4, 55, 0);
-  const Sampler independent(4, 55, 0, SamplerKind::kIndependent);
-  int same = 0;
-  for (std::uint64_t d = 0; d < 64; ++d) {
-    const float u = a.get1d();
-    EXPECT_EQ(u, b.at(d));
-    same += u == independent.at(d) ? 1 : 0;
-  }
-  EXPECT_EQ(same, 0);
-}
-
 }  // namespace
 }  // namespace pathex

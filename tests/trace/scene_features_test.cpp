@@ -22,7 +22,7 @@ struct IntegratorTestAccess {
   static int eye(const Integrator& in, Integrator::Thread& th, Sampler& rng, int px, int py) { return in.eye_subpath(th, rng, px, py); }
   // The light's first direction drawn in advance, after its pick and point (render.cpp's kLightRayDim).
   static int light(const Integrator& in, Integrator::Thread& th, Sampler& rng) {
-    return in.light_subpath(th, rng, rng, rng.at2d(rng.dimension() + 3));
+    return in.light_subpath(th, rng, rng.at2d(rng.dimension() + 3));
   }
 };
 
