@@ -20,8 +20,9 @@ import sys
 import tempfile
 
 
-def cpu_run(cmd, cwd=None):
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd)
+def cpu_run(cmd, cwd=None, cpu=None):
+    pin = (lambda: os.sched_setaffinity(0, {cpu})) if cpu is not None else None
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd, preexec_fn=pin)
     _, status, usage = os.wait4(proc.pid, 0)
     err = proc.stderr.read().decode()
     proc.stderr.close()
@@ -44,7 +45,12 @@ def main():
     ap.add_argument("--a-arg", action="append", default=[],
                     help="an extra argument for binary A only (repeatable), e.g. to compare two samplers or two builds "
                          "with the same non-default option")
+    ap.add_argument("--cpu", type=int, default=max(os.sched_getaffinity(0)),
+                    help="run every process on this one CPU (default: the highest this process may use; -1: "
+                         "let the scheduler choose). The vCPUs of a shared VM can differ in speed by 30 %% "
+                         "for minutes at a time, so a side that lands on the faster one more often wins")
     args = ap.parse_args()
+    cpu = None if args.cpu < 0 else args.cpu
     tail = (["trace"] + ([os.path.abspath(args.scene)] if args.scene else []) +
             ["--renderer", args.renderer, "--spp", str(args.spp), "--threads", "1", "--no-images", "--quiet", "--json"])
     samples = 64 * 64 * args.spp if args.scene is None else None
@@ -62,10 +68,11 @@ def main():
         order = sides[k:] + sides[:k] if len(sides) > 2 else (sides if r % 2 == 0 else sides[::-1])
         for name, binary in order:
             times[name].append(cpu_run([os.path.abspath(binary)] + tail + (args.a_arg if name == "a" else args.b_arg),
-                                       dirs[name]))
+                                       dirs[name], cpu))
     shutil.rmtree(work)
     rate = (lambda t: f"{samples / t / 1e6:.3f} M samples/CPU-s") if samples else (lambda t: f"{t:.3f} CPU-s")
-    print(f"{args.renderer}, {args.spp} spp, {args.rounds} interleaved rounds")
+    where = f"on CPU {cpu}" if cpu is not None else "on any CPU"
+    print(f"{args.renderer}, {args.spp} spp, {args.rounds} interleaved rounds, {where}")
     print(f"  A {args.a}: median {rate(statistics.median(times['a']))}")
     for name, binary in sides[1:]:
         ratios = [a / b for a, b in zip(times["a"], times[name])]
