@@ -198,7 +198,7 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   ro.spp = budget.spp ? budget.spp : (std::uint64_t{1} << 24);
   std::unique_ptr<PassDealer> dealer;  // under MPI, the ranks' shared deal of the rung's passes
   if (cluster != nullptr) {
-    dealer = cluster->deal(PassSet::range(0, ro.spp), kPassesPerChunk);
+    dealer = cluster->deal(PassSet::range(0, ro.spp), kPassesPerChunk, ro.batches);
     ro.dealer = dealer.get();
   }
   ro.seed = seed;

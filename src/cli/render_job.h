@@ -101,10 +101,11 @@ class Cluster {
   virtual int rank() const = 0;
   virtual int size() const = 0;
   // This rank's side of the deal of `todo` in chunks of `chunk` passes among the ranks
-  // (core/pass_deal.h): every rank makes one and renders the chunks it is handed until none is
-  // left (or it stops). Not collective; while it lives, this rank makes no other call on the
-  // cluster, and destroying it waits until every rank has left the deal.
-  virtual std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk) = 0;
+  // (core/pass_deal.h) for a render of `batches` batches: every rank makes one and renders the
+  // chunks it is handed until none is left (or it stops). Not collective; while it lives, this
+  // rank makes no other call on the cluster, and destroying it waits until every rank has left
+  // the deal.
+  virtual std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk, int batches) = 0;
   // Collective: adds every rank's sums, passes and run figures into rank 0's, exactly. The other
   // ranks' arguments are left unspecified (their sums are only read). Rank 0 calls `before_changing`
   // (when set) before it first changes `*sums`: until then others may read them (write them to a

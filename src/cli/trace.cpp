@@ -330,7 +330,7 @@ int run(const TraceArgs& a) {
   ro.spp = job.header.spp;
   std::unique_ptr<PassDealer> dealer;
   if (cluster != nullptr) {
-    dealer = cluster->deal(todo, kPassesPerChunk);
+    dealer = cluster->deal(todo, kPassesPerChunk, id.batches);
     ro.dealer = dealer.get();
   } else {
     ro.passes = todo;

@@ -77,6 +77,64 @@ TEST(ChunkDeal, ThreadsTakingTogetherGetEveryPassOnce) {
   EXPECT_EQ(all, PassSet::range(0, 3000));
 }
 
+// Two takers of a 32-batch render taking turns: each keeps to its half of the batches (chunks of 4
+// passes: taker 0 the chunks starting at passes 0, 4, 8, 12 mod 32, round-robin), and together
+// they get every pass once.
+TEST(LaneDeal, TakersKeepToTheirBatches) {
+  LaneDeal deal(PassSet::range(0, 128), 4, 32, 2);
+  EXPECT_EQ(deal.total(), 128u);
+  std::vector<PassRange> zero, one;
+  for (bool done = false; !done;) {
+    const std::optional<PassRange> a = deal.next(0), b = deal.next(1);
+    if (a) zero.push_back(*a);
+    if (b) one.push_back(*b);
+    done = !a && !b;
+  }
+  EXPECT_EQ(zero, (std::vector<PassRange>{{0, 4}, {4, 8}, {8, 12}, {12, 16}, {32, 36}, {36, 40}, {40, 44}, {44, 48},
+                                          {64, 68}, {68, 72}, {72, 76}, {76, 80}, {96, 100}, {100, 104}, {104, 108}, {108, 112}}));
+  for (const PassRange& c : one) EXPECT_GE(c.first % 32, 16u) << c.first;
+  EXPECT_EQ(one.size(), 16u);
+  EXPECT_EQ(deal.dealt(), 128u);
+  EXPECT_FALSE(deal.next(0));
+}
+
+// A taker whose lanes are done joins the lane with the most chunks left; a resumed render's
+// scattered passes (ranges not aligned to chunks or batches, chunks cut short at a range's end)
+// are each dealt once, whoever takes them.
+TEST(LaneDeal, FasterTakerJoinsTheLaneWithMostLeftAndEveryPassIsDealtOnce) {
+  LaneDeal deal(PassSet::range(0, 64), 4, 32, 2);
+  for (int i = 0; i < 8; ++i) ASSERT_TRUE(deal.next(0));  // taker 0's lanes: 8 chunks
+  EXPECT_EQ(deal.next(0), (PassRange{16, 20}));            // then taker 1's first lane (the first of most left)
+  EXPECT_EQ(deal.next(1), (PassRange{48, 52}));            // shared: taker 1 goes on in that lane
+  EXPECT_EQ(deal.next(0), (PassRange{20, 24}));            // it is done: taker 0 joins the next
+
+  PassSet scattered = PassSet::range(3, 50);
+  scattered.add(61, 62);
+  scattered.add(70, 201);
+  for (const int takers : {1, 2, 3, 40}) {
+    for (const std::uint64_t batches : {1u, 5u, 32u}) {
+      LaneDeal d(scattered, 4, batches, takers);
+      EXPECT_EQ(d.total(), scattered.count());
+      PassSet all;
+      std::size_t chunks = 0;
+      for (int t = 0;; t = (t + 1) % takers) {  // taker 0 takes three times as often as the others
+        const std::optional<PassRange> c = d.next(t == 0 ? 0 : t), c0 = d.next(0), c00 = d.next(0);
+        bool any = false;
+        for (const std::optional<PassRange>& x : {c, c0, c00})
+          if (x) {
+            EXPECT_TRUE(all.intersect(PassSet::range(x->first, x->last)).empty());
+            EXPECT_LE(x->last - x->first, 4u);
+            all.add(x->first, x->last), ++chunks, any = true;
+          }
+        if (!any) break;
+      }
+      EXPECT_EQ(all, scattered) << takers << " takers, " << batches << " batches";
+      EXPECT_EQ(chunks, scattered.chunks(4).size());
+      EXPECT_EQ(d.dealt(), scattered.count());
+    }
+  }
+}
+
 TEST(PassSet, SetOperationsAndText) {
   PassSet a = PassSet::range(0, 16);
   PassSet b = PassSet::range(4, 8);

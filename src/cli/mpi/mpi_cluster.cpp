@@ -138,10 +138,10 @@ MpiCluster::~MpiCluster() {
   MPI_Comm_free(&deal_comm_);
 }
 
-std::unique_ptr<PassDealer> MpiCluster::deal(const PassSet& todo, std::uint64_t chunk) {
+std::unique_ptr<PassDealer> MpiCluster::deal(const PassSet& todo, std::uint64_t chunk, int batches) {
   if (!serialized_)  // rank 0 could not serve the others from a thread: a static share each
     return std::make_unique<ChunkDeal>(todo.part(static_cast<std::uint64_t>(rank_), static_cast<std::uint64_t>(size_)), chunk);
-  if (rank_ == 0) return std::make_unique<RootDeal>(todo, chunk, deal_comm_, size_);
+  if (rank_ == 0) return std::make_unique<RootDeal>(todo, chunk, static_cast<std::uint64_t>(batches), deal_comm_, size_);
   return std::make_unique<RemoteDeal>(todo.count(), deal_comm_, rank_);
 }
 

@@ -20,7 +20,7 @@ class MpiCluster final : public Cluster {
 
   int rank() const override { return rank_; }
   int size() const override { return size_; }
-  std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk) override;
+  std::unique_ptr<PassDealer> deal(const PassSet& todo, std::uint64_t chunk, int batches) override;
   Result<bool> reduce(RenderSums* sums, PassSet* passes, ShardRun* run, const std::function<void()>& before_changing) override;
   int count_failures(bool ok) override;
 

@@ -36,8 +36,8 @@ int wait_sleeping(MPI_Request* request, MPI_Status* status, std::chrono::microse
   }
 }
 
-RootDeal::RootDeal(const PassSet& todo, std::uint64_t chunk, MPI_Comm comm, int ranks)
-    : deal_(todo, chunk), comm_(comm), ranks_(ranks) {
+RootDeal::RootDeal(const PassSet& todo, std::uint64_t chunk, std::uint64_t batches, MPI_Comm comm, int ranks)
+    : deal_(todo, chunk, batches, ranks), comm_(comm), ranks_(ranks) {
   if (ranks_ > 1) server_ = std::thread([this] { serve(); });
 }
 
@@ -57,7 +57,7 @@ void RootDeal::serve() {
       continue;
     }
     if (code == MPI_SUCCESS) {
-      const std::optional<PassRange> c = deal_.next();
+      const std::optional<PassRange> c = deal_.next(status.MPI_SOURCE);
       const std::uint64_t answer[2] = {c ? c->first : 0, c ? c->last : 0};
       code = MPI_Send(answer, 2, MPI_UINT64_T, status.MPI_SOURCE, kTag, comm_);
     }

@@ -2,7 +2,7 @@
 // next chunk, so a rank on a faster (or less loaded) core takes more of them than a static share
 // would give it, and no rank waits for another at the end for longer than about a chunk.
 //
-// Rank 0 holds the deal (a ChunkDeal: one atomic counter). Its own render takes chunks from it
+// Rank 0 holds the deal (a LaneDeal: each rank keeps to a share of the batches while it can). Its own render takes chunks from it
 // directly; a thread of its own serves the other ranks, which ask for chunks by point-to-point
 // messages on a communicator kept for this (MpiCluster's). A rank asks for its next chunk as soon
 // as it is handed one, so the answer travels while it renders; when the deal is done (or its
@@ -35,17 +35,17 @@ int wait_sleeping(MPI_Request* request, MPI_Status* status, std::chrono::microse
 // Rank 0's side: deals its own render's chunks and, from a thread, the other ranks'.
 class RootDeal final : public PassDealer {
  public:
-  RootDeal(const PassSet& todo, std::uint64_t chunk, MPI_Comm comm, int ranks);
+  RootDeal(const PassSet& todo, std::uint64_t chunk, std::uint64_t batches, MPI_Comm comm, int ranks);
   ~RootDeal() override;  // waits until every other rank has left the deal
   RootDeal(const RootDeal&) = delete;
   RootDeal& operator=(const RootDeal&) = delete;
-  std::optional<PassRange> next() override { return deal_.next(); }
+  std::optional<PassRange> next() override { return deal_.next(0); }
   std::uint64_t total() const override { return deal_.total(); }
   std::uint64_t dealt() const override { return deal_.dealt(); }
 
  private:
   void serve();
-  ChunkDeal deal_;
+  LaneDeal deal_;
   MPI_Comm comm_;
   int ranks_;
   std::thread server_;
