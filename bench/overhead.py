@@ -3,8 +3,8 @@
 
     python3 bench/overhead.py build/pathex [OLD/pathex] --resolution 256x256 --spp 1 --rounds 15
 
-Runs `pathex trace [SCENE] --resolution R --spp N --threads 1 --quiet --json --out DIR` with the
-default outputs (histogram.json, classes.exr, the PNGs), binaries interleaved, ROUNDS times. The
+Runs `pathex trace [SCENE] --resolution R --spp N --threads T --quiet --json --out DIR` (T: --threads,
+default 1; 0 runs without the option, on every core as a user's default run does) with the default outputs (histogram.json, classes.exr, the PNGs), binaries interleaved, ROUNDS times. The
 render's own time is the JSON's `time_s` (wall clock) and, where the binary reports it,
 `efficiency.cpu_s` (CPU seconds); the process's come from os.wait4 and the wall clock around it.
 Overhead = process - render, as CPU seconds (what the shared host cannot steal) and wall seconds
@@ -53,6 +53,7 @@ def main():
     ap.add_argument("--resolution", default="256x256")
     ap.add_argument("--spp", type=int, default=1)
     ap.add_argument("--rounds", type=int, default=15)
+    ap.add_argument("--threads", type=int, default=1, help="--threads of the runs; 0: no --threads (every core)")
     ap.add_argument("--extra", default="", help="more trace arguments, e.g. '--renderer pt-nee'")
     args = ap.parse_args()
     res = {b: [] for b in args.binaries}
@@ -62,8 +63,8 @@ def main():
             for i, b in enumerate(order):
                 out_dir = os.path.join(work, f"out{args.binaries.index(b)}")
                 cmd = ([b, "trace"] + ([args.scene] if args.scene else []) +
-                       ["--resolution", args.resolution, "--spp", str(args.spp), "--threads", "1", "--quiet", "--json",
-                        "--out", out_dir] + args.extra.split())
+                       ["--resolution", args.resolution, "--spp", str(args.spp)] +
+                       (["--threads", str(args.threads)] if args.threads > 0 else []) + ["--quiet", "--json", "--out", out_dir] + args.extra.split())
                 res[b].append(run(cmd, out_dir))
     # The process start alone (dynamic loading of the linked libraries): a bare --version, as many times.
     start = {b: [] for b in args.binaries}
@@ -73,7 +74,8 @@ def main():
             _, _, usage = os.wait4(proc.pid, 0)
             start[b].append(usage.ru_utime + usage.ru_stime)
     for b, rs in res.items():
-        print(f"{b}: {len(rs)} runs, {args.resolution}, {args.spp} spp")
+        threads = f"{args.threads} thread(s)" if args.threads > 0 else "every core"
+        print(f"{b}: {len(rs)} runs, {args.resolution}, {args.spp} spp, {threads}")
         print(f"  process CPU        {fmt([x[0] for x in rs])}")
         print(f"  process wall       {fmt([x[1] for x in rs])}")
         if all(x[2] is not None for x in rs):

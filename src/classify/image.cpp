@@ -236,6 +236,16 @@ void ClassImages::layer_rows(int layer, double scale, int y0, int rows, float* o
   }
 }
 
+bool ClassImages::same_sums(int a, int b) const {
+  const auto used = [&](int layer) {
+    std::vector<std::size_t> slots;
+    for (std::size_t slot : slots_of_layer_[static_cast<std::size_t>(layer)])
+      if (planes_ && planes_[slot].load(std::memory_order_acquire) != nullptr) slots.push_back(slot);
+    return slots;
+  };
+  return used(a) == used(b);
+}
+
 std::vector<ImageLayer> ClassImages::layers(double scale) const {
   std::vector<ImageLayer> out(static_cast<std::size_t>(num_layers()));
   tbb::parallel_for(0, num_layers(), [&](int l) { out[static_cast<std::size_t>(l)] = layer(l, scale); });

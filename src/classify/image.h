@@ -96,6 +96,10 @@ class ClassImages {
   // multiple of kTile (a tile's planes are summed once per call that covers it).
   void layer_rows(int layer, double scale, int y0, int rows, float* out) const;
   std::vector<ImageLayer> layers(double scale) const;  // every layer, in parallel
+  // Whether layers `a` and `b` sum the same planes among those anything was added to, so that
+  // their sums (and layer_rows) are equal pixel for pixel: e.g. a class that holds every path the
+  // render sampled and the total. Read after all writers are done.
+  bool same_sums(int a, int b) const;
   std::size_t memory_bytes() const;
 
   // --- the exact state, tile by tile (shard files, MPI reductions) ---

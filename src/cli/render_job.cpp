@@ -197,6 +197,7 @@ class RenderBands final : public LayerBands {
   std::size_t num_layers() const override { return layers_.size(); }
   const std::string& name(std::size_t layer) const override { return images_.layer_name(layers_[layer]); }
   void fill(std::size_t layer, int y0, int rows, float* out) const override { images_.layer_rows(layers_[layer], scale_, y0, rows, out); }
+  bool same_pixels(std::size_t a, std::size_t b) const override { return images_.same_sums(layers_[a], layers_[b]); }
 
  private:
   const ClassImages& images_;

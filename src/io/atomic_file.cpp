@@ -84,15 +84,26 @@ void AtomicFile::write_at(std::uint64_t offset, std::string_view bytes) {
   for (std::size_t i = 0; i < bytes.size(); ++i)
     if (offset + i >= written && offset + i < size_) buffer_[static_cast<std::size_t>(offset + i - written)] = bytes[i];
   const std::size_t in_file = static_cast<std::size_t>(std::min<std::uint64_t>(bytes.size(), written > offset ? written - offset : 0));
-  for (std::size_t done = 0; done < in_file && !error_;) {
-    const ssize_t n = ::pwrite(fd_, bytes.data() + done, in_file - done, static_cast<off_t>(offset + done));
+  if (in_file == 0) return;
+  // The part in the file waits in patch_ while the next piece continues it (it lies below what
+  // is written, so later appends do not touch it).
+  if (!patch_.empty() && offset != patch_at_ + patch_.size()) flush_patch();
+  if (patch_.empty()) patch_at_ = offset;
+  patch_.append(bytes.data(), in_file);
+}
+
+void AtomicFile::flush_patch() {
+  for (std::size_t done = 0; done < patch_.size() && !error_;) {
+    const ssize_t n = ::pwrite(fd_, patch_.data() + done, patch_.size() - done, static_cast<off_t>(patch_at_ + done));
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) return fail("cannot write");
     done += static_cast<std::size_t>(n);
   }
+  patch_.clear();
 }
 
 Result<bool> AtomicFile::commit() {
+  if (!error_) flush_patch();
   if (!error_) flush();
   if (error_) return *error_;
   ::fchmod(fd_, 0644);

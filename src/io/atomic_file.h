@@ -33,6 +33,8 @@ class AtomicFile {
   // Appends at the end (buffered).
   void append(std::string_view bytes);
   // Writes over bytes already appended, at `offset` (a header field known only at the end).
+  // Pieces that continue one another are gathered into one write: OpenEXR writes its table of
+  // line offsets eight bytes at a time (a 256-line image: 256 pwrite calls).
   void write_at(std::uint64_t offset, std::string_view bytes);
   std::uint64_t size() const { return size_; }
   // Flushes to disk and renames the temporary over the path, or returns the first error.
@@ -40,11 +42,14 @@ class AtomicFile {
 
  private:
   void flush();
+  void flush_patch();
   void fail(const std::string& what);
 
   std::string path_, tmp_;
   int fd_ = -1;
   std::string buffer_;  // appended bytes not yet written
+  std::string patch_;   // write_at bytes for the file not yet written, from patch_at_
+  std::uint64_t patch_at_ = 0;
   std::uint64_t size_ = 0;
   std::optional<Error> error_;
 };

@@ -111,8 +111,8 @@ class ExrStream {
     });
   }
 
-  // Rows [y0, y0 + rows), band[l] holding layer l's (rows × width × 3 floats).
-  Result<bool> write(int y0, int rows, const std::vector<std::vector<float>>& band) {
+  // Rows [y0, y0 + rows), band[l] pointing at layer l's (rows × width × 3 floats).
+  Result<bool> write(int y0, int rows, const std::vector<const float*>& band) {
     return guarded([&] {
       const std::size_t w = static_cast<std::size_t>(bands_.width()), size = options_.half ? sizeof(half) : sizeof(float);
       const std::size_t x_stride = 3 * size, y_stride = x_stride * w;
@@ -120,7 +120,7 @@ class ExrStream {
       Imf::FrameBuffer frame;
       static const char* const kChannel[3] = {"R", "G", "B"};
       for (std::size_t l = 0; l < band.size(); ++l) {
-        const char* data = reinterpret_cast<const char*>(band[l].data());
+        const char* data = reinterpret_cast<const char*>(band[l]);
         if (options_.half) {  // half channels need their own buffers
           const std::size_t n = static_cast<std::size_t>(rows) * w * 3;
           halves_[l].resize(n);
@@ -254,20 +254,19 @@ double exposure_of(std::vector<double> lum) {
   return top > 0 ? 1 / top : 1;
 }
 
-// The luminances of `pixels` RGB float pixels, non-finite ones as 0, appended to `lum`.
-void append_luminances(const float* rgb, std::size_t pixels, std::vector<double>* lum) {
+// The luminances of `pixels` RGB float pixels, non-finite ones as 0, into `lum`.
+void luminances_into(const float* rgb, std::size_t pixels, double* lum) {
   for (std::size_t i = 0; i < pixels; ++i) {
     const double l = luminance({rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]});
-    lum->push_back(std::isfinite(l) ? l : 0.0);
+    lum[i] = std::isfinite(l) ? l : 0.0;
   }
 }
 
 }  // namespace
 
 double preview_exposure(const RgbImage& total) {
-  std::vector<double> lum;
-  lum.reserve(total.rgb.size() / 3);
-  append_luminances(total.rgb.data(), total.rgb.size() / 3, &lum);
+  std::vector<double> lum(total.rgb.size() / 3);
+  luminances_into(total.rgb.data(), lum.size(), lum.data());
   return exposure_of(std::move(lum));
 }
 
@@ -469,24 +468,37 @@ Result<bool> write_image_files(const LayerBands& bands, const ImageFiles& files)
   }
   const bool previews = !files.previews.empty();
   const auto png_path = [&](std::size_t l) { return files.previews + "/" + bands.name(l) + ".png"; };
+  const std::size_t row_floats = static_cast<std::size_t>(w) * 3;
 
-  // --- the previews' exposure: a first pass over the total's bands ---
+  // --- layers with the same pixels: each is made (and its preview encoded) as the first of them ---
+  std::vector<std::size_t> like(n);
+  for (std::size_t l = 0; l < n; ++l) {
+    like[l] = l;
+    for (std::size_t k = 0; k < l && like[l] == l; ++k)
+      if (like[k] == k && bands.same_pixels(k, l)) like[l] = k;
+  }
+
+  // --- the previews' exposure: a first pass makes the total whole (kept for the bands) ---
   double exposure = 1;
+  std::size_t total = n;  // the layer kept whole; n: none
+  std::vector<float> total_rgb;
   if (previews) {
-    std::size_t total = 0;
+    total = 0;
     for (std::size_t l = 0; l < n; ++l)
       if (bands.name(l) == "total") {
         total = l;
         break;
       }
-    std::vector<double> lum;
-    lum.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-    std::vector<float> band(band_floats);
-    for (int y0 = 0; y0 < h; y0 += kBandRows) {
-      const int rows = std::min(kBandRows, h - y0);
-      bands.fill(total, y0, rows, band.data());
-      append_luminances(band.data(), static_cast<std::size_t>(rows) * static_cast<std::size_t>(w), &lum);
-    }
+    total = like[total];
+    total_rgb.resize(static_cast<std::size_t>(h) * row_floats);
+    std::vector<double> lum(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    tbb::parallel_for(0, (h + kBandRows - 1) / kBandRows, [&](int b) {
+      const int y0 = b * kBandRows, rows = std::min(kBandRows, h - y0);
+      float* band = total_rgb.data() + static_cast<std::size_t>(y0) * row_floats;
+      bands.fill(total, y0, rows, band);
+      luminances_into(band, static_cast<std::size_t>(rows) * static_cast<std::size_t>(w),
+                      lum.data() + static_cast<std::size_t>(y0) * static_cast<std::size_t>(w));
+    });
     exposure = exposure_of(std::move(lum));
   }
 
@@ -500,30 +512,45 @@ Result<bool> write_image_files(const LayerBands& bands, const ImageFiles& files)
     exr.emplace(&*exr_file, bands, files.exr_options);
     if (Result<bool> r = exr->open(); !r) return located(r.error(), files.exr);
   }
-  std::vector<PngStream> pngs(previews ? n : 0);
+  // Previews are encoded for the first layer of each same-pixels group only.
+  std::vector<std::size_t> encoded;
+  if (previews)
+    for (std::size_t l = 0; l < n; ++l)
+      if (like[l] == l) encoded.push_back(l);
+  std::vector<PngStream> pngs(encoded.size());
   std::vector<std::optional<Error>> png_errors(pngs.size());
-  for (std::size_t l = 0; l < pngs.size(); ++l)
-    if (Result<bool> r = pngs[l].begin(w, h); !r) png_errors[l] = located(r.error(), png_path(l));
-  std::vector<std::vector<float>> band(n, std::vector<float>(band_floats));
+  for (std::size_t i = 0; i < pngs.size(); ++i)
+    if (Result<bool> r = pngs[i].begin(w, h); !r) png_errors[i] = located(r.error(), png_path(encoded[i]));
+  // The layers made band by band: every first of a group but the total kept whole.
+  std::vector<std::size_t> made;
+  for (std::size_t l = 0; l < n; ++l)
+    if (like[l] == l && l != total) made.push_back(l);
+  std::vector<std::vector<float>> band(n);
+  for (std::size_t l : made) band[l].resize(band_floats);
+  std::vector<const float*> data(n);
   std::vector<std::vector<std::uint8_t>> rgb8(pngs.size(), std::vector<std::uint8_t>(band_floats));
   for (int y0 = 0; y0 < h; y0 += kBandRows) {
     const int rows = std::min(kBandRows, h - y0);
-    const std::size_t values = static_cast<std::size_t>(rows) * static_cast<std::size_t>(w) * 3;
-    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t l) { bands.fill(l, y0, rows, band[l].data()); });
+    const std::size_t values = static_cast<std::size_t>(rows) * row_floats;
+    tbb::parallel_for(std::size_t{0}, made.size(), [&](std::size_t i) { bands.fill(made[i], y0, rows, band[made[i]].data()); });
+    for (std::size_t l = 0; l < n; ++l) {
+      const std::size_t k = like[l];
+      data[l] = k == total ? total_rgb.data() + static_cast<std::size_t>(y0) * row_floats : band[k].data();
+    }
     tbb::task_group group;
     if (exr && !exr_error)
       group.run([&] {
-        if (Result<bool> r = exr->write(y0, rows, band); !r) exr_error = located(r.error(), files.exr);
+        if (Result<bool> r = exr->write(y0, rows, data); !r) exr_error = located(r.error(), files.exr);
       });
-    tbb::parallel_for(std::size_t{0}, pngs.size(), [&](std::size_t l) {
-      if (png_errors[l]) return;
-      tonemap_srgb8_into(band[l].data(), values, exposure, rgb8[l].data());
-      if (Result<bool> r = pngs[l].rows(rgb8[l].data(), rows); !r) png_errors[l] = located(r.error(), png_path(l));
+    tbb::parallel_for(std::size_t{0}, pngs.size(), [&](std::size_t i) {
+      if (png_errors[i]) return;
+      tonemap_srgb8_into(data[encoded[i]], values, exposure, rgb8[i].data());
+      if (Result<bool> r = pngs[i].rows(rgb8[i].data(), rows); !r) png_errors[i] = located(r.error(), png_path(encoded[i]));
     });
     group.wait();
   }
   // --- completed and put in place: the EXR beside the previews (each file's flush to disk waits
-  // beside the others') ---
+  // beside the others'); a layer like an earlier one gets that one's preview bytes ---
   std::optional<Result<bool>> exr_done;
   tbb::task_group group;
   if (exr && !exr_error)
@@ -531,15 +558,20 @@ Result<bool> write_image_files(const LayerBands& bands, const ImageFiles& files)
       if (Result<bool> r = exr->close(); !r) exr_error = located(r.error(), files.exr);
       else exr_done.emplace(exr_file->commit());
     });
-  tbb::parallel_for(std::size_t{0}, pngs.size(), [&](std::size_t l) {
-    if (png_errors[l]) return;
-    if (Result<bool> r = pngs[l].end(); !r) png_errors[l] = located(r.error(), png_path(l));
-    else if (Result<bool> wr = write_file_atomic(png_path(l), pngs[l].bytes()); !wr) png_errors[l] = wr.error();
+  std::vector<std::optional<Error>> layer_errors(previews ? n : 0);
+  tbb::parallel_for(std::size_t{0}, pngs.size(), [&](std::size_t i) {
+    if (!png_errors[i])
+      if (Result<bool> r = pngs[i].end(); !r) png_errors[i] = located(r.error(), png_path(encoded[i]));
+    for (std::size_t l = encoded[i]; l < n; ++l) {
+      if (like[l] != encoded[i]) continue;
+      if (png_errors[i]) layer_errors[l] = png_errors[i];
+      else if (Result<bool> wr = write_file_atomic(png_path(l), pngs[i].bytes()); !wr) layer_errors[l] = wr.error();
+    }
   });
   group.wait();
   if (exr_error) return *exr_error;
   if (exr_done && !*exr_done) return std::move(*exr_done);
-  for (const std::optional<Error>& e : png_errors)
+  for (const std::optional<Error>& e : layer_errors)
     if (e) return *e;
   return true;
 }

@@ -66,6 +66,10 @@ class LayerBands {
   // Rows [y0, y0 + rows) of a layer, rows × width × 3 floats (RGB, row-major), into `out`. Called
   // from several threads at once, with y0 a multiple of kBandRows.
   virtual void fill(std::size_t layer, int y0, int rows, float* out) const = 0;
+  // Whether layers `a` and `b` are known to be equal pixel for pixel (false: not known). The
+  // writer then makes the pixels and the preview of such layers once: in the default scene the
+  // class "local" holds every sampled path, and its layer was made and encoded as the total's was.
+  virtual bool same_pixels(std::size_t /*a*/, std::size_t /*b*/) const { return false; }
 };
 inline constexpr int kBandRows = 16;
 
@@ -76,9 +80,11 @@ struct ImageFiles {
 };
 // Writes `files` from `bands`: the EXR and every preview encoded band by band, the layers of a
 // band made in parallel and the EXR and the PNGs encoded side by side. The previews' exposure is
-// that of the layer named "total" (else the first), from a first pass over its bands. The bytes
-// are those of the whole-image writers. Errors name the file; the first in the order EXR,
-// previews by layer is returned.
+// that of the layer named "total" (else the first), from a first pass that makes that layer
+// whole (12 bytes per pixel, kept for the bands: it is made once). Layers with the same pixels
+// (LayerBands::same_pixels) are made and their previews encoded once. The bytes are those of the
+// whole-image writers. Errors name the file; the first in the order EXR, previews by layer is
+// returned.
 Result<bool> write_image_files(const LayerBands& bands, const ImageFiles& files);
 
 // --- PNG previews ---

@@ -587,6 +587,25 @@ TEST(ClassImages, ContributionsLandInTheTotalAndTheirClassesLayers) {
   EXPECT_EQ(total.image.at(1, 0, 1), 0.0f);
 }
 
+// Two layers sum the same planes among those anything was added to exactly when every
+// contribution so far lands in both (the default scene's "local" and the total): the image
+// writers then make them once.
+TEST(ClassImages, LayersThatSumTheSameUsedPlanesAreTheSame) {
+  Classes classes({{"point", "LS.*E"}, {"any", "L.*E"}, {"long", "L.{6,}E"}});
+  ClassImages images(3, 2, &*classes.classifier, {1, 0, 2});  // layers: total, any, point, long
+  Histogram h(HistogramLayout{}, &*classes.classifier);
+  EXPECT_TRUE(images.same_sums(0, 1) && images.same_sums(0, 2) && images.same_sums(0, 3)) << "nothing added: all empty";
+  EXPECT_TRUE(images.add(0, 0, h.class_set(h.intern("LSDDSE")), *to_exact(gray(1.0))));  // any, point
+  EXPECT_TRUE(images.same_sums(0, 1));
+  EXPECT_TRUE(images.same_sums(1, 2)) << "so far every path is a point-light path";
+  EXPECT_FALSE(images.same_sums(0, 3));
+  EXPECT_TRUE(images.add(2, 1, h.class_set(h.intern("LDDDSE")), *to_exact(gray(2.0))));  // any only
+  EXPECT_TRUE(images.same_sums(0, 1));
+  EXPECT_FALSE(images.same_sums(0, 2));
+  EXPECT_FALSE(images.same_sums(1, 2));
+  EXPECT_EQ(images.layer(0, 1.0).image.rgb, images.layer(1, 1.0).image.rgb);
+}
+
 TEST(ClassImages, PixelSumFlushEqualsDirectAddsAndTheTotalMatchesTheHistogram) {
   Classes classes({{"point", "LS.*E"}, {"area", "LD.*E"}});
   ClassImages direct(4, 4, &*classes.classifier, {0, 1}), buffered(4, 4, &*classes.classifier, {0, 1});

@@ -8,6 +8,7 @@
 #include <png.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -240,6 +241,52 @@ TEST(Png, PreviewsShareTheTotalsExposureAndReadBack) {
   EXPECT_EQ(c.at(0, 0, 0), 0);
 }
 
+// Layers said to have the same pixels are made and encoded once: the files are the bytes of the
+// writers that make every layer (write_exr, write_previews), and each layer still has its PNG.
+class SameBands final : public LayerBands {
+ public:
+  explicit SameBands(const std::vector<ImageLayer>& layers) : fills(layers.size()), layers_(layers) {}
+  mutable std::vector<std::atomic<int>> fills;  // fill() calls per layer
+  int width() const override { return layers_[0].image.width; }
+  int height() const override { return layers_[0].image.height; }
+  std::size_t num_layers() const override { return layers_.size(); }
+  const std::string& name(std::size_t layer) const override { return layers_[layer].name; }
+  void fill(std::size_t layer, int y0, int rows, float* out) const override {
+    ++fills[layer];
+    const std::size_t row = static_cast<std::size_t>(width()) * 3;
+    const float* src = layers_[layer].image.rgb.data() + static_cast<std::size_t>(y0) * row;
+    std::copy(src, src + static_cast<std::size_t>(rows) * row, out);
+  }
+  bool same_pixels(std::size_t a, std::size_t b) const override { return layers_[a].image.rgb == layers_[b].image.rgb; }
+
+ private:
+  const std::vector<ImageLayer>& layers_;
+};
+
+TEST(Png, LayersWithTheSamePixelsAreMadeOnceAndWrittenAsBefore) {
+  TempDir whole, once;
+  const int w = 37, h = 40;  // bands of 16 rows and a short last band
+  ImageLayer total = make_layer("total", w, h, 0.5f), local = total, other = make_layer("direct", w, h, 3.0f), copy = other;
+  local.name = "local";
+  copy.name = "copy";
+  for (float& v : total.image.rgb) v /= 5000;
+  local.image.rgb = total.image.rgb;
+  const std::vector<ImageLayer> layers = {local, other, total, copy};
+  ASSERT_TRUE(write_exr(whole.file("classes.exr"), layers));
+  ASSERT_TRUE(write_previews(whole.path().string(), layers));
+  const SameBands bands(layers);
+  ASSERT_TRUE(write_image_files(bands, ImageFiles{once.file("classes.exr"), {}, once.path().string()}));
+  EXPECT_EQ(once.entries(), whole.entries());
+  for (const std::string& f : whole.entries()) EXPECT_EQ(read_bytes(once.file(f)), read_bytes(whole.file(f))) << f;
+  EXPECT_EQ(read_bytes(once.file("local.png")), read_bytes(once.file("total.png")));
+  // "local" (the first of its pair) is made whole for the exposure, in bands of 16 rows; the
+  // others of each pair never.
+  EXPECT_EQ(bands.fills[0].load(), 3);
+  EXPECT_EQ(bands.fills[1].load(), 3);
+  EXPECT_EQ(bands.fills[2].load(), 0);
+  EXPECT_EQ(bands.fills[3].load(), 0);
+}
+
 TEST(Png, ExposureFallsBackForSparseAndBlackImages) {
   RgbImage black{4, 25, std::vector<float>(300, 0.0f)};
   EXPECT_EQ(preview_exposure(black), 1.0);
@@ -316,6 +363,30 @@ TEST(AtomicWrite, AStreamedFileHasTheBytesOfOneWrite) {
     abandoned.append("never committed");
   }
   EXPECT_EQ(dir.entries(), std::set<std::string>{"render.shard"});
+}
+
+// Patches that continue one another (OpenEXR's offset table, eight bytes at a time) are gathered
+// into one write; one that does not, or that writes over an earlier patch, still lands in order.
+TEST(AtomicWrite, PatchesInPiecesGiveTheBytesOfOneWrite) {
+  TempDir dir;
+  const std::string path = dir.file("classes.exr");
+  std::string expected(1 << 20, 'a');
+  {
+    AtomicFile file(path);
+    file.append(expected);
+    file.append("tail");  // the first MiB is in the file, "tail" still buffered
+    for (int i = 0; i < 100; ++i) file.write_at(1000 + 8 * static_cast<std::uint64_t>(i), std::string(8, static_cast<char>('A' + i % 26)));
+    file.write_at(500, "gap");       // not continuing: the pieces before it are written first
+    file.write_at(1000, "over");     // over the first piece, after it
+    file.write_at((1 << 20) - 1, "xy");  // one byte in the file, one buffered
+    ASSERT_TRUE(file.commit());
+  }
+  for (int i = 0; i < 100; ++i) expected.replace(1000 + 8 * static_cast<std::size_t>(i), 8, std::string(8, static_cast<char>('A' + i % 26)));
+  expected.replace(500, 3, "gap");
+  expected.replace(1000, 4, "over");
+  expected += "tail";
+  expected.replace((1 << 20) - 1, 2, "xy");
+  EXPECT_EQ(read_bytes(path), expected);
 }
 
 TEST(AtomicWrite, AMissingDirectoryIsAnErrorNamingThePath) {
