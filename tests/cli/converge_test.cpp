@@ -14,6 +14,7 @@
 
 #include "classify/convergence.h"
 #include "support/cli_run.h"
+#include "support/stat_seed.h"
 
 namespace {
 
@@ -34,7 +35,8 @@ std::vector<double> column(const nlohmann::json& rungs, const char* key) {
 TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
   const std::string dir = out_dir("sphere");
   const CliRun r = run_pathex("converge samples/scenes/closed-sphere-point.json --renderer pt-nee --renderer bdpt "
-                              "--spp 16,64,256,1024 --resolution 16x16 --json --out " + dir);
+                              "--spp 16,64,256,1024 --resolution 16x16 --json --seed " +
+                              std::to_string(pathex::test::stat_seed(1)) + " --out " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("reference").at("kind"), "closed-form");
@@ -45,6 +47,10 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
     EXPECT_EQ(ren.at("nonfinite_samples"), 0);
     for (const auto& c : ren.at("classes")) {
       const std::string what = ren.at("name").get<std::string>() + " " + c.at("name").get<std::string>();
+      const nlohmann::json& check = c.at("stderr_check");
+      if (check.at("chi2").is_number() && check.at("limit").is_number())
+        pathex::test::stat_log(what + " chi2/limit", check.at("chi2").get<double>() / check.at("limit").get<double>(), 1);
+      if (check.at("stability").is_number()) pathex::test::stat_log(what + " stability", check.at("stability").get<double>(), 0.7);
       EXPECT_FALSE(c.at("stderr_check").at("disagrees")) << what;
       EXPECT_FALSE(c.at("stderr_check").at("unstable")) << what;
       EXPECT_TRUE(c.at("warning").is_null()) << what;
@@ -53,6 +59,8 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
       // pt-nee's one- and two-bounce estimates have no variance (every pixel gets the closed form
       // by next-event estimation): their error is rounding, which does not fall.
       if (se.back() < 1e-6 * c.at("rungs").back().at("estimate").get<double>()) continue;
+      pathex::test::stat_log(what + " reported stderr slope", pathex::loglog_slope(spp, se), 0.1);
+      pathex::test::stat_log(what + " per-pixel RMS slope", pathex::loglog_slope(spp, column(c.at("rungs"), "rms_pixel_error")), 0.1);
       EXPECT_NEAR(pathex::loglog_slope(spp, se), -0.5, 0.1) << what << " reported stderr";
       EXPECT_NEAR(pathex::loglog_slope(spp, column(c.at("rungs"), "rms_pixel_error")), -0.5, 0.1) << what << " per-pixel RMS";
     }
