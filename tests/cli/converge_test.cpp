@@ -57,7 +57,8 @@ double slope_std_error(const std::vector<double>& x, const std::vector<double>& 
 //   whose error may fall faster than 1/sqrt(budget) (bdpt's one-bounce class: -0.545 on average),
 //   so the check is one-sided: at most -0.5 + 4 kRmsSlopeSE = -0.42 (a false failure below 3e-5 per
 //   slope, 2e-4 for the five), and at least -1. An error that falls as budget^-0.4 (a bias floor
-//   appearing) fails it at 9 of 10 seeds.
+//   appearing; test-only, the errors scaled by budget^0.1) failed 30 of 30 seeds, 104 of the 150
+//   slopes.
 // - a series at single-precision rounding already at the smallest budget (its first value below
 //   kRoundingFloor of the estimate: pt-nee's one- and two-bounce classes have no variance, and its
 //   three-bounce estimate under the Sobol sampler is exact in every pixel though its batches differ)
