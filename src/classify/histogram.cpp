@@ -418,9 +418,14 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   std::vector<std::uint32_t> path_set(classes.empty() ? 0 : static_cast<std::size_t>(h.num_paths()));
   std::vector<ExactRgb> path_sums(B);
 
+  // The batches anything was added to: the others hold no cell of any path (the default 16 spp
+  // fills 16 of 32), so their sums stay zero without being read.
+  std::vector<int> used;
+  for (int b = 0; b < nb; ++b)
+    if (h.batch_in_use(b)) used.push_back(b);
   for (Histogram::PathId p = 0; p < h.num_paths(); ++p) {
     std::uint64_t count = 0;
-    for (int b = 0; b < nb; ++b) {
+    for (int b : used) {
       const Histogram::Cell& c = h.cell(p, b);
       if (c.contributions != 0 && n[static_cast<std::size_t>(b)] == 0)
         return make_error(ErrorCode::kUsage, "batch " + std::to_string(b) +
@@ -435,7 +440,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
       path_set[static_cast<std::size_t>(p)] = set;
       for (int k : classifier->members(set)) {
         const std::size_t ks = static_cast<std::size_t>(k);
-        for (std::size_t b = 0; b < B; ++b) add_to(class_sums[ks][b], path_sums[b]);
+        for (int b : used) add_to(class_sums[ks][static_cast<std::size_t>(b)], path_sums[static_cast<std::size_t>(b)]);
         class_counts[ks] += count;
       }
     }
@@ -491,7 +496,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     std::uint64_t other_count = total_count;
     for (std::size_t i = 0; i < listed; ++i) {
       const Histogram::PathId p = order[i];
-      for (int b = 0; b < nb; ++b) {
+      for (int b : used) {
         const Histogram::Cell& c = h.cell(p, b);
         for (std::size_t ch = 0; ch < 3; ++ch) other_sums[static_cast<std::size_t>(b)][ch] -= c.sum[ch];
         other_count -= c.contributions;

@@ -136,15 +136,9 @@ class Writer {
     std::memcpy(window_.data() + used_, &v, 8);
     used_ += 8;
   }
-  // A pixel's channel sum: the low word raw, the high word as a zigzag varint of its signed
-  // value (one byte below 2^70 in magnitude, i.e. a sum below 64 on the pixel's grid).
-  void split(std::uint64_t low, std::uint64_t high) {
-    raw64(low);
-    const auto h = static_cast<std::int64_t>(high);
-    u((static_cast<std::uint64_t>(h) << 1) ^ static_cast<std::uint64_t>(h >> 63));
-  }
-  void text(const std::string& s) {
-    u(s.size());
+  // A signed 64-bit integer as the varint of its zigzag form (one byte from -64 to 63).
+  void signed64(std::int64_t v) { u((static_cast<std::uint64_t>(v) << 1) ^ static_cast<std::uint64_t>(v >> 63)); }
+  void bytes(std::string_view s) {
     for (std::size_t at = 0; at < s.size();) {
       room(1);
       const std::size_t n = std::min(s.size() - at, window_.size() - used_);
@@ -152,6 +146,10 @@ class Writer {
       used_ += n;
       at += n;
     }
+  }
+  void text(const std::string& s) {
+    u(s.size());
+    bytes(s);
   }
   // Compresses what is left and ends the frame; what follows starts another. Its compressed size.
   std::uint64_t end_frame() {
@@ -252,27 +250,30 @@ class Reader {
     p_ += 8;
     return v;
   }
-  // Writer::split's pair: the low word and the high word, into `words`.
-  void split(std::uint64_t* words) {
-    words[0] = raw64();
+  std::int64_t signed64() {
     const std::uint64_t z = u();
-    words[1] = (z >> 1) ^ (std::uint64_t{0} - (z & 1));
+    return static_cast<std::int64_t>((z >> 1) ^ (std::uint64_t{0} - (z & 1)));
+  }
+  // The next `n` ≤ kMaxBytes bytes, in the window: valid until the next read.
+  std::string_view bytes(std::size_t n) {
+    if (n > kMaxBytes) return fail(), std::string_view();
+    refill(n);
+    if (n > static_cast<std::size_t>(end_ - p_)) return fail(), std::string_view();
+    const std::string_view s(p_, n);
+    p_ += n;
+    return s;
   }
   // A string in the window: valid until the next read (no allocation per path string).
   std::string_view text() {
     const std::uint64_t n = u();
-    if (n > kMaxText) return fail(), std::string_view();
-    refill(static_cast<std::size_t>(n));
-    if (n > static_cast<std::uint64_t>(end_ - p_)) return fail(), std::string_view();
-    const std::string_view s(p_, static_cast<std::size_t>(n));
-    p_ += n;
-    return s;
+    if (n > kMaxBytes) return fail(), std::string_view();
+    return bytes(static_cast<std::size_t>(n));
   }
+  static constexpr std::size_t kMaxBytes = std::size_t{1} << 19;  // a string, or a piece of a byte plane
 
  private:
   static constexpr std::size_t kWindow = std::size_t{1} << 20;
   static constexpr std::size_t kMaxVarint = 19;  // 128 bits, 7 per byte
-  static constexpr std::uint64_t kMaxText = kWindow / 2;
   static ExactSum unzigzag(ExactSum z) { return (z >> 1) ^ (ExactSum{0} - (z & 1)); }
 
   // Makes at least `n` bytes readable, unless the body ends first.
@@ -655,19 +656,24 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const RenderSums& 
   const RowBatchSums row_sums = row_batch_sums(h);
   w.u(order.size());
   w.u(static_cast<std::uint64_t>(h.num_rows()));
+  // Only the batches that hold something: a shard of a few passes fills a few of the B, and a
+  // batch nothing was added to (the default 16 spp fills 16 of 32) holds no cell of any path.
+  std::vector<int> used;
+  for (int b = 0; b < h.num_batches(); ++b)
+    if (h.batch_in_use(b)) used.push_back(b);
+  std::vector<std::pair<int, const Histogram::Cell*>> held;
   for (Histogram::PathId p : order) {
     w.text(h.path(p));
-    // Only the batches that hold something: a shard of a few passes fills a few of the B.
-    const auto held = [&](int b) { return h.cell(p, b).contributions != 0 || !is_zero(h.cell(p, b).sum); };
-    int cells = 0;
-    for (int b = 0; b < h.num_batches(); ++b) cells += held(b) ? 1 : 0;
-    w.u(static_cast<std::uint64_t>(cells));
-    for (int b = 0, last = -1; b < h.num_batches(); ++b) {
-      if (!held(b)) continue;
-      w.u(static_cast<std::uint64_t>(b - last - 1));
-      last = b;
-      w.u(h.cell(p, b).contributions);
-      w.rgb(h.cell(p, b).sum);
+    held.clear();
+    for (int b : used)
+      if (const Histogram::Cell& c = h.cell(p, b); c.contributions != 0 || !is_zero(c.sum)) held.emplace_back(b, &c);
+    w.u(held.size());
+    int previous = -1;
+    for (const auto& [b, c] : held) {
+      w.u(static_cast<std::uint64_t>(b - previous - 1));
+      previous = b;
+      w.u(c->contributions);
+      w.rgb(c->sum);
     }
     const std::vector<int> rows = h.sorted_rows(p);
     w.u(rows.size());
@@ -685,14 +691,18 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const RenderSums& 
     }
   }
   sizes.push_back(w.end_frame());
-  // --- images, kTilesPerFrame stored tiles a frame ---
-  std::vector<std::uint64_t> first_keys;
+  // --- images, kTilesPerFrame stored tiles a frame: the tiles' keys and masks, then their sums'
+  // low words in byte planes, then their high words ---
+  std::vector<std::uint64_t> first_keys, low, high;
+  std::string plane;
   for (std::size_t f = 0; f < frames; ++f) {
     const std::size_t begin = f * kTilesPerFrame, end = std::min(stored.size(), begin + kTilesPerFrame);
     first_keys.push_back(stored[begin].first * tiles + stored[begin].second);
     w.u(planes);
     w.u(tiles);
     w.u(end - begin);
+    low.clear();
+    high.clear();
     for (std::size_t i = begin; i < end; ++i) {
       const auto [p, t] = stored[i];
       w.u(p);
@@ -704,8 +714,17 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const RenderSums& 
       w.raw64(mask);
       for (std::size_t k = 0; k < kTilePixels; ++k)
         if (mask >> k & 1)
-          for (std::size_t c = 0; c < 6; c += 2) w.split(words[6 * k + c], words[6 * k + c + 1]);
+          for (std::size_t c = 0; c < 6; c += 2) {
+            low.push_back(words[6 * k + c]);
+            high.push_back(words[6 * k + c + 1]);
+          }
     }
+    plane.resize(low.size());
+    for (int j = 0; j < 8; ++j) {
+      for (std::size_t i = 0; i < low.size(); ++i) plane[i] = static_cast<char>(low[i] >> (8 * j));
+      w.bytes(plane);
+    }
+    for (std::uint64_t v : high) w.signed64(static_cast<std::int64_t>(v));
     sizes.push_back(w.end_frame());
   }
   // --- connector statistics ---
@@ -875,23 +894,43 @@ BadBody add_image_frame(Reader& r, ClassImages* images, std::uint64_t first, std
   if (planes != images->num_planes() || tiles != images->num_tiles())
     return "its images have " + std::to_string(planes) + " planes of " + std::to_string(tiles) + " tiles; the merge's have " +
            std::to_string(images->num_planes()) + " of " + std::to_string(images->num_tiles());
-  std::array<std::uint64_t, ClassImages::kTileWords> words;
+  // The tiles' keys and masks (each key checked before the next is read: at most end - first).
+  std::vector<std::uint64_t> keys, masks;
+  std::size_t values = 0;  // channel sums in all: three per pixel of a mask
   for (std::uint64_t i = 0, next = first; i < stored; ++i) {
     const std::uint64_t p = r.u(), t = r.u();
     if (r.failed() || p >= planes || t >= tiles || p * tiles + t < next || p * tiles + t >= end)
       return "a stored tile is out of its frame's range or order";
     next = p * tiles + t + 1;
-    const std::uint64_t mask = r.raw64();
+    keys.push_back(p * tiles + t);
+    masks.push_back(r.raw64());
+    values += 3 * static_cast<std::size_t>(std::popcount(masks.back()));
+  }
+  if (r.failed()) return "an image frame ends early";
+  // The low words, a byte plane at a time, a piece of the window at a time.
+  std::vector<std::uint64_t> low(values, 0);
+  for (int j = 0; j < 8; ++j)
+    for (std::size_t i = 0; i < values;) {
+      const std::string_view piece = r.bytes(std::min(values - i, Reader::kMaxBytes));
+      if (r.failed()) return "an image frame ends early";
+      for (const char c : piece) low[i++] |= static_cast<std::uint64_t>(static_cast<unsigned char>(c)) << (8 * j);
+    }
+  std::array<std::uint64_t, ClassImages::kTileWords> words;
+  std::size_t v = 0;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
     for (std::size_t k = 0; k < kTilePixels; ++k) {
       std::uint64_t* px = words.data() + 6 * k;
-      if (mask >> k & 1) {
-        for (std::size_t c = 0; c < 6; c += 2) r.split(px + c);
+      if (masks[i] >> k & 1) {
+        for (std::size_t c = 0; c < 6; c += 2, ++v) {
+          px[c] = low[v];
+          px[c + 1] = static_cast<std::uint64_t>(r.signed64());
+        }
       } else {
         std::fill(px, px + 6, std::uint64_t{0});
       }
     }
     if (r.failed()) return "an image frame ends early";
-    images->add_tile(static_cast<std::size_t>(p), static_cast<std::size_t>(t), words.data());
+    images->add_tile(static_cast<std::size_t>(keys[i] / tiles), static_cast<std::size_t>(keys[i] % tiles), words.data());
   }
   if (!r.at_end()) return "bytes after an image frame's tiles";
   return std::nullopt;

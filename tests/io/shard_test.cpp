@@ -306,7 +306,7 @@ TEST(ShardFile, EveryTruncationAndEveryFlippedByteIsRefused) {
   EXPECT_EQ(message("hello, world, not a shard"), "not a pathex shard file (it does not begin with \"PXSHARD\")");
   std::string v2 = bytes;
   v2[8] = 2;  // version 2 had per-strategy sums, not per-technique rows
-  EXPECT_EQ(message(v2), "shard file format version 2; this pathex reads version 5");
+  EXPECT_EQ(message(v2), "shard file format version 2; this pathex reads version 6");
   EXPECT_EQ(message(bytes + "x"), "corrupted shard file: 1 bytes after its checksum");
 }
 
