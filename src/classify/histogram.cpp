@@ -130,6 +130,13 @@ int Histogram::technique_row(PathId id, int technique) {
   return r;
 }
 
+std::vector<int> Histogram::batches_in_use() const {
+  std::vector<int> used;
+  for (int b = 0; b < num_batches(); ++b)
+    if (batch_in_use(b)) used.push_back(b);
+  return used;
+}
+
 std::vector<int> Histogram::sorted_rows(PathId id) const {
   std::vector<int> out;
   for (int r = first_row(id); r >= 0; r = row(r).next) out.push_back(r);
@@ -418,11 +425,9 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   std::vector<std::uint32_t> path_set(classes.empty() ? 0 : static_cast<std::size_t>(h.num_paths()));
   std::vector<ExactRgb> path_sums(B);
 
-  // The batches anything was added to: the others hold no cell of any path (the default 16 spp
-  // fills 16 of 32), so their sums stay zero without being read.
-  std::vector<int> used;
-  for (int b = 0; b < nb; ++b)
-    if (h.batch_in_use(b)) used.push_back(b);
+  // The batches anything was added to: the others hold no cell of any path, so their sums stay
+  // zero without being read.
+  const std::vector<int> used = h.batches_in_use();
   for (Histogram::PathId p = 0; p < h.num_paths(); ++p) {
     std::uint64_t count = 0;
     for (int b : used) {

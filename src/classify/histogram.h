@@ -272,6 +272,9 @@ class Histogram {
   }
   // Whether anything was ever added to the batch's cells or row sums (the others are all zero).
   bool batch_in_use(int batch) const { return !cells_[static_cast<std::size_t>(batch)].empty(); }
+  // The batches in use, ascending: a shard of a few passes, or a render of fewer passes than
+  // batches (the default 16 spp fills 16 of 32), leaves the others empty.
+  std::vector<int> batches_in_use() const;
   int num_rows() const { return static_cast<int>(rows_.size()); }
   // The path's rows ordered by technique code (the order serialised forms use).
   std::vector<int> sorted_rows(PathId id) const;

@@ -591,9 +591,7 @@ RowBatchSums row_batch_sums(const Histogram& h) {
   const int rows = h.num_rows();
   RowBatchSums out;
   out.begin.assign(static_cast<std::size_t>(rows) + 1, 0);
-  std::vector<int> used;
-  for (int b = 0; b < h.num_batches(); ++b)
-    if (h.batch_in_use(b)) used.push_back(b);
+  const std::vector<int> used = h.batches_in_use();
   for (int b : used)
     for (int r = 0; r < rows; ++r) out.begin[static_cast<std::size_t>(r) + 1] += h.row_sum(r, b) != 0 ? 1 : 0;
   for (std::size_t r = 0; r < static_cast<std::size_t>(rows); ++r) out.begin[r + 1] += out.begin[r];
@@ -656,11 +654,8 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const RenderSums& 
   const RowBatchSums row_sums = row_batch_sums(h);
   w.u(order.size());
   w.u(static_cast<std::uint64_t>(h.num_rows()));
-  // Only the batches that hold something: a shard of a few passes fills a few of the B, and a
-  // batch nothing was added to (the default 16 spp fills 16 of 32) holds no cell of any path.
-  std::vector<int> used;
-  for (int b = 0; b < h.num_batches(); ++b)
-    if (h.batch_in_use(b)) used.push_back(b);
+  // Only the batches that hold something (a batch nothing was added to holds no cell of any path).
+  const std::vector<int> used = h.batches_in_use();
   std::vector<std::pair<int, const Histogram::Cell*>> held;
   for (Histogram::PathId p : order) {
     w.text(h.path(p));
