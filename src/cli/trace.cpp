@@ -370,6 +370,15 @@ int run(const TraceArgs& a) {
   }();
   const double cpu_s = process_cpu_seconds() - cpu_start;
   if (!out) return report(out.error());
+  // --only: a light aimed at the shapes a requested path can reach first is listed with the
+  // strategies the checker narrowed (the table's "narrowed:" lines, run.json's "pruned").
+  for (const AimedLight& l : out->aimed) {
+    std::ostringstream now;
+    now << "the cones around " << l.shapes << (l.shapes == 1 ? " shape" : " shapes") << " with a specular component ("
+        << std::fixed << std::setprecision(1) << 100.0 * l.share << " % of the directions)";
+    pruning->changes.push_back({"light /lights/" + std::to_string(l.light) + " (" + l.kind + ")", "emission (every direction)", now.str(),
+                                "every requested path scatters specularly at its first vertex"});
+  }
   // Non-finite samples are bugs (DESIGN §7): say so, and where the first arose.
   if (const std::uint64_t n = out->histogram.nonfinite(); n > 0) {
     std::cerr << "pathex: warning: " << n << " non-finite samples (dropped; any is a bug)";

@@ -21,6 +21,7 @@
 #include "trace/bsdf.h"
 #include "trace/joins/join.h"
 #include "trace/joins/manifold.h"
+#include "trace/prune.h"
 #include "trace/render.h"
 #include "trace/render_scene.h"
 #include "trace/rng.h"
@@ -83,7 +84,21 @@ class Integrator {
     features_ = rs.features;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
+    // --only: a point or spot light whose requested paths all scatter specularly first emits only
+    // towards the shapes that can (trace/emission_cones.h). With a pinhole or a lens, whose first
+    // letter is D, the test also rules out the light seen directly.
+    aimed_.resize(rs.lights.size());
+    if (o_.only != nullptr && sensor_pair_[0] == 'D' && max_light_ >= 2)
+      for (std::size_t i = 0; i < rs.lights.size(); ++i) {
+        const LightParams& l = rs.lights[i].params;
+        if ((std::holds_alternative<PointLightParams>(l) || std::holds_alternative<SpotLightParams>(l)) &&
+            o_.only->first_vertex_specular(light_pairs_[i][0], light_pairs_[i][1]))
+          aimed_[i] = EmissionCones::make(light_position(l), rs.specular_bounds);
+      }
   }
+
+  // The cones light i emits into under --only (trace/emission_cones.h); none: every direction.
+  const std::optional<EmissionCones>& aimed(std::size_t light) const { return aimed_[light]; }
 
   // A weighted JoinResult on its way to record() (estimate() makes it): with its segments queued
   // for visibility, or none needed.
@@ -234,6 +249,7 @@ class Integrator {
   }
   // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
   float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
+    if (const std::optional<EmissionCones>& cones = aimed_[static_cast<std::size_t>(&l - rs_.lights.data())]) return cones->pdf(w);
     const RayPdf p = pdf_ray(l.params, SurfacePoint{v.p, v.n, l.pdf_pos}, w);
     return finite_part(p.dir, p.delta_dir);
   }
@@ -457,6 +473,7 @@ class Integrator {
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
   std::vector<std::string> light_pairs_;  // each light's letters c0 c1
+  std::vector<std::optional<EmissionCones>> aimed_;  // per light: the cones it emits into, or none
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;

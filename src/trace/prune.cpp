@@ -11,6 +11,14 @@ Result<RequestedPaths> RequestedPaths::make(const std::vector<const PathClass*>&
   return out;
 }
 
+bool RequestedPaths::first_vertex_specular(char pos, char dir) const {
+  const Classifier::Direction& d = classifier_->forward();
+  Classifier::State s = Classifier::step(d, d.start, 'L');
+  s = Classifier::step(d, s, pos);
+  s = Classifier::step(d, s, dir);
+  return !classifier_->alive(d, Classifier::step(d, s, 'D'));
+}
+
 void SubpathPrefix::start(const RequestedPaths& only, bool light, char pos, char dir) {
   const Classifier& c = only.classifier();
   d_ = light ? &c.forward() : &c.backward();

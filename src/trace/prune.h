@@ -32,6 +32,13 @@ class RequestedPaths {
     return !classifier_->members(classifier_->set_of(d, s)).empty();
   }
 
+  // Whether every requested path that starts at a light with letters c0 c1 = `pos` `dir` has a
+  // specular first vertex: after L c0 c1 the letter D (a diffuse first vertex, or the first letter
+  // of a pinhole or a lens, the light seen directly) leaves no requested class to complete. Then a
+  // light subpath's first ray matters only where it meets a shape with a specular component
+  // (trace/emission_cones.h).
+  bool first_vertex_specular(char pos, char dir) const;
+
   const Classifier& classifier() const { return *classifier_; }
 
  private:

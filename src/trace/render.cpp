@@ -211,7 +211,16 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   y0.letter = light_pairs_[li][1];
   const SurfacePoint x = sample_point(l, rng, &y0.err);
   rng.skip(2);  // u_ray, drawn in advance
-  const std::optional<EndpointRay> r = sample_ray(l.params, x, u_ray);
+  std::optional<EndpointRay> r = sample_ray(l.params, x, u_ray);
+  if (const std::optional<EmissionCones>& cones = aimed_[li]; cones && r) {
+    // --only: the first direction drawn within the cones instead (trace/emission_cones.h).
+    float pdf = 0.0f;
+    r->direction = cones->sample(u_ray, &pdf);
+    r->value = spatial_emission(l.params) * directional_emission(l.params, r->normal, r->direction);
+    r->pdf.dir = pdf;
+    r->weight = r->value / pdf;
+    if (is_black(r->value)) r.reset();
+  }
   y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
     y0.p = x.position;
@@ -951,6 +960,11 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
                             : ClassImages(0, 0, nullptr, {}),
                    layout.strategies};
   Integrator integrator(*rs, *strategies, o);
+  const std::size_t area_lights = rs->lights.size() - scene.lights.size();  // the emissive shapes come first
+  for (std::size_t i = area_lights; i < rs->lights.size(); ++i)
+    if (const std::optional<EmissionCones>& c = integrator.aimed(i))
+      out.aimed.push_back({static_cast<int>(i - area_lights), std::holds_alternative<PointLightParams>(rs->lights[i].params) ? "point" : "spot",
+                           c->size(), c->share()});
   const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
   tbb::enumerable_thread_specific<Integrator::Thread> locals(

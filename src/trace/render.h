@@ -137,6 +137,15 @@ struct NonfiniteSample {
   std::tuple<std::uint64_t, int, int> order() const { return {pass, y, x}; }
 };
 
+// A light that emitted only towards the shapes a requested path can reach first (--only;
+// trace/emission_cones.h).
+struct AimedLight {
+  int light = 0;             // index into the scene's "lights"
+  std::string kind;          // "point" or "spot"
+  std::size_t shapes = 0;    // the shapes with a specular component it emitted towards
+  float share = 0.0f;        // the cones' solid angles over 4π (an upper bound of the share of directions)
+};
+
 struct RenderOutput {
   Histogram histogram;
   ClassImages images;
@@ -148,6 +157,7 @@ struct RenderOutput {
   std::uint64_t rays = 0;      // rays cast (intersections and shadow rays)
   std::vector<ConnectorStats> connectors{};  // one per connector strategy of the profile, in its order
   std::optional<NonfiniteSample> first_nonfinite{};  // when histogram.nonfinite() > 0
+  std::vector<AimedLight> aimed{};                   // --only: the lights whose emission was aimed
 };
 
 // The strategies of a profile the tracer runs: plain joins and the mirror and projection

@@ -1,10 +1,37 @@
 #include "trace/render_scene.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "trace/rng.h"
 
 namespace pathex {
+
+namespace {
+
+// A sphere holding the shape: exact for spheres and disks, around the corners' centre for quads,
+// around the bounding box's centre for meshes.
+BoundingSphere bounding_sphere(const ShapeGeometry& g) {
+  if (const auto* s = std::get_if<SphereShape>(&g)) return {s->center, s->radius};
+  if (const auto* d = std::get_if<DiskShape>(&g)) return {d->center, d->radius};
+  if (const auto* q = std::get_if<QuadShape>(&g)) {
+    const glm::vec3 c = q->corner + 0.5f * (q->edge1 + q->edge2);
+    return {c, 0.5f * std::max(glm::length(q->edge1 + q->edge2), glm::length(q->edge1 - q->edge2))};
+  }
+  const std::vector<glm::vec3>& p = std::get<MeshShape>(g).positions;
+  if (p.empty()) return {};
+  glm::vec3 lo = p[0], hi = p[0];
+  for (const glm::vec3& v : p) {
+    lo = glm::min(lo, v);
+    hi = glm::max(hi, v);
+  }
+  const glm::vec3 c = 0.5f * (lo + hi);
+  float r2 = 0.0f;
+  for (const glm::vec3& v : p) r2 = std::max(r2, glm::dot(v - c, v - c));
+  return {c, std::sqrt(r2)};
+}
+
+}  // namespace
 
 Result<RenderScene> make_render_scene(const Scene& scene) {
   RenderScene rs;
@@ -35,6 +62,8 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     rs.lights.push_back(l);
   }
   rs.features = scene_features(rs.material_of_shape);
+  for (std::size_t i = 0; i < scene.shapes.size(); ++i)
+    if (scene_features({rs.material_of_shape[i]}).specular) rs.specular_bounds.push_back(bounding_sphere(scene.shapes[i].geometry));
   for (const Light& light : scene.lights) {
     RenderLight l;
     if (const auto* p = std::get_if<PointLight>(&light)) {

@@ -21,6 +21,7 @@
 #include "scene/material.h"
 #include "scene/scene.h"
 #include "trace/embree_scene.h"
+#include "trace/emission_cones.h"
 #include "trace/emitters.h"
 #include "trace/joins/mirror.h"
 #include "trace/scene_features.h"
@@ -57,6 +58,9 @@ struct RenderScene {
   std::vector<PlanarMirror> mirrors;         // quads of a pure mirror material (the mirror connector's)
   RenderSensor camera;
   SceneFeatures features;                    // what the shapes' materials can do (trace/scene_features.h)
+  // A sphere around each shape whose material has a specular (Dirac) component: where a path whose
+  // first surface vertex scatters specularly can start (trace/emission_cones.h).
+  std::vector<BoundingSphere> specular_bounds;
 };
 
 Result<RenderScene> make_render_scene(const Scene& scene);
