@@ -1,5 +1,7 @@
 #include "trace/prune.h"
 
+#include <algorithm>
+
 namespace pathex {
 
 Result<RequestedPaths> RequestedPaths::make(const std::vector<const PathClass*>& classes, const Limits& limits) {
@@ -8,6 +10,27 @@ Result<RequestedPaths> RequestedPaths::make(const std::vector<const PathClass*>&
   if (!c) return c.error();
   RequestedPaths out;
   out.classifier_ = std::make_shared<const Classifier>(std::move(*c));
+  // The lengths of the requested paths: the live states after L and n letters, breadth first.
+  const Classifier& cl = *out.classifier_;
+  const Classifier::Direction& d = cl.forward();
+  std::vector<Classifier::State> now = {Classifier::step(d, d.start, 'L')}, next;
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(d.num_states()));
+  for (int n = 0; n <= accel::kMaxPackedLetters; ++n) {
+    bool any = false;
+    for (const Classifier::State s : now) any = any || !cl.members(cl.set_of(d, Classifier::step(d, s, 'E'))).empty();
+    out.lengths_.push_back(any ? 1 : 0);
+    std::fill(seen.begin(), seen.end(), 0);
+    next.clear();
+    for (const Classifier::State s : now)
+      for (const char letter : {'S', 'D'}) {
+        const Classifier::State t = Classifier::step(d, s, letter);
+        if (cl.alive(d, t) && seen[t / Classifier::kStride] == 0) {
+          seen[t / Classifier::kStride] = 1;
+          next.push_back(t);
+        }
+      }
+    now.swap(next);
+  }
   return out;
 }
 

@@ -39,10 +39,17 @@ class RequestedPaths {
   // (trace/emission_cones.h).
   bool first_vertex_specular(char pos, char dir) const;
 
+  // Whether some requested path has `n` letters between L and E (c0 … c(k+2)): a join whose path
+  // would have another length is not made (Integrator::connect). Lengths past the table: true.
+  bool has_length(int n) const {
+    return n < 0 || static_cast<std::size_t>(n) >= lengths_.size() || lengths_[static_cast<std::size_t>(n)] != 0;
+  }
+
   const Classifier& classifier() const { return *classifier_; }
 
  private:
   std::shared_ptr<const Classifier> classifier_;
+  std::vector<std::uint8_t> lengths_;  // lengths_[n]: has_length(n), for n up to a packed key's longest
 };
 
 // A subpath's letters so far, read from its end vertex (a light subpath forward from L c0 c1, an

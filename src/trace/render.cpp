@@ -439,6 +439,10 @@ void Integrator::record_nonfinite(Thread& th, const Pending& r) const {
 template <Integrator::Connection C>
 void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) const {
   constexpr bool by_light = C == Connection::kSplat || C == Connection::kOrtho || C == Connection::kLens;
+  // --only: a plain join whose path has a length no requested path has is not made (its numbers
+  // are its own dimensions, so no other join's change). Connectors count their attempts: they go on.
+  if constexpr (C != Connection::kDistant && C != Connection::kOrtho)
+    if (o_.only != nullptr && !o_.only->has_length(s + t + 2)) return;
   rng.set_dimension(kJoinDims + (static_cast<std::uint64_t>(C) * kMaxRuns + static_cast<std::uint64_t>(by_light ? s : t)) * kDimsPerJoin);
   // s = 0: the eye subpath's last vertex must lie on an area light, which most do not; tested
   // before the join is set up.

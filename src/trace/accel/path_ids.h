@@ -18,6 +18,7 @@ namespace pathex::accel {
 
 __extension__ typedef unsigned __int128 PathKey;
 inline constexpr int kLengthShift = 120;
+inline constexpr int kMaxPackedLetters = kLengthShift;  // a key holds the letters c0 … c(k+2) in its low bits
 inline constexpr PathKey bit(int i) { return static_cast<PathKey>(1) << i; }
 inline constexpr PathKey letter_bit(char c, int i) { return static_cast<PathKey>(c == 'S') << i; }  // no branch on the letter
 inline int packed_length(PathKey key) { return static_cast<int>(key >> kLengthShift); }
