@@ -356,6 +356,43 @@ TEST(DeadState, AStoppedSubpathCouldNotHaveContributed) {
   EXPECT_TRUE(all.alive());
 }
 
+// A join is not made when no requested path has its length (RequestedPaths::has_length), and a light
+// is aimed only when every requested path scatters specularly at its first vertex
+// (first_vertex_specular): both against every string of up to 14 letters between L and E.
+TEST(DeadState, LengthsAndSpecularFirstVerticesAreExact) {
+  const Scene glass = scene_at("point-glass.json", 8);  // a point light (L S D) and a pinhole
+  struct Case {
+    std::string expr;
+    std::vector<int> lengths;  // of the requested paths, up to 14 letters
+    bool specular_first;       // after L S D (a point light's letters)
+  };
+  for (const Case& c : std::vector<Case>{{"L.{8,}E", {8, 9, 10, 11, 12, 13, 14}, false},
+                                         {"L.{5}E | L.{7}E", {5, 7}, false},
+                                         {"LSDS+D.*E", {4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14}, true},
+                                         {"$caustic", {6, 7, 8, 9, 10, 11, 12, 13, 14}, true},
+                                         {"$direct", {5}, false}}) {
+    const RequestedPaths only = RequestedPaths::make(classes_for(glass, {c.expr}), Limits{}).expect("requested paths");
+    std::vector<int> lengths;
+    bool all_specular = true;
+    for (int n = 0; n <= 14; ++n) {
+      bool any = false;
+      for (std::uint32_t bits = 0; bits < (1u << n); ++bits) {
+        std::string path = "L";
+        for (int i = 0; i < n; ++i) path += ((bits >> i) & 1) ? 'S' : 'D';
+        path += 'E';
+        if (!only.records(accel::pack(path))) continue;
+        any = true;
+        if (path.compare(0, 3, "LSD") == 0 && path[3] != 'S') all_specular = false;
+      }
+      if (any) lengths.push_back(n);
+      EXPECT_EQ(only.has_length(n), any) << c.expr << ": " << n << " letters";
+    }
+    EXPECT_EQ(lengths, c.lengths) << c.expr;
+    EXPECT_EQ(only.first_vertex_specular('S', 'D'), all_specular && c.specular_first) << c.expr;
+    EXPECT_EQ(only.first_vertex_specular('S', 'D'), c.specular_first) << c.expr;
+  }
+}
+
 std::string run(const std::string& args, int* status) {
   std::string out;
   FILE* p = popen((std::string(PATHEX_BINARY) + " " + args + " 2>&1").c_str(), "r");
