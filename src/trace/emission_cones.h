@@ -69,12 +69,7 @@ class EmissionCones {
     const Cone& c = cones_[i];
     const float lo = i == 0 ? 0.0f : cdf_[i - 1];
     const float ux = std::clamp((x - lo) / (cdf_[i] - lo), 0.0f, kOneMinusEpsilon);
-    // Uniform in the cone: 1 − z = ux (1 − cos θ); sin² = (1 − z)(1 + z), without cancellation.
-    const float one_minus_z = ux * c.one_minus_cos;
-    const float z = 1.0f - one_minus_z;
-    const float r = std::sqrt(std::max(0.0f, one_minus_z * (2.0f - one_minus_z)));
-    const float phi = 2.0f * kPi * u.y;
-    const glm::vec3 w = glm::normalize(Frame::from_normal(c.axis).to_world({r * std::cos(phi), r * std::sin(phi), z}));
+    const glm::vec3 w = glm::normalize(Frame::from_normal(c.axis).to_world(sample_uniform_cone_by_height({ux, u.y}, c.one_minus_cos)));
     // The cone drawn from counts even where rounding puts w a hair outside it.
     int count = 1;
     for (std::size_t j = 0; j < cones_.size(); ++j)

@@ -194,13 +194,17 @@ inline glm::vec3 sample_uniform_sphere(glm::vec2 u) {
 }
 inline constexpr float kUniformSpherePdf = 0.25f * std::numbers::inv_pi_v<float>;
 
-// Uniform direction in the cone of half-angle acos(cos_max) about +z; density 1 / (2π(1 − cos_max)).
-inline glm::vec3 sample_uniform_cone(glm::vec2 u, float cos_max) {
-  const float z = 1.0f - u.x * (1.0f - cos_max);
-  const float r = safe_sqrt(1.0f - z * z);
+// Uniform direction in the cone about +z whose half-angle θ has 1 − cos θ = `one_minus_cos`
+// (given as such, so that a narrow cone keeps its precision); density 1 / (2π (1 − cos θ)).
+// 1 − z = u.x (1 − cos θ), and sin² = (1 − z)(1 + z), both without cancellation.
+inline glm::vec3 sample_uniform_cone_by_height(glm::vec2 u, float one_minus_cos) {
+  const float one_minus_z = u.x * one_minus_cos;
+  const float r = safe_sqrt(one_minus_z * (2.0f - one_minus_z));
   const float phi = 2.0f * kPi * u.y;
-  return {r * std::cos(phi), r * std::sin(phi), z};
+  return {r * std::cos(phi), r * std::sin(phi), 1.0f - one_minus_z};
 }
+// The same for the cone of half-angle acos(cos_max); density 1 / (2π(1 − cos_max)).
+inline glm::vec3 sample_uniform_cone(glm::vec2 u, float cos_max) { return sample_uniform_cone_by_height(u, 1.0f - cos_max); }
 inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f - cos_max)); }
 
 // Uniform barycentrics (b0, b1) on a triangle, b2 = 1 − b0 − b1 (the square-root-free fold).
