@@ -88,6 +88,15 @@ void add_limit_options(CLI::App* app, Limits* limits) {
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxWorkCeiling))->group("Limits");
   app->add_option("--max-file-size", limits->max_file_bytes, "Largest input file read (class, profile, check, scene, mesh), bytes")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxFileBytesCeiling))->group("Limits");
+  app->add_option("--max-scene-size", limits->max_scene_bytes, "Largest scene text read, the files it includes counted in, bytes")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxSceneBytesCeiling))->group("Limits");
+  app->add_option("--max-scene-depth", limits->max_scene_depth, "Deepest nesting of a scene's materials (Mitsuba's nested BSDFs)")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(1, kMaxSceneDepthCeiling))->group("Limits");
+  app->add_option("--max-material-nodes", limits->max_material_nodes,
+                  "Most material components an imported scene's materials expand to (mixtures of mixtures flattened), summed")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxMaterialNodesCeiling))->group("Limits");
+  app->add_option("--max-mesh-elements", limits->max_mesh_elements, "Most vertices plus triangles of a scene's meshes, summed")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxMeshElementsCeiling))->group("Limits");
 }
 
 void add_notation_options(CLI::App* app, NotationOptions* n) {

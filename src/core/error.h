@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <utility>
 #include <variant>
 
@@ -37,6 +38,11 @@ inline Error make_error(ErrorCode code, std::string message) {
   e.message = std::move(message);
   return e;
 }
+
+// A piece of the input echoed in a message, cut to its first `max_bytes` bytes (at a UTF-8
+// character boundary) followed by "…" when longer, so that a 16 MiB token gives one line of
+// stderr, not 16 MiB.
+std::string excerpt(std::string_view text, std::size_t max_bytes = 64);
 
 // Dereferencing a Result that was never checked is a bug even when it happens to hold a value:
 // the day the input changes it aborts (issue 17: `*compile(...)` of a constant that a user's

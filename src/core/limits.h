@@ -22,6 +22,11 @@ struct Limits {
   std::size_t max_length = 100000;   // --max-length: letters in one full-path string
   std::size_t max_work = 20000000;   // --max-work: work units of one operation (see core/budget.h)
   std::size_t max_file_bytes = std::size_t{64} << 20;  // --max-file-size: bytes of one input file
+  // What an imported scene may make pathex spend (scene/scene.h, SceneLoadOptions):
+  std::size_t max_scene_bytes = std::size_t{256} << 20;  // --max-scene-size: a scene's text, included files counted in
+  int max_scene_depth = 64;                              // --max-scene-depth: nesting of a scene's materials
+  std::size_t max_material_nodes = 1000000;              // --max-material-nodes: components its materials expand to
+  std::size_t max_mesh_elements = 50000000;              // --max-mesh-elements: vertices + triangles of its meshes
 };
 
 // The ceilings of the options above and of --max-bounces. At kMaxDepthCeiling the syntax tree's
@@ -36,6 +41,13 @@ inline constexpr std::size_t kMaxLengthCeiling = 100000000;
 inline constexpr std::size_t kMaxWorkCeiling = 4000000000;
 inline constexpr std::size_t kMaxFileBytesCeiling = std::size_t{16} << 30;
 inline constexpr int kMaxBouncesCeiling = 10000;
+// The scene limits' ceilings. Material nesting is the one recursion (Mitsuba's nested <bsdf>
+// elements): 1000 levels need well under 1 MiB of stack; 100 M material components take about
+// 3 GB; a mesh's vertex indices are 32-bit.
+inline constexpr std::size_t kMaxSceneBytesCeiling = std::size_t{64} << 30;
+inline constexpr int kMaxSceneDepthCeiling = 1000;
+inline constexpr std::size_t kMaxMaterialNodesCeiling = 100000000;
+inline constexpr std::size_t kMaxMeshElementsCeiling = 4000000000;
 
 // "the DFA exceeds the limit of 100000 states (raise it with --max-states)" and friends.
 std::string limit_message(const std::string& what, std::size_t limit, const std::string& unit,

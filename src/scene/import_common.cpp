@@ -1,11 +1,13 @@
 #include "scene/import_common.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <utility>
@@ -15,6 +17,9 @@
 #include <assimp/mesh.h>
 #include <assimp/scene.h>
 #include <dlfcn.h>
+
+#include "core/limits.h"
+#include "io/input_file.h"
 
 namespace pathex::import {
 
@@ -33,7 +38,8 @@ Error located(const Location& at, std::string message) {
 
 // --- files ---
 
-SceneFiles::SceneFiles(const std::string& main_file) {
+SceneFiles::SceneFiles(const std::string& main_file, const SceneLoadOptions& options)
+    : max_file_bytes_(options.max_file_bytes), max_scene_bytes_(options.max_scene_bytes) {
   const std::string dir = std::filesystem::path(main_file).parent_path().string();
   base_dir_ = dir.empty() ? "." : dir;
 }
@@ -43,13 +49,54 @@ std::string SceneFiles::resolve(const std::string& file) const {
   return p.is_absolute() ? file : (std::filesystem::path(base_dir_) / p).string();
 }
 
-Result<std::string> SceneFiles::read(const std::string& path, const Location& from, int depth, const std::string& directive) const {
+Result<std::string> SceneFiles::include(const std::string& name, const Location& from, const std::string& directive) const {
+  if (name.empty()) return located(from, directive + " needs a file name, found \"\"");
+  return resolve(name);
+}
+
+Result<std::string> SceneFiles::read(const std::string& path, const Location& from, int depth, const std::string& directive) {
   if (depth > 32) return located(from, directive + " nested more than 32 deep (a file including itself?)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return located(from, depth == 0 ? "cannot open the scene file" : "cannot open the included file '" + path + "'");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return std::move(ss).str();
+  const std::string what = depth == 0 ? "the scene file" : "the included file '" + path + "'";
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return located(from, what + " is a directory, expected a file");
+  const std::size_t left = max_scene_bytes_ - read_;
+  Result<std::string> text = read_input_file(path, std::min(max_file_bytes_, left));
+  if (!text) {
+    if (text.error().code != ErrorCode::kLimit) return located(from, "cannot open " + what);
+    Error e = left < max_file_bytes_ ? located(from, limit_message("the scene's text with its included files", max_scene_bytes_, "bytes",
+                                                                   "--max-scene-size"))
+                                     : located(from, limit_message(what, max_file_bytes_, "bytes", "--max-file-size"));
+    e.code = ErrorCode::kLimit;
+    return e;
+  }
+  read_ += text->size();
+  if (depth > 0) included_.push_back(path);
+  return text;
+}
+
+std::optional<Error> MaterialBudget::charge(const Material& m, const Location& at) {
+  const Mixture* mix = std::get_if<Mixture>(&m);
+  used_ += mix != nullptr ? mix->components.size() : 1;
+  if (used_ <= limit_) return std::nullopt;
+  Error e = located(at, limit_message("the expansion of the scene's materials", limit_, "components", "--max-material-nodes"));
+  e.code = ErrorCode::kLimit;
+  return e;
+}
+
+std::optional<std::string> matrix_problem(const glm::mat4& m) {
+  // glm is column-major: m[column][row].
+  const glm::vec4 last(m[0][3], m[1][3], m[2][3], m[3][3]);
+  if (!(std::fabs(last.x) <= 1e-6f && std::fabs(last.y) <= 1e-6f && std::fabs(last.z) <= 1e-6f && std::fabs(last.w - 1.0f) <= 1e-6f)) {
+    std::ostringstream row;
+    row << last.x << " " << last.y << " " << last.z << " " << last.w;
+    return "is projective (its last row is " + row.str() + ", expected 0 0 0 1): pathex applies affine transforms only";
+  }
+  // Singular when the determinant of the linear part vanishes against the product of its column
+  // lengths (its largest possible value, by Hadamard's inequality), computed in double.
+  const glm::dmat3 a(m);
+  const double bound = glm::length(a[0]) * glm::length(a[1]) * glm::length(a[2]);
+  if (!(std::fabs(glm::determinant(a)) > 1e-12 * bound)) return "is singular: it flattens space onto a plane, a line or a point";
+  return std::nullopt;
 }
 
 std::optional<Error> check_light_value(glm::vec3 v, const Location& at) {
@@ -77,14 +124,35 @@ std::optional<Error> check_light_value(glm::vec3 v, const Location& at) {
 
 namespace {
 
-void flatten(const Material& m, float w, std::vector<Mixture::Component>* out) {
+// A basic material's kind and parameters, as a key: equal keys are the same material.
+using MaterialKey = std::array<float, 5>;
+MaterialKey key_of(const BasicMaterial& m) {
+  return std::visit(
+      [&](const auto& k) -> MaterialKey {
+        using T = std::decay_t<decltype(k)>;
+        const auto kind = static_cast<float>(m.index());
+        if constexpr (std::is_same_v<T, Diffuse>) return {kind, k.albedo.x, k.albedo.y, k.albedo.z, 0.0f};
+        else if constexpr (std::is_same_v<T, Mirror>) return {kind, k.reflectance.x, k.reflectance.y, k.reflectance.z, 0.0f};
+        else if constexpr (std::is_same_v<T, Dielectric>) return {kind, k.tint.x, k.tint.y, k.tint.z, k.ior};
+        else return {kind, k.reflectance.x, k.reflectance.y, k.reflectance.z, k.roughness};
+      },
+      m);
+}
+
+// Adds `m` with weight `w` to `out`, merging components equal to one already there (`index`).
+void flatten(const Material& m, float w, std::vector<Mixture::Component>* out, std::map<MaterialKey, std::size_t>* index) {
+  auto add = [&](float weight, const BasicMaterial& basic) {
+    const auto [it, fresh] = index->emplace(key_of(basic), out->size());
+    if (fresh) out->push_back({weight, basic});
+    else (*out)[it->second].weight += weight;
+  };
   if (const auto* mix = std::get_if<Mixture>(&m)) {
-    for (const Mixture::Component& c : mix->components) out->push_back({w * c.weight, c.material});
+    for (const Mixture::Component& c : mix->components) add(w * c.weight, c.material);
     return;
   }
   std::visit(
       [&](const auto& k) {
-        if constexpr (!std::is_same_v<std::decay_t<decltype(k)>, Mixture>) out->push_back({w, BasicMaterial{k}});
+        if constexpr (!std::is_same_v<std::decay_t<decltype(k)>, Mixture>) add(w, BasicMaterial{k});
       },
       m);
 }
@@ -93,8 +161,9 @@ void flatten(const Material& m, float w, std::vector<Mixture::Component>* out) {
 
 Material blend(const Material& a, const Material& b, float w) {
   Mixture mix;
-  flatten(a, 1.0f - w, &mix.components);
-  flatten(b, w, &mix.components);
+  std::map<MaterialKey, std::size_t> index;
+  flatten(a, 1.0f - w, &mix.components, &index);
+  flatten(b, w, &mix.components, &index);
   return mix;
 }
 
@@ -321,10 +390,15 @@ std::pair<glm::vec3, float> bounding_sphere(const Scene& s) {
 
 }  // namespace
 
-Result<Scene> SceneBuilder::finish(const std::string& file) {
+Result<Scene> SceneBuilder::finish(const std::string& file, const std::vector<std::string>& included) {
   Scene s = std::move(scene_);
   s.name = file;
-  auto fail = [&](const std::string& message) { return located(Location{file}, message); };
+  // Errors about the scene as a whole are located at the main file and say which files it was read from.
+  std::string from;
+  for (std::size_t i = 0; i < included.size() && i < 3; ++i) from += (i == 0 ? "" : ", ") + included[i];
+  if (included.size() > 3) from += " and " + std::to_string(included.size() - 3) + " more";
+  if (!from.empty()) from = " (read from " + file + " and the files it includes: " + from + ")";
+  auto fail = [&](const std::string& message) { return located(Location{file}, message + from); };
   if (!has_camera_) return fail("the scene has no camera");
   if (s.shapes.empty()) return fail("the scene is empty: expected at least one shape");
   // --- every coordinate finite and within 1e30, as the JSON loader requires ---

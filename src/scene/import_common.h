@@ -39,18 +39,46 @@ struct Location {
 Error located(const Location& at, std::string message);
 
 // The files of one scene: relative names (includes, meshes) resolve against the main file's folder,
-// as pbrt-v4 and Mitsuba 3 resolve them, and includes nest at most 32 deep.
+// as pbrt-v4 and Mitsuba 3 resolve them, and includes nest at most 32 deep. Each file is read with
+// a cap (never whole first: `/dev/zero` stops there): at most options.max_file_bytes, and the main
+// file with everything it includes at most options.max_scene_bytes together.
 class SceneFiles {
  public:
-  explicit SceneFiles(const std::string& main_file);
+  SceneFiles(const std::string& main_file, const SceneLoadOptions& options);
   std::string resolve(const std::string& file) const;
+  // The path an include names, resolved; refused at `from` when the name is empty.
+  Result<std::string> include(const std::string& name, const Location& from, const std::string& directive) const;
   // The text of `path`, included from `from` at nesting `depth` (0: the main file); `directive`
-  // names the including directive in messages.
-  Result<std::string> read(const std::string& path, const Location& from, int depth, const std::string& directive) const;
+  // names the including directive in messages. A directory is refused.
+  Result<std::string> read(const std::string& path, const Location& from, int depth, const std::string& directive);
+  // The included files read so far, in order.
+  const std::vector<std::string>& included() const { return included_; }
 
  private:
   std::string base_dir_;
+  std::size_t max_file_bytes_, max_scene_bytes_;
+  std::size_t read_ = 0;  // bytes of the scene's text so far
+  std::vector<std::string> included_;
 };
+
+// The components a scene's materials expand to (a basic material is one, a mixture its
+// components), counted as each material is made: mixtures of mixtures are flattened, so a graph of
+// named materials that share parts could expand to exponentially many. Past the limit
+// (--max-material-nodes) the material at `at` is refused.
+class MaterialBudget {
+ public:
+  explicit MaterialBudget(std::size_t limit) : limit_(limit) {}
+  std::optional<Error> charge(const Material& m, const Location& at);
+
+ private:
+  std::size_t limit_, used_ = 0;
+};
+
+// Why a transform given as a whole matrix (pbrt's Transform and ConcatTransform, Mitsuba's
+// <matrix>) cannot be applied: it is projective (its last row is not 0 0 0 1) or singular (it
+// flattens space): "is projective (…)", "is singular: …"; std::nullopt when it is an invertible
+// affine transform.
+std::optional<std::string> matrix_problem(const glm::mat4& m);
 
 // A light's emission (radiance, intensity or irradiance, after any scale) must be non-negative and
 // at most kMaxLightValue (scene.h), as in JSON scenes; the error names `at`.
@@ -59,6 +87,8 @@ std::optional<Error> check_light_value(glm::vec3 v, const Location& at);
 // A mixture of `a` (weight 1 - w) and `b` (weight w), flattened: mixtures of mixtures become one
 // mixture whose weights are the products along the way (both formats' mix and blend choose one
 // material per shading point with these probabilities, which is the same linear combination).
+// Equal components are merged (their weights added: the same choice), so a mixture has at most
+// one component per distinct basic material however often the graph reaches it.
 Material blend(const Material& a, const Material& b, float w);
 
 // Normal-incidence reflectance of a conductor with complex index eta + i k, per channel.
@@ -91,7 +121,8 @@ class SceneBuilder {
   // `image_right` is the world direction of the image's +x.
   void set_camera(const Camera& camera, glm::vec3 image_right);
   bool has_camera() const { return has_camera_; }
-  Result<Scene> finish(const std::string& file);
+  // `included`: the files the main file included (named in errors about the whole scene).
+  Result<Scene> finish(const std::string& file, const std::vector<std::string>& included = {});
 
  private:
   Scene scene_;

@@ -6,6 +6,7 @@
 // unused, an unknown plugin type or tag is refused with its location.
 #include "scene/mitsuba_import.h"
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <filesystem>
@@ -107,11 +108,12 @@ class Props {
 
 class Importer {
  public:
-  explicit Importer(std::string path) : main_(std::move(path)), files_(main_) {}
+  Importer(std::string path, const SceneLoadOptions& options)
+      : main_(std::move(path)), options_(options), files_(main_, options), materials_budget_(options.max_material_nodes) {}
 
   Result<Scene> run() {
     if (auto e = read_file(main_, Location{main_}, 0)) return *e;
-    return builder_.finish(main_);
+    return builder_.finish(main_, files_.included());
   }
 
   // --- locations and attributes ---
@@ -148,7 +150,7 @@ class Importer {
       while (j < v.size() && (std::isalnum(static_cast<unsigned char>(v[j])) || v[j] == '_')) ++j;
       const std::string key = v.substr(i + 1, j - i - 1);
       auto it = defaults_.find(key);
-      if (it == defaults_.end()) return located(where(n), "unknown parameter $" + key + " (no <default name=\"" + key + "\">)");
+      if (it == defaults_.end()) return located(where(n), "unknown parameter $" + excerpt(key) + " (no <default name=\"" + excerpt(key) + "\">)");
       out += it->second;
       i = j - 1;
     }
@@ -166,7 +168,7 @@ class Importer {
       char* end = nullptr;
       const double x = std::strtod(word.c_str(), &end);
       if (end == word.c_str() || *end != '\0' || !std::isfinite(x))
-        return located(where(n), "bad number '" + word + "' in attribute " + name);
+        return located(where(n), "bad number '" + excerpt(word) + "' in attribute " + name);
       out.push_back(x);
     }
     return out;
@@ -217,6 +219,7 @@ class Importer {
           for (int r = 0; r < 4; ++r)
             for (int c = 0; c < 4; ++c) step[c][r] = static_cast<float>(v[static_cast<std::size_t>(4 * r + c)]);
         }
+        if (std::optional<std::string> why = import::matrix_problem(step)) return located(where(op), "the matrix " + *why);
       } else if (tag == "lookat") {
         MI_TRY(origin, numbers(op, "origin"));
         MI_TRY(target, numbers(op, "target"));
@@ -234,7 +237,7 @@ class Importer {
         const vec3 left = glm::normalize(glm::cross(glm::normalize(u), dir));
         step = glm::mat4(glm::vec4(left, 0), glm::vec4(glm::cross(dir, left), 0), glm::vec4(dir, 0), glm::vec4(o, 1));
       } else {
-        return located(where(op), "transform operation <" + tag + "> is not supported, expected translate, rotate, scale, matrix or lookat");
+        return located(where(op), "transform operation <" + excerpt(tag) + "> is not supported, expected translate, rotate, scale, matrix or lookat");
       }
       m = step * m;  // each operation applies after the ones before it
     }
@@ -244,10 +247,15 @@ class Importer {
  private:
   friend class Props;
   std::string main_;
+  SceneLoadOptions options_;
   import::SceneFiles files_;
+  import::MaterialBudget materials_budget_;
+  std::size_t mesh_elements_ = 0;  // vertices + triangles of the meshes so far (--max-mesh-elements)
   std::deque<Doc> docs_;
   std::map<std::string, std::string> defaults_;
-  std::map<std::string, pugi::xml_node> bsdfs_;  // top-level <bsdf id>
+  std::map<std::string, pugi::xml_node> ids_;       // every element with an id, in every file: ids are unique
+  std::map<std::string, Material> bsdf_materials_;  // top-level <bsdf id>, each made once; <ref>s share it
+  std::string defining_;                            // the id of the top-level <bsdf> being made
   std::map<std::string, int> bsdf_index_;
   int default_material_ = -1;
   import::SceneBuilder builder_;
@@ -273,9 +281,45 @@ class Importer {
     }
     const pugi::xml_node scene = d.xml.child("scene");
     if (!scene) return located(Location{path}, "expected a <scene> root element");
+    if (auto e = check_document(d)) return e;
     for (pugi::xml_node n : scene.children()) {
       if (n.type() != pugi::node_element) continue;
       if (auto e = top_level(n, depth)) return e;
+    }
+    return std::nullopt;
+  }
+
+  // What pugixml accepts and XML or Mitsuba do not: a second root element, an element with the
+  // same attribute twice (pugixml keeps both, and the first would silently win), and two objects
+  // with one id (the second would silently replace the first). The walk is iterative: the file
+  // may nest as deep as it likes.
+  std::optional<Error> check_document(const Doc& d) {
+    int roots = 0;
+    for (pugi::xml_node n : d.xml.children())
+      if (n.type() == pugi::node_element && ++roots == 2)
+        return located(where(n), "a second root element <" + excerpt(n.name()) + "> (a scene file has one root, <scene>)");
+    std::vector<std::string_view> names;
+    for (pugi::xml_node n = d.xml.first_child(); n;) {
+      if (n.type() == pugi::node_element) {
+        names.clear();
+        for (pugi::xml_attribute a : n.attributes()) names.emplace_back(a.name());
+        std::sort(names.begin(), names.end());
+        for (std::size_t i = 1; i < names.size(); ++i)
+          if (names[i] == names[i - 1])
+            return located(where(n), "<" + excerpt(n.name()) + "> has the attribute \"" + excerpt(names[i]) + "\" twice");
+        const std::string id = n.attribute("id").value();
+        if (!id.empty() && std::string_view(n.name()) != "ref") {
+          const auto [it, fresh] = ids_.emplace(id, n);
+          if (!fresh)
+            return located(where(n), "a second object with id \"" + excerpt(id) + "\" (the first is at " + where(it->second).str() + ")");
+        }
+      }
+      if (n.first_child()) {
+        n = n.first_child();
+        continue;
+      }
+      while (n && !n.next_sibling()) n = n.parent();
+      if (n) n = n.next_sibling();
     }
     return std::nullopt;
   }
@@ -291,41 +335,61 @@ class Importer {
     if (tag == "include") {
       Result<std::string> file = attr(n, "filename");
       if (!file) return file.error();
-      return read_file(files_.resolve(*file), where(n), depth + 1);
+      Result<std::string> path = files_.include(*file, where(n), "<include>");
+      if (!path) return path.error();
+      return read_file(*path, where(n), depth + 1);
     }
     if (tag == "bsdf") {
       const std::string id = n.attribute("id").value();
       if (id.empty()) return located(where(n), "a top-level <bsdf> needs an id");
-      bsdfs_[id] = n;
-      // Checked now, used or not: an unsupported BSDF is refused even before a shape refers to it.
-      Result<Material> m = bsdf(n);
+      // Made now, used or not: an unsupported BSDF is refused even before a shape refers to it.
+      // It is registered once made, so a <ref> inside it cannot reach it (issue 42: endless recursion).
+      defining_ = id;
+      Result<Material> m = bsdf(n, 1);
+      defining_.clear();
       if (!m) return m.error();
+      bsdf_materials_.emplace(id, std::move(*m));
       return std::nullopt;
     }
     if (tag == "shape") return shape(n);
     if (tag == "emitter") return emitter(n);
     if (tag == "sensor") return sensor(n);
     if (tag == "integrator") return std::nullopt;  // how to estimate is pathex's choice (see the README)
-    return located(where(n), "<" + tag + "> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)");
+    return located(where(n), "<" + excerpt(tag) + "> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)");
   }
 
   // --- materials ---
-  Result<Material> bsdf(pugi::xml_node n) {
+  // `depth`: the nesting of <bsdf> elements, 1 for a top-level or a shape's (--max-scene-depth).
+  // Every material made is charged to --max-material-nodes.
+  Result<Material> bsdf(pugi::xml_node n, int depth) {
+    MI_TRY(m, make_bsdf(n, depth));
+    if (auto e = materials_budget_.charge(m, where(n))) return *e;
+    return m;
+  }
+  Result<Material> make_bsdf(pugi::xml_node n, int depth) {
+    if (depth > options_.max_scene_depth) {
+      Error e = located(where(n), limit_message("the nesting of materials", static_cast<std::size_t>(options_.max_scene_depth), "levels",
+                                                "--max-scene-depth"));
+      e.code = ErrorCode::kLimit;
+      return e;
+    }
     if (std::string(n.name()) == "ref") {
       MI_TRY(id, attr(n, "id"));
-      auto it = bsdfs_.find(id);
-      if (it == bsdfs_.end()) return located(where(n), "unknown bsdf id \"" + id + "\"");
-      return bsdf(it->second);
+      if (!defining_.empty() && id == defining_)
+        return located(where(n), "<ref id=\"" + excerpt(id) + "\"> inside the bsdf it names: a bsdf cannot contain itself");
+      auto it = bsdf_materials_.find(id);
+      if (it == bsdf_materials_.end()) return located(where(n), "unknown bsdf id \"" + excerpt(id) + "\"");
+      return it->second;
     }
     MI_TRY(type, attr(n, "type"));
-    Props p(this, n, "<bsdf type=\"" + type + "\">");
+    Props p(this, n, "<bsdf type=\"" + excerpt(type) + "\">");
     p.ignore({"id"});
     Material m;
     if (type == "twosided") {
       // pathex's reflective materials are two-sided already.
       const std::vector<pugi::xml_node> inner = p.nested("bsdf");
       if (inner.size() != 1) return located(where(n), "twosided with " + std::to_string(inner.size()) + " nested BSDFs is not supported, expected one");
-      MI_TRY(x, bsdf(inner[0]));
+      MI_TRY(x, bsdf(inner[0], depth + 1));
       if (std::holds_alternative<Dielectric>(x)) return located(where(n), "a twosided dielectric is not supported");
       m = x;
     } else if (type == "diffuse") {
@@ -339,9 +403,11 @@ class Importer {
       if (p.find("eta") || p.find("k")) {
         MI_TRY(eta, p.color("eta", vec3(0.0f)));
         MI_TRY(k, p.color("k", vec3(1.0f)));
+        if (glm::any(glm::lessThan(eta, vec3(0.0f)))) return located(where(p.find("eta")), "conductor eta must be non-negative");
+        if (glm::any(glm::lessThan(k, vec3(0.0f)))) return located(where(p.find("k")), "conductor k must be non-negative");
         r0 = import::conductor_reflectance(eta, k);
       } else if (material != "none") {
-        return located(where(n), "conductor material \"" + material + "\" is a measured spectrum, which pathex cannot import: give eta and k as rgb, or material none with specular_reflectance");
+        return located(where(n), "conductor material \"" + excerpt(material) + "\" is a measured spectrum, which pathex cannot import: give eta and k as rgb, or material none with specular_reflectance");
       }
       MI_TRY(spec, p.color("specular_reflectance", vec3(1.0f)));
       r0 *= spec;
@@ -351,7 +417,7 @@ class Importer {
         m = Mirror{r0};
       } else {
         MI_TRY(dist, p.string("distribution", "beckmann"));
-        if (dist != "ggx") return located(where(n), "microfacet distribution \"" + dist + "\" is not supported: pathex's glossy lobe is GGX, set <string name=\"distribution\" value=\"ggx\"/>");
+        if (dist != "ggx") return located(where(n), "microfacet distribution \"" + excerpt(dist) + "\" is not supported: pathex's glossy lobe is GGX, set <string name=\"distribution\" value=\"ggx\"/>");
         if (p.find("alpha_u") || p.find("alpha_v")) return located(where(n), "anisotropic roughness (alpha_u, alpha_v) is not supported");
         MI_TRY(alpha, p.number("alpha", 0.1));
         p.ignore({"sample_visible"});
@@ -367,7 +433,7 @@ class Importer {
         if (std::string(q.name()) == "string") {
           MI_TRY(s, attr(q, "value"));
           std::optional<double> v = named_ior(s);
-          if (!v) return located(where(q), "unknown index of refraction \"" + s + "\"");
+          if (!v) return located(where(q), "unknown index of refraction \"" + excerpt(s) + "\"");
           ior[i] = *v;
         } else {
           MI_TRY(v, p.number(names[i], ior[i]));
@@ -387,11 +453,11 @@ class Importer {
       if (w < 0 || w > 1) return located(where(n), "weight must be within [0, 1]");
       const std::vector<pugi::xml_node> inner = p.nested("bsdf");
       if (inner.size() != 2) return located(where(n), "blendbsdf needs two nested BSDFs, found " + std::to_string(inner.size()));
-      MI_TRY(a, bsdf(inner[0]));
-      MI_TRY(b, bsdf(inner[1]));
+      MI_TRY(a, bsdf(inner[0], depth + 1));
+      MI_TRY(b, bsdf(inner[1], depth + 1));
       m = import::blend(a, b, static_cast<float>(w));
     } else {
-      return located(where(n), "bsdf \"" + type + "\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, blendbsdf or twosided");
+      return located(where(n), "bsdf \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, blendbsdf or twosided");
     }
     if (auto e = p.unused()) return *e;
     return m;
@@ -407,17 +473,17 @@ class Importer {
     if (std::string(b[0].name()) == "ref") {
       MI_TRY(id, attr(b[0], "id"));
       if (auto it = bsdf_index_.find(id); it != bsdf_index_.end()) return it->second;
-      MI_TRY(m, bsdf(b[0]));
+      MI_TRY(m, bsdf(b[0], 1));
       return bsdf_index_[id] = builder_.add_material(id, m);
     }
-    MI_TRY(m, bsdf(b[0]));
+    MI_TRY(m, bsdf(b[0], 1));
     return builder_.add_material(where(b[0]).str(), m);
   }
 
   // --- shapes ---
   std::optional<Error> shape(pugi::xml_node n) {
     MI_TRY(type, attr(n, "type"));
-    Props p(this, n, "<shape type=\"" + type + "\">");
+    Props p(this, n, "<shape type=\"" + excerpt(type) + "\">");
     p.ignore({"id"});
     Shape s;
     s.pointer = where(n).str();
@@ -427,7 +493,7 @@ class Importer {
     if (emitters.size() > 1) return located(where(n), "a shape with more than one emitter");
     if (emitters.size() == 1) {
       MI_TRY(etype, attr(emitters[0], "type"));
-      if (etype != "area") return located(where(emitters[0]), "emitter \"" + etype + "\" inside a shape is not supported, expected area");
+      if (etype != "area") return located(where(emitters[0]), "emitter \"" + excerpt(etype) + "\" inside a shape is not supported, expected area");
       Props e(this, emitters[0], "<emitter type=\"area\">");
       MI_TRY(radiance, e.color("radiance", vec3(1.0f)));
       if (auto u = e.unused()) return u;
@@ -438,18 +504,22 @@ class Importer {
     MI_TRY(flip, p.boolean("flip_normals", false));
     if (type == "obj" || type == "ply") {
       MI_TRY(file, p.string("filename", ""));
-      if (file.empty()) return located(where(n), "<shape type=\"" + type + "\"> needs a filename");
+      if (file.empty()) return located(where(n), "<shape type=\"" + excerpt(type) + "\"> needs a filename");
       MI_TRY(face_normals, p.boolean("face_normals", false));
       if (!face_normals)
         return located(where(n), "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face normals (add <boolean name=\"face_normals\" value=\"true\"/>)");
       MeshShape mesh;
       if (type == "obj") {
-        MI_TRY(obj, load_obj_mesh(files_.resolve(file)));
+        SceneLoadOptions whole = options_;
+        whole.triangles = true;  // the faces are checked here whatever the command needs
+        MI_TRY(obj, load_obj_mesh(files_.resolve(file), whole, &mesh_elements_));
         if (obj.triangles.empty()) return located(where(n), "the mesh '" + files_.resolve(file) + "' has no faces");
         mesh = std::move(obj);
       } else {
         MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), /*discard_normals=*/true));
         mesh = std::move(ply);
+        mesh_elements_ += mesh.positions.size() + mesh.triangles.size();
+        if (auto e = check_mesh_elements(mesh_elements_, options_, where(n).str())) return e;
       }
       mesh.file = file;
       for (vec3& q : mesh.positions) q = import::apply_point(m, q);
@@ -478,7 +548,7 @@ class Importer {
       const vec3 normal = import::apply_normal(m, vec3(0, 0, 1));
       s.geometry = DiskShape{import::apply_point(m, vec3(0.0f)), flip ? -normal : normal, r};
     } else {
-      return located(where(n), "shape \"" + type + "\" is not supported, expected obj, ply, sphere, rectangle or disk");
+      return located(where(n), "shape \"" + excerpt(type) + "\" is not supported, expected obj, ply, sphere, rectangle or disk");
     }
     if (auto e = p.unused()) return e;
     builder_.add_shape(std::move(s));
@@ -488,11 +558,11 @@ class Importer {
   // --- emitters ---
   std::optional<Error> emitter(pugi::xml_node n) {
     MI_TRY(type, attr(n, "type"));
-    Props p(this, n, "<emitter type=\"" + type + "\">");
+    Props p(this, n, "<emitter type=\"" + excerpt(type) + "\">");
     p.ignore({"id"});
     if (type == "area") return located(where(n), "an area emitter must be inside a <shape>");
     if (type != "point" && type != "spot" && type != "directional")
-      return located(where(n), "emitter \"" + type + "\" is not supported, expected point, spot, directional, or area inside a shape");
+      return located(where(n), "emitter \"" + excerpt(type) + "\" is not supported, expected point, spot, directional, or area inside a shape");
     const bool has_to_world = static_cast<bool>(p.find("to_world"));
     MI_TRY(m, p.transform("to_world"));
     if (type == "directional") {
@@ -539,8 +609,8 @@ class Importer {
     if (builder_.has_camera()) return located(where(n), "a second <sensor> (pathex renders one camera)");
     MI_TRY(type, attr(n, "type"));
     if (type != "perspective" && type != "thinlens" && type != "orthographic")
-      return located(where(n), "sensor \"" + type + "\" is not supported, expected perspective, thinlens or orthographic");
-    Props p(this, n, "<sensor type=\"" + type + "\">");
+      return located(where(n), "sensor \"" + excerpt(type) + "\" is not supported, expected perspective, thinlens or orthographic");
+    Props p(this, n, "<sensor type=\"" + excerpt(type) + "\">");
     p.ignore({"id", "near_clip", "far_clip", "shutter_open", "shutter_close", "sampler"});
     Camera c;
     c.width = 768;
@@ -549,7 +619,7 @@ class Importer {
     if (films.size() > 1) return located(where(n), "a sensor with more than one film");
     if (films.size() == 1) {
       MI_TRY(ftype, attr(films[0], "type"));
-      if (ftype != "hdrfilm") return located(where(films[0]), "film \"" + ftype + "\" is not supported, expected hdrfilm");
+      if (ftype != "hdrfilm") return located(where(films[0]), "film \"" + excerpt(ftype) + "\" is not supported, expected hdrfilm");
       Props f(this, films[0], "<film type=\"hdrfilm\">");
       MI_TRY(w, f.number("width", 768));
       MI_TRY(h, f.number("height", 576));
@@ -592,7 +662,7 @@ class Importer {
       if (axis == "x" || (axis == "smaller" && aspect <= 1.0f) || (axis == "larger" && aspect > 1.0f)) tan_y = t / aspect;
       else if (axis == "y" || axis == "smaller" || axis == "larger") tan_y = t;
       else if (axis == "diagonal") tan_y = t / std::sqrt(1.0f + aspect * aspect);
-      else return located(where(n), "fov_axis \"" + axis + "\" is not supported, expected x, y, diagonal, smaller or larger");
+      else return located(where(n), "fov_axis \"" + excerpt(axis) + "\" is not supported, expected x, y, diagonal, smaller or larger");
       c.fov_degrees = glm::degrees(2.0f * std::atan(tan_y));
       if (type == "thinlens") {
         c.type = SensorType::kLens;
@@ -615,7 +685,7 @@ std::optional<Error> Props::unused() const {
   for (const Child& c : children_) {
     if (c.used) continue;
     const std::string name = c.node.attribute("name").value();
-    return located(im_->where(c.node), "<" + std::string(c.node.name()) + (name.empty() ? "" : " name=\"" + name + "\"") + "> in " + what_ +
+    return located(im_->where(c.node), "<" + excerpt(c.node.name()) + (name.empty() ? "" : " name=\"" + excerpt(name) + "\"") + "> in " + what_ +
                                            " is not supported");
   }
   return std::nullopt;
@@ -676,6 +746,6 @@ Result<glm::mat4> Props::transform(const std::string& name) {
 
 }  // namespace
 
-Result<Scene> load_scene_mitsuba(const std::string& path) { return Importer(path).run(); }
+Result<Scene> load_scene_mitsuba(const std::string& path, const SceneLoadOptions& options) { return Importer(path, options).run(); }
 
 }  // namespace pathex

@@ -36,50 +36,83 @@ struct Token {
   Location at;
 };
 
-Result<std::vector<Token>> tokenize(const std::string& text, const std::string& file) {
-  std::vector<Token> out;
-  int line = 1;
-  std::size_t line_start = 0;
-  std::size_t i = 0;
-  while (i < text.size()) {
-    const char c = text[i];
-    if (c == '\n') {
-      ++line;
-      line_start = ++i;
-      continue;
+// The tokens of one file, made one at a time as the interpreter asks for them: a file's memory is
+// its text and one token, whatever it holds (16 Mi '[' used to become 16 Mi tokens and 1.3 GB
+// before the first was read). A malformed token ends the stream and is kept as error().
+class Lexer {
+ public:
+  Lexer(const std::string& text, const std::string& file) : text_(text), file_(file) {}
+  bool done() {
+    fill();
+    return !has_;
+  }
+  const Token& peek() {  // only when !done()
+    fill();
+    return token_;
+  }
+  void advance() {
+    fill();
+    filled_ = false;
+  }
+  const std::optional<Error>& error() const { return error_; }
+
+ private:
+  void fill() {
+    if (filled_) return;
+    filled_ = true;
+    has_ = false;
+    if (error_) return;
+    const std::string& text = text_;
+    while (i_ < text.size()) {
+      const char c = text[i_];
+      if (c == '\n') {
+        ++line_;
+        line_start_ = ++i_;
+      } else if (c == ' ' || c == '\t' || c == '\r') {
+        ++i_;
+      } else if (c == '#') {
+        while (i_ < text.size() && text[i_] != '\n') ++i_;
+      } else {
+        break;
+      }
     }
-    if (c == ' ' || c == '\t' || c == '\r') {
-      ++i;
-      continue;
-    }
-    if (c == '#') {
-      while (i < text.size() && text[i] != '\n') ++i;
-      continue;
-    }
-    Token t;
-    t.at = Location{file, line, static_cast<int>(i - line_start) + 1};
+    if (i_ >= text.size()) return;
+    const char c = text[i_];
+    Token& t = token_;
+    t.at = Location{file_, line_, static_cast<int>(i_ - line_start_) + 1};
     if (c == '[' || c == ']') {
       t.kind = c == '[' ? Token::kOpen : Token::kClose;
-      ++i;
+      t.text.assign(1, c);
+      ++i_;
     } else if (c == '"') {
-      std::size_t j = i + 1;
+      std::size_t j = i_ + 1;
       while (j < text.size() && text[j] != '"' && text[j] != '\n') ++j;
-      if (j >= text.size() || text[j] != '"') return located(t.at, "unterminated string, expected a closing '\"' on the same line");
+      if (j >= text.size() || text[j] != '"') {
+        error_ = located(t.at, "unterminated string, expected a closing '\"' on the same line");
+        return;
+      }
       t.kind = Token::kString;
-      t.text = text.substr(i + 1, j - i - 1);
-      i = j + 1;
+      t.text.assign(text, i_ + 1, j - i_ - 1);
+      i_ = j + 1;
     } else {
-      std::size_t j = i;
+      std::size_t j = i_;
       while (j < text.size() && std::string_view(" \t\r\n[]\"#").find(text[j]) == std::string_view::npos) ++j;
-      t.text = text.substr(i, j - i);
+      t.text.assign(text, i_, j - i_);
       const char f = t.text[0];
       t.kind = (std::isdigit(static_cast<unsigned char>(f)) || f == '-' || f == '+' || f == '.') ? Token::kNumber : Token::kWord;
-      i = j;
+      i_ = j;
     }
-    out.push_back(std::move(t));
+    has_ = true;
   }
-  return out;
-}
+
+  const std::string& text_;
+  std::string file_;
+  std::size_t i_ = 0, line_start_ = 0;
+  int line_ = 1;
+  Token token_;
+  bool filled_ = false, has_ = false;
+  std::optional<Error> error_;
+};
 
 // --- parameters: "type name" value or [values] ---
 
@@ -114,7 +147,7 @@ class Params {
   }
   std::optional<Error> unused(const std::string& what) const {
     for (const Param& p : list)
-      if (!p.used) return located(p.at, "parameter \"" + p.type + " " + p.name + "\" of " + what + " is not supported");
+      if (!p.used) return located(p.at, "parameter \"" + excerpt(p.type + " " + p.name) + "\" of " + what + " is not supported");
     return std::nullopt;
   }
 
@@ -206,17 +239,21 @@ struct GraphicsState {
 
 class Importer {
  public:
-  explicit Importer(std::string main_file) : main_file_(std::move(main_file)), files_(main_file_) {}
+  Importer(std::string main_file, const SceneLoadOptions& options)
+      : main_file_(std::move(main_file)), options_(options), files_(main_file_, options), materials_budget_(options.max_material_nodes) {}
 
   Result<Scene> run() {
     if (auto e = parse_file(main_file_, Location{main_file_}, 0)) return *e;
     if (auto e = make_camera()) return *e;
-    return builder_.finish(main_file_);
+    return builder_.finish(main_file_, files_.included());
   }
 
  private:
   std::string main_file_;
+  SceneLoadOptions options_;
   import::SceneFiles files_;
+  import::MaterialBudget materials_budget_;
+  std::size_t mesh_elements_ = 0;  // vertices + triangles of the meshes so far (--max-mesh-elements)
   import::SceneBuilder builder_;
   GraphicsState gs_;
   std::vector<GraphicsState> stack_;
@@ -234,37 +271,32 @@ class Importer {
   Location camera_at_;
   int width_ = 1280, height_ = 720;
 
-  // --- token stream helpers ---
-  struct Stream {
-    const std::vector<Token>* tokens;
-    std::size_t pos = 0;
-    Location end;
-    bool done() const { return pos >= tokens->size(); }
-    const Token& peek() const { return (*tokens)[pos]; }
-  };
+  using Stream = Lexer;
 
   Result<std::vector<double>> numbers(Stream& s, int count, const Location& at, const std::string& directive) {
     std::vector<double> out;
     const bool bracket = !s.done() && s.peek().kind == Token::kOpen;
-    if (bracket) ++s.pos;
+    if (bracket) s.advance();
     while (static_cast<int>(out.size()) < count) {
       if (s.done() || s.peek().kind != Token::kNumber)
         return located(s.done() ? at : s.peek().at, directive + " expects " + std::to_string(count) + " numbers");
       double x = 0;
-      if (!parse_number(s.peek().text, &x)) return located(s.peek().at, "bad number '" + s.peek().text + "'");
+      if (!parse_number(s.peek().text, &x)) return located(s.peek().at, "bad number '" + excerpt(s.peek().text) + "'");
       out.push_back(x);
-      ++s.pos;
+      s.advance();
     }
     if (bracket) {
       if (s.done() || s.peek().kind != Token::kClose) return located(s.done() ? at : s.peek().at, directive + " expects ']' after " + std::to_string(count) + " numbers");
-      ++s.pos;
+      s.advance();
     }
     return out;
   }
 
   Result<std::string> quoted(Stream& s, const Location& at, const std::string& directive) {
     if (s.done() || s.peek().kind != Token::kString) return located(s.done() ? at : s.peek().at, directive + " expects a quoted name");
-    return (*s.tokens)[s.pos++].text;
+    std::string text = s.peek().text;
+    s.advance();
+    return text;
   }
 
   Result<Params> params(Stream& s) {
@@ -274,16 +306,17 @@ class Importer {
       p.at = s.peek().at;
       std::istringstream decl(s.peek().text);
       std::string extra;
-      if (!(decl >> p.type >> p.name) || (decl >> extra)) return located(p.at, "bad parameter declaration \"" + s.peek().text + "\", expected \"type name\"");
-      ++s.pos;
+      if (!(decl >> p.type >> p.name) || (decl >> extra))
+        return located(p.at, "bad parameter declaration \"" + excerpt(s.peek().text) + "\", expected \"type name\"");
+      s.advance();
       const bool bracket = !s.done() && s.peek().kind == Token::kOpen;
-      if (bracket) ++s.pos;
+      if (bracket) s.advance();
       int count = 0;
       while (!s.done() && s.peek().kind != Token::kClose && (bracket || count == 0)) {
         const Token& t = s.peek();
         if (t.kind == Token::kNumber) {
           double x = 0;
-          if (!parse_number(t.text, &x)) return located(t.at, "bad number '" + t.text + "'");
+          if (!parse_number(t.text, &x)) return located(t.at, "bad number '" + excerpt(t.text) + "'");
           p.numbers.push_back(x);
         } else if (t.kind == Token::kString && (p.type == "string" || p.type == "texture" || p.type == "spectrum")) {
           p.strings.push_back(t.text);
@@ -292,14 +325,14 @@ class Importer {
         } else if (!bracket) {
           break;
         } else {
-          return located(t.at, "unexpected '" + t.text + "' in the values of parameter \"" + p.type + " " + p.name + "\"");
+          return located(t.at, "unexpected '" + excerpt(t.text) + "' in the values of parameter \"" + excerpt(p.type + " " + p.name) + "\"");
         }
-        ++s.pos;
+        s.advance();
         ++count;
       }
       if (bracket) {
-        if (s.done()) return located(p.at, "parameter \"" + p.type + " " + p.name + "\" expects ']'");
-        ++s.pos;
+        if (s.done()) return located(p.at, "parameter \"" + excerpt(p.type + " " + p.name) + "\" expects ']'");
+        s.advance();
       }
       if (count == 0) return located(p.at, "parameter \"" + p.type + " " + p.name + "\" has no value");
       if (p.type == "bool" && p.bools.size() != static_cast<std::size_t>(count)) return located(p.at, "parameter \"bool " + p.name + "\" expects true or false");
@@ -312,15 +345,15 @@ class Importer {
   std::optional<Error> parse_file(const std::string& path, const Location& from, int depth) {
     Result<std::string> text = files_.read(path, from, depth, "Include/Import");
     if (!text) return text.error();
-    Result<std::vector<Token>> tokens = tokenize(*text, path);
-    if (!tokens) return tokens.error();
-    Stream s{&*tokens, 0, Location{path}};
+    Lexer s(*text, path);
     while (!s.done()) {
-      const Token& t = s.peek();
-      if (t.kind != Token::kWord) return located(t.at, "expected a directive, found '" + t.text + "'");
-      ++s.pos;
-      if (auto e = directive(t.text, t.at, s, depth)) return e;
+      const Token t = s.peek();
+      if (t.kind != Token::kWord) return located(t.at, "expected a directive, found '" + excerpt(t.text) + "'");
+      s.advance();
+      // A directive that stopped at a malformed token reports the token.
+      if (auto e = directive(t.text, t.at, s, depth)) return s.error() ? s.error() : e;
     }
+    if (s.error()) return s.error();
     if (depth == 0 && !stack_.empty())
       return located(stack_at_.back(), std::string(stack_is_attribute_.back() ? "AttributeBegin" : "TransformBegin") + " has no matching End");
     return std::nullopt;
@@ -366,6 +399,7 @@ class Importer {
       float m[16];
       for (int i = 0; i < 16; ++i) m[i] = static_cast<float>((*v)[static_cast<std::size_t>(i)]);
       const glm::mat4 t = glm::make_mat4(m);  // pbrt lists the matrix column by column, as glm stores it
+      if (std::optional<std::string> why = import::matrix_problem(t)) return located(at, name + "'s matrix " + *why);
       gs_.ctm = name == "Transform" ? t : gs_.ctm * t;
       return std::nullopt;
     }
@@ -380,7 +414,7 @@ class Importer {
         return std::nullopt;
       }
       auto it = coordinate_systems_.find(n);
-      if (it == coordinate_systems_.end()) return located(at, "unknown coordinate system \"" + n + "\"");
+      if (it == coordinate_systems_.end()) return located(at, "unknown coordinate system \"" + excerpt(n) + "\"");
       gs_.ctm = it->second;
       return std::nullopt;
     }
@@ -407,7 +441,8 @@ class Importer {
     }
     if (name == "Include" || name == "Import") {
       PBRT_TRY(file, quoted(s, at, name));
-      return parse_file(files_.resolve(file), at, depth + 1);
+      PBRT_TRY(path, files_.include(file, at, name));
+      return parse_file(path, at, depth + 1);
     }
     if (name == "WorldBegin") {
       if (in_world_) return located(at, "a second WorldBegin");
@@ -422,24 +457,24 @@ class Importer {
     bool typed = false;
     for (const char* k : kTyped) typed = typed || name == k;
     if (!typed)
-      return located(at, "directive '" + name + "' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)");
+      return located(at, "directive '" + excerpt(name) + "' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)");
     PBRT_TRY(type, quoted(s, at, name));
     PBRT_TRY(ps, params(s));
     const bool scene_wide = name == "Camera" || name == "Film" || name == "Sampler" || name == "Integrator" ||
                             name == "PixelFilter" || name == "ColorSpace";
     if (scene_wide && in_world_) return located(at, name + " must come before WorldBegin");
     if (!scene_wide && !in_world_) return located(at, name + " must come after WorldBegin");
-    const std::string what = name + " \"" + type + "\"";
+    const std::string what = name + " \"" + excerpt(type) + "\"";
     if (name == "Sampler" || name == "Integrator" || name == "PixelFilter") {
       ps.ignore_all();  // how to estimate is pathex's choice (--renderer, --spp); see the README
       return std::nullopt;
     }
     if (name == "ColorSpace") {
-      if (type != "srgb") return located(at, "color space \"" + type + "\" is not supported, expected \"srgb\"");
+      if (type != "srgb") return located(at, "color space \"" + excerpt(type) + "\" is not supported, expected \"srgb\"");
       return std::nullopt;
     }
     if (name == "Film") {
-      if (type != "rgb") return located(at, "film \"" + type + "\" is not supported, expected \"rgb\"");
+      if (type != "rgb") return located(at, "film \"" + excerpt(type) + "\" is not supported, expected \"rgb\"");
       PBRT_TRY(w, ps.integer("xresolution", 1280));
       PBRT_TRY(h, ps.integer("yresolution", 720));
       if (w < 1 || h < 1 || w > 16384 || h > 16384) return located(at, "the film resolution must be within 1..16384");
@@ -449,8 +484,11 @@ class Importer {
       return ps.unused(what);
     }
     if (name == "Camera") {
+      // pbrt-v4 lets the last Camera win; a second one is more likely a mistake than a choice.
+      if (!camera_at_.file.empty())
+        return located(at, "a second Camera (the first is at " + camera_at_.str() + "): pathex renders one camera");
       if (type != "perspective" && type != "orthographic")
-        return located(at, "camera \"" + type + "\" is not supported, expected \"perspective\" or \"orthographic\"");
+        return located(at, "camera \"" + excerpt(type) + "\" is not supported, expected \"perspective\" or \"orthographic\"");
       camera_type_ = type;
       camera_params_ = std::move(ps);
       camera_from_world_ = gs_.ctm;
@@ -460,9 +498,10 @@ class Importer {
     }
     if (name == "MakeNamedMaterial") {
       PBRT_TRY(mtype, ps.string("type", ""));
-      if (mtype.empty()) return located(at, "MakeNamedMaterial \"" + type + "\" needs a \"string type\" parameter");
+      if (mtype.empty()) return located(at, "MakeNamedMaterial \"" + excerpt(type) + "\" needs a \"string type\" parameter");
       PBRT_TRY(m, material(mtype, ps, at));
-      if (auto e = ps.unused("material \"" + mtype + "\"")) return e;
+      if (auto e = ps.unused("material \"" + excerpt(mtype) + "\"")) return e;
+      if (auto e = materials_budget_.charge(m, at)) return e;
       named_materials_[type] = m;
       named_material_index_.erase(type);
       return std::nullopt;
@@ -475,11 +514,12 @@ class Importer {
     if (name == "Material") {
       PBRT_TRY(m, material(type, ps, at));
       if (auto e = ps.unused(what)) return e;
+      if (auto e = materials_budget_.charge(m, at)) return e;
       gs_.material = builder_.add_material(at.str(), m);
       return std::nullopt;
     }
     if (name == "AreaLightSource") {
-      if (type != "diffuse") return located(at, "area light \"" + type + "\" is not supported, expected \"diffuse\"");
+      if (type != "diffuse") return located(at, "area light \"" + excerpt(type) + "\" is not supported, expected \"diffuse\"");
       PBRT_TRY(l, ps.rgb("L", vec3(1.0f), false));
       PBRT_TRY(scale, ps.number("scale", 1.0));
       PBRT_TRY(two, ps.boolean("twosided", false));
@@ -502,7 +542,7 @@ class Importer {
   Result<int> named_index(const std::string& n, const Location& at) {
     if (auto it = named_material_index_.find(n); it != named_material_index_.end()) return it->second;
     auto it = named_materials_.find(n);
-    if (it == named_materials_.end()) return located(at, "unknown named material \"" + n + "\"");
+    if (it == named_materials_.end()) return located(at, "unknown named material \"" + excerpt(n) + "\"");
     const int index = builder_.add_material(n, it->second);
     named_material_index_[n] = index;
     return index;
@@ -534,6 +574,8 @@ class Importer {
       } else if (ps.find("eta") || ps.find("k")) {
         PBRT_TRY(eta, ps.rgb("eta", vec3(1.0f), true));
         PBRT_TRY(k, ps.rgb("k", vec3(0.0f), true));
+        if (glm::any(glm::lessThan(eta, vec3(0.0f)))) return located(ps.find("eta")->at, "conductor eta must be non-negative");
+        if (glm::any(glm::lessThan(k, vec3(0.0f)))) return located(ps.find("k")->at, "conductor k must be non-negative");
         r0 = import::conductor_reflectance(eta, k);
       } else {
         return located(at, "conductor needs \"rgb reflectance\" or rgb \"eta\" and \"k\" (pbrt's default copper is a spectrum, which pathex cannot import)");
@@ -563,12 +605,12 @@ class Importer {
       Material parts[2];
       for (int i = 0; i < 2; ++i) {
         auto it = named_materials_.find(m->strings[static_cast<std::size_t>(i)]);
-        if (it == named_materials_.end()) return located(m->at, "unknown named material \"" + m->strings[static_cast<std::size_t>(i)] + "\"");
+        if (it == named_materials_.end()) return located(m->at, "unknown named material \"" + excerpt(m->strings[static_cast<std::size_t>(i)]) + "\"");
         parts[i] = it->second;
       }
       return import::blend(parts[0], parts[1], static_cast<float>(amount));
     }
-    return located(at, "material \"" + type + "\" is not supported, expected diffuse, conductor, dielectric or mix");
+    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, dielectric or mix");
   }
 
   int current_material() {
@@ -582,7 +624,7 @@ class Importer {
     for (const char* p : {"power", "illuminance"})
       if (Param* q = ps.find(p)) return located(q->at, "parameter '" + std::string(p) + "' is not supported: give the light's I or L and scale");
     const bool point = type == "point", spot = type == "spot", distant = type == "distant";
-    if (!point && !spot && !distant) return located(at, "light \"" + type + "\" is not supported, expected point, spot, distant or an AreaLightSource");
+    if (!point && !spot && !distant) return located(at, "light \"" + excerpt(type) + "\" is not supported, expected point, spot, distant or an AreaLightSource");
     PBRT_TRY(value, ps.rgb(distant ? "L" : "I", vec3(1.0f), false));
     PBRT_TRY(scale, ps.number("scale", 1.0));
     const vec3 emitted = value * static_cast<float>(scale);
@@ -666,6 +708,8 @@ class Importer {
         if (file.empty()) return located(at, "plymesh needs a \"string filename\"");
         PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, /*discard_normals=*/false));
         mesh = std::move(ply);
+        mesh_elements_ += mesh.positions.size() + mesh.triangles.size();
+        if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
         mesh.file = file;
       } else {
         PBRT_TRY(p, ps.points("P"));
@@ -685,6 +729,8 @@ class Importer {
                                  (corners == 3 ? "triangle" : "patch") + ")");
         for (long long i : idx)
           if (i < 0 || i >= static_cast<long long>(p.size())) return located(ps.find("indices")->at, "index " + std::to_string(i) + " is out of range, expected 0.." + std::to_string(p.size() - 1));
+        mesh_elements_ += p.size() + idx.size() / corners * (corners - 2);  // a patch: 4 vertices and 2 triangles at most
+        if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
         mesh.positions = p;
         if (corners == 3) {
           for (std::size_t i = 0; i < idx.size(); i += 3) mesh.triangles.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
@@ -722,14 +768,14 @@ class Importer {
       builder_.add_shape(std::move(s));
       return std::nullopt;
     }
-    return located(at, "shape \"" + type + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere or disk");
+    return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere or disk");
   }
 
   // --- the camera, once the film is known ---
   std::optional<Error> make_camera() {
     Params& ps = camera_params_;
     const Location at = camera_at_.file.empty() ? Location{main_file_} : camera_at_;
-    const std::string what = "Camera \"" + camera_type_ + "\"";
+    const std::string what = "Camera \"" + excerpt(camera_type_) + "\"";
     for (const char* p : {"screenwindow", "frameaspectratio"})
       if (Param* q = ps.find(p)) return located(q->at, "parameter '" + std::string(p) + "' is not supported");
     ps.ignore({"shutteropen", "shutterclose"});
@@ -775,6 +821,6 @@ class Importer {
 
 }  // namespace
 
-Result<Scene> load_scene_pbrt(const std::string& path) { return Importer(path).run(); }
+Result<Scene> load_scene_pbrt(const std::string& path, const SceneLoadOptions& options) { return Importer(path, options).run(); }
 
 }  // namespace pathex

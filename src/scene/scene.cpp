@@ -6,6 +6,7 @@
 #include "scene/mitsuba_import.h"
 #include "scene/pbrt_import.h"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -20,6 +21,7 @@
 
 #include "io/input_file.h"
 #include "io/json_reader.h"
+#include "scene/import_common.h"
 
 namespace pathex {
 namespace {
@@ -181,10 +183,10 @@ vec3 apply_vector(const glm::mat4& m, vec3 v) { return vec3(m * glm::vec4(v, 0.0
 
 // OBJ meshes. tinyobjloader does the loading, but it only warns about out-of-range indices and
 // reads a malformed number as 0, so a first pass over the text checks every `v` and `f` line and
-// names the offending line: "mesh.obj:LINE: what was expected".
-Error obj_error(const std::string& path, int line, std::string message) {
+// names the offending line and column: "mesh.obj:LINE:COLUMN: what was expected".
+Error obj_error(const std::string& path, int line, int column, std::string message) {
   Error e = make_error(ErrorCode::kBadFile, std::move(message));
-  e.where = path + ":" + std::to_string(line);
+  e.where = path + ":" + std::to_string(line) + ":" + std::to_string(column);
   return e;
 }
 
@@ -216,16 +218,31 @@ void split_words(std::string_view line, std::vector<std::string_view>* words) {
 }
 
 // One face corner "v", "v/vt", "v//vn" or "v/vt/vn": each index 1..count, or negative (relative).
+// Any other form ("1/", "2//", "3///") is refused here, so that the scan alone decides whether a
+// mesh is valid: `query --scene` reads only this scan, `trace` tinyobjloader after it, and both
+// must give one verdict.
 std::optional<std::string> check_corner(std::string_view item, const long long counts[3]) {
   static const char* const kWhat[3] = {"vertex", "texture coordinate", "normal"};
-  for (int part = 0; part < 3 && !item.empty(); ++part) {
-    const std::size_t slash = item.find('/');
-    const std::string_view field = item.substr(0, slash);
-    item = slash == std::string_view::npos ? std::string_view() : item.substr(slash + 1);
-    if (field.empty() && part > 0) continue;  // "v//vn"
+  std::string_view fields[3];
+  std::size_t n = 0;
+  for (std::string_view rest = item;; ++n) {
+    const std::size_t slash = rest.find('/');
+    if (n == 3) return "bad face corner '" + excerpt(item) + "', expected v, v/vt, v//vn or v/vt/vn";
+    fields[n] = rest.substr(0, slash);
+    if (slash == std::string_view::npos) {
+      ++n;
+      break;
+    }
+    rest = rest.substr(slash + 1);
+  }
+  if (fields[n - 1].empty() || (n == 2 && fields[1].empty()))
+    return "bad face corner '" + excerpt(item) + "', expected v, v/vt, v//vn or v/vt/vn";
+  for (std::size_t part = 0; part < n; ++part) {
+    const std::string_view field = fields[part];
+    if (field.empty() && part == 1) continue;  // "v//vn"
     long long idx = 0;
     if (!parse_long(field, &idx))
-      return "bad face corner '" + std::string(field) + "', expected a " + kWhat[part] + " number";
+      return "bad face corner '" + excerpt(field) + "', expected a " + kWhat[part] + " number";
     const long long resolved = idx < 0 ? counts[part] + idx + 1 : idx;
     if (idx == 0 || resolved < 1 || resolved > counts[part])
       return std::string("face ") + kWhat[part] + " index " + std::to_string(idx) + " is out of range, expected " +
@@ -235,9 +252,10 @@ std::optional<std::string> check_corner(std::string_view item, const long long c
   return std::nullopt;
 }
 
-// Checks every `v` and `f` line, keeps the vertex positions and counts the faces.
+// Checks every `v` and `f` line, keeps the vertex positions and counts the faces. `elements`: the
+// vertices and triangles of the scene's meshes before this one, on entry; with this one's, on return.
 std::optional<Error> scan_obj(const std::string& path, std::string_view text, std::vector<vec3>* positions,
-                              std::size_t* faces) {
+                              std::size_t* faces, std::size_t* elements, const SceneLoadOptions& options) {
   long long counts[3] = {0, 0, 0};  // v, vt, vn defined so far
   std::vector<std::string_view> words;
   int line_no = 0;
@@ -252,18 +270,22 @@ std::optional<Error> scan_obj(const std::string& path, std::string_view text, st
     if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
     split_words(line, &words);
     if (words.empty()) continue;
+    auto column = [&](std::size_t i) { return static_cast<int>(words[i].data() - line.data()) + 1; };
     const std::string_view tag = words[0];
     if (tag == "v") {
       if (words.size() < 4)
-        return obj_error(path, line_no, "a vertex needs 3 coordinates, found " + std::to_string(words.size() - 1));
+        return obj_error(path, line_no, column(0), "a vertex needs 3 coordinates, found " + std::to_string(words.size() - 1));
       vec3 p;
       for (std::size_t i = 1; i < 4; ++i) {
         double x = 0;
-        if (!parse_double(words[i], &x)) return obj_error(path, line_no, "bad vertex coordinate '" + std::string(words[i]) + "', expected a number");
+        if (!parse_double(words[i], &x))
+          return obj_error(path, line_no, column(i), "bad vertex coordinate '" + excerpt(words[i]) + "', expected a number");
         if (!std::isfinite(x) || std::fabs(x) > 1e30)
-          return obj_error(path, line_no, "vertex coordinate " + std::string(words[i]) + " is not finite (or beyond 1e30)");
+          return obj_error(path, line_no, column(i), "vertex coordinate " + excerpt(words[i]) + " is not finite (or beyond 1e30)");
         p[static_cast<int>(i - 1)] = static_cast<float>(x);
       }
+      if (auto e = check_mesh_elements(++*elements, options, path + ":" + std::to_string(line_no) + ":" + std::to_string(column(0))))
+        return e;
       positions->push_back(p);
       ++counts[0];
     } else if (tag == "vt") {
@@ -271,12 +293,16 @@ std::optional<Error> scan_obj(const std::string& path, std::string_view text, st
     } else if (tag == "vn") {
       ++counts[2];
     } else if (tag == "f") {
-      if (words.size() < 4) return obj_error(path, line_no, "a face needs at least 3 vertices, found " + std::to_string(words.size() - 1));
+      if (words.size() < 4)
+        return obj_error(path, line_no, column(0), "a face needs at least 3 vertices, found " + std::to_string(words.size() - 1));
       if (words.size() - 1 > kMaxFaceCorners)
-        return obj_error(path, line_no, "a face of " + std::to_string(words.size() - 1) + " corners exceeds the limit of " +
+        return obj_error(path, line_no, column(0), "a face of " + std::to_string(words.size() - 1) + " corners exceeds the limit of " +
                                             std::to_string(kMaxFaceCorners) + " (split or triangulate it in the modeller)");
       for (std::size_t i = 1; i < words.size(); ++i)
-        if (std::optional<std::string> m = check_corner(words[i], counts)) return obj_error(path, line_no, *m);
+        if (std::optional<std::string> m = check_corner(words[i], counts)) return obj_error(path, line_no, column(i), *m);
+      *elements += words.size() - 3;  // its triangles
+      if (auto e = check_mesh_elements(*elements, options, path + ":" + std::to_string(line_no) + ":" + std::to_string(column(0))))
+        return e;
       ++*faces;
     }
   }
@@ -284,7 +310,7 @@ std::optional<Error> scan_obj(const std::string& path, std::string_view text, st
 }
 
 // The OBJ at `path`: checked and scanned for its vertices and faces, then (if asked) triangulated.
-Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& options, std::size_t* faces) {
+Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& options, std::size_t* faces, std::size_t* elements) {
   MeshShape mesh;
   mesh.file = path;
   {  // the text is released before tinyobjloader reads the file again, to keep peak memory low
@@ -295,7 +321,7 @@ Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& opti
       e.where = path;
       return e;
     }
-    if (std::optional<Error> e = scan_obj(path, *text, &mesh.positions, faces)) return *e;
+    if (std::optional<Error> e = scan_obj(path, *text, &mesh.positions, faces, elements, options)) return *e;
   }
   if (!options.triangles) return mesh;  // the positions alone: bounds and types, no triangulation
   tinyobj::ObjReaderConfig config;
@@ -328,12 +354,24 @@ Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& opti
   return mesh;
 }
 
+// A JSON scene's "mesh": an OBJ file, or a PLY file when its name ends in .ply (read as the
+// importers read PLY meshes, per-vertex normals ignored as an OBJ's are). `elements`: as scan_obj.
 Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file,
-                           const SceneLoadOptions& options) {
+                           const SceneLoadOptions& options, std::size_t* elements) {
   const std::string path = (std::filesystem::path(base_dir) / file).string();
   if (!std::ifstream(path, std::ios::binary)) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+  std::string ext = std::filesystem::path(file).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".ply") {
+    Result<MeshShape> ply = import::load_ply_mesh(path, import::Location{r.file() + ":" + ptr + "/file"}, /*discard_normals=*/true);
+    if (!ply) return ply.error();
+    *elements += ply->positions.size() + ply->triangles.size();
+    if (auto e = check_mesh_elements(*elements, options, r.file() + ":" + ptr + "/file")) return *e;
+    ply->file = file;
+    return ply;
+  }
   std::size_t faces = 0;
-  Result<MeshShape> mesh = read_obj(path, options, &faces);
+  Result<MeshShape> mesh = read_obj(path, options, &faces, elements);
   if (!mesh) return mesh.error();
   if (faces == 0 || (options.triangles && mesh->triangles.empty()))
     return r.fail(ptr + "/file", "the mesh '" + path + "' has no faces, expected at least one 'f' line");
@@ -343,9 +381,28 @@ Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::s
 
 }  // namespace
 
-Result<MeshShape> load_obj_mesh(const std::string& path, const SceneLoadOptions& options) {
-  std::size_t faces = 0;
-  return read_obj(path, options, &faces);
+Result<MeshShape> load_obj_mesh(const std::string& path, const SceneLoadOptions& options, std::size_t* mesh_elements) {
+  std::size_t faces = 0, none = 0;
+  return read_obj(path, options, &faces, mesh_elements != nullptr ? mesh_elements : &none);
+}
+
+std::optional<Error> check_mesh_elements(std::size_t elements, const SceneLoadOptions& options, const std::string& where) {
+  if (elements <= options.max_mesh_elements) return std::nullopt;
+  Error e = make_error(ErrorCode::kLimit, limit_message("the scene's mesh size", options.max_mesh_elements, "vertices and triangles",
+                                                        "--max-mesh-elements"));
+  e.where = where;
+  return e;
+}
+
+SceneLoadOptions scene_load_options(const Limits& limits, bool triangles) {
+  SceneLoadOptions o;
+  o.max_file_bytes = limits.max_file_bytes;
+  o.triangles = triangles;
+  o.max_scene_bytes = limits.max_scene_bytes;
+  o.max_scene_depth = limits.max_scene_depth;
+  o.max_material_nodes = limits.max_material_nodes;
+  o.max_mesh_elements = limits.max_mesh_elements;
+  return o;
 }
 
 namespace {
@@ -584,7 +641,7 @@ Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr)
 }
 
 Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr, const Scene& scene,
-                         const std::string& base_dir, const SceneLoadOptions& options) {
+                         const std::string& base_dir, const SceneLoadOptions& options, std::size_t* mesh_elements) {
   if (!j.is_object()) return r.fail(ptr, "expected a shape object, found " + Reader::kind(j));
   PATHEX_TRY(type, r.string(j, "type", ptr));
   Shape s;
@@ -648,7 +705,7 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
     s.geometry = DiskShape{apply_point(m, c), wn, static_cast<float>(rad) * scale};
   } else {
     PATHEX_TRY(file, r.string(j, "file", ptr));
-    PATHEX_TRY(mesh, load_obj(r, ptr, base_dir, file, options));
+    PATHEX_TRY(mesh, load_obj(r, ptr, base_dir, file, options, mesh_elements));
     for (vec3& p : mesh.positions) p = apply_point(m, p);
     s.geometry = std::move(mesh);
   }
@@ -708,8 +765,9 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   // --- shapes ---
   if (!doc.contains("shapes") || !doc["shapes"].is_array()) return r.fail("/shapes", "expected an array of shapes");
   if (doc["shapes"].empty()) return r.fail("/shapes", "the scene is empty: expected at least one shape");
+  std::size_t mesh_elements = 0;  // of all the meshes so far (--max-mesh-elements)
   for (std::size_t i = 0; i < doc["shapes"].size(); ++i) {
-    PATHEX_TRY(s, read_shape(r, doc["shapes"][i], "/shapes/" + std::to_string(i), scene, base_dir, options));
+    PATHEX_TRY(s, read_shape(r, doc["shapes"][i], "/shapes/" + std::to_string(i), scene, base_dir, options, &mesh_elements));
     scene.shapes.push_back(std::move(s));
   }
   // --- lights ---
@@ -744,8 +802,8 @@ std::optional<SceneRuleViolation> check_scene_rules(const Scene& scene) {
 
 Result<Scene> load_scene_file(const std::string& path, const SceneLoadOptions& options) {
   const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".pbrt") return load_scene_pbrt(path);
-  if (ext == ".xml") return load_scene_mitsuba(path);
+  if (ext == ".pbrt") return load_scene_pbrt(path, options);
+  if (ext == ".xml") return load_scene_mitsuba(path, options);
   Result<std::string> text = read_input_file(path, options.max_file_bytes);
   if (!text) {
     if (text.error().code == ErrorCode::kLimit) return text.error();

@@ -116,7 +116,17 @@ struct SceneLoadOptions {
   // false: meshes keep their vertex positions but are not triangulated (enough for the scene's
   // universe and the camera check; what `query --scene` and `check` need).
   bool triangles = true;
+  // An imported scene's resources (pbrt-v4, Mitsuba 3; README "Limits"): its text with every
+  // included file (--max-scene-size), the nesting of its materials (--max-scene-depth), the
+  // components its materials expand to (--max-material-nodes), and, in every format, the
+  // vertices plus triangles of all its meshes (--max-mesh-elements).
+  std::size_t max_scene_bytes = Limits{}.max_scene_bytes;
+  int max_scene_depth = Limits{}.max_scene_depth;
+  std::size_t max_material_nodes = Limits{}.max_material_nodes;
+  std::size_t max_mesh_elements = Limits{}.max_mesh_elements;
 };
+// The options of a command's limits (every command that reads a scene passes them through here).
+SceneLoadOptions scene_load_options(const Limits& limits, bool triangles = true);
 // An OBJ face may have at most this many corners (tinyobjloader's triangulation of one polygon
 // is quadratic in its corners; a modeller's n-gons are far smaller).
 inline constexpr std::size_t kMaxFaceCorners = 1024;
@@ -140,7 +150,12 @@ Result<Scene> load_scene_file(const std::string& path, const SceneLoadOptions& o
 
 // An OBJ file's triangles (polygons fan-triangulated); errors name the OBJ file and line. The
 // result may have no triangles: callers say where the mesh was asked for.
-Result<MeshShape> load_obj_mesh(const std::string& path, const SceneLoadOptions& options = {});
+// `mesh_elements`, when given: the vertices and triangles of the scene's meshes read before, on
+// entry, with this mesh's on return (checked against options.max_mesh_elements as they are read).
+Result<MeshShape> load_obj_mesh(const std::string& path, const SceneLoadOptions& options = {}, std::size_t* mesh_elements = nullptr);
+// A kLimit error at `where` when `elements` (the vertices plus triangles of a scene's meshes so
+// far) exceed options.max_mesh_elements.
+std::optional<Error> check_mesh_elements(std::size_t elements, const SceneLoadOptions& options, const std::string& where);
 
 // The scene-level rules above (a shape, a light, a camera that sees a shape), which every loader
 // checks once the scene is complete: the first one violated, with the JSON pointer it concerns.
