@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # bench/fuzz.sh SECONDS [HARNESS...]: installs clang-14 and builds the libFuzzer harnesses
 # (`setup.sh --fuzz`, fuzz/), then runs each in
-# turn, one at a time, SECONDS in total split evenly (default: all six harnesses: expression,
-# class_file, profile, check_file, scene, obj). Each starts from its seed corpus (made here from
-# grammar/corpus/, tests/scene/bad/, tests/reach/checks/ and samples/) and its dictionary
+# turn, one at a time, SECONDS in total split evenly (default: all eight harnesses: expression,
+# class_file, profile, check_file, scene, obj, pbrt, mitsuba). Each starts from its seed corpus
+# (made here from grammar/corpus/, tests/scene/bad/, tests/reach/checks/, samples/ and issue 42's
+# hostile scenes) and its dictionary
 # (fuzz/dict/). Each harness runs under small limits (fuzz_support.h), so that one input costs
 # milliseconds and an input past 5 s (-timeout) is a hang the work budget missed; a process over
 # 1 GiB (-rss_limit_mb) is a finding too. libFuzzer runs in fork mode and keeps going after a
@@ -16,7 +17,7 @@ cd "$(dirname "$0")/.."
 total=${1:?usage: bench/fuzz.sh SECONDS [HARNESS...]}
 shift
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(expression class_file profile check_file scene obj)
+[ ${#harnesses[@]} -gt 0 ] || harnesses=(expression class_file profile check_file scene obj pbrt mitsuba)
 per=$(( total / ${#harnesses[@]} ))
 [ "$per" -ge 1 ] || per=1
 
@@ -26,7 +27,7 @@ cmake --build build-fuzz -j2 --target $(printf 'fuzz_%s ' "${harnesses[@]}") >/d
 # --- seed corpora ---
 seeds=build-fuzz/seeds
 rm -rf "$seeds"
-mkdir -p "$seeds"/{expression,class_file,profile,check_file,scene,obj}
+mkdir -p "$seeds"/{expression,class_file,profile,check_file,scene,obj,pbrt,mitsuba}
 python3 - "$seeds" <<'PY'
 import json, pathlib, sys
 seeds = pathlib.Path(sys.argv[1])
@@ -37,12 +38,39 @@ for i, e in enumerate(exprs):
     (seeds / "expression" / f"corpus-{i}").write_text(e)
     entry = {"classes": [{"name": f"c{i}", "expr": e}, {"name": "h", "expr": "LSDE", "notation": "heckbert"}]}
     (seeds / "class_file" / f"corpus-{i}.json").write_text(json.dumps(entry))
+# Issue 42's reproducers, small (tests/scene/hostile_test.cpp has them all).
+head = 'LookAt 0 1 3  0 1 0  0 1 0\nCamera "perspective" "float fov" 40\nWorldBegin\nLightSource "point"\n'
+pbrt = {
+    "brackets": "WorldBegin\n" + "[" * 1000,
+    "include-dot": head + 'Include "."\n',
+    "include-zero": head + 'Include "/dev/zero"\n',
+    "projective": head + 'Transform [1 0 0 0  0 1 0 0  0 0 1 1  0 0 0 1]\nShape "sphere"\n',
+    "negative-k": head + 'Material "conductor" "rgb eta" [1 1 1] "rgb k" [-1 0 0]\nShape "sphere"\n',
+    "two-cameras": 'Camera "perspective"\nCamera "orthographic"\nWorldBegin\nLightSource "point"\nShape "sphere"\n',
+    "mix": head + 'MakeNamedMaterial "m2" "string type" "diffuse"\n' + "".join(
+        f'MakeNamedMaterial "m{i}" "string type" "mix" "string materials" ["m{i + 1}" "m{i + 1}"]\n' for i in (1, 0))
+        + 'NamedMaterial "m0"\nShape "sphere"\n',
+}
+xml = {
+    "self-ref": '<scene version="3.0.0"><bsdf type="twosided" id="a"><ref id="a"/></bsdf><shape type="sphere"><ref id="a"/></shape></scene>',
+    "nested": '<scene version="3.0.0"><shape type="sphere">' + '<bsdf type="twosided">' * 70 + '<bsdf type="diffuse"/>' + '</bsdf>' * 70 + '</shape></scene>',
+    "duplicates": '<scene version="3.0.0"><bsdf type="diffuse" id="a"/><shape type="sphere" type="disk" id="a"/></scene><scene/>',
+    "blend": '<scene version="3.0.0"><emitter type="point"/><bsdf type="diffuse" id="b2"/>'
+             '<bsdf type="blendbsdf" id="b1"><ref id="b2"/><ref id="b2"/></bsdf><bsdf type="blendbsdf" id="b0"><ref id="b1"/><ref id="b1"/></bsdf>'
+             '<shape type="sphere"><ref id="b0"/><transform name="to_world"><matrix value="1 0 0 0 0 1 0 0 0 0 1 0 0 0 1 1"/></transform></shape></scene>',
+}
+for name, text in pbrt.items():
+    (seeds / "pbrt" / f"{name}.pbrt").write_text(text)
+for name, text in xml.items():
+    (seeds / "mitsuba" / f"{name}.xml").write_text(text)
 PY
 cp samples/classes/*.json "$seeds/class_file/"
 cp samples/renderers/*.json "$seeds/profile/"
 cp samples/checks/*.json tests/reach/checks/*.json "$seeds/check_file/"
 cp samples/scenes/*.json tests/scene/bad/*.json "$seeds/scene/"
 cp tests/scene/bad/*.obj samples/scenes/meshes/*.obj "$seeds/obj/"
+cp samples/scenes/*.pbrt samples/scenes/include/*.pbrt "$seeds/pbrt/"
+cp samples/scenes/*.xml samples/scenes/include/*.xml "$seeds/mitsuba/"
 
 # --- runs ---
 status=0

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""The hang reproducers of issue 17, each run through the pathex binary under default limits.
+"""The hang reproducers of issues 17 and 42, each run through the pathex binary under default limits.
 
-Every input here once ran for 10 to 110 s. Each must now finish with its answer or stop with a
+Every input here once ran for 10 to 110 s, grew to gigabytes, or crashed (issue 42's scene
+importers: a stack overflow, a bad_alloc). Each must now finish with its answer or stop with a
 message naming the option that bounds it, within 1 s. What is measured is each process's CPU time
 (user + system, from os.wait4, the best of ROUNDS runs), not its wall time: on a shared machine
 the wall time counts what the other processes do. Prints one row per reproducer and exits 1 if any
@@ -41,6 +42,40 @@ def cases(tmp):
     zero_mesh = dict(cornell, shapes=[{"type": "mesh", "file": "/dev/zero",
                                        "material": cornell["shapes"][0]["material"]}] + cornell["shapes"][1:])
     literal = "L" + "D" * 30000 + "E"
+    # Issue 42: the pbrt-v4 and Mitsuba 3 importers under hostile input.
+    head = 'LookAt 0 1 3  0 1 0  0 1 0\nCamera "perspective" "float fov" 40\nWorldBegin\nLightSource "point" "point3 from" [0 2 2]\n'
+    sensor = ('<sensor type="perspective"><float name="fov" value="40"/><transform name="to_world">'
+              '<lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform></sensor>'
+              '<emitter type="point"><point name="position" x="0" y="3" z="3"/></emitter>')
+
+    def mix_levels(n):
+        return (head + f'MakeNamedMaterial "m{n}" "string type" "diffuse"\n' +
+                "".join(f'MakeNamedMaterial "m{i}" "string type" "mix" "string materials" ["m{i + 1}" "m{i + 1}"]\n'
+                        for i in range(n - 1, -1, -1)) + 'NamedMaterial "m0"\nShape "sphere"\n')
+    blend40 = ('<scene version="3.0.0">' + sensor + '<bsdf type="diffuse" id="b40"/>' +
+               "".join(f'<bsdf type="blendbsdf" id="b{i}"><ref id="b{i + 1}"/><ref id="b{i + 1}"/></bsdf>' for i in range(39, -1, -1)) +
+               '<shape type="sphere"><ref id="b0"/></shape></scene>')
+    scene = lambda path: ["query", "--scene", path, "L.*E"]
+    issue42 = [
+        ("pbrt: 16 Mi [ after WorldBegin", scene(file("brackets.pbrt", "WorldBegin\n" + "[" * (16 << 20))), 2,
+         "expected a directive, found '['"),
+        ("pbrt: Include \"/dev/zero\"", scene(file("zero.pbrt", head + 'Include "/dev/zero"\n')), 2, "--max-file-size"),
+        ("Mitsuba: <include> /dev/zero", scene(file("zero.xml", '<scene version="3.0.0"><include filename="/dev/zero"/></scene>')), 2,
+         "--max-file-size"),
+        ("Mitsuba: a bsdf that refers to itself", scene(file("self.xml", '<scene version="3.0.0"><bsdf type="twosided" id="a"><ref id="a"/>'
+                                                              '</bsdf><shape type="sphere"><ref id="a"/></shape></scene>')), 2,
+         "cannot contain itself"),
+        ("Mitsuba: 50,000 nested twosided", scene(file("twosided.xml", '<scene version="3.0.0"><shape type="sphere">' +
+                                                          '<bsdf type="twosided">' * 50000 + '<bsdf type="diffuse"/>' + '</bsdf>' * 50000 +
+                                                          '</shape></scene>')), 2, "--max-scene-depth"),
+        ("Mitsuba: 100,000 nested blendbsdf", scene(file("blend.xml", '<scene version="3.0.0"><shape type="sphere">' +
+                                                            '<bsdf type="blendbsdf"><bsdf type="diffuse"/>' * 100000 + '<bsdf type="diffuse"/>' +
+                                                            '</bsdf>' * 100000 + '</shape></scene>')), 2, "--max-scene-depth"),
+        ("pbrt: 40 levels of shared mix", scene(file("mix40.pbrt", mix_levels(40))), 0, "reachable"),
+        ("pbrt: 10,000 levels of shared mix", scene(file("mix10000.pbrt", mix_levels(10000))), 0, "reachable"),
+        ("Mitsuba: 40 levels of shared blendbsdf", scene(file("blend40.xml", blend40)), 0, "reachable"),
+        ("pbrt: a 16 MiB directive name", scene(file("name.pbrt", "A" * (16 << 20) + "\n")), 2, "…' is not supported"),
+    ]
     return [
         ("(S{1000}&D*){1000}", ["explain", "(S{1000}&D*){1000}"], 0, "language      empty"),
         ("L(.{7}){1000}E", ["explain", "--members", "0", "L(.{7}){1000}E"], 0, "language      finite"),
@@ -61,7 +96,7 @@ def cases(tmp):
          "--max-file-size"),
         ("OBJ face of 200,000 corners", ["query", "--scene", file("big-face.json", json.dumps(big_face)), "L.*E"], 2,
          "exceeds the limit of 1024"),
-    ]
+    ] + issue42
 
 
 def run(cmd):
@@ -81,7 +116,7 @@ def main():
     args = ap.parse_args()
     failed = 0
     with tempfile.TemporaryDirectory(prefix="pathex-hangs-") as tmp:
-        print(f"{'reproducer':34} {'exit':>4} {'CPU s':>7} {'wall s':>7}  stops with")
+        print(f"{'reproducer':38} {'exit':>4} {'CPU s':>7} {'wall s':>7}  stops with")
         for name, argv, code, expect in cases(tmp):
             runs = [run([args.pathex] + argv) for _ in range(args.rounds)]
             rc, text = runs[-1][0], runs[-1][1]
@@ -90,7 +125,7 @@ def main():
             ok = rc == code and expect in text and best_cpu < LIMIT_S
             failed += not ok
             said = "(answers)" if rc == 0 else text.strip().splitlines()[0][:90] if text.strip() else ""
-            print(f"{name:34} {rc:>4} {best_cpu:7.3f} {best_wall:7.3f}  {said}{'' if ok else '   <-- FAIL'}")
+            print(f"{name:38} {rc:>4} {best_cpu:7.3f} {best_wall:7.3f}  {said}{'' if ok else '   <-- FAIL'}")
     print(f"{failed} of the reproducers over {LIMIT_S:g} s of CPU or not as expected" if failed else
           f"every reproducer within {LIMIT_S:g} s of CPU")
     return 1 if failed else 0

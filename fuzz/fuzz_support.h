@@ -4,6 +4,8 @@
 
 #include <unistd.h>
 
+#include <cerrno>
+
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -37,6 +39,9 @@ inline Limits small_limits() {
 inline SceneLoadOptions small_scene_options() {
   SceneLoadOptions o;
   o.max_file_bytes = small_limits().max_file_bytes;
+  o.max_scene_bytes = std::size_t{4} << 20;
+  o.max_material_nodes = 100000;
+  o.max_mesh_elements = 1000000;
   return o;
 }
 
@@ -64,6 +69,19 @@ inline std::string write_scratch(const std::string& name, std::string_view bytes
 [[noreturn]] inline void finding(const char* what) {
   std::fprintf(stderr, "pathex fuzz finding: %s\n", what);
   std::abort();
+}
+
+// Links in the scratch folder to the sample scenes' include/ and meshes/ folders, so that a seed's
+// Include "include/cornell-materials.pbrt" or its PLY floor resolves beside the fuzzed file.
+inline void link_sample_folders() {
+  static const bool linked = [] {
+    for (const char* folder : {"include", "meshes"}) {
+      const std::string target = std::string(PATHEX_SOURCE_DIR "/samples/scenes/") + folder, link = scratch_dir() + "/" + folder;
+      if (::symlink(target.c_str(), link.c_str()) != 0 && errno != EEXIST) finding("cannot link the sample folders");
+    }
+    return true;
+  }();
+  (void)linked;
 }
 
 // A scene that loaded, rendered with every plain join (bdpt) at most 4 x 4 pixels, one pass: a

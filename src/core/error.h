@@ -43,6 +43,8 @@ inline Error make_error(ErrorCode code, std::string message) {
 // character boundary) followed by "…" when longer, so that a 16 MiB token gives one line of
 // stderr, not 16 MiB.
 std::string excerpt(std::string_view text, std::size_t max_bytes = 64);
+// A file name is cut only past the longest path Linux opens (PATH_MAX), which no file that exists has.
+inline constexpr std::size_t kMaxPathBytes = 4096;
 
 // Dereferencing a Result that was never checked is a bug even when it happens to hold a value:
 // the day the input changes it aborts (issue 17: `*compile(...)` of a constant that a user's

@@ -56,7 +56,7 @@ Result<std::string> SceneFiles::include(const std::string& name, const Location&
 
 Result<std::string> SceneFiles::read(const std::string& path, const Location& from, int depth, const std::string& directive) {
   if (depth > 32) return located(from, directive + " nested more than 32 deep (a file including itself?)");
-  const std::string what = depth == 0 ? "the scene file" : "the included file '" + path + "'";
+  const std::string what = depth == 0 ? "the scene file" : "the included file '" + excerpt(path, kMaxPathBytes) + "'";
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return located(from, what + " is a directory, expected a file");
   const std::size_t left = max_scene_bytes_ - read_;

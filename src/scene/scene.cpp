@@ -318,7 +318,7 @@ Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& opti
     if (!text) {
       if (text.error().code == ErrorCode::kLimit) return text.error();
       Error e = make_error(ErrorCode::kBadFile, "cannot open the mesh");
-      e.where = path;
+      e.where = excerpt(path, kMaxPathBytes);
       return e;
     }
     if (std::optional<Error> e = scan_obj(path, *text, &mesh.positions, faces, elements, options)) return *e;
@@ -348,7 +348,7 @@ Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& opti
     if (std::max(t.x, std::max(t.y, t.z)) >= mesh.positions.size()) {
       Error e = make_error(ErrorCode::kBadFile, "a face refers to a vertex that was not read; expected plain text lines "
                                                 "(no NUL bytes or lone carriage returns)");
-      e.where = path;
+      e.where = excerpt(path, kMaxPathBytes);
       return e;
     }
   return mesh;
@@ -359,7 +359,7 @@ Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& opti
 Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file,
                            const SceneLoadOptions& options, std::size_t* elements) {
   const std::string path = (std::filesystem::path(base_dir) / file).string();
-  if (!std::ifstream(path, std::ios::binary)) return r.fail(ptr + "/file", "cannot open the mesh '" + path + "'");
+  if (!std::ifstream(path, std::ios::binary)) return r.fail(ptr + "/file", "cannot open the mesh '" + excerpt(path, kMaxPathBytes) + "'");
   std::string ext = std::filesystem::path(file).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".ply") {
