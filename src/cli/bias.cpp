@@ -96,7 +96,7 @@ void print_text(const BiasReport& r, int top, const std::string& out_dir, bool i
 
 int run(BiasArgs a) {
   // --- scene, renderer, classes ---
-  Result<Scene> scene = load_scene_file(a.scene, SceneLoadOptions{a.options.limits.max_file_bytes});
+  Result<Scene> scene = load_scene_file(a.scene, scene_load_options(a.options.limits));
   if (!scene) return report(scene.error());
   if (!a.resolution.empty())
     if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return report(r.error());

@@ -247,7 +247,7 @@ Error at_case_key(Error e, const std::string& check_file, const std::string& poi
 // A finite requirement: renders the case's scene with its renderer (no images) and returns "" when
 // no contribution was non-finite, else how many and where the first arose.
 Result<std::string> render_finite(const Case& c, const Requirement& r, ReachCache& cache, const Limits& limits) {
-  Result<Scene> scene = load_scene_file(c.scene, SceneLoadOptions{limits.max_file_bytes});
+  Result<Scene> scene = load_scene_file(c.scene, scene_load_options(limits));
   if (!scene) return scene.error();
   Result<const Profile*> profile = cache.profile(c.renderer);
   if (!profile) return profile.error();
@@ -270,7 +270,7 @@ Result<std::string> render_finite(const Case& c, const Requirement& r, ReachCach
 // fails when the renderer misses more than max_share of the light; the counterexample is the
 // shortest path it cannot sample, and the details name the largest missed path.
 Result<bool> decide_missed(const CheckArgs& a, ReachCache& cache, const Case& c, const Requirement& r, Outcome* o) {
-  Result<Scene> scene = load_scene_file(c.scene, SceneLoadOptions{a.limits.max_file_bytes});
+  Result<Scene> scene = load_scene_file(c.scene, scene_load_options(a.limits));
   if (!scene) return at_case_key(scene.error(), a.file, c.pointer + "/scene", c.scene);
   Result<const Profile*> renderer = cache.profile(c.renderer);
   if (!renderer) return at_case_key(renderer.error(), a.file, c.pointer + "/renderer", c.renderer);

@@ -88,6 +88,8 @@ void add_limit_options(CLI::App* app, Limits* limits) {
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxWorkCeiling))->group("Limits");
   app->add_option("--max-file-size", limits->max_file_bytes, "Largest input file read (class, profile, check, scene, mesh), bytes")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxFileBytesCeiling))->group("Limits");
+  app->add_option("--max-mesh-elements", limits->max_mesh_elements, "Most vertices, and most faces, of one PLY mesh")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxMeshElementsCeiling))->group("Limits");
 }
 
 void add_notation_options(CLI::App* app, NotationOptions* n) {

@@ -417,7 +417,7 @@ int run(const ConvergeArgs& a) {
   if (a.renderers.empty()) return report(make_error(ErrorCode::kUsage, "name at least one --renderer"));
 
   // --- scene, output folder, profiles ---
-  Result<Scene> scene = load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
+  Result<Scene> scene = load_scene_file(a.scene, scene_load_options(a.limits));
   if (!scene) return report(scene.error());
   if (!a.resolution.empty())
     if (Result<bool> r = apply_resolution(a.resolution, &scene->camera); !r) return report(r.error());

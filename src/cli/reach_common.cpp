@@ -30,7 +30,7 @@ Result<const SceneUniverse*> ReachCache::scene(const std::string& path) {
   auto it = scenes_.find(path);
   if (it != scenes_.end()) return static_cast<const SceneUniverse*>(&it->second);
   // The universe needs the scene's light, sensor and material types, never its triangles.
-  Result<Scene> s = load_scene_file(path, SceneLoadOptions{limits_.max_file_bytes, /*triangles=*/false});
+  Result<Scene> s = load_scene_file(path, scene_load_options(limits_, /*triangles=*/false));
   if (!s) return s.error();
   const SceneTypes types = scene_types(*s);
   SceneUniverse u;

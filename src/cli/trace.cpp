@@ -127,7 +127,7 @@ struct Job {
 
 Result<bool> load_fresh(const TraceArgs& a, Job* job) {
   Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
-                                        : load_scene_file(a.scene, SceneLoadOptions{a.limits.max_file_bytes});
+                                        : load_scene_file(a.scene, scene_load_options(a.limits));
   if (!scene) return scene.error();
   // The content hash is the file's; the resolution is an option of the render, kept beside it.
   const std::string scene_hash = scene_content_hash(*scene);
@@ -210,7 +210,7 @@ Result<bool> load_resumed(const TraceArgs& a, Job* job) {
   const RenderIdentity& id = combined->header.identity;
   Result<Scene> scene = id.scene_file.empty()
                             ? load_scene_json(default_scene_json(), ".", id.scene)
-                            : load_scene_file(id.scene_file, SceneLoadOptions{a.limits.max_file_bytes});
+                            : load_scene_file(id.scene_file, scene_load_options(a.limits));
   if (!scene) return scene.error();
   if (scene_content_hash(*scene) != id.scene_hash)
     return make_error(ErrorCode::kUsage, "the scene " + id.scene + " changed since " + a.resume + " was rendered (content hash " +

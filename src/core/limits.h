@@ -22,6 +22,7 @@ struct Limits {
   std::size_t max_length = 100000;   // --max-length: letters in one full-path string
   std::size_t max_work = 20000000;   // --max-work: work units of one operation (see core/budget.h)
   std::size_t max_file_bytes = std::size_t{64} << 20;  // --max-file-size: bytes of one input file
+  std::size_t max_mesh_elements = 50000000;  // --max-mesh-elements: vertices, or faces, of one PLY mesh
 };
 
 // The ceilings of the options above and of --max-bounces. At kMaxDepthCeiling the syntax tree's
@@ -35,6 +36,9 @@ inline constexpr int kMaxRepeatCeiling = 100000;
 inline constexpr std::size_t kMaxLengthCeiling = 100000000;
 inline constexpr std::size_t kMaxWorkCeiling = 4000000000;
 inline constexpr std::size_t kMaxFileBytesCeiling = std::size_t{16} << 30;
+// Vertex indices are 32-bit (the scene model's glm::uvec3), and one index value marks a triangle
+// in a PLY face (scene/ply.h): so at most 2^32 - 2 vertices.
+inline constexpr std::size_t kMaxMeshElementsCeiling = 4294967294;
 inline constexpr int kMaxBouncesCeiling = 10000;
 
 // "the DFA exceeds the limit of 100000 states (raise it with --max-states)" and friends.

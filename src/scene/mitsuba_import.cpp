@@ -107,7 +107,7 @@ class Props {
 
 class Importer {
  public:
-  explicit Importer(std::string path) : main_(std::move(path)), files_(main_) {}
+  Importer(std::string path, const SceneLoadOptions& options) : main_(std::move(path)), options_(options), files_(main_) {}
 
   Result<Scene> run() {
     if (auto e = read_file(main_, Location{main_}, 0)) return *e;
@@ -244,6 +244,7 @@ class Importer {
  private:
   friend class Props;
   std::string main_;
+  SceneLoadOptions options_;
   import::SceneFiles files_;
   std::deque<Doc> docs_;
   std::map<std::string, std::string> defaults_;
@@ -273,11 +274,33 @@ class Importer {
     }
     const pugi::xml_node scene = d.xml.child("scene");
     if (!scene) return located(Location{path}, "expected a <scene> root element");
+    if (auto e = check_version(scene)) return e;
     for (pugi::xml_node n : scene.children()) {
       if (n.type() != pugi::node_element) continue;
       if (auto e = top_level(n, depth)) return e;
     }
     return std::nullopt;
+  }
+
+  // Every file's <scene> says its format's version, as Mitsuba requires; pathex reads 3.x (0.5,
+  // 0.6 and 2.x files name the same plugins and properties differently).
+  std::optional<Error> check_version(pugi::xml_node scene) const {
+    const char* const kReads = "; pathex reads Mitsuba 3 scenes (version 3.x)";
+    if (!scene.attribute("version")) return located(where(scene), std::string("the <scene> has no version attribute") + kReads);
+    const std::string v = scene.attribute("version").value();
+    std::vector<std::string> parts(1);
+    for (char c : v) {
+      if (c == '.') parts.emplace_back();
+      else parts.back() += c;
+    }
+    bool number = parts.size() <= 3;
+    for (const std::string& part : parts)
+      number = number && !part.empty() && part.size() <= 6 && part.find_first_not_of("0123456789") == std::string::npos;
+    if (!number) return located(where(scene), "scene version \"" + v.substr(0, 40) + (v.size() > 40 ? "…" : "") + "\" is not a version number" + kReads);
+    const int major = std::stoi(parts[0]);
+    if (major == 3) return std::nullopt;
+    const std::string release = major == 0 && parts.size() > 1 ? "0." + std::to_string(std::stoi(parts[1])) : std::to_string(major);
+    return located(where(scene), "scene version " + v + " is Mitsuba " + release + kReads);
   }
 
   std::optional<Error> top_level(pugi::xml_node n, int depth) {
@@ -444,11 +467,11 @@ class Importer {
         return located(where(n), "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face normals (add <boolean name=\"face_normals\" value=\"true\"/>)");
       MeshShape mesh;
       if (type == "obj") {
-        MI_TRY(obj, load_obj_mesh(files_.resolve(file)));
+        MI_TRY(obj, load_obj_mesh(files_.resolve(file), options_));
         if (obj.triangles.empty()) return located(where(n), "the mesh '" + files_.resolve(file) + "' has no faces");
         mesh = std::move(obj);
       } else {
-        MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), /*discard_normals=*/true));
+        MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), /*discard_normals=*/true, options_));
         mesh = std::move(ply);
       }
       mesh.file = file;
@@ -676,6 +699,6 @@ Result<glm::mat4> Props::transform(const std::string& name) {
 
 }  // namespace
 
-Result<Scene> load_scene_mitsuba(const std::string& path) { return Importer(path).run(); }
+Result<Scene> load_scene_mitsuba(const std::string& path, const SceneLoadOptions& options) { return Importer(path, options).run(); }
 
 }  // namespace pathex

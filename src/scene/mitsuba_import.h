@@ -10,6 +10,6 @@
 
 namespace pathex {
 
-Result<Scene> load_scene_mitsuba(const std::string& path);
+Result<Scene> load_scene_mitsuba(const std::string& path, const SceneLoadOptions& options = {});
 
 }  // namespace pathex

@@ -8,6 +8,7 @@
 // as is every directive, shape, material or light type outside the subset.
 #include "scene/pbrt_import.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -90,6 +91,7 @@ struct Param {
   std::vector<bool> bools;
   Location at;
   bool used = false;
+  bool attribute = false;  // an Attribute default (GraphicsState)
 };
 
 class Params {
@@ -114,7 +116,9 @@ class Params {
   }
   std::optional<Error> unused(const std::string& what) const {
     for (const Param& p : list)
-      if (!p.used) return located(p.at, "parameter \"" + p.type + " " + p.name + "\" of " + what + " is not supported");
+      if (!p.used)
+        return located(p.at, "parameter \"" + p.type + " " + p.name + "\"" + (p.attribute ? " (an Attribute default)" : "") + " of " + what +
+                                 " is not supported");
     return std::nullopt;
   }
 
@@ -202,11 +206,14 @@ struct GraphicsState {
   int material = -1;  // builder index; -1: pbrt's default (diffuse, reflectance 0.5)
   std::optional<AreaLight> area;
   bool reverse = false;
+  // pbrt-v4's Attribute "shape" / "light" / "material": parameters that later directives of that
+  // kind take when they do not give them themselves (kept with the attributes, so scoped).
+  std::vector<Param> shape_attributes, light_attributes, material_attributes;
 };
 
 class Importer {
  public:
-  explicit Importer(std::string main_file) : main_file_(std::move(main_file)), files_(main_file_) {}
+  Importer(std::string main_file, const SceneLoadOptions& options) : main_file_(std::move(main_file)), options_(options), files_(main_file_) {}
 
   Result<Scene> run() {
     if (auto e = parse_file(main_file_, Location{main_file_}, 0)) return *e;
@@ -216,6 +223,7 @@ class Importer {
 
  private:
   std::string main_file_;
+  SceneLoadOptions options_;
   import::SceneFiles files_;
   import::SceneBuilder builder_;
   GraphicsState gs_;
@@ -416,8 +424,42 @@ class Importer {
       coordinate_systems_["world"] = gs_.ctm;
       return std::nullopt;
     }
+    // --- hints and settings (README "Importing pbrt-v4 and Mitsuba 3 scenes": directives) ---
+    if (name == "ColorSpace") {  // anywhere, as in pbrt-v4; the RGB values after it are in that space
+      PBRT_TRY(space, quoted(s, at, name));
+      if (space != "srgb") return located(at, "color space \"" + space + "\" is not supported, expected \"srgb\"");
+      return std::nullopt;
+    }
+    if (name == "Option") return option(s, at);
+    if (name == "Attribute") {
+      PBRT_TRY(target, quoted(s, at, name));
+      PBRT_TRY(ps, params(s));
+      std::vector<Param>* into = target == "shape" ? &gs_.shape_attributes : target == "light" ? &gs_.light_attributes
+                               : target == "material" ? &gs_.material_attributes : nullptr;
+      if (target == "medium" || target == "texture") return std::nullopt;  // media and textures are refused where they are made
+      if (into == nullptr) return located(at, "Attribute target \"" + target + "\" is not supported, expected shape, light, material, medium or texture");
+      for (Param& p : ps.list) {
+        p.attribute = true;
+        into->push_back(std::move(p));
+      }
+      return std::nullopt;
+    }
+    if (name == "TransformTimes") {  // the shutter interval of moving transforms, which pathex refuses
+      if (in_world_) return located(at, "TransformTimes must come before WorldBegin");
+      Result<std::vector<double>> v = numbers(s, 2, at, name);
+      if (!v) return v.error();
+      return std::nullopt;
+    }
+    if (name == "ActiveTransform") {
+      if (s.done() || s.peek().kind != Token::kWord) return located(at, "ActiveTransform expects All, StartTime or EndTime");
+      const Token& which = (*s.tokens)[s.pos++];
+      if (which.text == "All") return std::nullopt;
+      if (which.text == "StartTime" || which.text == "EndTime")
+        return located(which.at, "ActiveTransform " + which.text + " (a moving transform, motion blur) is not supported: pathex renders static scenes");
+      return located(which.at, "ActiveTransform expects All, StartTime or EndTime");
+    }
     // --- directives with a type and parameters ---
-    static const char* const kTyped[] = {"Camera", "Film", "Sampler", "Integrator", "PixelFilter", "ColorSpace", "Shape",
+    static const char* const kTyped[] = {"Camera", "Film", "Sampler", "Integrator", "PixelFilter", "Accelerator", "Shape",
                                          "LightSource", "AreaLightSource", "Material", "MakeNamedMaterial", "NamedMaterial"};
     bool typed = false;
     for (const char* k : kTyped) typed = typed || name == k;
@@ -426,18 +468,21 @@ class Importer {
     PBRT_TRY(type, quoted(s, at, name));
     PBRT_TRY(ps, params(s));
     const bool scene_wide = name == "Camera" || name == "Film" || name == "Sampler" || name == "Integrator" ||
-                            name == "PixelFilter" || name == "ColorSpace";
+                            name == "PixelFilter" || name == "Accelerator";
     if (scene_wide && in_world_) return located(at, name + " must come before WorldBegin");
     if (!scene_wide && !in_world_) return located(at, name + " must come after WorldBegin");
     const std::string what = name + " \"" + type + "\"";
-    if (name == "Sampler" || name == "Integrator" || name == "PixelFilter") {
-      ps.ignore_all();  // how to estimate is pathex's choice (--renderer, --spp); see the README
+    if (name == "Sampler" || name == "Integrator" || name == "PixelFilter" || name == "Accelerator") {
+      ps.ignore_all();  // how to estimate (and to intersect) is pathex's choice (--renderer, --spp); see the README
       return std::nullopt;
     }
-    if (name == "ColorSpace") {
-      if (type != "srgb") return located(at, "color space \"" + type + "\" is not supported, expected \"srgb\"");
-      return std::nullopt;
-    }
+    // Attribute defaults: what the directive does not give itself.
+    const std::vector<Param>* defaults = name == "Shape" ? &gs_.shape_attributes
+                                       : name == "LightSource" || name == "AreaLightSource" ? &gs_.light_attributes
+                                       : name == "Material" || name == "MakeNamedMaterial" ? &gs_.material_attributes : nullptr;
+    if (defaults != nullptr)
+      for (const Param& d : *defaults)
+        if (std::none_of(ps.list.begin(), ps.list.end(), [&](const Param& p) { return p.name == d.name; })) ps.list.push_back(d);
     if (name == "Film") {
       if (type != "rgb") return located(at, "film \"" + type + "\" is not supported, expected \"rgb\"");
       PBRT_TRY(w, ps.integer("xresolution", 1280));
@@ -506,6 +551,24 @@ class Importer {
     const int index = builder_.add_material(n, it->second);
     named_material_index_[n] = index;
     return index;
+  }
+
+  // pbrt-v4's Option "type name" value: rendering settings. Those that do not change the light are
+  // accepted and ignored; forcediffuse true (every material rendered diffuse) is refused.
+  std::optional<Error> option(Stream& s, const Location& at) {
+    PBRT_TRY(ps, params(s));
+    if (ps.list.size() != 1) return located(at, "Option expects one parameter, such as \"bool disablepixeljitter\" true");
+    const Param& p = ps.list[0];
+    static const char* const kIgnored[] = {"disablepixeljitter", "disabletexturefiltering", "disablewavelengthjitter", "displacementedgescale",
+                                           "msereferenceimage", "msereferenceout", "rendercoordsys", "seed", "pixelstats", "wavefront"};
+    for (const char* k : kIgnored)
+      if (p.name == k) return std::nullopt;
+    if (p.name == "forcediffuse") {
+      if (p.type != "bool" || p.bools.size() != 1) return located(p.at, "Option forcediffuse expects one bool value");
+      if (p.bools[0]) return located(p.at, "Option forcediffuse true (every material rendered as diffuse) is not supported: remove it or set it false");
+      return std::nullopt;
+    }
+    return located(p.at, "unknown Option \"" + p.name + "\"");
   }
 
   // GGX alpha from pbrt's roughness parameters (remapped by sqrt unless remaproughness is false).
@@ -664,7 +727,7 @@ class Importer {
         ps.ignore({"edgelength"});
         PBRT_TRY(file, ps.string("filename", ""));
         if (file.empty()) return located(at, "plymesh needs a \"string filename\"");
-        PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, /*discard_normals=*/false));
+        PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, /*discard_normals=*/false, options_));
         mesh = std::move(ply);
         mesh.file = file;
       } else {
@@ -775,6 +838,6 @@ class Importer {
 
 }  // namespace
 
-Result<Scene> load_scene_pbrt(const std::string& path) { return Importer(path).run(); }
+Result<Scene> load_scene_pbrt(const std::string& path, const SceneLoadOptions& options) { return Importer(path, options).run(); }
 
 }  // namespace pathex

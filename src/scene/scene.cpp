@@ -744,8 +744,8 @@ std::optional<SceneRuleViolation> check_scene_rules(const Scene& scene) {
 
 Result<Scene> load_scene_file(const std::string& path, const SceneLoadOptions& options) {
   const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".pbrt") return load_scene_pbrt(path);
-  if (ext == ".xml") return load_scene_mitsuba(path);
+  if (ext == ".pbrt") return load_scene_pbrt(path, options);
+  if (ext == ".xml") return load_scene_mitsuba(path, options);
   Result<std::string> text = read_input_file(path, options.max_file_bytes);
   if (!text) {
     if (text.error().code == ErrorCode::kLimit) return text.error();

@@ -34,6 +34,10 @@ struct MeshShape {
   std::string file;                      // as given, relative to the scene file
   std::vector<glm::vec3> positions;
   std::vector<glm::uvec3> triangles;
+  // Per vertex, or empty: read from PLY files (scene/ply.h) for the shading normals and textures
+  // to come; nothing renders with them yet (the importers refuse or drop per-vertex normals).
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uvs;
 };
 struct SphereShape {
   glm::vec3 center{0.0f};
@@ -116,7 +120,16 @@ struct SceneLoadOptions {
   // false: meshes keep their vertex positions but are not triangulated (enough for the scene's
   // universe and the camera check; what `query --scene` and `check` need).
   bool triangles = true;
+  std::size_t max_mesh_elements = Limits{}.max_mesh_elements;  // vertices, or faces, of one PLY mesh (--max-mesh-elements)
 };
+// The options of a command's --max-file-size and --max-mesh-elements.
+inline SceneLoadOptions scene_load_options(const Limits& limits, bool triangles = true) {
+  SceneLoadOptions o;
+  o.max_file_bytes = limits.max_file_bytes;
+  o.triangles = triangles;
+  o.max_mesh_elements = limits.max_mesh_elements;
+  return o;
+}
 // An OBJ face may have at most this many corners (tinyobjloader's triangulation of one polygon
 // is quadratic in its corners; a modeller's n-gons are far smaller).
 inline constexpr std::size_t kMaxFaceCorners = 1024;
