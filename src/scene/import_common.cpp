@@ -166,6 +166,44 @@ Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, boo
   return mesh;
 }
 
+// --- generated meshes ---
+
+MeshShape cube_mesh() {
+  MeshShape m;
+  const glm::vec3 e[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (int axis = 0; axis < 3; ++axis)
+    for (float sign : {1.0f, -1.0f}) {
+      // u × v = the outward normal, so the corners below run counter-clockwise seen from outside.
+      glm::vec3 u = e[(axis + 1) % 3], v = e[(axis + 2) % 3];
+      if (sign < 0.0f) std::swap(u, v);
+      const glm::vec3 c = sign * e[axis];
+      const auto base = static_cast<unsigned>(m.positions.size());
+      m.positions.insert(m.positions.end(), {c - u - v, c + u - v, c + u + v, c - u + v});
+      m.uvs.insert(m.uvs.end(), {{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+      m.triangles.emplace_back(base, base + 1, base + 2);
+      m.triangles.emplace_back(base, base + 2, base + 3);
+    }
+  return m;
+}
+
+MeshShape tube_mesh(float radius, float z0, float z1) {
+  MeshShape m;
+  constexpr int n = kCylinderSegments;
+  for (int i = 0; i <= n; ++i) {  // the seam's column twice, for its two u values
+    const double phi = 2.0 * 3.14159265358979323846 * (i % n) / n;
+    const float x = radius * static_cast<float>(std::cos(phi)), y = radius * static_cast<float>(std::sin(phi));
+    m.positions.insert(m.positions.end(), {{x, y, z0}, {x, y, z1}});
+    const float u = static_cast<float>(i) / n;
+    m.uvs.insert(m.uvs.end(), {{u, 0.0f}, {u, 1.0f}});
+  }
+  for (unsigned i = 0; i < static_cast<unsigned>(n); ++i) {
+    const unsigned a = 2 * i, d = 2 * i + 1, b = 2 * i + 2, c = 2 * i + 3;  // (i, z0), (i, z1), (i + 1, z0), (i + 1, z1)
+    m.triangles.emplace_back(a, b, c);  // (b - a) × (c - a) points away from the axis
+    m.triangles.emplace_back(a, c, d);
+  }
+  return m;
+}
+
 // --- the builder ---
 
 int SceneBuilder::add_material(std::string name, Material m) {

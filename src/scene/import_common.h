@@ -73,6 +73,18 @@ glm::vec3 conductor_reflectance(glm::vec3 eta, glm::vec3 k);
 Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals,
                                 const SceneLoadOptions& options);
 
+// Mitsuba's cube: [-1, 1]^3 as 24 vertices (four per face, with that face's uv from (0, 0) to
+// (1, 1)) and 12 triangles whose front sides face outwards.
+MeshShape cube_mesh();
+
+// An open tube around the z axis (pbrt's and Mitsuba's cylinder, without caps as theirs are), of
+// radius `radius` from z0 to z1 > z0, its front side facing outwards, as a mesh of
+// kCylinderSegments quads (two triangles each) whose vertices lie on the surface; uv is
+// (angle / 2 pi, (z - z0) / (z1 - z0)). The mesh stands in for the analytic surface: its points are
+// within radius * (1 - cos(pi / 256)) (7.5e-5 radius) of it, and its area is 2.5e-5 smaller.
+inline constexpr int kCylinderSegments = 256;
+MeshShape tube_mesh(float radius, float z0, float z1);
+
 // Affine transform helpers.
 glm::vec3 apply_point(const glm::mat4& m, glm::vec3 p);
 glm::vec3 apply_vector(const glm::mat4& m, glm::vec3 v);

@@ -500,8 +500,29 @@ class Importer {
         return located(where(n), "an elliptical disk (to_world scales x and y differently) is not supported");
       const vec3 normal = import::apply_normal(m, vec3(0, 0, 1));
       s.geometry = DiskShape{import::apply_point(m, vec3(0.0f)), flip ? -normal : normal, r};
+    } else if (type == "cube") {  // a mesh in Mitsuba too: to_world mirrors its windings as an obj's
+      MeshShape mesh = import::cube_mesh();
+      for (vec3& q : mesh.positions) q = import::apply_point(m, q);
+      if (flip)
+        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      s.geometry = std::move(mesh);
+    } else if (type == "cylinder") {  // a tessellated tube (import::tube_mesh), facing outwards unless flip_normals
+      MI_TRY(p0, p.point("p0", vec3(0.0f)));
+      MI_TRY(p1, p.point("p1", vec3(0.0f, 0.0f, 1.0f)));
+      MI_TRY(radius, p.number("radius", 1.0));
+      if (!(radius > 0)) return located(where(n), "radius must be positive");
+      const float length = glm::length(p1 - p0);
+      if (!(length > 0.0f)) return located(where(n), "the cylinder's p0 and p1 coincide");
+      // A right-handed frame around the axis (its turn about the axis moves only the uv seam).
+      const vec3 d = (p1 - p0) / length;
+      const vec3 t1 = glm::normalize(glm::cross(std::fabs(d.x) < 0.9f ? vec3(1, 0, 0) : vec3(0, 1, 0), d)), t2 = glm::cross(d, t1);
+      MeshShape mesh = import::tube_mesh(static_cast<float>(radius), 0.0f, length);
+      for (vec3& q : mesh.positions) q = import::apply_point(m, p0 + q.x * t1 + q.y * t2 + q.z * d);
+      if (flip != import::swaps_handedness(m))  // analytic in Mitsuba: outwards whatever to_world's handedness
+        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      s.geometry = std::move(mesh);
     } else {
-      return located(where(n), "shape \"" + type + "\" is not supported, expected obj, ply, sphere, rectangle or disk");
+      return located(where(n), "shape \"" + type + "\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder");
     }
     if (auto e = p.unused()) return e;
     builder_.add_shape(std::move(s));

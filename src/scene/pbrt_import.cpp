@@ -785,7 +785,23 @@ class Importer {
       builder_.add_shape(std::move(s));
       return std::nullopt;
     }
-    return located(at, "shape \"" + type + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere or disk");
+    if (type == "cylinder") {  // a tessellated tube (import::tube_mesh)
+      if (Param* p = ps.find("phimax"); p && !(p->numbers.size() == 1 && p->numbers[0] >= 360.0))
+        return located(p->at, "partial cylinders (phimax) are not supported");
+      PBRT_TRY(radius, ps.number("radius", 1.0));
+      PBRT_TRY(zmin, ps.number("zmin", -1.0));
+      PBRT_TRY(zmax, ps.number("zmax", 1.0));
+      if (!(radius > 0)) return located(at, "radius must be positive");
+      if (zmin == zmax) return located(at, "a cylinder of zero height (zmin equals zmax)");
+      MeshShape mesh = import::tube_mesh(static_cast<float>(radius), static_cast<float>(std::min(zmin, zmax)), static_cast<float>(std::max(zmin, zmax)));
+      for (vec3& p : mesh.positions) p = import::apply_point(m, p);
+      if (flip)
+        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      s.geometry = std::move(mesh);
+      builder_.add_shape(std::move(s));
+      return std::nullopt;
+    }
+    return located(at, "shape \"" + type + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder");
   }
 
   // --- the camera, once the film is known ---

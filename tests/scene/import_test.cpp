@@ -393,8 +393,9 @@ std::vector<Refusal> refusals() {
        "directive 'ObjectBegin' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
       {"medium.pbrt", "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n", "medium.pbrt:4:1",
        "directive 'MakeNamedMedium' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
-      {"cylinder.pbrt", "Shape \"cylinder\"\n", "cylinder.pbrt:4:1",
-       "shape \"cylinder\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere or disk"},
+      {"curve.pbrt", "Shape \"curve\"\n", "curve.pbrt:4:1",
+       "shape \"curve\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder"},
+      {"cylinder.pbrt", "Shape \"cylinder\" \"float phimax\" 180\n", "cylinder.pbrt:4:18", "partial cylinders (phimax) are not supported"},
       {"coated.pbrt", "Material \"coateddiffuse\"\n", "coated.pbrt:4:1",
        "material \"coateddiffuse\" is not supported, expected diffuse, conductor, dielectric or mix"},
       {"infinite.pbrt", "LightSource \"infinite\" \"rgb L\" [1 1 1]\n", "infinite.pbrt:4:1",
@@ -437,8 +438,8 @@ std::vector<Refusal> refusals() {
       // Mitsuba 3
       {"negative.xml", "  <emitter type=\"point\">\n    <rgb name=\"intensity\" value=\"1, -1, 1\"/>\n  </emitter>\n</scene>\n", "negative.xml:2:3",
        "a light's emission must be non-negative"},
-      {"cube.xml", "  <shape type=\"cube\"/>\n</scene>\n", "cube.xml:2:3",
-       "shape \"cube\" is not supported, expected obj, ply, sphere, rectangle or disk"},
+      {"curve.xml", "  <shape type=\"bsplinecurve\"/>\n</scene>\n", "curve.xml:2:3",
+       "shape \"bsplinecurve\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder"},
       {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",
        "emitter \"envmap\" is not supported, expected point, spot, directional, or area inside a shape"},
       {"plastic.xml", "  <bsdf type=\"plastic\" id=\"unused\"/>\n</scene>\n", "plastic.xml:2:3",
@@ -529,6 +530,62 @@ TEST(ImportPbrt, HintsAreIgnoredAndAttributesHonoured) {
   ASSERT_EQ(b.lights.size(), 1u);
   expect_near(std::get<PointLight>(b.lights[0]).intensity, glm::vec3(3.0f), "the light's scale from its Attribute");
   EXPECT_EQ(describe(scene_types(b)), describe(scene_types(a)));
+}
+
+// Mitsuba's cube and both formats' cylinders become meshes whose front sides face outwards (inwards
+// under flip_normals / ReverseOrientation), on the analytic surface, of its area within 3e-5.
+TEST(ImportShapes, CubeAndCylindersAreMeshesFacingOutwards) {
+  struct Expect {
+    glm::vec3 axis_point, axis;  // cylinders; axis zero for the cube (centred at axis_point)
+    float radius, area;
+    int triangles;
+    bool inwards;
+  };
+  auto check = [](const Shape& shape, const Expect& e, const std::string& what) {
+    const auto* mesh = std::get_if<MeshShape>(&shape.geometry);
+    ASSERT_NE(mesh, nullptr) << what;
+    EXPECT_EQ(static_cast<int>(mesh->triangles.size()), e.triangles) << what;
+    EXPECT_EQ(mesh->uvs.size(), mesh->positions.size()) << what;
+    double area = 0.0;
+    for (const glm::uvec3& t : mesh->triangles) {
+      const glm::vec3 a = mesh->positions[t.x], b = mesh->positions[t.y], c = mesh->positions[t.z];
+      const glm::vec3 n = glm::cross(b - a, c - a);
+      area += 0.5 * glm::length(n);
+      glm::vec3 out = (a + b + c) / 3.0f - e.axis_point;
+      out -= glm::dot(out, e.axis) * e.axis;  // radial for a cylinder, from the centre for the cube
+      EXPECT_EQ(glm::dot(n, out) < 0.0f, e.inwards) << what;
+    }
+    EXPECT_NEAR(area, e.area, 3e-5 * e.area) << what;
+    if (glm::length(e.axis) > 0.0f)
+      for (const glm::vec3& p : mesh->positions) {
+        glm::vec3 r = p - e.axis_point;
+        r -= glm::dot(r, e.axis) * e.axis;
+        EXPECT_NEAR(glm::length(r), e.radius, 1e-5f) << what;
+      }
+  };
+  const float pi = 3.14159265f;
+  const std::string sensor = "<sensor type=\"perspective\"><float name=\"fov\" value=\"60\"/><transform name=\"to_world\">"
+                             "<lookat origin=\"0 1 8\" target=\"0 1 0\"/></transform></sensor>\n<emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"5\" z=\"5\"/></emitter>\n";
+  const Scene xml = load(write("shapes.xml",
+      "<scene version=\"3.0.0\">\n" + sensor +
+      "<shape type=\"cube\"><transform name=\"to_world\"><scale value=\"0.5\"/><translate x=\"2\"/></transform></shape>\n"
+      "<shape type=\"cube\"><boolean name=\"flip_normals\" value=\"true\"/></shape>\n"
+      "<shape type=\"cylinder\"><point name=\"p1\" x=\"0\" y=\"2\" z=\"0\"/><float name=\"radius\" value=\"0.5\"/></shape>\n"
+      "<shape type=\"cylinder\"><boolean name=\"flip_normals\" value=\"true\"/><transform name=\"to_world\"><scale x=\"-1\"/></transform></shape>\n"
+      "</scene>\n"));
+  ASSERT_EQ(xml.shapes.size(), 4u);
+  check(xml.shapes[0], {{2, 0, 0}, {0, 0, 0}, 0, 6.0f, 12, false}, "the cube");
+  check(xml.shapes[1], {{0, 0, 0}, {0, 0, 0}, 0, 24.0f, 12, true}, "the flipped cube");
+  check(xml.shapes[2], {{0, 0, 0}, {0, 1, 0}, 0.5f, 2 * pi * 0.5f * 2, 512, false}, "the cylinder");
+  check(xml.shapes[3], {{0, 0, 0}, {0, 0, 1}, 1.0f, 2 * pi, 512, true}, "the flipped cylinder under a mirror");
+  const Scene pbrt = load(write("shapes.pbrt",
+      "Scale -1 1 1\nLookAt 0 1 8  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 60\nWorldBegin\n"
+      "LightSource \"point\" \"point3 from\" [0 5 5]\nShape \"cylinder\" \"float radius\" 0.5 \"float zmin\" 0 \"float zmax\" 2\n"
+      "AttributeBegin\nScale -1 1 1\nShape \"cylinder\"\nReverseOrientation\nShape \"cylinder\"\nAttributeEnd\n"));
+  ASSERT_EQ(pbrt.shapes.size(), 3u);
+  check(pbrt.shapes[0], {{0, 0, 0}, {0, 0, 1}, 0.5f, 2 * pi * 0.5f * 2, 512, false}, "pbrt's cylinder");
+  check(pbrt.shapes[1], {{0, 0, 0}, {0, 0, 1}, 1.0f, 2 * pi * 2, 512, false}, "pbrt's cylinder under a mirror");
+  check(pbrt.shapes[2], {{0, 0, 0}, {0, 0, 1}, 1.0f, 2 * pi * 2, 512, true}, "pbrt's reversed cylinder");
 }
 
 // A Mitsuba file of another version names the same plugins differently: refused naming it.
