@@ -381,8 +381,15 @@ class Binary {
     pos_ += static_cast<std::size_t>(count) * size_of(t);
     return std::nullopt;
   }
-  // Whole entries of fixed size (checked against the data before reading).
-  void skip_bytes(std::uint64_t n) { pos_ += static_cast<std::size_t>(n); }
+  // `count` entries of `size` bytes each (earlier lists may have left less than the check before
+  // reading assumed).
+  std::optional<Error> skip_entries(std::uint64_t count, std::uint64_t size, const Context& c) {
+    if (count > available() / size)
+      return fail(pos_, "the file ends inside element " + quoted(c.element->name) + ", expected " + std::to_string(count) +
+                            " entries of " + std::to_string(size) + " bytes (" + std::to_string(available()) + " bytes left)");
+    pos_ += static_cast<std::size_t>(count * size);
+    return std::nullopt;
+  }
   std::optional<Error> finish() const {
     if (available() == 0) return std::nullopt;
     return fail(pos_, std::to_string(available()) + (available() == 1 ? " byte" : " bytes") + " after the last element: the header declares less data than the file holds");
@@ -593,7 +600,7 @@ std::optional<Error> read_data(Cursor& in, const Header& h, PlyMesh* m) {
     // --- any other element: skipped, every value read (ASCII: checked as a number of its type) ---
     if constexpr (std::is_same_v<Cursor, Binary>) {
       if (std::none_of(e.properties.begin(), e.properties.end(), [](const Property& p) { return p.list; })) {
-        in.skip_bytes(e.count * least(e, true));  // within the data (checked before reading)
+        if (auto err = in.skip_entries(e.count, least(e, true), c)) return err;
         continue;
       }
     }

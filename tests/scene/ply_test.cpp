@@ -278,6 +278,14 @@ std::vector<Refusal> refusals() {
       "ply\nformat binary_little_endian 1.0\nelement vertex 4" + kXyz + "element face 1\nproperty list uint int extra\n"
       "property list uchar int vertex_indices\nend_header\n";
   auto byte = [](std::size_t at) { return "byte " + std::to_string(at) + ": "; };
+  // A vertex whose skipped list is longer than the check before reading assumes (one count byte),
+  // then an element of fixed size the rest of the file cannot hold.
+  const std::string long_lists_head = "ply\nformat binary_little_endian 1.0\nelement vertex 1" + kXyz +
+                                      "property list uchar int junk\nelement edge 3\nproperty int a\nend_header\n";
+  std::string long_lists_data;
+  for (double v : {0, 0, 0}) put(&long_lists_data, "float", v, false);
+  put(&long_lists_data, "uchar", 10, false);
+  for (int i = 0; i < 10; ++i) put(&long_lists_data, "int", i, false);
   return {
       // issue 42 item 5: a header without end_header (it looped forever)
       {"no-end-header", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n", "m.ply:5:1",
@@ -334,6 +342,8 @@ std::vector<Refusal> refusals() {
        "byte " + std::to_string(face_at + 17) + ": 1 byte after the last element: the header declares less data than the file holds"},
       {"binary-truncated", binary_head("4") + binary_quad_vertices() + quad_face.substr(0, 15), "m.ply",
        "byte " + std::to_string(face_at + 13) + ": face 0: the file ends, expected an int (vertex_indices)"},
+      {"fixed-element-after-long-lists", long_lists_head + long_lists_data, "m.ply",
+       byte(long_lists_head.size() + long_lists_data.size()) + "the file ends inside element 'edge', expected 3 entries of 4 bytes (0 bytes left)"},
       // the header
       {"not-ply", "PLY\nformat ascii 1.0\n", "m.ply:1:1", "expected 'ply' on the first line: this is not a PLY file"},
       {"format", "ply\nformat binary 1.0\n", "m.ply:2:8", "unknown format 'binary', expected ascii, binary_little_endian or binary_big_endian"},
