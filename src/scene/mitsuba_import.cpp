@@ -467,7 +467,7 @@ class Importer {
         return located(where(n), "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face normals (add <boolean name=\"face_normals\" value=\"true\"/>)");
       MeshShape mesh;
       if (type == "obj") {
-        MI_TRY(obj, load_obj_mesh(files_.resolve(file), options_));
+        MI_TRY(obj, load_obj_mesh(files_.resolve(file)));
         if (obj.triangles.empty()) return located(where(n), "the mesh '" + files_.resolve(file) + "' has no faces");
         mesh = std::move(obj);
       } else {

@@ -9,11 +9,13 @@
 #include "scene/pbrt_import.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -206,10 +208,15 @@ struct GraphicsState {
   int material = -1;  // builder index; -1: pbrt's default (diffuse, reflectance 0.5)
   std::optional<AreaLight> area;
   bool reverse = false;
-  // pbrt-v4's Attribute "shape" / "light" / "material": parameters that later directives of that
-  // kind take when they do not give them themselves (kept with the attributes, so scoped).
-  std::vector<Param> shape_attributes, light_attributes, material_attributes;
+  // pbrt-v4's Attribute "shape", "light" and "material" (in that order): parameters that later
+  // directives of that kind take when they do not give them themselves, scoped like the rest of
+  // the state. Shared with the states AttributeBegin pushed until an Attribute changes them, so
+  // that a deep nesting copies nothing.
+  std::array<std::shared_ptr<std::vector<Param>>, 3> attributes;
 };
+// Distinct parameters one kind of Attribute holds at once (a later one of the same name replaces
+// the earlier); real scenes give a few.
+inline constexpr std::size_t kMaxAttributeParams = 64;
 
 class Importer {
  public:
@@ -434,13 +441,22 @@ class Importer {
     if (name == "Attribute") {
       PBRT_TRY(target, quoted(s, at, name));
       PBRT_TRY(ps, params(s));
-      std::vector<Param>* into = target == "shape" ? &gs_.shape_attributes : target == "light" ? &gs_.light_attributes
-                               : target == "material" ? &gs_.material_attributes : nullptr;
       if (target == "medium" || target == "texture") return std::nullopt;  // media and textures are refused where they are made
-      if (into == nullptr) return located(at, "Attribute target \"" + target + "\" is not supported, expected shape, light, material, medium or texture");
+      const int kind = target == "shape" ? 0 : target == "light" ? 1 : target == "material" ? 2 : -1;
+      if (kind < 0) return located(at, "Attribute target \"" + target + "\" is not supported, expected shape, light, material, medium or texture");
+      std::shared_ptr<std::vector<Param>>& list = gs_.attributes[static_cast<std::size_t>(kind)];
+      if (!list) list = std::make_shared<std::vector<Param>>();
+      else if (list.use_count() > 1) list = std::make_shared<std::vector<Param>>(*list);  // copied on the first change in a scope
       for (Param& p : ps.list) {
         p.attribute = true;
-        into->push_back(std::move(p));
+        auto same = std::find_if(list->begin(), list->end(), [&](const Param& q) { return q.name == p.name; });
+        if (same != list->end()) {
+          *same = std::move(p);
+        } else {
+          if (list->size() >= kMaxAttributeParams)
+            return located(p.at, "more than " + std::to_string(kMaxAttributeParams) + " parameters of Attribute \"" + target + "\" at once");
+          list->push_back(std::move(p));
+        }
       }
       return std::nullopt;
     }
@@ -477,10 +493,9 @@ class Importer {
       return std::nullopt;
     }
     // Attribute defaults: what the directive does not give itself.
-    const std::vector<Param>* defaults = name == "Shape" ? &gs_.shape_attributes
-                                       : name == "LightSource" || name == "AreaLightSource" ? &gs_.light_attributes
-                                       : name == "Material" || name == "MakeNamedMaterial" ? &gs_.material_attributes : nullptr;
-    if (defaults != nullptr)
+    const int kind = name == "Shape" ? 0 : name == "LightSource" || name == "AreaLightSource" ? 1
+                   : name == "Material" || name == "MakeNamedMaterial" ? 2 : -1;
+    if (const std::vector<Param>* defaults = kind < 0 ? nullptr : gs_.attributes[static_cast<std::size_t>(kind)].get())
       for (const Param& d : *defaults)
         if (std::none_of(ps.list.begin(), ps.list.end(), [&](const Param& p) { return p.name == d.name; })) ps.list.push_back(d);
     if (name == "Film") {

@@ -386,6 +386,16 @@ struct Refusal {
 const std::string kPbrtHead = "LookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n";
 const std::string kXmlHead = "<scene version=\"3.0.0\">\n";
 
+// Attribute "light" "float a0" 1 … "float a64" 1: the 65th (column 905) is one too many.
+const char* sixty_five_attributes() {
+  static const std::string text = [] {
+    std::string t = "Attribute \"light\" ";
+    for (int i = 0; i < 65; ++i) t += "\"float a" + std::to_string(i) + "\" 1 ";
+    return t + "\n";
+  }();
+  return text.c_str();
+}
+
 std::vector<Refusal> refusals() {
   return {
       // pbrt-v4
@@ -432,6 +442,7 @@ std::vector<Refusal> refusals() {
        "attribute-unused.pbrt:4:19", "parameter \"float radius\" (an Attribute default) of Shape \"trianglemesh\" is not supported"},
       {"attribute-zmax.pbrt", "AttributeBegin\nAttribute \"shape\" \"float zmax\" 0.5\nShape \"sphere\"\n", "attribute-zmax.pbrt:5:19",
        "partial spheres (zmax) are not supported"},
+      {"attributes.pbrt", sixty_five_attributes(), "attributes.pbrt:4:905", "more than 64 parameters of Attribute \"light\" at once"},
       {"motion.pbrt", "ActiveTransform StartTime\n", "motion.pbrt:4:17",
        "ActiveTransform StartTime (a moving transform, motion blur) is not supported: pathex renders static scenes"},
       {"accelerator.pbrt", "Accelerator \"bvh\"\n", "accelerator.pbrt:4:1", "Accelerator must come before WorldBegin"},
