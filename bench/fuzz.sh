@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # bench/fuzz.sh SECONDS [HARNESS...]: installs clang-14 and builds the libFuzzer harnesses
 # (`setup.sh --fuzz`, fuzz/), then runs each in
-# turn, one at a time, SECONDS in total split evenly (default: all eight harnesses: expression,
-# class_file, profile, check_file, scene, obj, pbrt, mitsuba). Each starts from its seed corpus
-# (made here from grammar/corpus/, tests/scene/bad/, tests/reach/checks/, samples/ and issue 42's
-# hostile scenes) and its dictionary
+# turn, one at a time, SECONDS in total split evenly (default: all nine harnesses: expression,
+# class_file, profile, check_file, scene, obj, pbrt, mitsuba, ply). Each starts from its seed corpus
+# (made here from grammar/corpus/, tests/scene/bad/, tests/reach/checks/, samples/, issue 42's
+# hostile scenes and PLY files generated here in each format) and its dictionary
 # (fuzz/dict/). Each harness runs under small limits (fuzz_support.h), so that one input costs
 # milliseconds and an input past 5 s (-timeout) is a hang the work budget missed; a process over
 # 1 GiB (-rss_limit_mb) is a finding too. libFuzzer runs in fork mode and keeps going after a
@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 total=${1:?usage: bench/fuzz.sh SECONDS [HARNESS...]}
 shift
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(expression class_file profile check_file scene obj pbrt mitsuba)
+[ ${#harnesses[@]} -gt 0 ] || harnesses=(expression class_file profile check_file scene obj pbrt mitsuba ply)
 per=$(( total / ${#harnesses[@]} ))
 [ "$per" -ge 1 ] || per=1
 
@@ -27,7 +27,7 @@ cmake --build build-fuzz -j2 --target $(printf 'fuzz_%s ' "${harnesses[@]}") >/d
 # --- seed corpora ---
 seeds=build-fuzz/seeds
 rm -rf "$seeds"
-mkdir -p "$seeds"/{expression,class_file,profile,check_file,scene,obj,pbrt,mitsuba}
+mkdir -p "$seeds"/{expression,class_file,profile,check_file,scene,obj,pbrt,mitsuba,ply}
 python3 - "$seeds" <<'PY'
 import json, pathlib, sys
 seeds = pathlib.Path(sys.argv[1])
@@ -63,6 +63,32 @@ for name, text in pbrt.items():
     (seeds / "pbrt" / f"{name}.pbrt").write_text(text)
 for name, text in xml.items():
     (seeds / "mitsuba" / f"{name}.xml").write_text(text)
+# PLY: a triangle and a quad in each format, with and without normals, uv and skipped properties.
+import gzip, struct
+for fmt in ("ascii", "binary_little_endian", "binary_big_endian"):
+    for extras in (False, True):
+        head = f"ply\nformat {fmt} 1.0\nelement vertex 5\n" + "".join(f"property float {c}\n" for c in "xyz")
+        if extras:
+            head += "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nproperty list uchar int junk\n"
+            head += "element edge 1\nproperty int a\nproperty list ushort double w\n"
+        head += "element face 2\nproperty list uchar int vertex_indices\n" + ("property short flag\n" if extras else "") + "end_header\n"
+        verts = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0.5, 0.5, 0)]
+        rows = []
+        for v in verts:
+            rows.append([("f", x) for x in v] + ([("f", 0), ("f", 0), ("f", 1), ("f", v[0]), ("f", v[1]), ("B", 1), ("i", 7)] if extras else []))
+        if extras:
+            rows.append([("i", 3), ("H", 2), ("d", 0.5), ("d", 1e300)])
+        for face in ((0, 1, 2), (0, 2, 3, 4)):
+            rows.append([("B", len(face))] + [("i", i) for i in face] + ([("h", -1)] if extras else []))
+        if fmt == "ascii":
+            body = "".join(" ".join(repr(x) for _, x in r) + "\n" for r in rows).encode()
+        else:
+            e = "<" if fmt == "binary_little_endian" else ">"
+            body = b"".join(struct.pack(e + t, x) for r in rows for t, x in r)
+        data = head.encode() + body
+        name = f"{fmt}{'-extras' if extras else ''}"
+        (seeds / "ply" / f"{name}.ply").write_bytes(data)
+        (seeds / "ply" / f"{name}.ply.gz").write_bytes(gzip.compress(data))
 PY
 cp samples/classes/*.json "$seeds/class_file/"
 cp samples/renderers/*.json "$seeds/profile/"
@@ -71,6 +97,7 @@ cp samples/scenes/*.json tests/scene/bad/*.json "$seeds/scene/"
 cp tests/scene/bad/*.obj samples/scenes/meshes/*.obj "$seeds/obj/"
 cp samples/scenes/*.pbrt samples/scenes/include/*.pbrt "$seeds/pbrt/"
 cp samples/scenes/*.xml samples/scenes/include/*.xml "$seeds/mitsuba/"
+cp samples/scenes/meshes/*.ply "$seeds/ply/"
 
 # --- runs ---
 status=0

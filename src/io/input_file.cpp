@@ -1,5 +1,8 @@
 #include "io/input_file.h"
 
+#include <zlib.h>
+
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -30,6 +33,56 @@ Result<std::string> read_input_file(const std::string& path, std::size_t max_byt
   }
   if (in.bad()) return error(ErrorCode::kBadFile, "cannot read the file");
   return out;
+}
+
+bool is_gzip(std::string_view bytes) {
+  return bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0x1f && static_cast<unsigned char>(bytes[1]) == 0x8b;
+}
+
+Result<std::string> gunzip(std::string_view bytes, std::size_t max_bytes, const std::string& name) {
+  auto error = [&](ErrorCode code, std::string message) {
+    Error e = make_error(code, std::move(message));
+    e.where = name;
+    return e;
+  };
+  struct Stream {
+    z_stream z{};
+    bool open = false;
+    ~Stream() {
+      if (open) inflateEnd(&z);
+    }
+  } s;
+  if (inflateInit2(&s.z, 16 + MAX_WBITS) != Z_OK) return error(ErrorCode::kBadFile, "cannot start zlib's inflate");
+  s.open = true;
+  std::string out;
+  char block[1 << 16];
+  std::size_t fed = 0;  // bytes of `bytes` handed to zlib so far (zlib counts in 32 bits)
+  for (;;) {
+    if (s.z.avail_in == 0 && fed < bytes.size()) {
+      const std::size_t n = std::min<std::size_t>(bytes.size() - fed, std::size_t{1} << 30);
+      s.z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data() + fed));
+      s.z.avail_in = static_cast<uInt>(n);
+      fed += n;
+    }
+    s.z.next_out = reinterpret_cast<Bytef*>(block);
+    s.z.avail_out = sizeof block;
+    const int r = inflate(&s.z, Z_NO_FLUSH);
+    const std::size_t got = sizeof block - s.z.avail_out;
+    if (got > max_bytes - out.size())
+      return error(ErrorCode::kLimit, limit_message("the inflated gzip file", max_bytes, "bytes", "--max-file-size"));
+    out.append(block, got);
+    const std::size_t left = bytes.size() - fed + s.z.avail_in;  // input not consumed yet
+    if (r == Z_STREAM_END) {
+      if (left == 0) return out;
+      if (!is_gzip(bytes.substr(bytes.size() - left)))
+        return error(ErrorCode::kBadFile, std::to_string(left) + " bytes after the end of the gzip stream, expected another gzip member or the end of the file");
+      if (inflateReset(&s.z) != Z_OK) return error(ErrorCode::kBadFile, "cannot restart zlib's inflate");
+      continue;
+    }
+    if (r == Z_BUF_ERROR && left == 0) return error(ErrorCode::kBadFile, "the gzip stream ends early (a truncated file?)");
+    if (r != Z_OK && r != Z_BUF_ERROR)
+      return error(ErrorCode::kBadFile, std::string("not a valid gzip stream: ") + (s.z.msg != nullptr ? std::string(s.z.msg) : "zlib error " + std::to_string(r)));
+  }
 }
 
 }  // namespace pathex

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <string>
+#include <string_view>
 
 #include "core/error.h"
 
@@ -14,5 +15,14 @@ namespace pathex {
 // The bytes of `path`. Errors name the file: it cannot be opened, is a directory, or is larger
 // than `max_bytes` (kLimit, naming --max-file-size).
 Result<std::string> read_input_file(const std::string& path, std::size_t max_bytes);
+
+// True when `bytes` start with the gzip magic (1f 8b).
+bool is_gzip(std::string_view bytes);
+
+// The inflated bytes of a gzip file (RFC 1952, through zlib; several members are concatenated, as
+// gunzip does). Errors name `name`: a stream zlib refuses, one that ends early, bytes after the
+// last member, or inflated bytes beyond `max_bytes` (kLimit, naming --max-file-size: the cap of a
+// file read whole applies to what it inflates to, so a small bomb stops there).
+Result<std::string> gunzip(std::string_view bytes, std::size_t max_bytes, const std::string& name);
 
 }  // namespace pathex

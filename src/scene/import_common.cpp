@@ -13,10 +13,7 @@
 #include <utility>
 #include <variant>
 
-#include <assimp/cimport.h>
-#include <assimp/mesh.h>
-#include <assimp/scene.h>
-#include <dlfcn.h>
+#include "scene/ply.h"
 
 #include "core/limits.h"
 #include "io/input_file.h"
@@ -195,93 +192,86 @@ bool is_similarity(const glm::mat4& m, float* scale) {
   return true;
 }
 
-// --- PLY meshes through assimp ---
+// --- PLY meshes ---
 
 namespace {
 
-// libassimp is loaded when a PLY mesh is read, not linked: with the libraries it pulls in (draco,
-// minizip) its mapping and relocation took about 40 % of every pathex process's start-up page
-// faults (`pathex --version` 25 -> 15 ms CPU, bench/README.md), and only imported scenes with PLY
-// meshes use it. Its C interface is looked up by name (PATHEX_ASSIMP_SONAME: the build's library).
-struct AssimpApi {
-  decltype(&::aiImportFile) import_file;
-  decltype(&::aiReleaseImport) release_import;
-  decltype(&::aiGetErrorString) error_string;
-};
-
-// The loaded library's functions, or the reason it could not be loaded.
-const std::variant<AssimpApi, std::string>& assimp_library() {
-  static const std::variant<AssimpApi, std::string> api = []() -> std::variant<AssimpApi, std::string> {
-    void* lib = ::dlopen(PATHEX_ASSIMP_SONAME, RTLD_NOW | RTLD_LOCAL);  // never closed: the process keeps it
-    if (lib == nullptr) return std::string("cannot load " PATHEX_ASSIMP_SONAME " (") + ::dlerror() + ")";
-    AssimpApi a{};
-    a.import_file = reinterpret_cast<decltype(a.import_file)>(::dlsym(lib, "aiImportFile"));
-    a.release_import = reinterpret_cast<decltype(a.release_import)>(::dlsym(lib, "aiReleaseImport"));
-    a.error_string = reinterpret_cast<decltype(a.error_string)>(::dlsym(lib, "aiGetErrorString"));
-    if (a.import_file == nullptr || a.release_import == nullptr || a.error_string == nullptr)
-      return std::string(PATHEX_ASSIMP_SONAME " lacks a function of assimp's C interface");
-    return a;
-  }();
-  return api;
+bool ends_with(std::string s, const std::string& suffix) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace
 
-Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".ply") return located(at, "the mesh '" + path + "' is not a .ply file");
-  const std::variant<AssimpApi, std::string>& loaded = assimp_library();
-  if (const std::string* why = std::get_if<std::string>(&loaded))
-    return located(at, "cannot read the PLY mesh '" + path + "': " + *why);
-  const AssimpApi& assimp = std::get<AssimpApi>(loaded);
-  // No post-processing: the faces arrive as written, so quads can be checked before splitting.
-  const std::unique_ptr<const aiScene, decltype(assimp.release_import)> imported(assimp.import_file(path.c_str(), 0),
-                                                                                assimp.release_import);
-  const aiScene* scene = imported.get();
-  if (scene == nullptr) return located(at, "cannot read the PLY mesh '" + path + "': " + assimp.error_string());
+Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals, const SceneLoadOptions& options) {
+  if (!ends_with(path, ".ply") && !ends_with(path, ".ply.gz")) return located(at, "the mesh '" + path + "' is not a .ply or .ply.gz file");
+  if (!std::ifstream(path, std::ios::binary)) return located(at, "cannot open the PLY mesh '" + path + "'");
+  Result<PlyMesh> read = read_ply_file(path, PlyReadOptions{options.max_file_bytes, options.max_mesh_elements});
+  if (!read) return read.error();  // located in the PLY file
+  PlyMesh& ply = *read;
+  if (!ply.normals.empty() && !discard_normals)
+    return located(at, "the PLY mesh '" + path +
+                           "' has per-vertex normals, which are not supported: pathex shades meshes with their face normals");
   MeshShape mesh;
   mesh.file = path;
-  for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
-    const aiMesh* m = scene->mMeshes[mi];
-    if (m == nullptr) continue;
-    if (m->HasNormals() && !discard_normals)
-      return located(at, "the PLY mesh '" + path +
-                             "' has per-vertex normals, which are not supported: pathex shades meshes with their face normals");
-    const auto base = static_cast<unsigned>(mesh.positions.size());
-    for (unsigned v = 0; v < m->mNumVertices; ++v) {
-      const aiVector3D& p = m->mVertices[v];
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        return located(at, "the PLY mesh '" + path + "' has a vertex that is not finite");
-      mesh.positions.emplace_back(p.x, p.y, p.z);
-    }
-    for (unsigned f = 0; f < m->mNumFaces; ++f) {
-      const aiFace& face = m->mFaces[f];
-      const unsigned n = face.mNumIndices;
-      for (unsigned i = 0; i < n; ++i)
-        if (face.mIndices[i] >= m->mNumVertices)
-          return located(at, "the PLY mesh '" + path + "' has face " + std::to_string(f) + " with an out-of-range vertex index");
-      if (n < 3)
-        return located(at, "the PLY mesh '" + path + "' has points or lines (face " + std::to_string(f) + "), expected triangles or quads");
-      if (n > 4)
-        return located(at, "the PLY mesh '" + path + "' has a polygon of " + std::to_string(n) + " vertices (face " +
-                               std::to_string(f) + "), expected triangles or quads");
-      const unsigned a = base + face.mIndices[0], b = base + face.mIndices[1], c = base + face.mIndices[2];
-      mesh.triangles.emplace_back(a, b, c);
-      if (n == 4) {
-        const unsigned d = base + face.mIndices[3];
-        const glm::vec3 pa = mesh.positions[a], pb = mesh.positions[b], pc = mesh.positions[c], pd = mesh.positions[d];
-        const glm::vec3 normal = glm::cross(pb - pa, pc - pa);
-        const float size = std::max({glm::length(pb - pa), glm::length(pc - pa), glm::length(pd - pa)});
-        if (glm::length(normal) > 0.0f && std::fabs(glm::dot(pd - pa, glm::normalize(normal))) > 1e-5f * size)
-          return located(at, "the PLY mesh '" + path + "' has a non-planar quad (face " + std::to_string(f) +
-                                 "), which pbrt renders as a curved bilinear patch; pathex supports planar quads only");
-        mesh.triangles.emplace_back(a, c, d);
-      }
-    }
+  mesh.positions = std::move(ply.positions);
+  if (!discard_normals) mesh.normals = std::move(ply.normals);
+  mesh.uvs = std::move(ply.uvs);
+  mesh.triangles.reserve(ply.faces.size());
+  for (std::size_t f = 0; f < ply.faces.size(); ++f) {
+    const glm::uvec4& face = ply.faces[f];
+    const unsigned a = face[0], b = face[1], c = face[2];
+    mesh.triangles.emplace_back(a, b, c);
+    if (face[3] == kPlyTriangle) continue;
+    const unsigned d = face[3];
+    const glm::vec3 pa = mesh.positions[a], pb = mesh.positions[b], pc = mesh.positions[c], pd = mesh.positions[d];
+    const glm::vec3 normal = glm::cross(pb - pa, pc - pa);
+    const float size = std::max({glm::length(pb - pa), glm::length(pc - pa), glm::length(pd - pa)});
+    if (glm::length(normal) > 0.0f && std::fabs(glm::dot(pd - pa, glm::normalize(normal))) > 1e-5f * size)
+      return located(at, "the PLY mesh '" + path + "' has a non-planar quad (face " + std::to_string(f) +
+                             "), which pbrt renders as a curved bilinear patch; pathex supports planar quads only");
+    mesh.triangles.emplace_back(a, c, d);  // split along v0-v2
   }
   if (mesh.triangles.empty()) return located(at, "the PLY mesh '" + path + "' has no faces");
   return mesh;
+}
+
+// --- generated meshes ---
+
+MeshShape cube_mesh() {
+  MeshShape m;
+  const glm::vec3 e[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (int axis = 0; axis < 3; ++axis)
+    for (float sign : {1.0f, -1.0f}) {
+      // u × v = the outward normal, so the corners below run counter-clockwise seen from outside.
+      glm::vec3 u = e[(axis + 1) % 3], v = e[(axis + 2) % 3];
+      if (sign < 0.0f) std::swap(u, v);
+      const glm::vec3 c = sign * e[axis];
+      const auto base = static_cast<unsigned>(m.positions.size());
+      m.positions.insert(m.positions.end(), {c - u - v, c + u - v, c + u + v, c - u + v});
+      m.uvs.insert(m.uvs.end(), {{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+      m.triangles.emplace_back(base, base + 1, base + 2);
+      m.triangles.emplace_back(base, base + 2, base + 3);
+    }
+  return m;
+}
+
+MeshShape tube_mesh(float radius, float z0, float z1) {
+  MeshShape m;
+  constexpr int n = kCylinderSegments;
+  for (int i = 0; i <= n; ++i) {  // the seam's column twice, for its two u values
+    const double phi = 2.0 * 3.14159265358979323846 * (i % n) / n;
+    const float x = radius * static_cast<float>(std::cos(phi)), y = radius * static_cast<float>(std::sin(phi));
+    m.positions.insert(m.positions.end(), {{x, y, z0}, {x, y, z1}});
+    const float u = static_cast<float>(i) / n;
+    m.uvs.insert(m.uvs.end(), {{u, 0.0f}, {u, 1.0f}});
+  }
+  for (unsigned i = 0; i < static_cast<unsigned>(n); ++i) {
+    const unsigned a = 2 * i, d = 2 * i + 1, b = 2 * i + 2, c = 2 * i + 3;  // (i, z0), (i, z1), (i + 1, z0), (i + 1, z1)
+    m.triangles.emplace_back(a, b, c);  // (b - a) × (c - a) points away from the axis
+    m.triangles.emplace_back(a, c, d);
+  }
+  return m;
 }
 
 // --- the builder ---

@@ -1,5 +1,5 @@
 // What the pbrt-v4 and Mitsuba 3 importers (pbrt_import.*, mitsuba_import.*) share: located
-// errors, the mapping of their materials onto pathex's, PLY meshes through assimp, and the
+// errors, the mapping of their materials onto pathex's, PLY meshes (scene/ply.h), and the
 // builder that completes a scene the same way for both formats.
 //
 // The builder's last step (finish) does three things neither format needs to repeat:
@@ -94,12 +94,26 @@ Material blend(const Material& a, const Material& b, float w);
 // Normal-incidence reflectance of a conductor with complex index eta + i k, per channel.
 glm::vec3 conductor_reflectance(glm::vec3 eta, glm::vec3 k);
 
-// A PLY file read by assimp: triangles and planar quads (split in two along v0-v2, the surface
-// pbrt-v4's bilinear patch has when the quad is planar). Refused, at `at`: a file assimp cannot
-// read, polygons of more than four vertices, non-planar quads, points and lines, and per-vertex
-// normals (pathex shades meshes with their face normals; a smooth-shaded mesh would look
-// different) unless `discard_normals` (Mitsuba's face_normals). The result has a triangle.
-Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals);
+// A PLY mesh (scene/ply.h; `.ply` or `.ply.gz`): triangles and planar quads (split in two along
+// v0-v2, the surface pbrt-v4's bilinear patch has when the quad is planar), with the file's uv.
+// Errors in the file are located in it; refused at `at`: a file that cannot be opened, non-planar
+// quads, a mesh without faces, and per-vertex normals (pathex shades meshes with their face
+// normals; a smooth-shaded mesh would look different) unless `discard_normals` (Mitsuba's
+// face_normals), which drops them.
+Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals,
+                                const SceneLoadOptions& options);
+
+// Mitsuba's cube: [-1, 1]^3 as 24 vertices (four per face, with that face's uv from (0, 0) to
+// (1, 1)) and 12 triangles whose front sides face outwards.
+MeshShape cube_mesh();
+
+// An open tube around the z axis (pbrt's and Mitsuba's cylinder, without caps as theirs are), of
+// radius `radius` from z0 to z1 > z0, its front side facing outwards, as a mesh of
+// kCylinderSegments quads (two triangles each) whose vertices lie on the surface; uv is
+// (angle / 2 pi, (z - z0) / (z1 - z0)). The mesh stands in for the analytic surface: its points are
+// within radius * (1 - cos(pi / 256)) (7.5e-5 radius) of it, and its area is 2.5e-5 smaller.
+inline constexpr int kCylinderSegments = 256;
+MeshShape tube_mesh(float radius, float z0, float z1);
 
 // Affine transform helpers.
 glm::vec3 apply_point(const glm::mat4& m, glm::vec3 p);

@@ -282,6 +282,7 @@ class Importer {
     const pugi::xml_node scene = d.xml.child("scene");
     if (!scene) return located(Location{path}, "expected a <scene> root element");
     if (auto e = check_document(d)) return e;
+    if (auto e = check_version(scene)) return e;
     for (pugi::xml_node n : scene.children()) {
       if (n.type() != pugi::node_element) continue;
       if (auto e = top_level(n, depth)) return e;
@@ -322,6 +323,27 @@ class Importer {
       if (n) n = n.next_sibling();
     }
     return std::nullopt;
+  }
+
+  // Every file's <scene> says its format's version, as Mitsuba requires; pathex reads 3.x (0.5,
+  // 0.6 and 2.x files name the same plugins and properties differently).
+  std::optional<Error> check_version(pugi::xml_node scene) const {
+    const char* const kReads = "; pathex reads Mitsuba 3 scenes (version 3.x)";
+    if (!scene.attribute("version")) return located(where(scene), std::string("the <scene> has no version attribute") + kReads);
+    const std::string v = scene.attribute("version").value();
+    std::vector<std::string> parts(1);
+    for (char c : v) {
+      if (c == '.') parts.emplace_back();
+      else parts.back() += c;
+    }
+    bool number = parts.size() <= 3;
+    for (const std::string& part : parts)
+      number = number && !part.empty() && part.size() <= 6 && part.find_first_not_of("0123456789") == std::string::npos;
+    if (!number) return located(where(scene), "scene version \"" + v.substr(0, 40) + (v.size() > 40 ? "…" : "") + "\" is not a version number" + kReads);
+    const int major = std::stoi(parts[0]);
+    if (major == 3) return std::nullopt;
+    const std::string release = major == 0 && parts.size() > 1 ? "0." + std::to_string(std::stoi(parts[1])) : std::to_string(major);
+    return located(where(scene), "scene version " + v + " is Mitsuba " + release + kReads);
   }
 
   std::optional<Error> top_level(pugi::xml_node n, int depth) {
@@ -516,7 +538,7 @@ class Importer {
         if (obj.triangles.empty()) return located(where(n), "the mesh '" + files_.resolve(file) + "' has no faces");
         mesh = std::move(obj);
       } else {
-        MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), /*discard_normals=*/true));
+        MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), /*discard_normals=*/true, options_));
         mesh = std::move(ply);
         mesh_elements_ += mesh.positions.size() + mesh.triangles.size();
         if (auto e = check_mesh_elements(mesh_elements_, options_, where(n).str())) return e;
@@ -547,8 +569,29 @@ class Importer {
         return located(where(n), "an elliptical disk (to_world scales x and y differently) is not supported");
       const vec3 normal = import::apply_normal(m, vec3(0, 0, 1));
       s.geometry = DiskShape{import::apply_point(m, vec3(0.0f)), flip ? -normal : normal, r};
+    } else if (type == "cube") {  // a mesh in Mitsuba too: to_world mirrors its windings as an obj's
+      MeshShape mesh = import::cube_mesh();
+      for (vec3& q : mesh.positions) q = import::apply_point(m, q);
+      if (flip)
+        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      s.geometry = std::move(mesh);
+    } else if (type == "cylinder") {  // a tessellated tube (import::tube_mesh), facing outwards unless flip_normals
+      MI_TRY(p0, p.point("p0", vec3(0.0f)));
+      MI_TRY(p1, p.point("p1", vec3(0.0f, 0.0f, 1.0f)));
+      MI_TRY(radius, p.number("radius", 1.0));
+      if (!(radius > 0)) return located(where(n), "radius must be positive");
+      const float length = glm::length(p1 - p0);
+      if (!(length > 0.0f)) return located(where(n), "the cylinder's p0 and p1 coincide");
+      // A right-handed frame around the axis (its turn about the axis moves only the uv seam).
+      const vec3 d = (p1 - p0) / length;
+      const vec3 t1 = glm::normalize(glm::cross(std::fabs(d.x) < 0.9f ? vec3(1, 0, 0) : vec3(0, 1, 0), d)), t2 = glm::cross(d, t1);
+      MeshShape mesh = import::tube_mesh(static_cast<float>(radius), 0.0f, length);
+      for (vec3& q : mesh.positions) q = import::apply_point(m, p0 + q.x * t1 + q.y * t2 + q.z * d);
+      if (flip != import::swaps_handedness(m))  // analytic in Mitsuba: outwards whatever to_world's handedness
+        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      s.geometry = std::move(mesh);
     } else {
-      return located(where(n), "shape \"" + excerpt(type) + "\" is not supported, expected obj, ply, sphere, rectangle or disk");
+      return located(where(n), "shape \"" + excerpt(type) + "\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder");
     }
     if (auto e = p.unused()) return e;
     builder_.add_shape(std::move(s));

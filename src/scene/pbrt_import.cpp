@@ -8,11 +8,14 @@
 // as is every directive, shape, material or light type outside the subset.
 #include "scene/pbrt_import.h"
 
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -123,6 +126,7 @@ struct Param {
   std::vector<bool> bools;
   Location at;
   bool used = false;
+  bool attribute = false;  // an Attribute default (GraphicsState)
 };
 
 class Params {
@@ -147,7 +151,9 @@ class Params {
   }
   std::optional<Error> unused(const std::string& what) const {
     for (const Param& p : list)
-      if (!p.used) return located(p.at, "parameter \"" + excerpt(p.type + " " + p.name) + "\" of " + what + " is not supported");
+      if (!p.used)
+        return located(p.at, "parameter \"" + excerpt(p.type + " " + p.name) + "\"" + (p.attribute ? " (an Attribute default)" : "") + " of " + what +
+                                 " is not supported");
     return std::nullopt;
   }
 
@@ -235,7 +241,15 @@ struct GraphicsState {
   int material = -1;  // builder index; -1: pbrt's default (diffuse, reflectance 0.5)
   std::optional<AreaLight> area;
   bool reverse = false;
+  // pbrt-v4's Attribute "shape", "light" and "material" (in that order): parameters that later
+  // directives of that kind take when they do not give them themselves, scoped like the rest of
+  // the state. Shared with the states AttributeBegin pushed until an Attribute changes them, so
+  // that a deep nesting copies nothing.
+  std::array<std::shared_ptr<std::vector<Param>>, 3> attributes;
 };
+// Distinct parameters one kind of Attribute holds at once (a later one of the same name replaces
+// the earlier); real scenes give a few.
+inline constexpr std::size_t kMaxAttributeParams = 64;
 
 class Importer {
  public:
@@ -451,8 +465,52 @@ class Importer {
       coordinate_systems_["world"] = gs_.ctm;
       return std::nullopt;
     }
+    // --- hints and settings (README "Importing pbrt-v4 and Mitsuba 3 scenes": directives) ---
+    if (name == "ColorSpace") {  // anywhere, as in pbrt-v4; the RGB values after it are in that space
+      PBRT_TRY(space, quoted(s, at, name));
+      if (space != "srgb") return located(at, "color space \"" + excerpt(space) + "\" is not supported, expected \"srgb\"");
+      return std::nullopt;
+    }
+    if (name == "Option") return option(s, at);
+    if (name == "Attribute") {
+      PBRT_TRY(target, quoted(s, at, name));
+      PBRT_TRY(ps, params(s));
+      if (target == "medium" || target == "texture") return std::nullopt;  // media and textures are refused where they are made
+      const int kind = target == "shape" ? 0 : target == "light" ? 1 : target == "material" ? 2 : -1;
+      if (kind < 0) return located(at, "Attribute target \"" + target + "\" is not supported, expected shape, light, material, medium or texture");
+      std::shared_ptr<std::vector<Param>>& list = gs_.attributes[static_cast<std::size_t>(kind)];
+      if (!list) list = std::make_shared<std::vector<Param>>();
+      else if (list.use_count() > 1) list = std::make_shared<std::vector<Param>>(*list);  // copied on the first change in a scope
+      for (Param& p : ps.list) {
+        p.attribute = true;
+        auto same = std::find_if(list->begin(), list->end(), [&](const Param& q) { return q.name == p.name; });
+        if (same != list->end()) {
+          *same = std::move(p);
+        } else {
+          if (list->size() >= kMaxAttributeParams)
+            return located(p.at, "more than " + std::to_string(kMaxAttributeParams) + " parameters of Attribute \"" + target + "\" at once");
+          list->push_back(std::move(p));
+        }
+      }
+      return std::nullopt;
+    }
+    if (name == "TransformTimes") {  // the shutter interval of moving transforms, which pathex refuses
+      if (in_world_) return located(at, "TransformTimes must come before WorldBegin");
+      Result<std::vector<double>> v = numbers(s, 2, at, name);
+      if (!v) return v.error();
+      return std::nullopt;
+    }
+    if (name == "ActiveTransform") {
+      if (s.done() || s.peek().kind != Token::kWord) return located(at, "ActiveTransform expects All, StartTime or EndTime");
+      const Token which = s.peek();  // a copy: advance() reuses the lexer's token
+      s.advance();
+      if (which.text == "All") return std::nullopt;
+      if (which.text == "StartTime" || which.text == "EndTime")
+        return located(which.at, "ActiveTransform " + which.text + " (a moving transform, motion blur) is not supported: pathex renders static scenes");
+      return located(which.at, "ActiveTransform expects All, StartTime or EndTime");
+    }
     // --- directives with a type and parameters ---
-    static const char* const kTyped[] = {"Camera", "Film", "Sampler", "Integrator", "PixelFilter", "ColorSpace", "Shape",
+    static const char* const kTyped[] = {"Camera", "Film", "Sampler", "Integrator", "PixelFilter", "Accelerator", "Shape",
                                          "LightSource", "AreaLightSource", "Material", "MakeNamedMaterial", "NamedMaterial"};
     bool typed = false;
     for (const char* k : kTyped) typed = typed || name == k;
@@ -461,18 +519,20 @@ class Importer {
     PBRT_TRY(type, quoted(s, at, name));
     PBRT_TRY(ps, params(s));
     const bool scene_wide = name == "Camera" || name == "Film" || name == "Sampler" || name == "Integrator" ||
-                            name == "PixelFilter" || name == "ColorSpace";
+                            name == "PixelFilter" || name == "Accelerator";
     if (scene_wide && in_world_) return located(at, name + " must come before WorldBegin");
     if (!scene_wide && !in_world_) return located(at, name + " must come after WorldBegin");
     const std::string what = name + " \"" + excerpt(type) + "\"";
-    if (name == "Sampler" || name == "Integrator" || name == "PixelFilter") {
-      ps.ignore_all();  // how to estimate is pathex's choice (--renderer, --spp); see the README
+    if (name == "Sampler" || name == "Integrator" || name == "PixelFilter" || name == "Accelerator") {
+      ps.ignore_all();  // how to estimate (and to intersect) is pathex's choice (--renderer, --spp); see the README
       return std::nullopt;
     }
-    if (name == "ColorSpace") {
-      if (type != "srgb") return located(at, "color space \"" + excerpt(type) + "\" is not supported, expected \"srgb\"");
-      return std::nullopt;
-    }
+    // Attribute defaults: what the directive does not give itself.
+    const int kind = name == "Shape" ? 0 : name == "LightSource" || name == "AreaLightSource" ? 1
+                   : name == "Material" || name == "MakeNamedMaterial" ? 2 : -1;
+    if (const std::vector<Param>* defaults = kind < 0 ? nullptr : gs_.attributes[static_cast<std::size_t>(kind)].get())
+      for (const Param& d : *defaults)
+        if (std::none_of(ps.list.begin(), ps.list.end(), [&](const Param& p) { return p.name == d.name; })) ps.list.push_back(d);
     if (name == "Film") {
       if (type != "rgb") return located(at, "film \"" + excerpt(type) + "\" is not supported, expected \"rgb\"");
       PBRT_TRY(w, ps.integer("xresolution", 1280));
@@ -546,6 +606,24 @@ class Importer {
     const int index = builder_.add_material(n, it->second);
     named_material_index_[n] = index;
     return index;
+  }
+
+  // pbrt-v4's Option "type name" value: rendering settings. Those that do not change the light are
+  // accepted and ignored; forcediffuse true (every material rendered diffuse) is refused.
+  std::optional<Error> option(Stream& s, const Location& at) {
+    PBRT_TRY(ps, params(s));
+    if (ps.list.size() != 1) return located(at, "Option expects one parameter, such as \"bool disablepixeljitter\" true");
+    const Param& p = ps.list[0];
+    static const char* const kIgnored[] = {"disablepixeljitter", "disabletexturefiltering", "disablewavelengthjitter", "displacementedgescale",
+                                           "msereferenceimage", "msereferenceout", "rendercoordsys", "seed", "pixelstats", "wavefront"};
+    for (const char* k : kIgnored)
+      if (p.name == k) return std::nullopt;
+    if (p.name == "forcediffuse") {
+      if (p.type != "bool" || p.bools.size() != 1) return located(p.at, "Option forcediffuse expects one bool value");
+      if (p.bools[0]) return located(p.at, "Option forcediffuse true (every material rendered as diffuse) is not supported: remove it or set it false");
+      return std::nullopt;
+    }
+    return located(p.at, "unknown Option \"" + p.name + "\"");
   }
 
   // GGX alpha from pbrt's roughness parameters (remapped by sqrt unless remaproughness is false).
@@ -706,7 +784,7 @@ class Importer {
         ps.ignore({"edgelength"});
         PBRT_TRY(file, ps.string("filename", ""));
         if (file.empty()) return located(at, "plymesh needs a \"string filename\"");
-        PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, /*discard_normals=*/false));
+        PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, /*discard_normals=*/false, options_));
         mesh = std::move(ply);
         mesh_elements_ += mesh.positions.size() + mesh.triangles.size();
         if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
@@ -768,7 +846,23 @@ class Importer {
       builder_.add_shape(std::move(s));
       return std::nullopt;
     }
-    return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere or disk");
+    if (type == "cylinder") {  // a tessellated tube (import::tube_mesh)
+      if (Param* p = ps.find("phimax"); p && !(p->numbers.size() == 1 && p->numbers[0] >= 360.0))
+        return located(p->at, "partial cylinders (phimax) are not supported");
+      PBRT_TRY(radius, ps.number("radius", 1.0));
+      PBRT_TRY(zmin, ps.number("zmin", -1.0));
+      PBRT_TRY(zmax, ps.number("zmax", 1.0));
+      if (!(radius > 0)) return located(at, "radius must be positive");
+      if (zmin == zmax) return located(at, "a cylinder of zero height (zmin equals zmax)");
+      MeshShape mesh = import::tube_mesh(static_cast<float>(radius), static_cast<float>(std::min(zmin, zmax)), static_cast<float>(std::max(zmin, zmax)));
+      for (vec3& p : mesh.positions) p = import::apply_point(m, p);
+      if (flip)
+        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      s.geometry = std::move(mesh);
+      builder_.add_shape(std::move(s));
+      return std::nullopt;
+    }
+    return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder");
   }
 
   // --- the camera, once the film is known ---

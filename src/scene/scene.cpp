@@ -360,10 +360,11 @@ Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::s
                            const SceneLoadOptions& options, std::size_t* elements) {
   const std::string path = (std::filesystem::path(base_dir) / file).string();
   if (!std::ifstream(path, std::ios::binary)) return r.fail(ptr + "/file", "cannot open the mesh '" + excerpt(path, kMaxPathBytes) + "'");
-  std::string ext = std::filesystem::path(file).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".ply") {
-    Result<MeshShape> ply = import::load_ply_mesh(path, import::Location{r.file() + ":" + ptr + "/file"}, /*discard_normals=*/true);
+  std::string lower = file;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  auto ends_with = [&](std::string_view tail) { return lower.size() >= tail.size() && lower.compare(lower.size() - tail.size(), tail.size(), tail) == 0; };
+  if (ends_with(".ply") || ends_with(".ply.gz")) {
+    Result<MeshShape> ply = import::load_ply_mesh(path, import::Location{r.file() + ":" + ptr + "/file"}, /*discard_normals=*/true, options);
     if (!ply) return ply.error();
     *elements += ply->positions.size() + ply->triangles.size();
     if (auto e = check_mesh_elements(*elements, options, r.file() + ":" + ptr + "/file")) return *e;

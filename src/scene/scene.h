@@ -34,6 +34,10 @@ struct MeshShape {
   std::string file;                      // as given, relative to the scene file
   std::vector<glm::vec3> positions;
   std::vector<glm::uvec3> triangles;
+  // Per vertex, or empty: read from PLY files (scene/ply.h) for the shading normals and textures
+  // to come; nothing renders with them yet (the importers refuse or drop per-vertex normals).
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uvs;
 };
 struct SphereShape {
   glm::vec3 center{0.0f};

@@ -386,6 +386,16 @@ struct Refusal {
 const std::string kPbrtHead = "LookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n";
 const std::string kXmlHead = "<scene version=\"3.0.0\">\n";
 
+// Attribute "light" "float a0" 1 … "float a64" 1: the 65th (column 905) is one too many.
+const char* sixty_five_attributes() {
+  static const std::string text = [] {
+    std::string t = "Attribute \"light\" ";
+    for (int i = 0; i < 65; ++i) t += "\"float a" + std::to_string(i) + "\" 1 ";
+    return t + "\n";
+  }();
+  return text.c_str();
+}
+
 std::vector<Refusal> refusals() {
   return {
       // pbrt-v4
@@ -393,8 +403,9 @@ std::vector<Refusal> refusals() {
        "directive 'ObjectBegin' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
       {"medium.pbrt", "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n", "medium.pbrt:4:1",
        "directive 'MakeNamedMedium' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
-      {"cylinder.pbrt", "Shape \"cylinder\"\n", "cylinder.pbrt:4:1",
-       "shape \"cylinder\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere or disk"},
+      {"curve.pbrt", "Shape \"curve\"\n", "curve.pbrt:4:1",
+       "shape \"curve\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder"},
+      {"cylinder.pbrt", "Shape \"cylinder\" \"float phimax\" 180\n", "cylinder.pbrt:4:18", "partial cylinders (phimax) are not supported"},
       {"coated.pbrt", "Material \"coateddiffuse\"\n", "coated.pbrt:4:1",
        "material \"coateddiffuse\" is not supported, expected diffuse, conductor, dielectric or mix"},
       {"infinite.pbrt", "LightSource \"infinite\" \"rgb L\" [1 1 1]\n", "infinite.pbrt:4:1",
@@ -419,11 +430,27 @@ std::vector<Refusal> refusals() {
        "a light's emission (1e+12 after scale) exceeds 1e9: the tracer sums contributions exactly below 2^50 and drops larger ones; scale "
        "the scene's lights down (the image scales with them)"},
       {"nolight.pbrt", "Shape \"sphere\"\n", "nolight.pbrt", "the scene has no light: expected a light source or an emitting shape"},
+      // pbrt-v4's hints and settings that change the light (README "Importing pbrt-v4 and Mitsuba 3 scenes")
+      {"colorspace.pbrt", "ColorSpace \"aces2065-1\"\n", "colorspace.pbrt:4:1", "color space \"aces2065-1\" is not supported, expected \"srgb\""},
+      {"forcediffuse.pbrt", "Option \"bool forcediffuse\" true\n", "forcediffuse.pbrt:4:8",
+       "Option forcediffuse true (every material rendered as diffuse) is not supported: remove it or set it false"},
+      {"option.pbrt", "Option \"bool fastrender\" true\n", "option.pbrt:4:8", "unknown Option \"fastrender\""},
+      {"attribute-target.pbrt", "Attribute \"camera\" \"float fov\" 30\n", "attribute-target.pbrt:4:1",
+       "Attribute target \"camera\" is not supported, expected shape, light, material, medium or texture"},
+      {"attribute-unused.pbrt",
+       "Attribute \"shape\" \"float radius\" 2\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n",
+       "attribute-unused.pbrt:4:19", "parameter \"float radius\" (an Attribute default) of Shape \"trianglemesh\" is not supported"},
+      {"attribute-zmax.pbrt", "AttributeBegin\nAttribute \"shape\" \"float zmax\" 0.5\nShape \"sphere\"\n", "attribute-zmax.pbrt:5:19",
+       "partial spheres (zmax) are not supported"},
+      {"attributes.pbrt", sixty_five_attributes(), "attributes.pbrt:4:905", "more than 64 parameters of Attribute \"light\" at once"},
+      {"motion.pbrt", "ActiveTransform StartTime\n", "motion.pbrt:4:17",
+       "ActiveTransform StartTime (a moving transform, motion blur) is not supported: pathex renders static scenes"},
+      {"accelerator.pbrt", "Accelerator \"bvh\"\n", "accelerator.pbrt:4:1", "Accelerator must come before WorldBegin"},
       // Mitsuba 3
       {"negative.xml", "  <emitter type=\"point\">\n    <rgb name=\"intensity\" value=\"1, -1, 1\"/>\n  </emitter>\n</scene>\n", "negative.xml:2:3",
        "a light's emission must be non-negative"},
-      {"cube.xml", "  <shape type=\"cube\"/>\n</scene>\n", "cube.xml:2:3",
-       "shape \"cube\" is not supported, expected obj, ply, sphere, rectangle or disk"},
+      {"curve.xml", "  <shape type=\"bsplinecurve\"/>\n</scene>\n", "curve.xml:2:3",
+       "shape \"bsplinecurve\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder"},
       {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",
        "emitter \"envmap\" is not supported, expected point, spot, directional, or area inside a shape"},
       {"plastic.xml", "  <bsdf type=\"plastic\" id=\"unused\"/>\n</scene>\n", "plastic.xml:2:3",
@@ -483,6 +510,124 @@ TEST(ImportRefusals, CliPrintsTheSameLineAndExits2) {
   EXPECT_NE(q.err.find("object.pbrt:4:1: directive 'ObjectBegin' is not supported"), std::string::npos) << q.err;
 }
 
+// pbrt-v4's hints are accepted and change nothing; Attribute defaults are honoured, scoped by
+// AttributeBegin/End, and a directive's own parameter wins over them.
+TEST(ImportPbrt, HintsAreIgnoredAndAttributesHonoured) {
+  const std::string plain = "Scale -1 1 1\nLookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n"
+                            "LightSource \"point\" \"rgb I\" [3 3 3] \"point3 from\" [0 2 2]\n"
+                            "Material \"diffuse\" \"rgb reflectance\" [0.2 0.3 0.4]\nShape \"sphere\" \"float radius\" 2\n"
+                            "Material \"diffuse\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 0.5\n";
+  const std::string hinted =
+      "Option \"bool disablepixeljitter\" true\nOption \"integer seed\" 7\nOption \"string rendercoordsys\" \"world\"\n"
+      "Option \"bool forcediffuse\" false\nScale -1 1 1\nLookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n"
+      "Accelerator \"kdtree\" \"integer maxprims\" 4\nTransformTimes 0 1\nColorSpace \"srgb\"\nWorldBegin\nActiveTransform All\n"
+      "ColorSpace \"srgb\"\nAttributeBegin\nAttribute \"light\" \"float scale\" 3\nLightSource \"point\" \"rgb I\" [1 1 1] \"point3 from\" [0 2 2]\n"
+      "Attribute \"material\" \"rgb reflectance\" [0.2 0.3 0.4]\nAttribute \"shape\" \"float radius\" 2\nMaterial \"diffuse\"\nShape \"sphere\"\n"
+      "AttributeEnd\nMaterial \"diffuse\"\nShape \"sphere\"\nAttribute \"shape\" \"float radius\" 3\nShape \"sphere\" \"float radius\" 0.5\n"
+      "Attribute \"texture\" \"float scale\" 2\nAttribute \"medium\" \"float scale\" 2\n";
+  const Scene a = load(write("plain.pbrt", plain));
+  const Scene b = load(write("hinted.pbrt", hinted));
+  ASSERT_EQ(a.shapes.size(), 3u);
+  ASSERT_EQ(b.shapes.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& sa = std::get<SphereShape>(a.shapes[i].geometry);
+    const auto& sb = std::get<SphereShape>(b.shapes[i].geometry);
+    EXPECT_EQ(sb.radius, sa.radius) << i;
+    EXPECT_EQ(sb.radius, (std::vector<float>{2.0f, 1.0f, 0.5f})[i]) << i;
+    EXPECT_EQ(std::get<Diffuse>(b.materials[static_cast<std::size_t>(b.shapes[i].material)]).albedo,
+              std::get<Diffuse>(a.materials[static_cast<std::size_t>(a.shapes[i].material)]).albedo)
+        << i;
+  }
+  ASSERT_EQ(b.lights.size(), 1u);
+  expect_near(std::get<PointLight>(b.lights[0]).intensity, glm::vec3(3.0f), "the light's scale from its Attribute");
+  EXPECT_EQ(describe(scene_types(b)), describe(scene_types(a)));
+}
+
+// Mitsuba's cube and both formats' cylinders become meshes whose front sides face outwards (inwards
+// under flip_normals / ReverseOrientation), on the analytic surface, of its area within 3e-5.
+TEST(ImportShapes, CubeAndCylindersAreMeshesFacingOutwards) {
+  struct Expect {
+    glm::vec3 axis_point, axis;  // cylinders; axis zero for the cube (centred at axis_point)
+    float radius, area;
+    int triangles;
+    bool inwards;
+  };
+  auto check = [](const Shape& shape, const Expect& e, const std::string& what) {
+    const auto* mesh = std::get_if<MeshShape>(&shape.geometry);
+    ASSERT_NE(mesh, nullptr) << what;
+    EXPECT_EQ(static_cast<int>(mesh->triangles.size()), e.triangles) << what;
+    EXPECT_EQ(mesh->uvs.size(), mesh->positions.size()) << what;
+    double area = 0.0;
+    for (const glm::uvec3& t : mesh->triangles) {
+      const glm::vec3 a = mesh->positions[t.x], b = mesh->positions[t.y], c = mesh->positions[t.z];
+      const glm::vec3 n = glm::cross(b - a, c - a);
+      area += 0.5 * glm::length(n);
+      glm::vec3 out = (a + b + c) / 3.0f - e.axis_point;
+      out -= glm::dot(out, e.axis) * e.axis;  // radial for a cylinder, from the centre for the cube
+      EXPECT_EQ(glm::dot(n, out) < 0.0f, e.inwards) << what;
+    }
+    EXPECT_NEAR(area, e.area, 3e-5 * e.area) << what;
+    if (glm::length(e.axis) > 0.0f)
+      for (const glm::vec3& p : mesh->positions) {
+        glm::vec3 r = p - e.axis_point;
+        r -= glm::dot(r, e.axis) * e.axis;
+        EXPECT_NEAR(glm::length(r), e.radius, 1e-5f) << what;
+      }
+  };
+  const float pi = 3.14159265f;
+  const std::string sensor = "<sensor type=\"perspective\"><float name=\"fov\" value=\"60\"/><transform name=\"to_world\">"
+                             "<lookat origin=\"0 1 8\" target=\"0 1 0\"/></transform></sensor>\n<emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"5\" z=\"5\"/></emitter>\n";
+  const Scene xml = load(write("shapes.xml",
+      "<scene version=\"3.0.0\">\n" + sensor +
+      "<shape type=\"cube\"><transform name=\"to_world\"><scale value=\"0.5\"/><translate x=\"2\"/></transform></shape>\n"
+      "<shape type=\"cube\"><boolean name=\"flip_normals\" value=\"true\"/></shape>\n"
+      "<shape type=\"cylinder\"><point name=\"p1\" x=\"0\" y=\"2\" z=\"0\"/><float name=\"radius\" value=\"0.5\"/></shape>\n"
+      "<shape type=\"cylinder\"><boolean name=\"flip_normals\" value=\"true\"/><transform name=\"to_world\"><scale x=\"-1\"/></transform></shape>\n"
+      "</scene>\n"));
+  ASSERT_EQ(xml.shapes.size(), 4u);
+  check(xml.shapes[0], {{2, 0, 0}, {0, 0, 0}, 0, 6.0f, 12, false}, "the cube");
+  check(xml.shapes[1], {{0, 0, 0}, {0, 0, 0}, 0, 24.0f, 12, true}, "the flipped cube");
+  check(xml.shapes[2], {{0, 0, 0}, {0, 1, 0}, 0.5f, 2 * pi * 0.5f * 2, 512, false}, "the cylinder");
+  check(xml.shapes[3], {{0, 0, 0}, {0, 0, 1}, 1.0f, 2 * pi, 512, true}, "the flipped cylinder under a mirror");
+  const Scene pbrt = load(write("shapes.pbrt",
+      "Scale -1 1 1\nLookAt 0 1 8  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 60\nWorldBegin\n"
+      "LightSource \"point\" \"point3 from\" [0 5 5]\nShape \"cylinder\" \"float radius\" 0.5 \"float zmin\" 0 \"float zmax\" 2\n"
+      "AttributeBegin\nScale -1 1 1\nShape \"cylinder\"\nReverseOrientation\nShape \"cylinder\"\nAttributeEnd\n"));
+  ASSERT_EQ(pbrt.shapes.size(), 3u);
+  check(pbrt.shapes[0], {{0, 0, 0}, {0, 0, 1}, 0.5f, 2 * pi * 0.5f * 2, 512, false}, "pbrt's cylinder");
+  check(pbrt.shapes[1], {{0, 0, 0}, {0, 0, 1}, 1.0f, 2 * pi * 2, 512, false}, "pbrt's cylinder under a mirror");
+  check(pbrt.shapes[2], {{0, 0, 0}, {0, 0, 1}, 1.0f, 2 * pi * 2, 512, true}, "pbrt's reversed cylinder");
+}
+
+// A Mitsuba file of another version names the same plugins differently: refused naming it.
+TEST(ImportMitsuba, AVersionOtherThan3IsRefusedNamingIt) {
+  const std::string body = "\n  <sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><transform name=\"to_world\">"
+                           "<lookat origin=\"0 0 5\" target=\"0 0 0\"/></transform></sensor>\n  <emitter type=\"point\"/>\n  <shape type=\"sphere\"/>\n</scene>\n";
+  for (const char* ok : {"3.0.0", "3.5.2", "3.1"}) EXPECT_TRUE(load_scene_file(write("v3.xml", "<scene version=\"" + std::string(ok) + "\">" + body)).ok()) << ok;
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"<scene version=\"0.6.0\">", "scene version 0.6.0 is Mitsuba 0.6; pathex reads Mitsuba 3 scenes (version 3.x)"},
+      {"<scene version=\"0.5.0\">", "scene version 0.5.0 is Mitsuba 0.5; pathex reads Mitsuba 3 scenes (version 3.x)"},
+      {"<scene version=\"2.1.0\">", "scene version 2.1.0 is Mitsuba 2; pathex reads Mitsuba 3 scenes (version 3.x)"},
+      {"<scene version=\"three\">", "scene version \"three\" is not a version number; pathex reads Mitsuba 3 scenes (version 3.x)"},
+      {"<scene>", "the <scene> has no version attribute; pathex reads Mitsuba 3 scenes (version 3.x)"},
+  };
+  for (const auto& [head, message] : refused) {
+    const Result<Scene> s = load_scene_file(write("v.xml", head + body));
+    ASSERT_FALSE(s.ok()) << head;
+    EXPECT_EQ(relative(s.error().where), "v.xml:1:1") << head;
+    EXPECT_EQ(s.error().message, message) << head;
+  }
+  // An included file too, at its own <scene>.
+  write("old.xml", "<?xml version=\"1.0\"?>\n<scene version=\"0.6.0\"/>\n");
+  const Result<Scene> inc = load_scene_file(write("includes-old.xml", "<scene version=\"3.0.0\">\n  <include filename=\"old.xml\"/>" + body));
+  ASSERT_FALSE(inc.ok());
+  EXPECT_EQ(relative(inc.error().where), "old.xml:2:1");
+  EXPECT_EQ(inc.error().message, "scene version 0.6.0 is Mitsuba 0.6; pathex reads Mitsuba 3 scenes (version 3.x)");
+  const pathex::test::CliRun run = pathex::test::run_pathex("trace " + write("v.xml", "<scene version=\"0.6.0\">" + body) + " --quiet --out " + scratch() + "/out");
+  EXPECT_EQ(run.code, 2);
+  EXPECT_EQ(relative(run.err), "pathex: error: v.xml:1:1: scene version 0.6.0 is Mitsuba 0.6; pathex reads Mitsuba 3 scenes (version 3.x)\n");
+}
+
 TEST(ImportRefusals, PlyMeshesWithNormalsOrCurvedQuads) {
   const std::string header = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n";
   write("normals.ply", header + "property float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\n"
@@ -500,7 +645,7 @@ TEST(ImportRefusals, PlyMeshesWithNormalsOrCurvedQuads) {
             "quads only");
   const Result<Scene> c = load_scene_file(write("ply-obj.pbrt", kPbrtHead + "Shape \"plymesh\" \"string filename\" \"mesh.obj\"\n"));
   ASSERT_FALSE(c.ok());
-  EXPECT_EQ(relative(c.error().message), "the mesh 'mesh.obj' is not a .ply file");
+  EXPECT_EQ(relative(c.error().message), "the mesh 'mesh.obj' is not a .ply or .ply.gz file");
 }
 
 }  // namespace
