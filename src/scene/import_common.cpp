@@ -441,6 +441,8 @@ Result<Scene> SceneBuilder::finish(const std::string& file, const std::vector<st
   const glm::vec3 fwd = glm::normalize(s.camera.look_at - s.camera.position);
   const glm::vec3 right_handed = glm::cross(fwd, glm::normalize(s.camera.up));
   if (glm::dot(right_handed, image_right_) < 0.0f) mirror_scene(&s, Mirror3{s.camera.position, glm::normalize(right_handed)});
+  // --- uniform infinite lights: the box around the finished scene (apertures and camera included) ---
+  for (const auto& [radiance, where] : environment_) add_uniform_environment(&s, radiance, where);
   if (std::optional<SceneRuleViolation> v = check_scene_rules(s)) {
     std::string message = v->message;
     if (v->pointer == "/lights") message = "the scene has no light: expected a light source or an emitting shape";

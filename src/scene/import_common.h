@@ -18,6 +18,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -129,6 +130,9 @@ class SceneBuilder {
   int add_material(std::string name, Material m);
   void add_shape(Shape s) { scene_.shapes.push_back(std::move(s)); }
   void add_light(Light l) { scene_.lights.push_back(std::move(l)); }
+  // A uniform infinite light (add_uniform_environment in scene.h, called by finish() once the
+  // scene is complete); `where` names it in messages.
+  void add_environment(glm::vec3 radiance, std::string where) { environment_.push_back({radiance, std::move(where)}); }
   // A distant light covering the whole scene (its aperture is placed by finish()).
   void add_distant(glm::vec3 direction, glm::vec3 irradiance);
   // `camera` holds position, look_at (position + forward), up (the image's up) and the optics;
@@ -144,6 +148,7 @@ class SceneBuilder {
     glm::vec3 direction, irradiance;
   };
   std::vector<Distant> distant_;
+  std::vector<std::pair<glm::vec3, std::string>> environment_;
   glm::vec3 image_right_{1.0f, 0.0f, 0.0f};
   bool has_camera_ = false;
 };

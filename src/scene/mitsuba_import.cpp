@@ -604,8 +604,17 @@ class Importer {
     Props p(this, n, "<emitter type=\"" + excerpt(type) + "\">");
     p.ignore({"id"});
     if (type == "area") return located(where(n), "an area emitter must be inside a <shape>");
+    if (type == "envmap")
+      return located(where(n), "emitter \"envmap\" (an image infinite light) is not supported: pathex renders a uniform infinite light (constant) only");
+    if (type == "constant") {  // the same radiance from every direction
+      MI_TRY(radiance, p.color("radiance", vec3(1.0f)));
+      if (auto bad = import::check_light_value(radiance, where(n))) return bad;
+      if (auto u = p.unused()) return u;
+      builder_.add_environment(radiance, where(n).str());
+      return std::nullopt;
+    }
     if (type != "point" && type != "spot" && type != "directional")
-      return located(where(n), "emitter \"" + excerpt(type) + "\" is not supported, expected point, spot, directional, or area inside a shape");
+      return located(where(n), "emitter \"" + excerpt(type) + "\" is not supported, expected point, spot, directional, constant, or area inside a shape");
     const bool has_to_world = static_cast<bool>(p.find("to_world"));
     MI_TRY(m, p.transform("to_world"));
     if (type == "directional") {
@@ -637,13 +646,14 @@ class Importer {
     }
     MI_TRY(cutoff, p.number("cutoff_angle", 20.0));
     MI_TRY(beam, p.number("beam_width", cutoff * 0.75));
-    if (beam != cutoff)
-      return located(where(n), "a spot light with a soft edge (beam_width < cutoff_angle) is not supported: pathex's spot has a hard edge, set beam_width equal to cutoff_angle");
     if (!(cutoff > 0.0) || cutoff > 180.0) return located(where(n), "cutoff_angle must be within (0, 180]");
+    if (!(beam >= 0.0) || beam > cutoff) return located(where(n), "beam_width must be within [0, cutoff_angle]");
     float s = 1.0f;
     if (!import::is_similarity(m, &s)) return located(where(n), "a spot light under a non-uniform scale is not supported");
     if (auto u = p.unused()) return u;
-    builder_.add_light(SpotLight{position, glm::normalize(import::apply_vector(m, vec3(0, 0, 1))), intensity, static_cast<float>(cutoff)});
+    // Mitsuba 3: full intensity within beam_width, then linear in the angle down to 0 at cutoff_angle.
+    builder_.add_light(SpotLight{position, glm::normalize(import::apply_vector(m, vec3(0, 0, 1))), intensity, static_cast<float>(cutoff),
+                                 static_cast<float>(beam), SpotFalloff::kLinear});
     return std::nullopt;
   }
 

@@ -701,12 +701,22 @@ class Importer {
   std::optional<Error> light(const std::string& type, Params& ps, const Location& at) {
     for (const char* p : {"power", "illuminance"})
       if (Param* q = ps.find(p)) return located(q->at, "parameter '" + std::string(p) + "' is not supported: give the light's I or L and scale");
-    const bool point = type == "point", spot = type == "spot", distant = type == "distant";
-    if (!point && !spot && !distant) return located(at, "light \"" + excerpt(type) + "\" is not supported, expected point, spot, distant or an AreaLightSource");
-    PBRT_TRY(value, ps.rgb(distant ? "L" : "I", vec3(1.0f), false));
+    const bool point = type == "point", spot = type == "spot", distant = type == "distant", infinite = type == "infinite";
+    if (!point && !spot && !distant && !infinite)
+      return located(at, "light \"" + excerpt(type) + "\" is not supported, expected point, spot, distant, infinite or an AreaLightSource");
+    if (infinite) {
+      if (Param* f = ps.find("filename"))
+        return located(f->at, "an image infinite light (filename) is not supported: pathex renders a uniform infinite light (\"rgb L\") only");
+      if (Param* q = ps.find("portal")) return located(q->at, "portals are not supported (pbrt-v4 uses them with image infinite lights only)");
+    }
+    PBRT_TRY(value, ps.rgb(distant || infinite ? "L" : "I", vec3(1.0f), false));
     PBRT_TRY(scale, ps.number("scale", 1.0));
     const vec3 emitted = value * static_cast<float>(scale);
     if (auto e = import::check_light_value(emitted, at)) return e;
+    if (infinite) {  // the same radiance from every direction: no transform changes it
+      builder_.add_environment(emitted, at.str());
+      return std::nullopt;
+    }
     PBRT_TRY(from, ps.point("from", vec3(0.0f)));
     if (point) {
       builder_.add_light(PointLight{import::apply_point(gs_.ctm, from), emitted});
@@ -721,12 +731,14 @@ class Importer {
     }
     PBRT_TRY(cone, ps.number("coneangle", 30.0));
     PBRT_TRY(delta, ps.number("conedeltaangle", 5.0));
-    if (delta != 0.0)
-      return located(at, "a spot light with a soft edge (conedeltaangle " + fmt_number(delta) + ") is not supported: pathex's spot has a hard edge, set conedeltaangle 0");
     float s = 1.0f;
     if (!import::is_similarity(gs_.ctm, &s)) return located(at, "a spot light under a non-uniform scale is not supported");
     if (!(cone > 0.0) || cone > 180.0) return located(at, "coneangle must be within (0, 180]");
-    builder_.add_light(SpotLight{import::apply_point(gs_.ctm, from), glm::normalize(dir), emitted, static_cast<float>(cone)});
+    if (!(delta >= 0.0)) return located(at, "conedeltaangle must not be negative");
+    // pbrt-v4: smoothstep in cos θ from cos(coneangle) to cos(coneangle − conedeltaangle); a delta
+    // past the cone's angle starts the falloff on the axis.
+    builder_.add_light(SpotLight{import::apply_point(gs_.ctm, from), glm::normalize(dir), emitted, static_cast<float>(cone),
+                                 static_cast<float>(std::max(0.0, cone - delta)), SpotFalloff::kSmoothstep});
     return std::nullopt;
   }
 

@@ -609,12 +609,20 @@ Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr)
     return Light{PointLight{p, i}};
   }
   if (type == "spot") {
-    if (auto k = r.keys(j, ptr, {"type", "position", "direction", "intensity", "cone"}); !k) return k.error();
+    if (auto k = r.keys(j, ptr, {"type", "position", "direction", "intensity", "cone", "falloff_start", "falloff"}); !k) return k.error();
     PATHEX_TRY(p, r.vector3(j, "position", ptr, true));
     PATHEX_TRY(d, r.vector3(j, "direction", ptr, true, vec3(0.0f), false, true));
     PATHEX_TRY(i, r.light_value(j, "intensity", ptr, true));
     PATHEX_TRY(cone, r.number(j, "cone", ptr, 1e-3, 180.0, 30.0));
-    return Light{SpotLight{p, glm::normalize(d), i, static_cast<float>(cone)}};
+    PATHEX_TRY(start, r.number(j, "falloff_start", ptr, 0.0, cone, cone));
+    SpotLight spot{p, glm::normalize(d), i, static_cast<float>(cone), static_cast<float>(start)};
+    if (j.contains("falloff")) {
+      const json& f = j["falloff"];
+      if (f == "smoothstep") spot.falloff = SpotFalloff::kSmoothstep;
+      else if (f == "linear") spot.falloff = SpotFalloff::kLinear;
+      else return r.fail(ptr + "/falloff", "expected \"smoothstep\" (in cos θ, as pbrt-v4) or \"linear\" (in θ, as Mitsuba 3)");
+    }
+    return Light{spot};
   }
   if (type == "distant") {
     if (auto k = r.keys(j, ptr, {"type", "direction", "irradiance", "aperture"}); !k) return k.error();
@@ -638,7 +646,7 @@ Result<Light> read_light(const Reader& r, const json& j, const std::string& ptr)
     PATHEX_TRY(pw, r.light_value(j, "power", ptr, true));
     return Light{LaserLight{p, glm::normalize(d), pw}};
   }
-  return r.fail(ptr + "/type", "unknown light type '" + type + "', expected point, spot, distant or laser (area lights are shapes with an emission)");
+  return r.fail(ptr + "/type", "unknown light type '" + type + "', expected point, spot, distant, laser or environment (area lights are shapes with an emission)");
 }
 
 Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr, const Scene& scene,
@@ -748,6 +756,74 @@ Result<ClosedFormReference> read_reference(const Reader& r, const nlohmann::json
 
 }  // namespace
 
+// The name of the environment box's material; the box is the shape with this material and the
+// environment's radiance.
+constexpr const char* kEnvironmentMaterial = "environment (absorbs)";
+
+void add_uniform_environment(Scene* scene, glm::vec3 radiance, const std::string& pointer) {
+  if (scene->environment) {  // a second infinite light: one box emitting the sum
+    for (Shape& s : scene->shapes)
+      if (scene->material_names[static_cast<std::size_t>(s.material)] == kEnvironmentMaterial && s.emission == *scene->environment)
+        s.emission += radiance;
+    *scene->environment += radiance;
+    return;
+  }
+  // --- what the box must hold ---
+  Box b;
+  for (const Shape& s : scene->shapes) {
+    const Box sb = shape_bounds(s);
+    b.add(sb.lo);
+    b.add(sb.hi);
+  }
+  const Camera& c = scene->camera;
+  const float camera_reach = c.type == SensorType::kLens          ? c.aperture_radius
+                             : c.type == SensorType::kOrthographic ? 0.5f * std::hypot(c.film_width, c.film_height)
+                                                                   : 0.0f;
+  b.add(c.position - vec3(camera_reach));
+  b.add(c.position + vec3(camera_reach));
+  for (const Light& l : scene->lights) {
+    if (const auto* d = std::get_if<DistantLight>(&l)) {
+      b.add(d->aperture_corner);
+      b.add(d->aperture_corner + d->aperture_edge1);
+      b.add(d->aperture_corner + d->aperture_edge2);
+      b.add(d->aperture_corner + d->aperture_edge1 + d->aperture_edge2);
+    } else {
+      std::visit([&](const auto& x) {
+        if constexpr (!std::is_same_v<std::decay_t<decltype(x)>, DistantLight>) b.add(x.position);
+      }, l);
+    }
+  }
+  // A tenth of the diagonal, and never less than rounding at the coordinates' magnitude.
+  const float pad = 0.1f * glm::length(b.hi - b.lo) + 1e-4f * std::max(max_abs(b.lo), max_abs(b.hi)) + 1e-6f;
+  const vec3 lo = b.lo - vec3(pad), hi = b.hi + vec3(pad);
+  // --- six faces of two triangles, each wound so that its normal (p1 − p0) × (p2 − p0) points in ---
+  MeshShape box;
+  for (int x = 0; x < 8; ++x) box.positions.push_back(vec3(x & 1 ? hi.x : lo.x, x & 2 ? hi.y : lo.y, x & 4 ? hi.z : lo.z));
+  for (int a = 0; a < 3; ++a) {
+    const int u = (a + 1) % 3, v = (a + 2) % 3;  // e_u × e_v = e_a
+    for (int side = 0; side < 2; ++side) {       // side 0: the low face, whose inward normal is +e_a
+      const unsigned base = side ? (1u << a) : 0u;
+      const unsigned c00 = base, c10 = base | (1u << u), c11 = base | (1u << u) | (1u << v), c01 = base | (1u << v);
+      if (side == 0) {
+        box.triangles.push_back({c00, c10, c11});
+        box.triangles.push_back({c00, c11, c01});
+      } else {
+        box.triangles.push_back({c00, c11, c10});
+        box.triangles.push_back({c00, c01, c11});
+      }
+    }
+  }
+  scene->material_names.push_back(kEnvironmentMaterial);
+  scene->materials.push_back(Material{Mixture{}});
+  Shape s;
+  s.geometry = std::move(box);
+  s.material = static_cast<int>(scene->materials.size()) - 1;
+  s.emission = radiance;
+  s.pointer = pointer;
+  scene->shapes.push_back(std::move(s));
+  scene->environment = radiance;
+}
+
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
                               const SceneLoadOptions& options) {
   const Reader r(name);
@@ -772,20 +848,29 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
     scene.shapes.push_back(std::move(s));
   }
   // --- lights ---
+  std::vector<std::pair<vec3, std::string>> environments;  // uniform infinite lights
   if (doc.contains("lights")) {
     if (!doc["lights"].is_array()) return r.fail("/lights", "expected an array of lights");
     for (std::size_t i = 0; i < doc["lights"].size(); ++i) {
       const std::string ptr = "/lights/" + std::to_string(i);
-      if (!doc["lights"][i].is_object()) return r.fail(ptr, "expected a light object");
-      PATHEX_TRY(l, read_light(r, doc["lights"][i], ptr));
+      const json& lj = doc["lights"][i];
+      if (!lj.is_object()) return r.fail(ptr, "expected a light object");
+      if (lj.contains("type") && lj["type"] == "environment") {  // added once the camera is known
+        if (auto k = r.keys(lj, ptr, {"type", "radiance"}); !k) return k.error();
+        PATHEX_TRY(radiance, r.light_value(lj, "radiance", ptr, true));
+        environments.emplace_back(radiance, ptr);
+        continue;
+      }
+      PATHEX_TRY(l, read_light(r, lj, ptr));
       scene.lights.push_back(std::move(l));
     }
   }
-  if (!has_light(scene)) return r.fail("/lights", kNoLight);
+  if (!has_light(scene) && environments.empty()) return r.fail("/lights", kNoLight);
   // --- camera ---
   if (!doc.contains("camera")) return r.fail("/camera", "missing camera, expected {type, position, look_at, …}");
   PATHEX_TRY(cam, read_camera(r, doc["camera"], "/camera"));
   scene.camera = cam;
+  for (const auto& [radiance, ptr] : environments) add_uniform_environment(&scene, radiance, ptr);
   if (!camera_sees_geometry(scene)) return r.fail("/camera", kSeesNothing);
   if (doc.contains("reference")) {
     PATHEX_TRY(ref, read_reference(r, doc["reference"], "/reference"));

@@ -14,6 +14,7 @@
 // spot meter's ray). The test is exact for those boxes, so it never refuses a visible object.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <set>
 #include <string>
@@ -64,9 +65,16 @@ struct Shape {
 struct PointLight {   // LSD
   glm::vec3 position{0.0f}, intensity{1.0f};  // W/sr
 };
-struct SpotLight {    // LSD: a point light restricted to a cone (hard edge)
+// How a soft-edged spot light's intensity falls between falloff_start_degrees and cone_degrees.
+enum class SpotFalloff : std::uint32_t {  // 32 bits: SpotLight has no padding (scene_hash.cpp hashes its bytes)
+  kSmoothstep,  // smoothstep in cos θ (pbrt-v4's spot, conedeltaangle)
+  kLinear,      // linear in θ (Mitsuba 3's spot, beam_width)
+};
+struct SpotLight {    // LSD: a point light restricted to a cone
   glm::vec3 position{0.0f}, direction{0.0f, -1.0f, 0.0f}, intensity{1.0f};
-  float cone_degrees = 30.0f;  // half angle
+  float cone_degrees = 30.0f;            // half angle: nothing is emitted at or beyond it
+  float falloff_start_degrees = -1.0f;   // where the falloff starts, ≤ cone_degrees; < 0: a hard edge
+  SpotFalloff falloff = SpotFalloff::kSmoothstep;
 };
 struct DistantLight { // LDS: parallel light of irradiance E entering through a finite aperture
   glm::vec3 direction{0.0f, -1.0f, 0.0f}, irradiance{1.0f};  // W/m² perpendicular to direction
@@ -112,7 +120,23 @@ struct Scene {
   std::vector<Light> lights;
   Camera camera;
   std::optional<ClosedFormReference> reference;  // "reference", when the scene declares one
+  // A uniform infinite light's radiance (pbrt-v4 `infinite` with `L`, Mitsuba 3 `constant`, JSON
+  // {"type": "environment"}), when the scene has one; add_uniform_environment() has made it a shape.
+  std::optional<glm::vec3> environment;
 };
+
+// A uniform infinite light of radiance L (DESIGN §1: an area light, letters LDD): light of the same
+// radiance L arriving at every point from every direction not blocked by the scene. It is rendered
+// exactly as a closed box around everything the scene holds (its shapes, the camera with its lens
+// or film, the point-like lights and the distant lights' apertures), padded by a tenth of its
+// diagonal, whose six faces emit L inwards and absorb whatever reaches them (a material with no
+// components, which gives no letter). Every ray that leaves the scene meets the box and carries L
+// back, whatever its origin and direction, which is the infinite light's definition; nothing is
+// approximated. Emitter hits, next-event estimation (uniform by area over the box) and light
+// subpaths (cosine-weighted from the box) then need no kind of their own. Call it once the scene's
+// shapes, lights and camera are complete; several calls add their radiances into one box.
+// `pointer` names the light in messages ("/lights/2", "scene.pbrt:14:1").
+void add_uniform_environment(Scene* scene, glm::vec3 radiance, const std::string& pointer);
 
 // How much of a scene to load.
 struct SceneLoadOptions {

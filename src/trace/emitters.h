@@ -135,10 +135,10 @@ RayPdf pdf_ray(const PointLightParams& p, const glm::vec3& direction);
 std::optional<EndpointConnection> connect(const PointLightParams& p, const glm::vec3& ref);
 glm::vec3 power(const PointLightParams& p);  // 4π I
 
-// Spot light, LSD: I(w) = intensity · falloff(cos θ), θ from the axis. falloff is 1 inside
-// cos_falloff_start, 0 outside cos_total, and smoothstep in between (pbrt-v4's SpotLight); with
-// cos_falloff_start == cos_total the edge is hard. The edge itself (cos θ == cos_total) emits
-// nothing. Scene spot lights have a hard edge (cone_degrees is the half angle). Directions are
+// Spot light, LSD: I(w) = intensity · falloff(θ), θ from the axis. falloff is 1 inside the
+// falloff's start, 0 outside the cone, and in between either smoothstep in cos θ (pbrt-v4's
+// SpotLight) or linear in θ (`linear_in_angle`, Mitsuba 3's spot); with cos_falloff_start ==
+// cos_total the edge is hard. The edge itself (cos θ == cos_total) emits nothing. Directions are
 // sampled uniformly in the cone.
 struct SpotLightParams {
   glm::vec3 position{0.0f};
@@ -146,6 +146,7 @@ struct SpotLightParams {
   glm::vec3 intensity{1.0f};          // on the axis [W/sr]
   float cos_total = 0.5f;             // cosine of the cone's half-angle, in (−1, 1)
   float cos_falloff_start = 0.5f;     // in [cos_total, 1]
+  bool linear_in_angle = false;       // Mitsuba 3's ramp; false: pbrt-v4's smoothstep in cos θ
   static constexpr Letter kPosLetter = kS;
   static constexpr Letter kDirLetter = kD;
 };
@@ -154,7 +155,9 @@ glm::vec3 intensity(const SpotLightParams& p, const glm::vec3& direction);
 std::optional<EndpointRay> sample_ray(const SpotLightParams& p, glm::vec2 u);
 RayPdf pdf_ray(const SpotLightParams& p, const glm::vec3& direction);
 std::optional<EndpointConnection> connect(const SpotLightParams& p, const glm::vec3& ref);
-glm::vec3 power(const SpotLightParams& p);  // 2π I (1 − (cos_falloff_start + cos_total) / 2)
+// 2π I (1 − (cs + ct) / 2) for the smoothstep (cs, ct: the cosines of the falloff's start and the
+// cone), 2π I ((1 − cs) + ((θt − θs) cs − sin θt + sin θs) / (θt − θs)) for the linear ramp.
+glm::vec3 power(const SpotLightParams& p);
 
 // Distant light through an aperture, LDS: parallel light of irradiance E (measured perpendicular
 // to `direction`) entering the scene through the parallelogram corner + a·edge1 + b·edge2,

@@ -181,6 +181,10 @@ inline glm::vec3 power(const PointLightParams& p) { return p.intensity * (4.0f *
 inline float spot_falloff(const SpotLightParams& p, float cos_theta) {
   if (!(cos_theta > p.cos_total)) return 0.0f;  // the cone's boundary itself emits nothing
   if (cos_theta >= p.cos_falloff_start) return 1.0f;
+  if (p.linear_in_angle) {
+    const float total = std::acos(p.cos_total), start = std::acos(p.cos_falloff_start);
+    return std::clamp((total - std::acos(cos_theta)) / (total - start), 0.0f, 1.0f);
+  }
   const float t = (cos_theta - p.cos_total) / (p.cos_falloff_start - p.cos_total);
   return t * t * (3.0f - 2.0f * t);
 }
@@ -222,7 +226,12 @@ inline std::optional<EndpointConnection> connect(const SpotLightParams& p, const
 }
 
 inline glm::vec3 power(const SpotLightParams& p) {
-  return p.intensity * (2.0f * kPi * (1.0f - 0.5f * (p.cos_falloff_start + p.cos_total)));
+  const float cs = p.cos_falloff_start, ct = p.cos_total;
+  if (p.linear_in_angle && cs > ct) {
+    const float ts = std::acos(cs), tt = std::acos(ct);
+    return p.intensity * (2.0f * kPi * ((1.0f - cs) + ((tt - ts) * cs - std::sin(tt) + std::sin(ts)) / (tt - ts)));
+  }
+  return p.intensity * (2.0f * kPi * (1.0f - 0.5f * (cs + ct)));
 }
 
 // --- distant light through an aperture ---

@@ -70,7 +70,9 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
       l.params = PointLightParams{p->position, p->intensity};
     } else if (const auto* s = std::get_if<SpotLight>(&light)) {
       const float cos_cone = std::cos(glm::radians(s->cone_degrees));
-      l.params = SpotLightParams{s->position, s->direction, s->intensity, cos_cone, cos_cone};  // a hard edge
+      const float cos_start = s->falloff_start_degrees < 0.0f ? cos_cone : std::cos(glm::radians(s->falloff_start_degrees));
+      l.params = SpotLightParams{s->position, s->direction, s->intensity, cos_cone, std::max(cos_start, cos_cone),
+                                 s->falloff == SpotFalloff::kLinear};
     } else if (const auto* d = std::get_if<DistantLight>(&light)) {
       const DistantLightParams params{d->direction, d->irradiance, d->aperture_corner, d->aperture_edge1, d->aperture_edge2};
       l.params = params;

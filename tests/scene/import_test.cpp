@@ -374,6 +374,60 @@ TEST(ImportMitsuba, LightsKeepTheirUnitsAndPlaces) {
   expect_near(d.irradiance, glm::vec3(5), "irradiance");
 }
 
+// The environment box holds every shape, the camera and the lights, and its faces emit inwards.
+void expect_environment_box(const Scene& s, glm::vec3 radiance) {
+  ASSERT_TRUE(s.environment.has_value());
+  expect_near(*s.environment, radiance, "the environment's radiance");
+  const Shape& box = s.shapes.back();
+  expect_near(box.emission, radiance, "the box emits the environment's radiance");
+  const auto& mesh = std::get<MeshShape>(box.geometry);
+  ASSERT_EQ(mesh.positions.size(), 8u);
+  ASSERT_EQ(mesh.triangles.size(), 12u);
+  glm::vec3 lo(1e30f), hi(-1e30f);
+  for (const glm::vec3& p : mesh.positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  const glm::vec3 centre = 0.5f * (lo + hi);
+  for (const glm::uvec3& t : mesh.triangles) {  // every face's normal points at the box's centre
+    const glm::vec3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+    EXPECT_GT(glm::dot(glm::cross(b - a, c - a), centre - a), 0.0f);
+  }
+  EXPECT_TRUE(glm::all(glm::lessThan(lo, s.camera.position)) && glm::all(glm::lessThan(s.camera.position, hi)));
+  EXPECT_TRUE(std::holds_alternative<Mixture>(s.materials[static_cast<std::size_t>(box.material)]));
+  EXPECT_EQ(letters_of(s.materials[static_cast<std::size_t>(box.material)]), 0u);  // it absorbs: no letter
+  EXPECT_EQ(describe(scene_types(s)).substr(0, 11), "lights area");
+}
+
+TEST(ImportPbrt, UniformInfiniteLightAndSoftSpot) {
+  const Scene s = load(write("infinite.pbrt",
+                             "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n"
+                             "LightSource \"infinite\" \"rgb L\" [0.5 0.25 0.5] \"float scale\" 2\n"
+                             "LightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\n"
+                             "LightSource \"spot\" \"point3 from\" [0 3 0] \"point3 to\" [0 0 0] \"float coneangle\" 30 \"float conedeltaangle\" 10\n"
+                             "Shape \"sphere\"\n"));
+  expect_environment_box(s, glm::vec3(1.5f, 1.0f, 1.5f));  // two infinite lights add up
+  ASSERT_EQ(s.lights.size(), 1u);
+  const auto& spot = std::get<SpotLight>(s.lights[0]);
+  EXPECT_FLOAT_EQ(spot.cone_degrees, 30.0f);
+  EXPECT_FLOAT_EQ(spot.falloff_start_degrees, 20.0f);  // coneangle − conedeltaangle
+  EXPECT_EQ(spot.falloff, SpotFalloff::kSmoothstep);
+}
+
+TEST(ImportMitsuba, ConstantEmitterAndSoftSpot) {
+  const Scene s = load(write("constant.xml",
+                             "<scene version=\"3.0.0\"><sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/>"
+                             "<transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>"
+                             "<emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.25\"/></emitter>"
+                             "<emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"25\"/><float name=\"beam_width\" value=\"15\"/></emitter>"
+                             "<shape type=\"sphere\"/></scene>"));
+  expect_environment_box(s, glm::vec3(0.25f));
+  const auto& spot = std::get<SpotLight>(s.lights[0]);
+  EXPECT_FLOAT_EQ(spot.cone_degrees, 25.0f);
+  EXPECT_FLOAT_EQ(spot.falloff_start_degrees, 15.0f);
+  EXPECT_EQ(spot.falloff, SpotFalloff::kLinear);
+}
+
 // --- refusals: located, exact ---
 
 struct Refusal {
@@ -408,8 +462,10 @@ std::vector<Refusal> refusals() {
       {"cylinder.pbrt", "Shape \"cylinder\" \"float phimax\" 180\n", "cylinder.pbrt:4:18", "partial cylinders (phimax) are not supported"},
       {"coated.pbrt", "Material \"coateddiffuse\"\n", "coated.pbrt:4:1",
        "material \"coateddiffuse\" is not supported, expected diffuse, conductor, dielectric or mix"},
-      {"infinite.pbrt", "LightSource \"infinite\" \"rgb L\" [1 1 1]\n", "infinite.pbrt:4:1",
-       "light \"infinite\" is not supported, expected point, spot, distant or an AreaLightSource"},
+      {"infinite.pbrt", "LightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "infinite.pbrt:4:24",
+       "an image infinite light (filename) is not supported: pathex renders a uniform infinite light (\"rgb L\") only"},
+      {"goniometric.pbrt", "LightSource \"goniometric\"\n", "goniometric.pbrt:4:1",
+       "light \"goniometric\" is not supported, expected point, spot, distant, infinite or an AreaLightSource"},
       {"zmin.pbrt", "Shape \"sphere\" \"float zmin\" -0.5\n", "zmin.pbrt:4:16", "partial spheres (zmin) are not supported"},
       {"typo.pbrt", "Shape \"sphere\" \"float radiu\" 2\n", "typo.pbrt:4:16", "parameter \"float radiu\" of Shape \"sphere\" is not supported"},
       {"rough-glass.pbrt", "Material \"dielectric\" \"float roughness\" 0.1\n", "rough-glass.pbrt:4:1",
@@ -418,8 +474,6 @@ std::vector<Refusal> refusals() {
        "parameter \"blackbody I\" is not supported: pathex renders in RGB, give \"rgb I\" [r g b]"},
       {"texture.pbrt", "Material \"diffuse\" \"texture reflectance\" \"checks\"\n", "texture.pbrt:4:20",
        "textures are not supported (parameter \"texture reflectance\"), give \"rgb reflectance\" [r g b]"},
-      {"soft-spot.pbrt", "LightSource \"spot\" \"rgb I\" [1 1 1]\n", "soft-spot.pbrt:4:1",
-       "a spot light with a soft edge (conedeltaangle 5) is not supported: pathex's spot has a hard edge, set conedeltaangle 0"},
       {"normals.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1 0 0 1 0 0 1]\n", "normals.pbrt:4:53",
        "per-vertex normals and tangents (N) are not supported: pathex shades meshes with their face normals"},
       {"include.pbrt", "Include \"missing.pbrt\"\n", "include.pbrt:4:1", "cannot open the included file 'missing.pbrt'"},
@@ -452,7 +506,9 @@ std::vector<Refusal> refusals() {
       {"curve.xml", "  <shape type=\"bsplinecurve\"/>\n</scene>\n", "curve.xml:2:3",
        "shape \"bsplinecurve\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder"},
       {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",
-       "emitter \"envmap\" is not supported, expected point, spot, directional, or area inside a shape"},
+       "emitter \"envmap\" (an image infinite light) is not supported: pathex renders a uniform infinite light (constant) only"},
+      {"projector.xml", "  <emitter type=\"projector\"/>\n</scene>\n", "projector.xml:2:3",
+       "emitter \"projector\" is not supported, expected point, spot, directional, constant, or area inside a shape"},
       {"plastic.xml", "  <bsdf type=\"plastic\" id=\"unused\"/>\n</scene>\n", "plastic.xml:2:3",
        "bsdf \"plastic\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, blendbsdf or twosided"},
       {"medium.xml", "  <medium type=\"homogeneous\"/>\n</scene>\n", "medium.xml:2:3",
@@ -469,9 +525,8 @@ std::vector<Refusal> refusals() {
       {"smooth.xml", "  <shape type=\"obj\">\n    <string name=\"filename\" value=\"x.obj\"/>\n  </shape>\n</scene>\n", "smooth.xml:2:3",
        "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face "
        "normals (add <boolean name=\"face_normals\" value=\"true\"/>)"},
-      {"soft-spot.xml", "  <emitter type=\"spot\"/>\n</scene>\n", "soft-spot.xml:2:3",
-       "a spot light with a soft edge (beam_width < cutoff_angle) is not supported: pathex's spot has a hard edge, set beam_width equal to "
-       "cutoff_angle"},
+      {"wide-beam.xml", "  <emitter type=\"spot\">\n    <float name=\"beam_width\" value=\"30\"/>\n  </emitter>\n</scene>\n", "wide-beam.xml:2:3",
+       "beam_width must be within [0, cutoff_angle]"},
       {"param.xml", "  <shape type=\"sphere\">\n    <float name=\"radius\" value=\"$r\"/>\n  </shape>\n</scene>\n", "param.xml:3:5",
        "unknown parameter $r (no <default name=\"r\">)"},
       {"broken.xml", "  <shape type=\"sphere\">\n</scene>\n", "broken.xml:3:3", "not valid XML: Start-end tags mismatch"},

@@ -244,6 +244,7 @@ TEST(SampleScenes, TypesAndUniverses) {
       {"spotmeter-caustic.json", {LightType::kPoint}, SensorType::kSpotmeter, sd, "LSD[SD]*SSE"},
       {"point-glass.json", {LightType::kPoint}, SensorType::kPinhole, sd, "LSD[SD]*DSE"},
       {"sun-window.json", {LightType::kDistant}, SensorType::kPinhole, d, "LDSD*DSE"},
+      {"sky-glass.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // the sky is an area light
       {"laser.json", {LightType::kLaser}, SensorType::kPinhole, sd, "LSS[SD]*DSE"},
       {"closed-sphere-point.json", {LightType::kPoint}, SensorType::kPinhole, d, "LSDD*DSE"},
       {"closed-sphere-emitting.json", {LightType::kArea}, SensorType::kPinhole, d, "LDDD*DSE"},

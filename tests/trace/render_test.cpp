@@ -214,6 +214,80 @@ TEST(ClosedForm, SpotLightOverAPlaneIsThePointLightInsideItsCone) {
   }
 }
 
+// Soft-edged spot lights, with the falloff of each source renderer: pbrt-v4's smoothstep in cos θ
+// (coneangle 60°, conedeltaangle 50°) and Mitsuba 3's ramp linear in θ (cutoff_angle 60°,
+// beam_width 10°). The floor's radiance is the point light's times the falloff; the falloff is
+// written here from its definition, not from emitters.h. The two falloffs differ by 20 % here
+// (about 40 bdpt standard errors), so a spot that took one for the other fails. Class LSD D DSE.
+TEST(ClosedForm, SoftSpotLightsFallOffAsTheirRenderersDefine) {
+  const double rho = 0.6, intensity = 2.0, h = 1.0, total = 60.0 * kPi / 180.0, start = 10.0 * kPi / 180.0;
+  for (const char* falloff : {"smoothstep", "linear"}) {
+    const std::string scene = std::string("{") + kFloorCamera + R"(,
+      "materials": {"plane": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+      "shapes": [{"type": "quad", "corner": [-100, 0, 100], "edge1": [200, 0, 0], "edge2": [0, 0, -200], "material": "plane"}],
+      "lights": [{"type": "spot", "position": [0.3, 1, 0], "direction": [0, -1, 0], "cone": 60, "falloff_start": 10,
+                  "falloff": ")" + std::string(falloff) + R"(", "intensity": [2, 2, 2]}]})";
+    const bool linear = std::string(falloff) == "linear";
+    const double expected = floor_reference([&](const glm::dvec3& p) {
+      const double dx = p.x - 0.3, d2 = dx * dx + h * h + p.z * p.z, cos_theta = h / std::sqrt(d2);
+      const double theta = std::acos(cos_theta);
+      double f = 0.0;
+      if (theta < start) {
+        f = 1.0;
+      } else if (theta < total) {
+        if (linear) {
+          f = (total - theta) / (total - start);
+        } else {
+          const double t = (cos_theta - std::cos(total)) / (std::cos(start) - std::cos(total));
+          f = t * t * (3.0 - 2.0 * t);
+        }
+      }
+      return rho * intensity * f * cos_theta / (kPi * d2);
+    });
+    ASSERT_GT(expected, 0.0);
+    for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
+      Rendered r = render_json(scene, renderer, {"LSDDDSE"}, 256);
+      EXPECT_EQ(r.report.nonfinite_samples, 0u);
+      expect_close(r.report.classes[0].estimate, expected, 3.0, 0.005, std::string(renderer) + " " + falloff + " spot");
+    }
+  }
+}
+
+// A uniform infinite light of radiance L (DESIGN §1: letters LDD, an area light) over a diffuse
+// sphere of albedo rho: the sphere is convex, so each of its points sees only the light, and its
+// radiance is rho L everywhere (the furnace). The camera's whole view is on the sphere, so every
+// pixel is rho L in class L DD D DS E and there is nothing else. Every renderer must agree.
+TEST(ClosedForm, UniformInfiniteLightOverADiffuseSphereIsTheFurnace) {
+  const double rho = 0.7, radiance = 1.5;
+  const std::string scene = R"({"camera": {"type": "pinhole", "position": [0, 0, -3], "look_at": [0, 0, 0], "up": [0, 1, 0],
+                                  "fov": 20, "width": 6, "height": 6},
+    "materials": {"ball": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "ball"}],
+    "lights": [{"type": "environment", "radiance": [1.5, 1.5, 1.5]}]})";
+  for (const char* renderer : {"pt", "pt-nee", "lt", "bdpt"}) {
+    Rendered r = render_json(scene, renderer, {"LDDDDSE", "L.*E"}, 256);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    expect_close(r.report.classes[0].estimate, rho * radiance, 3.0, 0.005, std::string(renderer) + " furnace");
+    expect_close(r.report.classes[1].estimate, rho * radiance, 3.0, 0.005, std::string(renderer) + " furnace, every path");
+  }
+}
+
+// The same light seen directly: a camera that looks away from the only shape sees L in every pixel
+// (class L DD DS E), and a second environment entry adds its radiance.
+TEST(ClosedForm, UniformInfiniteLightSeenDirectlyIsItsRadiance) {
+  const std::string scene = R"({"camera": {"type": "pinhole", "position": [0, 0, -3], "look_at": [0, 0, -6], "up": [0, 1, 0],
+                                  "fov": 60, "width": 6, "height": 6},
+    "materials": {"ball": {"type": "diffuse", "albedo": [0.7, 0.7, 0.7]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "ball"}],
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}, {"type": "environment", "radiance": [0.5, 0.5, 0.5]}]})";
+  for (const char* renderer : {"pt", "pt-nee"}) {  // one strategy: the eye ray's hit, exactly L
+    Rendered r = render_json(scene, renderer, {"LDDDSE"}, 16);
+    expect_close(r.report.classes[0].estimate, 1.5, 0.0, 1e-5, std::string(renderer) + " environment seen directly");
+  }
+  Rendered r = render_json(scene, "bdpt", {"LDDDSE"}, 64);  // the hit weighed against the camera join
+  expect_close(r.report.classes[0].estimate, 1.5, 3.0, 0.005, "bdpt environment seen directly");
+}
+
 // DESIGN §9: a planar mirror of reflectance R throws a caustic that is the floor lit by the
 // light's mirror image with intensity R I. Light at height 1, a large mirror facing down at
 // height 2 (image light at height 3), the camera below the mirror. Class LSD S D DSE, which
