@@ -215,6 +215,15 @@ TEST(PlyReader, FacesBeforeVerticesAndCrlfHeaderLines) {
   EXPECT_EQ(m->positions[2], glm::vec3(0, 1, 0));
 }
 
+TEST(PlyReader, ACountIsItsValueWhateverItsLeadingZeros) {
+  const std::string bytes = "ply\nformat ascii 1.0\nelement vertex 0000000000000000000000003\nproperty float x\nproperty float y\n"
+                            "property float z\nelement face 01\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  Result<PlyMesh> m = parse(bytes);
+  ASSERT_TRUE(m.ok()) << m.error().render();
+  EXPECT_EQ(m->positions.size(), 3u);
+  EXPECT_EQ(m->faces.size(), 1u);
+}
+
 // Debian 12's assimp 5.2.5 skipped whitespace after end_header, so a binary file whose data starts
 // with 0x0a (or 0x0d 0x0a) lost its first bytes and read as "a vertex that is not finite".
 TEST(PlyReader, BinaryDataStartingWithANewlineByteReadsExactly) {
