@@ -176,6 +176,7 @@ Command add_bias(CLI::App& app) {
   sub->add_flag("--quiet", args->quiet, "No progress bar");
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs (the numbers are the same)");
   add_limit_options(sub, &args->options.limits);
+  add_scene_limit_options(sub, &args->options.limits);
   return {sub, [args] { return run(*args); }};
 }
 

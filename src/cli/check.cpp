@@ -465,6 +465,7 @@ Command add_check(CLI::App& app) {
   sub->add_flag("--json", args->json, "Machine-readable report");
   sub->add_option("--junit", args->junit, "Also write a JUnit XML report here");
   add_limit_options(sub, &args->limits);
+  add_scene_limit_options(sub, &args->limits);
   return {sub, [args] { return run(*args); }};
 }
 

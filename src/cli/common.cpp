@@ -88,6 +88,9 @@ void add_limit_options(CLI::App* app, Limits* limits) {
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxWorkCeiling))->group("Limits");
   app->add_option("--max-file-size", limits->max_file_bytes, "Largest input file read (class, profile, check, scene, mesh), bytes")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxFileBytesCeiling))->group("Limits");
+}
+
+void add_scene_limit_options(CLI::App* app, Limits* limits) {
   app->add_option("--max-scene-size", limits->max_scene_bytes, "Largest scene text read, the files it includes counted in, bytes")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxSceneBytesCeiling))->group("Limits");
   app->add_option("--max-scene-depth", limits->max_scene_depth, "Deepest nesting of a scene's materials (Mitsuba's nested BSDFs)")

@@ -32,6 +32,9 @@ struct NotationOptions {
 };
 
 void add_limit_options(CLI::App* app, Limits* limits);
+// The limits of an imported scene (--max-scene-size, --max-scene-depth, --max-material-nodes,
+// --max-mesh-elements), for the commands that read scenes.
+void add_scene_limit_options(CLI::App* app, Limits* limits);
 // Refuses a value with a minus sign: CLI11 reads "-1" into an unsigned option as 2^64 - 1.
 const CLI::Validator& non_negative();
 void add_notation_options(CLI::App* app, NotationOptions* n);

@@ -853,6 +853,7 @@ Command add_converge(CLI::App& app) {
   sub->add_flag("--json", args->json, "Print converge.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress lines");
   add_limit_options(sub, &args->limits);
+  add_scene_limit_options(sub, &args->limits);
   return {sub, [args] { return run(*args); }};
 }
 

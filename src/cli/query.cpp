@@ -148,6 +148,7 @@ Command add_query(CLI::App& app) {
   sub->add_flag("--json", args->json, "An array with one object per expression and renderer");
   add_notation_options(sub, &args->notation);
   add_limit_options(sub, &args->limits);
+  add_scene_limit_options(sub, &args->limits);
   return {sub, [args] { return run(*args); }};
 }
 

@@ -616,6 +616,7 @@ Command add_trace(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   add_manifold_options(sub, &args->manifold);
   add_limit_options(sub, &args->limits);
+  add_scene_limit_options(sub, &args->limits);
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
                                   "--resolution", "--max-paths", "--sampler", "--rr-depth", "--rr-threshold"})

@@ -200,7 +200,7 @@ TEST(Issue17Inputs, ObjFacesHaveACornerLimit) {
   const CliRun r = pathex({"query", "--scene", scratch("big-face.json").string(), "L.*E"});
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "pathex: error: " + scratch("big-face.obj").string() +
-                       ":2001: a face of 200000 corners exceeds the limit of 1024 (split or triangulate it in the modeller)\n");
+                       ":2001:1: a face of 200000 corners exceeds the limit of 1024 (split or triangulate it in the modeller)\n");
 }
 
 // `query --scene` and `check` need the scene's types, not its triangles: the meshes keep their
