@@ -103,4 +103,22 @@ inline void render_tiny(Scene scene, int max_bounces) {
   if (out && out->histogram.nonfinite() != 0) finding("a non-finite sample");
 }
 
+// An imported scene (pbrt-v4, Mitsuba 3): the bytes become `name` (its extension picks the
+// format) in the scratch folder beside links to the sample scenes' include/ and meshes/ (so the
+// seeds' includes and PLY meshes resolve), loaded under small limits; a refusal must carry a
+// message of at most 16 KiB (echoed tokens are cut by excerpt(), file names past PATH_MAX too),
+// and a scene that loads is rendered tiny.
+inline int fuzz_scene_file(const std::uint8_t* data, std::size_t size, const std::string& name) {
+  link_sample_folders();
+  const std::string path = write_scratch(name, as_text(data, size));
+  Result<Scene> scene = load_scene_file(path, small_scene_options());
+  if (!scene) {
+    if (scene.error().message.empty()) finding("an error without a message");
+    if (scene.error().message.size() + scene.error().where.size() > 16384) finding("a message of more than 16 KiB");
+    return 0;
+  }
+  render_tiny(std::move(*scene), 4);
+  return 0;
+}
+
 }  // namespace pathex::fuzz

@@ -851,11 +851,7 @@ class Importer {
           return std::nullopt;
         }
       }
-      for (vec3& p : mesh.positions) p = import::apply_point(m, p);
-      if (flip)
-        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
-      s.geometry = std::move(mesh);
-      builder_.add_shape(std::move(s));
+      add_mesh(std::move(s), std::move(mesh), m, flip);
       return std::nullopt;
     }
     if (type == "cylinder") {  // a tessellated tube (import::tube_mesh)
@@ -867,14 +863,19 @@ class Importer {
       if (!(radius > 0)) return located(at, "radius must be positive");
       if (zmin == zmax) return located(at, "a cylinder of zero height (zmin equals zmax)");
       MeshShape mesh = import::tube_mesh(static_cast<float>(radius), static_cast<float>(std::min(zmin, zmax)), static_cast<float>(std::max(zmin, zmax)));
-      for (vec3& p : mesh.positions) p = import::apply_point(m, p);
-      if (flip)
-        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
-      s.geometry = std::move(mesh);
-      builder_.add_shape(std::move(s));
+      add_mesh(std::move(s), std::move(mesh), m, flip);
       return std::nullopt;
     }
     return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder");
+  }
+
+  // A mesh in object space, placed by `m` and wound so its front side is pbrt's (`flip`).
+  void add_mesh(Shape s, MeshShape mesh, const glm::mat4& m, bool flip) {
+    for (vec3& p : mesh.positions) p = import::apply_point(m, p);
+    if (flip)
+      for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+    s.geometry = std::move(mesh);
+    builder_.add_shape(std::move(s));
   }
 
   // --- the camera, once the film is known ---

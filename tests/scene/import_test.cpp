@@ -14,6 +14,7 @@
 #include "io/profile_json.h"
 #include "scene/scene.h"
 #include "support/cli_run.h"
+#include "support/scratch_files.h"
 #include "trace/render.h"
 
 namespace pathex {
@@ -22,23 +23,9 @@ namespace {
 const std::string kDir = PATHEX_SOURCE_DIR;
 const std::string kScenes = kDir + "/samples/scenes/";
 
-// Inline scenes go to the test process's scratch folder; locations in errors are shown relative to it.
-const std::string& scratch() {
-  static const std::string dir = pathex::test::scratch_dir().string();
-  return dir;
-}
-
-std::string write(const std::string& name, const std::string& text) {
-  const std::string path = scratch() + "/" + name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
-std::string relative(std::string s) {
-  for (const std::string& prefix : {scratch() + "/", kDir + "/"})
-    for (std::size_t at; (at = s.find(prefix)) != std::string::npos;) s.erase(at, prefix.size());
-  return s;
-}
+using test::relative;
+using test::scratch;
+using test::write;
 
 Scene load(const std::string& path) {
   Result<Scene> s = load_scene_file(path);

@@ -19,28 +19,16 @@
 #include "scene/ply.h"
 #include "scene/scene.h"
 #include "support/cli_run.h"
+#include "support/scratch_files.h"
 
 namespace pathex {
 namespace {
 
 const std::string kDir = PATHEX_SOURCE_DIR;
 
-const std::string& scratch() {
-  static const std::string dir = pathex::test::scratch_dir().string();
-  return dir;
-}
-
-std::string write(const std::string& name, const std::string& bytes) {
-  const std::string path = scratch() + "/" + name;
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
-}
-
-std::string relative(std::string s) {
-  for (const std::string& prefix : {scratch() + "/", kDir + "/"})
-    for (std::size_t at; (at = s.find(prefix)) != std::string::npos;) s.erase(at, prefix.size());
-  return s;
-}
+using test::relative;
+using test::scratch;
+using test::write;
 
 // --- writing PLY files ---
 
