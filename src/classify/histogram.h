@@ -71,7 +71,8 @@ using ExactRgb = std::array<ExactSum, 3>;
 
 inline constexpr int kFractionBits = 64;
 inline constexpr double kMaxContribution = 0x1p50;  // |c| ≥ this counts as non-finite
-inline constexpr int kDefaultBatches = 32;
+inline constexpr int kDefaultBatches = 32;       // the independent sampler's (trace/render.h, default_batches())
+inline constexpr int kDefaultSobolBatches = 32;  // the sobol sampler's
 
 // Rec. 709 luminance.
 inline double luminance(const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
