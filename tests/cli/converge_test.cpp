@@ -145,7 +145,10 @@ TEST(Converge, ReferenceRunIsWrittenAndReadBack) {
   const std::string first = out_dir("run"), second = out_dir("file");
   CliRun r = run_pathex("converge samples/scenes/point-plane.json --renderer pt-nee --spp 4,16 --resolution 8x8 --quiet --out " + first);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("reference: run (a reference run of pt-nee at 64 spp"), std::string::npos) << r.out;
+  // The default reference renderer is pathex bias's (bdpt plus the connectors the scene needs), not
+  // the first --renderer.
+  EXPECT_NE(r.out.find("reference: run (a reference run of bdpt"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" at 64 spp"), std::string::npos) << r.out;
   ASSERT_TRUE(std::filesystem::exists(first + "/reference.json"));
   ASSERT_TRUE(std::filesystem::exists(first + "/reference.exr"));
   r = run_pathex("converge samples/scenes/point-plane.json --renderer bdpt --spp 4,16 --resolution 8x8 --json --out " + second +
@@ -155,6 +158,46 @@ TEST(Converge, ReferenceRunIsWrittenAndReadBack) {
   EXPECT_EQ(j.at("reference").at("kind"), "file");
   EXPECT_EQ(j.at("reference").at("classes").at(0).at("per_pixel"), true);
   EXPECT_FALSE(j.at("renderers").at(0).at("classes").at(0).at("rungs").at(0).at("rms_pixel_error").is_null());
+}
+
+// Issue 36: on point-glass (a point light's caustic through a glass sphere) pt-nee cannot sample
+// the caustic. The default reference samples everything the ladder's renderers sample, so every
+// class is measurable, and pt-nee is never ranked on a class holding a path it cannot sample. With
+// pt-nee as the reference, the classes holding paths bdpt samples and pt-nee cannot are "not
+// measurable with this reference": no error, no z, no ranking against it.
+TEST(Converge, ReferencesSeeWhatTheyJudgeAndNoRendererIsRankedOnWhatItCannotSample) {
+  const std::string dir = out_dir("reach"), dir2 = out_dir("reach-pt-nee");
+  CliRun r = run_pathex("converge samples/scenes/point-glass.json --renderer pt-nee --renderer bdpt --spp 4,16 --resolution 8x8 "
+                        "--json --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  const std::string ref_name = j.at("reference").at("run").at("renderer");
+  EXPECT_EQ(ref_name.rfind("bdpt+", 0), 0u) << ref_name;
+  for (const auto& c : j.at("reference").at("classes")) EXPECT_EQ(c.at("measurable"), true) << c.dump();
+  const auto& pt_nee = j.at("renderers").at(0);
+  ASSERT_EQ(pt_nee.at("name"), "pt-nee");
+  ASSERT_EQ(pt_nee.at("classes").at(0).at("name"), "total");
+  EXPECT_TRUE(pt_nee.at("classes").at(0).at("cannot_sample").is_string());  // the caustic's paths
+  std::size_t ranked_classes = 0;
+  for (const auto& b : j.at("best")) {
+    ++ranked_classes;
+    for (const auto& c : j.at("renderers"))
+      if (c.at("name") == b.at("renderer"))
+        for (const auto& cc : c.at("classes"))
+          if (cc.at("name") == b.at("class")) EXPECT_TRUE(cc.at("cannot_sample").is_null()) << b.dump();
+    EXPECT_NE(b.at("class"), "total") << "pt-nee and bdpt both miss light of the total that the reference samples";
+  }
+  EXPECT_GE(ranked_classes, 1u);  // bdpt on "local" (L.*DD.*E)
+  // The first --renderer as the reference: the classes it cannot see are not measurable.
+  r = run_pathex("converge samples/scenes/point-glass.json --renderer pt-nee --renderer bdpt --spp 4,16 --resolution 8x8 "
+                 "--reference-renderer pt-nee --quiet --out " + dir2);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("class total $all: reference not measurable with this reference (pt-nee cannot sample LS"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("  total: not measurable with this reference (pt-nee cannot sample LS"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("sigma off"), std::string::npos) << "no error is measured against a reference that cannot see the class:\n"
+                                                         << r.out;
+  EXPECT_EQ(r.out.find("x pt-nee's"), std::string::npos) << r.out;
 }
 
 // --only measures the requested classes alone (as pathex trace --only): the table and
