@@ -404,6 +404,10 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
                                                   : "a stderr of 0 with an error of " + fmt(s.error[static_cast<std::size_t>(s.check.max_z_rung)], "%.3g")) +
                 " at " + at.budget.text();
   }
+  if (s.check.too_large)
+    s.warning += std::string(s.warning.empty() ? "" : "; ") + "the reported stderr is larger than the true error: chi2 " +
+                 fmt(s.check.lower_chi2, "%.3g") + " over " + std::to_string(s.check.lower_dof) + " rungs (below " +
+                 fmt(s.check.lower_limit, "%.3g") + ", the lower limit at p = 0.001): the error bars overstate the error";
   if (s.check.unstable)
     s.warning += std::string(s.warning.empty() ? "" : "; ") + "the stderr is unstable: its batch variance has a relative error of " +
                  fmt(s.check.stability, "%.2f") + " (limit " + fmt(kUnstableVariance, "%.2f") + "): a few batches carry the estimate";
@@ -797,8 +801,10 @@ int run(const ConvergeArgs& a) {
                     {"cannot_sample", cannot[k][i] ? nlohmann::ordered_json(*cannot[k][i]) : nlohmann::ordered_json(nullptr)},
                     {"stderr_check",
                      {{"chi2", number_or_null(s.check.chi2)}, {"dof", s.check.dof}, {"limit", s.check.limit},
+                      {"lower_chi2", number_or_null(s.check.lower_chi2)}, {"lower_dof", s.check.lower_dof},
+                      {"lower_limit", s.check.lower_limit},
                       {"max_abs_z", number_or_null(s.check.max_abs_z)}, {"stability", number_or_null(s.check.stability)},
-                      {"disagrees", s.check.disagrees}, {"unstable", s.check.unstable}}},
+                      {"disagrees", s.check.disagrees}, {"too_large", s.check.too_large}, {"unstable", s.check.unstable}}},
                     {"warning", s.warning.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.warning)}});
     }
     jren.push_back({{"name", profiles[k].name}, {"nonfinite_samples", nonfinite}, {"classes", jc}});
