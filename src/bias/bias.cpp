@@ -65,6 +65,14 @@ Result<int> reference_bound(const std::string& renderer, std::optional<int> rend
                   std::max(kDefaultReferenceBounces, renderer_bound ? *renderer_bound + kReferenceExtraBounces : 0));
 }
 
+Dfa reference_scope(const Scene& scene, int bound) {
+  return dfa_intersect(scene_universe(scene_types(scene)), dfa_universe_bounded(bound));
+}
+
+std::optional<std::string> first_unsampled(const Dfa& reachable, const Dfa& scope, const Dfa& language) {
+  return shortest_member(dfa_difference(dfa_intersect(language, scope), reachable));
+}
+
 Result<Profile> choose_reference(const std::string& name_or_path, const Scene& scene, const Profile& renderer,
                                  const BiasOptions& o) {
   Result<Profile> ref = [&]() -> Result<Profile> {
@@ -111,7 +119,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
   if (!r) return r.error();
   Result<CompiledProfile> ref = compile_profile(reference, *bound, o.limits);
   if (!ref) return ref.error();
-  const Dfa scope = dfa_intersect(scene_universe(scene_types(scene)), dfa_universe_bounded(*bound));
+  const Dfa scope = reference_scope(scene, *bound);
   const Dfa missed = dfa_difference(scope, r->reachable);
   const Dfa neither = dfa_difference(missed, ref->reachable);
 

@@ -56,6 +56,15 @@ Result<Profile> default_reference(const Dfa& universe, int bound, const Limits& 
 Result<int> reference_bound(const std::string& renderer, std::optional<int> renderer_bound,
                             std::optional<int> requested);
 
+// What a reference is judged on: the paths of the scene's universe with at most `bound` interior
+// vertices (U_s ∩ U_{≤B} above).
+Dfa reference_scope(const Scene& scene, int bound);
+
+// The shortest path of `language` within `scope` outside `reachable` (a profile's, CompiledProfile),
+// or nothing when the profile samples every one (then its estimate of `language` is unbiased;
+// otherwise it may miss light there).
+std::optional<std::string> first_unsampled(const Dfa& reachable, const Dfa& scope, const Dfa& language);
+
 struct BiasOptions;
 // The reference for `renderer` in `scene`: `name_or_path` (a built-in name or a profile file), or
 // default_reference() when it is empty. Fails (kUsage) when the tracer cannot run it.

@@ -103,6 +103,10 @@ StderrCheck check_stderr(const std::vector<RungError>& rungs, double reference, 
     else if (err > 0.0) z = std::numeric_limits<double>::infinity();  // a zero stderr, a zero reference, an error
     c.chi2 += z * z;
     ++c.dof;
+    if (r.std_error > rounding) {
+      c.lower_chi2 += z * z;
+      ++c.lower_dof;
+    }
     if (z > c.max_abs_z || c.max_z_rung < 0) {
       c.max_abs_z = z;
       c.max_z_rung = static_cast<int>(i);
@@ -110,6 +114,8 @@ StderrCheck check_stderr(const std::vector<RungError>& rungs, double reference, 
   }
   c.limit = c.dof > 0 ? chi2_upper_quantile(c.dof, kStderrCheckAlpha) : 0.0;
   c.disagrees = c.dof > 0 && c.chi2 > c.limit;
+  c.lower_limit = c.lower_dof > 0 ? chi2_upper_quantile(c.lower_dof, 1.0 - kStderrCheckAlpha) : 0.0;
+  c.too_large = c.lower_dof > 0 && c.lower_chi2 < c.lower_limit;
   c.stability = median(stabilities);
   c.unstable = std::isfinite(c.stability) && c.stability >= kUnstableVariance;
   return c;

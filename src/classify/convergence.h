@@ -10,8 +10,10 @@
 //
 // is close to a standard normal variable, independent across rungs, and Σ z_i² follows a χ²
 // distribution with n degrees of freedom. The first check flags a ladder whose Σ z_i² exceeds the
-// χ²_n quantile at 1 − kStderrCheckAlpha: the estimates are further from the reference than
-// their error bars allow (a renderer that misses a near-delta peak reports a tiny stderr while it
+// χ²_n quantile at 1 − kStderrCheckAlpha, or falls below its quantile at kStderrCheckAlpha (the
+// lower tail: the estimates are closer to the reference than their error bars allow, a stderr
+// that overstates the error, as one computed from correlated batches did; issue 36). Upper: the
+// estimates are further from the reference than their error bars allow (a renderer that misses a near-delta peak reports a tiny stderr while it
 // is many σ off). A rung whose reported stderr is 0 while its error is not counts as infinitely
 // far off. The tracer computes in single precision, so an error below kRoundingFloor of the
 // reference is rounding, not noise: σ_i² gets (kRoundingFloor · R)² added (an estimator with no
@@ -65,12 +67,19 @@ struct StderrCheck {
   double chi2 = 0.0;        // Σ z_i² over the rungs with a stderr
   int dof = 0;              // how many
   double limit = 0.0;       // chi2_upper_quantile(dof, kStderrCheckAlpha)
+  // The lower tail counts only the rungs whose stderr is above the rounding floor (an exact
+  // estimator's error of 0 is no sign of an overstated stderr): their Σ z_i², how many, and
+  // chi2_upper_quantile(lower_dof, 1 − kStderrCheckAlpha).
+  double lower_chi2 = 0.0;
+  int lower_dof = 0;
+  double lower_limit = 0.0;
   double max_abs_z = 0.0;   // the largest |z_i| (inf: a zero stderr with a nonzero error)
   int max_z_rung = -1;
   double stability = 0.0;   // median ε over the rungs (NaN: unknown)
-  bool disagrees = false;   // chi2 > limit
+  bool disagrees = false;   // chi2 > limit: the stderr understates the error
+  bool too_large = false;   // lower_chi2 < lower_limit: the stderr overstates the error
   bool unstable = false;    // stability ≥ kUnstableVariance
-  bool lies() const { return disagrees || unstable; }
+  bool lies() const { return disagrees || too_large || unstable; }
 };
 
 // Both checks over one ladder against a reference value R ± reference_stderr.

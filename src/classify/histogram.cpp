@@ -353,6 +353,18 @@ class TechniqueTables {
     }
     std::vector<TechniqueEstimate> out;
     out.reserve(entries.size());
+    // Each technique's own batch-means variance, and the sum of them all.
+    std::vector<std::vector<double>> deviations;
+    std::vector<double> own;
+    double own_sum = 0;
+    for (int e : entries) {
+      deviations.push_back(batch_deviations(batch_sums(e), n));
+      double v = 0;
+      for (double d : deviations.back()) v += d * d;
+      own.push_back(v);
+      own_sum += v;
+    }
+    std::size_t k = 0;
     for (int e : entries) {
       const std::vector<ExactSum> sums = batch_sums(e);
       ExactSum sum = 0;
@@ -362,12 +374,17 @@ class TechniqueTables {
       te.name = Technique::from_code(key.code).name(h_.layout(), key.chain);
       te.share = lum != 0 ? to_double(sum) / lum : 0.0;
       te.samples = contributions_[static_cast<std::size_t>(e)];
-      if (nonempty >= 2 && variance > 0) {
-        const std::vector<double> dt = batch_deviations(sums, n);
-        double covariance = 0;
-        for (std::size_t b = 0; b < dt.size(); ++b) covariance += dt[b] * dw[b];
-        te.variance_share = covariance / variance;
+      if (nonempty >= 2 && variance > 0 && own_sum > 0) {
+        const std::vector<double>& dt = deviations[k];
+        te.variance_share = own[k] / own_sum;
+        double covariance = 0, rest = 0;  // with the rest of the whole: dw − dt
+        for (std::size_t b = 0; b < dt.size(); ++b) {
+          covariance += dt[b] * (dw[b] - dt[b]);
+          rest += (dw[b] - dt[b]) * (dw[b] - dt[b]);
+        }
+        if (own[k] > 0 && rest > 0) te.correlation = std::clamp(covariance / std::sqrt(own[k] * rest), -1.0, 1.0);
       }
+      ++k;
       out.push_back(std::move(te));
     }
     return out;

@@ -71,7 +71,8 @@ using ExactRgb = std::array<ExactSum, 3>;
 
 inline constexpr int kFractionBits = 64;
 inline constexpr double kMaxContribution = 0x1p50;  // |c| ≥ this counts as non-finite
-inline constexpr int kDefaultBatches = 32;
+inline constexpr int kDefaultBatches = 32;       // the independent sampler's (trace/render.h, default_batches())
+inline constexpr int kDefaultSobolBatches = 32;  // the sobol sampler's
 
 // Rec. 709 luminance.
 inline double luminance(const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
@@ -385,15 +386,21 @@ struct TechniqueEstimate {
   std::string name;           // Technique::name()
   double share = 0;           // its luminance / the luminance of the whole (0 when that is 0)
   std::uint64_t samples = 0;  // its nonzero contributions
-  // Its part of the whole's variance by batch means: Σ_b (S_tb − n_b X̄_t)(S_b − n_b X̄) over
-  // Σ_b (S_b − n_b X̄)², the covariance of its batch estimates with the whole's, over the
-  // whole's variance. The parts of all techniques sum to 1 (a part may be negative when
-  // techniques are anticorrelated). NaN when the whole has no standard error.
+  // Its own share of the variance by batch means: v_t = Σ_b (S_tb − n_b X̄_t)², its batch
+  // estimates' own variance, over Σ_t v_t of the whole's techniques: ≥ 0, and the shares of a
+  // whole sum to 1, like the luminance shares (issue 36: the covariance share it replaced read as
+  // a negative share). NaN when the whole has no standard error.
   double variance_share = std::numeric_limits<double>::quiet_NaN();
-  // Equal values (two NaN variance shares are equal: both unknown).
+  // Where covariance matters: the correlation, over the batches, of its estimates with the rest
+  // of the whole's (the sum of the other techniques'): negative when their errors partly cancel
+  // (the whole's variance is then below the sum of its techniques'), positive when they add up.
+  // NaN when it alone carries the whole or either side has no variance.
+  double correlation = std::numeric_limits<double>::quiet_NaN();
+  // Equal values (two NaN values are equal: both unknown).
   bool operator==(const TechniqueEstimate& o) const {
-    return name == o.name && share == o.share && samples == o.samples &&
-           (variance_share == o.variance_share || (std::isnan(variance_share) && std::isnan(o.variance_share)));
+    const auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+    return name == o.name && share == o.share && samples == o.samples && same(variance_share, o.variance_share) &&
+           same(correlation, o.correlation);
   }
 };
 

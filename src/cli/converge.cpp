@@ -33,6 +33,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "automata/ops.h"
+#include "bias/bias.h"
 #include "classify/convergence.h"
 #include "cli/common.h"
 #include "cli/converge_plot.h"
@@ -125,6 +127,9 @@ struct ClassRow {
   std::optional<double> reference;         // image mean luminance
   double reference_stderr = 0.0;           // 0 for a closed form
   std::optional<std::vector<float>> pixels;  // per-pixel reference luminance, row-major
+  // Non-empty: the reference cannot sample every path of the class (the checker's shortest such
+  // path, and whose), so its value is not the class's and no error is measured against it.
+  std::string unmeasurable;
 };
 
 struct Reference {
@@ -281,7 +286,9 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
 // --- reference from a file: an earlier run's histogram.json (with classes.exr beside it, or
 // the EXR of the same name), or an EXR alone ---
 
-Result<bool> load_reference_file(const std::string& file, int width, int height, std::vector<ClassRow>* rows) {
+// `renderer` gets the histogram's renderer (empty for an EXR alone).
+Result<bool> load_reference_file(const std::string& file, int width, int height, std::vector<ClassRow>* rows,
+                                 std::string* renderer) {
   namespace fs = std::filesystem;
   std::string exr;
   if (file.ends_with(".json")) {
@@ -289,6 +296,7 @@ Result<bool> load_reference_file(const std::string& file, int width, int height,
     if (!text) return text.error();
     Result<HistogramFile> h = parse_histogram_json(*text, file);
     if (!h) return h.error();
+    *renderer = h->report.run.renderer;
     for (ClassRow& row : *rows) {
       if (row.name == "total") {
         if (!h->report.only.empty()) continue;  // an --only render's total is not the image's
@@ -396,6 +404,10 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
                                                   : "a stderr of 0 with an error of " + fmt(s.error[static_cast<std::size_t>(s.check.max_z_rung)], "%.3g")) +
                 " at " + at.budget.text();
   }
+  if (s.check.too_large)
+    s.warning += std::string(s.warning.empty() ? "" : "; ") + "the reported stderr is larger than the true error: chi2 " +
+                 fmt(s.check.lower_chi2, "%.3g") + " over " + std::to_string(s.check.lower_dof) + " rungs (below " +
+                 fmt(s.check.lower_limit, "%.3g") + ", the lower limit at p = 0.001): the error bars overstate the error";
   if (s.check.unstable)
     s.warning += std::string(s.warning.empty() ? "" : "; ") + "the stderr is unstable: its batch variance has a relative error of " +
                  fmt(s.check.stability, "%.2f") + " (limit " + fmt(kUnstableVariance, "%.2f") + "): a few batches carry the estimate";
@@ -437,15 +449,22 @@ int run(const ConvergeArgs& a) {
     if (Result<StrategySet> ok = runnable_strategies(*p); !ok) return report(ok.error());
     profiles.push_back(std::move(*p));
   }
-  const std::string ref_renderer_name = a.reference_renderer.empty() ? a.renderers.front() : a.reference_renderer;
-  Result<Profile> ref_profile = resolve_profile(ref_renderer_name, a.limits);
-  if (!ref_profile) return report(ref_profile.error());
-  if (Result<StrategySet> ok = runnable_strategies(*ref_profile); !ok) return report(ok.error());
-
   // --- classes: the class file's, else the closed form's, else the built-ins; "total" first ---
   // The class file's classes, or the built-ins (as trace compiles them), unless the scene declares a
   // closed form and no class file is given: then its classes.
   const SceneTypes types = scene_types(*scene);
+  // The reference run's profile: --reference-renderer, else one the checker says samples every path
+  // of the scene within the deepest renderer's bound — pathex bias's default reference, bdpt plus
+  // the connectors the tracer runs whose chains the scene has (issue 36: the first --renderer was
+  // the default, and pt-nee cannot see a point light's caustic).
+  int bound = a.max_bounces.value_or(16);
+  if (!a.max_bounces)
+    for (const Profile& p : profiles) bound = std::max(bound, p.max_bounces.value_or(16));
+  Result<Profile> ref_profile = a.reference_renderer.empty() ? default_reference(scene_universe(types), bound, a.limits)
+                                                             : resolve_profile(a.reference_renderer, a.limits);
+  if (!ref_profile) return report(ref_profile.error());
+  if (a.reference_renderer.empty()) ref_profile->max_bounces = bound;
+  if (Result<StrategySet> ok = runnable_strategies(*ref_profile); !ok) return report(ok.error());
   RenderIdentity ends;
   for (LightType l : types.lights) ends.lights.push_back(to_string(l));
   ends.sensor = to_string(types.sensor);
@@ -532,8 +551,9 @@ int run(const ConvergeArgs& a) {
   // --- the reference ---
   Reference ref;
   std::optional<RungResult> ref_run;
+  std::string file_renderer;  // --reference FILE: the renderer that made it
   if (!a.reference.empty()) {
-    if (Result<bool> r = load_reference_file(a.reference, width, height, &rows); !r) return report(r.error());
+    if (Result<bool> r = load_reference_file(a.reference, width, height, &rows, &file_renderer); !r) return report(r.error());
     ref.kind = "file";
     ref.source = a.reference;
   } else if (closed_form) {
@@ -579,6 +599,61 @@ int run(const ConvergeArgs& a) {
     ref_run = std::move(*r);
   }
 
+  // --- what the reference and each renderer can sample of every class (the checker's verdict) ---
+  // A class holding a path that a renderer of the ladder samples and the reference cannot is not
+  // measurable with that reference: its value lacks that path's light, so every error against it
+  // would be wrong (a renderer that is right would be "many σ off"). A renderer is never ranked on a
+  // class holding a path it cannot sample that the reference (or, when what the reference samples
+  // is not known, another renderer of the ladder) samples. Paths none of them samples are in no
+  // estimate (pathex bias lists them).
+  const Dfa scope = reference_scope(*scene, bound);
+  std::vector<const Dfa*> languages{only && (*listed)->requested_language ? &*(*listed)->requested_language : &scope};
+  for (const PathClass* c : classes) languages.push_back(&c->dfa);
+  const auto unsampled = [&](const Dfa& reachable, const Dfa& within) {
+    std::vector<std::optional<std::string>> out;
+    for (const Dfa* l : languages) out.push_back(first_unsampled(reachable, within, *l));
+    return out;
+  };
+  std::vector<Dfa> reach;  // per renderer of the ladder
+  Dfa ladder_reach = dfa_empty();
+  for (const Profile& p : profiles) {
+    Result<CompiledProfile> cp = compile_profile(p, a.max_bounces.value_or(p.max_bounces.value_or(16)), a.limits);
+    if (!cp) return report(cp.error());
+    ladder_reach = dfa_union(ladder_reach, cp->reachable);
+    reach.push_back(std::move(cp->reachable));
+  }
+  std::string ref_reach_note;  // why what the reference reaches is not known, when it is not
+  std::optional<Dfa> ref_reach;
+  if (ref.kind != "closed-form") {
+    std::optional<Profile> judged;
+    if (ref.kind == "run") {
+      judged = *ref_profile;
+    } else if (file_renderer.empty()) {
+      ref_reach_note = "the reference is an image alone: what its renderer samples is not known, so no class is checked";
+    } else if (file_renderer == ref_profile->name) {  // e.g. an earlier converge's reference.json
+      judged = *ref_profile;
+    } else if (Result<Profile> p = resolve_profile(file_renderer, a.limits); p) {
+      judged = std::move(*p);
+    } else {
+      ref_reach_note = "the reference's renderer '" + file_renderer + "' is not a built-in profile or a file here: what it samples is not checked";
+    }
+    if (judged) {
+      Result<CompiledProfile> cp = compile_profile(*judged, a.max_bounces.value_or(judged->max_bounces.value_or(16)), a.limits);
+      if (!cp) return report(cp.error());
+      ref_reach = std::move(cp->reachable);
+      const std::vector<std::optional<std::string>> miss = unsampled(*ref_reach, dfa_intersect(scope, ladder_reach));
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        if (miss[i] && rows[i].reference) {
+          rows[i].unmeasurable = judged->name + " cannot sample " + *miss[i];
+          rows[i].reference.reset();
+          rows[i].pixels.reset();
+        }
+    }
+  }
+  std::vector<std::vector<std::optional<std::string>>> cannot;  // [renderer][row]: a path it cannot sample
+  const Dfa seen = dfa_intersect(scope, ref_reach ? *ref_reach : ladder_reach);
+  for (const Dfa& r : reach) cannot.push_back(unsampled(r, seen));
+
   // --- the ladder: every renderer at every budget, each rung its own render and seed ---
   std::vector<std::vector<RungResult>> results(profiles.size());
   bool complete = true;
@@ -619,10 +694,14 @@ int run(const ConvergeArgs& a) {
   nlohmann::ordered_json best = nlohmann::ordered_json::array();
   std::vector<std::string> best_lines;
   for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (!rows[i].unmeasurable.empty()) {
+      best_lines.push_back(rows[i].name + ": not measurable with this reference (" + rows[i].unmeasurable + "); nothing ranked");
+      continue;
+    }
     int top = -1, second = -1;
     for (std::size_t k = 0; k < profiles.size(); ++k) {
       const double e = series[k][i].pooled_efficiency;
-      if (!std::isfinite(e)) continue;
+      if (!std::isfinite(e) || cannot[k][i]) continue;
       if (top < 0 || e > series[static_cast<std::size_t>(top)][i].pooled_efficiency) {
         second = top;
         top = static_cast<int>(k);
@@ -630,7 +709,13 @@ int run(const ConvergeArgs& a) {
         second = static_cast<int>(k);
       }
     }
-    if (top < 0) continue;
+    std::string excluded;  // the renderers not ranked on the class: they cannot sample all of it
+    for (std::size_t k = 0; k < profiles.size(); ++k)
+      if (cannot[k][i]) excluded += (excluded.empty() ? "" : ", ") + profiles[k].name + " cannot sample " + *cannot[k][i];
+    if (top < 0) {
+      if (rows[i].reference && !excluded.empty()) best_lines.push_back(rows[i].name + ": none ranked (" + excluded + ")");
+      continue;
+    }
     const double et = series[static_cast<std::size_t>(top)][i].pooled_efficiency;
     nlohmann::ordered_json b = {{"class", rows[i].name}, {"renderer", profiles[static_cast<std::size_t>(top)].name}, {"efficiency", et}};
     std::string line = rows[i].name + ": " + profiles[static_cast<std::size_t>(top)].name + " (efficiency " + fmt(et, "%.3g");
@@ -644,6 +729,7 @@ int run(const ConvergeArgs& a) {
       b["ratio"] = nullptr;
     }
     if (!series[static_cast<std::size_t>(top)][i].warning.empty()) line += "; its stderr is flagged";
+    if (!excluded.empty()) line += "; not ranked: " + excluded;
     best.push_back(b);
     best_lines.push_back(line + ")");
   }
@@ -675,8 +761,12 @@ int run(const ConvergeArgs& a) {
   nlohmann::ordered_json jrefc = nlohmann::ordered_json::array();
   for (const ClassRow& r : rows)
     jrefc.push_back({{"name", r.name}, {"expr", r.expr}, {"luminance", r.reference ? number_or_null(*r.reference) : nullptr},
-                     {"stderr", r.reference_stderr}, {"per_pixel", r.pixels.has_value()}});
+                     {"stderr", r.reference_stderr}, {"per_pixel", r.pixels.has_value()},
+                     {"measurable", r.unmeasurable.empty()},
+                     {"note", r.unmeasurable.empty() ? nlohmann::ordered_json(nullptr)
+                                                     : nlohmann::ordered_json("not measurable with this reference: " + r.unmeasurable)}});
   jref["classes"] = jrefc;
+  jref["reach_note"] = ref_reach_note.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(ref_reach_note);
   doc["reference"] = jref;
   doc["stderr_check"] = {{"alpha", kStderrCheckAlpha}, {"unstable_variance", kUnstableVariance}};
   nlohmann::ordered_json jren = nlohmann::ordered_json::array();
@@ -708,10 +798,13 @@ int run(const ConvergeArgs& a) {
                     {"rungs", jr},
                     {"slope", number_or_null(s.slope)},
                     {"efficiency", number_or_null(s.pooled_efficiency)},
+                    {"cannot_sample", cannot[k][i] ? nlohmann::ordered_json(*cannot[k][i]) : nlohmann::ordered_json(nullptr)},
                     {"stderr_check",
                      {{"chi2", number_or_null(s.check.chi2)}, {"dof", s.check.dof}, {"limit", s.check.limit},
+                      {"lower_chi2", number_or_null(s.check.lower_chi2)}, {"lower_dof", s.check.lower_dof},
+                      {"lower_limit", s.check.lower_limit},
                       {"max_abs_z", number_or_null(s.check.max_abs_z)}, {"stability", number_or_null(s.check.stability)},
-                      {"disagrees", s.check.disagrees}, {"unstable", s.check.unstable}}},
+                      {"disagrees", s.check.disagrees}, {"too_large", s.check.too_large}, {"unstable", s.check.unstable}}},
                     {"warning", s.warning.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.warning)}});
     }
     jren.push_back({{"name", profiles[k].name}, {"nonfinite_samples", nonfinite}, {"classes", jc}});
@@ -778,6 +871,7 @@ int run(const ConvergeArgs& a) {
   // --- the table ---
   std::cout << "scene " << a.scene << ", reference: " << ref.kind << " (" << ref.source << ")"
             << (complete ? "" : "; interrupted: the finished rungs only") << "\n";
+  if (!ref_reach_note.empty()) std::cout << "note: " << ref_reach_note << "\n";
   if (only) {
     std::cout << "rendered only";
     for (std::size_t i = 1; i < rows.size(); ++i) std::cout << (i > 1 ? "," : "") << " " << rows[i].name << " (" << rows[i].expr << ")";
@@ -786,7 +880,9 @@ int run(const ConvergeArgs& a) {
   }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     std::cout << "\nclass " << rows[i].name << " " << rows[i].expr << ": reference "
-              << (rows[i].reference ? fmt(*rows[i].reference, "%.6g") : std::string("none (no errors measured)"));
+              << (rows[i].reference             ? fmt(*rows[i].reference, "%.6g")
+                  : !rows[i].unmeasurable.empty() ? "not measurable with this reference (" + rows[i].unmeasurable + "); no errors measured"
+                                                  : std::string("none (no errors measured)"));
     if (rows[i].reference && rows[i].reference_stderr > 0) std::cout << " ± " << fmt(rows[i].reference_stderr, "%.2g");
     std::cout << "\n  " << std::left << std::setw(16) << "renderer" << std::right << std::setw(10) << "budget" << std::setw(9)
               << "cpu s" << std::setw(9) << "wall s" << std::setw(12) << "estimate" << std::setw(11) << "stderr" << std::setw(11)
@@ -805,6 +901,7 @@ int run(const ConvergeArgs& a) {
                   << (m.rms_pixel ? fmt(*m.rms_pixel, "%.3g") : "-") << std::setw(11)
                   << (j < s.efficiency.size() ? fmt(s.efficiency[j], "%.3g") : "-") << "\n";
       }
+      if (cannot[k][i]) std::cout << "  " << profiles[k].name << " cannot sample " << *cannot[k][i] << " of this class: not ranked on it\n";
       if (rows[i].reference && !results[k].empty())
         std::cout << "  " << profiles[k].name << ": error slope against time " << fmt(s.slope, "%.2f")
                   << " (1/sqrt(t): -0.5), efficiency " << fmt(s.pooled_efficiency, "%.3g")
@@ -838,7 +935,8 @@ Command add_converge(CLI::App& app) {
   sub->add_option("--time", args->time_list, "Ladder of wall-clock seconds per render, increasing")->type_name("S,S,...");
   sub->add_option("--reference", args->reference, "An earlier run's histogram.json (classes.exr beside it adds per-pixel errors) or EXR");
   sub->add_option("--reference-renderer", args->reference_renderer,
-                  "Renderer of the reference run made when the scene declares no closed form and --reference is not given; default: the first --renderer");
+                  "Renderer of the reference run made when the scene declares no closed form and --reference is not given; "
+                  "default: bdpt plus the connectors the scene needs (as pathex bias)");
   sub->add_option("--reference-factor", args->reference_factor, "The reference run's budget over the ladder's largest")
       ->capture_default_str()->check(CLI::Range(1, 1024));
   sub->add_option("--seed", args->seed, "Base seed: rung i of renderer k uses seed + 1000 k + i")->capture_default_str()->check(non_negative());

@@ -55,6 +55,7 @@ struct TraceArgs {
   SamplerKind sampler = RenderOptions{}.sampler;  // the defaults of these three: RenderOptions'
   int rr_depth = RenderOptions{}.rr_depth;
   float rr_threshold = RenderOptions{}.rr_threshold;
+  std::optional<int> batches;  // --batches; unset: default_batches(sampler)
   ManifoldOptions manifold = RenderOptions{}.manifold;
   std::string resolution;  // "WxH"; empty: the scene's
   std::uint64_t max_paths = 1000;
@@ -154,11 +155,10 @@ Result<bool> load_fresh(const TraceArgs& a, Job* job) {
   id.seed = a.seed;
   // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
   id.max_bounces = a.max_bounces.value_or(profile->max_bounces.value_or(16));
-  const RenderOptions defaults;
   id.sampler = to_string(a.sampler);
   id.rr_depth = a.rr_depth;
   id.rr_threshold = a.rr_threshold;
-  id.batches = defaults.batches;
+  id.batches = a.batches.value_or(default_batches(a.sampler));
   id.images = !a.no_images;
   id.width = scene->camera.width;
   id.height = scene->camera.height;
@@ -586,6 +586,11 @@ Command add_trace(CLI::App& app) {
                                                                               {"sobol", SamplerKind::kSobol}})
                      .description("{independent,sobol}"))  // CLI11 would print the enum's bytes
       ->default_str(to_string(RenderOptions{}.sampler));
+  sub->add_option("--batches", args->batches,
+                  "Batches of passes (pass mod B) whose means give the standard error; under sobol each is an independently "
+                  "scrambled sequence. Default: " + std::to_string(default_batches(SamplerKind::kSobol)) + " (sobol), " +
+                      std::to_string(default_batches(SamplerKind::kIndependent)) + " (independent)")
+      ->check(CLI::Range(2, 1024));
   sub->add_option("--rr-depth", args->rr_depth,
                   "Russian roulette from this vertex of a subpath on (the camera or light point is the first)")
       ->capture_default_str()->check(CLI::Range(1, 1000));
@@ -619,7 +624,7 @@ Command add_trace(CLI::App& app) {
   add_scene_limit_options(sub, &args->limits);
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
-                                  "--resolution", "--max-paths", "--sampler", "--rr-depth", "--rr-threshold"})
+                                  "--resolution", "--max-paths", "--sampler", "--batches", "--rr-depth", "--rr-threshold"})
               if (sub->count(o) > 0) args->settings_given.push_back(o);
             for (const std::string& o : manifold_option_names())
               if (sub->count(o) > 0) args->settings_given.push_back(o);

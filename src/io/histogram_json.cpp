@@ -43,6 +43,7 @@ json techniques_json(const std::vector<TechniqueEstimate>& ts) {
     v["share"] = t.share;
     v["samples"] = t.samples;
     v["variance_share"] = stderr_json(t.variance_share);
+    v["correlation"] = stderr_json(t.correlation);
     if (const auto [it, added] = at.emplace(t.name, members.size()); !added)
       (members.begin() + static_cast<std::ptrdiff_t>(it->second))->second = std::move(v);
     else
@@ -163,7 +164,7 @@ class Reader {
     return e;
   }
 
-  // {name: {share, samples, variance_share}, …} (TechniqueEstimate); optional under `key`.
+  // {name: {share, samples, variance_share, correlation}, …} (TechniqueEstimate); optional under `key`.
   std::vector<TechniqueEstimate> techniques(const json& obj, const std::string& ptr, const char* key) {
     std::vector<TechniqueEstimate> out;
     if (!obj.is_object() || !obj.contains(key)) return out;
@@ -181,6 +182,8 @@ class Reader {
       t.samples = uint(tj, tp, "samples");
       if (const json* v = field(tj, tp, "variance_share"); v != nullptr && !v->is_null())
         t.variance_share = number(*v, tp + "/variance_share");
+      if (const json* v = field(tj, tp, "correlation"); v != nullptr && !v->is_null())
+        t.correlation = number(*v, tp + "/correlation");
       out.push_back(std::move(t));
     }
     return out;

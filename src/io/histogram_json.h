@@ -30,12 +30,13 @@
 // total's. `samples` in `total` is an addition to the keys listed in issue 4.
 //
 // `strategies` (of a path, of "other", of a class) says which sampling technique carries the
-// estimate: {"<strategy> (s, chain, t)": {share, samples, variance_share}, …}, one key per
+// estimate: {"<strategy> (s, chain, t)": {share, samples, variance_share, correlation}, …}, one key per
 // technique that contributed — the profile strategy's name and its split: s vertices from the
 // light, the chain (DD for a plain join, DSD for a connector), t vertices from the sensor.
 // share is its luminance over the whole's, samples its nonzero contributions, variance_share its
-// covariance with the whole over the whole's variance by batch means (TechniqueEstimate: the
-// shares of a row sum to 1, and so do its variance shares; null without a standard error).
+// own batch-means variance over the sum of its row's techniques' (≥ 0; the shares of a row sum to
+// 1, and so do its variance shares; null without a standard error), correlation that of its batch
+// estimates with the rest of the row's (null when unknown) — TechniqueEstimate.
 //
 // The optional "raw" section carries the Histogram itself — per path and batch the exact
 // fixed-point sums (as the signed hexadecimal strings of exact_to_string) and contribution

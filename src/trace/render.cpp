@@ -54,8 +54,9 @@ Result<StrategySet> runnable_strategies(const Profile& profile) {
 
 namespace tracer {
 namespace {
-// Passes go to batches round-robin: every batch covers the whole image, passes are i.i.d., and
-// an interrupted render still spreads what it has over all batches (so its error is defined).
+// Passes go to batches round-robin: every batch covers the whole image, and an interrupted render
+// still spreads what it has over all batches (so its error is defined). Batches are independent:
+// under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
 // Paths a thread's histogram has room for before it first regrows (address space only).
 constexpr std::size_t kReservedPaths = std::size_t{1} << 14;
 
@@ -888,7 +889,7 @@ void Integrator::trace_shadows(Thread& th) const {
 
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
-  Sampler rng(o_.seed, pixel, pass, o_.sampler);
+  Sampler rng(o_.seed, pixel, pass, o_.sampler, static_cast<std::uint64_t>(o_.batches));
   rng.set_dimension(kEyeDims);
   // The light's first direction, computed before the eye subpath is traced: a Sobol point's chain
   // of dependent multiplies then overlaps the eye subpath's work instead of delaying the light

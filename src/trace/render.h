@@ -54,6 +54,14 @@ class RequestedPaths;  // trace/prune.h
 // cancelled render stops, after whole chunks, so every finished pass covers the whole image.
 inline constexpr std::uint64_t kPassesPerChunk = 4;
 
+// The batch count of a render with `sampler` when none is given (`pathex trace --batches`): the
+// batch means are the standard error's replicates (classify/histogram.h). Under `sobol` every batch
+// is an independently scrambled sequence (trace/rng.h, sobol_stream()), so a batch of m passes
+// gains what m points of one sequence gain: fewer, larger batches keep more of the quasi-Monte
+// Carlo gain, more batches make the standard error itself more precise (its relative error is
+// about 1/sqrt(2(B-1))). The choice, measured: README "Design decisions", bench/README.md.
+constexpr int default_batches(SamplerKind sampler) { return sampler == SamplerKind::kSobol ? kDefaultSobolBatches : kDefaultBatches; }
+
 struct RenderOptions {
   std::uint64_t spp = 16;              // samples (passes) per pixel
   // The passes to take (a shard's share, what a resumed render still lacks); unset: [0, spp).
@@ -72,7 +80,7 @@ struct RenderOptions {
   int rr_depth = 3;
   float rr_threshold = 1.0f;
   SamplerKind sampler = SamplerKind::kSobol;  // --sampler
-  int batches = kDefaultBatches;       // for batch-means standard errors
+  int batches = default_batches(SamplerKind::kSobol);  // for batch-means standard errors (`pathex trace --batches`)
   std::vector<int> layer_classes;      // classifier classes that get an image layer
   // Accumulate the images at all. Off (`pathex trace --no-images`), the render keeps only the
   // histogram, which is the same either way, and RenderOutput::images is empty (0 × 0): no

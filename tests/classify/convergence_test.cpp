@@ -63,6 +63,28 @@ TEST(Convergence, StderrCheckPassesHonestLaddersAndFlagsLyingOnes) {
   EXPECT_FALSE(check_stderr({{1.05, 0.01, 0.25}}, 1.0, 0.02).disagrees);
 }
 
+// Issue 36: the lower tail. χ²_2's lower point at p is −2 ln(1 − p) in closed form (its survival
+// function is e^(−x/2)); a ladder whose errors are far inside their error bars — a stderr 30×
+// the true error at every rung — is flagged as too large, and an honest one is not. Rungs with a
+// stderr at the rounding floor (exact estimators) do not count: an error of 0 there is no sign.
+TEST(Convergence, StderrCheckFlagsAStderrThatIsTooLarge) {
+  EXPECT_NEAR(chi2_upper_quantile(2, 1.0 - 1e-3), -2.0 * std::log(1.0 - 1e-3), 1e-9);
+  EXPECT_NEAR(chi2_upper_quantile(4, 1.0 - 1e-3), 0.09080, 1e-4);  // A & S table 26.8
+  const StderrCheck big = check_stderr({{1.0003, 0.01, 0.25}, {0.99985, 0.005, 0.3}, {1.0001, 0.0025, 0.2}, {1.00004, 0.00125, 0.2}}, 1.0, 0.0);
+  EXPECT_TRUE(big.too_large);
+  EXPECT_FALSE(big.disagrees);
+  EXPECT_TRUE(big.lies());
+  EXPECT_EQ(big.lower_dof, 4);
+  EXPECT_NEAR(big.lower_chi2, 0.0009 + 0.0009 + 0.0016 + 0.001024, 1e-9);
+  EXPECT_NEAR(big.lower_limit, 0.09080, 1e-4);
+  EXPECT_FALSE(check_stderr({{1.01, 0.01, 0.25}, {0.995, 0.005, 0.3}, {1.002, 0.0025, 0.2}}, 1.0, 0.0).too_large);
+  // An exact estimator: its stderr (1e-11) is below the rounding floor of 0.159 (1.6e-7), so its
+  // error of 0 is not counted in the lower tail.
+  const StderrCheck exact = check_stderr({{0.159154943, 1e-11, 0.25}, {0.159154943, 1e-12, 0.25}}, 0.159154943, 0.0);
+  EXPECT_EQ(exact.lower_dof, 0);
+  EXPECT_FALSE(exact.lies());
+}
+
 TEST(Convergence, LogLogSlope) {
   EXPECT_NEAR(loglog_slope({1, 4, 16, 64}, {1, 0.5, 0.25, 0.125}), -0.5, 1e-12);
   EXPECT_NEAR(loglog_slope({1, 10, 0, 100}, {3, 30, 1, 300}), 1.0, 1e-12);  // x = 0 is left out

@@ -2,6 +2,7 @@
 // against closed forms and the textbook standard error, exact and order-independent merging,
 // non-finite contributions, class shares, and lock-free image accumulation.
 #include "classify/histogram.h"
+#include "cli/estimate_text.h"
 
 #include <gtest/gtest.h>
 
@@ -459,10 +460,15 @@ TEST(HistogramReport, TechniqueSharesVarianceAndOrdering) {
   EXPECT_NEAR(n0.share, 0.75, 1e-15);
   EXPECT_NEAR(l0.share, 0.25, 1e-15);
   EXPECT_EQ(n0.samples, 1u);
-  // Batch sums 3 and 1 (mean 2, deviations ±1, Σd² = 2); nee's are 3 and 0 (deviations ±1.5),
-  // light tracing's 0 and 1 (∓0.5): covariances 3 and -1, so variance shares 1.5 and -0.5.
-  EXPECT_DOUBLE_EQ(n0.variance_share, 1.5);
-  EXPECT_DOUBLE_EQ(l0.variance_share, -0.5);
+  // Batch sums 3 and 1 (mean 2, deviations ±1, Σd² = 2); nee's are 3 and 0 (deviations ±1.5, own
+  // Σd² = 4.5), light tracing's 0 and 1 (∓0.5, 0.5): own variance shares 0.9 and 0.1, both ≥ 0
+  // (issue 36: the covariance shares 1.5 and -0.5 they replace), and each is perfectly
+  // anticorrelated with the other: correlation -1.
+  EXPECT_DOUBLE_EQ(n0.variance_share, 0.9);
+  EXPECT_DOUBLE_EQ(l0.variance_share, 0.1);
+  EXPECT_DOUBLE_EQ(n0.correlation, -1.0);
+  EXPECT_DOUBLE_EQ(l0.correlation, -1.0);
+  EXPECT_TRUE(std::isnan(r->paths[2].strategies[0].correlation)) << "one technique: nothing to correlate with";
   // One technique carries all of a path: share and variance share exactly 1.
   ASSERT_EQ(r->paths[2].strategies.size(), 1u);
   EXPECT_EQ(r->paths[2].strategies[0].name, "emitter-hit (0, DD, 5)");
@@ -473,6 +479,19 @@ TEST(HistogramReport, TechniqueSharesVarianceAndOrdering) {
   EXPECT_EQ(r->paths[1].strategies[0].variance_share, 1.0);
   EXPECT_DOUBLE_EQ(r->paths[0].estimate.luminance, 2.0);
   EXPECT_DOUBLE_EQ(r->total.luminance, 5.0);
+}
+
+// The table's words for the shares (cli/estimate_text.h): both shares as percentages, and a
+// correlation said in words only where it matters (|r| ≥ 0.3).
+TEST(HistogramReport, TechniquesTextSaysWhereErrorsCancel) {
+  TechniqueEstimate a{"nee (1, DD, 2)", 0.942, 10, 0.9, -0.57}, b{"emitter-hit (0, DD, 3)", 0.058, 3, 0.1, -0.57};
+  EXPECT_EQ(cli::techniques_text({a, b}, 3),
+            "nee (1, DD, 2) 94.2 % (90.0 % of the variance; its errors partly cancel the others', r = -0.57), "
+            "emitter-hit (0, DD, 3) 5.8 % (10.0 %; its errors partly cancel the others', r = -0.57)");
+  a.correlation = b.correlation = 0.1;
+  EXPECT_EQ(cli::techniques_text({a, b}, 1), "nee (1, DD, 2) 94.2 % (90.0 % of the variance), and 1 more");
+  a.correlation = 0.45;
+  EXPECT_EQ(cli::techniques_text({a}, 1), "nee (1, DD, 2) 94.2 % (90.0 % of the variance; its errors add to the others', r = 0.45)");
 }
 
 TEST(HistogramReport, ClassTechniquesSumTheirPaths) {

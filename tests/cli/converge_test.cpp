@@ -48,17 +48,20 @@ double slope_std_error(const std::vector<double>& x, const std::vector<double>& 
 //
 // - the reported stderr (batch means): at B batches (B = spp up to 32: passes go to the batches
 //   round-robin) its log has standard error 1/sqrt(2 (B - 1)) for normal batch means, so the slope
-//   has 0.049. It must be -0.5 within 5 of those (0.25): at 100 seeds the slopes scattered by
-//   0.037-0.062 (heavier tails than normal), so 5 is at least 3.9 of their own standard deviations,
-//   below 1e-4 per slope and 0.1 % for the six. That catches a stderr that does not fall or falls as
-//   1/budget, not a slope of -0.4: converge's χ² check below compares it with the true error.
+//   has 0.049. It must fall at least as 1/sqrt(budget), within 5 of those (0.25): at most -0.25.
+//   One-sided since issue 36: converge renders with the Sobol sampler, whose batches are now
+//   independent replicates of budget/B points each, and both the true error and the (honest)
+//   stderr fall faster than 1/sqrt(budget) once a replicate holds several points (at this seed
+//   bdpt's one- and three-bounce stderr: slopes -0.86 and -1.36; pt-nee's three-bounce stderr
+//   reaches rounding at 1024 spp: -5.1). That catches a stderr that does not fall; converge's χ²
+//   check below (both tails) compares it with the true error rung by rung.
 // - the per-pixel RMS error (256 pixels): its slope scattered by 0.015-0.020 at 100 seeds (normal
-//   pixel errors would give 0.014), so kRmsSlopeSE = 0.02. converge renders with the Sobol sampler,
-//   whose error may fall faster than 1/sqrt(budget) (bdpt's one-bounce class: -0.545 on average),
+//   pixel errors would give 0.014), so kRmsSlopeSE = 0.02. Under Sobol the error may fall faster
+//   than 1/sqrt(budget) (bdpt's three-bounce class: -1.37 at this seed with independent replicates),
 //   so the check is one-sided: at most -0.5 + 4 kRmsSlopeSE = -0.42 (a false failure below 3e-5 per
-//   slope, 2e-4 for the five), and at least -1. An error that falls as budget^-0.4 (a bias floor
-//   appearing; test-only, the errors scaled by budget^0.1) failed 30 of 30 seeds, 104 of the 150
-//   slopes.
+//   slope, 2e-4 for the six). An error that falls as budget^-0.4 (a bias floor appearing; test-only,
+//   the errors scaled by budget^0.1) failed 30 of 30 seeds, 104 of the 150 slopes (measured before
+//   issue 36).
 // - a series at single-precision rounding already at the smallest budget (its first value below
 //   kRoundingFloor of the estimate: pt-nee's one- and two-bounce classes have no variance, and its
 //   three-bounce estimate under the Sobol sampler is exact in every pixel though its batches differ)
@@ -94,6 +97,7 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
         pathex::test::stat_log(what + " chi2/limit", check.at("chi2").get<double>() / check.at("limit").get<double>(), 1);
       if (check.at("stability").is_number()) pathex::test::stat_log(what + " stability", check.at("stability").get<double>(), 0.7);
       EXPECT_FALSE(check.at("disagrees")) << what;
+      EXPECT_FALSE(check.at("too_large")) << what;
       EXPECT_FALSE(check.at("unstable")) << what;
       EXPECT_TRUE(c.at("warning").is_null()) << what;
       ASSERT_EQ(c.at("rungs").size(), 4u) << what;
@@ -102,7 +106,7 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
       if (se.front() >= rounding) {
         const double slope = pathex::loglog_slope(spp, se);
         pathex::test::stat_log(what + " reported stderr slope", slope, kStderrSlopeSigmas * stderr_slope_se);
-        EXPECT_NEAR(slope, -0.5, kStderrSlopeSigmas * stderr_slope_se) << what << " reported stderr";
+        EXPECT_LE(slope, -0.5 + kStderrSlopeSigmas * stderr_slope_se) << what << " reported stderr";
         ++fitted;
       }
       const std::vector<double> rms = column(c.at("rungs"), "rms_pixel_error");
@@ -110,12 +114,13 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
         const double slope = pathex::loglog_slope(spp, rms);
         pathex::test::stat_log(what + " per-pixel RMS slope", slope, kRmsSlopeSigmas * kRmsSlopeSE);
         EXPECT_LE(slope, -0.5 + kRmsSlopeSigmas * kRmsSlopeSE) << what << " per-pixel RMS";
-        EXPECT_GE(slope, -1.0) << what << " per-pixel RMS";
         ++fitted;
       }
     }
   }
-  EXPECT_EQ(fitted, 11);  // pt-nee: total (both), bounce3 (stderr); bdpt: every class (both)
+  // pt-nee: total (both), bounce3 (both: with independent replicates its 16-spp rung is no longer
+  // exact in every pixel); bdpt: every class (both).
+  EXPECT_EQ(fitted, 12);
   EXPECT_EQ(pathex::test::read_file(dir + "/converge.svg").substr(0, 5), "<?xml");
   EXPECT_EQ(pathex::test::read_file(dir + "/converge.png").substr(1, 3), "PNG");
   EXPECT_EQ(pathex::test::read_file(dir + "/converge.json"), r.out);
@@ -145,7 +150,10 @@ TEST(Converge, ReferenceRunIsWrittenAndReadBack) {
   const std::string first = out_dir("run"), second = out_dir("file");
   CliRun r = run_pathex("converge samples/scenes/point-plane.json --renderer pt-nee --spp 4,16 --resolution 8x8 --quiet --out " + first);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("reference: run (a reference run of pt-nee at 64 spp"), std::string::npos) << r.out;
+  // The default reference renderer is pathex bias's (bdpt plus the connectors the scene needs), not
+  // the first --renderer.
+  EXPECT_NE(r.out.find("reference: run (a reference run of bdpt"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" at 64 spp"), std::string::npos) << r.out;
   ASSERT_TRUE(std::filesystem::exists(first + "/reference.json"));
   ASSERT_TRUE(std::filesystem::exists(first + "/reference.exr"));
   r = run_pathex("converge samples/scenes/point-plane.json --renderer bdpt --spp 4,16 --resolution 8x8 --json --out " + second +
@@ -155,6 +163,46 @@ TEST(Converge, ReferenceRunIsWrittenAndReadBack) {
   EXPECT_EQ(j.at("reference").at("kind"), "file");
   EXPECT_EQ(j.at("reference").at("classes").at(0).at("per_pixel"), true);
   EXPECT_FALSE(j.at("renderers").at(0).at("classes").at(0).at("rungs").at(0).at("rms_pixel_error").is_null());
+}
+
+// Issue 36: on point-glass (a point light's caustic through a glass sphere) pt-nee cannot sample
+// the caustic. The default reference samples everything the ladder's renderers sample, so every
+// class is measurable, and pt-nee is never ranked on a class holding a path it cannot sample. With
+// pt-nee as the reference, the classes holding paths bdpt samples and pt-nee cannot are "not
+// measurable with this reference": no error, no z, no ranking against it.
+TEST(Converge, ReferencesSeeWhatTheyJudgeAndNoRendererIsRankedOnWhatItCannotSample) {
+  const std::string dir = out_dir("reach"), dir2 = out_dir("reach-pt-nee");
+  CliRun r = run_pathex("converge samples/scenes/point-glass.json --renderer pt-nee --renderer bdpt --spp 4,16 --resolution 8x8 "
+                        "--json --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  const std::string ref_name = j.at("reference").at("run").at("renderer");
+  EXPECT_EQ(ref_name.rfind("bdpt+", 0), 0u) << ref_name;
+  for (const auto& c : j.at("reference").at("classes")) EXPECT_EQ(c.at("measurable"), true) << c.dump();
+  const auto& pt_nee = j.at("renderers").at(0);
+  ASSERT_EQ(pt_nee.at("name"), "pt-nee");
+  ASSERT_EQ(pt_nee.at("classes").at(0).at("name"), "total");
+  EXPECT_TRUE(pt_nee.at("classes").at(0).at("cannot_sample").is_string());  // the caustic's paths
+  std::size_t ranked_classes = 0;
+  for (const auto& b : j.at("best")) {
+    ++ranked_classes;
+    for (const auto& c : j.at("renderers"))
+      if (c.at("name") == b.at("renderer"))
+        for (const auto& cc : c.at("classes"))
+          if (cc.at("name") == b.at("class")) EXPECT_TRUE(cc.at("cannot_sample").is_null()) << b.dump();
+    EXPECT_NE(b.at("class"), "total") << "pt-nee and bdpt both miss light of the total that the reference samples";
+  }
+  EXPECT_GE(ranked_classes, 1u);  // bdpt on "local" (L.*DD.*E)
+  // The first --renderer as the reference: the classes it cannot see are not measurable.
+  r = run_pathex("converge samples/scenes/point-glass.json --renderer pt-nee --renderer bdpt --spp 4,16 --resolution 8x8 "
+                 "--reference-renderer pt-nee --quiet --out " + dir2);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("class total $all: reference not measurable with this reference (pt-nee cannot sample LS"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("  total: not measurable with this reference (pt-nee cannot sample LS"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("sigma off"), std::string::npos) << "no error is measured against a reference that cannot see the class:\n"
+                                                         << r.out;
+  EXPECT_EQ(r.out.find("x pt-nee's"), std::string::npos) << r.out;
 }
 
 // --only measures the requested classes alone (as pathex trace --only): the table and

@@ -87,7 +87,7 @@ TEST(HistogramJson, HasTheDocumentedKeysInOrder) {
             (std::vector<std::string>{"path", "estimate", "luminance", "stderr", "samples", "strategies"}));
   EXPECT_EQ(keys(doc["paths"][0]["strategies"]), (std::vector<std::string>{"nee (1, DD, 3)", "emitter-hit (0, DD, 3)"}));
   EXPECT_EQ(keys(doc["paths"][0]["strategies"]["nee (1, DD, 3)"]),
-            (std::vector<std::string>{"share", "samples", "variance_share"}));
+            (std::vector<std::string>{"share", "samples", "variance_share", "correlation"}));
   for (std::size_t i = 1; i < doc["paths"].size(); ++i)
     EXPECT_GE(doc["paths"][i - 1]["luminance"].get<double>(), doc["paths"][i]["luminance"].get<double>());
   EXPECT_FALSE(doc.contains("raw"));

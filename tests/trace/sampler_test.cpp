@@ -1,8 +1,9 @@
 // The `sobol` sampler (trace/sobol.h through trace/rng.h's Sampler): the generator matches the
 // Sobol sequence's definition, its scrambles are nested permutations, every 2-D projection a
 // pixel draws is stratified over its passes (one point in each elementary interval), its numbers
-// are pure functions of (seed, pixel, pass, dimension), and each number on its own is uniform and
-// independent of the other dimension pairs.
+// are pure functions of (seed, pixel, pass, dimension) and the batch count, each batch of passes is
+// a sequence scrambled on its own, and each number on its own is uniform and independent of the
+// other dimension pairs.
 //
 // Statistical tolerances as in rng_test.cpp: chi-square against the critical value at z = 5
 // (Wilson–Hilferty), fixed seeds.
@@ -119,6 +120,57 @@ TEST(SobolSampler, EachSingleDimensionIsStratifiedOverThePassesOfAPixel) {
         ++count[static_cast<std::size_t>(Sampler(3, 12, pass, SamplerKind::kSobol).at(dim) * static_cast<float>(n))];
       for (std::uint32_t c = 0; c < n; ++c) ASSERT_EQ(count[c], 1) << "dimension " << dim << ", 2^" << m << " passes";
     }
+}
+
+// Issue 36: under `sobol` every batch of passes (pass mod B) is a sequence scrambled on its own
+// whose index is pass div B, so that the batch means the standard error is computed from are
+// independent. The number is the definition's: point index pass div B, scrambling seeds from the
+// stream of (seed, pixel, batch); with one batch, the key of the pixel's one sequence (pass >> 32).
+TEST(SobolSampler, EachBatchIsASequenceScrambledOnItsOwn) {
+  const auto expected = [](std::uint64_t seed, std::uint64_t pixel, std::uint64_t pass, std::uint64_t batches,
+                           std::uint64_t dim) {
+    const std::uint64_t key = stream_key(seed, pixel, ((pass % batches) << 32) | ((pass / batches) >> 32));
+    const std::uint64_t h = stream_bits(key, dim);
+    const sobol::Seeds s{static_cast<std::uint32_t>(h), static_cast<std::uint32_t>(h >> 32), 0u};
+    return sobol::to_unit_float(sobol::point1(sobol::reverse_bits(static_cast<std::uint32_t>(pass / batches)), s));
+  };
+  for (std::uint64_t batches : {1u, 3u, 8u, 32u})
+    for (std::uint64_t pass : {0u, 1u, 2u, 31u, 32u, 33u, 1000u})
+      for (std::uint64_t dim : {0u, 7u, 2049u})
+        EXPECT_EQ(Sampler(5, 77, pass, SamplerKind::kSobol, batches).at(dim), expected(5, 77, pass, batches, dim))
+            << "batches " << batches << " pass " << pass << " dimension " << dim;
+  // One batch: the pixel's one sequence, as before batches had their own (pass >> 32 keys it).
+  EXPECT_EQ(Sampler(5, 77, 9, SamplerKind::kSobol, 1).at(3), Sampler(5, 77, 9, SamplerKind::kSobol).at(3));
+  // The first points of two batches are different points (independent scrambles), while the
+  // independent sampler does not depend on the batch count at all.
+  EXPECT_NE(Sampler(5, 77, 0, SamplerKind::kSobol, 32).at(0), Sampler(5, 77, 1, SamplerKind::kSobol, 32).at(0));
+  EXPECT_EQ(Sampler(5, 77, 40, SamplerKind::kIndependent, 32).at(3), Sampler(5, 77, 40, SamplerKind::kIndependent).at(3));
+}
+
+// Each batch's passes b, b + B, b + 2B, … are stratified as one pixel's passes are with one batch:
+// its first 2^m put one point in every elementary interval of every pair of dimensions.
+TEST(SobolSampler, TheFirstPassesOfEveryBatchAreStratified) {
+  for (std::uint64_t batches : {3u, 32u})
+    for (std::uint64_t batch : {std::uint64_t{0}, batches - 1})
+      for (std::uint64_t dim : {0u, 1024u, 2600u})
+        for (int m : {4, 8}) {
+          const std::uint32_t n = 1u << m;
+          std::vector<std::array<float, 2>> pts;
+          for (std::uint32_t i = 0; i < n; ++i) {
+            Sampler s(3, 12, batch + batches * i, SamplerKind::kSobol, batches);
+            s.set_dimension(dim);
+            const glm::vec2 u = s.get2d();
+            pts.push_back({u.x, u.y});
+          }
+          for (int k = 0; k <= m; ++k) {
+            const std::uint32_t nx = 1u << k, ny = 1u << (m - k);
+            std::vector<int> count(n, 0);
+            for (const auto& p : pts)
+              ++count[static_cast<std::uint32_t>(p[0] * static_cast<float>(nx)) * ny + static_cast<std::uint32_t>(p[1] * static_cast<float>(ny))];
+            for (std::uint32_t c = 0; c < n; ++c)
+              ASSERT_EQ(count[c], 1) << "batches " << batches << " batch " << batch << " dimension " << dim << " 2^" << m;
+          }
+        }
 }
 
 TEST(SobolSampler, IsAPureFunctionOfSeedPixelPassAndDimension) {
