@@ -538,8 +538,8 @@ int run(const ConvergeArgs& a) {
   Result<Classifier> classifier = Classifier::build(classes, a.limits);
   if (!classifier) return report(classifier.error());
   // Row 0 is every path measured: the scene's total, or with --only the requested paths' total.
-  std::vector<ClassRow> rows{{only ? "requested" : "total", only ? requested_text : "$all", std::nullopt, 0.0, std::nullopt}};
-  for (const PathClass* c : classes) rows.push_back({c->name, c->text, std::nullopt, 0.0, std::nullopt});
+  std::vector<ClassRow> rows{{only ? "requested" : "total", only ? requested_text : "$all", std::nullopt, 0.0, std::nullopt, ""}};
+  for (const PathClass* c : classes) rows.push_back({c->name, c->text, std::nullopt, 0.0, std::nullopt, ""});
 
   RungSetup setup{&*scene, &*classifier, a.threads, a.max_bounces, only ? &*only : nullptr};
   const int width = scene->camera.width, height = scene->camera.height;

@@ -3,11 +3,15 @@
 //   - every path string with a nonzero estimate is in the profile's reachable language (the
 //     checker's R under the same bound): the tracer never samples what the checker forbids;
 //   - every string that bdpt finds carrying more than 1 % of the image, and that the profile can
-//     reach, is found by the profile with an estimate within 4 standard errors of bdpt's
-//     (the two errors combined);
+//     reach, is found by the profile with an estimate within the family-wise tolerance of bdpt's
+//     (the two errors combined; test::family_sigmas over every such comparison, 0.1 %);
+//     "can reach" is the checker's R, except that the mirror connector joins across planar
+//     mirrors only (quads of a pure mirror material, trace/joins/mirror.h), which the checker,
+//     knowing no geometry, cannot see: in a scene without one, its strategies are left out;
 //   - no sample is non-finite.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -17,6 +21,7 @@
 #include "reach/query.h"
 #include "scene/scene.h"
 #include "trace/render.h"
+#include "support/stat_seed.h"
 
 namespace pathex {
 namespace {
@@ -42,12 +47,30 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
   for (Profile& p : builtin_profiles(Limits{}).expect("a test input"))
     if (p.name != "bdpt") profiles.push_back(std::move(p));
   ASSERT_EQ(profiles.size(), 13u);
-  int compared = 0;
+  struct Comparison {
+    std::string what;
+    double deviation, sigma;
+  };
+  std::vector<Comparison> comparisons;
+  auto has_mirror_connector = [](const Profile& p) {
+    return std::any_of(p.strategies.begin(), p.strategies.end(), [](const Strategy& st) { return st.connector == ConnectorKind::kMirror; });
+  };
+  std::map<std::string, CompiledProfile> pruned;  // per profile: its checker without the mirror connector
+  auto without_mirror = [&](const Profile& p) -> const CompiledProfile& {
+    auto it = pruned.find(p.name);
+    if (it != pruned.end()) return it->second;
+    Profile q = p;
+    std::erase_if(q.strategies, [](const Strategy& st) { return st.connector == ConnectorKind::kMirror; });
+    return pruned.emplace(p.name, compile_profile(q, kBounces, Limits{}).expect("a test input")).first->second;
+  };
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".json") continue;
     Result<Scene> loaded = load_scene_file(entry.path().string());
     ASSERT_TRUE(loaded.ok()) << loaded.error().render();
     Scene scene = *loaded;
+    const bool planar_mirror = std::any_of(scene.shapes.begin(), scene.shapes.end(), [&](const Shape& sh) {
+      return std::holds_alternative<QuadShape>(sh.geometry) && std::holds_alternative<Mirror>(scene.materials[static_cast<std::size_t>(sh.material)]);
+    });
     if (scene.camera.type != SensorType::kSpotmeter) scene.camera.width = scene.camera.height = 16;
     const std::uint64_t spp = scene.camera.type == SensorType::kSpotmeter ? 8192 : 128;
     const Profile bdpt = resolve_profile("bdpt", Limits{}).expect("a test input");
@@ -74,19 +97,25 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
           EXPECT_TRUE(checker.reachable.accepts(p.path)) << where << ": " << p.path;
         }
       }
+      const CompiledProfile& reach = planar_mirror || !has_mirror_connector(profile) ? checker : without_mirror(profile);
       for (const PathEstimate& p : reference.paths) {
-        if (!(p.estimate.luminance > 0.01 * reference.total.luminance) || !checker.reachable.accepts(p.path)) continue;
+        if (!(p.estimate.luminance > 0.01 * reference.total.luminance) || !reach.reachable.accepts(p.path)) continue;
         auto it = found.find(p.path);
         ASSERT_NE(it, found.end()) << where << ": bdpt finds " << p.path << " but the profile never samples it";
         const double sigma = std::hypot(p.estimate.std_error, it->second->estimate.std_error);
-        EXPECT_LE(std::fabs(p.estimate.luminance - it->second->estimate.luminance), 4.0 * sigma + 1e-9)
-            << where << ": " << p.path << " bdpt " << p.estimate.luminance << " ± " << p.estimate.std_error << ", "
-            << name << " " << it->second->estimate.luminance << " ± " << it->second->estimate.std_error;
-        ++compared;
+        comparisons.push_back({where + ": " + p.path + " bdpt " + std::to_string(p.estimate.luminance) + " ± " +
+                                   std::to_string(p.estimate.std_error) + ", " + name + " " +
+                                   std::to_string(it->second->estimate.luminance) + " ± " + std::to_string(it->second->estimate.std_error),
+                               std::fabs(p.estimate.luminance - it->second->estimate.luminance), sigma});
       }
     }
   }
-  EXPECT_GT(compared, 40);
+  EXPECT_GT(comparisons.size(), 40u);
+  const double tolerance = test::family_sigmas(static_cast<int>(comparisons.size()));
+  for (const Comparison& c : comparisons) {
+    test::stat_log(c.what, c.deviation / c.sigma, tolerance);
+    EXPECT_LE(c.deviation, tolerance * c.sigma + 1e-9) << c.what;
+  }
 }
 
 }  // namespace
