@@ -6,6 +6,7 @@
 // of the component that carried the transport.
 #pragma once
 
+#include <cmath>
 #include <type_traits>
 #include <variant>
 #include <vector>
@@ -28,6 +29,11 @@ struct Dielectric {
   float ior = 1.5f;          // index of refraction inside / outside; Fresnel and total internal reflection
   glm::vec3 tint{1.0f};      // multiplies transmission and reflection
 };
+
+// The indices a dielectric may have, in every scene format: within [0.1, 10] and not 1. Below 1 the
+// inside is the less dense medium (an air bubble in water, pbrt-v4's eta < 1); 1 is no surface.
+inline bool valid_ior(double eta) { return eta >= 0.1 && eta <= 10.0 && std::fabs(eta - 1.0) >= 1e-4; }
+inline constexpr const char* kValidIor = "within [0.1, 10] and not 1 (1 is no surface)";
 
 struct Glossy {
   glm::vec3 reflectance{0.8f};  // GGX microfacet reflection with Schlick Fresnel from this colour

@@ -466,7 +466,11 @@ class Importer {
       MI_TRY(trans, p.color("specular_transmittance", vec3(1.0f)));
       if (refl != trans) return located(where(n), "different specular_reflectance and specular_transmittance are not supported: pathex's dielectric has one tint");
       const double eta = ior[0] / ior[1];
-      if (!(eta > 1.0001) || eta > 10.0) return located(where(n), "int_ior / ext_ior must be within (1, 10], found " + std::to_string(eta));
+      if (!valid_ior(eta)) {
+        std::ostringstream found;
+        found << eta;
+        return located(where(n), std::string("int_ior / ext_ior must be ") + kValidIor + ", found " + found.str());
+      }
       m = Dielectric{static_cast<float>(eta), refl};
     } else if (type == "roughdielectric") {
       return located(where(n), "roughdielectric is not supported: pathex has no rough transmission");

@@ -672,7 +672,7 @@ class Importer {
       PBRT_TRY(eta, ps.number("eta", 1.5));
       PBRT_TRY(a, alpha(ps, at));
       if (a >= 1e-3f) return located(at, "a rough dielectric is not supported: pathex has no rough transmission (set roughness 0)");
-      if (!(eta > 1.0001) || eta > 10.0) return located(at, "dielectric eta must be within (1, 10], found " + std::to_string(eta));
+      if (!valid_ior(eta)) return located(at, std::string("dielectric eta must be ") + kValidIor + ", found " + fmt_number(eta));
       return Material{Dielectric{static_cast<float>(eta), vec3(1.0f)}};
     }
     if (type == "mix") {

@@ -103,7 +103,8 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
   }
   if (type == "dielectric") {
     if (auto k = r.keys(j, ptr, {"type", "ior", "tint"}); !k) return k.error();
-    PATHEX_TRY(ior, r.number(j, "ior", ptr, 1.0001, 10.0, 1.5));
+    PATHEX_TRY(ior, r.number(j, "ior", ptr, -1e30, 1e30, 1.5));
+    if (!valid_ior(ior)) return r.fail(ptr + "/ior", std::string("expected an index of refraction ") + kValidIor + ", found " + Reader::fmt(ior));
     PATHEX_TRY(tint, r.vector3(j, "tint", ptr, false, vec3(1.0f), true));
     return BasicMaterial{Dielectric{static_cast<float>(ior), tint}};
   }

@@ -408,6 +408,17 @@ TEST(ImportPbrt, UniformInfiniteLightAndSoftSpot) {
   EXPECT_EQ(spot.falloff, SpotFalloff::kSmoothstep);
 }
 
+// An index below 1 (the inside the less dense medium) is read as given, in both formats.
+TEST(ImportDielectric, AnIndexBelowOneIsTheBubble) {
+  const Scene pbrt = load(write("bubble.pbrt", "LookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nLightSource \"point\"\nMaterial \"dielectric\" \"float eta\" 0.75\nShape \"sphere\"\n"));
+  EXPECT_FLOAT_EQ(std::get<Dielectric>(pbrt.materials[static_cast<std::size_t>(pbrt.shapes[0].material)]).ior, 0.75f);
+  const Scene xml = load(write("bubble.xml", "<scene version=\"3.0.0\"><sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><transform name=\"to_world\"><lookat origin=\"0, 0, 5\" "
+                                                        "target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor><emitter type=\"point\"/>"
+                                                        "<shape type=\"sphere\"><bsdf type=\"dielectric\"><string name=\"int_ior\" value=\"air\"/>"
+                                                        "<string name=\"ext_ior\" value=\"water\"/></bsdf></shape></scene>"));
+  EXPECT_NEAR(std::get<Dielectric>(xml.materials[static_cast<std::size_t>(xml.shapes[0].material)]).ior, 1.000277 / 1.333, 1e-6);
+}
+
 TEST(ImportMitsuba, ConstantEmitterAndSoftSpot) {
   const Scene s = load(write("constant.xml",
                              "<scene version=\"3.0.0\"><sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/>"
@@ -462,6 +473,8 @@ std::vector<Refusal> refusals() {
        "light \"goniometric\" is not supported, expected point, spot, distant, infinite or an AreaLightSource"},
       {"zmin.pbrt", "Shape \"sphere\" \"float zmin\" -0.5\n", "zmin.pbrt:4:16", "partial spheres (zmin) are not supported"},
       {"typo.pbrt", "Shape \"sphere\" \"float radiu\" 2\n", "typo.pbrt:4:16", "parameter \"float radiu\" of Shape \"sphere\" is not supported"},
+      {"eta-one.pbrt", "Material \"dielectric\" \"float eta\" 1\n", "eta-one.pbrt:4:1",
+       "dielectric eta must be within [0.1, 10] and not 1 (1 is no surface), found 1"},
       {"rough-glass.pbrt", "Material \"dielectric\" \"float roughness\" 0.1\n", "rough-glass.pbrt:4:1",
        "a rough dielectric is not supported: pathex has no rough transmission (set roughness 0)"},
       {"blackbody.pbrt", "LightSource \"point\" \"blackbody I\" 3000\n", "blackbody.pbrt:4:21",

@@ -272,6 +272,28 @@ TEST(ClosedForm, UniformInfiniteLightOverADiffuseSphereIsTheFurnace) {
   }
 }
 
+// The white furnace for glass: a lossless dielectric sphere in a uniform infinite light of
+// radiance L reflects and transmits without loss, so every ray that meets it leaves it again and
+// brings back L, whatever the index: 1.5 (glass) and 1 / 1.5 (the inside less dense, as an air
+// bubble in glass; pbrt-v4's eta < 1). The camera sees only the sphere, so every pixel is L, in
+// paths L DD S+ DS E that only an emitter hit samples. A wrong Fresnel weight, a lost factor of
+// η² on the way in or out, or a refraction that fails below 1 would each move it.
+TEST(ClosedForm, GlassInAUniformLightIsInvisibleWhateverItsIndex) {
+  for (const char* ior : {"1.5", "0.6666667"}) {
+    const std::string scene = R"({"camera": {"type": "pinhole", "position": [0, 0, -3], "look_at": [0, 0, 0], "up": [0, 1, 0],
+                                    "fov": 20, "width": 6, "height": 6},
+      "materials": {"glass": {"type": "dielectric", "ior": )" + std::string(ior) + R"(}},
+      "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "glass"}],
+      "lights": [{"type": "environment", "radiance": [0.8, 0.8, 0.8]}]})";
+    for (const char* renderer : {"pt", "pt-nee", "bdpt"}) {
+      Rendered r = render_json(scene, renderer, {"LDDS+DSE", "L.*E"}, 64);
+      EXPECT_EQ(r.report.nonfinite_samples, 0u);
+      expect_close(r.report.classes[0].estimate, 0.8, 3.0, 0.005, std::string(renderer) + " glass furnace, ior " + ior);
+      expect_close(r.report.classes[1].estimate, 0.8, 3.0, 0.005, std::string(renderer) + " glass furnace, every path, ior " + ior);
+    }
+  }
+}
+
 // The same light seen directly: a camera that looks away from the only shape sees L in every pixel
 // (class L DD DS E), and a second environment entry adds its radiance.
 TEST(ClosedForm, UniformInfiniteLightSeenDirectlyIsItsRadiance) {
