@@ -16,11 +16,11 @@
 #include "classify/classifier.h"
 #include "classify/histogram.h"
 #include "classify/image.h"
-#include "trace/accel/nee_mis.h"
 #include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/joins/join.h"
 #include "trace/joins/manifold.h"
+#include "trace/mis.h"
 #include "trace/prune.h"
 #include "trace/render.h"
 #include "trace/render_scene.h"
@@ -36,8 +36,7 @@ static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms pa
 
 class Integrator {
  public:
-  // `general_mis` (for tests) turns off the per-sample MIS sums, leaving the general recurrence.
-  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, bool general_mis = false)
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o)
       : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), table_(strategies.strategies) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
@@ -65,19 +64,6 @@ class Integrator {
                       has_manifold_;
     mirror_shape_.assign(rs.material_of_shape.size(), 0);
     for (const PlanarMirror& m : rs.mirrors) mirror_shape_[static_cast<std::size_t>(m.shape)] = 1;
-    eye0_runs_ = (runs_mask_[1] >> 1) & 1;
-    all_runs_ = !has_connectors_ && !general_mis;  // the per-sample sums below know plain joins only
-    for (std::size_t n = 1; n < runs_mask_.size(); ++n) {
-      const std::uint64_t below = (std::uint64_t{1} << n) - 1;  // s2 < n: t2 >= 1
-      all_runs_ = all_runs_ && (runs_mask_[n] & below) == below && ((runs_mask_[n] >> n) & 1) == (eye0_runs_ ? 1u : 0u);
-    }
-    // The general recurrence reads the subpaths' stored ratios only beyond the two vertices nearest
-    // each end of a join, that is for another strategy at least 3 splits away from the join's own.
-    int spread = 0;
-    for (const std::uint64_t m : runs_mask_)
-      if (m != 0) spread = std::max(spread, (63 - std::countl_zero(m)) - std::countr_zero(m));
-    stored_ratios_ = all_runs_ || has_connectors_ || general_mis || spread >= 3;
-    nee_mis_ = !has_connectors_ && !has_manifold_ && !general_mis && accel::nee_mis_applies(runs_mask_);
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
     sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
     for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
@@ -99,6 +85,28 @@ class Integrator {
 
   // The cones light i emits into under --only (trace/emission_cones.h); none: every direction.
   const std::optional<EmissionCones>& aimed(std::size_t light) const { return aimed_[light]; }
+
+  // A full path x0 … xk in light-to-eye order as a join forms it, without copying a vertex: s light
+  // vertices (y0 replaced by a fresh sample light0 when given), the m vertices a connector
+  // constructs, t eye vertices in reverse (z0 replaced by eye0 when given). Or, when `whole` is
+  // set, the vertices whole[0 … s + m + t) (a path assembled elsewhere, as the tests do).
+  struct PathView {
+    const Vertex* light = nullptr;
+    const Vertex* light0 = nullptr;
+    const Vertex* chain = nullptr;
+    const Vertex* eye = nullptr;
+    const Vertex* eye0 = nullptr;
+    const Vertex* whole = nullptr;
+    int s = 0, m = 0, t = 0;
+    int size() const { return s + m + t; }
+    const Vertex& operator[](int i) const {
+      if (whole) return whole[i];
+      if (i < s) return i == 0 && light0 ? *light0 : light[i];
+      if (i < s + m) return chain[i - s];
+      const int j = s + m + t - 1 - i;
+      return j == 0 && eye0 ? *eye0 : eye[j];
+    }
+  };
 
   // A weighted JoinResult on its way to record() (estimate() makes it): with its segments queued
   // for visibility, or none needed.
@@ -128,26 +136,20 @@ class Integrator {
     JoinResult join{};  // the join being made (joins build into it; estimate() consumes it)
     std::vector<ChainVertex> manifold_seed{};       // the manifold connector's chain being solved
     std::vector<ManifoldSolution> manifold_found{};  // and the distinct chains its first batch found
-    std::vector<Vertex> path{};         // a whole path x0 … xk for path_weight()
-    std::vector<double> rel{}, eye_density{};  // path_weight()'s density ratios and remapped ef
-    // The subpaths' letters packed (set by prepare_joins()): light_mask has c0 c1 of y0, then
+    // The MIS weight's working space (mis_weight()): the strategies that sample the path being
+    // weighed, and its vertices' densities.
+    std::array<mis::Technique, 3 * mis::kMaxPath + 3> techniques{};
+    std::array<mis::Densities, mis::kMaxPath> densities{};
+    // The subpaths' letters packed (set by set_masks()): light_mask has c0 c1 of y0, then
     // bit i + 1 for y_i's letter; eye_masks[t] has the eye subpath's last t + 1 letters (z(t-1)
     // … z0 and z0's spatial letter) as they sit after c(s) in any connection with t eye vertices.
     PathKey light_mask = 0;
     std::array<PathKey, kMaxVertices + 1> eye_masks{};
     ClassImages* images = nullptr;  // the shared image that splats go to
     ClassImages::SplatBuffer splats = ClassImages::SplatBuffer();  // they go through this; render() flushes it at the end
-    std::array<double, kMaxVertices> light_ratio{}, eye_ratio{};  // set by prepare_joins()
-    // With every strategy run (all_runs_), the MIS sums over each subpath's fixed part, from its
-    // start to vertex j (set by prepare_joins()): light_acc[j] = Σ_{i <= j, strategy (i, ·)
-    // samples the letters} Π_{m=i..j} light_ratio[m]², and eye_acc likewise.
-    std::array<double, kMaxVertices> light_acc{}, eye_acc{};
-    // 1 / (remapped forward density) of each vertex (set by prepare_joins()): a weight multiplies
-    // by it rather than dividing on its critical path.
-    std::array<double, kMaxVertices> light_inv_fwd{}, eye_inv_fwd{};
     int ns = 0, nt = 0;        // the current subpaths' lengths
     int px = 0;                // the current sample's column
-    bool joins_ready = false;  // prepare_joins() runs on the sample's first recorded contribution
+    bool joins_ready = false;  // set_masks() runs on the sample's first recorded contribution
     // Shadow rays queued by connect(), traced when the batch is full and when a row ends
     // (finish_row()); pending[lane] is what lane's ray decides on. A row is one thread's work
     // from start to end, so which rays share a packet does not depend on the thread count.
@@ -160,43 +162,10 @@ class Integrator {
     std::optional<NonfiniteSample> first_nonfinite{};
   };
 
-  // A vertex's density ratio in the MIS sums, a Dirac's densities (stored as 0) counting as 1.
+  // The path of join `jr` over th's subpaths.
+  static PathView path_of(const Thread& th, const JoinResult& jr);
+  // A vertex's density as the MIS weight reads it, a Dirac's (stored as 0) counting as 1.
   static double remap(float f) { return remap_density(f); }
-  static double ratio(const Vertex& v) { return remap(v.pdf_rev) / remap(v.pdf_fwd); }
-  static double inv_fwd(const Vertex& v) { return 1.0 / remap(v.pdf_fwd); }
-  // Per sample, before its first recorded contribution: the letter masks, and each vertex's
-  // ratio of reverse to forward density (a join changes only the two nearest each end) when a
-  // weight can read them (stored_ratios_; pt-nee's never do).
-  void prepare_joins(Thread& th, int ns, int nt) const {
-    set_masks(th, ns, nt);
-    if (!stored_ratios_) return;
-    for (int i = 0; i < ns; ++i) {
-      th.light_ratio[static_cast<std::size_t>(i)] = ratio(th.light[static_cast<std::size_t>(i)]);
-      th.light_inv_fwd[static_cast<std::size_t>(i)] = inv_fwd(th.light[static_cast<std::size_t>(i)]);
-    }
-    for (int i = 0; i < nt; ++i) {
-      th.eye_ratio[static_cast<std::size_t>(i)] = ratio(th.eye[static_cast<std::size_t>(i)]);
-      th.eye_inv_fwd[static_cast<std::size_t>(i)] = inv_fwd(th.eye[static_cast<std::size_t>(i)]);
-    }
-    if (!all_runs_) return;
-    // Strategy (i, ·) on the light side joins at y(i-1) and y_i: letters c_i and c_(i+1), bits i
-    // and i + 1 of light_mask. On the eye side strategy (·, j) joins at z_j and z(j-1): letters
-    // z_j's and z(j-1)'s (z0's spatial letter for j = 0, which also needs the lens).
-    double acc = 0.0;
-    for (int j = 0; j < ns; ++j) {
-      const double r = th.light_ratio[static_cast<std::size_t>(j)];
-      acc = r * r * (static_cast<double>(((th.light_mask >> j) & 3) == 0) + acc);
-      th.light_acc[static_cast<std::size_t>(j)] = acc;
-    }
-    acc = 0.0;
-    for (int j = 0; j < nt; ++j) {
-      const char before = j > 0 ? th.eye[static_cast<std::size_t>(j - 1)].letter : th.eye[0].pos_letter;
-      const bool runs = th.eye[static_cast<std::size_t>(j)].letter == 'D' && before == 'D' && (j > 0 || eye0_runs_);
-      const double r = th.eye_ratio[static_cast<std::size_t>(j)];
-      acc = r * r * (static_cast<double>(runs) + acc);
-      th.eye_acc[static_cast<std::size_t>(j)] = acc;
-    }
-  }
   // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key().
   void set_masks(Thread& th, int ns, int nt) const {
     th.joins_ready = true;
@@ -332,22 +301,38 @@ class Integrator {
   // u_ray: the numbers of the light's first direction (Sampler::at2d_now at kLightRayDim).
   int light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const;
 
-  // --- connections ---
-  // The five kinds of connection, one instantiation of connect() each, so that the kind is not a
-  // branch taken anew (and mispredicted) on every call.
-  enum class Connection {
-    kEmitter,  // s = 0: the eye subpath's last vertex lies on an area light
-    kLens,     // t = 0: the light subpath's last vertex lies on the lens
-    kSplat,    // t = 1: a light vertex joined to a fresh sensor sample
-    kNee,      // s = 1: an eye vertex joined to a fresh light sample
-    kJoin,     // s, t >= 2: a shadow ray between two subpath vertices
-    kDistant,  // distant-projection (0, DSD, t): an eye vertex joined to a distant light's aperture
-    kOrtho,    // ortho-projection (s, DSD, 0): a light vertex joined to an orthographic film
-  };
-  // The profile's strategy running a projection connector with this many eye (distant: its chain
-  // is c0 c1 c2, so (0, DSD, t)) or light (ortho: (s, DSD, 0)) vertices, or -1.
-  int distant_of(int t) const { return table_.at(0, ConnectorKind::kDistantProjection, t); }
-  int ortho_of(int s) const { return table_.at(s, ConnectorKind::kOrthoProjection, 0); }
+  static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;  // the most joins of one kind per sample
+  // --- joins (trace/joins/): each makes th.join from the two subpaths, or returns false ---
+  // Random numbers: each join draws from a block of its own, per kind and subpath length, so that
+  // adding a strategy leaves every other strategy's numbers unchanged (trace/rng.h).
+  enum class JoinBlock : std::uint64_t { kEmitter, kLens, kSplat, kNee, kShadow, kDistant, kOrtho, kMirrorLight, kMirrorEye, kManifoldLight };
+  static constexpr std::uint64_t kJoinDims = 2048;  // after the eye's and the light subpath's blocks
+  static constexpr std::uint64_t kDimsPerJoin = 4;
+  static void join_numbers(Sampler& rng, JoinBlock block, int index) {
+    rng.set_dimension(kJoinDims + (static_cast<std::uint64_t>(block) * kMaxRuns + static_cast<std::uint64_t>(index)) * kDimsPerJoin);
+  }
+  bool join_emitter(Thread& th, int t) const;  // (0, DD, t): z(t-1) lies on an area light
+  bool join_lens(Thread& th, int s) const;     // (s, DD, 0): y(s-1) lies on the lens
+  // (s, DD, 1): y(s-1) joined to a fresh sensor point (kNone), or ortho-projection (s, DSD, 0):
+  // to the film point on its line of sight (kOrthoProjection).
+  bool join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind) const;
+  // (1, DD, t): z(t-1) joined to a fresh light point (kNone), or distant-projection (0, DSD, t):
+  // to the aperture point on the line through it against the light (kDistantProjection).
+  bool join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind) const;
+  bool join_shadow(Thread& th, int s, int t) const;  // (s, DD, t), s, t >= 2: a shadow ray between y(s-1) and z(t-1)
+  // The scattering function at a join's end vertex v towards unit w (leaving v along the join): a
+  // light vertex's directional emission (its beta holds the spatial part), else its BSDF, with the
+  // shading-normal correction at the light end (mode kImportance); the BSDF's densities for free
+  // into *pdfs when given. Every join evaluates its ends here.
+  vec3 end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs = nullptr) const;
+  // A join's start (th.join reset for strategy (s, kind, t)) and end: its contribution, the S
+  // letters a projection adds, the one segment to test (none: from is null). False when black.
+  void begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const;
+  bool end_join(Thread& th, const vec3& contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const;
+  // The one way a join makes a fresh endpoint: a sensor vertex at connection c (th.join.eye0), a
+  // vertex of light li at p (th.join.light0).
+  Vertex& fresh_sensor_vertex(Thread& th, const EndpointConnection& c, char letter) const;
+  Vertex& fresh_light_vertex(Thread& th, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const;
   // Density of the far end of a parallel beam per unit area there, relative to the near end's:
   // points x and y on one line along w, with unit normals (zero: no surface), map areas as
   // dA_x |cos θ_x| = dA_y |cos θ_y|.
@@ -355,15 +340,17 @@ class Integrator {
     const float c = abs_cos(near, w);
     return c > 0.0f ? abs_cos(far, w) / c : 0.0f;
   }
-  template <Connection C>
-  [[gnu::always_inline]] inline void connect(Thread& th, Sampler& rng, int s, int t, int batch) const;
+  // The profile's strategy running a projection connector with this many eye (distant: its chain
+  // is c0 c1 c2, so (0, DSD, t)) or light (ortho: (s, DSD, 0)) vertices, or -1.
+  int distant_of(int t) const { return table_.at(0, ConnectorKind::kDistantProjection, t); }
+  int ortho_of(int s) const { return table_.at(s, ConnectorKind::kOrthoProjection, 0); }
   // The mirror connector (s, DSD, t), s, t >= 1: y(s-1) (a fresh light sample for s = 1) joined to
   // z(t-1) (a fresh sensor sample for t = 1) across each planar mirror by the image method.
   void connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const;
   int mirror_of(int s, int t) const { return table_.at(s, ConnectorKind::kMirror, t); }
   // A connector's light end for s = 1: a fresh light sample in th.join.light0 from random-number
   // block `block` (one per t), or null when the light picked has a Dirac direction (no D end).
-  const Vertex* fresh_light_end(Thread& th, Sampler& rng, int t, std::uint64_t block) const;
+  const Vertex* fresh_light_end(Thread& th, Sampler& rng, int t, JoinBlock block) const;
   // The manifold connector (s, DS+D, t), s >= 1, t >= 2 (trace/joins/manifold.h): y(s-1) (a
   // fresh light sample for s = 1) joined to z(t-1) across a chain of smooth glass by specular
   // manifold sampling. Defined in trace/joins/manifold_join.cpp.
@@ -382,48 +369,22 @@ class Integrator {
   ManifoldFailure seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
                              std::vector<ChainVertex>& chain) const;
   void init_manifold();
-  // Whether the manifold connector (s, DS^mD, ·) could build the chain x_s … x(s+m-1) of th.path
+  // Whether the manifold connector (s, DS^mD, ·) could build the chain x_s … x(s+m-1) of path x
   // (letters `key`): the profile runs it there, its eye end is a surface, and every chain vertex is
   // a reflection or refraction on smooth glass or a reflection on a mirror.
-  bool manifold_at(const Thread& th, PathKey key, int s, int m) const;
-  // --- MIS over whole paths, for profiles with the mirror or the manifold connector ---
-  // Puts the path x0 … xk of a contribution into th.path: s light vertices (fresh_light for y0 when
-  // given), the `chain_length` vertices of `chain` (the mirror vertex, the manifold's chain), t eye
-  // vertices (fresh_eye for z0 when given).
-  void gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* chain, int chain_length,
-              const Vertex* fresh_eye) const;
-  // Whether the path of connection (s, t) with letters `key` could also be sampled by the mirror
-  // connector (then every strategy weighs it with path_weight()).
-  bool mirror_can_sample(const Thread& th, int s, int t, PathKey key) const;
-  // The power-heuristic weight of strategy `self` (kNone: split s; kMirror: mirror vertex x_s)
-  // for the path in th.path with letters `key`, from every vertex's two area densities.
-  float path_weight(Thread& th, PathKey key, ConnectorKind self, int s) const;
-  // The power-heuristic weight of a plain or projection join (s, t) with letters `key` (a fresh
-  // endpoint `sampled` standing for z0 when t = 1, else for y0 when s = 1), from the subpaths'
-  // stored densities and the join's own (`join`: what the join computed; null: recompute it).
-  float mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const JoinDensity* join = nullptr,
-                   ConnectorKind self = ConnectorKind::kNone) const;
-  // mis_weight() for nee_mis_ profiles and t >= 2, by the fast path (trace/accel/nee_mis.h): 1
-  // when the other strategy cannot sample the letters, else its density of the point on the light
-  // against this one's.
-  float nee_mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const JoinDensity* join) const {
-    // As mis_weight() tests it: the other strategy, (0, t + 1) or (1, t - 1), runs, and its join
-    // letters are D.
-    const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));
-    if (((runs_mask_[static_cast<std::size_t>(s + t)] & d_pairs) >> (1 - s) & 1) == 0) return 1.0f;
-    const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
-    if (s == 0) return accel::emitter_hit_weight(pt, pdf_light_origin(pt));
-    const Vertex& y0 = sampled ? *sampled : th.light[0];
-    JoinDensity own;
-    if (join == nullptr) {  // as mis_weight() recomputes it
-      const vec3 e = pt.p - y0.p;
-      own.d2 = glm::dot(e, e);
-      own.w = own.d2 > 0.0f ? e * (1.0f / std::sqrt(own.d2)) : vec3(0.0f);
-      join = &own;
-    }
-    const float dir = join->at_pt.known ? join->at_pt.to_wi : pdf_dir(pt, &pt.wo, -join->w);
-    return accel::nee_weight(y0, dir, join->w, join->d2);
-  }
+  bool manifold_at(const PathView& x, PathKey key, int s, int m) const;
+  // --- the MIS weight (trace/mis_weight.cpp; the routine itself is trace/mis.h) ---
+  // The power-heuristic weight of path x (letters `key`) as strategy `self` sampled it (at split
+  // x.s, its x.m constructed vertices after it), against every strategy of the profile that samples
+  // the same path. `join`: the densities the join computed at its two ends (null: recomputed).
+  float mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const;
+  // The strategies that sample path x, `self` first, into th.techniques; returns their count.
+  int techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const;
+  // th.densities[lo … hi) of a plain or projection join's path: the subpaths' stored densities with
+  // the four the join changes recomputed.
+  void join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const;
+  // th.densities[lo … hi) of a path with constructed vertices: every one computed from the vertices.
+  void path_densities(Thread& th, const PathView& x, PathKey key, int lo, int hi) const;
   // The estimator's one consumer of joins: weighs th.join by MIS over every strategy of the
   // profile, then records it, or queues its segments and records it once all are found clear.
   void estimate(Thread& th, int batch) const;
@@ -442,7 +403,6 @@ class Integrator {
   const StrategySet& strategies_;
   const RenderOptions& o_;
   int max_bounces_ = 16;
-  static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;
   StrategyTable table_;  // which strategy runs each (s, chain, t)
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
   bool has_mirror_ = false;      // a mirror strategy runs and the scene has a planar mirror
@@ -459,17 +419,6 @@ class Integrator {
   // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
   static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
   std::array<std::uint64_t, 64> runs_mask_{};
-  // The profile runs every (s, t) with t >= 1 (full BDPT), and (s, 0) for all s or none
-  // (eye0_runs_): which strategies sample a path then depends on its letters alone, so the MIS
-  // sums over each subpath's fixed part are computed once per sample (prepare_joins()).
-  bool all_runs_ = false;
-  bool eye0_runs_ = false;
-  // A weight may read the ratios prepare_joins() stores (else it skips them): some n has two
-  // strategies 3 or more splits apart, or the sums above or a connector's weights need them.
-  bool stored_ratios_ = true;
-  // The profile's plain joins are the emitter hit and next-event estimation alone, and no connector
-  // runs: the estimator weighs joins with t >= 2 by the fast path (nee_mis_weight()).
-  bool nee_mis_ = false;
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
   std::vector<std::string> light_pairs_;  // each light's letters c0 c1

@@ -67,10 +67,8 @@ int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % s
 // draw at most 4 + 4 per vertex; each connection (kind, subpath length) then draws at most 4.
 constexpr std::uint64_t kEyeDims = 0;
 constexpr std::uint64_t kLightDims = 1024;
-constexpr std::uint64_t kJoinDims = 2048;
 // The light subpath's first direction, after the light's pick (1) and point (2).
 constexpr std::uint64_t kLightRayDim = kLightDims + 3;
-constexpr std::uint64_t kDimsPerJoin = 4;
 static_assert(4 + 4 * 64 <= kLightDims - kEyeDims, "a subpath's numbers fit its block");
 
 float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
@@ -276,144 +274,6 @@ void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled
   c(s + 1) = 'D';
 }
 
-float Integrator::mis_weight(const Thread& th, int s, int t, const Vertex* sampled, PathKey key, const JoinDensity* join,
-                             ConnectorKind self) const {
-  // Strategy (s2, t2) samples this string when the profile runs it and its join letters c(s2),
-  // c(s2+1) are both D: one mask for all of them, bit s2 (runs_mask_ holds the profile's part).
-  // When no other strategy can sample this string (pt, lt, and many strings of every profile),
-  // the weight is 1 and no density needs recomputing.
-  const int n = s + t;
-  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c_(i+1) are D
-  std::uint64_t others = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
-  if (self == ConnectorKind::kNone) others &= ~(std::uint64_t{1} << s);
-  // The projection connectors sample the split (1, n - 1) of strings beginning DSD (a distant
-  // light) and the split (n - 1, 1) of strings ending DSD (an orthographic sensor). Their density
-  // is the plain split's with the projected endpoint's area density (light choice aside) replaced
-  // by 1, so their ratios to the plain recurrence's carry a factor 1 / pdf_pos (`conn_w2`, squared).
-  double conn_w2_first = 0.0, conn_w2_last = 0.0, self_w2 = 1.0;
-  if (has_connectors_) {
-    const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };  // c_i c_(i+1) c_(i+2) = DSD
-    if (n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && !(self == ConnectorKind::kDistantProjection)) {
-      const Vertex& x0 = s == 1 && t != 1 && sampled ? *sampled : th.light[0];
-      const double pos = rs_.lights[static_cast<std::size_t>(x0.light)].pdf_pos;
-      conn_w2_first = 1.0 / (pos * pos);
-      others |= std::uint64_t{1} << 1;
-    }
-    if (n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && !(self == ConnectorKind::kOrthoProjection)) {
-      conn_w2_last = 1.0 / (static_cast<double>(cam_.pdf_pos) * cam_.pdf_pos);
-      others |= std::uint64_t{1} << (n - 1);
-    }
-    if (self == ConnectorKind::kDistantProjection) {
-      const double pos = rs_.lights[static_cast<std::size_t>((sampled ? *sampled : th.light[0]).light)].pdf_pos;
-      self_w2 = pos * pos;
-    }
-    if (self == ConnectorKind::kOrthoProjection) self_w2 = static_cast<double>(cam_.pdf_pos) * cam_.pdf_pos;
-  }
-  if (others == 0) return 1.0f;
-  // The loops below reach only as far as the farthest strategy that can: the light side down to
-  // s2 = light_lo, the eye side up to s2 = eye_hi; densities beyond are not needed.
-  const std::uint64_t below = others & ((std::uint64_t{1} << s) - 1), above = others & ~below;
-  const int light_lo = below != 0 ? std::countr_zero(below) : s;
-  const int eye_hi = above != 0 ? 63 - std::countl_zero(above) : s;
-  const int eye_lo = n - eye_hi;  // the eye loop's last index: t when it does not run
-  const std::array<Vertex, kMaxVertices>& L = th.light;
-  const std::array<Vertex, kMaxVertices>& E = th.eye;
-  // The join's vertices; a fresh sample stands for z0 when t = 1, else for y0 when s = 1.
-  const Vertex* qs = s > 0 ? (s == 1 && t != 1 && sampled ? sampled : &L[static_cast<std::size_t>(s - 1)]) : nullptr;
-  const Vertex* pt = t > 0 ? (t == 1 && sampled ? sampled : &E[static_cast<std::size_t>(t - 1)]) : nullptr;
-  const Vertex* qsm = s > 1 ? &L[static_cast<std::size_t>(s - 2)] : nullptr;
-  const Vertex* ptm = t > 1 ? &E[static_cast<std::size_t>(t - 2)] : nullptr;
-  // --- the four reverse densities the join changes (the subpaths themselves stay untouched) ---
-  // Every direction is at hand: the join's (w, from qs to pt, at squared distance d2) and each
-  // vertex's unit direction to its predecessor (wo, at d2_wo); no normalisation is needed.
-  // Area density at `next` from solid-angle density `pdf_w` along unit `w` over squared distance `dist2`.
-  const auto area = [](float pdf_w, const Vertex& next, const vec3& w, float dist2) {
-    return dist2 > 0.0f ? pdf_w * abs_cos(next, w) / dist2 : 0.0f;
-  };
-  float rev_qs = 0.0f, rev_pt = 0.0f, rev_qsm = 0.0f, rev_ptm = 0.0f;
-  const bool need_pt = eye_lo <= t - 1, need_ptm = ptm && eye_lo <= t - 2;
-  const bool need_qs = light_lo <= s - 1, need_qsm = qsm && light_lo <= s - 2;
-  if (qs && pt) {
-    JoinDensity own;
-    if (join == nullptr) {
-      const vec3 e = pt->p - qs->p;
-      own.d2 = glm::dot(e, e);
-      own.w = own.d2 > 0.0f ? e * (1.0f / std::sqrt(own.d2)) : vec3(0.0f);  // as connect() forms it
-      join = &own;
-    }
-    const vec3 w = join->w, back = -w;
-    const float d2 = join->d2;
-    const bsdf::JoinPdfs& at_qs = join->at_qs;
-    const bsdf::JoinPdfs& at_pt = join->at_pt;
-    if (need_pt) rev_pt = area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2);
-    if (need_qs) rev_qs = area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2);
-    // A connector's endpoint sends a parallel beam: the density at the other end is per area.
-    if (self == ConnectorKind::kDistantProjection) rev_pt = parallel_jacobian(*pt, *qs, w);
-    if (self == ConnectorKind::kOrthoProjection) rev_qs = parallel_jacobian(*qs, *pt, w);
-    if (need_ptm) rev_ptm = area(at_pt.known ? at_pt.to_wo : pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo);
-    if (need_qsm) rev_qsm = area(at_qs.known ? at_qs.to_wo : pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo);
-  } else if (pt) {  // s = 0: pt lies on an area light
-    rev_pt = pdf_light_origin(*pt);
-    if (need_ptm) {
-      const RenderLight& l = rs_.lights[static_cast<std::size_t>(rs_.light_of_shape[static_cast<std::size_t>(pt->shape)])];
-      rev_ptm = area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo);
-    }
-  } else if (qs) {  // t = 0: qs is the lens point
-    rev_qs = cam_.pdf_pos;
-    if (need_qsm) rev_qsm = area(sensor_pdf_dir(*qs, qs->wo), *qsm, qs->wo, qs->d2_wo);
-  }
-  // --- hypothetical strategies: shorter eye subpaths, then shorter light subpaths ---
-  // Ratios in double: long paths multiply many of them. Dirac densities are stored as 0 and
-  // count as 1 here; their strategies are excluded by letter.
-  double sum = 0.0;
-  const auto runs = [&](int s2) { return static_cast<double>((others >> s2) & 1); };
-  // The term of strategy s2 for density ratio ri (a connector's carries its factor; profiles
-  // without connectors never take the branch).
-  const auto term = [&](int s2, double ri) {
-    double r2 = ri * ri;
-    if (has_connectors_) [[unlikely]]
-      r2 *= s2 == 1 && conn_w2_first != 0.0 ? conn_w2_first : s2 == n - 1 && conn_w2_last != 0.0 ? conn_w2_last : 1.0;
-    return r2;
-  };
-  if (all_runs_) {
-    // Each side: the join's two ratios, then the subpath's fixed part from prepare_joins().
-    if (eye_lo <= t - 1) {
-      const double a = remap(rev_pt) * (t == 1 && sampled ? inv_fwd(*pt) : th.eye_inv_fwd[static_cast<std::size_t>(t - 1)]);
-      const double a2 = a * a;
-      sum += a2 * runs(n - (t - 1));
-      if (need_ptm) {
-        const double b = remap(rev_ptm) * th.eye_inv_fwd[static_cast<std::size_t>(t - 2)];
-        sum += a2 * b * b * (runs(n - (t - 2)) + (t >= 3 ? th.eye_acc[static_cast<std::size_t>(t - 3)] : 0.0));
-      }
-    }
-    if (light_lo <= s - 1) {
-      const double a = remap(rev_qs) * (qs != &L[static_cast<std::size_t>(s - 1)] ? inv_fwd(*qs) : th.light_inv_fwd[static_cast<std::size_t>(s - 1)]);
-      const double a2 = a * a;
-      sum += a2 * runs(s - 1);
-      if (need_qsm) {
-        const double b = remap(rev_qsm) * th.light_inv_fwd[static_cast<std::size_t>(s - 2)];
-        sum += a2 * b * b * (runs(s - 2) + (s >= 3 ? th.light_acc[static_cast<std::size_t>(s - 3)] : 0.0));
-      }
-    }
-    return static_cast<float>(1.0 / (1.0 + sum));
-  }
-  double ri = 1.0;
-  for (int i = t - 1; i >= eye_lo; --i) {
-    ri *= i == t - 1   ? remap(rev_pt) / remap(pt->pdf_fwd)
-          : i == t - 2 ? remap(rev_ptm) / remap(E[static_cast<std::size_t>(i)].pdf_fwd)
-                       : th.eye_ratio[static_cast<std::size_t>(i)];
-    if ((others >> (n - i)) & 1) sum += term(n - i, ri);
-  }
-  ri = 1.0;
-  for (int i = s - 1; i >= light_lo; --i) {
-    ri *= i == s - 1   ? remap(rev_qs) / remap(qs->pdf_fwd)
-          : i == s - 2 ? remap(rev_qsm) / remap(L[static_cast<std::size_t>(i)].pdf_fwd)
-                       : th.light_ratio[static_cast<std::size_t>(i)];
-    if ((others >> i) & 1) sum += term(i, ri);
-  }
-  return static_cast<float>(1.0 / (1.0 + sum * self_w2));
-}
-
 void Integrator::record(Thread& th, const Pending& r) const {
   const Rgb rgb{r.c.x, r.c.y, r.c.z};
   ExactRgb e;
@@ -437,198 +297,24 @@ void Integrator::record_nonfinite(Thread& th, const Pending& r) const {
                                          th.pass, r.px, th.py};
 }
 
-template <Integrator::Connection C>
-void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) const {
-  constexpr bool by_light = C == Connection::kSplat || C == Connection::kOrtho || C == Connection::kLens;
-  // --only: a plain join whose path has a length no requested path has is not made (its numbers
-  // are its own dimensions, so no other join's change). Connectors count their attempts: they go on.
-  if constexpr (C != Connection::kDistant && C != Connection::kOrtho)
-    if (o_.only != nullptr && !o_.only->has_length(s + t + 2)) return;
-  rng.set_dimension(kJoinDims + (static_cast<std::uint64_t>(C) * kMaxRuns + static_cast<std::uint64_t>(by_light ? s : t)) * kDimsPerJoin);
-  // s = 0: the eye subpath's last vertex must lie on an area light, which most do not; tested
-  // before the join is set up.
-  [[maybe_unused]] int hit_light = -1;
-  if constexpr (C == Connection::kEmitter) {
-    const Vertex& z = th.eye[static_cast<std::size_t>(t - 1)];
-    if (z.kind != Kind::kSurface) return;
-    hit_light = rs_.light_of_shape[static_cast<std::size_t>(z.shape)];
-    if (hit_light < 0) return;
-  }
-  constexpr ConnectorKind kind = C == Connection::kDistant ? ConnectorKind::kDistantProjection : C == Connection::kOrtho ? ConnectorKind::kOrthoProjection : ConnectorKind::kNone;
-  const int strategy_index = C == Connection::kDistant ? distant_of(t) : C == Connection::kOrtho ? ortho_of(s) : strategy(s, t);
-  ConnectorStats* stats = kind != ConnectorKind::kNone ? &th.connectors[static_cast<std::size_t>(strategy_index)] : nullptr;
-  PathKey chain_s = 0;  // a connector's S letter
-  vec3 contrib{0.0f};
-  // The join builds into th.join (its fresh endpoint stands for z0 for a splat or a film point,
-  // for y0 otherwise); estimate() weighs and records it.
-  JoinResult& jr = th.join;
-  jr.chain = kind;
-  jr.s = s;
-  jr.t = t;
-  jr.strategy = strategy_index;
-  jr.density = JoinDensity{};
-  constexpr bool fresh_eye = C == Connection::kSplat || C == Connection::kOrtho;
-  Vertex& sampled = fresh_eye ? jr.eye0 : jr.light0;
-  bool splat = false;
-  float rx = 0.0f, ry = 0.0f;
-  const Vertex* qs = s > 0 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
-  const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
-  JoinDensity& join = jr.density;
-  bool joined = false;  // `join` describes this connection (every case but s = 0 and t = 0)
-  std::array<const Vertex*, 2> ends{};  // the shadow ray's ends, in the order visible() takes them
-  if constexpr (C == Connection::kEmitter) {
-    // --- eye path hits an area light (hit_light, above) ---
-    const LightParams& l = rs_.lights[static_cast<std::size_t>(hit_light)].params;
-    contrib = pt->beta * spatial_emission(l) * directional_emission(l, pt->n, pt->wo);
-  } else if constexpr (C == Connection::kLens) {
-    // --- light path hits the lens ---
-    if (qs->kind != Kind::kLens) return;
-    glm::vec2 raster;
-    const vec3 we = importance(cam_.params, qs->p, qs->wo, &raster);
-    if (is_black(we)) return;
-    to_pixels(raster, &rx, &ry);
-    contrib = qs->beta * we;
-    splat = true;
-  } else if constexpr (C == Connection::kSplat || C == Connection::kOrtho) {
-    // --- a light vertex joined to a sensor point: a fresh one (the splat, t = 1) or, for
-    //     ortho-projection, the film point on the line of sight through qs ---
-    if (qs->kind == Kind::kLens || !qs->finite) return;
-    std::optional<EndpointConnection> c;
-    if constexpr (C == Connection::kSplat) {
-      if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no DD join
-      c = connect_finite(cam_.params, rng.get2d_if(reads_lens_numbers(cam_.params)), qs->p);
-      if (!c) return;
-    } else {
-      const auto* film = std::get_if<OrthographicParams>(&cam_.params);
-      if (film == nullptr) return;
-      ++stats->attempts;
-      c = pathex::connect(*film, qs->p);
-      if (!c) {
-        ++stats->outside;
-        return;
-      }
-      chain_s = bit(s + 1);  // c(k+1), the sensor's direction
-    }
-    sampled = Vertex{};
-    sampled.kind = Kind::kCamera;
-    sampled.p = c->position;
-    sampled.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c->normal;  // a pinhole is a point
-    sampled.ns = sampled.n;
-    sampled.letter = C == Connection::kSplat ? 'D' : sensor_pair_[0];
-    sampled.pos_letter = sensor_pair_[1];
-    sampled.pdf_fwd = cam_.pdf_pos;
-    const vec3 w = c->wi;  // from qs to the sensor
-    to_pixels(c->raster, &rx, &ry);
-    vec3 fq;
-    // A light vertex's beta already holds its spatial emission; only the directional part is left.
-    if (qs->kind == Kind::kLight) fq = vec3(directional_emission(rs_.lights[static_cast<std::size_t>(qs->light)].params, qs->n, w));
-    else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                        qs->wo, w, qs->ns, qs->n, &join.at_qs);
-    join.w = w;
-    join.d2 = c->distance * c->distance;
-    joined = true;
-    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);  // weight: We cos / d² (splat), We (film)
-    ends = {qs, &sampled};
-    splat = true;
-  } else if constexpr (C == Connection::kNee || C == Connection::kDistant) {
-    // --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
-    //     for distant-projection, the aperture point on the line through pt against the light ---
-    if (pt->kind != Kind::kSurface || !pt->finite || rs_.lights.empty()) return;
-    const std::size_t li = pick_light(rng);
-    const RenderLight& l = rs_.lights[li];
-    std::optional<EndpointConnection> c;
-    vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
-    if constexpr (C == Connection::kNee) {
-      if (light_pairs_[li][1] != 'D') return;  // Dirac directions (distant, laser): no DD join
-      c = pathex::connect(l.params, sample_point(l, rng, &err), pt->p);
-      if (!c) return;
-    } else {
-      if (!std::holds_alternative<DistantLightParams>(l.params)) return;  // the light picked is not distant
-      ++stats->attempts;
-      c = pathex::connect(l.params, SurfacePoint{}, pt->p);
-      if (!c) {
-        ++stats->outside;
-        return;
-      }
-      err = aperture_error(l);
-      chain_s = bit(1);  // c1, the light's direction
-    }
-    sampled = Vertex{};
-    sampled.kind = Kind::kLight;
-    sampled.light = static_cast<int>(li);
-    sampled.pos_letter = light_pairs_[li][0];
-    sampled.letter = C == Connection::kNee ? 'D' : light_pairs_[li][1];
-    sampled.p = c->position;
-    sampled.n = c->normal;
-    sampled.err = err;
-    sampled.ns = sampled.n;
-    sampled.pdf_fwd = light_pick_ * l.pdf_pos;
-    const vec3 w = c->wi;  // from pt to the light
-    const vec3 f = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
-                             pt->wo, w, pt->ns, pt->n, &join.at_pt);
-    join.w = -w;  // w runs from pt to the light, the join's from the light to pt
-    join.d2 = c->distance * c->distance;
-    joined = true;
-    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;  // weight: Le cos / (p d²), I / d², E
-    ends = {pt, &sampled};
-  } else {
-    // --- a shadow ray between y(s-1) and z(t-1) ---
-    if (qs->kind == Kind::kLens || pt->kind != Kind::kSurface || qs->kind != Kind::kSurface) return;
-    if (!qs->finite || !pt->finite) return;
-    const vec3 d = pt->p - qs->p;
-    const float d2 = glm::dot(d, d);
-    if (d2 <= 0.0f) return;
-    const vec3 w = d * (1.0f / std::sqrt(d2));  // one division, not three
-    const vec3 fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                              qs->wo, w, qs->ns, qs->n, &join.at_qs);
-    const vec3 fp = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
-                              pt->wo, -w, pt->ns, pt->n, &join.at_pt);
-    join.w = w;
-    join.d2 = d2;
-    joined = true;
-    const float g = abs_cos(*qs, w) * abs_cos(*pt, w) / d2;
-    contrib = qs->beta * fq * fp * pt->beta * g;
-    ends = {qs, pt};
-  }
-  if (is_black(contrib)) {
-    if (stats) ++stats->no_transport;
-    return;
-  }
-  const bool fresh = C == Connection::kSplat || C == Connection::kNee || kind != ConnectorKind::kNone;
-  jr.has_eye0 = fresh && fresh_eye;
-  jr.has_light0 = fresh && !fresh_eye;
-  jr.chain_length = 0;
-  if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
-  jr.letters = path_key(th, s, t, fresh ? &sampled : nullptr) | chain_s;
-  jr.contribution = contrib;
-  jr.has_density = joined;
-  jr.splat = splat;
-  jr.rx = rx;
-  jr.ry = ry;
-  // No segment to test when the path's last edge was traced (an eye path on a light, a light
-  // path on the lens); else the shadow ray between the join's two ends.
-  jr.num_segments = C == Connection::kEmitter || C == Connection::kLens ? 0 : 1;
-  jr.segments[0] = {ends[0], ends[1]};
-  estimate(th, batch);
+Integrator::PathView Integrator::path_of(const Thread& th, const JoinResult& jr) {
+  PathView x;
+  x.light = th.light.data();
+  x.light0 = jr.has_light0 ? &jr.light0 : nullptr;
+  x.chain = jr.chain_vertices.data();
+  x.eye = th.eye.data();
+  x.eye0 = jr.has_eye0 ? &jr.eye0 : nullptr;
+  x.s = jr.s;
+  x.m = jr.chain_length;
+  x.t = jr.t;
+  return x;
 }
 
 void Integrator::estimate(Thread& th, int batch) const {
   const JoinResult& jr = th.join;
-  // The MIS weight over every strategy of the profile that samples this path: over whole-path
-  // densities when the mirror connector is one of them, else by the join-local recurrence.
   if (o_.only != nullptr && !o_.only->records(jr.letters)) return;  // --only: not requested, no weight, no shadow ray
-  float weight = 0.0f;
-  // With the manifold connector every path is weighed over whole paths (which chains it could
-  // build depends on the path's vertices, not on the join's).
-  if (has_manifold_ || jr.chain == ConnectorKind::kMirror || (has_mirror_ && mirror_can_sample(th, jr.s, jr.t, jr.letters))) {
-    gather(th, jr.s, jr.t, jr.has_light0 ? &jr.light0 : nullptr, jr.chain_length > 0 ? jr.chain_vertices.data() : nullptr, jr.chain_length,
-           jr.has_eye0 ? &jr.eye0 : nullptr);
-    weight = path_weight(th, jr.letters, jr.chain, jr.s);
-  } else if (nee_mis_ && jr.t >= 2) {  // pt-nee's two strategies (trace/accel/nee_mis.h)
-    weight = nee_mis_weight(th, jr.s, jr.t, jr.fresh(), jr.letters, jr.has_density ? &jr.density : nullptr);
-  } else {
-    weight = mis_weight(th, jr.s, jr.t, jr.fresh(), jr.letters, jr.has_density ? &jr.density : nullptr, jr.chain);
-  }
+  // The MIS weight over every strategy of the profile that samples this path (trace/mis_weight.cpp).
+  const float weight = mis_weight(th, path_of(th, jr), jr.letters, jr.chain, jr.has_density ? &jr.density : nullptr);
   // The technique, as the histogram names it: a projection's chain starts at c0 (distant: s = 0)
   // or ends at c(k+2) (ortho: t = 0).
   const bool connector = jr.chain != ConnectorKind::kNone;
@@ -653,224 +339,6 @@ void Integrator::estimate(Thread& th, int batch) const {
     if (i + 1 < jr.num_segments) lane.segments = 0;
   }
   if (th.shadow.full()) trace_shadows(th);
-}
-
-// --- the mirror connector ---
-
-void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const {
-  const int strategy_index = mirror_of(s, t);
-  ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
-  // Random numbers: a fresh light sample's from one block per t, a fresh sensor sample's from one
-  // block per s, after the seven blocks of connect()'s kinds.
-  constexpr std::uint64_t kLightBlock = 7, kEyeBlock = 8;
-  // --- the light end a: y(s-1), or a fresh light sample ---
-  const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, kLightBlock);
-  if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
-  const RenderLight* light = s == 1 ? &rs_.lights[static_cast<std::size_t>(a->light)] : nullptr;
-  // --- the eye end b: z(t-1), or (t = 1) a fresh sensor sample drawn per mirror ---
-  const Vertex* b = t >= 2 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
-  glm::vec2 u_lens{0.0f};
-  if (b) {
-    if (b->kind != Kind::kSurface || !b->finite) return;
-  } else {
-    if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no D end
-    rng.set_dimension(kJoinDims + (kEyeBlock * kMaxRuns + static_cast<std::uint64_t>(s)) * kDimsPerJoin);
-    u_lens = rng.get2d_if(reads_lens_numbers(cam_.params));
-  }
-  if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
-  // The letters: y(s-1)'s c(s) = D, the mirror's c(s+1) = S, z(t-1)'s c(s+2) = D.
-  const PathKey light_part = s == 1 ? letter_bit(a->pos_letter, 0) : th.light_mask & (bit(s) - 1);
-  const PathKey key = light_part | bit(s + 1) | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + 2)) & ~bit(s + 2)) |
-                      static_cast<PathKey>(s + t + 3) << kLengthShift;
-  for (const PlanarMirror& mirror : rs_.mirrors) {
-    ++stats.attempts;
-    float rx = 0.0f, ry = 0.0f;
-    std::optional<EndpointConnection> c;  // t = 1: the sensor's join to a's image
-    if (t == 1) {
-      c = connect_finite(cam_.params, u_lens, mirror_image(mirror, a->p));
-      if (!c) {
-        ++stats.outside;
-        continue;
-      }
-      Vertex& z0 = th.join.eye0;
-      z0 = Vertex{};
-      z0.kind = Kind::kCamera;
-      z0.p = c->position;
-      z0.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c->normal;
-      z0.ns = z0.n;
-      z0.letter = 'D';
-      z0.pos_letter = sensor_pair_[1];
-      z0.pdf_fwd = cam_.pdf_pos;
-      to_pixels(c->raster, &rx, &ry);
-      b = &z0;
-    }
-    MirrorMiss miss = MirrorMiss::kNone;
-    const std::optional<MirrorJoin> j = mirror_join(mirror, a->p, b->p, &miss);
-    if (!j) {
-      ++stats.outside;  // off the mirror, or the ends on different sides of its plane
-      continue;
-    }
-    // f at a towards the mirror: the light's directional emission, or the BSDF.
-    const vec3 fa = light ? vec3(directional_emission(light->params, a->n, j->w_a))
-                          : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, j->w_a, a->ns, a->n);
-    // Across the mirror the geometry term is the straight one to the image: |cos_a| |cos_b| / D².
-    vec3 contrib = a->beta * fa * mirror.reflectance * abs_cos(*a, j->w_a);
-    if (t == 1) {
-      contrib *= c->weight;  // We cos / (p D²), D = |a' − sensor point|
-    } else {
-      const vec3 fb = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(b->shape)], b->wo, j->w_b, b->ns, b->n);
-      contrib *= fb * b->beta * (abs_cos(*b, j->w_b) / (j->unfolded * j->unfolded));
-    }
-    if (is_black(contrib)) {
-      ++stats.no_transport;
-      continue;
-    }
-    JoinResult& jr = th.join;
-    Vertex& m = jr.chain_vertices[0];
-    m = Vertex{};
-    m.kind = Kind::kSurface;
-    m.letter = 'S';
-    m.p = j->point;
-    m.n = mirror.normal;
-    m.ns = mirror.normal;
-    m.err = mirror.error;
-    m.shape = mirror.shape;
-    jr.set_connector(ConnectorKind::kMirror, s, t, strategy_index, key, contrib, 1);
-    jr.segments = {Segment{a, &m}, Segment{&m, b}};  // both must be clear
-    jr.num_segments = 2;
-    jr.has_density = false;  // MIS over whole paths recomputes every density
-    jr.splat = t == 1;
-    jr.rx = rx;
-    jr.ry = ry;
-    estimate(th, batch);
-  }
-}
-
-const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, std::uint64_t block) const {
-  if (rs_.lights.empty()) return nullptr;
-  rng.set_dimension(kJoinDims + (block * kMaxRuns + static_cast<std::uint64_t>(t)) * kDimsPerJoin);
-  const std::size_t li = pick_light(rng);
-  const RenderLight& light = rs_.lights[li];
-  if (light_pairs_[li][1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
-  Vertex& y0 = th.join.light0;
-  y0 = Vertex{};
-  y0.kind = Kind::kLight;
-  y0.light = static_cast<int>(li);
-  y0.pos_letter = light_pairs_[li][0];
-  y0.letter = 'D';
-  const SurfacePoint x = sample_point(light, rng, &y0.err);
-  y0.p = light.is_area() ? x.position : light_position(light.params);
-  y0.n = light.is_area() ? x.normal : vec3(0.0f);
-  y0.ns = y0.n;
-  y0.pdf_fwd = light_pick_ * light.pdf_pos;
-  y0.beta = spatial_emission(light.params) / (light_pick_ * (light.pdf_pos > 0.0f ? light.pdf_pos : 1.0f));
-  return &y0;
-}
-
-void Integrator::gather(Thread& th, int s, int t, const Vertex* fresh_light, const Vertex* chain, int chain_length,
-                        const Vertex* fresh_eye) const {
-  th.path.clear();
-  for (int i = 0; i < s; ++i) th.path.push_back(i == 0 && fresh_light ? *fresh_light : th.light[static_cast<std::size_t>(i)]);
-  for (int i = 0; i < chain_length; ++i) th.path.push_back(chain[i]);
-  for (int j = t - 1; j >= 0; --j) th.path.push_back(j == 0 && fresh_eye ? *fresh_eye : th.eye[static_cast<std::size_t>(j)]);
-  Vertex& x0 = th.path.front();
-  if (s == 0) {  // an eye vertex on an area light starts the path
-    x0.kind = Kind::kLight;
-    x0.light = rs_.light_of_shape[static_cast<std::size_t>(x0.shape)];
-  }
-  if (t == 0) th.path.back().kind = Kind::kCamera;  // a light vertex on the lens ends it
-}
-
-bool Integrator::mirror_can_sample(const Thread& th, int s, int t, PathKey key) const {
-  const int k = packed_length(key) - 3;
-  for (int m = 1; m <= k - 1; ++m) {
-    if (((key >> m) & 7) != 2 || mirror_of(m, k - m) < 0) continue;  // c(m) c(m+1) c(m+2) = DSD
-    const Vertex& x = m < s ? th.light[static_cast<std::size_t>(m)] : th.eye[static_cast<std::size_t>(s + t - 1 - m)];
-    if (x.kind == Kind::kSurface && mirror_shape_[static_cast<std::size_t>(x.shape)]) return true;
-  }
-  return false;
-}
-
-float Integrator::path_weight(Thread& th, PathKey key, ConnectorKind self, int s) const {
-  // Every vertex's area density as the light walk (lf) and as the eye walk (ef) would sample it,
-  // Dirac ones stored as 0 and counted as 1 (remap()), as the subpaths store them. The density of
-  // plain split i (light vertices x0 … x(i-1)) is Π_{v<i} lf(v) Π_{v>=i} ef(v); the mirror
-  // connector's with its vertex at x_m lacks x_m's factor, Π_{v<m} lf(v) Π_{v>m} ef(v); the
-  // projections' are split 1's and split k's with the projected endpoint's area density replaced
-  // by 1 (as in mis_weight()). All are kept relative to split 0's: rel[i] = P_i / P_0.
-  const std::vector<Vertex>& x = th.path;
-  const int k = static_cast<int>(x.size()) - 1, n = k + 1;
-  const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
-  const auto lf = [&](int v) -> double {
-    if (v == 0) return light_pick_ * rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
-    if (v == 1 && letter_s(1) && rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos > 0.0f)
-      return parallel_jacobian(x[1], x[0], glm::normalize(x[1].p - x[0].p));  // a distant light's parallel beam
-    if (letter_s(v)) return 0.0;  // x(v-1) is a Dirac
-    return pdf(v >= 2 ? &x[static_cast<std::size_t>(v - 2)] : nullptr, x[static_cast<std::size_t>(v - 1)], x[static_cast<std::size_t>(v)]);
-  };
-  const auto ef = [&](int v) -> double {
-    if (v == k) return cam_.pdf_pos;
-    if (v == k - 1 && letter_s(k + 1) && cam_.pdf_pos > 0.0f)
-      return parallel_jacobian(x[static_cast<std::size_t>(k - 1)], x[static_cast<std::size_t>(k)],
-                               glm::normalize(x[static_cast<std::size_t>(k - 1)].p - x[static_cast<std::size_t>(k)].p));
-    if (letter_s(v + 2)) return 0.0;  // x(v+1) is a Dirac
-    return pdf(v + 2 <= k ? &x[static_cast<std::size_t>(v + 2)] : nullptr, x[static_cast<std::size_t>(v + 1)], x[static_cast<std::size_t>(v)]);
-  };
-  std::vector<double>& rel = th.rel;
-  std::vector<double>& e = th.eye_density;
-  rel.assign(static_cast<std::size_t>(n) + 1, 1.0);
-  e.assign(static_cast<std::size_t>(n), 1.0);
-  for (int v = 0; v <= k; ++v) {
-    e[static_cast<std::size_t>(v)] = remap(static_cast<float>(ef(v)));
-    rel[static_cast<std::size_t>(v) + 1] = rel[static_cast<std::size_t>(v)] * remap(static_cast<float>(lf(v))) / e[static_cast<std::size_t>(v)];
-  }
-  const double light_pos = rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
-  const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };
-  // The number of S vertices from x_i on (letters c(i+1) …), and the density of a chain
-  // connector whose chain is x_i … x(i+m-1): the light walk's up to x(i-1), the eye walk's from
-  // x(i+m) on, the chain's own vertices omitted (they are constructed, as the mirror's vertex).
-  const auto s_run = [&](int i) {
-    int m = 0;
-    while (i + m <= k - 1 && letter_s(i + m + 1)) ++m;
-    return m;
-  };
-  const auto chain_density = [&](int i, int m) {
-    double r = rel[static_cast<std::size_t>(i)];
-    for (int v = i; v < i + m; ++v) r /= e[static_cast<std::size_t>(v)];
-    return r;
-  };
-  const auto mirror_at = [&](int m) {
-    return m >= 1 && m <= k - 1 && dsd_at(m) && mirror_of(m, k - m) >= 0 && x[static_cast<std::size_t>(m)].kind == Kind::kSurface &&
-           mirror_shape_[static_cast<std::size_t>(x[static_cast<std::size_t>(m)].shape)];
-  };
-  double own = 0.0;
-  switch (self) {
-    case ConnectorKind::kNone: own = rel[static_cast<std::size_t>(s)]; break;
-    case ConnectorKind::kDistantProjection: own = rel[1] / light_pos; break;
-    case ConnectorKind::kOrthoProjection: own = rel[static_cast<std::size_t>(n - 1)] / cam_.pdf_pos; break;
-    case ConnectorKind::kMirror: own = rel[static_cast<std::size_t>(s)] / e[static_cast<std::size_t>(s)]; break;
-    case ConnectorKind::kManifold: own = chain_density(s, s_run(s)); break;
-  }
-  double sum = 0.0;
-  const auto add = [&](double p) {
-    const double r = p / own;
-    sum += r * r;
-  };
-  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));
-  const std::uint64_t plain = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
-  for (int i = 0; i <= n; ++i)
-    if ((plain >> i) & 1) add(rel[static_cast<std::size_t>(i)]);
-  if (n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && light_pos > 0.0) add(rel[1] / light_pos);
-  if (n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f) add(rel[static_cast<std::size_t>(n - 1)] / cam_.pdf_pos);
-  for (int m = 1; m <= k - 1; ++m)
-    if (mirror_at(m)) add(rel[static_cast<std::size_t>(m)] / e[static_cast<std::size_t>(m)]);
-  // The manifold's chains: every maximal run of S vertices x_i … x(i+m-1) between two D vertices.
-  if (has_manifold_)
-    for (int i = 1; i <= k - 1; ++i) {
-      const int m = s_run(i);
-      if (m > 0 && !letter_s(i) && manifold_at(th, key, i, m)) add(chain_density(i, m));
-    }
-  return sum > 0.0 && std::isfinite(sum) ? static_cast<float>(1.0 / sum) : 0.0f;
 }
 
 void Integrator::trace_shadows(Thread& th) const {
@@ -912,24 +380,30 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   // A light subpath that reached the lens ends there (random_walk stops), so only its last vertex
   // can be a lens vertex; it forms the t = 0 connection and no other.
   const bool lens_end = ns >= 2 && th.light[static_cast<std::size_t>(ns - 1)].kind == Kind::kLens;
-  if (lens_end && lens_hits_ && ns - 2 <= max_bounces_ && strategy(ns, 0) >= 0)
-    connect<Connection::kLens>(th, rng, ns, 0, batch);
+  // --- joins (trace/joins/): each makes th.join from the subpaths; estimate() weighs and records it ---
+  // --only: a plain join whose path has a length no requested path has is not made (its numbers
+  // are its own dimensions, so no other join's change). Connectors count their attempts: they go on.
+  const auto wanted = [&](int s, int t) { return o_.only == nullptr || o_.only->has_length(s + t + 2); };
+  const auto made = [&](bool joined) {
+    if (joined) estimate(th, batch);
+  };
+  if (lens_end && lens_hits_ && ns - 2 <= max_bounces_ && strategy(ns, 0) >= 0 && wanted(ns, 0)) made(join_lens(th, ns));
   // s = 1 takes a fresh light sample, so it runs even when no light subpath was traced.
   const int s_max = (rs_.lights.empty() ? ns : std::max(ns, 1)) - (lens_end ? 1 : 0);
   if (nt >= 1)
     for (int s = 1; s <= std::min(s_max, max_bounces_ + 1); ++s)
-      if (strategy(s, 1) >= 0) connect<Connection::kSplat>(th, rng, s, 1, batch);
+      if (strategy(s, 1) >= 0 && wanted(s, 1)) made(join_sensor(th, rng, s, ConnectorKind::kNone));
   for (int t = 2; t <= nt; ++t) {
     const int s_hi = std::min(s_max, max_bounces_ + 2 - t);
-    if (s_hi >= 0 && strategy(0, t) >= 0) connect<Connection::kEmitter>(th, rng, 0, t, batch);
-    if (s_hi >= 1 && strategy(1, t) >= 0) connect<Connection::kNee>(th, rng, 1, t, batch);
-    if (s_hi >= 1 && distant_of(t) >= 0) connect<Connection::kDistant>(th, rng, 1, t, batch);
+    if (s_hi >= 0 && strategy(0, t) >= 0 && wanted(0, t)) made(join_emitter(th, t));
+    if (s_hi >= 1 && strategy(1, t) >= 0 && wanted(1, t)) made(join_light(th, rng, t, ConnectorKind::kNone));
+    if (s_hi >= 1 && distant_of(t) >= 0) made(join_light(th, rng, t, ConnectorKind::kDistantProjection));
     for (int s = 2; s <= s_hi; ++s)
-      if (strategy(s, t) >= 0) connect<Connection::kJoin>(th, rng, s, t, batch);
+      if (strategy(s, t) >= 0 && wanted(s, t)) made(join_shadow(th, s, t));
   }
   if (has_connectors_ && nt >= 1)
     for (int s = 1; s <= std::min(ns - (lens_end ? 1 : 0), max_bounces_ + 1); ++s)
-      if (ortho_of(s) >= 0) connect<Connection::kOrtho>(th, rng, s, 1, batch);
+      if (ortho_of(s) >= 0) made(join_sensor(th, rng, s, ConnectorKind::kOrthoProjection));
   // The mirror connector's path has s + t + 1 vertices: s + t - 1 interior ones.
   if (has_mirror_)
     for (int t = 1; t <= nt; ++t)

@@ -3,10 +3,10 @@
 // scene and every profile the tracer runs, each strategy's weight is computed from its own side
 // (the vertices re-split at its join, densities recomputed as it would sample them) and summed.
 //
-// The renderer weighs a plain or projection join by the join-local recurrence (mis_weight(), with
-// per-sample sums when the profile runs every plain join); the general routine, path_weight(),
-// weighs whole paths from every vertex's two densities (profiles with the mirror connector use
-// it). The fast routine is a special case of the general one: the test pins the two equal.
+// The renderer weighs every join by one routine (trace/mis.h) over each vertex's two densities:
+// for a plain or projection join those the subpaths stored, with the four the join changes
+// recomputed; for a connector that constructs vertices, every density recomputed from the path.
+// The test pins the two sources equal on plain joins (the whole path's densities recomputed).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -35,7 +35,7 @@ struct IntegratorTestAccess {
     *ns = in.light_subpath(th, rng, rng.at2d(rng.dimension() + 3));
     th.ns = *ns;
     th.nt = nt;
-    in.prepare_joins(th, *ns, nt);
+    in.set_masks(th, *ns, nt);
     return nt;
   }
   // The full-path string of connection (s, t), spelled out from the vertices.
@@ -48,35 +48,67 @@ struct IntegratorTestAccess {
   static std::string packed_label(const Integrator& in, const Integrator::Thread& th, int s, int t) {
     return unpack(in.path_key(th, s, t, nullptr));
   }
+  // The path of connection (s, t) of the current subpaths (a fresh light point `y0` for s = 1).
+  static Integrator::PathView plain_path(const Thread& th, int s, int t, const Vertex* y0 = nullptr) {
+    Integrator::PathView x;
+    x.light = th.light.data();
+    x.light0 = s == 1 ? y0 : nullptr;
+    x.eye = th.eye.data();
+    x.s = s;
+    x.t = t;
+    return x;
+  }
   // The weight of connection (s, t) of the current subpaths, as the renderer computes it.
   static float own_weight(const Integrator& in, Integrator::Thread& th, int s, int t) {
-    in.prepare_joins(th, th.ns, th.nt);
-    return in.mis_weight(th, s, t, nullptr, in.path_key(th, s, t, nullptr));
+    in.set_masks(th, th.ns, th.nt);
+    return in.mis_weight(th, plain_path(th, s, t), in.path_key(th, s, t, nullptr), ConnectorKind::kNone, nullptr);
   }
-  // The same weight by the general routine over the whole path's densities.
+  // The path x0 … xk of connection (s, t) as one array (an eye vertex on a light becoming x0's
+  // light vertex, a light vertex on the lens xk's camera vertex), as a connector's path is formed.
+  static std::vector<Vertex> gather(const Integrator& in, const Thread& th, int s, int t) {
+    std::vector<Vertex> path;
+    for (int i = 0; i < s; ++i) path.push_back(th.light[static_cast<std::size_t>(i)]);
+    for (int j = t - 1; j >= 0; --j) path.push_back(th.eye[static_cast<std::size_t>(j)]);
+    if (s == 0) {
+      path.front().kind = Kind::kLight;
+      path.front().light = in.rs_.light_of_shape[static_cast<std::size_t>(path.front().shape)];
+    }
+    if (t == 0) path.back().kind = Kind::kCamera;
+    return path;
+  }
+  // Strategy (s, m constructed, t) over the whole path `path`.
+  static Integrator::PathView whole(const std::vector<Vertex>& path, int s, int m) {
+    Integrator::PathView x;
+    x.whole = path.data();
+    x.s = s;
+    x.m = m;
+    x.t = static_cast<int>(path.size()) - s - m;
+    return x;
+  }
+  // The same weight with every density recomputed from the path's vertices.
   static float general_weight(const Integrator& in, Integrator::Thread& th, int s, int t) {
-    in.gather(th, s, t, nullptr, nullptr, 0, nullptr);
-    return in.path_weight(th, in.path_key(th, s, t, nullptr), ConnectorKind::kNone, s);
+    const std::vector<Vertex> path = gather(in, th, s, t);
+    return in.mis_weight(th, whole(path, s, 0), in.path_key(th, s, t, nullptr), ConnectorKind::kNone, nullptr);
   }
-  // For the path of plain connection (s, t) (gathered into th.path): the weights that path_weight()
-  // gives it as each strategy that could sample it, the plain joins (s2, DD, ·) whose letters are
-  // D and the manifold's chains, each computed as its own strategy. *chains: how many manifold
-  // chains could build it. Must sum to 1.
+  // For the path of plain connection (s, t): the weights that the routine gives it, with every
+  // density recomputed, as each strategy that could sample it, the plain joins (s2, DD, ·) whose
+  // letters are D and the manifold's chains, each computed as its own strategy. *chains: how many
+  // manifold chains could build it. Must sum to 1.
   static double whole_path_weight_sum(const Integrator& in, Integrator::Thread& th, int s, int t, int* chains) {
-    in.gather(th, s, t, nullptr, nullptr, 0, nullptr);
+    const std::vector<Vertex> path = gather(in, th, s, t);
     const PathKey key = in.path_key(th, s, t, nullptr);
-    const int k = static_cast<int>(th.path.size()) - 1, n = k + 1;
+    const int k = static_cast<int>(path.size()) - 1, n = k + 1;
     double sum = 0.0;
     *chains = 0;
     for (int s2 = 0; s2 <= n; ++s2)
       if (((in.runs_mask_[static_cast<std::size_t>(n)] >> s2) & 1) && packed_is_d(key, s2) && packed_is_d(key, s2 + 1))
-        sum += in.path_weight(th, key, ConnectorKind::kNone, s2);
+        sum += in.mis_weight(th, whole(path, s2, 0), key, ConnectorKind::kNone, nullptr);
     for (int i = 1; i <= k - 1; ++i) {
       int m = 0;
       while (i + m <= k - 1 && !packed_is_d(key, i + m + 1)) ++m;
-      if (m > 0 && in.manifold_at(th, key, i, m)) {
+      if (m > 0 && in.manifold_at(whole(path, i, m), key, i, m)) {
         ++*chains;
-        sum += in.path_weight(th, key, ConnectorKind::kManifold, i);
+        sum += in.mis_weight(th, whole(path, i, m), key, ConnectorKind::kManifold, nullptr);
       }
     }
     return sum;
@@ -110,13 +142,15 @@ struct IntegratorTestAccess {
     return true;
   }
   // The weight of connection (s, t) of the current subpaths (a fresh light point `y0` for s = 1)
-  // with the join's density `join` (null: recomputed), and the letters it records.
-  // As the estimator chooses: the fast path when the integrator takes it (t >= 2 here).
-  static float weight_of(const Integrator& in, const Thread& th, int s, int t, const Vertex* y0, const JoinDensity* join) {
-    const PathKey key = in.path_key(th, s, t, y0);
-    return in.nee_mis_ ? in.nee_mis_weight(th, s, t, y0, key, join) : in.mis_weight(th, s, t, y0, key, join);
+  // with the join's density `join` (null: recomputed), as the estimator computes it.
+  static float weight_of(const Integrator& in, Thread& th, int s, int t, const Vertex* y0, const JoinDensity* join) {
+    return in.mis_weight(th, plain_path(th, s, t, y0), in.path_key(th, s, t, y0), ConnectorKind::kNone, join);
   }
-  static bool takes_nee_fast_path(const Integrator& in) { return in.nee_mis_; }
+  // The density with which next-event estimation draws the point `on_light` of an area light.
+  static float light_point_density(const Integrator& in, const Vertex& on_light) {
+    return in.light_pick_ * in.rs_.lights[static_cast<std::size_t>(in.rs_.light_of_shape[static_cast<std::size_t>(on_light.shape)])].pdf_pos;
+  }
+  static const Material& material(const Integrator& in, const Vertex& v) { return *in.rs_.material_of_shape[static_cast<std::size_t>(v.shape)]; }
   // Whether (s, t) joins two vertices that can be joined (s = 0: an eye vertex on an area light;
   // t = 0: a light vertex on the lens; otherwise two surfaces with finite parts).
   static bool joinable(const Integrator& in, const Integrator::Thread& th, int s, int t) {
@@ -208,12 +242,12 @@ struct IntegratorTestAccess {
         th.light[1].pdf_fwd = Integrator::parallel_jacobian(th.light[1], th.light[0], glm::normalize(th.light[1].p - th.light[0].p));
       if (t2 >= 2 && in.cam_.pdf_pos > 0.0f && in.sensor_pair_[0] == 'S')
         th.eye[1].pdf_fwd = Integrator::parallel_jacobian(th.eye[1], th.eye[0], glm::normalize(th.eye[1].p - th.eye[0].p));
-      in.prepare_joins(th, s2, t2);  // the ratios of the re-split subpaths
-      sum += in.mis_weight(th, s2, t2, nullptr, pack(letters), nullptr, kind);
+      in.set_masks(th, s2, t2);
+      sum += in.mis_weight(th, plain_path(th, s2, t2), pack(letters), kind, nullptr);
     }
     th.light = saved_light_eye.light;
     th.eye = saved_light_eye.eye;
-    in.prepare_joins(th, th.ns, th.nt);
+    in.set_masks(th, th.ns, th.nt);
     return sum;
   }
 };
@@ -225,8 +259,7 @@ struct MisCheck {
   int s = 0, t = 0;
   double weight_sum = 0.0;
   double weight = 0.0;          // as the renderer computes it
-  double weight_recurrence = 0.0;  // by the recurrence without the per-sample sums
-  double weight_general = 0.0;  // by the general routine over whole paths
+  double weight_general = 0.0;  // with every density recomputed from the path
   std::string recorded;         // the label as the renderer packs and records it: must equal `path`
 };
 
@@ -241,7 +274,6 @@ std::vector<MisCheck> check_mis_weights(const Scene& scene, const Profile& profi
   HistogramLayout layout;
   ClassImages images(1, 1, nullptr, {});
   const Integrator integrator(rs, strategies, o);
-  const Integrator recurrence(rs, strategies, o, /*general_mis=*/true);
   Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
   th.images = &images;
   th.connectors.resize(strategies.strategies.size());
@@ -259,9 +291,8 @@ std::vector<MisCheck> check_mis_weights(const Scene& scene, const Profile& profi
         if (table.plain(s, t) < 0 || !A::joinable(integrator, th, s, t)) continue;
         const float sum = A::weight_sum(integrator, th, s, t);
         const float weight = A::own_weight(integrator, th, s, t);
-        const float weight_recurrence = A::own_weight(recurrence, th, s, t);
         const float weight_general = A::general_weight(integrator, th, s, t);
-        out.push_back({A::label(integrator, th, s, t), s, t, sum, weight, weight_recurrence, weight_general,
+        out.push_back({A::label(integrator, th, s, t), s, t, sum, weight, weight_general,
                        A::packed_label(integrator, th, s, t)});
       }
   }
@@ -289,9 +320,7 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
         };
         EXPECT_NEAR(c.weight_sum, 1.0, 1e-4) << where();
         EXPECT_EQ(c.recorded, c.path) << "the packed label differs: " << where();
-        // The per-sample sums (profiles running every plain join) and the join-local recurrence
-        // are special cases of the general routine over whole paths and must give its weight.
-        EXPECT_NEAR(c.weight, c.weight_recurrence, 1e-5 * std::max(1.0, c.weight_recurrence)) << where();
+        // The subpaths' stored densities give the weight that the path's recomputed ones give.
         EXPECT_NEAR(c.weight, c.weight_general, 1e-4 * std::max(1.0, c.weight_general)) << where();
       }
     }
@@ -300,14 +329,20 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
   EXPECT_GE(by_length.size(), 5u);  // paths of many lengths
 }
 
-// pt-nee's fast path (trace/accel/nee_mis.h) is a special case of the general MIS routine: on
-// random paths of every sample scene, the weights of its emitter hits (0, t) and of its next-event
-// estimation (1, t) from fresh light points equal, bit for bit, those of the join-local recurrence
-// (an integrator built with general_mis, which takes no fast path), with the join's densities as
-// connect() computes them and recomputed. Fixed seed; every profile the fast path applies to.
-TEST(Mis, NeeFastPathEqualsTheGeneralRoutine) {
+// Where a profile's plain joins are the emitter hit and next-event estimation alone (pt-nee, pt,
+// and pbrt-v4-path and mitsuba3-path where their distant connector cannot run), a path is weighed
+// against one other strategy at most, and the two differ in one density: the point on the light,
+// drawn from the light (its pick times its point's area density) by next-event estimation, or by
+// the BSDF at the eye vertex before it (solid angle, to area at the light point) by the emitter
+// hit. The one MIS routine must give the two-strategy power heuristic of those two numbers,
+// computed here independently of it, on random paths of every sample scene. Fixed seed.
+TEST(Mis, PathTracerWeightsAreTheTwoStrategyPowerHeuristic) {
   const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes";
   using A = IntegratorTestAccess;
+  const auto heuristic = [](double own, double other) {  // a Dirac's density, stored as 0, counts as 1
+    const double r = remap_density(static_cast<float>(other)) / remap_density(static_cast<float>(own));
+    return 1.0 / (1.0 + r * r);
+  };
   int scenes = 0, nee_weighed = 0, hits_weighed = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".json") continue;
@@ -317,19 +352,18 @@ TEST(Mis, NeeFastPathEqualsTheGeneralRoutine) {
       const Profile profile = resolve_profile(renderer, Limits{}).expect("a built-in profile");
       const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
       const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
+      // Only where no connector can run (a distant-projection needs a distant light).
+      bool connector = false;
+      for (const Strategy& st : strategies.strategies)
+        for (const RenderLight& l : rs.lights)
+          connector = connector || (st.connector != ConnectorKind::kNone && std::holds_alternative<DistantLightParams>(l.params));
+      if (connector) continue;
       RenderOptions o;
       o.seed = 17;
       o.max_bounces = std::min(8, profile.max_bounces.value_or(8));
       HistogramLayout layout;
       ClassImages images(1, 1, nullptr, {});
-      const Integrator fast(rs, strategies, o);
-      const Integrator general(rs, strategies, o, /*general_mis=*/true);
-      ASSERT_FALSE(A::takes_nee_fast_path(general));
-      // pt-nee and pt always; pbrt-v4-path and mitsuba3-path where their distant connector cannot run.
-      if (std::string(renderer) == "pt-nee" || std::string(renderer) == "pt") {
-        EXPECT_TRUE(A::takes_nee_fast_path(fast)) << renderer;
-      }
-      if (!A::takes_nee_fast_path(fast)) continue;
+      const Integrator in(rs, strategies, o);
       Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
       th.images = &images;
       th.connectors.resize(strategies.strategies.size());
@@ -337,28 +371,37 @@ TEST(Mis, NeeFastPathEqualsTheGeneralRoutine) {
       for (int i = 0; i < 400; ++i) {
         Sampler rng(17, static_cast<std::uint64_t>(i), 0);
         int ns = 0;
-        const int nt = A::trace_subpaths(fast, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
+        const int nt = A::trace_subpaths(in, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
         for (int t = 2; t <= nt && t - 2 <= *o.max_bounces; ++t) {
           const auto where = [&](int s) {
-            return entry.path().filename().string() + " " + renderer + " " + A::label(fast, th, s, t) + " (s=" + std::to_string(s) +
+            return entry.path().filename().string() + " " + renderer + " " + A::label(in, th, s, t) + " (s=" + std::to_string(s) +
                    ", t=" + std::to_string(t) + ", sample " + std::to_string(i) + ")";
           };
-          if (table.plain(0, t) >= 0 && A::joinable(fast, th, 0, t)) {
-            const float w = A::weight_of(fast, th, 0, t, nullptr, nullptr);
-            EXPECT_EQ(std::bit_cast<std::uint32_t>(w), std::bit_cast<std::uint32_t>(A::weight_of(general, th, 0, t, nullptr, nullptr)))
-                << where(0);
+          const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
+          if (table.plain(0, t) >= 0 && A::joinable(in, th, 0, t)) {
+            // The emitter hit against next-event estimation (1, t - 1) from z(t-2), where it runs
+            // and z(t-2) is D.
+            const bool other = t >= 3 && table.plain(1, t - 1) >= 0 && th.eye[static_cast<std::size_t>(t - 2)].letter == 'D';
+            const double expected = other ? heuristic(pt.pdf_fwd, A::light_point_density(in, pt)) : 1.0;
+            const float w = A::weight_of(in, th, 0, t, nullptr, nullptr);
+            EXPECT_NEAR(w, expected, 1e-6) << where(0);
             if (w < 1.0f) ++hits_weighed;
           }
           Vertex y0;
           JoinDensity join;
           Sampler light_rng(17, static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(t));
-          if (t + 1 - 2 <= *o.max_bounces && table.plain(1, t) >= 0 && A::nee_join(fast, th, t, light_rng, &y0, &join)) {
-            const float w = A::weight_of(fast, th, 1, t, &y0, &join);
-            EXPECT_EQ(std::bit_cast<std::uint32_t>(w), std::bit_cast<std::uint32_t>(A::weight_of(general, th, 1, t, &y0, &join)))
-                << where(1);
-            EXPECT_EQ(std::bit_cast<std::uint32_t>(A::weight_of(fast, th, 1, t, &y0, nullptr)),
-                      std::bit_cast<std::uint32_t>(A::weight_of(general, th, 1, t, &y0, nullptr)))
-                << where(1) << ", the join's density recomputed";
+          if (t + 1 - 2 <= *o.max_bounces && table.plain(1, t) >= 0 && A::nee_join(in, th, t, light_rng, &y0, &join)) {
+            // Next-event estimation against the emitter hit (0, t + 1), where it runs and the light's
+            // position letter is D: the BSDF's density towards y0, to area at y0.
+            const vec3 e = y0.p - pt.p;
+            const float d2 = glm::dot(e, e);
+            const vec3 w_to = e / std::sqrt(d2);
+            const float hit = bsdf::pdf(A::material(in, pt), pt.wo, w_to, pt.ns, pt.n) * abs_cos(y0, w_to) / d2;
+            const bool other = table.plain(0, t + 1) >= 0 && y0.pos_letter == 'D';
+            const double expected = other ? heuristic(y0.pdf_fwd, hit) : 1.0;
+            const float w = A::weight_of(in, th, 1, t, &y0, &join);
+            EXPECT_NEAR(w, expected, 1e-5 * expected) << where(1);
+            EXPECT_NEAR(w, A::weight_of(in, th, 1, t, &y0, nullptr), 1e-6) << where(1) << ", the join's density recomputed";
             if (w < 1.0f) ++nee_weighed;
           }
         }

@@ -51,22 +51,21 @@ void Integrator::init_manifold() {
   scene_size_ = std::isfinite(size) && size > 0.0 ? size : 1.0;
 }
 
-bool Integrator::manifold_at(const Thread& th, PathKey key, int i, int m) const {
-  const std::vector<Vertex>& x = th.path;
-  const int k = static_cast<int>(x.size()) - 1;
+bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const {
+  const int k = x.size() - 1;
   const int t = k + 1 - i - m;  // letters after the chain
   if (i < 1 || m < 1 || m > kMaxChain || t < 2 || manifold_of(i, t) < 0) return false;
   if (!packed_is_d(key, i) || !packed_is_d(key, i + m + 1)) return false;
-  const Vertex& a = x[static_cast<std::size_t>(i - 1)];
-  const Vertex& b = x[static_cast<std::size_t>(i + m)];
+  const Vertex& a = x[i - 1];
+  const Vertex& b = x[i + m];
   if (b.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(b.shape)]) return false;
   if (i >= 2 && (a.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(a.shape)])) return false;
   for (int v = i; v < i + m; ++v) {
-    const Vertex& c = x[static_cast<std::size_t>(v)];
+    const Vertex& c = x[v];
     if (c.kind != Kind::kSurface) return false;
     const std::size_t shape = static_cast<std::size_t>(c.shape);
-    const float before = glm::dot(x[static_cast<std::size_t>(v - 1)].p - c.p, c.n);
-    const float after = glm::dot(x[static_cast<std::size_t>(v + 1)].p - c.p, c.n);
+    const float before = glm::dot(x[v - 1].p - c.p, c.n);
+    const float after = glm::dot(x[v + 1].p - c.p, c.n);
     // Glass reflects or refracts; a mirror (or a mixture's mirror part) reflects.
     if (glass_ior_[shape] == 0.0f && (is_black(mirror_reflectance_[shape]) || !(before * after > 0.0f))) return false;
   }
@@ -137,10 +136,9 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
 void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = manifold_of(s, t);
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
-  constexpr std::uint64_t kLightBlock = 9;  // after connect()'s seven blocks and the mirror's two
   const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
   if (b->kind != Kind::kSurface || !b->finite) return;
-  const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, kLightBlock);
+  const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kManifoldLight);
   if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
   // The seeds draw from their own counter-based stream (an unbounded count of numbers per join).
   const std::uint64_t stream = stream_key(rng.key(), th.pass, 0x6d616e69666f6c64ULL + static_cast<std::uint64_t>(s) * kMaxRuns +
@@ -225,7 +223,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
 }
 
 PathKey Integrator::manifold_key(Thread& th, const Vertex& a, int s, int t, int m) const {
-  if (!th.joins_ready) prepare_joins(th, th.ns, th.nt);
+  if (!th.joins_ready) set_masks(th, th.ns, th.nt);
   // The letters: a's c(s) = D, the chain's c(s+1) … c(s+m) = S, b's c(s+m+1) = D.
   const PathKey light_part = s == 1 ? letter_bit(a.pos_letter, 0) : th.light_mask & (bit(s) - 1);
   PathKey key = light_part | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + m + 1)) & ~bit(s + m + 1)) |
@@ -268,9 +266,8 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
   const vec3 w_a = glm::normalize(jr.chain_vertices[0].p - a->p);
   const vec3 w_b = glm::normalize(jr.chain_vertices[static_cast<std::size_t>(m - 1)].p - b->p);
   // f at a towards the chain: the light's directional emission (a's beta holds the spatial part), or the BSDF.
-  const vec3 fa = s == 1 ? vec3(directional_emission(rs_.lights[static_cast<std::size_t>(a->light)].params, a->n, w_a))
-                         : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, w_a, a->ns, a->n);
-  const vec3 fb = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(b->shape)], b->wo, w_b, b->ns, b->n);
+  const vec3 fa = end_f(*a, w_a, TransportMode::kImportance);
+  const vec3 fb = end_f(*b, w_b, TransportMode::kRadiance);
   // Flux leaving a into dω lands on dA_b = dω / |dω_a/dA_b|: the generalized geometry term, here
   // times the chain's estimated inverse probability (`weight`).
   const vec3 contrib = a->beta * fa * abs_cos(*a, w_a) * transmit * fb * b->beta *

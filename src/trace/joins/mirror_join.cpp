@@ -1,0 +1,104 @@
+// The mirror connector (s, DSD, t) of DESIGN §4: y(s-1) (or a fresh light sample) joined to z(t-1)
+// (or a fresh sensor sample) across each planar mirror by the image method (trace/joins/mirror.h
+// for the geometry), one JoinResult per mirror that the straight line to the image meets.
+#include "trace/integrator.h"
+#include "trace/joins/mirror.h"
+
+namespace pathex::tracer {
+namespace {
+bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+}  // namespace
+
+void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const {
+  const int strategy_index = mirror_of(s, t);
+  ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
+  // Random numbers: a fresh light sample's from one block per t, a fresh sensor sample's from one
+  // block per s.
+  // --- the light end a: y(s-1), or a fresh light sample ---
+  const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kMirrorLight);
+  if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
+  // --- the eye end b: z(t-1), or (t = 1) a fresh sensor sample drawn per mirror ---
+  const Vertex* b = t >= 2 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
+  glm::vec2 u_lens{0.0f};
+  if (b) {
+    if (b->kind != Kind::kSurface || !b->finite) return;
+  } else {
+    if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no D end
+    join_numbers(rng, JoinBlock::kMirrorEye, s);
+    u_lens = rng.get2d_if(reads_lens_numbers(cam_.params));
+  }
+  if (!th.joins_ready) set_masks(th, th.ns, th.nt);
+  // The letters: y(s-1)'s c(s) = D, the mirror's c(s+1) = S, z(t-1)'s c(s+2) = D.
+  const PathKey light_part = s == 1 ? letter_bit(a->pos_letter, 0) : th.light_mask & (bit(s) - 1);
+  const PathKey key = light_part | bit(s + 1) | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + 2)) & ~bit(s + 2)) |
+                      static_cast<PathKey>(s + t + 3) << kLengthShift;
+  for (const PlanarMirror& mirror : rs_.mirrors) {
+    ++stats.attempts;
+    float rx = 0.0f, ry = 0.0f;
+    std::optional<EndpointConnection> c;  // t = 1: the sensor's join to a's image
+    if (t == 1) {
+      c = connect_finite(cam_.params, u_lens, mirror_image(mirror, a->p));
+      if (!c) {
+        ++stats.outside;
+        continue;
+      }
+      const Vertex& z0 = fresh_sensor_vertex(th, *c, 'D');
+      to_pixels(c->raster, &rx, &ry);
+      b = &z0;
+    }
+    MirrorMiss miss = MirrorMiss::kNone;
+    const std::optional<MirrorJoin> j = mirror_join(mirror, a->p, b->p, &miss);
+    if (!j) {
+      ++stats.outside;  // off the mirror, or the ends on different sides of its plane
+      continue;
+    }
+    // f at a towards the mirror: the light's directional emission, or the BSDF.
+    const vec3 fa = end_f(*a, j->w_a, TransportMode::kImportance);
+    // Across the mirror the geometry term is the straight one to the image: |cos_a| |cos_b| / D².
+    vec3 contrib = a->beta * fa * mirror.reflectance * abs_cos(*a, j->w_a);
+    if (t == 1) {
+      contrib *= c->weight;  // We cos / (p D²), D = |a' − sensor point|
+    } else {
+      const vec3 fb = end_f(*b, j->w_b, TransportMode::kRadiance);
+      contrib *= fb * b->beta * (abs_cos(*b, j->w_b) / (j->unfolded * j->unfolded));
+    }
+    if (is_black(contrib)) {
+      ++stats.no_transport;
+      continue;
+    }
+    JoinResult& jr = th.join;
+    Vertex& m = jr.chain_vertices[0];
+    m = Vertex{};
+    m.kind = Kind::kSurface;
+    m.letter = 'S';
+    m.p = j->point;
+    m.n = mirror.normal;
+    m.ns = mirror.normal;
+    m.err = mirror.error;
+    m.shape = mirror.shape;
+    jr.set_connector(ConnectorKind::kMirror, s, t, strategy_index, key, contrib, 1);
+    jr.segments = {Segment{a, &m}, Segment{&m, b}};  // both must be clear
+    jr.num_segments = 2;
+    jr.has_density = false;  // MIS over whole paths recomputes every density
+    jr.splat = t == 1;
+    jr.rx = rx;
+    jr.ry = ry;
+    estimate(th, batch);
+  }
+}
+
+const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinBlock block) const {
+  if (rs_.lights.empty()) return nullptr;
+  join_numbers(rng, block, t);
+  const std::size_t li = pick_light(rng);
+  const RenderLight& light = rs_.lights[li];
+  if (light_pairs_[li][1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
+  vec3 err{0.0f};
+  const SurfacePoint x = sample_point(light, rng, &err);
+  Vertex& y0 = fresh_light_vertex(th, li, light.is_area() ? x.position : light_position(light.params),
+                                  light.is_area() ? x.normal : vec3(0.0f), err, 'D');
+  y0.beta = spatial_emission(light.params) / (light_pick_ * (light.pdf_pos > 0.0f ? light.pdf_pos : 1.0f));
+  return &y0;
+}
+
+}  // namespace pathex::tracer

@@ -1,0 +1,212 @@
+// The plain joins (s, DD, t) of DESIGN §4 and the two projection connectors (distant (0, DSD, t),
+// orthographic (s, DSD, 0)), each a function from the two subpaths to the JoinResult in th.join
+// (true when it made one): its vertices, letters, contribution before weighting, the segments that
+// must be clear and the densities MIS needs of it. The estimator (render.cpp) weighs and records it.
+//
+// Each join draws its random numbers from a block of its own (join_numbers()), so that adding a
+// strategy leaves every other strategy's numbers unchanged. At a join's two end vertices the
+// scattering functions are evaluated by one helper, end_f().
+#include <cmath>
+
+#include "trace/bsdf.h"
+#include "trace/integrator.h"
+#include "trace/prune.h"
+
+namespace pathex::tracer {
+namespace {
+bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+}  // namespace
+
+vec3 Integrator::end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs) const {
+  // A light vertex's beta already holds its spatial emission; only the directional part is left.
+  if (v.kind == Kind::kLight) return vec3(directional_emission(rs_.lights[static_cast<std::size_t>(v.light)].params, v.n, w));
+  const Material& m = *rs_.material_of_shape[static_cast<std::size_t>(v.shape)];
+  const vec3 f = pdfs ? bsdf::eval(m, v.wo, w, v.ns, v.n, pdfs) : bsdf::eval(m, v.wo, w, v.ns, v.n);
+  // The light end carries importance: shading normals make its transport asymmetric (Veach §5.3).
+  return mode == TransportMode::kImportance ? f * bsdf::shading_normal_correction(v.wo, w, v.ns, v.n, mode) : f;
+}
+
+void Integrator::begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const {
+  JoinResult& jr = th.join;
+  jr.chain = kind;
+  jr.s = s;
+  jr.t = t;
+  jr.strategy = strategy_index;
+  jr.density = JoinDensity{};
+  jr.has_density = false;
+  jr.has_light0 = jr.has_eye0 = false;
+  jr.chain_length = 0;
+  jr.splat = false;
+  jr.rx = jr.ry = 0.0f;
+  jr.num_segments = 0;
+}
+
+bool Integrator::end_join(Thread& th, const vec3& contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const {
+  JoinResult& jr = th.join;
+  if (is_black(contrib)) {
+    if (jr.chain != ConnectorKind::kNone) ++th.connectors[static_cast<std::size_t>(jr.strategy)].no_transport;
+    return false;
+  }
+  if (!th.joins_ready) set_masks(th, th.ns, th.nt);
+  jr.letters = path_key(th, jr.s, jr.t, jr.fresh()) | chain_s;
+  jr.contribution = contrib;
+  // No segment to test when the path's last edge was traced (an eye path on a light, a light
+  // path on the lens); else the shadow ray between the join's two ends.
+  jr.num_segments = from ? 1 : 0;
+  jr.segments[0] = {from, to};
+  return true;
+}
+
+Vertex& Integrator::fresh_sensor_vertex(Thread& th, const EndpointConnection& c, char letter) const {
+  Vertex& z0 = th.join.eye0;
+  z0 = Vertex{};
+  z0.kind = Kind::kCamera;
+  z0.p = c.position;
+  z0.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c.normal;  // a pinhole is a point
+  z0.ns = z0.n;
+  z0.letter = letter;
+  z0.pos_letter = sensor_pair_[1];
+  z0.pdf_fwd = cam_.pdf_pos;
+  th.join.has_eye0 = true;
+  return z0;
+}
+
+Vertex& Integrator::fresh_light_vertex(Thread& th, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const {
+  Vertex& y0 = th.join.light0;
+  y0 = Vertex{};
+  y0.kind = Kind::kLight;
+  y0.light = static_cast<int>(li);
+  y0.pos_letter = light_pairs_[li][0];
+  y0.letter = letter;
+  y0.p = p;
+  y0.n = n;
+  y0.ns = n;
+  y0.err = err;
+  y0.pdf_fwd = light_pick_ * rs_.lights[li].pdf_pos;
+  th.join.has_light0 = true;
+  return y0;
+}
+
+// --- s = 0: the eye subpath's last vertex lies on an area light ---
+bool Integrator::join_emitter(Thread& th, int t) const {
+  const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
+  if (pt.kind != Kind::kSurface) return false;
+  const int hit_light = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];
+  if (hit_light < 0) return false;
+  begin_join(th, ConnectorKind::kNone, 0, t, strategy(0, t));
+  const LightParams& l = rs_.lights[static_cast<std::size_t>(hit_light)].params;
+  return end_join(th, pt.beta * spatial_emission(l) * directional_emission(l, pt.n, pt.wo), 0, nullptr, nullptr);
+}
+
+// --- t = 0: the light subpath's last vertex lies on the lens ---
+bool Integrator::join_lens(Thread& th, int s) const {
+  const Vertex& qs = th.light[static_cast<std::size_t>(s - 1)];
+  if (qs.kind != Kind::kLens) return false;
+  glm::vec2 raster;
+  const vec3 we = importance(cam_.params, qs.p, qs.wo, &raster);
+  if (is_black(we)) return false;
+  begin_join(th, ConnectorKind::kNone, s, 0, strategy(s, 0));
+  JoinResult& jr = th.join;
+  to_pixels(raster, &jr.rx, &jr.ry);
+  jr.splat = true;
+  return end_join(th, qs.beta * we, 0, nullptr, nullptr);
+}
+
+// --- a light vertex joined to a sensor point: a fresh one (the splat, t = 1) or, for
+//     ortho-projection, the film point on the line of sight through y(s-1) ---
+bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind) const {
+  const Vertex& qs = th.light[static_cast<std::size_t>(s - 1)];
+  if (qs.kind == Kind::kLens || !qs.finite) return false;
+  const bool ortho = kind == ConnectorKind::kOrthoProjection;
+  join_numbers(rng, ortho ? JoinBlock::kOrtho : JoinBlock::kSplat, s);
+  std::optional<EndpointConnection> c;
+  if (!ortho) {
+    if (sensor_pair_[0] != 'D') return false;  // a Dirac direction (orthographic, spot meter): no DD join
+    c = connect_finite(cam_.params, rng.get2d_if(reads_lens_numbers(cam_.params)), qs.p);
+    if (!c) return false;
+    begin_join(th, kind, s, 1, strategy(s, 1));
+  } else {
+    const auto* film = std::get_if<OrthographicParams>(&cam_.params);
+    if (film == nullptr) return false;
+    begin_join(th, kind, s, 1, ortho_of(s));
+    ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
+    ++stats.attempts;
+    c = pathex::connect(*film, qs.p);
+    if (!c) {
+      ++stats.outside;
+      return false;
+    }
+  }
+  JoinResult& jr = th.join;
+  const Vertex& z0 = fresh_sensor_vertex(th, *c, ortho ? sensor_pair_[0] : 'D');
+  const vec3 w = c->wi;  // from qs to the sensor
+  to_pixels(c->raster, &jr.rx, &jr.ry);
+  jr.splat = true;
+  const vec3 fq = end_f(qs, w, TransportMode::kImportance, &jr.density.at_qs);
+  jr.density.w = w;
+  jr.density.d2 = c->distance * c->distance;
+  jr.has_density = true;
+  // weight: We cos / d² (splat), We (film); an ortho path's S letter is c(k+1), the sensor's direction.
+  return end_join(th, qs.beta * fq * (abs_cos(qs, w) * c->weight), ortho ? bit(s + 1) : 0, &qs, &z0);
+}
+
+// --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
+//     for distant-projection, the aperture point on the line through z(t-1) against the light ---
+bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind) const {
+  const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
+  if (pt.kind != Kind::kSurface || !pt.finite || rs_.lights.empty()) return false;
+  const bool distant = kind == ConnectorKind::kDistantProjection;
+  join_numbers(rng, distant ? JoinBlock::kDistant : JoinBlock::kNee, t);
+  const std::size_t li = pick_light(rng);
+  const RenderLight& l = rs_.lights[li];
+  std::optional<EndpointConnection> c;
+  vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
+  if (!distant) {
+    if (light_pairs_[li][1] != 'D') return false;  // Dirac directions (distant, laser): no DD join
+    c = pathex::connect(l.params, sample_point(l, rng, &err), pt.p);
+    if (!c) return false;
+    begin_join(th, kind, 1, t, strategy(1, t));
+  } else {
+    if (!std::holds_alternative<DistantLightParams>(l.params)) return false;  // the light picked is not distant
+    begin_join(th, kind, 1, t, distant_of(t));
+    ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
+    ++stats.attempts;
+    c = pathex::connect(l.params, SurfacePoint{}, pt.p);
+    if (!c) {
+      ++stats.outside;
+      return false;
+    }
+    err = aperture_error(l);
+  }
+  JoinResult& jr = th.join;
+  const Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? light_pairs_[li][1] : 'D');
+  const vec3 w = c->wi;  // from pt to the light
+  const vec3 f = end_f(pt, w, TransportMode::kRadiance, &jr.density.at_pt);
+  jr.density.w = -w;  // w runs from pt to the light, the join's from the light to pt
+  jr.density.d2 = c->distance * c->distance;
+  jr.has_density = true;
+  // weight: Le cos / (p d²), I / d², E; a distant path's S letter is c1, the light's direction.
+  return end_join(th, pt.beta * f * (abs_cos(pt, w) / light_pick_) * c->weight, distant ? bit(1) : 0, &pt, &y0);
+}
+
+// --- s, t >= 2: a shadow ray between y(s-1) and z(t-1) ---
+bool Integrator::join_shadow(Thread& th, int s, int t) const {
+  const Vertex& qs = th.light[static_cast<std::size_t>(s - 1)];
+  const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
+  if (qs.kind != Kind::kSurface || pt.kind != Kind::kSurface || !qs.finite || !pt.finite) return false;
+  const vec3 d = pt.p - qs.p;
+  const float d2 = glm::dot(d, d);
+  if (d2 <= 0.0f) return false;
+  begin_join(th, ConnectorKind::kNone, s, t, strategy(s, t));
+  JoinResult& jr = th.join;
+  const vec3 w = d * (1.0f / std::sqrt(d2));  // one division, not three
+  const vec3 fq = end_f(qs, w, TransportMode::kImportance, &jr.density.at_qs);
+  const vec3 fp = end_f(pt, -w, TransportMode::kRadiance, &jr.density.at_pt);
+  jr.density.w = w;
+  jr.density.d2 = d2;
+  jr.has_density = true;
+  const float g = abs_cos(qs, w) * abs_cos(pt, w) / d2;
+  return end_join(th, qs.beta * fq * fp * pt.beta * g, 0, &qs, &pt);
+}
+
+}  // namespace pathex::tracer

@@ -1,0 +1,148 @@
+// The estimator's MIS weight (DESIGN §7): which strategies of the profile sample a join's path, and
+// the two densities of each vertex they differ in, handed to the one weight routine (trace/mis.h).
+//
+// Which strategies sample a path follows from its letters: a plain join (s', DD, t') when the
+// profile runs it and its join letters c(s') c(s'+1) are D; a projection where the path starts
+// (distant) or ends (orthographic) with DSD; the mirror connector where a DSD has its S on a planar
+// mirror; the manifold connector at every maximal run of S vertices it could solve.
+//
+// The densities come from where they are: a plain join's path is made of the two subpaths, which
+// keep each vertex's densities as their walks sampled them (Vertex::pdf_fwd, pdf_rev); the join
+// changes only the reverse densities of the two vertices nearest each end, and those four are
+// computed here (from the BSDF densities the join's evaluation gave, when it gave them). A
+// connector that constructs vertices (the mirror's, the manifold's chain) makes a path no walk
+// sampled: every density is computed from the vertices.
+#include <cmath>
+
+#include "trace/integrator.h"
+#include "trace/mis.h"
+
+namespace pathex::tracer {
+
+int Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
+  const int n = x.size(), k = n - 1, s = x.s;
+  mis::Technique* out = th.techniques.data();
+  const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
+  const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };   // c_i c(i+1) c(i+2) = DSD
+  const auto light_pos = [&] { return static_cast<double>(rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos); };
+  // The number of S vertices from x_i on (letters c(i+1) …).
+  const auto s_run = [&](int i) {
+    int m = 0;
+    while (i + m <= k - 1 && letter_s(i + m + 1)) ++m;
+    return m;
+  };
+  // --- the strategy that sampled the path, first ---
+  switch (self) {
+    case ConnectorKind::kNone: out[0] = {s, 0, 1.0}; break;
+    case ConnectorKind::kDistantProjection: out[0] = {1, 0, 1.0 / light_pos()}; break;
+    case ConnectorKind::kOrthoProjection: out[0] = {n - 1, 0, 1.0 / cam_.pdf_pos}; break;
+    case ConnectorKind::kMirror:
+    case ConnectorKind::kManifold: out[0] = {s, x.m, 1.0}; break;
+  }
+  int count = 1;
+  // --- the plain joins whose two join letters are D ---
+  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
+  std::uint64_t plain = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
+  if (self == ConnectorKind::kNone) plain &= ~(std::uint64_t{1} << s);
+  for (; plain != 0; plain &= plain - 1) out[count++] = {std::countr_zero(plain), 0, 1.0};
+  if (!has_connectors_) return count;
+  // --- the connectors: one term each, the plain density with their constructed vertices left out ---
+  if (self != ConnectorKind::kDistantProjection && n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && light_pos() > 0.0)
+    out[count++] = {1, 0, 1.0 / light_pos()};
+  if (self != ConnectorKind::kOrthoProjection && n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f)
+    out[count++] = {n - 1, 0, 1.0 / cam_.pdf_pos};
+  if (has_mirror_)
+    for (int m = 1; m <= k - 1; ++m)
+      if (!(self == ConnectorKind::kMirror && m == s) && dsd_at(m) && mirror_of(m, k - m) >= 0 && x[m].kind == Kind::kSurface &&
+          mirror_shape_[static_cast<std::size_t>(x[m].shape)])
+        out[count++] = {m, 1, 1.0};
+  if (has_manifold_)
+    for (int i = 1; i <= k - 1; ++i) {
+      const int m = s_run(i);
+      if (m > 0 && !letter_s(i) && !(self == ConnectorKind::kManifold && i == s) && manifold_at(x, key, i, m)) out[count++] = {i, m, 1.0};
+    }
+  return count;
+}
+
+void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const {
+  const int s = x.s, t = x.t, n = x.size();
+  mis::Densities* d = th.densities.data();
+  // The subpaths' own: a light vertex's forward density is the light walk's, an eye vertex's the eye walk's.
+  for (int v = lo; v < hi; ++v) {
+    const Vertex& y = x[v];
+    d[v] = v < s ? mis::Densities{remap(y.pdf_fwd), remap(y.pdf_rev)} : mis::Densities{remap(y.pdf_rev), remap(y.pdf_fwd)};
+  }
+  const auto needed = [&](int v) { return v >= lo && v < hi; };
+  // --- the four reverse densities the join changes: qs = x(s-1), its predecessor qsm, pt = x_s, ptm ---
+  // Every direction is at hand: the join's (w, from qs to pt, at squared distance d2) and each
+  // vertex's unit direction to its predecessor (wo, at d2_wo); no normalisation is needed.
+  const auto area = [](float pdf_w, const Vertex& next, const vec3& w, float dist2) {
+    return dist2 > 0.0f ? pdf_w * abs_cos(next, w) / dist2 : 0.0f;
+  };
+  const Vertex* qs = s > 0 ? &x[s - 1] : nullptr;
+  const Vertex* pt = t > 0 ? &x[s] : nullptr;
+  const Vertex* qsm = s > 1 ? &x[s - 2] : nullptr;
+  const Vertex* ptm = t > 1 ? &x[s + 1] : nullptr;
+  if (qs && pt) {
+    JoinDensity own;
+    if (join == nullptr) {
+      const vec3 e = pt->p - qs->p;
+      own.d2 = glm::dot(e, e);
+      own.w = own.d2 > 0.0f ? e * (1.0f / std::sqrt(own.d2)) : vec3(0.0f);  // as the join forms it
+      join = &own;
+    }
+    const vec3 w = join->w, back = -w;
+    const float d2 = join->d2;
+    const bsdf::JoinPdfs& at_qs = join->at_qs;
+    const bsdf::JoinPdfs& at_pt = join->at_pt;
+    // A projected endpoint sends a parallel beam: the density at the other end is per area.
+    if (self == ConnectorKind::kDistantProjection) d[s].light = remap(parallel_jacobian(*pt, *qs, w));
+    else if (needed(s)) d[s].light = remap(area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2));
+    if (self == ConnectorKind::kOrthoProjection) d[s - 1].eye = remap(parallel_jacobian(*qs, *pt, w));
+    else if (needed(s - 1)) d[s - 1].eye = remap(area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2));
+    if (ptm && needed(s + 1)) d[s + 1].light = remap(area(at_pt.known ? at_pt.to_wo : pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo));
+    if (qsm && needed(s - 2)) d[s - 2].eye = remap(area(at_qs.known ? at_qs.to_wo : pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo));
+  } else if (pt) {  // s = 0: pt lies on an area light
+    d[0].light = remap(pdf_light_origin(*pt));
+    if (ptm && needed(1)) {
+      const RenderLight& l = rs_.lights[static_cast<std::size_t>(rs_.light_of_shape[static_cast<std::size_t>(pt->shape)])];
+      d[1].light = remap(area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo));
+    }
+  } else if (qs) {  // t = 0: qs is the lens point
+    d[n - 1].eye = remap(cam_.pdf_pos);
+    if (qsm && needed(n - 2)) d[n - 2].eye = remap(area(sensor_pdf_dir(*qs, qs->wo), *qsm, qs->wo, qs->d2_wo));
+  }
+}
+
+void Integrator::path_densities(Thread& th, const PathView& x, PathKey key, int lo, int hi) const {
+  // Every vertex's area density as the light walk (lf) and as the eye walk (ef) would sample it,
+  // Dirac ones stored as 0 (remapped to 1), as the subpaths store them.
+  const int k = x.size() - 1;
+  const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
+  const auto lf = [&](int v) -> float {
+    if (v == 0) return light_pick_ * rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+    if (v == 1 && letter_s(1) && rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos > 0.0f)
+      return parallel_jacobian(x[1], x[0], glm::normalize(x[1].p - x[0].p));  // a distant light's parallel beam
+    if (letter_s(v)) return 0.0f;  // x(v-1) is a Dirac
+    return pdf(v >= 2 ? &x[v - 2] : nullptr, x[v - 1], x[v]);
+  };
+  const auto ef = [&](int v) -> float {
+    if (v == k) return cam_.pdf_pos;
+    if (v == k - 1 && letter_s(k + 1) && cam_.pdf_pos > 0.0f) return parallel_jacobian(x[k - 1], x[k], glm::normalize(x[k - 1].p - x[k].p));
+    if (letter_s(v + 2)) return 0.0f;  // x(v+1) is a Dirac
+    return pdf(v + 2 <= k ? &x[v + 2] : nullptr, x[v + 1], x[v]);
+  };
+  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = {remap(lf(v)), remap(ef(v))};
+}
+
+float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const {
+  const int count = techniques(th, x, key, self);
+  if (count == 1) return 1.0f;  // no other strategy samples the path: no density is needed
+  int lo = 0, hi = 0;
+  mis::read_range(th.techniques.data(), count, &lo, &hi);
+  if (x.m > 0 || x.whole != nullptr) path_densities(th, x, key, lo, hi);
+  else join_densities(th, x, self, join, lo, hi);
+  return mis::weight(th.densities.data(), th.techniques.data(), count);
+}
+
+}  // namespace pathex::tracer
