@@ -138,8 +138,10 @@ class Integrator {
     std::vector<ManifoldSolution> manifold_found{};  // and the distinct chains its first batch found
     // The MIS weight's working space (mis_weight()): the strategies that sample the path being
     // weighed, and its vertices' densities.
-    std::array<mis::Technique, 3 * mis::kMaxPath + 3> techniques{};
+    std::array<mis::Technique, 2 * mis::kMaxPath + 2> techniques{};
     std::array<mis::Densities, mis::kMaxPath> densities{};
+    // Each subpath vertex's densities as its walk stored them (set by set_masks(), once per sample).
+    std::array<mis::Densities, kMaxVertices> light_densities{}, eye_densities{};
     // The subpaths' letters packed (set by set_masks()): light_mask has c0 c1 of y0, then
     // bit i + 1 for y_i's letter; eye_masks[t] has the eye subpath's last t + 1 letters (z(t-1)
     // … z0 and z0's spatial letter) as they sit after c(s) in any connection with t eye vertices.
@@ -167,8 +169,20 @@ class Integrator {
   // A vertex's density as the MIS weight reads it, a Dirac's (stored as 0) counting as 1.
   static double remap(float f) { return remap_density(f); }
   // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key().
+  // And each vertex's densities for the MIS weight, a light vertex's eye-over-light ratio and an
+  // eye vertex's light-over-eye (the ones a join's weight reads).
   void set_masks(Thread& th, int ns, int nt) const {
     th.joins_ready = true;
+    for (int i = 0; i < ns; ++i) {
+      const Vertex& y = th.light[static_cast<std::size_t>(i)];
+      const double light = remap(y.pdf_fwd), eye = remap(y.pdf_rev);
+      th.light_densities[static_cast<std::size_t>(i)] = {light, eye, 1.0, eye / light};
+    }
+    for (int j = 0; j < nt; ++j) {
+      const Vertex& z = th.eye[static_cast<std::size_t>(j)];
+      const double light = remap(z.pdf_rev), eye = remap(z.pdf_fwd);
+      th.eye_densities[static_cast<std::size_t>(j)] = {light, eye, light / eye, 1.0};
+    }
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
     for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
@@ -378,8 +392,8 @@ class Integrator {
   // x.s, its x.m constructed vertices after it), against every strategy of the profile that samples
   // the same path. `join`: the densities the join computed at its two ends (null: recomputed).
   float mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const;
-  // The strategies that sample path x, `self` first, into th.techniques; returns their count.
-  int techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const;
+  // The strategies that sample path x, `self` the own one (connectors listed in th.techniques).
+  mis::Strategies techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const;
   // th.densities[lo … hi) of a plain or projection join's path: the subpaths' stored densities with
   // the four the join changes recomputed.
   void join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const;

@@ -17,16 +17,25 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <cstddef>
 
 namespace pathex::tracer::mis {
 
 // Vertex x_i's area densities: as the light walk samples it (`light`) and as the eye walk does
-// (`eye`), Dirac densities counted as 1 (tracer::remap_density()).
+// (`eye`), Dirac densities counted as 1 (tracer::remap_density()); and their two ratios, which the
+// weight multiplies by going towards the eye (`right` = light / eye) and towards the light (`left`
+// = eye / light). The ratios are kept so that a subpath's vertices divide once per sample, not
+// once per join: a caller may fill only the ratio the weight will read (the one pointing away
+// from the own strategy's split).
 struct Densities {
   double light = 1.0;
   double eye = 1.0;
+  double right = 1.0;
+  double left = 1.0;
+  static Densities of(double light, double eye) { return {light, eye, light / eye, eye / light}; }
 };
 
 // A strategy that samples the path: the light walk up to x(split-1), the eye walk from
@@ -41,39 +50,79 @@ struct Technique {
 // The longest full path (vertices): 2 * kMaxVertices (trace/vertex.h) bounds every join's.
 inline constexpr int kMaxPath = 128;
 
-// The power-heuristic weight of techniques[0] among techniques[0 … count) (every strategy that
-// samples the path, each once), from the densities x[v] of the path's vertices. Reads x only
-// between the smallest split and the largest split + constructed (the caller fills that range:
-// read_range()). 0 when the sum is not finite (a density overflowed: no weight rather than NaN).
-inline void read_range(const Technique* techniques, int count, int* lo, int* hi) {
-  *lo = techniques[0].split;
-  *hi = techniques[0].split + techniques[0].constructed;
-  for (int i = 1; i < count; ++i) {
-    *lo = std::min(*lo, techniques[i].split);
-    *hi = std::max(*hi, techniques[i].split + techniques[i].constructed);
+// Every strategy that samples a path: the one that sampled it (`own`), the other plain joins (bit
+// i of `plain`: the join at split i; the own split's bit clear when own is a plain join), and the
+// connectors (the first `count` of `connectors`, own not among them).
+struct Strategies {
+  Technique own;
+  std::uint64_t plain = 0;
+  const Technique* connectors = nullptr;
+  int count = 0;
+  bool alone() const { return plain == 0 && count == 0; }
+  // The vertices the weight reads: x[lo … hi), from the smallest split to the largest split +
+  // constructed (the caller fills that range of x).
+  void read_range(int* lo, int* hi) const {
+    *lo = own.split;
+    *hi = own.split + own.constructed;
+    if (plain != 0) {
+      *lo = std::min(*lo, std::countr_zero(plain));
+      *hi = std::max(*hi, 63 - std::countl_zero(plain));
+    }
+    for (int i = 0; i < count; ++i) {
+      *lo = std::min(*lo, connectors[i].split);
+      *hi = std::max(*hi, connectors[i].split + connectors[i].constructed);
+    }
   }
-}
+};
 
-inline float weight(const Densities* x, const Technique* techniques, int count) {
-  if (count == 1) return 1.0f;
-  int lo = 0, hi = 0;
-  read_range(techniques, count, &lo, &hi);
-  // rel[i - lo] = P_i / P_b for the own split b: outwards from b, one vertex's ratio at a time.
-  const int b = techniques[0].split;
+// A path's vertices' densities as pbrt-v4 keeps them, in two arrays: x_v is light[v] for v < s
+// (the light subpath's vertices) and eye[n - 1 - v] for the others (the eye subpath's, from z0).
+struct PathDensities {
+  const Densities* light = nullptr;
+  const Densities* eye = nullptr;
+  int s = 0, n = 0;
+  const Densities& operator[](int v) const { return v < s ? light[v] : eye[n - 1 - v]; }
+};
+
+// The power-heuristic weight of st.own among the strategies `st`, from the densities x[v] of the
+// path's vertices in [lo, hi) (read_range()). 0 when the sum is not finite (a density overflowed:
+// no weight rather than NaN).
+inline float weight(const PathDensities& x, const Strategies& st, int lo, int hi) {
+  if (st.alone()) return 1.0f;
+  // rel(i) = P_i / P_b for the own split b, outwards from b one vertex's ratio at a time; the
+  // plain joins' terms are summed on the way, and rel kept for the connectors when there are any.
+  const Technique& own = st.own;
+  const int b = own.split;
   double rel[kMaxPath + 1];
-  rel[b - lo] = 1.0;
-  for (int i = b + 1; i <= hi; ++i) rel[i - lo] = rel[i - 1 - lo] * x[i - 1].light / x[i - 1].eye;
-  for (int i = b - 1; i >= lo; --i) rel[i - lo] = rel[i + 1 - lo] * x[i].eye / x[i].light;
-  const auto density = [&](const Technique& c) {  // relative to P_b
-    double d = rel[c.split - lo] * c.factor;
+  const bool keep = st.count > 0;
+  if (keep) rel[b - lo] = 1.0;
+  // A technique's density relative to P_b: a connector's constructed vertices are not sampled by
+  // the eye walk, and a projection carries its factor.
+  const auto density = [&](const Technique& c, double r) {
+    double d = r * c.factor;
     for (int v = c.split; v < c.split + c.constructed; ++v) d /= x[v].eye;
     return d;
   };
-  const double own = density(techniques[0]);
-  double sum = 1.0;
-  for (int i = 1; i < count; ++i) {
-    const double r = density(techniques[i]) / own;
-    sum += r * r;
+  const double scale = own.constructed == 0 && own.factor == 1.0 ? 1.0 : 1.0 / density(own, 1.0);
+  const double scale2 = scale * scale;
+  double plain_sum = 0.0;
+  double r = 1.0;
+  for (int i = b + 1; i <= hi; ++i) {
+    r *= x[i - 1].right;
+    if (keep) rel[i - lo] = r;
+    if ((st.plain >> i) & 1) plain_sum += r * r;
+  }
+  r = 1.0;
+  for (int i = b - 1; i >= lo; --i) {
+    r *= x[i].left;
+    if (keep) rel[i - lo] = r;
+    if ((st.plain >> i) & 1) plain_sum += r * r;
+  }
+  double sum = 1.0 + plain_sum * scale2;
+  for (int i = 0; i < st.count; ++i) {
+    const Technique& c = st.connectors[i];
+    const double d = density(c, rel[c.split - lo]) * scale;
+    sum += d * d;
   }
   return std::isfinite(sum) ? static_cast<float>(1.0 / sum) : 0.0f;
 }

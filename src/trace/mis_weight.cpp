@@ -12,6 +12,8 @@
 // computed here (from the BSDF densities the join's evaluation gave, when it gave them). A
 // connector that constructs vertices (the mirror's, the manifold's chain) makes a path no walk
 // sampled: every density is computed from the vertices.
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "trace/integrator.h"
@@ -19,9 +21,9 @@
 
 namespace pathex::tracer {
 
-int Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
+mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
   const int n = x.size(), k = n - 1, s = x.s;
-  mis::Technique* out = th.techniques.data();
+  mis::Strategies st;
   const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
   const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };   // c_i c(i+1) c(i+2) = DSD
   const auto light_pos = [&] { return static_cast<double>(rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos); };
@@ -31,22 +33,23 @@ int Integrator::techniques(Thread& th, const PathView& x, PathKey key, Connector
     while (i + m <= k - 1 && letter_s(i + m + 1)) ++m;
     return m;
   };
-  // --- the strategy that sampled the path, first ---
+  // --- the strategy that sampled the path ---
   switch (self) {
-    case ConnectorKind::kNone: out[0] = {s, 0, 1.0}; break;
-    case ConnectorKind::kDistantProjection: out[0] = {1, 0, 1.0 / light_pos()}; break;
-    case ConnectorKind::kOrthoProjection: out[0] = {n - 1, 0, 1.0 / cam_.pdf_pos}; break;
+    case ConnectorKind::kNone: st.own = {s, 0, 1.0}; break;
+    case ConnectorKind::kDistantProjection: st.own = {1, 0, 1.0 / light_pos()}; break;
+    case ConnectorKind::kOrthoProjection: st.own = {n - 1, 0, 1.0 / cam_.pdf_pos}; break;
     case ConnectorKind::kMirror:
-    case ConnectorKind::kManifold: out[0] = {s, x.m, 1.0}; break;
+    case ConnectorKind::kManifold: st.own = {s, x.m, 1.0}; break;
   }
-  int count = 1;
   // --- the plain joins whose two join letters are D ---
   const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
-  std::uint64_t plain = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
-  if (self == ConnectorKind::kNone) plain &= ~(std::uint64_t{1} << s);
-  for (; plain != 0; plain &= plain - 1) out[count++] = {std::countr_zero(plain), 0, 1.0};
-  if (!has_connectors_) return count;
+  st.plain = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
+  if (self == ConnectorKind::kNone) st.plain &= ~(std::uint64_t{1} << s);
+  if (!has_connectors_) return st;
   // --- the connectors: one term each, the plain density with their constructed vertices left out ---
+  mis::Technique* out = th.techniques.data();
+  int& count = st.count;
+  st.connectors = out;
   if (self != ConnectorKind::kDistantProjection && n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && light_pos() > 0.0)
     out[count++] = {1, 0, 1.0 / light_pos()};
   if (self != ConnectorKind::kOrthoProjection && n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f)
@@ -61,18 +64,31 @@ int Integrator::techniques(Thread& th, const PathView& x, PathKey key, Connector
       const int m = s_run(i);
       if (m > 0 && !letter_s(i) && !(self == ConnectorKind::kManifold && i == s) && manifold_at(x, key, i, m)) out[count++] = {i, m, 1.0};
     }
-  return count;
+  return st;
 }
 
 void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const {
   const int s = x.s, t = x.t, n = x.size();
-  mis::Densities* d = th.densities.data();
-  // The subpaths' own: a light vertex's forward density is the light walk's, an eye vertex's the eye walk's.
-  for (int v = lo; v < hi; ++v) {
-    const Vertex& y = x[v];
-    d[v] = v < s ? mis::Densities{remap(y.pdf_fwd), remap(y.pdf_rev)} : mis::Densities{remap(y.pdf_rev), remap(y.pdf_fwd)};
-  }
+  // The subpaths' own densities, as set_masks() stored them once per sample, are overwritten in
+  // place where the join changes them (mis_weight() restores them). A fresh endpoint's: its
+  // forward density, the reverse one set below. The own split is s, so the weight reads a light
+  // vertex's `left` ratio and an eye vertex's `right`.
+  const auto at = [&](int v) -> mis::Densities& {
+    return v < s ? th.light_densities[static_cast<std::size_t>(v)] : th.eye_densities[static_cast<std::size_t>(n - 1 - v)];
+  };
+  if (x.light0) at(0) = {remap(x.light0->pdf_fwd), 1.0, 1.0, 1.0};
+  if (x.eye0) at(n - 1) = {1.0, remap(x.eye0->pdf_fwd), 1.0, 1.0};
   const auto needed = [&](int v) { return v >= lo && v < hi; };
+  const auto set_light = [&](int v, float f) {  // an eye-side vertex's light density
+    mis::Densities& d = at(v);
+    d.light = remap(f);
+    d.right = d.light / d.eye;
+  };
+  const auto set_eye = [&](int v, float f) {  // a light-side vertex's eye density
+    mis::Densities& d = at(v);
+    d.eye = remap(f);
+    d.left = d.eye / d.light;
+  };
   // --- the four reverse densities the join changes: qs = x(s-1), its predecessor qsm, pt = x_s, ptm ---
   // Every direction is at hand: the join's (w, from qs to pt, at squared distance d2) and each
   // vertex's unit direction to its predecessor (wo, at d2_wo); no normalisation is needed.
@@ -96,21 +112,21 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
     const bsdf::JoinPdfs& at_qs = join->at_qs;
     const bsdf::JoinPdfs& at_pt = join->at_pt;
     // A projected endpoint sends a parallel beam: the density at the other end is per area.
-    if (self == ConnectorKind::kDistantProjection) d[s].light = remap(parallel_jacobian(*pt, *qs, w));
-    else if (needed(s)) d[s].light = remap(area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2));
-    if (self == ConnectorKind::kOrthoProjection) d[s - 1].eye = remap(parallel_jacobian(*qs, *pt, w));
-    else if (needed(s - 1)) d[s - 1].eye = remap(area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2));
-    if (ptm && needed(s + 1)) d[s + 1].light = remap(area(at_pt.known ? at_pt.to_wo : pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo));
-    if (qsm && needed(s - 2)) d[s - 2].eye = remap(area(at_qs.known ? at_qs.to_wo : pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo));
+    if (self == ConnectorKind::kDistantProjection) set_light(s, parallel_jacobian(*pt, *qs, w));
+    else if (needed(s)) set_light(s, area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2));
+    if (self == ConnectorKind::kOrthoProjection) set_eye(s - 1, parallel_jacobian(*qs, *pt, w));
+    else if (needed(s - 1)) set_eye(s - 1, area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2));
+    if (ptm && needed(s + 1)) set_light(s + 1, area(at_pt.known ? at_pt.to_wo : pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo));
+    if (qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo));
   } else if (pt) {  // s = 0: pt lies on an area light
-    d[0].light = remap(pdf_light_origin(*pt));
+    set_light(0, pdf_light_origin(*pt));
     if (ptm && needed(1)) {
       const RenderLight& l = rs_.lights[static_cast<std::size_t>(rs_.light_of_shape[static_cast<std::size_t>(pt->shape)])];
-      d[1].light = remap(area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo));
+      set_light(1, area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo));
     }
   } else if (qs) {  // t = 0: qs is the lens point
-    d[n - 1].eye = remap(cam_.pdf_pos);
-    if (qsm && needed(n - 2)) d[n - 2].eye = remap(area(sensor_pdf_dir(*qs, qs->wo), *qsm, qs->wo, qs->d2_wo));
+    set_eye(n - 1, cam_.pdf_pos);
+    if (qsm && needed(n - 2)) set_eye(n - 2, area(sensor_pdf_dir(*qs, qs->wo), *qsm, qs->wo, qs->d2_wo));
   }
 }
 
@@ -132,17 +148,30 @@ void Integrator::path_densities(Thread& th, const PathView& x, PathKey key, int 
     if (letter_s(v + 2)) return 0.0f;  // x(v+1) is a Dirac
     return pdf(v + 2 <= k ? &x[v + 2] : nullptr, x[v + 1], x[v]);
   };
-  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = {remap(lf(v)), remap(ef(v))};
+  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = mis::Densities::of(remap(lf(v)), remap(ef(v)));
 }
 
 float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const {
-  const int count = techniques(th, x, key, self);
-  if (count == 1) return 1.0f;  // no other strategy samples the path: no density is needed
+  const mis::Strategies st = techniques(th, x, key, self);
+  if (st.alone()) return 1.0f;  // no other strategy samples the path: no density is needed
   int lo = 0, hi = 0;
-  mis::read_range(th.techniques.data(), count, &lo, &hi);
-  if (x.m > 0 || x.whole != nullptr) path_densities(th, x, key, lo, hi);
-  else join_densities(th, x, self, join, lo, hi);
-  return mis::weight(th.densities.data(), th.techniques.data(), count);
+  st.read_range(&lo, &hi);
+  const int n = x.size();
+  if (x.m > 0 || x.whole != nullptr) {
+    path_densities(th, x, key, lo, hi);
+    return mis::weight({th.densities.data(), nullptr, n, n}, st, lo, hi);
+  }
+  // A plain join: the subpaths' stored densities with the join's changes made in place and undone
+  // after (pbrt-v4's ScopedAssignment): the two vertices nearest each end.
+  const int s = x.s, t = x.t;
+  std::array<mis::Densities, 2> light_kept{}, eye_kept{};
+  for (int i = 0; i < std::min(s, 2); ++i) light_kept[static_cast<std::size_t>(i)] = th.light_densities[static_cast<std::size_t>(s - 1 - i)];
+  for (int i = 0; i < std::min(t, 2); ++i) eye_kept[static_cast<std::size_t>(i)] = th.eye_densities[static_cast<std::size_t>(t - 1 - i)];
+  join_densities(th, x, self, join, lo, hi);
+  const float w = mis::weight({th.light_densities.data(), th.eye_densities.data(), s, n}, st, lo, hi);
+  for (int i = 0; i < std::min(s, 2); ++i) th.light_densities[static_cast<std::size_t>(s - 1 - i)] = light_kept[static_cast<std::size_t>(i)];
+  for (int i = 0; i < std::min(t, 2); ++i) th.eye_densities[static_cast<std::size_t>(t - 1 - i)] = eye_kept[static_cast<std::size_t>(i)];
+  return w;
 }
 
 }  // namespace pathex::tracer

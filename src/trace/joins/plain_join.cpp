@@ -23,7 +23,8 @@ vec3 Integrator::end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf:
   const Material& m = *rs_.material_of_shape[static_cast<std::size_t>(v.shape)];
   const vec3 f = pdfs ? bsdf::eval(m, v.wo, w, v.ns, v.n, pdfs) : bsdf::eval(m, v.wo, w, v.ns, v.n);
   // The light end carries importance: shading normals make its transport asymmetric (Veach §5.3).
-  return mode == TransportMode::kImportance ? f * bsdf::shading_normal_correction(v.wo, w, v.ns, v.n, mode) : f;
+  // (1 where the shading normal is the geometric one; the test saves the call.)
+  return mode == TransportMode::kImportance && v.ns != v.n ? f * bsdf::shading_normal_correction(v.wo, w, v.ns, v.n, mode) : f;
 }
 
 void Integrator::begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const {
