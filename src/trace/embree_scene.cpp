@@ -336,6 +336,8 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
     const vec3 n = glm::cross(p1 - p0, p2 - p0);
     const float len = glm::length(n);
     h.normal = len > 0.0f ? n / len : -glm::normalize(d);  // degenerate triangles face the ray
+    h.shading_normal = m->normals.empty() ? h.normal : mesh_shading_normal(*m, t, rh.hit.u, rh.hit.v, h.normal);
+    return out;
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
     h.normal = quad_normals_[static_cast<std::size_t>(h.shape)];
     h.error = shape_errors_[static_cast<std::size_t>(h.shape)];  // the projection too: p lies within the quad

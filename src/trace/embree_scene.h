@@ -46,7 +46,7 @@ struct Hit {
   float t = 0.0f;                  // along the query's direction as given (not normalised)
   glm::vec3 position{0.0f};        // on the surface
   glm::vec3 normal{0.0f};          // geometric, unit, the shape's outward side (whichever side was hit)
-  glm::vec3 shading_normal{0.0f};  // equal to `normal` (no interpolated normals yet)
+  glm::vec3 shading_normal{0.0f};  // unit: a mesh's interpolated vertex normals where it has them, else `normal`
   glm::vec3 error{0.0f};           // bound on |position - the exact surface point|, per component
   int shape = -1;                  // index into Scene::shapes
   int primitive = -1;              // triangle index for meshes, 0 otherwise

@@ -527,7 +527,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     join.w = w;
     join.d2 = c->distance * c->distance;
     joined = true;
-    contrib = qs->beta * fq * (abs_cos(*qs, w) * c->weight);  // weight: We cos / d² (splat), We (film)
+    contrib = qs->beta * fq * (light_end_cos(*qs, w) * c->weight);  // weight: We cos / d² (splat), We (film)
     ends = {qs, &sampled};
     splat = true;
   } else if constexpr (C == Connection::kNee || C == Connection::kDistant) {
@@ -569,7 +569,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     join.w = -w;  // w runs from pt to the light, the join's from the light to pt
     join.d2 = c->distance * c->distance;
     joined = true;
-    contrib = pt->beta * f * (abs_cos(*pt, w) / light_pick_) * c->weight;  // weight: Le cos / (p d²), I / d², E
+    contrib = pt->beta * f * (eye_end_cos(*pt, w) / light_pick_) * c->weight;  // weight: Le cos / (p d²), I / d², E
     ends = {pt, &sampled};
   } else {
     // --- a shadow ray between y(s-1) and z(t-1) ---
@@ -586,7 +586,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     join.w = w;
     join.d2 = d2;
     joined = true;
-    const float g = abs_cos(*qs, w) * abs_cos(*pt, w) / d2;
+    const float g = light_end_cos(*qs, w) * eye_end_cos(*pt, w) / d2;
     contrib = qs->beta * fq * fp * pt->beta * g;
     ends = {qs, pt};
   }
@@ -714,12 +714,12 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     const vec3 fa = light ? vec3(directional_emission(light->params, a->n, j->w_a))
                           : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, j->w_a, a->ns, a->n);
     // Across the mirror the geometry term is the straight one to the image: |cos_a| |cos_b| / D².
-    vec3 contrib = a->beta * fa * mirror.reflectance * abs_cos(*a, j->w_a);
+    vec3 contrib = a->beta * fa * mirror.reflectance * light_end_cos(*a, j->w_a);
     if (t == 1) {
       contrib *= c->weight;  // We cos / (p D²), D = |a' − sensor point|
     } else {
       const vec3 fb = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(b->shape)], b->wo, j->w_b, b->ns, b->n);
-      contrib *= fb * b->beta * (abs_cos(*b, j->w_b) / (j->unfolded * j->unfolded));
+      contrib *= fb * b->beta * (eye_end_cos(*b, j->w_b) / (j->unfolded * j->unfolded));
     }
     if (is_black(contrib)) {
       ++stats.no_transport;

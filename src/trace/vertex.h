@@ -54,4 +54,23 @@ inline float abs_cos(const Vertex& v, const vec3& w) {
   return std::fabs(glm::dot(v.n, w)) + static_cast<float>(!v.has_normal());
 }
 
+// The cosines a join puts at its two ends, with shading normals (Veach's thesis §5.3; pbrt-v3's
+// bdpt: G with the shading normals, CorrectShadingNormal on the light side). Written as the
+// path integral has them, with `w` the join's direction at v:
+// - at the eye subpath's end (radiance transport): the BSDF's own cosine |w·ns|; the area
+//   measure's cosine is the other end's.
+// - at the light subpath's end (importance transport): |w·ns| times the adjoint's correction
+//   |wo·ns| |w·ng| / (|wo·ng| |w·ns|) = |w·ng| |wo·ns| / |wo·ng|: the geometric cosine of the area
+//   measure, and the correction of the segment the light came in on (the random walk applies the
+//   same factor, bsdf::shading_normal_correction()).
+// Both are abs_cos(v, w) wherever ns == n (every surface but a smooth-shaded mesh, and points).
+inline float eye_end_cos(const Vertex& v, const vec3& w) {
+  return std::fabs(glm::dot(v.ns, w)) + static_cast<float>(!v.has_normal());
+}
+inline float light_end_cos(const Vertex& v, const vec3& w) {
+  if (v.ns == v.n) return abs_cos(v, w);  // also light vertices (no wo) and points
+  const float den = std::fabs(glm::dot(v.wo, v.n));
+  return den > 0.0f ? std::fabs(glm::dot(w, v.n)) * std::fabs(glm::dot(v.wo, v.ns)) / den : 0.0f;
+}
+
 }  // namespace pathex::tracer
