@@ -20,6 +20,7 @@
 #include <pugixml.hpp>
 
 #include "scene/import_common.h"
+#include "scene/serialized.h"
 
 namespace pathex {
 namespace {
@@ -528,7 +529,32 @@ class Importer {
     }
     MI_TRY(m, p.transform("to_world"));
     MI_TRY(flip, p.boolean("flip_normals", false));
-    if (type == "obj" || type == "ply") {
+    if (type == "serialized") {
+      MI_TRY(file, p.string("filename", ""));
+      if (file.empty()) return located(where(n), "<shape type=\"serialized\"> needs a filename");
+      MI_TRY(index_value, p.number("shape_index", 0));
+      if (!(index_value >= 0 && index_value <= 1e9 && index_value == std::floor(index_value)))
+        return located(where(n), "shape_index must be an integer of 0 or more");
+      const auto index = static_cast<std::size_t>(index_value);
+      MI_TRY(face_normals, p.boolean("face_normals", false));
+      MI_TRY(read, read_serialized_file(files_.resolve(file), index,
+                                        SerializedReadOptions{options_.max_file_bytes, options_.max_mesh_elements}));
+      mesh_elements_ += read.positions.size() + read.triangles.size();
+      if (auto e = check_mesh_elements(mesh_elements_, options_, where(n).str())) return e;
+      if (read.triangles.empty()) return located(where(n), "shape " + std::to_string(index) + " of '" + file + "' has no triangles");
+      MeshShape mesh;
+      mesh.file = file;
+      mesh.positions = std::move(read.positions);
+      mesh.triangles = std::move(read.triangles);
+      mesh.uvs = std::move(read.uvs);
+      // Smooth unless face_normals (the file's flag or the property), as Mitsuba: the file's normals, or its own angle-weighted ones.
+      const bool flat = face_normals || read.face_normals;
+      const bool compute = !flat && read.normals.empty();
+      if (!flat && !compute) mesh.normals = std::move(read.normals);
+      if (auto e = import::place_mesh(&mesh, m, flip, flip, where(n))) return e;
+      if (compute) import::angle_weighted_normals(&mesh);
+      s.geometry = std::move(mesh);
+    } else if (type == "obj" || type == "ply") {
       MI_TRY(file, p.string("filename", ""));
       if (file.empty()) return located(where(n), "<shape type=\"" + excerpt(type) + "\"> needs a filename");
       MI_TRY(face_normals, p.boolean("face_normals", false));
@@ -594,7 +620,7 @@ class Importer {
       if (auto e = import::place_mesh(&mesh, m * axis, flip, flip, where(n))) return e;
       s.geometry = std::move(mesh);
     } else {
-      return located(where(n), "shape \"" + excerpt(type) + "\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder");
+      return located(where(n), "shape \"" + excerpt(type) + "\" is not supported, expected obj, ply, serialized, sphere, rectangle, disk, cube or cylinder");
     }
     if (auto e = p.unused()) return e;
     builder_.add_shape(std::move(s));

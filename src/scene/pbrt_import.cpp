@@ -165,6 +165,15 @@ class Params {
     if (!ok || p->numbers.size() != 1) return located(p->at, "parameter '" + name + "' expects one " + *types.begin() + " value");
     return p->numbers[0];
   }
+  // All numbers of a parameter of `type` (say point2), finite; empty when it is absent.
+  Result<std::vector<double>> numbers_of(const std::string& name, const std::string& type) {
+    Param* p = find(name);
+    if (!p) return std::vector<double>{};
+    if (p->type != type) return located(p->at, "parameter '" + name + "' expects " + type + " values");
+    for (double x : p->numbers)
+      if (!std::isfinite(x)) return located(p->at, "parameter '" + name + "' has a value that is not finite");
+    return p->numbers;
+  }
   Result<int> integer(const std::string& name, int fallback) {
     Result<double> x = number(name, fallback, {"integer"});
     if (!x) return x.error();
@@ -789,7 +798,7 @@ class Importer {
     }
     if (type == "trianglemesh" || type == "bilinearmesh" || type == "plymesh") {
       // "S" (per-vertex tangents) orients anisotropic BSDFs only, which pathex's meshes take from the normal.
-      ps.ignore({"uv", "faceIndices", "S"});
+      ps.ignore({"faceIndices", "S"});
       MeshShape mesh;
       if (type == "plymesh") {
         if (Param* p = ps.find("displacement")) return located(p->at, "displacement is not supported");
@@ -827,6 +836,12 @@ class Importer {
           return located(ps.find("N")->at, "\"normal N\" has " + std::to_string(normals.size()) + " normals for " + std::to_string(p.size()) +
                                                " points, expected one per point");
         if (corners == 3) mesh.normals = std::move(normals);  // bilinear patches: flat, as the planar ones pathex takes are
+        PBRT_TRY(uv, ps.numbers_of("uv", "point2"));
+        if (!uv.empty() && uv.size() != 2 * p.size())
+          return located(ps.find("uv")->at, "\"point2 uv\" has " + std::to_string(uv.size() / 2) + " pairs for " + std::to_string(p.size()) +
+                                                " points, expected one per point");
+        for (std::size_t i = 0; corners == 3 && i + 1 < uv.size(); i += 2)
+          mesh.uvs.emplace_back(static_cast<float>(uv[i]), static_cast<float>(uv[i + 1]));
         if (corners == 3) {
           for (std::size_t i = 0; i < idx.size(); i += 3) mesh.triangles.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
         } else {

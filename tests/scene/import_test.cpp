@@ -483,6 +483,8 @@ std::vector<Refusal> refusals() {
        "textures are not supported (parameter \"texture reflectance\"), give \"rgb reflectance\" [r g b]"},
       {"normals.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1 0 0 1]\n", "normals.pbrt:4:53",
        "\"normal N\" has 2 normals for 3 points, expected one per point"},
+      {"uv-count.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"point2 uv\" [0 0 1 0]\n", "uv-count.pbrt:4:53",
+       "\"point2 uv\" has 2 pairs for 3 points, expected one per point"},
       {"zero-normal.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1 0 0 0 0 0 1]\n", "zero-normal.pbrt:4:1",
        "normal 1 of the mesh is zero, expected a direction"},
       {"include.pbrt", "Include \"missing.pbrt\"\n", "include.pbrt:4:1", "cannot open the included file 'missing.pbrt'"},
@@ -513,7 +515,7 @@ std::vector<Refusal> refusals() {
       {"negative.xml", "  <emitter type=\"point\">\n    <rgb name=\"intensity\" value=\"1, -1, 1\"/>\n  </emitter>\n</scene>\n", "negative.xml:2:3",
        "a light's emission must be non-negative"},
       {"curve.xml", "  <shape type=\"bsplinecurve\"/>\n</scene>\n", "curve.xml:2:3",
-       "shape \"bsplinecurve\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder"},
+       "shape \"bsplinecurve\" is not supported, expected obj, ply, serialized, sphere, rectangle, disk, cube or cylinder"},
       {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",
        "emitter \"envmap\" (an image infinite light) is not supported: pathex renders a uniform infinite light (constant) only"},
       {"projector.xml", "  <emitter type=\"projector\"/>\n</scene>\n", "projector.xml:2:3",
@@ -712,7 +714,8 @@ TEST(ImportShapes, VertexNormalsArePlacedAndWindTheirTriangles) {
   };
   // Wound clockwise seen from +z (face -z) with normals +z: rewound to face +z. Rotated 90° about x
   // (+z to -y). Reversed: the normals turn to -z and the winding with them.
-  const std::string tri = "Shape \"trianglemesh\" \"point3 P\" [0 0 0 0 1 0 1 0 0] \"integer indices\" [0 1 2] \"normal N\" [0 0 2 0 0 1 0 0 1]\n";
+  const std::string tri = "Shape \"trianglemesh\" \"point3 P\" [0 0 0 0 1 0 1 0 0] \"integer indices\" [0 1 2] \"normal N\" [0 0 2 0 0 1 0 0 1] "
+                          "\"point2 uv\" [0 0 0 1 1 0]\n";
   const Scene s = load(write("vertex-normals.pbrt", kPbrtHead + "LightSource \"point\"\n" + tri +
                                                          "AttributeBegin\nRotate 90 1 0 0\n" + tri + "AttributeEnd\n"
                                                          "AttributeBegin\nReverseOrientation\n" + tri + "AttributeEnd\n"));
@@ -723,6 +726,7 @@ TEST(ImportShapes, VertexNormalsArePlacedAndWindTheirTriangles) {
     ASSERT_EQ(m.normals.size(), 3u) << i;
     for (const glm::vec3& n : m.normals) expect_near(n, expected[i], "pbrt vertex normal of shape " + std::to_string(i));
     expect_near(face(m, 0), expected[i], "pbrt face normal of shape " + std::to_string(i));
+    EXPECT_EQ(m.uvs, (std::vector<glm::vec2>{{0, 0}, {0, 1}, {1, 0}})) << i;  // "point2 uv", one pair per point
   }
   // Mitsuba: a PLY's normals unless face_normals; an OBJ (whose vn pathex does not read) gets
   // Mitsuba's angle-weighted normals: two faces meeting at a right angle along the y axis, +z
