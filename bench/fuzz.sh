@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # bench/fuzz.sh SECONDS [HARNESS...]: installs clang-14 and builds the libFuzzer harnesses
 # (`setup.sh --fuzz`, fuzz/), then runs each in
-# turn, one at a time, SECONDS in total split evenly (default: all nine harnesses: expression,
-# class_file, profile, check_file, scene, obj, pbrt, mitsuba, ply). Each starts from its seed corpus
+# turn, one at a time, SECONDS in total split evenly (default: all ten harnesses: expression,
+# class_file, profile, check_file, scene, obj, pbrt, mitsuba, ply, serialized). Each starts from its seed corpus
 # (made here from grammar/corpus/, tests/scene/bad/, tests/reach/checks/, samples/, issue 42's
 # hostile scenes and PLY files generated here in each format) and its dictionary
 # (fuzz/dict/). Each harness runs under small limits (fuzz_support.h), so that one input costs
@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 total=${1:?usage: bench/fuzz.sh SECONDS [HARNESS...]}
 shift
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(expression class_file profile check_file scene obj pbrt mitsuba ply)
+[ ${#harnesses[@]} -gt 0 ] || harnesses=(expression class_file profile check_file scene obj pbrt mitsuba ply serialized)
 per=$(( total / ${#harnesses[@]} ))
 [ "$per" -ge 1 ] || per=1
 
@@ -27,7 +27,7 @@ cmake --build build-fuzz -j2 --target $(printf 'fuzz_%s ' "${harnesses[@]}") >/d
 # --- seed corpora ---
 seeds=build-fuzz/seeds
 rm -rf "$seeds"
-mkdir -p "$seeds"/{expression,class_file,profile,check_file,scene,obj,pbrt,mitsuba,ply}
+mkdir -p "$seeds"/{expression,class_file,profile,check_file,scene,obj,pbrt,mitsuba,ply,serialized}
 python3 - "$seeds" <<'PY'
 import json, pathlib, sys
 seeds = pathlib.Path(sys.argv[1])
@@ -89,6 +89,28 @@ for fmt in ("ascii", "binary_little_endian", "binary_big_endian"):
         name = f"{fmt}{'-extras' if extras else ''}"
         (seeds / "ply" / f"{name}.ply").write_bytes(data)
         (seeds / "ply" / f"{name}.ply.gz").write_bytes(gzip.compress(data))
+# Mitsuba serialized (scene/serialized.h): versions 3 and 4, one and two shapes, single and double
+# precision, with normals, uv and colours.
+import zlib
+def shape(version, double, extras):
+    flags = (0x2000 if double else 0x1000) | (0x000B if extras else 0)
+    f = "d" if double else "f"
+    d = struct.pack("<I", flags) + (b"quad\0" if version == 4 else b"") + struct.pack("<QQ", 4, 2)
+    d += struct.pack("<12" + f, 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0)
+    if extras:
+        d += struct.pack("<12" + f, *([0, 0, 1] * 4)) + struct.pack("<8" + f, 0, 0, 1, 0, 1, 1, 0, 1) + struct.pack("<12" + f, *([1] * 12))
+    d += struct.pack("<6I", 0, 1, 2, 0, 2, 3)
+    return struct.pack("<HH", 0x041C, version) + zlib.compress(d)
+for version in (3, 4):
+    for double in (False, True):
+        for count in (1, 2):
+            shapes = [shape(version, double, i % 2 == 1) for i in range(count)]
+            offsets, body = [], b""
+            for s in shapes:
+                offsets.append(len(body))
+                body += s
+            table = b"".join(struct.pack("<Q" if version == 4 else "<I", o) for o in offsets) + struct.pack("<I", count)
+            (seeds / "serialized" / f"v{version}-{'double' if double else 'single'}-{count}.serialized").write_bytes(body + table)
 PY
 cp samples/classes/*.json "$seeds/class_file/"
 cp samples/renderers/*.json "$seeds/profile/"

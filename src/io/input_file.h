@@ -25,4 +25,8 @@ bool is_gzip(std::string_view bytes);
 // file read whole applies to what it inflates to, so a small bomb stops there).
 Result<std::string> gunzip(std::string_view bytes, std::size_t max_bytes, const std::string& name);
 
+// The inflated bytes of one zlib stream (RFC 1950: Mitsuba's serialized meshes), the bytes after
+// its end not read; errors and the cap as gunzip's.
+Result<std::string> inflate_zlib(std::string_view bytes, std::size_t max_bytes, const std::string& name);
+
 }  // namespace pathex

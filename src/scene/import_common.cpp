@@ -203,19 +203,16 @@ bool ends_with(std::string s, const std::string& suffix) {
 
 }  // namespace
 
-Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals, const SceneLoadOptions& options) {
+Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, const SceneLoadOptions& options) {
   if (!ends_with(path, ".ply") && !ends_with(path, ".ply.gz")) return located(at, "the mesh '" + path + "' is not a .ply or .ply.gz file");
   if (!std::ifstream(path, std::ios::binary)) return located(at, "cannot open the PLY mesh '" + path + "'");
   Result<PlyMesh> read = read_ply_file(path, PlyReadOptions{options.max_file_bytes, options.max_mesh_elements});
   if (!read) return read.error();  // located in the PLY file
   PlyMesh& ply = *read;
-  if (!ply.normals.empty() && !discard_normals)
-    return located(at, "the PLY mesh '" + path +
-                           "' has per-vertex normals, which are not supported: pathex shades meshes with their face normals");
   MeshShape mesh;
   mesh.file = path;
   mesh.positions = std::move(ply.positions);
-  if (!discard_normals) mesh.normals = std::move(ply.normals);
+  mesh.normals = std::move(ply.normals);
   mesh.uvs = std::move(ply.uvs);
   mesh.triangles.reserve(ply.faces.size());
   for (std::size_t f = 0; f < ply.faces.size(); ++f) {
@@ -234,6 +231,58 @@ Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, boo
   }
   if (mesh.triangles.empty()) return located(at, "the PLY mesh '" + path + "' has no faces");
   return mesh;
+}
+
+// --- per-vertex (shading) normals ---
+
+std::optional<Error> place_mesh(MeshShape* mesh, const glm::mat4& m, bool flip_normals, bool flip_winding, const Location& at) {
+  for (glm::vec3& p : mesh->positions) p = apply_point(m, p);
+  if (mesh->normals.empty()) {
+    if (flip_winding)
+      for (glm::uvec3& t : mesh->triangles) std::swap(t.y, t.z);
+    return std::nullopt;
+  }
+  if (mesh->normals.size() != mesh->positions.size())
+    return located(at, "the mesh has " + std::to_string(mesh->normals.size()) + " normals for " + std::to_string(mesh->positions.size()) +
+                           " vertices, expected one normal per vertex");
+  for (std::size_t i = 0; i < mesh->normals.size(); ++i) {
+    const glm::vec3 n = mesh->normals[i];
+    if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z) || !(glm::length(n) > 0.0f))
+      return located(at, "normal " + std::to_string(i) + " of the mesh is " + (glm::length(n) > 0.0f ? "not finite" : "zero") +
+                             ", expected a direction");
+    mesh->normals[i] = (flip_normals ? -1.0f : 1.0f) * apply_normal(m, n);
+  }
+  for (glm::uvec3& t : mesh->triangles) {
+    const glm::vec3 p0 = mesh->positions[t.x], p1 = mesh->positions[t.y], p2 = mesh->positions[t.z];
+    const glm::vec3 sum = mesh->normals[t.x] + mesh->normals[t.y] + mesh->normals[t.z];
+    if (glm::dot(glm::cross(p1 - p0, p2 - p0), sum) < 0.0f) std::swap(t.y, t.z);
+  }
+  return std::nullopt;
+}
+
+void angle_weighted_normals(MeshShape* mesh) {
+  std::vector<glm::dvec3> sum(mesh->positions.size(), glm::dvec3(0.0));
+  std::vector<glm::vec3> first(mesh->positions.size(), glm::vec3(0.0f));
+  for (const glm::uvec3& t : mesh->triangles) {
+    const unsigned idx[3] = {t.x, t.y, t.z};
+    const glm::dvec3 p[3] = {glm::dvec3(mesh->positions[t.x]), glm::dvec3(mesh->positions[t.y]), glm::dvec3(mesh->positions[t.z])};
+    const glm::dvec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
+    const double len = glm::length(n);
+    if (!(len > 0.0)) continue;  // a degenerate face has no direction to give
+    for (int i = 0; i < 3; ++i) {
+      const glm::dvec3 a = p[(i + 1) % 3] - p[i], b = p[(i + 2) % 3] - p[i];
+      const double la = glm::length(a), lb = glm::length(b);
+      if (!(la > 0.0 && lb > 0.0)) continue;
+      const double angle = std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0));
+      sum[idx[i]] += (angle / len) * n;
+      if (first[idx[i]] == glm::vec3(0.0f)) first[idx[i]] = glm::vec3(n / len);
+    }
+  }
+  mesh->normals.resize(mesh->positions.size());
+  for (std::size_t i = 0; i < sum.size(); ++i) {
+    const double len = glm::length(sum[i]);
+    mesh->normals[i] = len > 0.0 ? glm::vec3(sum[i] / len) : first[i] != glm::vec3(0.0f) ? first[i] : glm::vec3(0.0f, 0.0f, 1.0f);
+  }
 }
 
 // --- generated meshes ---
@@ -265,6 +314,8 @@ MeshShape tube_mesh(float radius, float z0, float z1) {
     m.positions.insert(m.positions.end(), {{x, y, z0}, {x, y, z1}});
     const float u = static_cast<float>(i) / n;
     m.uvs.insert(m.uvs.end(), {{u, 0.0f}, {u, 1.0f}});
+    const glm::vec3 radial(static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)), 0.0f);
+    m.normals.insert(m.normals.end(), {radial, radial});  // the analytic surface's, so it shades as one
   }
   for (unsigned i = 0; i < static_cast<unsigned>(n); ++i) {
     const unsigned a = 2 * i, d = 2 * i + 1, b = 2 * i + 2, c = 2 * i + 3;  // (i, z0), (i, z1), (i + 1, z0), (i + 1, z1)
@@ -308,6 +359,7 @@ void mirror_scene(Scene* s, const Mirror3& r) {
           using T = std::decay_t<decltype(g)>;
           if constexpr (std::is_same_v<T, MeshShape>) {
             for (glm::vec3& p : g.positions) p = r.point(p);
+            for (glm::vec3& n : g.normals) n = r.vector(n);
             for (glm::uvec3& t : g.triangles) std::swap(t.y, t.z);  // keeps each face's front side
           } else if constexpr (std::is_same_v<T, SphereShape>) {
             g.center = r.point(g.center);

@@ -96,13 +96,30 @@ Material blend(const Material& a, const Material& b, float w);
 glm::vec3 conductor_reflectance(glm::vec3 eta, glm::vec3 k);
 
 // A PLY mesh (scene/ply.h; `.ply` or `.ply.gz`): triangles and planar quads (split in two along
-// v0-v2, the surface pbrt-v4's bilinear patch has when the quad is planar), with the file's uv.
-// Errors in the file are located in it; refused at `at`: a file that cannot be opened, non-planar
-// quads, a mesh without faces, and per-vertex normals (pathex shades meshes with their face
-// normals; a smooth-shaded mesh would look different) unless `discard_normals` (Mitsuba's
-// face_normals), which drops them.
-Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, bool discard_normals,
-                                const SceneLoadOptions& options);
+// v0-v2, the surface pbrt-v4's bilinear patch has when the quad is planar), with the file's uv and
+// per-vertex normals (empty when the file has none). Errors in the file are located in it; refused
+// at `at`: a file that cannot be opened, non-planar quads, a mesh without faces.
+Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, const SceneLoadOptions& options);
+
+// --- per-vertex (shading) normals ---
+// A mesh with per-vertex normals is shaded with their interpolation (EmbreeScene::intersect); its
+// geometric normal only says where the real surface is. Both formats take the vertex normals'
+// side as the front: pbrt-v4 turns the geometric normal to the shading normal's side
+// (FaceForward), Mitsuba decides inside and outside in the shading frame. pathex does it once, at
+// load: place_mesh() winds every triangle so that its geometric normal faces the side of its
+// three vertex normals' sum, so emitters, the offsets of rays and the checker see the same front.
+//
+// The mesh placed by `m`: positions by m, normals by its inverse transpose; `flip_normals` negates
+// the normals (pbrt's ReverseOrientation, Mitsuba's flip_normals) and `flip_winding` reverses the
+// winding of a mesh without normals (its front side then comes from the winding alone). The
+// normals are checked (one per vertex, finite, not zero; refused at `at` otherwise) and normalised.
+std::optional<Error> place_mesh(MeshShape* mesh, const glm::mat4& m, bool flip_normals, bool flip_winding, const Location& at);
+
+// Mitsuba's vertex normals for a mesh that has none and is not face_normals: each vertex the sum
+// of its faces' unit normals weighted by the face's angle at the vertex (Thürmer and Wüthrich
+// 1998, as Mitsuba 3's Mesh::recompute_vertex_normals). A vertex no face gives a direction keeps
+// the normal of its first face (or +z when it has none).
+void angle_weighted_normals(MeshShape* mesh);
 
 // Mitsuba's cube: [-1, 1]^3 as 24 vertices (four per face, with that face's uv from (0, 0) to
 // (1, 1)) and 12 triangles whose front sides face outwards.
@@ -110,8 +127,8 @@ MeshShape cube_mesh();
 
 // An open tube around the z axis (pbrt's and Mitsuba's cylinder, without caps as theirs are), of
 // radius `radius` from z0 to z1 > z0, its front side facing outwards, as a mesh of
-// kCylinderSegments quads (two triangles each) whose vertices lie on the surface; uv is
-// (angle / 2 pi, (z - z0) / (z1 - z0)). The mesh stands in for the analytic surface: its points are
+// kCylinderSegments quads (two triangles each) whose vertices lie on the surface, with the
+// surface's normals (so it shades as the analytic tube); uv is (angle / 2 pi, (z - z0) / (z1 - z0)). The mesh stands in for the analytic surface: its points are
 // within radius * (1 - cos(pi / 256)) (7.5e-5 radius) of it, and its area is 2.5e-5 smaller.
 inline constexpr int kCylinderSegments = 256;
 MeshShape tube_mesh(float radius, float z0, float z1);

@@ -20,6 +20,7 @@
 #include <pugixml.hpp>
 
 #include "scene/import_common.h"
+#include "scene/serialized.h"
 
 namespace pathex {
 namespace {
@@ -528,12 +529,35 @@ class Importer {
     }
     MI_TRY(m, p.transform("to_world"));
     MI_TRY(flip, p.boolean("flip_normals", false));
-    if (type == "obj" || type == "ply") {
+    if (type == "serialized") {
+      MI_TRY(file, p.string("filename", ""));
+      if (file.empty()) return located(where(n), "<shape type=\"serialized\"> needs a filename");
+      MI_TRY(index_value, p.number("shape_index", 0));
+      if (!(index_value >= 0 && index_value <= 1e9 && index_value == std::floor(index_value)))
+        return located(where(n), "shape_index must be an integer of 0 or more");
+      const auto index = static_cast<std::size_t>(index_value);
+      MI_TRY(face_normals, p.boolean("face_normals", false));
+      MI_TRY(read, read_serialized_file(files_.resolve(file), index,
+                                        SerializedReadOptions{options_.max_file_bytes, options_.max_mesh_elements}));
+      mesh_elements_ += read.positions.size() + read.triangles.size();
+      if (auto e = check_mesh_elements(mesh_elements_, options_, where(n).str())) return e;
+      if (read.triangles.empty()) return located(where(n), "shape " + std::to_string(index) + " of '" + file + "' has no triangles");
+      MeshShape mesh;
+      mesh.file = file;
+      mesh.positions = std::move(read.positions);
+      mesh.triangles = std::move(read.triangles);
+      mesh.uvs = std::move(read.uvs);
+      // Smooth unless face_normals (the file's flag or the property), as Mitsuba: the file's normals, or its own angle-weighted ones.
+      const bool flat = face_normals || read.face_normals;
+      const bool compute = !flat && read.normals.empty();
+      if (!flat && !compute) mesh.normals = std::move(read.normals);
+      if (auto e = import::place_mesh(&mesh, m, flip, flip, where(n))) return e;
+      if (compute) import::angle_weighted_normals(&mesh);
+      s.geometry = std::move(mesh);
+    } else if (type == "obj" || type == "ply") {
       MI_TRY(file, p.string("filename", ""));
       if (file.empty()) return located(where(n), "<shape type=\"" + excerpt(type) + "\"> needs a filename");
       MI_TRY(face_normals, p.boolean("face_normals", false));
-      if (!face_normals)
-        return located(where(n), "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face normals (add <boolean name=\"face_normals\" value=\"true\"/>)");
       MeshShape mesh;
       if (type == "obj") {
         SceneLoadOptions whole = options_;
@@ -542,15 +566,18 @@ class Importer {
         if (obj.triangles.empty()) return located(where(n), "the mesh '" + files_.resolve(file) + "' has no faces");
         mesh = std::move(obj);
       } else {
-        MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), /*discard_normals=*/true, options_));
+        MI_TRY(ply, import::load_ply_mesh(files_.resolve(file), where(n), options_));
         mesh = std::move(ply);
         mesh_elements_ += mesh.positions.size() + mesh.triangles.size();
         if (auto e = check_mesh_elements(mesh_elements_, options_, where(n).str())) return e;
       }
       mesh.file = file;
-      for (vec3& q : mesh.positions) q = import::apply_point(m, q);
-      if (flip)
-        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      // Smooth unless face_normals: the file's normals, or (none, or an OBJ's, which pathex does not
+      // read) Mitsuba's own angle-weighted ones, computed in world space as Mitsuba does.
+      const bool compute = !face_normals && (type == "obj" || mesh.normals.empty());
+      if (face_normals || compute) mesh.normals.clear();
+      if (auto e = import::place_mesh(&mesh, m, flip, flip, where(n))) return e;
+      if (compute) import::angle_weighted_normals(&mesh);
       s.geometry = std::move(mesh);
     } else if (type == "sphere") {
       MI_TRY(centre, p.point("center", vec3(0.0f)));
@@ -575,9 +602,7 @@ class Importer {
       s.geometry = DiskShape{import::apply_point(m, vec3(0.0f)), flip ? -normal : normal, r};
     } else if (type == "cube") {  // a mesh in Mitsuba too: to_world mirrors its windings as an obj's
       MeshShape mesh = import::cube_mesh();
-      for (vec3& q : mesh.positions) q = import::apply_point(m, q);
-      if (flip)
-        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      if (auto e = import::place_mesh(&mesh, m, flip, flip, where(n))) return e;
       s.geometry = std::move(mesh);
     } else if (type == "cylinder") {  // a tessellated tube (import::tube_mesh), facing outwards unless flip_normals
       MI_TRY(p0, p.point("p0", vec3(0.0f)));
@@ -590,12 +615,12 @@ class Importer {
       const vec3 d = (p1 - p0) / length;
       const vec3 t1 = glm::normalize(glm::cross(std::fabs(d.x) < 0.9f ? vec3(1, 0, 0) : vec3(0, 1, 0), d)), t2 = glm::cross(d, t1);
       MeshShape mesh = import::tube_mesh(static_cast<float>(radius), 0.0f, length);
-      for (vec3& q : mesh.positions) q = import::apply_point(m, p0 + q.x * t1 + q.y * t2 + q.z * d);
-      if (flip != import::swaps_handedness(m))  // analytic in Mitsuba: outwards whatever to_world's handedness
-        for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+      const glm::mat4 axis(glm::vec4(t1, 0.0f), glm::vec4(t2, 0.0f), glm::vec4(d, 0.0f), glm::vec4(p0, 1.0f));
+      // The tube's normals give its front side: outwards whatever to_world's handedness, as Mitsuba's analytic one.
+      if (auto e = import::place_mesh(&mesh, m * axis, flip, flip, where(n))) return e;
       s.geometry = std::move(mesh);
     } else {
-      return located(where(n), "shape \"" + excerpt(type) + "\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder");
+      return located(where(n), "shape \"" + excerpt(type) + "\" is not supported, expected obj, ply, serialized, sphere, rectangle, disk, cube or cylinder");
     }
     if (auto e = p.unused()) return e;
     builder_.add_shape(std::move(s));

@@ -165,6 +165,15 @@ class Params {
     if (!ok || p->numbers.size() != 1) return located(p->at, "parameter '" + name + "' expects one " + *types.begin() + " value");
     return p->numbers[0];
   }
+  // All numbers of a parameter of `type` (say point2), finite; empty when it is absent.
+  Result<std::vector<double>> numbers_of(const std::string& name, const std::string& type) {
+    Param* p = find(name);
+    if (!p) return std::vector<double>{};
+    if (p->type != type) return located(p->at, "parameter '" + name + "' expects " + type + " values");
+    for (double x : p->numbers)
+      if (!std::isfinite(x)) return located(p->at, "parameter '" + name + "' has a value that is not finite");
+    return p->numbers;
+  }
   Result<int> integer(const std::string& name, int fallback) {
     Result<double> x = number(name, fallback, {"integer"});
     if (!x) return x.error();
@@ -202,11 +211,12 @@ class Params {
     if (p->type == "texture") return located(p->at, "textures are not supported (parameter \"texture " + name + "\"), give \"rgb " + name + "\" [r g b]");
     return located(p->at, "parameter '" + name + "' expects \"rgb " + name + "\" [r g b]");
   }
-  Result<std::vector<vec3>> points(const std::string& name) {
+  // Triples of a point3 (`kind` "point") or normal3 (`kind` "normal") parameter; pbrt-v4 also takes the type without the 3.
+  Result<std::vector<vec3>> points(const std::string& name, const std::string& kind = "point") {
     Param* p = find(name);
     if (!p) return std::vector<vec3>{};
-    if ((p->type != "point3" && p->type != "point") || p->numbers.size() % 3 != 0)
-      return located(p->at, "parameter '" + name + "' expects point3 values (a multiple of 3 numbers)");
+    if ((p->type != kind + "3" && p->type != kind) || p->numbers.size() % 3 != 0)
+      return located(p->at, "parameter '" + name + "' expects " + kind + "3 values (a multiple of 3 numbers)");
     std::vector<vec3> out;
     for (std::size_t i = 0; i < p->numbers.size(); i += 3) {
       const vec3 v(p->numbers[i], p->numbers[i + 1], p->numbers[i + 2]);
@@ -787,16 +797,15 @@ class Importer {
       return std::nullopt;
     }
     if (type == "trianglemesh" || type == "bilinearmesh" || type == "plymesh") {
-      for (const char* n : {"N", "S"})
-        if (Param* p = ps.find(n)) return located(p->at, "per-vertex normals and tangents (" + std::string(n) + ") are not supported: pathex shades meshes with their face normals");
-      ps.ignore({"uv", "faceIndices"});
+      // "S" (per-vertex tangents) orients anisotropic BSDFs only, which pathex's meshes take from the normal.
+      ps.ignore({"faceIndices", "S"});
       MeshShape mesh;
       if (type == "plymesh") {
         if (Param* p = ps.find("displacement")) return located(p->at, "displacement is not supported");
         ps.ignore({"edgelength"});
         PBRT_TRY(file, ps.string("filename", ""));
         if (file.empty()) return located(at, "plymesh needs a \"string filename\"");
-        PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, /*discard_normals=*/false, options_));
+        PBRT_TRY(ply, import::load_ply_mesh(files_.resolve(file), at, options_));
         mesh = std::move(ply);
         mesh_elements_ += mesh.positions.size() + mesh.triangles.size();
         if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
@@ -822,6 +831,17 @@ class Importer {
         mesh_elements_ += p.size() + idx.size() / corners * (corners - 2);  // a patch: 4 vertices and 2 triangles at most
         if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
         mesh.positions = p;
+        PBRT_TRY(normals, ps.points("N", "normal"));
+        if (!normals.empty() && normals.size() != p.size())
+          return located(ps.find("N")->at, "\"normal N\" has " + std::to_string(normals.size()) + " normals for " + std::to_string(p.size()) +
+                                               " points, expected one per point");
+        if (corners == 3) mesh.normals = std::move(normals);  // bilinear patches: flat, as the planar ones pathex takes are
+        PBRT_TRY(uv, ps.numbers_of("uv", "point2"));
+        if (!uv.empty() && uv.size() != 2 * p.size())
+          return located(ps.find("uv")->at, "\"point2 uv\" has " + std::to_string(uv.size() / 2) + " pairs for " + std::to_string(p.size()) +
+                                                " points, expected one per point");
+        for (std::size_t i = 0; corners == 3 && i + 1 < uv.size(); i += 2)
+          mesh.uvs.emplace_back(static_cast<float>(uv[i]), static_cast<float>(uv[i + 1]));
         if (corners == 3) {
           for (std::size_t i = 0; i < idx.size(); i += 3) mesh.triangles.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
         } else {
@@ -851,7 +871,7 @@ class Importer {
           return std::nullopt;
         }
       }
-      add_mesh(std::move(s), std::move(mesh), m, flip);
+      if (auto e = add_mesh(std::move(s), std::move(mesh), m, flip, at)) return e;
       return std::nullopt;
     }
     if (type == "cylinder") {  // a tessellated tube (import::tube_mesh)
@@ -863,19 +883,20 @@ class Importer {
       if (!(radius > 0)) return located(at, "radius must be positive");
       if (zmin == zmax) return located(at, "a cylinder of zero height (zmin equals zmax)");
       MeshShape mesh = import::tube_mesh(static_cast<float>(radius), static_cast<float>(std::min(zmin, zmax)), static_cast<float>(std::max(zmin, zmax)));
-      add_mesh(std::move(s), std::move(mesh), m, flip);
+      if (auto e = add_mesh(std::move(s), std::move(mesh), m, flip, at)) return e;
       return std::nullopt;
     }
     return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder");
   }
 
-  // A mesh in object space, placed by `m` and wound so its front side is pbrt's (`flip`).
-  void add_mesh(Shape s, MeshShape mesh, const glm::mat4& m, bool flip) {
-    for (vec3& p : mesh.positions) p = import::apply_point(m, p);
-    if (flip)
-      for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+  // A mesh in object space, placed by `m` with its front side pbrt's: the winding's, reversed by
+  // `flip` (ReverseOrientation xor a mirroring transform), or with per-vertex normals theirs,
+  // negated by ReverseOrientation alone (a mirroring transform carries normals correctly).
+  std::optional<Error> add_mesh(Shape s, MeshShape mesh, const glm::mat4& m, bool flip, const import::Location& at) {
+    if (auto e = import::place_mesh(&mesh, m, /*flip_normals=*/gs_.reverse, /*flip_winding=*/flip, at)) return e;
     s.geometry = std::move(mesh);
     builder_.add_shape(std::move(s));
+    return std::nullopt;
   }
 
   // --- the camera, once the film is known ---

@@ -356,7 +356,7 @@ Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& opti
 }
 
 // A JSON scene's "mesh": an OBJ file, or a PLY file when its name ends in .ply (read as the
-// importers read PLY meshes, per-vertex normals ignored as an OBJ's are). `elements`: as scan_obj.
+// importers read PLY meshes: its per-vertex normals, if any, shade it; an OBJ's are not read). `elements`: as scan_obj.
 Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::string& base_dir, const std::string& file,
                            const SceneLoadOptions& options, std::size_t* elements) {
   const std::string path = (std::filesystem::path(base_dir) / file).string();
@@ -365,7 +365,7 @@ Result<MeshShape> load_obj(const Reader& r, const std::string& ptr, const std::s
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   auto ends_with = [&](std::string_view tail) { return lower.size() >= tail.size() && lower.compare(lower.size() - tail.size(), tail.size(), tail) == 0; };
   if (ends_with(".ply") || ends_with(".ply.gz")) {
-    Result<MeshShape> ply = import::load_ply_mesh(path, import::Location{r.file() + ":" + ptr + "/file"}, /*discard_normals=*/true, options);
+    Result<MeshShape> ply = import::load_ply_mesh(path, import::Location{r.file() + ":" + ptr + "/file"}, options);
     if (!ply) return ply.error();
     *elements += ply->positions.size() + ply->triangles.size();
     if (auto e = check_mesh_elements(*elements, options, r.file() + ":" + ptr + "/file")) return *e;
@@ -716,7 +716,7 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
   } else {
     PATHEX_TRY(file, r.string(j, "file", ptr));
     PATHEX_TRY(mesh, load_obj(r, ptr, base_dir, file, options, mesh_elements));
-    for (vec3& p : mesh.positions) p = apply_point(m, p);
+    if (auto e = import::place_mesh(&mesh, m, false, false, import::Location{r.file() + ":" + ptr + "/file"})) return *e;
     s.geometry = std::move(mesh);
   }
   return s;

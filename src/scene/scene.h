@@ -35,8 +35,9 @@ struct MeshShape {
   std::string file;                      // as given, relative to the scene file
   std::vector<glm::vec3> positions;
   std::vector<glm::uvec3> triangles;
-  // Per vertex, or empty: read from PLY files (scene/ply.h) for the shading normals and textures
-  // to come; nothing renders with them yet (the importers refuse or drop per-vertex normals).
+  // Per vertex, or empty. `normals` (unit): the mesh is smooth-shaded with their interpolation,
+  // and each triangle is wound to face their side (import::place_mesh). `uvs`: read for the
+  // textures to come; nothing renders with them yet.
   std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uvs;
 };

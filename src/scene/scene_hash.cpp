@@ -40,6 +40,10 @@ void hash_geometry(Fnv64& h, const ShapeGeometry& g) {
           h.bytes(k.positions.data(), k.positions.size() * sizeof(glm::vec3));
           h.add(static_cast<std::uint64_t>(k.triangles.size()));
           h.bytes(k.triangles.data(), k.triangles.size() * sizeof(glm::uvec3));
+          if (!k.normals.empty()) {  // only then, so that the hashes of meshes without normals stay as they were
+            h.add(static_cast<std::uint64_t>(k.normals.size()));
+            h.bytes(k.normals.data(), k.normals.size() * sizeof(glm::vec3));
+          }
         } else {
           h.add(k);
         }

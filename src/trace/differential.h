@@ -5,7 +5,10 @@
 // u and v run along an orthonormal tangent frame (s, t) at the point, chosen from the normal
 // alone (Duff et al. 2017), so that the parametrisation has no pole: p(u, v) moves along s and t,
 // and n(u, v) turns with the surface's curvature. Spheres: dn/du = s / r (outward normal).
-// Quads, disks and the flat triangles of meshes: dn = 0 (meshes have no interpolated normals).
+// Quads, disks and the triangles of meshes without vertex normals: dn = 0. A mesh with vertex
+// normals is smooth-shaded: its shading normal ns is their interpolation (mesh_shading_normal(),
+// the tracer's too), and dn/du, dn/dv are ns's derivatives along the triangle's plane, so that a
+// specular constraint (the manifold walk) sees the surface the tracer shades.
 #pragma once
 
 #include <cmath>
@@ -20,9 +23,19 @@ namespace pathex {
 
 struct SurfaceDerivatives {
   glm::dvec3 n{0.0};                  // the unit outward (geometric) normal
-  glm::dvec3 dpdu{0.0}, dpdv{0.0};    // unit, orthogonal, tangent
-  glm::dvec3 dndu{0.0}, dndv{0.0};
+  glm::dvec3 ns{0.0};                 // the unit shading normal (n but on smooth-shaded meshes)
+  glm::dvec3 dpdu{0.0}, dpdv{0.0};    // unit, orthogonal, tangent (to n)
+  glm::dvec3 dndu{0.0}, dndv{0.0};    // of ns
 };
+
+// The shading normal of triangle `t` of `m` (which has vertex normals) at Embree's barycentrics
+// (u, v) (the weights of its second and third vertex): the vertex normals interpolated and
+// normalised; `fallback` (the geometric normal) where they cancel.
+inline glm::vec3 mesh_shading_normal(const MeshShape& m, const glm::uvec3& t, float u, float v, const glm::vec3& fallback) {
+  const glm::vec3 n = (1.0f - u - v) * m.normals[t.x] + u * m.normals[t.y] + v * m.normals[t.z];
+  const float len = glm::length(n);
+  return len > 0.0f ? n / len : fallback;
+}
 
 // An orthonormal tangent pair for unit n (Duff et al., "Building an Orthonormal Basis, Revisited").
 inline void tangent_frame(const glm::dvec3& n, glm::dvec3* s, glm::dvec3* t) {
@@ -41,6 +54,39 @@ inline glm::dvec3 mesh_normal(const MeshShape& m, int primitive) {
   const double len = glm::length(n);
   return len > 0.0 ? n / len : glm::dvec3(0.0, 0.0, 1.0);
 }
+// A smooth-shaded triangle at p: r.n set. With the raw normal N = w0 n0 + w1 n1 + w2 n2 (the
+// barycentrics w linear in p) and ns = N / |N|, a tangent step a changes N by
+// dw1(a) (n1 - n0) + dw2(a) (n2 - n0), and ns by that change's part perpendicular to ns, / |N|.
+inline SurfaceDerivatives smooth_triangle(const MeshShape& m, int primitive, const glm::dvec3& p, SurfaceDerivatives r) {
+  const glm::uvec3 t = m.triangles[static_cast<std::size_t>(primitive)];
+  const glm::dvec3 o = d(m.positions[t.x]), e1 = d(m.positions[t.y]) - o, e2 = d(m.positions[t.z]) - o;
+  const glm::dvec3 n0 = d(m.normals[t.x]), n1 = d(m.normals[t.y]), n2 = d(m.normals[t.z]);
+  const glm::dvec3 c = glm::cross(e1, e2);
+  const double c2 = glm::dot(c, c);
+  tangent_frame(r.n, &r.dpdu, &r.dpdv);
+  if (!(c2 > 0.0)) {  // degenerate: flat
+    r.ns = r.n;
+    return r;
+  }
+  // Barycentric weights of the second and third vertex for a point (or, without o, a step) in the plane.
+  const auto w12 = [&](const glm::dvec3& a) { return glm::dvec2(glm::dot(glm::cross(a, e2), c) / c2, glm::dot(glm::cross(e1, a), c) / c2); };
+  const glm::dvec2 w = w12(p - o);
+  const glm::dvec3 raw = (1.0 - w.x - w.y) * n0 + w.x * n1 + w.y * n2;
+  const double len = glm::length(raw);
+  if (!(len > 0.0)) {
+    r.ns = r.n;
+    return r;
+  }
+  r.ns = raw / len;
+  const auto turn = [&](const glm::dvec3& a) {
+    const glm::dvec2 dw = w12(a);
+    const glm::dvec3 dn = dw.x * (n1 - n0) + dw.y * (n2 - n0);
+    return (dn - glm::dot(dn, r.ns) * r.ns) / len;
+  };
+  r.dndu = turn(r.dpdu);
+  r.dndv = turn(r.dpdv);
+  return r;
+}
 }  // namespace differential_detail
 
 // The derivatives of `shape` at p (a point on it; `primitive`: the triangle of a mesh).
@@ -56,8 +102,11 @@ inline SurfaceDerivatives surface_derivatives(const ShapeGeometry& shape, int pr
   } else if (const auto* k = std::get_if<DiskShape>(&shape)) {
     r.n = glm::normalize(d(k->normal));
   } else {
-    r.n = differential_detail::mesh_normal(std::get<MeshShape>(shape), primitive);
+    const MeshShape& m = std::get<MeshShape>(shape);
+    r.n = differential_detail::mesh_normal(m, primitive);
+    if (!m.normals.empty()) return differential_detail::smooth_triangle(m, primitive, p, r);
   }
+  r.ns = r.n;
   tangent_frame(r.n, &r.dpdu, &r.dpdv);
   r.dndu = curvature * r.dpdu;
   r.dndv = curvature * r.dpdv;

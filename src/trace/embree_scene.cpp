@@ -331,11 +331,16 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
   if (const auto* m = std::get_if<MeshShape>(&shape.geometry)) {
     const glm::uvec3 t = m->triangles[rh.hit.primID];
     const vec3 p0 = m->positions[t.x], p1 = m->positions[t.y], p2 = m->positions[t.z];
-    if (detail == HitDetail::kFull) h.uv = {rh.hit.u, rh.hit.v};
+    if (detail == HitDetail::kFull) {  // the mesh's uv, or pbrt-v4's default (0, 0), (1, 0), (1, 1) per triangle
+      const float w1 = rh.hit.u, w2 = rh.hit.v;
+      h.uv = m->uvs.empty() ? glm::vec2(w1 + w2, w2) : (1.0f - w1 - w2) * m->uvs[t.x] + w1 * m->uvs[t.y] + w2 * m->uvs[t.z];
+    }
     h.position = triangle_point(p0, p1, p2, 1.0f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v, &h.error);
     const vec3 n = glm::cross(p1 - p0, p2 - p0);
     const float len = glm::length(n);
     h.normal = len > 0.0f ? n / len : -glm::normalize(d);  // degenerate triangles face the ray
+    h.shading_normal = m->normals.empty() ? h.normal : mesh_shading_normal(*m, t, rh.hit.u, rh.hit.v, h.normal);
+    return out;
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
     h.normal = quad_normals_[static_cast<std::size_t>(h.shape)];
     h.error = shape_errors_[static_cast<std::size_t>(h.shape)];  // the projection too: p lies within the quad

@@ -46,12 +46,13 @@ struct Hit {
   float t = 0.0f;                  // along the query's direction as given (not normalised)
   glm::vec3 position{0.0f};        // on the surface
   glm::vec3 normal{0.0f};          // geometric, unit, the shape's outward side (whichever side was hit)
-  glm::vec3 shading_normal{0.0f};  // equal to `normal` (no interpolated normals yet)
+  glm::vec3 shading_normal{0.0f};  // unit: a mesh's interpolated vertex normals where it has them, else `normal`
   glm::vec3 error{0.0f};           // bound on |position - the exact surface point|, per component
   int shape = -1;                  // index into Scene::shapes
   int primitive = -1;              // triangle index for meshes, 0 otherwise
-  // Surface parameters (HitDetail::kFull only; zero otherwise): mesh, Embree's barycentrics (weights of the triangle's second and third
-  // vertex); quad, position = corner + u edge1 + v edge2; sphere, u = phi / 2pi with
+  // Surface parameters (HitDetail::kFull only; zero otherwise), the textures' coordinates: mesh,
+  // its per-vertex uv interpolated, or without them pbrt-v4's default (0, 0), (1, 0), (1, 1) at the
+  // triangle's corners, (w1 + w2, w2) for Embree's barycentrics w1, w2; quad, position = corner + u edge1 + v edge2; sphere, u = phi / 2pi with
   // phi = atan2(y, x) about the centre in world axes, v = theta / pi with theta from +z; disk,
   // u = phi / 2pi in the disk's Frame::from_normal, v = distance from the centre / radius.
   glm::vec2 uv{0.0f};

@@ -54,4 +54,14 @@ inline float abs_cos(const Vertex& v, const vec3& w) {
   return std::fabs(glm::dot(v.n, w)) + static_cast<float>(!v.has_normal());
 }
 
+// |cos| at `v` towards `w` with its shading normal: the BSDF's own cosine, which a join puts at
+// both its ends (Veach's thesis §5.3; pbrt-v3's bdpt G with the shading normals). At the light
+// subpath's end end_f() multiplies f by the adjoint's correction |wo·ns| |w·ng| / (|wo·ng| |w·ns|),
+// so that end's factor is |w·ng| |wo·ns| / |wo·ng|: the area measure's geometric cosine and the
+// correction of the segment the light came in on, as the random walk applies it. 1 for vertices
+// without a surface; abs_cos(v, w) wherever ns == n (every surface but a smooth-shaded mesh).
+inline float shading_cos(const Vertex& v, const vec3& w) {
+  return std::fabs(glm::dot(v.ns, w)) + static_cast<float>(!v.has_normal());
+}
+
 }  // namespace pathex::tracer

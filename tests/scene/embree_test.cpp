@@ -52,10 +52,21 @@ TEST(Embree, TwoRaySmokeTest) {
   EXPECT_EQ(hit->primitive, 0);
   EXPECT_EQ(hit->normal, vec3(0, 0, 1));
   EXPECT_EQ(hit->shading_normal, vec3(0, 0, 1));
-  // (0, 0) = 1/4 p0 + 1/4 p1 + 1/2 p2: barycentrics (u, v) of p1 and p2.
-  EXPECT_NEAR(hit->uv.x, 0.25f, 1e-6f);
+  // (0, 0) = 1/4 p0 + 1/4 p1 + 1/2 p2; without uv pbrt-v4's (0, 0), (1, 0), (1, 1) at the corners.
+  EXPECT_NEAR(hit->uv.x, 0.75f, 1e-6f);
   EXPECT_NEAR(hit->uv.y, 0.5f, 1e-6f);
   EXPECT_FALSE((*es)->intersect({5, 5, 1}, {0, 0, -1}, 0.0f, INFINITY).has_value());
+  // With the file's uv: interpolated with the same weights.
+  std::ofstream("/tmp/pathex-smoke-uv.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                               "property float u\nproperty float v\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                               "end_header\n-1 -1 0 0.2 0.1\n1 -1 0 0.6 0.1\n0 1 0 0.4 0.9\n3 0 1 2\n";
+  const Scene t = one_shape(R"({"type": "mesh", "file": "pathex-smoke-uv.ply", "material": "m"})");
+  auto et = EmbreeScene::build(t);
+  ASSERT_TRUE(et.ok()) << et.error().render();
+  const std::optional<Hit> uv_hit = (*et)->intersect({0, 0, 1}, {0, 0, -1}, 0.0f, INFINITY);
+  ASSERT_TRUE(uv_hit.has_value());
+  EXPECT_NEAR(uv_hit->uv.x, 0.25f * 0.2f + 0.25f * 0.6f + 0.5f * 0.4f, 1e-6f);
+  EXPECT_NEAR(uv_hit->uv.y, 0.25f * 0.1f + 0.25f * 0.1f + 0.5f * 0.9f, 1e-6f);
 }
 
 // Debian's Embree aborts the process on a non-finite ray (an assertion); the queries must keep

@@ -481,8 +481,12 @@ std::vector<Refusal> refusals() {
        "parameter \"blackbody I\" is not supported: pathex renders in RGB, give \"rgb I\" [r g b]"},
       {"texture.pbrt", "Material \"diffuse\" \"texture reflectance\" \"checks\"\n", "texture.pbrt:4:20",
        "textures are not supported (parameter \"texture reflectance\"), give \"rgb reflectance\" [r g b]"},
-      {"normals.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1 0 0 1 0 0 1]\n", "normals.pbrt:4:53",
-       "per-vertex normals and tangents (N) are not supported: pathex shades meshes with their face normals"},
+      {"normals.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1 0 0 1]\n", "normals.pbrt:4:53",
+       "\"normal N\" has 2 normals for 3 points, expected one per point"},
+      {"uv-count.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"point2 uv\" [0 0 1 0]\n", "uv-count.pbrt:4:53",
+       "\"point2 uv\" has 2 pairs for 3 points, expected one per point"},
+      {"zero-normal.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1 0 0 0 0 0 1]\n", "zero-normal.pbrt:4:1",
+       "normal 1 of the mesh is zero, expected a direction"},
       {"include.pbrt", "Include \"missing.pbrt\"\n", "include.pbrt:4:1", "cannot open the included file 'missing.pbrt'"},
       {"self.pbrt", "Include \"loop.pbrt\"\n", "loop.pbrt:1:1", "Include/Import nested more than 32 deep (a file including itself?)"},
       {"end.pbrt", "AttributeEnd\n", "end.pbrt:4:1", "AttributeEnd has no matching AttributeBegin"},
@@ -511,7 +515,7 @@ std::vector<Refusal> refusals() {
       {"negative.xml", "  <emitter type=\"point\">\n    <rgb name=\"intensity\" value=\"1, -1, 1\"/>\n  </emitter>\n</scene>\n", "negative.xml:2:3",
        "a light's emission must be non-negative"},
       {"curve.xml", "  <shape type=\"bsplinecurve\"/>\n</scene>\n", "curve.xml:2:3",
-       "shape \"bsplinecurve\" is not supported, expected obj, ply, sphere, rectangle, disk, cube or cylinder"},
+       "shape \"bsplinecurve\" is not supported, expected obj, ply, serialized, sphere, rectangle, disk, cube or cylinder"},
       {"envmap.xml", "  <emitter type=\"envmap\"/>\n</scene>\n", "envmap.xml:2:3",
        "emitter \"envmap\" (an image infinite light) is not supported: pathex renders a uniform infinite light (constant) only"},
       {"projector.xml", "  <emitter type=\"projector\"/>\n</scene>\n", "projector.xml:2:3",
@@ -529,9 +533,6 @@ std::vector<Refusal> refusals() {
        "bitmap.xml:4:7", "textures are not supported ('reflectance'), give an <rgb>"},
       {"typo.xml", "  <shape type=\"sphere\">\n    <float name=\"radiuss\" value=\"1\"/>\n  </shape>\n</scene>\n", "typo.xml:3:5",
        "<float name=\"radiuss\"> in <shape type=\"sphere\"> is not supported"},
-      {"smooth.xml", "  <shape type=\"obj\">\n    <string name=\"filename\" value=\"x.obj\"/>\n  </shape>\n</scene>\n", "smooth.xml:2:3",
-       "smooth shading is not supported: Mitsuba interpolates vertex normals unless face_normals is true, pathex shades meshes with their face "
-       "normals (add <boolean name=\"face_normals\" value=\"true\"/>)"},
       {"wide-beam.xml", "  <emitter type=\"spot\">\n    <float name=\"beam_width\" value=\"30\"/>\n  </emitter>\n</scene>\n", "wide-beam.xml:2:3",
        "beam_width must be within [0, cutoff_angle]"},
       {"param.xml", "  <shape type=\"sphere\">\n    <float name=\"radius\" value=\"$r\"/>\n  </shape>\n</scene>\n", "param.xml:3:5",
@@ -690,16 +691,9 @@ TEST(ImportMitsuba, AVersionOtherThan3IsRefusedNamingIt) {
   EXPECT_EQ(relative(run.err), "pathex: error: v.xml:1:1: scene version 0.6.0 is Mitsuba 0.6; pathex reads Mitsuba 3 scenes (version 3.x)\n");
 }
 
-TEST(ImportRefusals, PlyMeshesWithNormalsOrCurvedQuads) {
+TEST(ImportRefusals, PlyMeshesWithCurvedQuadsOrOfAnotherFormat) {
   const std::string header = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n";
-  write("normals.ply", header + "property float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\n"
-                                "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n");
   write("curved.ply", header + "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 1\n0 1 0\n4 0 1 2 3\n");
-  const Result<Scene> a = load_scene_file(write("ply-normals.pbrt", kPbrtHead + "Shape \"plymesh\" \"string filename\" \"normals.ply\"\n"));
-  ASSERT_FALSE(a.ok());
-  EXPECT_EQ(relative(a.error().where), "ply-normals.pbrt:4:1");
-  EXPECT_EQ(relative(a.error().message),
-            "the PLY mesh 'normals.ply' has per-vertex normals, which are not supported: pathex shades meshes with their face normals");
   const Result<Scene> b = load_scene_file(write("ply-curved.pbrt", kPbrtHead + "Shape \"plymesh\" \"string filename\" \"curved.ply\"\n"));
   ASSERT_FALSE(b.ok());
   EXPECT_EQ(relative(b.error().message),
@@ -708,6 +702,60 @@ TEST(ImportRefusals, PlyMeshesWithNormalsOrCurvedQuads) {
   const Result<Scene> c = load_scene_file(write("ply-obj.pbrt", kPbrtHead + "Shape \"plymesh\" \"string filename\" \"mesh.obj\"\n"));
   ASSERT_FALSE(c.ok());
   EXPECT_EQ(relative(c.error().message), "the mesh 'mesh.obj' is not a .ply or .ply.gz file");
+}
+
+// Per-vertex normals (README "Importing pbrt-v4 and Mitsuba 3 scenes"): transformed as normals,
+// negated by ReverseOrientation / flip_normals, and each triangle wound to face their side.
+TEST(ImportShapes, VertexNormalsArePlacedAndWindTheirTriangles) {
+  const auto mesh_of = [](const Scene& s, std::size_t i) -> const MeshShape& { return std::get<MeshShape>(s.shapes.at(i).geometry); };
+  const auto face = [](const MeshShape& m, std::size_t t) {
+    const glm::uvec3 v = m.triangles[t];
+    return glm::normalize(glm::cross(m.positions[v.y] - m.positions[v.x], m.positions[v.z] - m.positions[v.x]));
+  };
+  // Wound clockwise seen from +z (face -z) with normals +z: rewound to face +z. Rotated 90° about x
+  // (+z to -y). Reversed: the normals turn to -z and the winding with them.
+  const std::string tri = "Shape \"trianglemesh\" \"point3 P\" [0 0 0 0 1 0 1 0 0] \"integer indices\" [0 1 2] \"normal N\" [0 0 2 0 0 1 0 0 1] "
+                          "\"point2 uv\" [0 0 0 1 1 0]\n";
+  const Scene s = load(write("vertex-normals.pbrt", kPbrtHead + "LightSource \"point\"\n" + tri +
+                                                         "AttributeBegin\nRotate 90 1 0 0\n" + tri + "AttributeEnd\n"
+                                                         "AttributeBegin\nReverseOrientation\n" + tri + "AttributeEnd\n"));
+  ASSERT_EQ(s.shapes.size(), 3u);
+  const glm::vec3 expected[3] = {{0, 0, 1}, {0, -1, 0}, {0, 0, -1}};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const MeshShape& m = mesh_of(s, i);
+    ASSERT_EQ(m.normals.size(), 3u) << i;
+    for (const glm::vec3& n : m.normals) expect_near(n, expected[i], "pbrt vertex normal of shape " + std::to_string(i));
+    expect_near(face(m, 0), expected[i], "pbrt face normal of shape " + std::to_string(i));
+    EXPECT_EQ(m.uvs, (std::vector<glm::vec2>{{0, 0}, {0, 1}, {1, 0}})) << i;  // "point2 uv", one pair per point
+  }
+  // Mitsuba: a PLY's normals unless face_normals; an OBJ (whose vn pathex does not read) gets
+  // Mitsuba's angle-weighted normals: two faces meeting at a right angle along the y axis, +z
+  // (angle 45° at (0, 1, 0)) and +x (angle atan 2 there), so (0, 1, 0)'s normal is
+  // normalize(atan(2) x + (pi/4) z), not the area-weighted normalize(x + z / 2).
+  write("normals.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                       "property float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\n"
+                       "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n");
+  write("roof.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 2\nf 1 2 3\nf 1 3 4\n");
+  const std::string sensor = "<sensor type=\"perspective\"><float name=\"fov\" value=\"60\"/><transform name=\"to_world\">"
+                             "<lookat origin=\"0 1 8\" target=\"0 1 0\"/></transform></sensor>\n<emitter type=\"point\"/>\n";
+  const Scene x = load(write("vertex-normals.xml", kXmlHead + sensor +
+      "<shape type=\"ply\"><string name=\"filename\" value=\"normals.ply\"/></shape>\n"
+      "<shape type=\"ply\"><string name=\"filename\" value=\"normals.ply\"/><boolean name=\"face_normals\" value=\"true\"/></shape>\n"
+      "<shape type=\"ply\"><string name=\"filename\" value=\"normals.ply\"/><boolean name=\"flip_normals\" value=\"true\"/></shape>\n"
+      "<shape type=\"obj\"><string name=\"filename\" value=\"roof.obj\"/></shape>\n</scene>\n"));
+  ASSERT_EQ(x.shapes.size(), 4u);
+  ASSERT_EQ(mesh_of(x, 0).normals.size(), 3u);
+  expect_near(mesh_of(x, 0).normals[1], {0, 0, 1}, "the PLY's own normal");
+  EXPECT_TRUE(mesh_of(x, 1).normals.empty());
+  expect_near(mesh_of(x, 2).normals[1], {0, 0, -1}, "flip_normals");
+  expect_near(face(mesh_of(x, 2), 0), {0, 0, -1}, "flip_normals' winding");
+  const MeshShape& roof = mesh_of(x, 3);
+  ASSERT_EQ(roof.normals.size(), 4u);
+  const float pi = 3.14159265f;
+  expect_near(roof.normals[2], glm::normalize(std::atan(2.0f) * glm::vec3(1, 0, 0) + (pi / 4) * glm::vec3(0, 0, 1)), "angle-weighted");
+  expect_near(roof.normals[0], glm::normalize(glm::vec3(1, 0, 1)), "angle-weighted at the right-angled corner");
+  expect_near(roof.normals[1], {0, 0, 1}, "one face");
+  expect_near(roof.normals[3], {1, 0, 0}, "the other face");
 }
 
 }  // namespace

@@ -520,17 +520,14 @@ TEST(PlyImport, PbrtAndMitsubaReadGzippedPlyWithUvAndSplitQuadsAlongV0V2) {
   EXPECT_EQ(mesh.positions[4], glm::vec3(0, 0.5f, 0));
 }
 
-TEST(PlyImport, MitsubaFaceNormalsDropTheFilesNormals) {
+TEST(PlyImport, TheFilesNormalsAreKeptOnePerVertex) {
   Ply ply;
   ply.normals = true;
   ply.positions[4] = {0, 0.5, 0};
   write("normals.ply", ply.bytes());
-  const Result<MeshShape> kept = import::load_ply_mesh(scratch() + "/normals.ply", import::Location{"s.xml", 2, 3}, /*discard_normals=*/true, {});
+  const Result<MeshShape> kept = import::load_ply_mesh(scratch() + "/normals.ply", import::Location{"s.xml", 2, 3}, {});
   ASSERT_TRUE(kept.ok()) << kept.error().render();
-  EXPECT_TRUE(kept->normals.empty());
-  const Result<MeshShape> refused = import::load_ply_mesh(scratch() + "/normals.ply", import::Location{"s.pbrt", 4, 1}, false, {});
-  ASSERT_FALSE(refused.ok());
-  EXPECT_EQ(refused.error().where, "s.pbrt:4:1");
+  EXPECT_EQ(kept->normals.size(), kept->positions.size());
 }
 
 TEST(PlyImport, TraceRefusesEachHostileFileWithItsMessageAndExitCode2) {
@@ -574,7 +571,7 @@ TEST(PlyRepository, EveryPlyInSamplesAndTestsLoads) {
   EXPECT_GE(files, 1);
   // The Cornell floor: what assimp read (the exported box's test renders it against cornell.json).
   const Result<MeshShape> floor =
-      import::load_ply_mesh(kDir + "/samples/scenes/meshes/cornell-floor.ply", import::Location{"cornell.pbrt", 20, 1}, false, {});
+      import::load_ply_mesh(kDir + "/samples/scenes/meshes/cornell-floor.ply", import::Location{"cornell.pbrt", 20, 1}, {});
   ASSERT_TRUE(floor.ok()) << floor.error().render();
   EXPECT_EQ(floor->positions, (std::vector<glm::vec3>{{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}));
   EXPECT_EQ(floor->triangles, (std::vector<glm::uvec3>{{0, 1, 2}, {0, 2, 3}}));

@@ -53,6 +53,54 @@ TEST(ManifoldWalk, FlatInterfaceMatchesTheParaxialClosedForm) {
   EXPECT_NEAR(w.dw_db, 1.0 / ((h1 + h2 / eta) * (h1 + h2 / eta)), 1e-6 * w.dw_db);
 }
 
+// A smooth-shaded triangle (trace/differential.h): its shading normal is the vertex normals'
+// interpolation, and dn/du, dn/dv are that normal's derivatives along the triangle (checked here
+// against central differences of mesh_shading_normal, the function the tracer shades with).
+TEST(ManifoldWalk, SmoothShadedTrianglesNormalAndItsDerivatives) {
+  MeshShape m;
+  m.positions = {{-1, 0, 1}, {1, 0, 1}, {0, 0, -1}};
+  m.triangles = {{0, 1, 2}};
+  m.normals = {glm::normalize(glm::vec3(-0.4f, 1, 0.1f)), glm::normalize(glm::vec3(0.5f, 1, 0.2f)), glm::normalize(glm::vec3(0, 1, -0.6f))};
+  const ShapeGeometry g = m;
+  const dvec3 p(0.1, 0.0, 0.2);
+  const SurfaceDerivatives d = surface_derivatives(g, 0, p);
+  EXPECT_NEAR(glm::length(d.n - dvec3(0, 1, 0)), 0.0, 1e-12);  // wound (0 1 2): (e1 × e2) points up
+  // The barycentrics of p: w1 = 0.35, w2 = 0.4 (p = 0.25 p0 + 0.35 p1 + 0.4 p2).
+  const glm::vec3 ns = mesh_shading_normal(m, m.triangles[0], 0.35f, 0.4f, glm::vec3(d.n));
+  EXPECT_NEAR(glm::length(d.ns - dvec3(ns)), 0.0, 1e-6);
+  const auto shade_at = [&](const dvec3& q) { return surface_derivatives(g, 0, q).ns; };
+  const double h = 1e-5;
+  const dvec3 fd_u = (shade_at(p + h * d.dpdu) - shade_at(p - h * d.dpdu)) / (2 * h);
+  const dvec3 fd_v = (shade_at(p + h * d.dpdv) - shade_at(p - h * d.dpdv)) / (2 * h);
+  EXPECT_GT(glm::length(fd_u), 0.05);  // the normal does turn
+  EXPECT_NEAR(glm::length(d.dndu - fd_u), 0.0, 1e-7);
+  EXPECT_NEAR(glm::length(d.dndv - fd_v), 0.0, 1e-7);
+}
+
+// A flat triangle whose vertex normals all lean the same way refracts as a tilted interface: the
+// walk solves Snell's law about the shading normal (the tracer's), not the geometric one.
+TEST(ManifoldWalk, SmoothShadedInterfaceRefractsAboutItsShadingNormal) {
+  MeshShape m;
+  m.positions = {{-5, 0, 5}, {5, 0, 5}, {0, 0, -10}};
+  m.triangles = {{0, 1, 2}};
+  const glm::vec3 lean = glm::normalize(glm::vec3(0.3f, 1, 0));
+  m.normals = {lean, lean, lean};
+  const ShapeGeometry g = m;
+  const dvec3 a(0.2, 1.3, 0.1), b(-0.1, -0.7, 0.0);
+  std::vector<ChainVertex> x{on(g, dvec3(0.0, 0.0, 0.0), true, 1.5)};
+  const ManifoldWalk w = solve_chain(x, a, b, dvec3(0, 1, 0), 10.0, ManifoldOptions{});
+  ASSERT_EQ(w.failure, ManifoldFailure::kNone);
+  const dvec3 n = surface_derivatives(g, 0, x[0].p).ns;
+  EXPECT_NEAR(glm::length(n - dvec3(lean)), 0.0, 1e-6);
+  const dvec3 wi = glm::normalize(a - x[0].p), wo = glm::normalize(b - x[0].p);
+  const double ci = glm::dot(wi, n), co = glm::dot(wo, n);
+  EXPECT_NEAR(std::sqrt(1 - ci * ci), 1.5 * std::sqrt(1 - co * co), 1e-6);  // Snell about ns
+  EXPECT_NEAR(glm::dot(glm::cross(wi, n), wo), 0.0, 1e-6);                  // in the plane of incidence
+  const dvec3 ng(0, 1, 0);
+  const double gi = glm::dot(wi, ng), go = glm::dot(wo, ng);
+  EXPECT_GT(std::fabs(std::sqrt(1 - gi * gi) - 1.5 * std::sqrt(1 - go * go)), 1e-2);  // and not about ng
+}
+
 // Off the axis the flat interface's term is still closed-form: with the refraction point r along the
 // plane, θ1 and θ2 its angles, dA_b / dω_a = (h1 / cos θ1 ... ) — checked here against the
 // definition instead: moving b by δ and re-solving moves the direction leaving a by dω.

@@ -26,7 +26,7 @@ std::optional<glm::dvec2> constraint(const std::vector<ChainVertex>& x, std::siz
   const double li = glm::length(ei), lo = glm::length(eo);
   if (!(li > 0.0) || !(lo > 0.0)) return std::nullopt;
   const dvec3 wi = ei / li, wo = eo / lo;
-  const dvec3 n = surface_derivatives(*x[i].shape, x[i].primitive, p).n;
+  const dvec3 n = surface_derivatives(*x[i].shape, x[i].primitive, p).ns;  // the normal the tracer shades with
   dvec3 h = x[i].eta_light * wi + x[i].eta_eye * wo;
   const double lh = glm::length(h);
   if (!(lh > 0.0)) return std::nullopt;

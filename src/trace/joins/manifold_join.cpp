@@ -248,14 +248,15 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     v.kind = Kind::kSurface;
     v.letter = 'S';
     v.p = vec3(c.p);
-    v.n = vec3(surface_derivatives(*c.shape, c.primitive, c.p).n);
-    v.ns = v.n;
+    const SurfaceDerivatives geometry = surface_derivatives(*c.shape, c.primitive, c.p);
+    v.n = vec3(geometry.n);
+    v.ns = vec3(geometry.ns);
     v.finite = false;
     // Rounding of the solved point: its float position and the surface's own test, as a hit's bound.
     v.err = error_gamma(16) * (glm::abs(v.p) + vec3(static_cast<float>(scene_size_)));
     v.shape = c.id;
     const glm::dvec3 prev = i == 0 ? glm::dvec3(a->p) : chain[static_cast<std::size_t>(i - 1)].p;
-    const float cos_prev = static_cast<float>(glm::dot(glm::normalize(prev - c.p), glm::dvec3(v.n)));
+    const float cos_prev = static_cast<float>(glm::dot(glm::normalize(prev - c.p), geometry.ns));
     if (const auto* glass = std::get_if<Dielectric>(rs_.material_of_shape[static_cast<std::size_t>(c.id)])) {
       const float f = bsdf::fresnel_dielectric(cos_prev, glass->ior);
       transmit *= glass->tint * (c.reflect ? f : 1.0f - f);
@@ -269,9 +270,12 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
   const vec3 fa = end_f(*a, w_a, TransportMode::kImportance);
   const vec3 fb = end_f(*b, w_b, TransportMode::kRadiance);
   // Flux leaving a into dω lands on dA_b = dω / |dω_a/dA_b|: the generalized geometry term, here
-  // times the chain's estimated inverse probability (`weight`).
-  const vec3 contrib = a->beta * fa * abs_cos(*a, w_a) * transmit * fb * b->beta *
-                       static_cast<float>(weight);
+  // times the chain's estimated inverse probability (`weight`). Its cosine at b is the area
+  // measure's (geometric); b's shading cosine replaces it (shading_cos, vertex.h).
+  const float cos_b = abs_cos(*b, w_b);
+  const float shade_b = cos_b > 0.0f ? shading_cos(*b, w_b) / cos_b : 0.0f;
+  const vec3 contrib = a->beta * fa * shading_cos(*a, w_a) * transmit * fb * b->beta *
+                       (static_cast<float>(weight) * shade_b);
   if (is_black(contrib)) {
     ++stats.no_transport;
     return;

@@ -55,12 +55,12 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     // f at a towards the mirror: the light's directional emission, or the BSDF.
     const vec3 fa = end_f(*a, j->w_a, TransportMode::kImportance);
     // Across the mirror the geometry term is the straight one to the image: |cos_a| |cos_b| / D².
-    vec3 contrib = a->beta * fa * mirror.reflectance * abs_cos(*a, j->w_a);
+    vec3 contrib = a->beta * fa * mirror.reflectance * shading_cos(*a, j->w_a);
     if (t == 1) {
       contrib *= c->weight;  // We cos / (p D²), D = |a' − sensor point|
     } else {
       const vec3 fb = end_f(*b, j->w_b, TransportMode::kRadiance);
-      contrib *= fb * b->beta * (abs_cos(*b, j->w_b) / (j->unfolded * j->unfolded));
+      contrib *= fb * b->beta * (shading_cos(*b, j->w_b) / (j->unfolded * j->unfolded));
     }
     if (is_black(contrib)) {
       ++stats.no_transport;

@@ -148,7 +148,7 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   jr.density.d2 = c->distance * c->distance;
   jr.has_density = true;
   // weight: We cos / d² (splat), We (film); an ortho path's S letter is c(k+1), the sensor's direction.
-  return end_join(th, qs.beta * fq * (abs_cos(qs, w) * c->weight), ortho ? bit(s + 1) : 0, &qs, &z0);
+  return end_join(th, qs.beta * fq * (shading_cos(qs, w) * c->weight), ortho ? bit(s + 1) : 0, &qs, &z0);
 }
 
 // --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
@@ -187,7 +187,7 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   jr.density.d2 = c->distance * c->distance;
   jr.has_density = true;
   // weight: Le cos / (p d²), I / d², E; a distant path's S letter is c1, the light's direction.
-  return end_join(th, pt.beta * f * (abs_cos(pt, w) / light_pick_) * c->weight, distant ? bit(1) : 0, &pt, &y0);
+  return end_join(th, pt.beta * f * (shading_cos(pt, w) / light_pick_) * c->weight, distant ? bit(1) : 0, &pt, &y0);
 }
 
 // --- s, t >= 2: a shadow ray between y(s-1) and z(t-1) ---
@@ -206,7 +206,7 @@ bool Integrator::join_shadow(Thread& th, int s, int t) const {
   jr.density.w = w;
   jr.density.d2 = d2;
   jr.has_density = true;
-  const float g = abs_cos(qs, w) * abs_cos(pt, w) / d2;
+  const float g = shading_cos(qs, w) * shading_cos(pt, w) / d2;
   return end_join(th, qs.beta * fq * fp * pt.beta * g, 0, &qs, &pt);
 }
 
