@@ -523,7 +523,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     // A light vertex's beta already holds its spatial emission; only the directional part is left.
     if (qs->kind == Kind::kLight) fq = vec3(directional_emission(rs_.lights[static_cast<std::size_t>(qs->light)].params, qs->n, w));
     else fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                        qs->wo, w, qs->ns, qs->n, &join.at_qs);
+                        qs->wo, w, qs->ns, qs->n, &join.at_qs, TransportMode::kImportance);
     join.w = w;
     join.d2 = c->distance * c->distance;
     joined = true;
@@ -580,7 +580,7 @@ void Integrator::connect(Thread& th, Sampler& rng, int s, int t, int batch) cons
     if (d2 <= 0.0f) return;
     const vec3 w = d * (1.0f / std::sqrt(d2));  // one division, not three
     const vec3 fq = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(qs->shape)],
-                              qs->wo, w, qs->ns, qs->n, &join.at_qs);
+                              qs->wo, w, qs->ns, qs->n, &join.at_qs, TransportMode::kImportance);
     const vec3 fp = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(pt->shape)],
                               pt->wo, -w, pt->ns, pt->n, &join.at_pt);
     join.w = w;
@@ -712,7 +712,8 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     }
     // f at a towards the mirror: the light's directional emission, or the BSDF.
     const vec3 fa = light ? vec3(directional_emission(light->params, a->n, j->w_a))
-                          : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, j->w_a, a->ns, a->n);
+                          : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, j->w_a, a->ns, a->n,
+                                       TransportMode::kImportance);
     // Across the mirror the geometry term is the straight one to the image: |cos_a| |cos_b| / D².
     vec3 contrib = a->beta * fa * mirror.reflectance * abs_cos(*a, j->w_a);
     if (t == 1) {

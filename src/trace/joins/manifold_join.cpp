@@ -269,7 +269,8 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
   const vec3 w_b = glm::normalize(jr.chain_vertices[static_cast<std::size_t>(m - 1)].p - b->p);
   // f at a towards the chain: the light's directional emission (a's beta holds the spatial part), or the BSDF.
   const vec3 fa = s == 1 ? vec3(directional_emission(rs_.lights[static_cast<std::size_t>(a->light)].params, a->n, w_a))
-                         : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, w_a, a->ns, a->n);
+                         : bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(a->shape)], a->wo, w_a, a->ns, a->n,
+                                      TransportMode::kImportance);
   const vec3 fb = bsdf::eval(*rs_.material_of_shape[static_cast<std::size_t>(b->shape)], b->wo, w_b, b->ns, b->n);
   // Flux leaving a into dω lands on dA_b = dω / |dω_a/dA_b|: the generalized geometry term, here
   // times the chain's estimated inverse probability (`weight`).
