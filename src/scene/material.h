@@ -52,7 +52,7 @@ inline constexpr float kSmoothAlpha = 1e-3f;
 // tangents are those of the shading frame (trace/frame.h), not the surface's u direction.
 struct Conductor {
   glm::vec3 eta{0.104494f, 0.978171f, 1.204672f};  // default: pbrt-v4's copper (scene/metal_spectra.h)
-  glm::vec3 k{3.273334f, 2.592352f, 2.369246f};
+  glm::vec3 k{2.721234f, 2.622372f, 2.358023f};
   float alpha_u = 0.0f;
   float alpha_v = 0.0f;
   glm::vec3 tint{1.0f};  // multiplies the Fresnel reflectance (Mitsuba's specular_reflectance; 1 in pbrt)

@@ -2,7 +2,8 @@
 // (github.com/mmp/pbrt-v4 at 5f7a606, Copyright (c) 2020 Matt Pharr, Wenzel Jakob and Greg
 // Humphreys, Apache License 2.0): its measured complex indices of refraction eta + i k of
 // metals, named as pbrt-v4 names them ("metal-Au-eta", "metal-Au-k", ...), each turned into
-// linear sRGB by the plain CIE-weighted average under D65 (the script's docstring says how).
+// linear sRGB: eta by the plain CIE-weighted average under D65, k matched to the spectral albedo
+// (the script's docstring says how and why).
 // Physical data: do not edit by hand, rerun the script.
 #pragma once
 
@@ -17,11 +18,11 @@ struct MetalSpectrum {
 };
 
 inline constexpr MetalSpectrum kMetalSpectra[] = {
-    {"Ag", {0.128470f, 0.123528f, 0.150892f}, {4.064882f, 3.286323f, 2.391750f}},
-    {"Al", {1.407420f, 0.926655f, 0.584036f}, {7.740400f, 6.602609f, 5.360294f}},
-    {"Au", {0.080050f, 0.404655f, 1.561354f}, {3.390462f, 2.503773f, 1.770894f}},
-    {"Cu", {0.104494f, 0.978171f, 1.204672f}, {3.273334f, 2.592352f, 2.369246f}},
-    {"CuZn", {0.418443f, 0.519917f, 1.123137f}, {3.667759f, 2.680758f, 1.771031f}},
+    {"Ag", {0.128470f, 0.123528f, 0.150892f}, {4.092627f, 3.321023f, 2.407571f}},
+    {"Al", {1.407420f, 0.926655f, 0.584036f}, {7.672421f, 6.589476f, 5.323600f}},
+    {"Au", {0.080050f, 0.404655f, 1.561354f}, {20.079735f, 2.339813f, 1.713809f}},
+    {"Cu", {0.104494f, 0.978171f, 1.204672f}, {2.721234f, 2.622372f, 2.358023f}},
+    {"CuZn", {0.418443f, 0.519917f, 1.123137f}, {4.010302f, 2.655662f, 1.807402f}},
     {"MgO", {1.733715f, 1.740943f, 1.753547f}, {0.000000f, 0.000000f, 0.000000f}},
     {"TiO2", {2.860378f, 2.956486f, 3.185538f}, {0.000089f, 0.000000f, 0.000551f}},
 };
