@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -121,17 +122,18 @@ std::optional<Error> check_light_value(glm::vec3 v, const Location& at) {
 
 namespace {
 
-// A basic material's kind and parameters, as a key: equal keys are the same material.
-using MaterialKey = std::array<float, 5>;
+// A basic material's kind and parameters, as a key: equal keys are the same material. Every kind
+// is a plain struct of floats, so its bytes are its parameters.
+using MaterialKey = std::vector<std::uint32_t>;
 MaterialKey key_of(const BasicMaterial& m) {
   return std::visit(
       [&](const auto& k) -> MaterialKey {
         using T = std::decay_t<decltype(k)>;
-        const auto kind = static_cast<float>(m.index());
-        if constexpr (std::is_same_v<T, Diffuse>) return {kind, k.albedo.x, k.albedo.y, k.albedo.z, 0.0f};
-        else if constexpr (std::is_same_v<T, Mirror>) return {kind, k.reflectance.x, k.reflectance.y, k.reflectance.z, 0.0f};
-        else if constexpr (std::is_same_v<T, Dielectric>) return {kind, k.tint.x, k.tint.y, k.tint.z, k.ior};
-        else return {kind, k.reflectance.x, k.reflectance.y, k.reflectance.z, k.roughness};
+        static_assert(std::is_trivially_copyable_v<T> && sizeof(T) % sizeof(std::uint32_t) == 0);
+        MaterialKey key(1 + sizeof(T) / sizeof(std::uint32_t));
+        key[0] = static_cast<std::uint32_t>(m.index());
+        std::memcpy(key.data() + 1, &k, sizeof(T));
+        return key;
       },
       m);
 }
@@ -162,11 +164,6 @@ Material blend(const Material& a, const Material& b, float w) {
   flatten(a, 1.0f - w, &mix.components, &index);
   flatten(b, w, &mix.components, &index);
   return mix;
-}
-
-glm::vec3 conductor_reflectance(glm::vec3 eta, glm::vec3 k) {
-  const glm::vec3 k2 = k * k;
-  return ((eta - 1.0f) * (eta - 1.0f) + k2) / ((eta + 1.0f) * (eta + 1.0f) + k2);
 }
 
 // --- transforms ---

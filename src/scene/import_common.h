@@ -92,9 +92,6 @@ std::optional<Error> check_light_value(glm::vec3 v, const Location& at);
 // one component per distinct basic material however often the graph reaches it.
 Material blend(const Material& a, const Material& b, float w);
 
-// Normal-incidence reflectance of a conductor with complex index eta + i k, per channel.
-glm::vec3 conductor_reflectance(glm::vec3 eta, glm::vec3 k);
-
 // A PLY mesh (scene/ply.h; `.ply` or `.ply.gz`): triangles and planar quads (split in two along
 // v0-v2, the surface pbrt-v4's bilinear patch has when the quad is planar), with the file's uv and
 // per-vertex normals (empty when the file has none). Errors in the file are located in it; refused

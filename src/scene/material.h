@@ -6,6 +6,7 @@
 // of the component that carried the transport.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <type_traits>
 #include <variant>
@@ -40,7 +41,53 @@ struct Glossy {
   float roughness = 0.2f;       // GGX alpha; > 0 (finite BSDF, letter D)
 };
 
-using BasicMaterial = std::variant<Diffuse, Mirror, Dielectric, Glossy>;
+// pbrt-v4's EffectivelySmooth(): a GGX alpha below this (in both tangent directions) is sampled as
+// a Dirac delta (letter S); the importers and the JSON reader make such a conductor smooth and such
+// a dielectric the smooth Dielectric.
+inline constexpr float kSmoothAlpha = 1e-3f;
+
+// A metal: exact Fresnel reflectance of the complex index eta + i k per RGB channel (pbrt-v4's
+// conductor). GGX alpha per tangent direction; alpha_u and alpha_v both below 1e-3 make it smooth,
+// a Dirac delta (letter S, pbrt-v4's EffectivelySmooth), else a finite lobe (letter D). The
+// tangents are those of the shading frame (trace/frame.h), not the surface's u direction.
+struct Conductor {
+  glm::vec3 eta{0.104494f, 0.978171f, 1.204672f};  // default: pbrt-v4's copper (scene/metal_spectra.h)
+  glm::vec3 k{2.721234f, 2.622372f, 2.358023f};
+  float alpha_u = 0.0f;
+  float alpha_v = 0.0f;
+  glm::vec3 tint{1.0f};  // multiplies the Fresnel reflectance (Mitsuba's specular_reflectance; 1 in pbrt)
+  bool smooth() const { return std::max(alpha_u, alpha_v) < kSmoothAlpha; }
+};
+
+// A rough dielectric interface (pbrt-v4's DielectricBxDF with a rough distribution, Walter et al.
+// 2007): GGX reflection and transmission, Fresnel between them, single scattering (the energy the
+// microfacets scatter more than once is lost, as in pbrt-v4). Always a finite lobe (letter D):
+// alpha below 1e-3 is imported as the smooth Dielectric instead. Oriented as Dielectric.
+struct RoughDielectric {
+  float ior = 1.5f;      // η_inside / η_outside, valid_ior()
+  glm::vec3 tint{1.0f};  // multiplies reflection and transmission
+  float alpha_u = 0.1f;
+  float alpha_v = 0.1f;
+};
+
+// A thin dielectric slab (pbrt-v4's ThinDielectricBxDF): the reflection R' = R + T² R / (1 − R²)
+// of the slab's infinitely many internal bounces, a Dirac delta (S), and the rest passing straight
+// through (wi = −wo), another Dirac delta (S). No refraction: the ray keeps its direction.
+struct ThinDielectric {
+  float ior = 1.5f;  // of the slab against the outside, valid_ior()
+  glm::vec3 tint{1.0f};
+};
+
+// Lambertian reflection and Lambertian transmission on both sides (pbrt-v4's
+// DiffuseTransmissionBxDF): f = reflectance / π on wo's side, transmittance / π on the other.
+// Finite, letter D. reflectance + transmittance ≤ 1 per channel.
+struct DiffuseTransmission {
+  glm::vec3 reflectance{0.25f};
+  glm::vec3 transmittance{0.25f};
+};
+
+using BasicMaterial = std::variant<Diffuse, Mirror, Dielectric, Glossy, Conductor, RoughDielectric, ThinDielectric,
+                                   DiffuseTransmission>;
 
 // A weighted sum of basic components: 0.5 diffuse + 0.1 mirror, the remaining 0.4 absorbed.
 // Weights are non-negative and sum to at most 1.
@@ -52,11 +99,18 @@ struct Mixture {
   std::vector<Component> components;
 };
 
-using Material = std::variant<Diffuse, Mirror, Dielectric, Glossy, Mixture>;
+using Material = std::variant<Diffuse, Mirror, Dielectric, Glossy, Mixture, Conductor, RoughDielectric, ThinDielectric,
+                              DiffuseTransmission>;
 
 // The letter a basic material gives to a vertex: D for finite BSDFs, S for Dirac deltas.
+// Diffuse, Glossy, RoughDielectric, DiffuseTransmission: D. Mirror, Dielectric, ThinDielectric: S.
+// Conductor: S when smooth, else D.
 inline Letter letter_of(const BasicMaterial& m) {
-  return std::holds_alternative<Mirror>(m) || std::holds_alternative<Dielectric>(m) ? kS : kD;
+  if (const auto* c = std::get_if<Conductor>(&m)) return c->smooth() ? kS : kD;
+  return std::holds_alternative<Mirror>(m) || std::holds_alternative<Dielectric>(m) ||
+                 std::holds_alternative<ThinDielectric>(m)
+             ? kS
+             : kD;
 }
 
 // The letters a material can give (bit per letter), the union over a mixture's components.

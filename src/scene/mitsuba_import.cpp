@@ -21,6 +21,7 @@
 
 #include "scene/import_common.h"
 #include "scene/serialized.h"
+#include "scene/metal_spectra.h"
 
 namespace pathex {
 namespace {
@@ -413,41 +414,47 @@ class Importer {
       const std::vector<pugi::xml_node> inner = p.nested("bsdf");
       if (inner.size() != 1) return located(where(n), "twosided with " + std::to_string(inner.size()) + " nested BSDFs is not supported, expected one");
       MI_TRY(x, bsdf(inner[0], depth + 1));
-      if (std::holds_alternative<Dielectric>(x)) return located(where(n), "a twosided dielectric is not supported");
+      if (std::holds_alternative<Dielectric>(x) || std::holds_alternative<RoughDielectric>(x) || std::holds_alternative<ThinDielectric>(x))
+        return located(where(n), "a twosided dielectric is not supported");
       m = x;
     } else if (type == "diffuse") {
       MI_TRY(r, p.color("reflectance", vec3(0.5f)));
       if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
         return located(where(n), "diffuse reflectance must be within [0, 1]");
       m = Diffuse{r};
-    } else if (type == "conductor" || type == "roughconductor") {
+    } else if (type == "conductor" || type == "roughconductor") {  // letters: S (conductor), D (roughconductor)
+      // Mitsuba 3's defaults: material "none" (eta 0, k 1: reflects everything at every angle).
+      Conductor c;
+      c.eta = vec3(0.0f);
+      c.k = vec3(1.0f);
       MI_TRY(material, p.string("material", "none"));
-      vec3 r0(1.0f);
       if (p.find("eta") || p.find("k")) {
         MI_TRY(eta, p.color("eta", vec3(0.0f)));
         MI_TRY(k, p.color("k", vec3(1.0f)));
         if (glm::any(glm::lessThan(eta, vec3(0.0f)))) return located(where(p.find("eta")), "conductor eta must be non-negative");
         if (glm::any(glm::lessThan(k, vec3(0.0f)))) return located(where(p.find("k")), "conductor k must be non-negative");
-        r0 = import::conductor_reflectance(eta, k);
+        c.eta = eta;
+        c.k = k;
       } else if (material != "none") {
-        return located(where(n), "conductor material \"" + excerpt(material) + "\" is a measured spectrum, which pathex cannot import: give eta and k as rgb, or material none with specular_reflectance");
+        const MetalSpectrum* metal = find_metal(material);
+        if (!metal)
+          return located(where(p.find("material")), "conductor material \"" + excerpt(material) + "\" is not supported: pathex has the measured "
+                                                    "spectra of " + kMetalNames + " (pbrt-v4's tables); give eta and k as rgb for another");
+        c.eta = vec3(metal->eta[0], metal->eta[1], metal->eta[2]);
+        c.k = vec3(metal->k[0], metal->k[1], metal->k[2]);
       }
       MI_TRY(spec, p.color("specular_reflectance", vec3(1.0f)));
-      r0 *= spec;
-      if (glm::any(glm::lessThan(r0, vec3(0.0f))) || glm::any(glm::greaterThan(r0, vec3(1.0f))))
-        return located(where(n), "conductor reflectance must be within [0, 1]");
-      if (type == "conductor") {
-        m = Mirror{r0};
-      } else {
-        MI_TRY(dist, p.string("distribution", "beckmann"));
-        if (dist != "ggx") return located(where(n), "microfacet distribution \"" + excerpt(dist) + "\" is not supported: pathex's glossy lobe is GGX, set <string name=\"distribution\" value=\"ggx\"/>");
-        if (p.find("alpha_u") || p.find("alpha_v")) return located(where(n), "anisotropic roughness (alpha_u, alpha_v) is not supported");
-        MI_TRY(alpha, p.number("alpha", 0.1));
-        p.ignore({"sample_visible"});
-        if (!(alpha >= 1e-4) || alpha > 1.0) return located(where(n), "alpha must be within [1e-4, 1]");
-        m = Glossy{r0, static_cast<float>(alpha)};
+      if (glm::any(glm::lessThan(spec, vec3(0.0f))) || glm::any(glm::greaterThan(spec, vec3(1.0f))))
+        return located(where(n), "specular_reflectance must be within [0, 1]");
+      c.tint = spec;
+      if (type == "roughconductor") {
+        MI_TRY(a, mitsuba_alphas(p, n));
+        c.alpha_u = a.x;
+        c.alpha_v = a.y;
       }
-    } else if (type == "dielectric") {
+      m = c;
+    } else if (type == "dielectric" || type == "roughdielectric" || type == "thindielectric") {
+      // letters: S (dielectric, thindielectric), D (roughdielectric, alpha at least 1e-3)
       double ior[2] = {1.5046, 1.000277};
       const char* names[2] = {"int_ior", "ext_ior"};
       for (int i = 0; i < 2; ++i) {
@@ -472,9 +479,18 @@ class Importer {
         found << eta;
         return located(where(n), std::string("int_ior / ext_ior must be ") + kValidIor + ", found " + found.str());
       }
-      m = Dielectric{static_cast<float>(eta), refl};
-    } else if (type == "roughdielectric") {
-      return located(where(n), "roughdielectric is not supported: pathex has no rough transmission");
+      if (type == "thindielectric") {
+        m = ThinDielectric{static_cast<float>(eta), refl};
+      } else if (type == "roughdielectric") {
+        MI_TRY(a, mitsuba_alphas(p, n));
+        if (std::max(a.x, a.y) >= kSmoothAlpha) m = RoughDielectric{static_cast<float>(eta), refl, a.x, a.y};
+        else m = Dielectric{static_cast<float>(eta), refl};
+      } else {
+        m = Dielectric{static_cast<float>(eta), refl};
+      }
+    } else if (type == "principled" || type == "principledthin") {
+      return located(where(n), "bsdf \"" + type + "\" is not supported: it needs the Disney principled BSDF (sheen, clearcoat, "
+                               "specular transmission and their blend), which pathex does not have");
     } else if (type == "blendbsdf") {
       MI_TRY(w, p.number("weight", 0.5));
       if (w < 0 || w > 1) return located(where(n), "weight must be within [0, 1]");
@@ -484,10 +500,27 @@ class Importer {
       MI_TRY(b, bsdf(inner[1], depth + 1));
       m = import::blend(a, b, static_cast<float>(w));
     } else {
-      return located(where(n), "bsdf \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, blendbsdf or twosided");
+      return located(where(n), "bsdf \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, "
+                               "roughdielectric (ggx), thindielectric, blendbsdf or twosided");
     }
     if (auto e = p.unused()) return *e;
     return m;
+  }
+
+  // GGX alphas of roughconductor and roughdielectric: "alpha" (default 0.1) or "alpha_u" and
+  // "alpha_v", each within [0, 1] (Mitsuba's alphas are GGX alphas: no remapping). Only the ggx
+  // distribution; its tangents are the shading frame's.
+  Result<glm::vec2> mitsuba_alphas(Props& p, pugi::xml_node n) {
+    MI_TRY(dist, p.string("distribution", "beckmann"));
+    if (dist != "ggx") return located(where(n), "microfacet distribution \"" + excerpt(dist) + "\" is not supported: pathex's microfacets are GGX, set <string name=\"distribution\" value=\"ggx\"/>");
+    p.ignore({"sample_visible"});
+    MI_TRY(alpha, p.number("alpha", 0.1));
+    MI_TRY(u, p.number("alpha_u", alpha));
+    MI_TRY(v, p.number("alpha_v", alpha));
+    if (p.find("alpha") && (p.find("alpha_u") || p.find("alpha_v"))) return located(where(p.find("alpha")), "give either alpha or alpha_u and alpha_v");
+    for (double a : {u, v})
+      if (!(a >= 0.0) || a > 1.0) return located(where(n), "alpha must be within [0, 1]");
+    return glm::vec2(static_cast<float>(u), static_cast<float>(v));
   }
 
   Result<int> material_of(Props& p, pugi::xml_node shape_node) {

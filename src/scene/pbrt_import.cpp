@@ -17,12 +17,14 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "scene/import_common.h"
+#include "scene/metal_spectra.h"
 
 namespace pathex {
 namespace {
@@ -246,9 +248,13 @@ struct AreaLight {
   bool two_sided = false;
 };
 
+// pbrt-v4's "interface" material: no surface at all (it only bounds media). Its shapes are not
+// imported: a ray passes where they are. Letters: none (no vertex).
+constexpr int kInterface = -2;
+
 struct GraphicsState {
   glm::mat4 ctm{1.0f};
-  int material = -1;  // builder index; -1: pbrt's default (diffuse, reflectance 0.5)
+  int material = -1;  // builder index; -1: pbrt's default (diffuse, reflectance 0.5); kInterface
   std::optional<AreaLight> area;
   bool reverse = false;
   // pbrt-v4's Attribute "shape", "light" and "material" (in that order): parameters that later
@@ -286,6 +292,7 @@ class Importer {
   bool in_world_ = false;
   std::map<std::string, glm::mat4> coordinate_systems_;
   std::map<std::string, Material> named_materials_;
+  std::set<std::string> interface_names_;  // named materials of type "interface"
   std::map<std::string, int> named_material_index_;
   int default_material_ = -1;
   // The camera and film, combined once the file is read.
@@ -569,6 +576,13 @@ class Importer {
     if (name == "MakeNamedMaterial") {
       PBRT_TRY(mtype, ps.string("type", ""));
       if (mtype.empty()) return located(at, "MakeNamedMaterial \"" + excerpt(type) + "\" needs a \"string type\" parameter");
+      interface_names_.erase(type);
+      if (mtype == "interface") {
+        named_materials_.erase(type);
+        named_material_index_.erase(type);
+        interface_names_.insert(type);
+        return ps.unused("material \"interface\"");
+      }
       PBRT_TRY(m, material(mtype, ps, at));
       if (auto e = ps.unused("material \"" + excerpt(mtype) + "\"")) return e;
       if (auto e = materials_budget_.charge(m, at)) return e;
@@ -577,11 +591,19 @@ class Importer {
       return std::nullopt;
     }
     if (name == "NamedMaterial") {
+      if (interface_names_.count(type) != 0) {
+        gs_.material = kInterface;
+        return ps.unused(what);
+      }
       PBRT_TRY(index, named_index(type, at));
       gs_.material = index;
       return ps.unused(what);
     }
     if (name == "Material") {
+      if (type == "interface") {
+        gs_.material = kInterface;
+        return ps.unused(what);
+      }
       PBRT_TRY(m, material(type, ps, at));
       if (auto e = ps.unused(what)) return e;
       if (auto e = materials_budget_.charge(m, at)) return e;
@@ -636,15 +658,41 @@ class Importer {
     return located(p.at, "unknown Option \"" + p.name + "\"");
   }
 
-  // GGX alpha from pbrt's roughness parameters (remapped by sqrt unless remaproughness is false).
-  Result<float> alpha(Params& ps, const Location& at) {
+  // GGX alphas (u, v) from pbrt's roughness parameters: "roughness" for both, "uroughness" and
+  // "vroughness" for each, remapped by sqrt unless remaproughness is false (pbrt-v4's
+  // TrowbridgeReitzDistribution::RoughnessToAlpha). Below 1e-3 in both, pbrt-v4 renders the
+  // surface smooth (EffectivelySmooth), and so does pathex. The anisotropy follows the shading
+  // frame's tangents, not pbrt's dpdu.
+  Result<glm::vec2> alphas(Params& ps, const Location& at, const char* what) {
     PBRT_TRY(r, ps.number("roughness", 0.0));
     PBRT_TRY(u, ps.number("uroughness", r));
     PBRT_TRY(v, ps.number("vroughness", r));
     PBRT_TRY(remap, ps.boolean("remaproughness", true));
-    if (u != v) return located(at, "anisotropic roughness (uroughness != vroughness) is not supported");
-    if (u < 0) return located(at, "roughness must be non-negative");
-    return static_cast<float>(remap ? std::sqrt(u) : u);
+    if (u < 0 || v < 0) return located(at, "roughness must be non-negative");
+    const glm::vec2 a(static_cast<float>(remap ? std::sqrt(u) : u), static_cast<float>(remap ? std::sqrt(v) : v));
+    if (a.x > 1.0f || a.y > 1.0f)
+      return located(at, std::string(what) + " roughness gives GGX alpha " + fmt_number(std::max(a.x, a.y)) + ", pathex accepts at most 1");
+    return a;
+  }
+
+  // A conductor's eta or k: "rgb" (or a float), or one of pbrt-v4's named metal spectra
+  // ("spectrum eta" "metal-Au-eta"), turned into RGB from its measured table (scene/metal_spectra.h).
+  Result<vec3> metal_rgb(Params& ps, const std::string& name, vec3 fallback) {
+    Param* p = ps.find(name);
+    if (!p || p->type != "spectrum") return ps.rgb(name, fallback, true);
+    if (p->strings.size() != 1)
+      return located(p->at, "parameter \"spectrum " + name + "\" with sampled values is not supported: give a named metal spectrum "
+                            "(\"metal-Cu-" + name + "\") or \"rgb " + name + "\" [r g b]");
+    const std::string& s = p->strings[0];
+    const bool is_eta = s.size() > 4 && s.compare(s.size() - 4, 4, "-eta") == 0;
+    const bool is_k = s.size() > 2 && s.compare(s.size() - 2, 2, "-k") == 0;
+    const MetalSpectrum* metal = nullptr;
+    if (s.rfind("metal-", 0) == 0 && (is_eta || is_k)) metal = find_metal(s.substr(6, s.size() - 6 - (is_eta ? 4 : 2)));
+    if (!metal)
+      return located(p->at, "unknown spectrum \"" + excerpt(s) + "\" for " + name + ", expected metal-<name>-eta or metal-<name>-k with <name> one of " +
+                                kMetalNames);
+    const float* v = is_eta ? metal->eta : metal->k;
+    return vec3(v[0], v[1], v[2]);
   }
 
   Result<Material> material(const std::string& type, Params& ps, const Location& at) {
@@ -654,37 +702,59 @@ class Importer {
         return located(at, "diffuse reflectance must be within [0, 1]");
       return Material{Diffuse{r}};
     }
-    if (type == "conductor") {
-      vec3 r0;
-      if (ps.find("reflectance")) {
-        PBRT_TRY(r, ps.rgb("reflectance", vec3(1.0f), true));
-        r0 = r;
-      } else if (ps.find("eta") || ps.find("k")) {
-        PBRT_TRY(eta, ps.rgb("eta", vec3(1.0f), true));
-        PBRT_TRY(k, ps.rgb("k", vec3(0.0f), true));
-        if (glm::any(glm::lessThan(eta, vec3(0.0f)))) return located(ps.find("eta")->at, "conductor eta must be non-negative");
-        if (glm::any(glm::lessThan(k, vec3(0.0f)))) return located(ps.find("k")->at, "conductor k must be non-negative");
-        r0 = import::conductor_reflectance(eta, k);
+    if (type == "conductor") {  // letters: S when smooth, D when rough
+      Conductor c;  // pbrt-v4's default: metal-Cu-eta, metal-Cu-k
+      if (Param* r = ps.find("reflectance")) {
+        // pbrt-v4: eta = 1 and k = 2 sqrt(r) / sqrt(1 − r), r clamped to [0, 0.9999], which
+        // reflects r at normal incidence.
+        if (ps.find("eta") || ps.find("k")) return located(r->at, "conductor takes either reflectance or eta and k, not both");
+        PBRT_TRY(refl, ps.rgb("reflectance", vec3(1.0f), true));
+        const vec3 rc = glm::clamp(refl, vec3(0.0f), vec3(0.9999f));
+        c.eta = vec3(1.0f);
+        c.k = 2.0f * glm::sqrt(rc) / glm::sqrt(vec3(1.0f) - rc);
       } else {
-        return located(at, "conductor needs \"rgb reflectance\" or rgb \"eta\" and \"k\" (pbrt's default copper is a spectrum, which pathex cannot import)");
+        PBRT_TRY(eta, metal_rgb(ps, "eta", c.eta));
+        PBRT_TRY(k, metal_rgb(ps, "k", c.k));
+        if (!(glm::all(glm::greaterThan(eta, vec3(0.0f))))) return located(ps.find("eta")->at, "conductor eta must be positive");
+        if (glm::any(glm::lessThan(k, vec3(0.0f)))) return located(ps.find("k")->at, "conductor k must be non-negative");
+        c.eta = eta;
+        c.k = k;
       }
-      if (glm::any(glm::lessThan(r0, vec3(0.0f))) || glm::any(glm::greaterThan(r0, vec3(1.0f))))
-        return located(at, "conductor reflectance must be within [0, 1]");
-      PBRT_TRY(a, alpha(ps, at));
-      if (a < 1e-3f) return Material{Mirror{r0}};  // pbrt treats alpha < 1e-3 as smooth
-      if (a > 1.0f) return located(at, "conductor roughness gives GGX alpha " + std::to_string(a) + ", pathex's glossy accepts at most 1");
-      return Material{Glossy{r0, a}};
+      PBRT_TRY(a, alphas(ps, at, "conductor"));
+      c.alpha_u = a.x;
+      c.alpha_v = a.y;
+      return Material{c};
     }
-    if (type == "dielectric") {
+    if (type == "dielectric" || type == "thindielectric") {  // letters: S when smooth (always for thin), D when rough
+      const bool thin = type == "thindielectric";
       Param* eta_p = ps.find("eta");
       if (eta_p && eta_p->type != "float")
         return located(eta_p->at, "parameter \"" + eta_p->type + " eta\" is not supported: give \"float eta\" (pathex's dielectric has one index)");
       PBRT_TRY(eta, ps.number("eta", 1.5));
-      PBRT_TRY(a, alpha(ps, at));
-      if (a >= 1e-3f) return located(at, "a rough dielectric is not supported: pathex has no rough transmission (set roughness 0)");
-      if (!valid_ior(eta)) return located(at, std::string("dielectric eta must be ") + kValidIor + ", found " + fmt_number(eta));
+      if (!valid_ior(eta)) return located(at, type + " eta must be " + kValidIor + ", found " + fmt_number(eta));
+      if (thin) return Material{ThinDielectric{static_cast<float>(eta), vec3(1.0f)}};
+      PBRT_TRY(a, alphas(ps, at, "dielectric"));
+      if (std::max(a.x, a.y) >= kSmoothAlpha) return Material{RoughDielectric{static_cast<float>(eta), vec3(1.0f), a.x, a.y}};
       return Material{Dielectric{static_cast<float>(eta), vec3(1.0f)}};
     }
+    if (type == "diffusetransmission") {  // letters: D
+      PBRT_TRY(r, ps.rgb("reflectance", vec3(0.25f), true));
+      PBRT_TRY(t, ps.rgb("transmittance", vec3(0.25f), true));
+      PBRT_TRY(scale, ps.number("scale", 1.0));
+      // pbrt-v4 clamps each of scale · reflectance and scale · transmittance to [0, 1].
+      const vec3 rs = glm::clamp(r * static_cast<float>(scale), vec3(0.0f), vec3(1.0f));
+      const vec3 ts = glm::clamp(t * static_cast<float>(scale), vec3(0.0f), vec3(1.0f));
+      return Material{DiffuseTransmission{rs, ts}};
+    }
+    if (type == "measured")
+      return located(at, "material \"measured\" is not supported: it needs the RGL measured-BSDF file reader and its "
+                         "spectral tables, which pathex does not have");
+    if (type == "subsurface")
+      return located(at, "material \"subsurface\" is not supported: it needs volumetric path tracing under the surface "
+                         "(a medium and random walks inside it), which pathex does not have");
+    if (type == "hair")
+      return located(at, "material \"hair\" is not supported: it needs pbrt-v4's hair BSDF on curve shapes, which pathex "
+                         "does not have");
     if (type == "mix") {
       Param* m = ps.find("materials");
       if (!m || m->type != "string" || m->strings.size() != 2) return located(m ? m->at : at, "mix needs \"string materials\" [\"a\" \"b\"]");
@@ -692,13 +762,17 @@ class Importer {
       if (amount < 0 || amount > 1) return located(at, "mix amount must be within [0, 1]");
       Material parts[2];
       for (int i = 0; i < 2; ++i) {
+        if (interface_names_.count(m->strings[static_cast<std::size_t>(i)]) != 0)
+          return located(m->at, "mix with the interface material \"" + excerpt(m->strings[static_cast<std::size_t>(i)]) +
+                                    "\" (no surface) is not supported");
         auto it = named_materials_.find(m->strings[static_cast<std::size_t>(i)]);
         if (it == named_materials_.end()) return located(m->at, "unknown named material \"" + excerpt(m->strings[static_cast<std::size_t>(i)]) + "\"");
         parts[i] = it->second;
       }
       return import::blend(parts[0], parts[1], static_cast<float>(amount));
     }
-    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, dielectric or mix");
+    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, dielectric, "
+                       "thindielectric, diffusetransmission, interface or mix");
   }
 
   int current_material() {
@@ -760,6 +834,11 @@ class Importer {
 
   // --- shapes ---
   std::optional<Error> shape(const std::string& type, Params& ps, const Location& at) {
+    if (gs_.material == kInterface) {  // no surface: nothing to import
+      if (gs_.area) return located(at, "an area light on a shape of material \"interface\" (no surface) is not supported");
+      ps.ignore_all();
+      return std::nullopt;
+    }
     if (Param* p = ps.find("alpha")) return located(p->at, "alpha cut-outs are not supported");
     Shape s;
     s.pointer = at.str();

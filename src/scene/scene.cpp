@@ -22,6 +22,7 @@
 #include "io/input_file.h"
 #include "io/json_reader.h"
 #include "scene/import_common.h"
+#include "scene/metal_spectra.h"
 
 namespace pathex {
 namespace {
@@ -86,7 +87,18 @@ class Reader : public JsonReader {
   if (!var##_r) return var##_r.error(); \
   auto var = std::move(*var##_r)
 
+// GGX alphas of a conductor or dielectric: "roughness" for both tangents, "roughness_u" and
+// "roughness_v" for each (default: "roughness"), each in [0, 1]; below 1e-3 in both is smooth.
+Result<glm::vec2> read_alphas(const Reader& r, const json& j, const std::string& ptr) {
+  PATHEX_TRY(both, r.number(j, "roughness", ptr, 0.0, 1.0, 0.0));
+  PATHEX_TRY(u, r.number(j, "roughness_u", ptr, 0.0, 1.0, both));
+  PATHEX_TRY(v, r.number(j, "roughness_v", ptr, 0.0, 1.0, both));
+  return glm::vec2(static_cast<float>(u), static_cast<float>(v));
+}
+
 // `component`: inside a mixture, where only basic materials are allowed.
+const std::string kBasicTypes = "diffuse, mirror, dielectric, glossy, conductor, thin_dielectric or diffuse_transmission";
+
 Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::string& ptr, bool component) {
   PATHEX_TRY(type, r.string(j, "type", ptr));
   if (type == "diffuse") {
@@ -101,12 +113,49 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     if (const float hi = max_component(refl); hi > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1], found " + Reader::fmt(hi));
     return BasicMaterial{Mirror{refl}};
   }
-  if (type == "dielectric") {
-    if (auto k = r.keys(j, ptr, {"type", "ior", "tint"}); !k) return k.error();
+  if (type == "dielectric" || type == "thin_dielectric") {
+    const bool thin = type == "thin_dielectric";
+    if (auto k = thin ? r.keys(j, ptr, {"type", "ior", "tint"})
+                      : r.keys(j, ptr, {"type", "ior", "tint", "roughness", "roughness_u", "roughness_v"});
+        !k)
+      return k.error();
     PATHEX_TRY(ior, r.number(j, "ior", ptr, -1e30, 1e30, 1.5));
     if (!valid_ior(ior)) return r.fail(ptr + "/ior", std::string("expected an index of refraction ") + kValidIor + ", found " + Reader::fmt(ior));
     PATHEX_TRY(tint, r.vector3(j, "tint", ptr, false, vec3(1.0f), true));
+    if (thin) return BasicMaterial{ThinDielectric{static_cast<float>(ior), tint}};
+    PATHEX_TRY(alpha, read_alphas(r, j, ptr));
+    if (std::max(alpha.x, alpha.y) >= kSmoothAlpha)
+      return BasicMaterial{RoughDielectric{static_cast<float>(ior), tint, alpha.x, alpha.y}};
     return BasicMaterial{Dielectric{static_cast<float>(ior), tint}};
+  }
+  if (type == "conductor") {
+    if (auto k = r.keys(j, ptr, {"type", "metal", "eta", "k", "roughness", "roughness_u", "roughness_v"}); !k) return k.error();
+    Conductor c;  // pbrt-v4's default: copper
+    if (j.contains("metal")) {
+      if (j.contains("eta") || j.contains("k")) return r.fail(ptr + "/metal", "expected either metal or eta and k, found both");
+      PATHEX_TRY(name, r.string(j, "metal", ptr));
+      const MetalSpectrum* metal = find_metal(name);
+      if (!metal) return r.fail(ptr + "/metal", "unknown metal '" + name + "', expected one of " + kMetalNames);
+      c.eta = vec3(metal->eta[0], metal->eta[1], metal->eta[2]);
+      c.k = vec3(metal->k[0], metal->k[1], metal->k[2]);
+    } else if (j.contains("eta") || j.contains("k")) {
+      PATHEX_TRY(eta, r.vector3(j, "eta", ptr, true, vec3(1.0f), true));
+      PATHEX_TRY(k, r.vector3(j, "k", ptr, true, vec3(0.0f), true));
+      c.eta = eta;
+      c.k = k;
+    }
+    PATHEX_TRY(alpha, read_alphas(r, j, ptr));
+    c.alpha_u = alpha.x;
+    c.alpha_v = alpha.y;
+    return BasicMaterial{c};
+  }
+  if (type == "diffuse_transmission") {
+    if (auto k = r.keys(j, ptr, {"type", "reflectance", "transmittance"}); !k) return k.error();
+    PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(0.25f), true));
+    PATHEX_TRY(trans, r.vector3(j, "transmittance", ptr, false, vec3(0.25f), true));
+    if (const float hi = max_component(refl + trans); hi > 1.0f)
+      return r.fail(ptr + "/transmittance", "expected reflectance + transmittance within [0, 1], found " + Reader::fmt(hi));
+    return BasicMaterial{DiffuseTransmission{refl, trans}};
   }
   if (type == "glossy") {
     if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness"}); !k) return k.error();
@@ -116,8 +165,8 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     return BasicMaterial{Glossy{refl, static_cast<float>(rough)}};
   }
   if (component)
-    return r.fail(ptr + "/type", "material type '" + type + "' cannot be a mixture's component, expected diffuse, mirror, dielectric or glossy");
-  return r.fail(ptr + "/type", "unknown material type '" + type + "', expected diffuse, mirror, dielectric, glossy or mixture");
+    return r.fail(ptr + "/type", "material type '" + type + "' cannot be a mixture's component, expected " + kBasicTypes);
+  return r.fail(ptr + "/type", "unknown material type '" + type + "', expected " + kBasicTypes + " or mixture");
 }
 
 Result<Material> read_material(const Reader& r, const json& j, const std::string& ptr) {

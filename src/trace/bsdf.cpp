@@ -10,6 +10,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "trace/bsdf_kinds.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
 
@@ -19,9 +20,7 @@ namespace {
 template <class T, class V>
 constexpr bool is = std::is_same_v<std::decay_t<V>, T>;
 
-bool is_delta_kind(const BasicMaterial& m) {
-  return std::holds_alternative<Mirror>(m) || std::holds_alternative<Dielectric>(m);
-}
+bool is_delta_kind(const BasicMaterial& m) { return letter_of(m) == kS; }
 
 bool finite_vec(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -38,30 +37,11 @@ float total_weight(const Mixture& mix) {
   return total;
 }
 
-// --- GGX (Trowbridge–Reitz) with height-correlated Smith masking, in the shading frame ---
-//
-// Directions are local with z > 0 (the caller flipped them to wo's side). The forms avoid both
-// 1 − cos² (which loses the whole distribution near its peak when alpha ~ 1e-4) and divisions by
-// cos θ (which overflow at grazing angles): with r² = x² + y²,
-//   D(h)       = α² / (π (h_x² + h_y² + α² h_z²)²)               for unit h
-//   z·Λ(w)     = α² r² / (2 (z + sqrt(z² + α² r²)))             (Λ = Smith's lambda)
-//   G1(w)      = z / (z + zΛ(w))
-//   G2(o, i)   = z_o z_i / (z_o z_i + z_i·zΛ(o) + z_o·zΛ(i))
+// --- the glossy lobe: GGX (trace/microfacet.h) with Schlick's Fresnel, in the shading frame ---
 
-float ggx_alpha(const Glossy& g) {
-  return std::clamp(std::isfinite(g.roughness) ? g.roughness : 1.0f, kMinGlossyRoughness, 1.0f);
-}
-
-float ggx_d(const glm::vec3& h, float alpha) {
-  const float a2 = alpha * alpha;
-  const float t = h.x * h.x + h.y * h.y + a2 * h.z * h.z;
-  return a2 / (kPi * t * t);
-}
-
-float ggx_z_lambda(const glm::vec3& w, float alpha) {
-  const float a2r2 = alpha * alpha * (w.x * w.x + w.y * w.y);
-  const float z = std::abs(w.z);
-  return a2r2 / (2.0f * (z + std::sqrt(z * z + a2r2)));
+Ggx glossy_ggx(const Glossy& g) {
+  const float a = std::clamp(std::isfinite(g.roughness) ? g.roughness : 1.0f, kMinGlossyRoughness, 1.0f);
+  return Ggx{a, a};
 }
 
 glm::vec3 schlick(const glm::vec3& r0, float cos_h) {
@@ -74,61 +54,51 @@ glm::vec3 schlick(const glm::vec3& r0, float cos_h) {
 // under exchange (IEEE + and * commute; the sums are grouped so that exchange only reorders
 // commuting operands).
 glm::vec3 ggx_eval(const Glossy& g, const glm::vec3& wo, const glm::vec3& wi) {
-  const float alpha = ggx_alpha(g);
+  const Ggx ggx = glossy_ggx(g);
   const glm::vec3 hs = wo + wi;
   const float len2 = glm::dot(hs, hs);
   if (!(len2 > 0.0f)) return glm::vec3(0.0f);
   const glm::vec3 h = hs / std::sqrt(len2);
-  const float d = ggx_d(h, alpha);
+  const float d = ggx.d(h);
   const float cos_h = 0.5f * (glm::dot(wo, h) + glm::dot(wi, h));
-  const float zo = wo.z, zi = wi.z;
   // 4 z_o z_i (1 + Λo + Λi), without dividing by either cosine.
-  const float denom =
-      4.0f * (zo * zi + (zi * ggx_z_lambda(wo, alpha) + zo * ggx_z_lambda(wi, alpha)));
+  const float denom = ggx.reflection_denominator(wo, wi);
   if (!(denom > 0.0f)) return glm::vec3(0.0f);
   return schlick(g.reflectance, cos_h) * (d / denom);
 }
 
 // Density of visible-normal sampling: G1(wo) D(h) / (4 z_o) = D(h) / (4 (z_o + zΛ(wo))).
 float ggx_pdf(const Glossy& g, const glm::vec3& wo, const glm::vec3& wi) {
-  const float alpha = ggx_alpha(g);
+  const Ggx ggx = glossy_ggx(g);
   const glm::vec3 hs = wo + wi;
   const float len2 = glm::dot(hs, hs);
   if (!(len2 > 0.0f)) return 0.0f;
   const glm::vec3 h = hs / std::sqrt(len2);
-  const float denom = 4.0f * (wo.z + ggx_z_lambda(wo, alpha));
+  const float denom = 4.0f * (wo.z + ggx.z_lambda(wo));
   if (!(denom > 0.0f)) return 0.0f;
-  return ggx_d(h, alpha) / denom;
+  return ggx.d(h) / denom;
 }
 
-// Heitz 2018, "Sampling the GGX Distribution of Visible Normals": a microfacet normal with density
-// D_wo(m) = G1(wo) max(0, wo·m) D(m) / z_o. wo.z > 0.
-glm::vec3 ggx_sample_visible_normal(const glm::vec3& wo, float alpha, glm::vec2 u) {
-  const glm::vec3 vh = glm::normalize(glm::vec3(alpha * wo.x, alpha * wo.y, wo.z));
-  const float lensq = vh.x * vh.x + vh.y * vh.y;
-  const glm::vec3 t1 = lensq > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq)
-                                    : glm::vec3(1.0f, 0.0f, 0.0f);
-  const glm::vec3 t2 = glm::cross(vh, t1);
-  const float r = std::sqrt(u.x);
-  const float phi = 2.0f * kPi * u.y;
-  const float p1 = r * std::cos(phi);
-  float p2 = r * std::sin(phi);
-  const float s = 0.5f * (1.0f + vh.z);
-  p2 = (1.0f - s) * safe_sqrt(1.0f - p1 * p1) + s * p2;
-  const glm::vec3 nh = p1 * t1 + p2 * t2 + safe_sqrt(1.0f - p1 * p1 - p2 * p2) * vh;
-  return glm::normalize(glm::vec3(alpha * nh.x, alpha * nh.y, std::max(0.0f, nh.z)));
-}
+// --- finite components, local frame flipped so that wo.z > 0 (wi on either side) ---
 
-// --- finite components, local frame, directions as given (either side) ---
+// The relative index of the side wo is not on, for an oriented kind (bsdf_kinds.h).
+float far_eta(float ior, bool inside) { return inside ? 1.0f / ior : ior; }
 
-// The finite BSDF of one basic component; both directions already flipped to z > 0.
-glm::vec3 eval_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+// The finite BSDF of one basic component. `inside`: wo was on −ns's side before the flip.
+glm::vec3 eval_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec3& wi, bool inside,
+                     TransportMode mode) {
   return std::visit(
       [&](const auto& k) -> glm::vec3 {
         if constexpr (is<Diffuse, decltype(k)>) {
-          return k.albedo * kInvPi;
+          return wi.z > 0.0f ? k.albedo * kInvPi : glm::vec3(0.0f);
         } else if constexpr (is<Glossy, decltype(k)>) {
-          return ggx_eval(k, wo, wi);
+          return wi.z > 0.0f ? ggx_eval(k, wo, wi) : glm::vec3(0.0f);
+        } else if constexpr (is<Conductor, decltype(k)>) {
+          return kinds::conductor_eval(k, wo, wi);
+        } else if constexpr (is<RoughDielectric, decltype(k)>) {
+          return kinds::rough_dielectric_eval(k, far_eta(k.ior, inside), wo, wi, mode);
+        } else if constexpr (is<DiffuseTransmission, decltype(k)>) {
+          return kinds::diffuse_transmission_eval(k, wo, wi);
         } else {
           return glm::vec3(0.0f);  // deltas: nothing for a generic wi
         }
@@ -136,13 +106,19 @@ glm::vec3 eval_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec
       m);
 }
 
-float pdf_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+float pdf_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec3& wi, bool inside) {
   return std::visit(
       [&](const auto& k) -> float {
         if constexpr (is<Diffuse, decltype(k)>) {
           return cosine_hemisphere_pdf(wi.z);
         } else if constexpr (is<Glossy, decltype(k)>) {
-          return ggx_pdf(k, wo, wi);
+          return wi.z > 0.0f ? ggx_pdf(k, wo, wi) : 0.0f;
+        } else if constexpr (is<Conductor, decltype(k)>) {
+          return kinds::conductor_pdf(k, wo, wi);
+        } else if constexpr (is<RoughDielectric, decltype(k)>) {
+          return kinds::rough_dielectric_pdf(k, far_eta(k.ior, inside), wo, wi);
+        } else if constexpr (is<DiffuseTransmission, decltype(k)>) {
+          return kinds::diffuse_transmission_pdf(k, wo, wi);
         } else {
           return 0.0f;
         }
@@ -150,16 +126,20 @@ float pdf_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec3& wi
       m);
 }
 
-// Local wo/wi of a reflection configuration flipped so that both have z > 0, or false if wo and
-// wi are not strictly on one side of both the shading and the geometric normal.
-bool reflection_local(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-                      const glm::vec3& ng, glm::vec3* wo_l, glm::vec3* wi_l) {
-  if (!(glm::dot(wo, ng) * glm::dot(wi, ng) > 0.0f)) return false;
+// Local wo/wi flipped so that wo.z > 0, or false if the pair is neither a reflection (wo and wi
+// strictly on one side of both the shading and the geometric normal) nor a transmission
+// (strictly on opposite sides of both). *inside: wo was on −ns's side.
+bool local_pair(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns, const glm::vec3& ng,
+                glm::vec3* wo_l, glm::vec3* wi_l, bool* inside) {
+  const float sides_g = glm::dot(wo, ng) * glm::dot(wi, ng);
+  if (!(sides_g > 0.0f) && !(sides_g < 0.0f)) return false;
   const Frame frame = Frame::from_normal(ns);
   *wo_l = frame.to_local(wo);
   *wi_l = frame.to_local(wi);
-  if (!(wo_l->z * wi_l->z > 0.0f)) return false;
-  if (wo_l->z < 0.0f) {
+  const float sides_s = wo_l->z * wi_l->z;
+  if (sides_g > 0.0f ? !(sides_s > 0.0f) : !(sides_s < 0.0f)) return false;
+  *inside = wo_l->z < 0.0f;
+  if (*inside) {
     wo_l->z = -wo_l->z;
     wi_l->z = -wi_l->z;
   }
@@ -188,6 +168,15 @@ std::optional<DeltaSample> sample_delta(const BasicMaterial& m, const glm::vec3&
   if (const auto* mirror = std::get_if<Mirror>(&m)) {
     return DeltaSample{reflected, mirror->reflectance, std::abs(cos_o), 1.0f, 1.0f, 1.0f,
                        Lobe::kSpecularReflection};
+  }
+  if (const auto* c = std::get_if<Conductor>(&m)) {
+    return DeltaSample{reflected, kinds::conductor_reflectance(*c, cos_o), std::abs(cos_o), 1.0f, 1.0f, 1.0f,
+                       Lobe::kSpecularReflection};
+  }
+  if (const auto* t = std::get_if<ThinDielectric>(&m)) {  // reflect with R', else pass straight through
+    const float r = kinds::thin_dielectric_reflectance(*t, cos_o);
+    if (uc < r) return DeltaSample{reflected, t->tint, std::abs(cos_o), r, r, 1.0f, Lobe::kSpecularReflection};
+    return DeltaSample{-wo, t->tint, std::abs(cos_o), 1.0f - r, 1.0f - r, 1.0f, Lobe::kSpecularTransmission};
   }
   const auto& d = std::get<Dielectric>(m);
   if (!(d.ior > 0.0f) || !std::isfinite(d.ior)) return std::nullopt;
@@ -220,7 +209,13 @@ float delta_probability(const BasicMaterial& m, const glm::vec3& wo, const glm::
     if (lobe == Lobe::kSpecularTransmission) return 1.0f - f_refl;
     return 0.0f;
   }
-  if (std::holds_alternative<Mirror>(m)) return lobe == Lobe::kSpecularReflection ? 1.0f : 0.0f;
+  if (const auto* t = std::get_if<ThinDielectric>(&m)) {
+    const float r = kinds::thin_dielectric_reflectance(*t, glm::dot(wo, ns));
+    if (lobe == Lobe::kSpecularReflection) return r;
+    if (lobe == Lobe::kSpecularTransmission) return 1.0f - r;
+    return 0.0f;
+  }
+  if (std::holds_alternative<Mirror>(m) || is_delta_kind(m)) return lobe == Lobe::kSpecularReflection ? 1.0f : 0.0f;
   return 0.0f;
 }
 
@@ -272,29 +267,16 @@ std::optional<Pick> pick(const Material& m, float u, BasicMaterial* storage) {
 
 // --- public functions ---
 
-float fresnel_dielectric(float cos_i, float eta) {
-  cos_i = std::clamp(cos_i, -1.0f, 1.0f);
-  if (cos_i < 0.0f) {  // incidence from inside: swap the media
-    eta = 1.0f / eta;
-    cos_i = -cos_i;
-  }
-  const float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1.0f) return 1.0f;  // total internal reflection
-  const float cos_t = safe_sqrt(1.0f - sin2_t);
-  const float r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  const float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  return 0.5f * (r_parl * r_parl + r_perp * r_perp);
-}
-
 glm::vec3 detail::eval_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-                               const glm::vec3& ng) {
+                               const glm::vec3& ng, TransportMode mode) {
   glm::vec3 wo_l, wi_l;
-  if (!reflection_local(wo, wi, ns, ng, &wo_l, &wi_l)) return glm::vec3(0.0f);
+  bool inside;
+  if (!local_pair(wo, wi, ns, ng, &wo_l, &wi_l, &inside)) return glm::vec3(0.0f);
   if (const auto* mix = std::get_if<Mixture>(&m)) {
     glm::vec3 sum(0.0f);
     for (const auto& c : mix->components) {
       const float w = usable_weight(c.weight);
-      if (w > 0.0f && !is_delta_kind(c.material)) sum += w * eval_basic(c.material, wo_l, wi_l);
+      if (w > 0.0f && !is_delta_kind(c.material)) sum += w * eval_basic(c.material, wo_l, wi_l, inside, mode);
     }
     return sum;
   }
@@ -303,7 +285,7 @@ glm::vec3 detail::eval_general(const Material& m, const glm::vec3& wo, const glm
         if constexpr (is<Mixture, decltype(k)>) {
           return glm::vec3(0.0f);
         } else {
-          return eval_basic(BasicMaterial{k}, wo_l, wi_l);
+          return eval_basic(BasicMaterial{k}, wo_l, wi_l, inside, mode);
         }
       },
       m);
@@ -312,7 +294,8 @@ glm::vec3 detail::eval_general(const Material& m, const glm::vec3& wo, const glm
 float detail::pdf_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
                           const glm::vec3& ng) {
   glm::vec3 wo_l, wi_l;
-  if (!reflection_local(wo, wi, ns, ng, &wo_l, &wi_l)) return 0.0f;
+  bool inside;
+  if (!local_pair(wo, wi, ns, ng, &wo_l, &wi_l, &inside)) return 0.0f;
   if (const auto* mix = std::get_if<Mixture>(&m)) {
     const float total = total_weight(*mix);
     if (!(total > 0.0f)) return 0.0f;
@@ -320,7 +303,7 @@ float detail::pdf_general(const Material& m, const glm::vec3& wo, const glm::vec
     for (const auto& c : mix->components) {
       const float w = usable_weight(c.weight);
       if (w > 0.0f && !is_delta_kind(c.material))
-        sum += (w / total) * pdf_basic(c.material, wo_l, wi_l);
+        sum += (w / total) * pdf_basic(c.material, wo_l, wi_l, inside);
     }
     return sum;
   }
@@ -329,7 +312,7 @@ float detail::pdf_general(const Material& m, const glm::vec3& wo, const glm::vec
         if constexpr (is<Mixture, decltype(k)>) {
           return 0.0f;
         } else {
-          return pdf_basic(BasicMaterial{k}, wo_l, wi_l);
+          return pdf_basic(BasicMaterial{k}, wo_l, wi_l, inside);
         }
       },
       m);
@@ -374,18 +357,33 @@ std::optional<BsdfSample> detail::sample_general(const Material& m, const glm::v
     const bool flip = wo_l.z < 0.0f;
     if (flip) wo_l.z = -wo_l.z;
     glm::vec3 wi_l;
+    std::optional<kinds::LocalSample> other;  // the kinds in their own files
     if (const auto* g = std::get_if<Glossy>(&c)) {
-      const glm::vec3 wm = ggx_sample_visible_normal(wo_l, ggx_alpha(*g), u);
+      const glm::vec3 wm = glossy_ggx(*g).sample_visible_normal(wo_l, u);
       wi_l = 2.0f * glm::dot(wo_l, wm) * wm - wo_l;
       s.lobe = Lobe::kGlossyReflection;
+    } else if (const auto* k = std::get_if<Conductor>(&c)) {
+      other = kinds::conductor_sample(*k, wo_l, u);
+    } else if (const auto* r = std::get_if<RoughDielectric>(&c)) {
+      other = kinds::rough_dielectric_sample(*r, far_eta(r->ior, flip), wo_l, chosen->u, u);
+      if (!other) return std::nullopt;
+    } else if (const auto* t = std::get_if<DiffuseTransmission>(&c)) {
+      other = kinds::diffuse_transmission_sample(*t, wo_l, chosen->u, u);
     } else {
       wi_l = sample_cosine_hemisphere(u);
       s.lobe = Lobe::kDiffuseReflection;
     }
-    if (!(wi_l.z > 0.0f)) return std::nullopt;  // below the (micro)surface: energy not reflected
+    if (other) {
+      wi_l = other->wi;
+      s.lobe = other->lobe;
+      s.eta = other->eta;
+    }
+    const bool transmits = s.lobe == Lobe::kGlossyTransmission || s.lobe == Lobe::kDiffuseTransmission;
+    // Below the (micro)surface for a reflection, above it for a transmission: nothing passes.
+    if (transmits ? !(wi_l.z < 0.0f) : !(wi_l.z > 0.0f)) return std::nullopt;
     if (flip) wi_l.z = -wi_l.z;
     s.wi = glm::normalize(frame.to_world(wi_l));
-    s.f = eval(m, wo, s.wi, ns, ng);
+    s.f = eval(m, wo, s.wi, ns, ng, mode);
     s.pdf = pdf(m, wo, s.wi, ns, ng);
     if (!(s.pdf > 0.0f) || is_black(s.f) || !finite_vec(s.f)) return std::nullopt;
     s.pdf_rev = pdf(m, s.wi, wo, ns, ng);
@@ -425,7 +423,7 @@ bool has_finite_component(const Material& m) {
       if (usable_weight(c.weight) > 0.0f && !is_delta_kind(c.material)) return true;
     return false;
   }
-  return std::holds_alternative<Diffuse>(m) || std::holds_alternative<Glossy>(m);
+  return (letters_of(m) & (1u << kD)) != 0;
 }
 
 float shading_normal_correction(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,

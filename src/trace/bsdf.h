@@ -9,10 +9,19 @@
 // wo's side of ng, a refraction on the other side): sample() returns nullopt for them and eval()
 // and pdf() return 0, consistently.
 //
-// Sidedness. Diffuse, mirror and glossy are two-sided: the normal is flipped to wo's side. A
-// dielectric is oriented: `ns` points to the outside (index 1), the inside has index `ior`.
+// Sidedness. Diffuse, mirror, glossy, conductor, thin dielectric and diffuse transmission are
+// two-sided: the normal is flipped to wo's side. A dielectric, smooth or rough, is oriented: `ns`
+// points to the outside (index 1), the inside has index `ior`. Finite lobes may transmit (rough
+// dielectric, diffuse transmission): eval() and pdf() take wo and wi on opposite sides of both
+// normals as a transmission and on one side of both as a reflection; a pair that ns and ng
+// disagree about carries nothing.
 //
-// Dirac deltas (mirror, smooth dielectric; DESIGN §7 "MIS": handled symbolically). For a delta
+// Each kind's sampling and evaluation lives in its own file: bsdf.cpp (diffuse, mirror, smooth
+// dielectric, glossy, mixtures, and the dispatch), bsdf_conductor.cpp, bsdf_dielectric.cpp (rough
+// and thin dielectrics), bsdf_transmission.cpp (diffuse transmission); trace/fresnel.h and
+// trace/microfacet.h are the Fresnel and GGX they share.
+//
+// Dirac deltas (mirror, smooth dielectric, smooth conductor, thin dielectric; DESIGN §7 "MIS": handled symbolically). For a delta
 // the BSDF is f · δ_σ(wi − w_delta), a Dirac in solid angle with weight f = R / |cos θi|, so the
 // throughput update f · |cos θi| / pdf is one formula for both kinds; `pdf` is then the discrete
 // probability of having chosen that delta, never a huge number. eval() and pdf() see only the
@@ -29,8 +38,9 @@
 //
 // Radiance and importance (Veach §5.2). Refraction compresses radiance by (η_wo / η_wi)^2 but not
 // importance: in TransportMode::kRadiance (eye subpaths: wo towards the camera) the transmitted f
-// carries 1/η'^2 with η' = η_wi / η_wo; in kImportance (light subpaths) it does not. Every other
-// kind is symmetric. The extra factor that shading normals cause for importance transport is
+// carries 1/η'^2 with η' = η_wi / η_wo; in kImportance (light subpaths) it does not. So eval() of
+// a rough dielectric depends on the mode: a join evaluates a light subpath's vertex with
+// kImportance, an eye subpath's with kRadiance (the default). Every other kind is symmetric. The extra factor that shading normals cause for importance transport is
 // shading_normal_correction(), applied by the integrator.
 //
 // Robustness (DESIGN §10). GGX is evaluated in forms that stay finite as roughness → 1e-4 (D from
@@ -52,6 +62,8 @@
 #include "alphabet/alphabet.h"
 #include "scene/material.h"
 #include "trace/frame.h"
+#include "trace/fresnel.h"
+#include "trace/microfacet.h"
 #include "trace/rng.h"
 
 namespace pathex {
@@ -67,6 +79,8 @@ enum class Lobe : std::uint8_t {
   kGlossyReflection,
   kSpecularReflection,
   kSpecularTransmission,
+  kGlossyTransmission,   // rough dielectric (D)
+  kDiffuseTransmission,  // diffuse transmission (D)
 };
 
 inline constexpr float kMinGlossyRoughness = 1e-6f;
@@ -106,8 +120,9 @@ struct NumbersRead {
 inline NumbersRead numbers_read(const Material& m) {
   if (std::holds_alternative<Diffuse>(m) || std::holds_alternative<Glossy>(m)) return {false, true};
   if (std::holds_alternative<Mirror>(m)) return {false, false};
-  if (std::holds_alternative<Dielectric>(m)) return {true, false};
-  return {true, true};  // a mixture
+  if (std::holds_alternative<Dielectric>(m) || std::holds_alternative<ThinDielectric>(m)) return {true, false};
+  if (const auto* c = std::get_if<Conductor>(&m)) return {false, !c->smooth()};
+  return {true, true};  // a mixture, a rough dielectric, diffuse transmission
 }
 
 namespace detail {
@@ -121,20 +136,21 @@ inline bool same_side(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3&
   return glm::dot(wo, ns) * *cos_i > 0.0f;
 }
 glm::vec3 eval_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-                       const glm::vec3& ng);
+                       const glm::vec3& ng, TransportMode mode);
 float pdf_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
                   const glm::vec3& ng);
 }  // namespace detail
 
-// The BSDF summed over the finite components, weighted by the mixture weights. Reciprocal:
-// eval(wo, wi) == eval(wi, wo) bit for bit.
+// The BSDF summed over the finite components, weighted by the mixture weights. Reflection is
+// reciprocal: eval(wo, wi) == eval(wi, wo) bit for bit. `mode` matters only for a rough
+// dielectric's transmission (see "Radiance and importance").
 inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-                      const glm::vec3& ng) {
+                      const glm::vec3& ng, TransportMode mode = TransportMode::kRadiance) {
   if (const auto* lambert = std::get_if<Diffuse>(&m)) {
     float cos_i;
     return detail::same_side(wo, wi, ns, ng, &cos_i) ? lambert->albedo * std::numbers::inv_pi_v<float> : glm::vec3(0.0f);
   }
-  return detail::eval_general(m, wo, wi, ns, ng);
+  return detail::eval_general(m, wo, wi, ns, ng, mode);
 }
 inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi,
                       const glm::vec3& n) {
@@ -217,7 +233,7 @@ struct JoinPdfs {
 // more products), bit for bit what pdf() gives: same_side() is symmetric in wo and wi. Other
 // materials leave `pdfs` unknown, for the caller to compute only if it needs them.
 inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
-                      const glm::vec3& ng, JoinPdfs* pdfs) {
+                      const glm::vec3& ng, JoinPdfs* pdfs, TransportMode mode = TransportMode::kRadiance) {
   if (const auto* lambert = std::get_if<Diffuse>(&m)) {
     float cos_i;
     pdfs->known = true;
@@ -230,7 +246,7 @@ inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& w
     return lambert->albedo * std::numbers::inv_pi_v<float>;
   }
   pdfs->known = false;
-  return detail::eval_general(m, wo, wi, ns, ng);
+  return detail::eval_general(m, wo, wi, ns, ng, mode);
 }
 
 // The discrete probability that sample() picks the delta lobe `lobe` of component `component`
@@ -243,10 +259,8 @@ float component_probability(const Material& m, const glm::vec3& wo, const glm::v
 // a join (shadow ray, connection) at a vertex on it carry energy.
 bool has_finite_component(const Material& m);
 
-// Exact unpolarised Fresnel reflectance of a smooth dielectric interface. `cos_i` is the cosine
-// between the incident direction and the normal on the outside; negative means incidence from
-// inside. `eta` is η_inside / η_outside. Returns exactly 1 beyond the critical angle.
-float fresnel_dielectric(float cos_i, float eta);
+// The dielectric Fresnel reflectance (trace/fresnel.h), under its old name.
+using pathex::fresnel_dielectric;
 
 // Veach's correction for shading normals in importance transport (thesis §5.3, pbrt-v3's
 // CorrectShadingNormal): multiply a light subpath's throughput f · |wi·ns| / pdf by

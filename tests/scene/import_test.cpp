@@ -312,9 +312,15 @@ TEST(ImportPbrt, MaterialsMapOntoPathexKinds) {
   EXPECT_FLOAT_EQ(mix.components[0].weight, 0.75f);
   expect_near(std::get<Diffuse>(mix.components[0].material).albedo, glm::vec3(0.2f, 0.4f, 0.6f), "diffuse");
   EXPECT_FLOAT_EQ(mix.components[1].weight, 0.25f);
-  EXPECT_FLOAT_EQ(std::get<Glossy>(mix.components[1].material).roughness, 0.2f);  // alpha = sqrt(roughness)
-  const auto& mirror = std::get<Mirror>(s.materials[static_cast<std::size_t>(s.shapes[1].material)]);
-  expect_near(mirror.reflectance, glm::vec3(1.0f / 9.0f), "((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2)");
+  const auto& rough = std::get<Conductor>(mix.components[1].material);
+  EXPECT_FLOAT_EQ(rough.alpha_u, 0.2f);  // alpha = sqrt(roughness)
+  EXPECT_FLOAT_EQ(rough.alpha_v, 0.2f);
+  expect_near(rough.eta, glm::vec3(1.0f), "reflectance: eta 1");
+  expect_near(rough.k, glm::vec3(2.0f * std::sqrt(0.9f / 0.1f)), "reflectance: k = 2 sqrt(r / (1 - r))");
+  const auto& smooth = std::get<Conductor>(s.materials[static_cast<std::size_t>(s.shapes[1].material)]);
+  EXPECT_TRUE(smooth.smooth());
+  expect_near(smooth.eta, glm::vec3(2.0f), "eta");
+  expect_near(smooth.k, glm::vec3(0.0f), "k");
 }
 
 TEST(ImportMitsuba, FovAxisAndOrthographicFilm) {
@@ -466,7 +472,8 @@ std::vector<Refusal> refusals() {
        "shape \"curve\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder"},
       {"cylinder.pbrt", "Shape \"cylinder\" \"float phimax\" 180\n", "cylinder.pbrt:4:18", "partial cylinders (phimax) are not supported"},
       {"coated.pbrt", "Material \"coateddiffuse\"\n", "coated.pbrt:4:1",
-       "material \"coateddiffuse\" is not supported, expected diffuse, conductor, dielectric or mix"},
+       "material \"coateddiffuse\" is not supported, expected diffuse, conductor, dielectric, thindielectric, diffusetransmission, "
+       "interface or mix"},
       {"infinite.pbrt", "LightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "infinite.pbrt:4:24",
        "an image infinite light (filename) is not supported: pathex renders a uniform infinite light (\"rgb L\") only"},
       {"goniometric.pbrt", "LightSource \"goniometric\"\n", "goniometric.pbrt:4:1",
@@ -475,8 +482,9 @@ std::vector<Refusal> refusals() {
       {"typo.pbrt", "Shape \"sphere\" \"float radiu\" 2\n", "typo.pbrt:4:16", "parameter \"float radiu\" of Shape \"sphere\" is not supported"},
       {"eta-one.pbrt", "Material \"dielectric\" \"float eta\" 1\n", "eta-one.pbrt:4:1",
        "dielectric eta must be within [0.1, 10] and not 1 (1 is no surface), found 1"},
-      {"rough-glass.pbrt", "Material \"dielectric\" \"float roughness\" 0.1\n", "rough-glass.pbrt:4:1",
-       "a rough dielectric is not supported: pathex has no rough transmission (set roughness 0)"},
+      {"measured.pbrt", "Material \"measured\" \"string filename\" \"gold.bsdf\"\n", "measured.pbrt:4:1",
+       "material \"measured\" is not supported: it needs the RGL measured-BSDF file reader and its spectral tables, which pathex does not "
+       "have"},
       {"blackbody.pbrt", "LightSource \"point\" \"blackbody I\" 3000\n", "blackbody.pbrt:4:21",
        "parameter \"blackbody I\" is not supported: pathex renders in RGB, give \"rgb I\" [r g b]"},
       {"texture.pbrt", "Material \"diffuse\" \"texture reflectance\" \"checks\"\n", "texture.pbrt:4:20",
@@ -521,13 +529,15 @@ std::vector<Refusal> refusals() {
       {"projector.xml", "  <emitter type=\"projector\"/>\n</scene>\n", "projector.xml:2:3",
        "emitter \"projector\" is not supported, expected point, spot, directional, constant, or area inside a shape"},
       {"plastic.xml", "  <bsdf type=\"plastic\" id=\"unused\"/>\n</scene>\n", "plastic.xml:2:3",
-       "bsdf \"plastic\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, blendbsdf or twosided"},
+       "bsdf \"plastic\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, roughdielectric (ggx), "
+       "thindielectric, blendbsdf or twosided"},
       {"medium.xml", "  <medium type=\"homogeneous\"/>\n</scene>\n", "medium.xml:2:3",
        "<medium> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)"},
-      {"rough-glass.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"roughdielectric\"/>\n  </shape>\n</scene>\n", "rough-glass.xml:3:5",
-       "roughdielectric is not supported: pathex has no rough transmission"},
+      {"principled.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"principled\"/>\n  </shape>\n</scene>\n", "principled.xml:3:5",
+       "bsdf \"principled\" is not supported: it needs the Disney principled BSDF (sheen, clearcoat, specular transmission and their "
+       "blend), which pathex does not have"},
       {"beckmann.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"roughconductor\"/>\n  </shape>\n</scene>\n", "beckmann.xml:3:5",
-       "microfacet distribution \"beckmann\" is not supported: pathex's glossy lobe is GGX, set <string name=\"distribution\" value=\"ggx\"/>"},
+       "microfacet distribution \"beckmann\" is not supported: pathex's microfacets are GGX, set <string name=\"distribution\" value=\"ggx\"/>"},
       {"bitmap.xml",
        "  <shape type=\"sphere\">\n    <bsdf type=\"diffuse\">\n      <texture type=\"bitmap\" name=\"reflectance\"/>\n    </bsdf>\n  </shape>\n</scene>\n",
        "bitmap.xml:4:7", "textures are not supported ('reflectance'), give an <rgb>"},

@@ -21,14 +21,15 @@
 
 #include <glm/geometric.hpp>
 
+#include "support/bsdf_stats.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
 
 namespace pathex {
 namespace {
 
-constexpr double kZ = 4.0;
-constexpr double kPiD = std::numbers::pi;
+using namespace bsdf_stats;  // NOLINT: the statistics shared with bsdf_materials_test
+
 const glm::vec3 kUp(0.0f, 0.0f, 1.0f);
 
 // A unit direction at polar angle theta (degrees) from +z and azimuth phi (degrees).
@@ -48,164 +49,6 @@ Material mixture(std::vector<Mixture::Component> components) {
   Mixture m;
   m.components = std::move(components);
   return m;
-}
-
-// --- statistics ---
-
-struct Estimate {
-  double mean = 0.0;
-  double se = 0.0;
-};
-
-struct Accumulator {
-  double sum = 0.0, sum2 = 0.0;
-  std::uint64_t n = 0;
-  void add(double x) {
-    sum += x;
-    sum2 += x * x;
-    ++n;
-  }
-  Estimate estimate() const {
-    const double mean = sum / static_cast<double>(n);
-    const double var = std::max(0.0, sum2 / static_cast<double>(n) - mean * mean);
-    return {mean, std::sqrt(var / static_cast<double>(n))};
-  }
-};
-
-double chi2_critical(double k, double z) {
-  const double h = 2.0 / (9.0 * k);
-  return k * std::pow(1.0 - h + z * std::sqrt(h), 3.0);
-}
-
-// Chi-square of observed against expected counts, pooling cells expected below 5 (pbrt's
-// chi2test); a cell with nothing expected but something observed is an immediate failure.
-struct Chi2 {
-  double statistic = 0.0;
-  double critical = 0.0;
-  bool impossible_count = false;
-};
-Chi2 chi2_test(const std::vector<double>& observed, const std::vector<double>& expected) {
-  std::vector<std::size_t> order(observed.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return expected[a] < expected[b]; });
-  Chi2 r;
-  double pooled_o = 0.0, pooled_e = 0.0;
-  int cells = 0;
-  for (std::size_t i : order) {
-    if (expected[i] <= 0.0) {
-      if (observed[i] > 0.0) r.impossible_count = true;
-      continue;
-    }
-    if (expected[i] < 5.0 || pooled_e > 0.0) {
-      pooled_o += observed[i];
-      pooled_e += expected[i];
-      if (pooled_e >= 5.0) {
-        r.statistic += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
-        ++cells;
-        pooled_o = pooled_e = 0.0;
-      }
-      continue;
-    }
-    r.statistic += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++cells;
-  }
-  if (pooled_e > 0.0) {
-    r.statistic += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
-    ++cells;
-  }
-  r.critical = chi2_critical(std::max(cells - 1, 1), 5.0);
-  return r;
-}
-
-// sample() against pdf(): the directions of n samples of `sampled` binned over the sphere
-// (equal-area bins in cos θ × φ about the normal), plus one cell for all delta samples and one for
-// "no sample". Expected counts integrate pdf() of `m` over each bin (midpoint rule on a 6 × 6
-// sub-grid); the delta cell expects n · Σ component_probability; "no sample" gets the rest.
-Chi2 chi2_sample_vs_pdf(const Material& sampled, const Material& m, const glm::vec3& wo,
-                        const glm::vec3& n, std::uint64_t seed, int samples) {
-  constexpr int kU = 40, kPhi = 80, kSub = 6;
-  const Frame frame = Frame::from_normal(n);
-  std::vector<double> observed(kU * kPhi + 2, 0.0), expected(kU * kPhi + 2, 0.0);
-  for (int i = 0; i < samples; ++i) {
-    Sampler s(seed, 0, static_cast<std::uint64_t>(i));
-    const float uc = s.get1d();
-    const auto r = bsdf::sample(sampled, wo, n, n, uc, s.get2d(), TransportMode::kRadiance);
-    if (!r) {
-      observed[kU * kPhi + 1] += 1.0;
-    } else if (r->is_delta) {
-      observed[kU * kPhi] += 1.0;
-    } else {
-      const glm::vec3 l = frame.to_local(r->wi);
-      const double u = std::clamp(static_cast<double>(l.z), -1.0, 1.0);
-      double phi = std::atan2(static_cast<double>(l.y), static_cast<double>(l.x));
-      if (phi < 0.0) phi += 2.0 * kPiD;
-      const int iu = std::min(static_cast<int>((u + 1.0) / 2.0 * kU), kU - 1);
-      const int ip = std::min(static_cast<int>(phi / (2.0 * kPiD) * kPhi), kPhi - 1);
-      observed[static_cast<std::size_t>(iu * kPhi + ip)] += 1.0;
-    }
-  }
-  double total = 0.0;
-  const double du = 2.0 / kU, dphi = 2.0 * kPiD / kPhi;
-  for (int iu = 0; iu < kU; ++iu) {
-    for (int ip = 0; ip < kPhi; ++ip) {
-      double integral = 0.0;
-      for (int a = 0; a < kSub; ++a) {
-        for (int b = 0; b < kSub; ++b) {
-          const double u = -1.0 + (iu + (a + 0.5) / kSub) * du;
-          const double phi = (ip + (b + 0.5) / kSub) * dphi;
-          const double r = std::sqrt(std::max(0.0, 1.0 - u * u));
-          const glm::vec3 wi = frame.to_world(glm::vec3(static_cast<float>(r * std::cos(phi)),
-                                                        static_cast<float>(r * std::sin(phi)),
-                                                        static_cast<float>(u)));
-          integral += bsdf::pdf(m, wo, wi, n);
-        }
-      }
-      integral *= du * dphi / (kSub * kSub);
-      expected[static_cast<std::size_t>(iu * kPhi + ip)] = integral * samples;
-      total += integral;
-    }
-  }
-  double p_delta = 0.0;
-  const int components = std::holds_alternative<Mixture>(m)
-                             ? static_cast<int>(std::get<Mixture>(m).components.size())
-                             : 1;
-  for (int c = 0; c < components; ++c)
-    for (Lobe lobe : {Lobe::kSpecularReflection, Lobe::kSpecularTransmission})
-      p_delta += bsdf::component_probability(m, wo, n, c, lobe);
-  expected[kU * kPhi] = p_delta * samples;
-  expected[kU * kPhi + 1] = std::max(0.0, 1.0 - total - p_delta) * samples;
-  return chi2_test(observed, expected);
-}
-Chi2 chi2_sample_vs_pdf(const Material& m, const glm::vec3& wo, const glm::vec3& n,
-                        std::uint64_t seed, int samples) {
-  return chi2_sample_vs_pdf(m, m, wo, n, seed, samples);
-}
-
-// Mean of sample().weight (first channel), a nullopt counting 0: the directional albedo.
-Estimate albedo_by_sampling(const Material& m, const glm::vec3& wo, const glm::vec3& n,
-                            std::uint64_t seed, int samples,
-                            TransportMode mode = TransportMode::kRadiance) {
-  Accumulator acc;
-  for (int i = 0; i < samples; ++i) {
-    Sampler s(seed, 1, static_cast<std::uint64_t>(i));
-    const float uc = s.get1d();
-    const auto r = bsdf::sample(m, wo, n, n, uc, s.get2d(), mode);
-    acc.add(r ? r->weight.x : 0.0);
-  }
-  return acc.estimate();
-}
-
-// ∫ eval · |cos| over the sphere with uniformly distributed directions: independent of sample().
-Estimate albedo_by_uniform_eval(const Material& m, const glm::vec3& wo, const glm::vec3& n,
-                                std::uint64_t seed, int samples) {
-  Accumulator acc;
-  for (int i = 0; i < samples; ++i) {
-    Sampler s(seed, 2, static_cast<std::uint64_t>(i));
-    const glm::vec3 wi = sample_uniform_sphere(s.get2d());
-    acc.add(bsdf::eval(m, wo, wi, n).x * std::abs(glm::dot(wi, n)) * 4.0 * kPiD);
-  }
-  return acc.estimate();
 }
 
 // The classic microfacet estimator (Walter et al. 2007): m drawn from D(m) cos θm with the
@@ -238,10 +81,6 @@ Estimate albedo_by_classic_ggx(const Material& m, float alpha, const glm::vec3& 
   return acc.estimate();
 }
 
-void expect_agree(const Estimate& a, const Estimate& b, const char* what) {
-  EXPECT_NEAR(a.mean, b.mean, kZ * std::sqrt(a.se * a.se + b.se * b.se) + 1e-6)
-      << what << ": " << a.mean << " ± " << a.se << " vs " << b.mean << " ± " << b.se;
-}
 
 // --- frame ---
 

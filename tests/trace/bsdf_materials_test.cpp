@@ -1,0 +1,320 @@
+// The materials of issue 35 (trace/bsdf_conductor.cpp, bsdf_dielectric.cpp, bsdf_transmission.cpp)
+// against closed forms and against themselves: sample() against pdf() by chi-square over the
+// sphere for several incident angles and roughnesses, the sampled weight against f·cos/pdf, the
+// density's integral against the albedo, reciprocity of every reflection (and the adjoint relation
+// of refraction between radiance and importance transport), the rough dielectric's limit as
+// alpha → 0 (the smooth one), the exact Fresnel of a complex index, and each kind's letters.
+//
+// Tolerances (support/bsdf_stats.h): means within kZ = 4 standard errors, chi-square below the
+// critical value at z = 5; all at fixed seeds.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "scene/material.h"
+#include "scene/metal_spectra.h"
+#include "support/bsdf_stats.h"
+#include "trace/bsdf.h"
+#include "trace/fresnel.h"
+#include "trace/rng.h"
+
+namespace pathex {
+namespace {
+
+using namespace bsdf_stats;  // NOLINT
+
+const glm::vec3 kUp(0.0f, 0.0f, 1.0f);
+
+glm::vec3 polar(double theta_deg, double phi_deg = 0.0) {
+  const double t = theta_deg * kPiD / 180.0, p = phi_deg * kPiD / 180.0;
+  return glm::vec3(static_cast<float>(std::sin(t) * std::cos(p)), static_cast<float>(std::sin(t) * std::sin(p)),
+                   static_cast<float>(std::cos(t)));
+}
+
+Conductor gold(float au, float av) {
+  const MetalSpectrum* m = find_metal("Au");
+  Conductor c;
+  c.eta = glm::vec3(m->eta[0], m->eta[1], m->eta[2]);
+  c.k = glm::vec3(m->k[0], m->k[1], m->k[2]);
+  c.alpha_u = au;
+  c.alpha_v = av;
+  return c;
+}
+
+struct Case {
+  std::string name;
+  Material material;
+};
+
+// The finite kinds at several roughnesses, and a mixture of all of them with a delta.
+std::vector<Case> finite_cases() {
+  std::vector<Case> out;
+  for (float a : {0.1f, 0.3f, 0.7f}) out.push_back({"conductor alpha " + std::to_string(a), gold(a, a)});
+  out.push_back({"conductor alpha 0.1 x 0.5", gold(0.1f, 0.5f)});
+  for (float a : {0.1f, 0.3f, 0.7f}) {
+    out.push_back({"rough glass alpha " + std::to_string(a), RoughDielectric{1.5f, glm::vec3(1.0f), a, a}});
+    out.push_back({"rough bubble alpha " + std::to_string(a), RoughDielectric{1.0f / 1.5f, glm::vec3(1.0f), a, a}});
+  }
+  out.push_back({"rough glass alpha 0.15 x 0.6", RoughDielectric{1.33f, glm::vec3(1.0f), 0.15f, 0.6f}});
+  out.push_back({"diffuse transmission", DiffuseTransmission{glm::vec3(0.3f, 0.5f, 0.1f), glm::vec3(0.6f, 0.2f, 0.1f)}});
+  Mixture mix;
+  mix.components = {{0.3f, RoughDielectric{1.5f, glm::vec3(1.0f), 0.3f, 0.3f}},
+                    {0.3f, DiffuseTransmission{glm::vec3(0.5f), glm::vec3(0.5f)}},
+                    {0.2f, gold(0.2f, 0.2f)},
+                    {0.2f, ThinDielectric{1.5f, glm::vec3(1.0f)}}};
+  out.push_back({"mixture", mix});
+  return out;
+}
+
+// wo from outside at several angles, and from inside (below the normal). Not exactly normal: a
+// rough refraction at normal incidence is a lobe narrower than the chi-square's polar bin can
+// integrate (the albedo test takes normal incidence instead). Not 35° either: a rough refraction's
+// density jumps where the half vector turns horizontal (wi.z = −wo.z / η, Walter's model), and at
+// 35° into glass that edge falls just inside a row of bins whose midpoints all lie beyond it.
+std::vector<glm::vec3> incident_directions() {
+  std::vector<glm::vec3> out;
+  for (double theta : {12.0, 40.0, 60.0, 85.0}) out.push_back(polar(theta, 40.0));
+  for (double theta : {20.0, 50.0, 80.0}) out.push_back(polar(180.0 - theta, 110.0));
+  return out;
+}
+
+TEST(MaterialsSampleVersusPdf, ChiSquareForEveryNewFiniteKindAngleAndRoughness) {
+  std::uint64_t seed = 1000;
+  for (const Case& c : finite_cases()) {
+    for (const glm::vec3& wo : incident_directions()) {
+      const Chi2 r = chi2_sample_vs_pdf(c.material, wo, kUp, seed++, 200'000);
+      EXPECT_FALSE(r.impossible_count) << c.name << " wo.z " << wo.z;
+      EXPECT_LT(r.statistic, r.critical) << c.name << " wo.z " << wo.z << ": chi-square " << r.statistic;
+    }
+  }
+}
+
+// sample() returns f == eval(), pdf == pdf(), pdf_rev == pdf(wi, wo) and weight == f |cos| / pdf,
+// in both transport modes; the letter is D and the lobe says reflection or transmission by side.
+TEST(MaterialsSample, ValuesAreEvalAndPdfInBothModes) {
+  for (const Case& c : finite_cases()) {
+    for (const glm::vec3& wo : incident_directions()) {
+      for (TransportMode mode : {TransportMode::kRadiance, TransportMode::kImportance}) {
+        for (int i = 0; i < 2000; ++i) {
+          Sampler s(77, 0, static_cast<std::uint64_t>(i));
+          const float uc = s.get1d();
+          const auto r = bsdf::sample(c.material, wo, kUp, kUp, uc, s.get2d(), mode);
+          if (!r || r->is_delta) continue;
+          const glm::vec3 f = bsdf::eval(c.material, wo, r->wi, kUp, kUp, mode);
+          ASSERT_EQ(r->f, f) << c.name;
+          ASSERT_EQ(r->pdf, bsdf::pdf(c.material, wo, r->wi, kUp)) << c.name;
+          ASSERT_EQ(r->pdf_rev, bsdf::pdf(c.material, r->wi, wo, kUp)) << c.name;
+          const glm::vec3 w = f * (std::abs(r->wi.z) / r->pdf);
+          for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(r->weight[ch], w[ch], 1e-5f * std::max(1.0f, w[ch])) << c.name;
+          EXPECT_EQ(r->letter, kD) << c.name;
+          const bool transmitted = r->wi.z * wo.z < 0.0f;
+          const bool says = r->lobe == Lobe::kGlossyTransmission || r->lobe == Lobe::kDiffuseTransmission;
+          if (!std::holds_alternative<Mixture>(c.material)) {
+            EXPECT_EQ(transmitted, says) << c.name;
+          }
+          if (transmitted && std::holds_alternative<RoughDielectric>(c.material)) {
+            const float ior = std::get<RoughDielectric>(c.material).ior;
+            EXPECT_FLOAT_EQ(r->eta, wo.z > 0.0f ? ior : 1.0f / ior) << c.name;
+          }
+        }
+      }
+    }
+  }
+}
+
+// The directional albedo by sampling equals the integral of eval·|cos| over the sphere with
+// uniform directions (independent of sample() and pdf()), and is at most 1.
+TEST(MaterialsAlbedo, SamplingAgreesWithUniformEvaluationAndNeverExceedsOne) {
+  std::uint64_t seed = 3000;
+  for (const Case& c : finite_cases()) {
+    if (std::holds_alternative<Mixture>(c.material)) continue;  // its delta is not in eval()
+    std::vector<glm::vec3> wos = incident_directions();
+    wos.push_back(kUp);
+    wos.push_back(-kUp);
+    for (const glm::vec3& wo : wos) {
+      const Estimate by_sampling = albedo_by_sampling(c.material, wo, kUp, seed++, 200'000);
+      const Estimate by_eval = albedo_by_uniform_eval(c.material, wo, kUp, seed++, 400'000);
+      expect_agree(by_sampling, by_eval, c.name.c_str());
+      // Radiance transport scales refracted radiance by 1/η'², which may exceed 1; importance
+      // transport does not, and conserves energy.
+      const Estimate importance = albedo_by_sampling(c.material, wo, kUp, seed++, 200'000, TransportMode::kImportance);
+      EXPECT_LE(importance.mean, 1.0 + kZ * importance.se) << c.name;
+    }
+  }
+}
+
+// Reflection is reciprocal; refraction is adjoint: importance transport's f(wo, wi) is radiance
+// transport's f(wi, wo) (Veach §5.2), which is what makes lt and pt agree through rough glass.
+TEST(MaterialsReciprocity, ReflectionIsSymmetricAndRefractionAdjoint) {
+  for (const Case& c : finite_cases()) {
+    for (int i = 0; i < 4000; ++i) {
+      Sampler s(5, 0, static_cast<std::uint64_t>(i));
+      const glm::vec3 a = sample_uniform_sphere(s.get2d());
+      const glm::vec3 b = sample_uniform_sphere(s.get2d());
+      const glm::vec3 f_ab = bsdf::eval(c.material, a, b, kUp, kUp, TransportMode::kRadiance);
+      const glm::vec3 f_ba = bsdf::eval(c.material, b, a, kUp, kUp, TransportMode::kRadiance);
+      const glm::vec3 adj = bsdf::eval(c.material, b, a, kUp, kUp, TransportMode::kImportance);
+      if (a.z * b.z > 0.0f) {
+        ASSERT_EQ(f_ab, f_ba) << c.name;
+      } else {
+        for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(f_ab[ch], adj[ch], 1e-4f * std::max(1.0f, f_ab[ch])) << c.name;
+      }
+    }
+  }
+}
+
+// As alpha → 0 the rough dielectric becomes the smooth one: at alpha 1e-3 the share reflected is
+// Fresnel's, a transmitted direction is Snell's, and the transmitted weight in radiance transport
+// carries 1/η'² as the smooth one's does.
+TEST(RoughDielectric, AtAlphaToZeroIsTheSmoothDielectric) {
+  for (float ior : {1.5f, 1.0f / 1.5f}) {
+    for (double theta : {0.0, 25.0, 40.0, 70.0}) {
+      const glm::vec3 wo = polar(theta, 30.0);
+      const Material rough = RoughDielectric{ior, glm::vec3(1.0f), 1e-3f, 1e-3f};
+      const Material smooth = Dielectric{ior, glm::vec3(1.0f)};
+      Accumulator refl, trans;
+      glm::dvec3 dir_t(0.0), dir_smooth(0.0);
+      int n_t = 0;
+      for (int i = 0; i < 20'000; ++i) {
+        Sampler s(11, 0, static_cast<std::uint64_t>(i));
+        const float uc = s.get1d();
+        const glm::vec2 u = s.get2d();
+        const auto r = bsdf::sample(rough, wo, kUp, kUp, uc, u, TransportMode::kRadiance);
+        const bool t = r && r->wi.z < 0.0f;
+        refl.add(r && !t ? r->weight.x : 0.0);
+        trans.add(t ? r->weight.x : 0.0);
+        if (t) {
+          dir_t += glm::dvec3(r->wi);
+          ++n_t;
+        }
+      }
+      const float f = fresnel_dielectric(wo.z, ior);
+      const std::string what = "ior " + std::to_string(ior) + " theta " + std::to_string(theta);
+      EXPECT_NEAR(refl.estimate().mean, f, kZ * refl.estimate().se + 5e-3) << what;
+      EXPECT_NEAR(trans.estimate().mean, (1.0 - f) / (ior * ior), kZ * trans.estimate().se + 5e-3) << what;
+      if (f < 1.0f) {
+        const auto d = bsdf::sample(smooth, wo, kUp, kUp, /*u_component=*/0.9999f, glm::vec2(0.5f), TransportMode::kRadiance);
+        ASSERT_TRUE(d && d->wi.z < 0.0f) << what;
+        const glm::dvec3 mean = dir_t / static_cast<double>(n_t);
+        EXPECT_NEAR(glm::length(mean - glm::dvec3(d->wi)), 0.0, 1e-2) << what;
+        EXPECT_NEAR(d->weight.x, 1.0f / (ior * ior), 1e-6f) << what;
+      } else {
+        EXPECT_EQ(n_t, 0) << what;  // total internal reflection
+      }
+    }
+  }
+}
+
+TEST(FresnelComplex, ClosedFormsAndTheDielectricLimit) {
+  // Normal incidence: ((n − 1)² + k²) / ((n + 1)² + k²).
+  for (auto [n, k] : {std::pair{0.2f, 3.9f}, std::pair{1.5f, 0.0f}, std::pair{0.08f, 3.39f}})
+    EXPECT_NEAR(fresnel_complex(1.0f, n, k), ((n - 1) * (n - 1) + k * k) / ((n + 1) * (n + 1) + k * k), 1e-6f);
+  // k = 0 is the dielectric; grazing incidence reflects everything; eta 0, k 1 (Mitsuba's "none") reflects everything.
+  for (float c : {1.0f, 0.8f, 0.5f, 0.2f, 0.05f}) EXPECT_NEAR(fresnel_complex(c, 1.5f, 0.0f), fresnel_dielectric(c, 1.5f), 1e-6f);
+  EXPECT_NEAR(fresnel_complex(0.0f, 0.2f, 3.9f), 1.0f, 1e-6f);
+  for (float c : {1.0f, 0.5f, 0.1f}) EXPECT_NEAR(fresnel_complex(c, 0.0f, 1.0f), 1.0f, 1e-6f);
+}
+
+// A smooth conductor is a Dirac delta (S) of weight F(cos θ) per channel; one with alpha ≥ 1e-3
+// is finite (D).
+TEST(Conductor, SmoothIsADeltaWithTheComplexFresnelWeight) {
+  const Conductor c = gold(0.0f, 5e-4f);
+  EXPECT_TRUE(c.smooth());
+  EXPECT_EQ(letter_of(c), kS);
+  EXPECT_EQ(letter_of(gold(1e-3f, 0.0f)), kD);
+  for (double theta : {0.0, 45.0, 80.0}) {
+    const glm::vec3 wo = polar(theta, 10.0);
+    const auto r = bsdf::sample(c, wo, kUp, kUp, 0.3f, glm::vec2(0.7f, 0.2f), TransportMode::kRadiance);
+    ASSERT_TRUE(r);
+    EXPECT_TRUE(r->is_delta);
+    EXPECT_EQ(r->letter, kS);
+    EXPECT_EQ(r->lobe, Lobe::kSpecularReflection);
+    EXPECT_NEAR(glm::length(r->wi - glm::vec3(-wo.x, -wo.y, wo.z)), 0.0f, 1e-6f);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(r->weight[ch], fresnel_complex(wo.z, c.eta[ch], c.k[ch]), 1e-6f);
+    EXPECT_EQ(bsdf::component_probability(c, wo, kUp, 0, Lobe::kSpecularReflection), 1.0f);
+    EXPECT_EQ(bsdf::eval(c, wo, glm::vec3(-wo.x, -wo.y, wo.z), kUp), glm::vec3(0.0f));
+  }
+  EXPECT_FALSE(bsdf::has_finite_component(c));
+  EXPECT_TRUE(bsdf::has_finite_component(gold(0.1f, 0.1f)));
+}
+
+// pbrt-v4's thin dielectric: reflect with R' = R + T²R / (1 − R²), else pass straight through;
+// both S, both of weight 1 (nothing absorbed).
+TEST(ThinDielectric, ReflectsWithTheSlabsReflectanceAndPassesStraightThrough) {
+  const ThinDielectric t{1.5f, glm::vec3(1.0f)};
+  EXPECT_EQ(letter_of(t), kS);
+  for (double theta : {0.0, 50.0, 85.0}) {
+    const glm::vec3 wo = polar(theta, 200.0);
+    const float r = fresnel_dielectric(wo.z, 1.5f);
+    const float r_slab = r + (1 - r) * (1 - r) * r / (1 - r * r);
+    EXPECT_NEAR(bsdf::component_probability(t, wo, kUp, 0, Lobe::kSpecularReflection), r_slab, 1e-6f);
+    EXPECT_NEAR(bsdf::component_probability(t, wo, kUp, 0, Lobe::kSpecularTransmission), 1 - r_slab, 1e-6f);
+    const auto refl = bsdf::sample(t, wo, kUp, kUp, r_slab * 0.5f, glm::vec2(0.5f), TransportMode::kRadiance);
+    const auto pass = bsdf::sample(t, wo, kUp, kUp, r_slab + 0.5f * (1 - r_slab), glm::vec2(0.5f), TransportMode::kRadiance);
+    ASSERT_TRUE(refl && pass);
+    EXPECT_EQ(refl->lobe, Lobe::kSpecularReflection);
+    EXPECT_EQ(pass->lobe, Lobe::kSpecularTransmission);
+    EXPECT_EQ(refl->letter, kS);
+    EXPECT_EQ(pass->letter, kS);
+    EXPECT_EQ(pass->wi, -wo);
+    EXPECT_EQ(pass->weight, glm::vec3(1.0f));
+    EXPECT_EQ(refl->weight, glm::vec3(1.0f));
+    EXPECT_EQ(pass->eta, 1.0f);
+  }
+}
+
+// Diffuse transmission: each sample's weight is R / p_r or T / (1 − p_r), so the albedo is
+// exactly R + T; reflection and transmission are both D; 0.5 + 0.5 loses nothing.
+TEST(DiffuseTransmission, AlbedoIsReflectancePlusTransmittance) {
+  const DiffuseTransmission d{glm::vec3(0.5f), glm::vec3(0.5f)};
+  EXPECT_EQ(letter_of(d), kD);
+  for (const glm::vec3& wo : incident_directions()) {
+    const Estimate a = albedo_by_sampling(d, wo, kUp, 9, 10'000);
+    EXPECT_NEAR(a.mean, 1.0, 1e-6);
+  }
+  EXPECT_NEAR(bsdf::eval(d, kUp, -kUp, kUp).x, 0.5f / kPiD, 1e-7);
+  EXPECT_NEAR(bsdf::eval(d, kUp, kUp, kUp).x, 0.5f / kPiD, 1e-7);
+}
+
+// The letters the checker sees (letters_of): a mixture's are the union of its components'.
+TEST(MaterialsLetters, EachKindAndAMixture) {
+  const LetterMask d = 1u << kD, s = 1u << kS;
+  EXPECT_EQ(letters_of(gold(0.0f, 0.0f)), s);
+  EXPECT_EQ(letters_of(gold(0.2f, 0.2f)), d);
+  EXPECT_EQ(letters_of(RoughDielectric{}), d);
+  EXPECT_EQ(letters_of(ThinDielectric{}), s);
+  EXPECT_EQ(letters_of(DiffuseTransmission{}), d);
+  Mixture mix;
+  mix.components = {{0.5f, ThinDielectric{}}, {0.5f, DiffuseTransmission{}}};
+  EXPECT_EQ(letters_of(mix), d | s);
+}
+
+// What numbers_read() says a kind does not read, sample() does not read (bit for bit).
+TEST(MaterialsSample, IgnoresTheNumbersItDoesNotRead) {
+  const std::vector<Material> kinds = {gold(0.0f, 0.0f), gold(0.2f, 0.3f), RoughDielectric{}, ThinDielectric{},
+                                       DiffuseTransmission{}};
+  const glm::vec3 wo = polar(35.0, 60.0);
+  for (const Material& m : kinds) {
+    const bsdf::NumbersRead reads = bsdf::numbers_read(m);
+    for (int i = 0; i < 200; ++i) {
+      Sampler s(3, 0, static_cast<std::uint64_t>(i));
+      const float uc = s.get1d();
+      const glm::vec2 u = s.get2d();
+      const auto a = bsdf::sample(m, wo, kUp, kUp, uc, u, TransportMode::kRadiance);
+      const auto b = bsdf::sample(m, wo, kUp, kUp, reads.component ? uc : 0.123f, reads.direction ? u : glm::vec2(0.9f, 0.4f),
+                                  TransportMode::kRadiance);
+      ASSERT_EQ(a.has_value(), b.has_value());
+      if (a) {
+        EXPECT_EQ(a->wi, b->wi);
+        EXPECT_EQ(a->weight, b->weight);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pathex
