@@ -122,7 +122,7 @@ std::optional<Error> check_light_value(glm::vec3 v, const Location& at) {
 namespace {
 
 // A basic material's kind and parameters, as a key: equal keys are the same material.
-using MaterialKey = std::array<float, 5>;
+using MaterialKey = std::array<float, 13>;
 MaterialKey key_of(const BasicMaterial& m) {
   return std::visit(
       [&](const auto& k) -> MaterialKey {
@@ -131,6 +131,9 @@ MaterialKey key_of(const BasicMaterial& m) {
         if constexpr (std::is_same_v<T, Diffuse>) return {kind, k.albedo.x, k.albedo.y, k.albedo.z, 0.0f};
         else if constexpr (std::is_same_v<T, Mirror>) return {kind, k.reflectance.x, k.reflectance.y, k.reflectance.z, 0.0f};
         else if constexpr (std::is_same_v<T, Dielectric>) return {kind, k.tint.x, k.tint.y, k.tint.z, k.ior};
+        else if constexpr (std::is_same_v<T, CoatedDiffuse>)
+          return {kind, k.reflectance.x, k.reflectance.y, k.reflectance.z, k.roughness, k.albedo.x, k.albedo.y, k.albedo.z,
+                  k.eta, k.thickness, k.g, static_cast<float>(k.max_depth), static_cast<float>(k.samples)};
         else return {kind, k.reflectance.x, k.reflectance.y, k.reflectance.z, k.roughness};
       },
       m);

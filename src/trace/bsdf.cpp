@@ -10,6 +10,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "trace/bsdf_layered.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
 
@@ -129,6 +130,8 @@ glm::vec3 eval_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec
           return k.albedo * kInvPi;
         } else if constexpr (is<Glossy, decltype(k)>) {
           return ggx_eval(k, wo, wi);
+        } else if constexpr (is<CoatedDiffuse, decltype(k)>) {
+          return layered::eval(k, wo, wi);
         } else {
           return glm::vec3(0.0f);  // deltas: nothing for a generic wi
         }
@@ -143,6 +146,8 @@ float pdf_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec3& wi
           return cosine_hemisphere_pdf(wi.z);
         } else if constexpr (is<Glossy, decltype(k)>) {
           return ggx_pdf(k, wo, wi);
+        } else if constexpr (is<CoatedDiffuse, decltype(k)>) {
+          return layered::pdf(k, wo, wi);
         } else {
           return 0.0f;
         }
@@ -221,6 +226,8 @@ float delta_probability(const BasicMaterial& m, const glm::vec3& wo, const glm::
     return 0.0f;
   }
   if (std::holds_alternative<Mirror>(m)) return lobe == Lobe::kSpecularReflection ? 1.0f : 0.0f;
+  if (const auto* coat = std::get_if<CoatedDiffuse>(&m))
+    return lobe == Lobe::kSpecularReflection ? layered::specular_probability(*coat, glm::dot(wo, ns)) : 0.0f;
   return 0.0f;
 }
 
@@ -347,6 +354,8 @@ std::optional<BsdfSample> detail::sample_general(const Material& m, const glm::v
   const std::optional<Pick> chosen = pick(m, u_component, &storage);
   if (!chosen) return std::nullopt;
   const BasicMaterial& c = *chosen->material;
+  if (const auto* coat = std::get_if<CoatedDiffuse>(&c))  // its own walk (trace/bsdf_layered.h)
+    return layered::sample_world(m, *coat, chosen->index, chosen->probability, chosen->weight, wo, ns, ng, chosen->u, u);
 
   BsdfSample s;
   s.component = chosen->index;
@@ -425,7 +434,7 @@ bool has_finite_component(const Material& m) {
       if (usable_weight(c.weight) > 0.0f && !is_delta_kind(c.material)) return true;
     return false;
   }
-  return std::holds_alternative<Diffuse>(m) || std::holds_alternative<Glossy>(m);
+  return std::holds_alternative<Diffuse>(m) || std::holds_alternative<Glossy>(m) || std::holds_alternative<CoatedDiffuse>(m);
 }
 
 float shading_normal_correction(const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
