@@ -951,7 +951,7 @@ TEST(CoatedDiffuse, AThinCoatIsTheFresnelWeightedLambertianSeries) {
         const double t_o = 1.0 - fresnel_exact(wo.z, eta), t_i = 1.0 - fresnel_exact(wi.z, eta);
         const double f = t_o * t_i * rho / (kPiD * eta * eta) * series(rho * r_bar, k);
         Accumulator ef, ep;
-        for (std::uint64_t key = 0; key < 4000; ++key) {
+        for (std::uint64_t key = 0; key < 2000; ++key) {
           ef.add(bsdf::layered::eval_estimate(m, wo, wi, key).x);
           if (rho == 1.0f) ep.add(bsdf::layered::pdf_estimate(m, wo, wi, key));
         }
@@ -967,7 +967,7 @@ TEST(CoatedDiffuse, AThinCoatIsTheFresnelWeightedLambertianSeries) {
         const glm::vec3 wo = polar(to);
         const double r_o = fresnel_exact(wo.z, eta);
         const double albedo = r_o + (1.0 - r_o) * rho * (1.0 - r_bar) * series(rho * r_bar, k);
-        const Estimate a = albedo_by_sampling(m, wo, kUp, 7, 200'000);
+        const Estimate a = albedo_by_sampling(m, wo, kUp, 7, 50'000);
         EXPECT_NEAR(a.mean, albedo, kZ * a.se + 1e-6) << "albedo, depth " << depth << " rho " << rho << " at " << to;
       }
     }
