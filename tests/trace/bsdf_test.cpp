@@ -1206,5 +1206,73 @@ TEST(CoatedDiffuse, ASmoothCoatReflectsAsSAndTheRestIsD) {
   }
 }
 
+// A measurement, not a test (disabled; run with --gtest_also_run_disabled_tests): the directional
+// albedo of Mitsuba 3's roughplastic, recomputed from the formulas of its roughplastic.cpp (GGX,
+// separable Smith G; the diffuse lobe ρ / (1 − R̄_int) · t(θi) t(θo) / (π η²) with t = 1 − the rough
+// reflection's albedo and R̄_int the internal one, on 64 cosines), against the coat of thickness 0
+// that the importer makes of it. README's import table quotes these differences.
+double mi_lambda(const glm::dvec3& w, double a) { const double z = w.z, r2 = w.x * w.x + w.y * w.y; return (std::sqrt(1 + a * a * r2 / (z * z)) - 1) / 2; }
+double mi_g1(const glm::dvec3& w, double a) { return 1 / (1 + mi_lambda(w, a)); }
+glm::dvec3 mi_vndf(const glm::dvec3& wo, double a, glm::vec2 u) {
+  glm::dvec3 vh = glm::normalize(glm::dvec3(a * wo.x, a * wo.y, wo.z));
+  const double lensq = vh.x * vh.x + vh.y * vh.y;
+  const glm::dvec3 t1 = lensq > 0 ? glm::dvec3(-vh.y, vh.x, 0) / std::sqrt(lensq) : glm::dvec3(1, 0, 0);
+  const glm::dvec3 t2 = glm::cross(vh, t1);
+  const double r = std::sqrt(u.x), phi = 2 * kPiD * u.y;
+  const double p1 = r * std::cos(phi);
+  double p2 = r * std::sin(phi);
+  const double s = 0.5 * (1 + vh.z);
+  p2 = (1 - s) * std::sqrt(std::max(0.0, 1 - p1 * p1)) + s * p2;
+  const glm::dvec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1 - p1 * p1 - p2 * p2)) * vh;
+  return glm::normalize(glm::dvec3(a * nh.x, a * nh.y, std::max(nh.z, 1e-9)));
+}
+double mi_spec_albedo(double mu, double a, double eta, int n, std::uint64_t seed) {
+  const glm::dvec3 wo(std::sqrt(1 - mu * mu), 0, mu);
+  double sum = 0;
+  for (int i = 0; i < n; ++i) {
+    Sampler s(seed, 9, static_cast<std::uint64_t>(i));
+    const glm::dvec3 m = mi_vndf(wo, a, s.get2d());
+    const double d = glm::dot(wo, m);
+    const glm::dvec3 wi = 2 * d * m - wo;
+    if (wi.z <= 0) continue;
+    sum += fresnel_exact(d, eta) * mi_g1(wi, a);
+  }
+  return sum / n;
+}
+TEST(CoatedDiffuse, DISABLED_MeasureRoughPlasticAgainstMitsubasFormulas) {
+  const double eta = 1.49 / 1.000277;
+  for (double a : {0.1, 0.3}) {
+    const int nm = 64;
+    std::vector<double> t(nm);
+    double rint = 0, integ = 0;
+    for (int i = 0; i < nm; ++i) {
+      const double mu = (i + 0.5) / nm;
+      t[static_cast<std::size_t>(i)] = 1 - mi_spec_albedo(mu, a, eta, 20000, 1);
+      rint += 2 * mu * mi_spec_albedo(mu, a, 1 / eta, 20000, 2) / nm;
+      integ += 2 * mu * t[static_cast<std::size_t>(i)] / nm / (eta * eta);
+    }
+    for (double rho : {0.5, 1.0}) {
+      for (double mu0 : {0.999, 0.5}) {
+        const double spec = mi_spec_albedo(mu0, a, eta, 200000, 3);
+        const double ti = 1 - mi_spec_albedo(mu0, a, eta, 200000, 4);
+        const double mitsuba = spec + rho / (1 - rint) * ti * integ;
+        const float rbar = bsdf::layered::mean_internal_reflectance(static_cast<float>(eta));
+        CoatedDiffuse c = coated(static_cast<float>(a), glm::vec3(static_cast<float>(rho / (1 - rbar + rho * rbar))), 0.0f, glm::vec3(0.0f), 0.0f, 64);
+        c.eta = static_cast<float>(eta);
+        const glm::vec3 wo(static_cast<float>(std::sqrt(1 - mu0 * mu0)), 0.0f, static_cast<float>(mu0));
+        Accumulator acc;
+        for (int k = 0; k < 400000; ++k) {
+          Sampler s(5, 1, static_cast<std::uint64_t>(k));
+          const float uc = s.get1d();
+          const auto r = bsdf::layered::sample(c, wo, uc, s.get2d());
+          acc.add(r ? r->weight.x : 0.0);
+        }
+        std::printf("alpha %.1f rho %.1f mu %.3f: mitsuba %.4f (spec %.4f, Rint %.4f) pathex %.4f +- %.4f  diff %+.2f%%\n", a, rho, mu0, mitsuba, spec, rint,
+                    acc.estimate().mean, acc.estimate().se, 100 * (acc.estimate().mean / mitsuba - 1));
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pathex
