@@ -86,8 +86,30 @@ struct DiffuseTransmission {
   glm::vec3 transmittance{0.25f};
 };
 
+
+// pbrt-v4's coateddiffuse (trace/bsdf_layered.h): a dielectric coat over a Lambertian base with a
+// homogeneous layer between (σ_t = 1 per unit thickness), evaluated and sampled by pbrt-v4's
+// stochastic random walk between the two interfaces. Letters: a smooth coat (roughness < 1e-3)
+// reflects as a Dirac delta, S, and everything that passes it is D; a rough coat is D only.
+struct CoatedDiffuse {
+  glm::vec3 reflectance{0.5f};  // the base's Lambertian reflectance in [0, 1]
+  glm::vec3 albedo{0.0f};       // the layer medium's single-scattering albedo in [0, 1]
+  float roughness = 0.0f;       // the coat's GGX alpha (pbrt's roughness after remapping); < 1e-3 is smooth
+  float eta = 1.5f;             // the coat's index (inside / outside), valid_ior()
+  float thickness = 0.01f;      // the layer's optical thickness (σ_t = 1), >= 0
+  float g = 0.0f;               // Henyey–Greenstein asymmetry of the medium in (-1, 1)
+  int max_depth = 10;           // scattering events of one walk, at least 1
+  int samples = 1;              // walks per eval() and pdf() estimate, at least 1
+  bool smooth() const { return roughness < 1e-3f; }
+};
+
+// The largest walk length and walk count a coat may ask for (every format): each eval() and pdf()
+// costs up to samples × max_depth steps.
+inline constexpr int kMaxCoatDepth = 10000;
+inline constexpr int kMaxCoatSamples = 1024;
+
 using BasicMaterial = std::variant<Diffuse, Mirror, Dielectric, Glossy, Conductor, RoughDielectric, ThinDielectric,
-                                   DiffuseTransmission>;
+                                   DiffuseTransmission, CoatedDiffuse>;
 
 // A weighted sum of basic components: 0.5 diffuse + 0.1 mirror, the remaining 0.4 absorbed.
 // Weights are non-negative and sum to at most 1.
@@ -100,17 +122,20 @@ struct Mixture {
 };
 
 using Material = std::variant<Diffuse, Mirror, Dielectric, Glossy, Mixture, Conductor, RoughDielectric, ThinDielectric,
-                              DiffuseTransmission>;
+                              DiffuseTransmission, CoatedDiffuse>;
 
-// The letter a basic material gives to a vertex: D for finite BSDFs, S for Dirac deltas.
+// The letters a basic material can give to a vertex (bit per letter): D for finite BSDFs, S for
+// Dirac deltas, both for a smooth coat (its reflection is S, what passes it D). A sampled vertex
+// gets the letter of the sampled event (BsdfSample::letter).
 // Diffuse, Glossy, RoughDielectric, DiffuseTransmission: D. Mirror, Dielectric, ThinDielectric: S.
-// Conductor: S when smooth, else D.
-inline Letter letter_of(const BasicMaterial& m) {
-  if (const auto* c = std::get_if<Conductor>(&m)) return c->smooth() ? kS : kD;
-  return std::holds_alternative<Mirror>(m) || std::holds_alternative<Dielectric>(m) ||
-                 std::holds_alternative<ThinDielectric>(m)
-             ? kS
-             : kD;
+// Conductor: S when smooth, else D. CoatedDiffuse: S and D when smooth, else D.
+inline LetterMask letters_of(const BasicMaterial& m) {
+  constexpr auto kOnlyS = static_cast<LetterMask>(1u << kS), kOnlyD = static_cast<LetterMask>(1u << kD);
+  if (const auto* coat = std::get_if<CoatedDiffuse>(&m)) return coat->smooth() ? static_cast<LetterMask>(kOnlyS | kOnlyD) : kOnlyD;
+  if (const auto* c = std::get_if<Conductor>(&m)) return c->smooth() ? kOnlyS : kOnlyD;
+  return std::holds_alternative<Mirror>(m) || std::holds_alternative<Dielectric>(m) || std::holds_alternative<ThinDielectric>(m)
+             ? kOnlyS
+             : kOnlyD;
 }
 
 // The letters a material can give (bit per letter), the union over a mixture's components.
@@ -120,10 +145,10 @@ inline LetterMask letters_of(const Material& m) {
         if constexpr (std::is_same_v<std::decay_t<decltype(k)>, Mixture>) {
           LetterMask out = 0;
           for (const auto& c : k.components)
-            if (c.weight > 0.0f) out = static_cast<LetterMask>(out | (1u << letter_of(c.material)));
+            if (c.weight > 0.0f) out = static_cast<LetterMask>(out | letters_of(c.material));
           return out;
         } else {
-          return static_cast<LetterMask>(1u << letter_of(BasicMaterial{k}));
+          return letters_of(BasicMaterial{k});
         }
       },
       m);

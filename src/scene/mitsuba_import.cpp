@@ -22,6 +22,7 @@
 #include "scene/import_common.h"
 #include "scene/serialized.h"
 #include "scene/metal_spectra.h"
+#include "trace/bsdf_layered.h"  // the coat's internal reflectance, for plastic
 
 namespace pathex {
 namespace {
@@ -390,6 +391,32 @@ class Importer {
     if (auto e = materials_budget_.charge(m, where(n))) return *e;
     return m;
   }
+  // int_ior / ext_ior (numbers or Mitsuba's named indices), within valid_ior().
+  Result<double> relative_ior(Props& p, pugi::xml_node n, double int_default) {
+    double ior[2] = {int_default, 1.000277};
+    const char* names[2] = {"int_ior", "ext_ior"};
+    for (int i = 0; i < 2; ++i) {
+      pugi::xml_node q = p.find(names[i]);
+      if (!q) continue;
+      if (std::string(q.name()) == "string") {
+        MI_TRY(s, attr(q, "value"));
+        std::optional<double> v = named_ior(s);
+        if (!v) return located(where(q), "unknown index of refraction \"" + excerpt(s) + "\"");
+        ior[i] = *v;
+      } else {
+        MI_TRY(v, p.number(names[i], ior[i]));
+        ior[i] = v;
+      }
+    }
+    const double eta = ior[0] / ior[1];
+    if (!valid_ior(eta)) {
+      std::ostringstream found;
+      found << eta;
+      return located(where(n), std::string("int_ior / ext_ior must be ") + kValidIor + ", found " + found.str());
+    }
+    return eta;
+  }
+
   Result<Material> make_bsdf(pugi::xml_node n, int depth) {
     if (depth > options_.max_scene_depth) {
       Error e = located(where(n), limit_message("the nesting of materials", static_cast<std::size_t>(options_.max_scene_depth), "levels",
@@ -455,30 +482,10 @@ class Importer {
       m = c;
     } else if (type == "dielectric" || type == "roughdielectric" || type == "thindielectric") {
       // letters: S (dielectric, thindielectric), D (roughdielectric, alpha at least 1e-3)
-      double ior[2] = {1.5046, 1.000277};
-      const char* names[2] = {"int_ior", "ext_ior"};
-      for (int i = 0; i < 2; ++i) {
-        pugi::xml_node q = p.find(names[i]);
-        if (!q) continue;
-        if (std::string(q.name()) == "string") {
-          MI_TRY(s, attr(q, "value"));
-          std::optional<double> v = named_ior(s);
-          if (!v) return located(where(q), "unknown index of refraction \"" + excerpt(s) + "\"");
-          ior[i] = *v;
-        } else {
-          MI_TRY(v, p.number(names[i], ior[i]));
-          ior[i] = v;
-        }
-      }
+      MI_TRY(eta, relative_ior(p, n, 1.5046));
       MI_TRY(refl, p.color("specular_reflectance", vec3(1.0f)));
       MI_TRY(trans, p.color("specular_transmittance", vec3(1.0f)));
       if (refl != trans) return located(where(n), "different specular_reflectance and specular_transmittance are not supported: pathex's dielectric has one tint");
-      const double eta = ior[0] / ior[1];
-      if (!valid_ior(eta)) {
-        std::ostringstream found;
-        found << eta;
-        return located(where(n), std::string("int_ior / ext_ior must be ") + kValidIor + ", found " + found.str());
-      }
       if (type == "thindielectric") {
         m = ThinDielectric{static_cast<float>(eta), refl};
       } else if (type == "roughdielectric") {
@@ -491,6 +498,31 @@ class Importer {
     } else if (type == "principled" || type == "principledthin") {
       return located(where(n), "bsdf \"" + type + "\" is not supported: it needs the Disney principled BSDF (sheen, clearcoat, "
                                "specular transmission and their blend), which pathex does not have");
+    } else if (type == "plastic" || type == "roughplastic") {
+      // Mitsuba's plastic as pbrt-v4's coateddiffuse with a coat of thickness 0 (README import
+      // table): the same Fresnel-weighted coat over a Lambertian base with its internal
+      // reflections. Mitsuba's default (nonlinear false) makes diffuse_reflectance the albedo under
+      // the coat, ρ T(θo); the base that gives it is ρ / (1 − R̄ + ρ R̄) (R̄ the coat's internal
+      // reflectance), which the walk's series ρ' (1 − R̄) / (1 − ρ' R̄) returns to ρ.
+      MI_TRY(eta, relative_ior(p, n, 1.49));
+      MI_TRY(spec, p.color("specular_reflectance", vec3(1.0f)));
+      if (spec != vec3(1.0f)) return located(where(p.find("specular_reflectance")), "specular_reflectance other than 1 is not supported: pathex's coat reflects by the Fresnel equations alone");
+      MI_TRY(rho, p.color("diffuse_reflectance", vec3(0.5f)));
+      if (glm::any(glm::lessThan(rho, vec3(0.0f))) || glm::any(glm::greaterThan(rho, vec3(1.0f))))
+        return located(where(p.find("diffuse_reflectance")), "diffuse_reflectance must be within [0, 1]");
+      MI_TRY(nonlinear, p.boolean("nonlinear", false));
+      CoatedDiffuse c;
+      c.eta = static_cast<float>(eta);
+      c.thickness = 0.0f;
+      c.max_depth = 64;  // (ρ R̄)^32 < 1e-7 of the series is left out
+      if (type == "roughplastic") {
+        MI_TRY(a, mitsuba_alphas(p, n));
+        if (a.x != a.y) return located(where(n), "an anisotropic coat (alpha_u unlike alpha_v) is not supported: pathex's coat is isotropic");
+        c.roughness = a.x < kSmoothAlpha ? 0.0f : a.x;
+      }
+      const float r_bar = bsdf::layered::mean_internal_reflectance(c.eta);
+      c.reflectance = nonlinear ? rho : rho / (1.0f - r_bar + rho * r_bar);
+      m = c;
     } else if (type == "blendbsdf") {
       MI_TRY(w, p.number("weight", 0.5));
       if (w < 0 || w > 1) return located(where(n), "weight must be within [0, 1]");
@@ -501,7 +533,7 @@ class Importer {
       m = import::blend(a, b, static_cast<float>(w));
     } else {
       return located(where(n), "bsdf \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, "
-                               "roughdielectric (ggx), thindielectric, blendbsdf or twosided");
+                               "roughdielectric (ggx), thindielectric, plastic, roughplastic (ggx), blendbsdf or twosided");
     }
     if (auto e = p.unused()) return *e;
     return m;

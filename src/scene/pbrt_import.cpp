@@ -755,6 +755,42 @@ class Importer {
     if (type == "hair")
       return located(at, "material \"hair\" is not supported: it needs pbrt-v4's hair BSDF on curve shapes, which pathex "
                          "does not have");
+    if (type == "coateddiffuse") {  // pbrt-v4's layered model (trace/bsdf_layered.h), its defaults
+      CoatedDiffuse c;
+      PBRT_TRY(r, ps.rgb("reflectance", vec3(0.5f), true));
+      if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
+        return located(ps.find("reflectance")->at, "coateddiffuse reflectance must be within [0, 1]");
+      PBRT_TRY(albedo, ps.rgb("albedo", vec3(0.0f), true));
+      if (glm::any(glm::lessThan(albedo, vec3(0.0f))) || glm::any(glm::greaterThan(albedo, vec3(1.0f))))
+        return located(ps.find("albedo")->at, "coateddiffuse albedo must be within [0, 1]");
+      Param* eta_p = ps.find("eta");
+      if (eta_p && eta_p->type != "float")
+        return located(eta_p->at, "parameter \"" + eta_p->type + " eta\" is not supported: give \"float eta\" (pathex's coat has one index)");
+      PBRT_TRY(eta, ps.number("eta", 1.5));
+      if (!valid_ior(eta)) return located(eta_p ? eta_p->at : at, std::string("coateddiffuse eta must be ") + kValidIor + ", found " + fmt_number(eta));
+      PBRT_TRY(a2, alphas(ps, at, "coateddiffuse"));
+      if (a2.x != a2.y) return located(at, "anisotropic roughness (uroughness != vroughness) is not supported");
+      const float a = a2.x;
+      PBRT_TRY(thickness, ps.number("thickness", 0.01));
+      if (!(thickness >= 0.0 && thickness <= 1e6)) return located(ps.find("thickness")->at, "coateddiffuse thickness must be within [0, 1e6]");
+      PBRT_TRY(g, ps.number("g", 0.0));
+      if (!(g > -1.0 && g < 1.0)) return located(ps.find("g")->at, "coateddiffuse g must be within (-1, 1)");
+      PBRT_TRY(depth, ps.integer("maxdepth", 10));
+      if (depth < 1 || depth > kMaxCoatDepth)
+        return located(ps.find("maxdepth")->at, "coateddiffuse maxdepth must be within [1, " + std::to_string(kMaxCoatDepth) + "]");
+      PBRT_TRY(samples, ps.integer("nsamples", 1));
+      if (samples < 1 || samples > kMaxCoatSamples)
+        return located(ps.find("nsamples")->at, "coateddiffuse nsamples must be within [1, " + std::to_string(kMaxCoatSamples) + "]");
+      c.reflectance = r;
+      c.albedo = albedo;
+      c.roughness = a < 1e-3f ? 0.0f : a;  // pbrt treats alpha < 1e-3 as smooth
+      c.eta = static_cast<float>(eta);
+      c.thickness = static_cast<float>(thickness);
+      c.g = static_cast<float>(std::clamp(g, -0.999, 0.999));
+      c.max_depth = depth;
+      c.samples = samples;
+      return Material{c};
+    }
     if (type == "mix") {
       Param* m = ps.find("materials");
       if (!m || m->type != "string" || m->strings.size() != 2) return located(m ? m->at : at, "mix needs \"string materials\" [\"a\" \"b\"]");
@@ -771,7 +807,7 @@ class Importer {
       }
       return import::blend(parts[0], parts[1], static_cast<float>(amount));
     }
-    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, dielectric, "
+    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, coateddiffuse, conductor, dielectric, "
                        "thindielectric, diffusetransmission, interface or mix");
   }
 

@@ -97,7 +97,7 @@ Result<glm::vec2> read_alphas(const Reader& r, const json& j, const std::string&
 }
 
 // `component`: inside a mixture, where only basic materials are allowed.
-const std::string kBasicTypes = "diffuse, mirror, dielectric, glossy, conductor, thin_dielectric or diffuse_transmission";
+const std::string kBasicTypes = "diffuse, mirror, dielectric, glossy, conductor, thin_dielectric, diffuse_transmission, coateddiffuse";
 
 Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::string& ptr, bool component) {
   PATHEX_TRY(type, r.string(j, "type", ptr));
@@ -163,6 +163,31 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     if (const float hi = max_component(refl); hi > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1], found " + Reader::fmt(hi));
     PATHEX_TRY(rough, r.number(j, "roughness", ptr, 1e-4, 1.0, 0.2));
     return BasicMaterial{Glossy{refl, static_cast<float>(rough)}};
+  }
+  if (type == "coateddiffuse") {  // pbrt-v4's layered coateddiffuse (scene/material.h CoatedDiffuse)
+    if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness", "eta", "thickness", "albedo", "g", "max_depth", "samples"}); !k)
+      return k.error();
+    CoatedDiffuse c;
+    PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(0.5f), true));
+    if (const float hi = max_component(refl); hi > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1], found " + Reader::fmt(hi));
+    PATHEX_TRY(albedo, r.vector3(j, "albedo", ptr, false, vec3(0.0f), true));
+    if (const float hi = max_component(albedo); hi > 1.0f) return r.fail(ptr + "/albedo", "expected values in [0, 1], found " + Reader::fmt(hi));
+    PATHEX_TRY(rough, r.number(j, "roughness", ptr, 0.0, 1.0, 0.0));
+    PATHEX_TRY(eta, r.number(j, "eta", ptr, -1e30, 1e30, 1.5));
+    if (!valid_ior(eta)) return r.fail(ptr + "/eta", std::string("expected an index of refraction ") + kValidIor + ", found " + Reader::fmt(eta));
+    PATHEX_TRY(thickness, r.number(j, "thickness", ptr, 0.0, 1e6, 0.01));
+    PATHEX_TRY(g, r.number(j, "g", ptr, -0.999, 0.999, 0.0));
+    PATHEX_TRY(depth, r.integer(j, "max_depth", ptr, 1, kMaxCoatDepth, 10));
+    PATHEX_TRY(samples, r.integer(j, "samples", ptr, 1, kMaxCoatSamples, 1));
+    c.reflectance = refl;
+    c.albedo = albedo;
+    c.roughness = static_cast<float>(rough);
+    c.eta = static_cast<float>(eta);
+    c.thickness = static_cast<float>(thickness);
+    c.g = static_cast<float>(g);
+    c.max_depth = static_cast<int>(depth);
+    c.samples = static_cast<int>(samples);
+    return BasicMaterial{c};
   }
   if (component)
     return r.fail(ptr + "/type", "material type '" + type + "' cannot be a mixture's component, expected " + kBasicTypes);

@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "trace/bsdf_kinds.h"
+#include "trace/bsdf_layered.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
 
@@ -20,7 +21,8 @@ namespace {
 template <class T, class V>
 constexpr bool is = std::is_same_v<std::decay_t<V>, T>;
 
-bool is_delta_kind(const BasicMaterial& m) { return letter_of(m) == kS; }
+// A kind that is only Dirac deltas (a smooth coat is not: what passes it is finite).
+bool is_delta_kind(const BasicMaterial& m) { return letters_of(m) == static_cast<LetterMask>(1u << kS); }
 
 bool finite_vec(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -99,6 +101,8 @@ glm::vec3 eval_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec
           return kinds::rough_dielectric_eval(k, far_eta(k.ior, inside), wo, wi, mode);
         } else if constexpr (is<DiffuseTransmission, decltype(k)>) {
           return kinds::diffuse_transmission_eval(k, wo, wi);
+        } else if constexpr (is<CoatedDiffuse, decltype(k)>) {
+          return wi.z > 0.0f ? layered::eval(k, wo, wi) : glm::vec3(0.0f);  // a coat over an opaque base reflects only
         } else {
           return glm::vec3(0.0f);  // deltas: nothing for a generic wi
         }
@@ -119,6 +123,8 @@ float pdf_basic(const BasicMaterial& m, const glm::vec3& wo, const glm::vec3& wi
           return kinds::rough_dielectric_pdf(k, far_eta(k.ior, inside), wo, wi);
         } else if constexpr (is<DiffuseTransmission, decltype(k)>) {
           return kinds::diffuse_transmission_pdf(k, wo, wi);
+        } else if constexpr (is<CoatedDiffuse, decltype(k)>) {
+          return wi.z > 0.0f ? layered::pdf(k, wo, wi) : 0.0f;
         } else {
           return 0.0f;
         }
@@ -216,6 +222,8 @@ float delta_probability(const BasicMaterial& m, const glm::vec3& wo, const glm::
     return 0.0f;
   }
   if (std::holds_alternative<Mirror>(m) || is_delta_kind(m)) return lobe == Lobe::kSpecularReflection ? 1.0f : 0.0f;
+  if (const auto* coat = std::get_if<CoatedDiffuse>(&m))
+    return lobe == Lobe::kSpecularReflection ? layered::specular_probability(*coat, glm::dot(wo, ns)) : 0.0f;
   return 0.0f;
 }
 
@@ -330,6 +338,8 @@ std::optional<BsdfSample> detail::sample_general(const Material& m, const glm::v
   const std::optional<Pick> chosen = pick(m, u_component, &storage);
   if (!chosen) return std::nullopt;
   const BasicMaterial& c = *chosen->material;
+  if (const auto* coat = std::get_if<CoatedDiffuse>(&c))  // its own walk (trace/bsdf_layered.h)
+    return layered::sample_world(m, *coat, chosen->index, chosen->probability, chosen->weight, wo, ns, ng, chosen->u, u);
 
   BsdfSample s;
   s.component = chosen->index;

@@ -36,6 +36,12 @@
 // D either way, since every finite kind is D. For a delta component f = w_j f_j and pdf =
 // (w_j / W) · p_j. The sampled vertex's letter is the chosen component's (DESIGN §7 "Labelling").
 //
+// Layered coats (CoatedDiffuse, trace/bsdf_layered.h): eval() and pdf() are Monte Carlo estimates
+// from walks keyed by a hash of the directions, so still pure functions of material and
+// directions, reciprocal in expectation rather than bit for bit; a smooth coat's reflection is a
+// delta like a mirror's (letter S), the rest is D. A finite coated sample carries f == eval() and
+// pdf == pdf() as above, but its weight is the walk's own unbiased product, not f·|cos θi|/pdf.
+//
 // Radiance and importance (Veach §5.2). Refraction compresses radiance by (η_wo / η_wi)^2 but not
 // importance: in TransportMode::kRadiance (eye subpaths: wo towards the camera) the transmitted f
 // carries 1/η'^2 with η' = η_wi / η_wo; in kImportance (light subpaths) it does not. So eval() of
@@ -142,8 +148,8 @@ float pdf_general(const Material& m, const glm::vec3& wo, const glm::vec3& wi, c
 }  // namespace detail
 
 // The BSDF summed over the finite components, weighted by the mixture weights. Reflection is
-// reciprocal: eval(wo, wi) == eval(wi, wo) bit for bit. `mode` matters only for a rough
-// dielectric's transmission (see "Radiance and importance").
+// reciprocal: eval(wo, wi) == eval(wi, wo) bit for bit (a layered coat's: in expectation, see
+// above). `mode` matters only for a rough dielectric's transmission (see "Radiance and importance").
 inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& ns,
                       const glm::vec3& ng, TransportMode mode = TransportMode::kRadiance) {
   if (const auto* lambert = std::get_if<Diffuse>(&m)) {

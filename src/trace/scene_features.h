@@ -22,7 +22,7 @@
 namespace pathex {
 
 struct SceneFeatures {
-  bool specular = true;      // some material has a Dirac lobe (mirror, dielectric) of nonzero weight
+  bool specular = true;      // some material has a Dirac lobe (mirror, dielectric, smooth coat) of nonzero weight
   bool transmission = true;  // some material has a dielectric (refracting) lobe, smooth or rough, of nonzero weight
   bool operator==(const SceneFeatures&) const = default;
 };
@@ -32,7 +32,7 @@ inline SceneFeatures scene_features(const std::vector<const Material*>& material
   SceneFeatures f{false, false};
   const auto add = [&f](const BasicMaterial& m, float weight) {
     if (!(weight > 0.0f)) return;
-    f.specular = f.specular || letter_of(m) == kS;
+    f.specular = f.specular || (letters_of(m) & (1u << kS)) != 0;
     f.transmission = f.transmission || std::holds_alternative<Dielectric>(m) || std::holds_alternative<RoughDielectric>(m);
   };
   for (const Material* m : materials) {
