@@ -592,6 +592,26 @@ class Importer {
       if (auto bad = import::check_light_value(radiance, where(emitters[0]))) return bad;
       s.emission = radiance;
     }
+    for (pugi::xml_node md : p.nested("medium")) {  // an absorbing interior (trace/media.h)
+      MI_TRY(side, attr(md, "name"));
+      if (side != "interior")
+        return located(where(md), "an exterior medium is not supported: pathex's media are the absorbing interiors of shapes, surrounded by vacuum");
+      MI_TRY(mtype, attr(md, "type"));
+      if (mtype != "homogeneous")
+        return located(where(md), "medium \"" + excerpt(mtype) + "\" is not supported: pathex has absorbing homogeneous media only");
+      Props mp(this, md, "<medium type=\"homogeneous\">");
+      MI_TRY(albedo, mp.color("albedo", vec3(0.75f)));
+      if (albedo != vec3(0.0f))
+        return located(where(md), "a scattering medium (albedo not 0; Mitsuba's default is 0.75) needs a volume letter that pathex's alphabet "
+                                  "does not have; give <rgb name=\"albedo\" value=\"0\"/> for an absorbing one");
+      MI_TRY(sigma_t, mp.color("sigma_t", vec3(1.0f)));
+      MI_TRY(scale, mp.number("scale", 1.0));
+      mp.ignore({"sample_emitters", "has_spectral_extinction", "phase"});
+      if (auto u = mp.unused()) return u;
+      s.absorption = sigma_t * static_cast<float>(scale);
+      if (!(glm::all(glm::greaterThanEqual(s.absorption, vec3(0.0f))) && std::isfinite(s.absorption.x + s.absorption.y + s.absorption.z)))
+        return located(where(md), "sigma_t × scale must be finite and non-negative");
+    }
     MI_TRY(m, p.transform("to_world"));
     MI_TRY(flip, p.boolean("flip_normals", false));
     if (type == "serialized") {

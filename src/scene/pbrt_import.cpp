@@ -257,6 +257,7 @@ struct GraphicsState {
   int material = -1;  // builder index; -1: pbrt's default (diffuse, reflectance 0.5); kInterface
   std::optional<AreaLight> area;
   bool reverse = false;
+  std::string interior;  // MediumInterface's interior medium for the shapes that follow ("" none)
   // pbrt-v4's Attribute "shape", "light" and "material" (in that order): parameters that later
   // directives of that kind take when they do not give them themselves, scoped like the rest of
   // the state. Shared with the states AttributeBegin pushed until an Attribute changes them, so
@@ -293,6 +294,7 @@ class Importer {
   std::map<std::string, glm::mat4> coordinate_systems_;
   std::map<std::string, Material> named_materials_;
   std::set<std::string> interface_names_;  // named materials of type "interface"
+  std::map<std::string, vec3> media_;       // MakeNamedMedium: σa × scale of each absorbing medium
   std::map<std::string, int> named_material_index_;
   int default_material_ = -1;
   // The camera and film, combined once the file is read.
@@ -525,6 +527,46 @@ class Importer {
       if (which.text == "StartTime" || which.text == "EndTime")
         return located(which.at, "ActiveTransform " + which.text + " (a moving transform, motion blur) is not supported: pathex renders static scenes");
       return located(which.at, "ActiveTransform expects All, StartTime or EndTime");
+    }
+    // --- media (trace/media.h): absorbing interiors of shapes ---
+    if (name == "MediumInterface") {
+      PBRT_TRY(inside, quoted(s, at, name));
+      std::string outside = inside;
+      if (!s.done() && s.peek().kind == Token::kString) {
+        outside = s.peek().text;
+        s.advance();
+      }
+      if (!outside.empty())
+        return located(at, "an exterior medium (\"" + excerpt(outside) + "\") is not supported: pathex's media are the absorbing "
+                           "interiors of shapes, surrounded by vacuum (give MediumInterface \"" + excerpt(inside) + "\" \"\")");
+      if (!inside.empty() && media_.count(inside) == 0)
+        return located(at, "medium \"" + excerpt(inside) + "\" is not defined (MakeNamedMedium must come first)");
+      gs_.interior = inside;
+      return std::nullopt;
+    }
+    if (name == "MakeNamedMedium") {
+      PBRT_TRY(medium, quoted(s, at, name));
+      PBRT_TRY(ps, params(s));
+      PBRT_TRY(type, ps.string("type", ""));
+      if (type != "homogeneous")
+        return located(at, "medium type \"" + excerpt(type) + "\" is not supported: pathex has absorbing homogeneous media only");
+      for (const char* refused : {"preset", "Le"})
+        if (Param* q = ps.find(refused)) return located(q->at, std::string("medium parameter '") + refused + "' is not supported: pathex's media only absorb");
+      if (ps.find("sigma_s") == nullptr)
+        return located(at, "medium \"" + excerpt(medium) + "\" scatters (pbrt-v4's default sigma_s is not 0): a scattering medium needs a "
+                           "volume letter that pathex's alphabet does not have; give \"rgb sigma_s\" [0 0 0] for an absorbing one");
+      PBRT_TRY(sigma_s, ps.rgb("sigma_s", vec3(0.0f), true));
+      if (sigma_s != vec3(0.0f))
+        return located(ps.find("sigma_s")->at, "a scattering medium (sigma_s not 0) needs a volume letter that pathex's alphabet does not have");
+      PBRT_TRY(sigma_a, ps.rgb("sigma_a", vec3(0.0011f, 0.0024f, 0.014f), true));
+      PBRT_TRY(scale, ps.number("scale", 1.0));
+      const vec3 absorption = sigma_a * static_cast<float>(scale);
+      if (!(glm::all(glm::greaterThanEqual(absorption, vec3(0.0f))) && std::isfinite(absorption.x + absorption.y + absorption.z)))
+        return located(at, "medium \"" + excerpt(medium) + "\": sigma_a × scale must be finite and non-negative");
+      ps.ignore({"g", "Lescale"});  // g shapes scattering, Lescale emission: neither exists here
+      if (auto e = ps.unused("MakeNamedMedium \"" + excerpt(medium) + "\"")) return e;
+      media_[medium] = absorption;
+      return std::nullopt;
     }
     // --- directives with a type and parameters ---
     static const char* const kTyped[] = {"Camera", "Film", "Sampler", "Integrator", "PixelFilter", "Accelerator", "Shape",
@@ -872,6 +914,9 @@ class Importer {
   std::optional<Error> shape(const std::string& type, Params& ps, const Location& at) {
     if (gs_.material == kInterface) {  // no surface: nothing to import
       if (gs_.area) return located(at, "an area light on a shape of material \"interface\" (no surface) is not supported");
+      if (!gs_.interior.empty())
+        return located(at, "a medium bounded by the \"interface\" material (no surface) is not supported: pathex's media fill the inside of a "
+                           "transmissive surface, such as a dielectric");
       ps.ignore_all();
       return std::nullopt;
     }
@@ -879,6 +924,7 @@ class Importer {
     Shape s;
     s.pointer = at.str();
     s.material = current_material();
+    if (!gs_.interior.empty()) s.absorption = media_.at(gs_.interior);  // defined: checked by MediumInterface
     if (gs_.area) {
       s.emission = gs_.area->radiance;
       s.two_sided = gs_.area->two_sided;

@@ -730,7 +730,7 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
   PATHEX_TRY(type, r.string(j, "type", ptr));
   Shape s;
   s.pointer = ptr;
-  const std::initializer_list<const char*> common = {"type", "material", "emission", "two_sided", "transform"};
+  const std::initializer_list<const char*> common = {"type", "material", "emission", "two_sided", "absorption", "transform"};
   auto allowed = [&](std::initializer_list<const char*> extra) {
     std::vector<const char*> all(common);
     all.insert(all.end(), extra);
@@ -762,6 +762,8 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
     if (!j["two_sided"].is_boolean()) return r.fail(ptr + "/two_sided", "expected true or false");
     s.two_sided = j["two_sided"].get<bool>();
   }
+  PATHEX_TRY(absorption, r.vector3(j, "absorption", ptr, false, vec3(0.0f), /*nonneg=*/true));
+  s.absorption = absorption;  // σa of an absorbing interior (trace/media.h)
   glm::mat4 m(1.0f);
   bool uniform = true;
   float scale = 1.0f;

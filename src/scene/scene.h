@@ -59,6 +59,9 @@ struct Shape {
   int material = 0;             // index into Scene::materials
   glm::vec3 emission{0.0f};     // radiance Le; nonzero makes the shape an area light (LDD)
   bool two_sided = false;       // emits from both sides
+  // σa (per unit length, per channel) of the shape's interior: an absorbing medium that light
+  // entering the shape through a transmissive surface crosses (trace/media.h); zero: vacuum.
+  glm::vec3 absorption{0.0f};
   std::string pointer;          // "/shapes/3", for messages
   bool emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
 };

@@ -63,6 +63,7 @@ std::string scene_content_hash(const Scene& scene) {
     h.add(s.material);
     h.add(s.emission);
     h.add(s.two_sided);
+    if (s.absorption != glm::vec3(0.0f)) h.add(s.absorption);  // only then: the hashes of scenes without media stay as they were
   }
   h.add(static_cast<std::uint64_t>(scene.lights.size()));
   for (const Light& l : scene.lights) {

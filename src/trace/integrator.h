@@ -68,6 +68,7 @@ class Integrator {
     sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
     for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
     features_ = rs.features;
+    absorbing_ = rs.absorbing;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
     // --only: a point or spot light whose requested paths all scatter specularly first emits only
@@ -342,7 +343,7 @@ class Integrator {
   // A join's start (th.join reset for strategy (s, kind, t)) and end: its contribution, the S
   // letters a projection adds, the one segment to test (none: from is null). False when black.
   void begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const;
-  bool end_join(Thread& th, const vec3& contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const;
+  bool end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const;
   // The one way a join makes a fresh endpoint: a sensor vertex at connection c (th.join.eye0), a
   // vertex of light li at p (th.join.light0).
   Vertex& fresh_sensor_vertex(Thread& th, const EndpointConnection& c, char letter) const;
@@ -442,6 +443,7 @@ class Integrator {
   float light_pick_ = 0.0f;
   bool lens_hits_ = false;
   SceneFeatures features_;  // what the scene's materials can do: the walk skips the rest
+  bool absorbing_ = false;  // some shape has an absorbing interior (trace/media.h)
 };
 
 }  // namespace pathex::tracer

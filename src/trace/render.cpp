@@ -27,6 +27,7 @@
 #include <cmath>
 
 #include "trace/accel/path_ids.h"
+#include "trace/media.h"
 #include "trace/bsdf.h"
 #include "trace/frame.h"
 #include "trace/integrator.h"
@@ -126,6 +127,10 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.wo = -d;
     const vec3 e = v.p - prev.p;
     v.d2_wo = glm::dot(e, e);
+    if (absorbing_) {  // Beer–Lambert along the segment (trace/media.h)
+      v.sigma = segment_absorption(prev, d, rs_.absorption_of_shape);
+      beta *= beer_lambert(v.sigma, std::sqrt(v.d2_wo));
+    }
     v.beta = beta;
     // Solid angle at prev to area at v, along the unit ray direction d.
     // 0 for coincident points (and a subnormal distance, whose inverse would overflow): no density.

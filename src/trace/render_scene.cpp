@@ -43,6 +43,8 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     const Shape& s = scene.shapes[i];
     rs.material_of_shape.push_back(&scene.materials[static_cast<std::size_t>(s.material)]);
     rs.emission_of_shape.push_back(s.emission);
+    rs.absorption_of_shape.push_back(s.absorption);
+    rs.absorbing = rs.absorbing || s.absorption != glm::vec3(0.0f);
     // Planar mirrors, for the mirror connector: quads of a pure mirror material.
     const auto* quad = std::get_if<QuadShape>(&s.geometry);
     const auto* mirror = std::get_if<Mirror>(rs.material_of_shape.back());

@@ -54,6 +54,8 @@ struct RenderScene {
   std::vector<const Material*> material_of_shape;
   std::vector<glm::vec3> emission_of_shape;  // Le, zero for non-emitters
   std::vector<int> light_of_shape;           // index into lights, -1 for non-emitters
+  std::vector<glm::vec3> absorption_of_shape;  // σa of the shape's interior (trace/media.h), zero for none
+  bool absorbing = false;                    // some shape has an absorbing interior
   std::vector<RenderLight> lights;
   std::vector<PlanarMirror> mirrors;         // quads of a pure mirror material (the mirror connector's)
   RenderSensor camera;

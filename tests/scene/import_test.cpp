@@ -468,7 +468,22 @@ std::vector<Refusal> refusals() {
       {"object.pbrt", "ObjectBegin \"thing\"\n", "object.pbrt:4:1",
        "directive 'ObjectBegin' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
       {"medium.pbrt", "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n", "medium.pbrt:4:1",
-       "directive 'MakeNamedMedium' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
+       "medium \"fog\" scatters (pbrt-v4's default sigma_s is not 0): a scattering medium needs a volume letter that pathex's alphabet "
+       "does not have; give \"rgb sigma_s\" [0 0 0] for an absorbing one"},
+      {"medium-scatters.pbrt", "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0.1 0]\n", "medium-scatters.pbrt:4:51",
+       "a scattering medium (sigma_s not 0) needs a volume letter that pathex's alphabet does not have"},
+      {"medium-grid.pbrt", "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\"\n", "medium-grid.pbrt:4:1",
+       "medium type \"uniformgrid\" is not supported: pathex has absorbing homogeneous media only"},
+      {"medium-exterior.pbrt", "MediumInterface \"\" \"fog\"\n", "medium-exterior.pbrt:4:1",
+       "an exterior medium (\"fog\") is not supported: pathex's media are the absorbing interiors of shapes, surrounded by vacuum (give "
+       "MediumInterface \"\" \"\")"},
+      {"medium-undefined.pbrt", "MediumInterface \"tea\" \"\"\n", "medium-undefined.pbrt:4:1",
+       "medium \"tea\" is not defined (MakeNamedMedium must come first)"},
+      {"medium-interface.pbrt",
+       "MakeNamedMedium \"tea\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0]\nMaterial \"interface\"\nMediumInterface \"tea\" \"\"\nShape \"sphere\"\n",
+       "medium-interface.pbrt:7:1",
+       "a medium bounded by the \"interface\" material (no surface) is not supported: pathex's media fill the inside of a transmissive surface, "
+       "such as a dielectric"},
       {"curve.pbrt", "Shape \"curve\"\n", "curve.pbrt:4:1",
        "shape \"curve\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder"},
       {"cylinder.pbrt", "Shape \"cylinder\" \"float phimax\" 180\n", "cylinder.pbrt:4:18", "partial cylinders (phimax) are not supported"},
@@ -557,7 +572,7 @@ std::vector<Refusal> refusals() {
        "microfacet distribution \"beckmann\" is not supported: pathex's microfacets are GGX, set <string name=\"distribution\" value=\"ggx\"/>"},
       {"roughplastic-alpha.xml",
        "  <bsdf type=\"roughplastic\" id=\"p\">\n    <string name=\"distribution\" value=\"ggx\"/>\n    <float name=\"alpha\" value=\"2\"/>\n  </bsdf>\n</scene>\n",
-       "roughplastic-alpha.xml:4:5", "alpha must be within [1e-4, 1]"},
+       "roughplastic-alpha.xml:2:3", "alpha must be within [0, 1]"},
       {"medium.xml", "  <medium type=\"homogeneous\"/>\n</scene>\n", "medium.xml:2:3",
        "<medium> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)"},
       {"principled.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"principled\"/>\n  </shape>\n</scene>\n", "principled.xml:3:5",
@@ -793,6 +808,7 @@ TEST(ImportShapes, VertexNormalsArePlacedAndWindTheirTriangles) {
   expect_near(roof.normals[0], glm::normalize(glm::vec3(1, 0, 1)), "angle-weighted at the right-angled corner");
   expect_near(roof.normals[1], {0, 0, 1}, "one face");
   expect_near(roof.normals[3], {1, 0, 0}, "the other face");
+}
 
 // --- coated materials: pbrt-v4's coateddiffuse, Mitsuba 3's plastic and roughplastic ---
 
@@ -891,6 +907,38 @@ TEST(ImportMitsuba, PlasticIsACoatOfThicknessZero) {
     }
     const double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
     EXPECT_NEAR(mean, mitsuba, 0.003 * mitsuba + 4 * se) << to << ", " << ti;
+  }
+}
+
+// Absorbing media (README "Importing pbrt-v4 and Mitsuba 3 scenes", trace/media.h): pbrt-v4's
+// MakeNamedMedium homogeneous with sigma_s 0 behind MediumInterface, scaled, scoped by
+// AttributeBegin; Mitsuba 3's homogeneous interior of albedo 0, sigma_t × scale.
+TEST(ImportMedia, AbsorbingInteriorsInBothFormats) {
+  const Scene p = load(write("tea.pbrt", kPbrtHead + "LightSource \"point\"\n"
+      "MakeNamedMedium \"tea\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.5 1 2] \"rgb sigma_s\" [0 0 0] \"float scale\" 3\n"
+      "Material \"dielectric\"\nAttributeBegin\nMediumInterface \"tea\" \"\"\nShape \"sphere\"\nAttributeEnd\nShape \"sphere\" \"float radius\" 2\n"));
+  ASSERT_EQ(p.shapes.size(), 2u);
+  EXPECT_EQ(p.shapes[0].absorption, glm::vec3(1.5f, 3.0f, 6.0f));
+  EXPECT_EQ(p.shapes[1].absorption, glm::vec3(0.0f));  // outside the AttributeBegin: vacuum again
+  const std::string head = kXmlHead + "<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/></sensor>\n<emitter type=\"point\"/>\n";
+  const Scene x = load(write("tea.xml", head +
+      "<shape type=\"sphere\"><bsdf type=\"dielectric\"/><medium type=\"homogeneous\" name=\"interior\"><rgb name=\"albedo\" value=\"0\"/>"
+      "<rgb name=\"sigma_t\" value=\"0.5, 1, 2\"/><float name=\"scale\" value=\"2\"/></medium></shape>\n</scene>\n"));
+  ASSERT_EQ(x.shapes.size(), 1u);
+  EXPECT_EQ(x.shapes[0].absorption, glm::vec3(1.0f, 2.0f, 4.0f));
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"<medium type=\"homogeneous\" name=\"interior\"/>",
+       "a scattering medium (albedo not 0; Mitsuba's default is 0.75) needs a volume letter that pathex's alphabet does not have; give "
+       "<rgb name=\"albedo\" value=\"0\"/> for an absorbing one"},
+      {"<medium type=\"homogeneous\" name=\"exterior\"/>",
+       "an exterior medium is not supported: pathex's media are the absorbing interiors of shapes, surrounded by vacuum"},
+      {"<medium type=\"heterogeneous\" name=\"interior\"/>", "medium \"heterogeneous\" is not supported: pathex has absorbing homogeneous media only"},
+  };
+  for (const auto& [medium, message] : refused) {
+    const Result<Scene> s = load_scene_file(write("bad-medium.xml", head + "<shape type=\"sphere\">\n  " + medium + "\n</shape>\n</scene>\n"));
+    ASSERT_FALSE(s.ok()) << medium;
+    EXPECT_EQ(relative(s.error().where), "bad-medium.xml:5:3") << medium;
+    EXPECT_EQ(s.error().message, message);
   }
 }
 

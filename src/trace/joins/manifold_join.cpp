@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "trace/media.h"
 #include "trace/frame.h"
 #include "trace/integrator.h"
 #include "trace/joins/manifold.h"
@@ -262,6 +263,18 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
       transmit *= glass->tint * (c.reflect ? f : 1.0f - f);
     } else {
       transmit *= mirror_reflectance_[static_cast<std::size_t>(c.id)];
+    }
+  }
+  if (absorbing_) {  // Beer–Lambert along the chain's m + 1 segments, a to b (trace/media.h)
+    const Vertex* from = a;
+    for (int i = 0; i <= m; ++i) {
+      Vertex* to = i < m ? &jr.chain_vertices[static_cast<std::size_t>(i)] : nullptr;
+      const vec3 e = (to ? to->p : b->p) - from->p;
+      const float length = glm::length(e);
+      const vec3 sigma = length > 0.0f ? segment_absorption(*from, e / length, rs_.absorption_of_shape) : from->sigma;
+      transmit *= beer_lambert(sigma, length);
+      if (to) to->sigma = sigma;
+      from = to;
     }
   }
   const vec3 w_a = glm::normalize(jr.chain_vertices[0].p - a->p);

@@ -1,6 +1,7 @@
 // The mirror connector (s, DSD, t) of DESIGN §4: y(s-1) (or a fresh light sample) joined to z(t-1)
 // (or a fresh sensor sample) across each planar mirror by the image method (trace/joins/mirror.h
 // for the geometry), one JoinResult per mirror that the straight line to the image meets.
+#include "trace/media.h"
 #include "trace/integrator.h"
 #include "trace/joins/mirror.h"
 
@@ -62,6 +63,8 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
       const vec3 fb = end_f(*b, j->w_b, TransportMode::kRadiance);
       contrib *= fb * b->beta * (shading_cos(*b, j->w_b) / (j->unfolded * j->unfolded));
     }
+    // Both legs lie in the medium a's leg starts in (a mirror has no interior: trace/media.h).
+    if (absorbing_) contrib *= beer_lambert(segment_absorption(*a, j->w_a, rs_.absorption_of_shape), glm::length(j->point - a->p) + glm::length(j->point - b->p));
     if (is_black(contrib)) {
       ++stats.no_transport;
       continue;

@@ -10,6 +10,7 @@
 
 #include "trace/bsdf.h"
 #include "trace/integrator.h"
+#include "trace/media.h"
 #include "trace/prune.h"
 
 namespace pathex::tracer {
@@ -42,8 +43,13 @@ void Integrator::begin_join(Thread& th, ConnectorKind kind, int s, int t, int st
   jr.num_segments = 0;
 }
 
-bool Integrator::end_join(Thread& th, const vec3& contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const {
+bool Integrator::end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const {
   JoinResult& jr = th.join;
+  if (absorbing_ && from != nullptr) {  // Beer–Lambert along the joining segment (trace/media.h)
+    const vec3 e = to->p - from->p;
+    const float length = std::sqrt(glm::dot(e, e));
+    if (length > 0.0f) contrib *= beer_lambert(segment_absorption(*from, e / length, rs_.absorption_of_shape), length);
+  }
   if (is_black(contrib)) {
     if (jr.chain != ConnectorKind::kNone) ++th.connectors[static_cast<std::size_t>(jr.strategy)].no_transport;
     return false;
