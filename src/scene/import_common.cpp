@@ -44,7 +44,18 @@ SceneFiles::SceneFiles(const std::string& main_file, const SceneLoadOptions& opt
 
 std::string SceneFiles::resolve(const std::string& file) const {
   const std::filesystem::path p(file);
-  return p.is_absolute() ? file : (std::filesystem::path(base_dir_) / p).string();
+  if (p.is_absolute()) return file;
+  for (auto dir = search_paths_.rbegin(); dir != search_paths_.rend(); ++dir) {
+    const std::filesystem::path candidate = std::filesystem::path(*dir) / p;
+    std::error_code ec;
+    if (std::filesystem::exists(candidate, ec)) return candidate.string();
+  }
+  return (std::filesystem::path(base_dir_) / p).string();
+}
+
+void SceneFiles::add_search_path(const std::string& dir) {
+  const std::filesystem::path p(dir);
+  search_paths_.push_back(p.is_absolute() ? dir : (std::filesystem::path(base_dir_) / p).string());
 }
 
 Result<std::string> SceneFiles::include(const std::string& name, const Location& from, const std::string& directive) const {

@@ -46,7 +46,12 @@ Error located(const Location& at, std::string message);
 class SceneFiles {
  public:
   SceneFiles(const std::string& main_file, const SceneLoadOptions& options);
+  // A relative name: the first of the search paths (the latest added first) and the main file's
+  // folder where the file exists, else the main file's folder.
   std::string resolve(const std::string& file) const;
+  // Mitsuba's <path value="dir"/>: `dir` (relative to the main file's folder unless absolute) is
+  // searched before the folders added earlier.
+  void add_search_path(const std::string& dir);
   // The path an include names, resolved; refused at `from` when the name is empty.
   Result<std::string> include(const std::string& name, const Location& from, const std::string& directive) const;
   // The text of `path`, included from `from` at nesting `depth` (0: the main file); `directive`
@@ -57,6 +62,7 @@ class SceneFiles {
 
  private:
   std::string base_dir_;
+  std::vector<std::string> search_paths_;  // resolved, in the order added
   std::size_t max_file_bytes_, max_scene_bytes_;
   std::size_t read_ = 0;  // bytes of the scene's text so far
   std::vector<std::string> included_;

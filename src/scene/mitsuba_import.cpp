@@ -357,6 +357,12 @@ class Importer {
       defaults_.emplace(name, n.attribute("value").value());  // the first definition wins
       return std::nullopt;
     }
+    if (tag == "path") {  // a folder searched for the files the scene names, before the scene's own (Mitsuba's file resolver)
+      Result<std::string> dir = attr(n, "value");
+      if (!dir) return dir.error();
+      files_.add_search_path(*dir);
+      return std::nullopt;
+    }
     if (tag == "include") {
       Result<std::string> file = attr(n, "filename");
       if (!file) return file.error();
@@ -380,7 +386,7 @@ class Importer {
     if (tag == "emitter") return emitter(n);
     if (tag == "sensor") return sensor(n);
     if (tag == "integrator") return std::nullopt;  // how to estimate is pathex's choice (see the README)
-    return located(where(n), "<" + excerpt(tag) + "> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)");
+    return located(where(n), "<" + excerpt(tag) + "> is not supported (pathex imports shapes, bsdfs, emitters, a sensor, includes and paths)");
   }
 
   // --- materials ---
@@ -838,6 +844,8 @@ class Importer {
         if (!(ar > 0) || !(fd > 0)) return located(where(n), "thinlens needs a positive aperture_radius and focus_distance");
         c.aperture_radius = static_cast<float>(ar);
         c.focus_distance = static_cast<float>(fd);
+      } else {
+        p.ignore({"focus_distance"});  // a pinhole has no focus (Mitsuba's own cbox.xml gives one to its perspective sensor)
       }
     }
     if (auto u = p.unused()) return u;

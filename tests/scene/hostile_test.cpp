@@ -92,7 +92,7 @@ std::vector<Case> refusals() {
       {"long-directive.pbrt", kPbrtHead + std::string(std::size_t{1} << 20, 'A') + "\n", "long-directive.pbrt:4:1",
        "directive '" + a64 + "…' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
       {"long-tag.xml", kXmlHead + "<" + std::string(std::size_t{1} << 20, 'A') + "/>\n</scene>\n", "long-tag.xml:2:1",
-       "<" + a64 + "…> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)"},
+       "<" + a64 + "…> is not supported (pathex imports shapes, bsdfs, emitters, a sensor, includes and paths)"},
       {"no-light.pbrt", kPbrtHead + "Include \"parts.pbrt\"\n", "no-light.pbrt",
        "the scene has no light: expected a light source or an emitting shape (read from no-light.pbrt and the files it includes: parts.pbrt)"},
       {"no-sensor.xml", kXmlHead + "  <emitter type=\"point\"/>\n  <shape type=\"sphere\"/>\n</scene>\n", "no-sensor.xml", "the scene has no camera"},

@@ -574,7 +574,7 @@ std::vector<Refusal> refusals() {
        "  <bsdf type=\"roughplastic\" id=\"p\">\n    <string name=\"distribution\" value=\"ggx\"/>\n    <float name=\"alpha\" value=\"2\"/>\n  </bsdf>\n</scene>\n",
        "roughplastic-alpha.xml:2:3", "alpha must be within [0, 1]"},
       {"medium.xml", "  <medium type=\"homogeneous\"/>\n</scene>\n", "medium.xml:2:3",
-       "<medium> is not supported (pathex imports shapes, bsdfs, emitters, a sensor and includes)"},
+       "<medium> is not supported (pathex imports shapes, bsdfs, emitters, a sensor, includes and paths)"},
       {"principled.xml", "  <shape type=\"sphere\">\n    <bsdf type=\"principled\"/>\n  </shape>\n</scene>\n", "principled.xml:3:5",
        "bsdf \"principled\" is not supported: it needs the Disney principled BSDF (sheen, clearcoat, specular transmission and their "
        "blend), which pathex does not have"},
