@@ -14,6 +14,7 @@
 #include <utility>
 #include <variant>
 
+#include "scene/cie_tables.h"
 #include "scene/ply.h"
 
 #include "core/limits.h"
@@ -240,6 +241,36 @@ Result<MeshShape> load_ply_mesh(const std::string& path, const Location& at, con
   if (mesh.triangles.empty()) return located(at, "the PLY mesh '" + path + "' has no faces");
   return mesh;
 }
+
+// --- sampled spectra ---
+
+namespace {
+glm::vec3 xyz_to_srgb(const glm::dvec3& xyz) {
+  glm::dvec3 rgb(0.0);
+  for (int r = 0; r < 3; ++r) rgb[r] = cie::kXyzToSrgb[r][0] * xyz.x + cie::kXyzToSrgb[r][1] * xyz.y + cie::kXyzToSrgb[r][2] * xyz.z;
+  return glm::vec3(rgb);
+}
+}  // namespace
+
+glm::vec3 spectrum_to_rgb(const std::vector<double>& wavelengths, const std::vector<double>& values, bool emission) {
+  glm::dvec3 xyz(0.0);
+  double norm = 0.0;
+  std::size_t k = 0;
+  for (int i = 0; i < cie::kCieSamples; ++i) {
+    const double w = cie::kCieFirst + cie::kCieStep * i;
+    const double weight = emission ? 1.0 : cie::kD65[i];
+    norm += weight * cie::kY[i];
+    if (w < wavelengths.front() || w > wavelengths.back()) continue;
+    while (k + 2 < wavelengths.size() && wavelengths[k + 1] < w) ++k;
+    const double t = (w - wavelengths[k]) / (wavelengths[k + 1] - wavelengths[k]);
+    const double v = values[k] + std::clamp(t, 0.0, 1.0) * (values[k + 1] - values[k]);
+    xyz += v * weight * glm::dvec3(cie::kX[i], cie::kY[i], cie::kZ[i]);
+  }
+  const glm::vec3 rgb = glm::max(xyz_to_srgb(xyz / norm), glm::vec3(0.0f));
+  return emission ? rgb : glm::min(rgb, glm::vec3(1.0f));
+}
+
+glm::vec3 equal_energy_rgb() { return xyz_to_srgb(glm::dvec3(1.0)); }
 
 // --- per-vertex (shading) normals ---
 

@@ -98,6 +98,16 @@ std::optional<Error> check_light_value(glm::vec3 v, const Location& at);
 // one component per distinct basic material however often the graph reaches it.
 Material blend(const Material& a, const Material& b, float w);
 
+// A sampled spectrum (wavelengths in nm, strictly increasing, at least two) as linear sRGB, as
+// Mitsuba 3's RGB variants convert one (spectrum_list_to_srgb): linear between the samples, zero
+// outside them, against the CIE 1931 matching functions every 5 nm (scene/cie_tables.h). A
+// reflectance (`emission` false) is weighted by D65 and normalised by D65's luminance, so 1 is
+// (1, 1, 1), and clamped to [0, 1]; an emission spectrum is integrated alone and normalised by the
+// integral of y-bar (a constant 1 is the equal-energy white, luminance 1), negative channels 0.
+glm::vec3 spectrum_to_rgb(const std::vector<double>& wavelengths, const std::vector<double>& values, bool emission);
+// Mitsuba's uniform emission spectrum of value 1 in sRGB: the equal-energy white XYZ (1, 1, 1).
+glm::vec3 equal_energy_rgb();
+
 // A PLY mesh (scene/ply.h; `.ply` or `.ply.gz`): triangles and planar quads (split in two along
 // v0-v2, the surface pbrt-v4's bilinear patch has when the quad is planar), with the file's uv and
 // per-vertex normals (empty when the file has none). Errors in the file are located in it; refused

@@ -76,15 +76,7 @@ class Props {
     return {};
   }
   // Nested objects with this tag (bsdf, emitter, film, ...), including <ref>s to them.
-  std::vector<pugi::xml_node> nested(const std::string& tag) {
-    std::vector<pugi::xml_node> out;
-    for (Child& c : children_)
-      if (c.node.name() == tag || (std::string(c.node.name()) == "ref" && tag == "bsdf")) {
-        c.used = true;
-        out.push_back(c.node);
-      }
-    return out;
-  }
+  std::vector<pugi::xml_node> nested(const std::string& tag);
   void ignore(std::initializer_list<const char*> names) {
     for (Child& c : children_)
       for (const char* n : names) c.used = c.used || c.node.attribute("name").value() == std::string(n) || c.node.name() == std::string(n);
@@ -177,6 +169,35 @@ class Importer {
     return out;
   }
 
+  // <spectrum value="400:0.343, 404:0.445, …"/>: wavelength:value pairs (nm, increasing), as linear sRGB.
+  Result<vec3> sampled_spectrum(pugi::xml_node n, const std::string& text, bool emission) const {
+    std::vector<double> wavelengths, values;
+    std::string list = text;
+    for (char& c : list)
+      if (c == ',') c = ' ';
+    std::istringstream in(list);
+    std::string word;
+    while (in >> word) {
+      const std::size_t colon = word.find(':');
+      char* end1 = nullptr;
+      char* end2 = nullptr;
+      const double w = colon == std::string::npos ? NAN : std::strtod(word.substr(0, colon).c_str(), &end1);
+      const double v = colon == std::string::npos ? NAN : std::strtod(word.c_str() + colon + 1, &end2);
+      if (colon == std::string::npos || colon == 0 || *end1 != '\0' || end2 == word.c_str() + colon + 1 || *end2 != '\0' ||
+          !std::isfinite(w) || !std::isfinite(v))
+        return located(where(n), "bad spectrum entry '" + excerpt(word) + "', expected wavelength:value");
+      if (!wavelengths.empty() && !(w > wavelengths.back()))
+        return located(where(n), "the spectrum's wavelengths must increase, found " + excerpt(word) + " after " + std::to_string(wavelengths.back()));
+      wavelengths.push_back(w);
+      values.push_back(v);
+    }
+    if (wavelengths.size() < 2) return located(where(n), "a sampled spectrum needs at least two wavelength:value pairs");
+    if (!emission)
+      for (double v : values)
+        if (v < 0.0) return located(where(n), "a reflectance spectrum must be non-negative");
+    return import::spectrum_to_rgb(wavelengths, values, emission);
+  }
+
   Result<vec3> vector3(pugi::xml_node n, vec3 fallback) const {
     if (n.attribute("value")) {
       MI_TRY(v, numbers(n, "value"));
@@ -249,6 +270,7 @@ class Importer {
 
  private:
   friend class Props;
+  bool is_area_emitter(const std::string& id) const { return area_emitters_.count(id) != 0; }
   std::string main_;
   SceneLoadOptions options_;
   import::SceneFiles files_;
@@ -260,6 +282,7 @@ class Importer {
   std::map<std::string, Material> bsdf_materials_;  // top-level <bsdf id>, each made once; <ref>s share it
   std::string defining_;                            // the id of the top-level <bsdf> being made
   std::map<std::string, int> bsdf_index_;
+  std::map<std::string, pugi::xml_node> area_emitters_;  // top-level area emitters by id, for shapes' <ref>s
   int default_material_ = -1;
   import::SceneBuilder builder_;
 
@@ -286,6 +309,10 @@ class Importer {
     if (!scene) return located(Location{path}, "expected a <scene> root element");
     if (auto e = check_document(d)) return e;
     if (auto e = check_version(scene)) return e;
+    // Area emitters defined by id may come after the shapes that <ref> them (Mitsuba's cbox.xml).
+    for (pugi::xml_node n : scene.children("emitter"))
+      if (std::string(n.attribute("type").value()) == "area" && !std::string(n.attribute("id").value()).empty())
+        area_emitters_[n.attribute("id").value()] = n;
     for (pugi::xml_node n : scene.children()) {
       if (n.type() != pugi::node_element) continue;
       if (auto e = top_level(n, depth)) return e;
@@ -587,9 +614,10 @@ class Importer {
     s.pointer = where(n).str();
     MI_TRY(mat, material_of(p, n));
     s.material = mat;
-    const std::vector<pugi::xml_node> emitters = p.nested("emitter");
+    std::vector<pugi::xml_node> emitters = p.nested("emitter");
     if (emitters.size() > 1) return located(where(n), "a shape with more than one emitter");
     if (emitters.size() == 1) {
+      if (std::string(emitters[0].name()) == "ref") emitters[0] = area_emitters_.at(emitters[0].attribute("id").value());
       MI_TRY(etype, attr(emitters[0], "type"));
       if (etype != "area") return located(where(emitters[0]), "emitter \"" + excerpt(etype) + "\" inside a shape is not supported, expected area");
       Props e(this, emitters[0], "<emitter type=\"area\">");
@@ -723,7 +751,12 @@ class Importer {
     MI_TRY(type, attr(n, "type"));
     Props p(this, n, "<emitter type=\"" + excerpt(type) + "\">");
     p.ignore({"id"});
-    if (type == "area") return located(where(n), "an area emitter must be inside a <shape>");
+    if (type == "area") {  // defined once by id, used by the shapes that <ref> it (Mitsuba's cbox.xml does)
+      const std::string id = n.attribute("id").value();
+      if (id.empty()) return located(where(n), "an area emitter must be inside a <shape> or have an id that shapes <ref>");
+      area_emitters_[id] = n;
+      return std::nullopt;
+    }
     if (type == "envmap")
       return located(where(n), "emitter \"envmap\" (an image infinite light) is not supported: pathex renders a uniform infinite light (constant) only");
     if (type == "constant") {  // the same radiance from every direction
@@ -891,15 +924,35 @@ Result<std::string> Props::string(const std::string& name, const std::string& fa
   return im_->attr(n, "value");
 }
 
+std::vector<pugi::xml_node> Props::nested(const std::string& tag) {
+  std::vector<pugi::xml_node> out;
+  for (Child& c : children_) {
+    const bool ref = std::string(c.node.name()) == "ref";
+    const bool emitter_ref = ref && im_->is_area_emitter(c.node.attribute("id").value());
+    if (c.node.name() == tag || (ref && tag == "bsdf" && !emitter_ref) || (emitter_ref && tag == "emitter")) {
+      c.used = true;
+      out.push_back(c.node);
+    }
+  }
+  return out;
+}
+
 Result<vec3> Props::color(const std::string& name, vec3 fallback) {
   pugi::xml_node n = find(name);
   if (!n) return fallback;
   const std::string tag = n.name();
   if (tag == "texture") return located(im_->where(n), "textures are not supported ('" + name + "'), give an <rgb>");
   if (tag != "rgb" && tag != "float" && tag != "spectrum") return located(im_->where(n), "'" + name + "' must be an <rgb>");
+  // An emitter's spectrum is light, every other one a reflectance (Mitsuba's Properties::get_texture).
+  const bool emission = what_.rfind("<emitter", 0) == 0;
+  if (tag == "spectrum") {
+    if (n.attribute("filename")) return located(im_->where(n), "a <spectrum> from a file is not supported: give its wavelength:value pairs");
+    const std::string text = n.attribute("value").value();
+    if (text.find(':') != std::string::npos) return im_->sampled_spectrum(n, text, emission);
+  }
   MI_TRY(v, im_->numbers(n, "value"));
-  if (tag == "spectrum" && v.size() != 1)
-    return located(im_->where(n), "a sampled <spectrum> is not supported: pathex renders in RGB, give an <rgb>");
+  if (tag == "spectrum" && v.size() != 1) return located(im_->where(n), "a <spectrum> value is one number or wavelength:value pairs");
+  if (tag == "spectrum" && emission) return static_cast<float>(v[0]) * import::equal_energy_rgb();  // Mitsuba's uniform light spectrum
   if (v.size() == 1) return vec3(static_cast<float>(v[0]));
   if (tag != "rgb" || v.size() != 3) return located(im_->where(n), "'" + name + "' expects 3 numbers");
   return vec3(v[0], v[1], v[2]);

@@ -942,5 +942,43 @@ TEST(ImportMedia, AbsorbingInteriorsInBothFormats) {
   }
 }
 
+// Mitsuba 3's spectra in its RGB variants (Properties::get_texture, spectrum_list_to_srgb): a
+// reflectance of wavelength:value pairs by the CIE 1931 curves under D65 (so a constant 0.5 over
+// 360..830 nm is grey 0.5), a uniform light spectrum as the equal-energy white (sRGB of XYZ
+// (1, 1, 1): (1.2049, 0.9484, 0.9086)); and an area emitter defined by id after the shape that
+// <ref>s it, as Mitsuba's own cbox.xml has it.
+TEST(ImportMitsuba, SpectraAndAreaEmittersByReference) {
+  const std::string head = kXmlHead + "<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/></sensor>\n";
+  const Scene x = load(write("spectra.xml", head +
+      "<bsdf type=\"diffuse\" id=\"grey\"><spectrum name=\"reflectance\" value=\"360:0.5, 830:0.5\"/></bsdf>\n"
+      "<bsdf type=\"diffuse\" id=\"red\"><spectrum name=\"reflectance\" value=\"400:0, 550:0, 600:0.9, 700:0.9\"/></bsdf>\n"
+      "<shape type=\"sphere\"><ref id=\"grey\"/><ref id=\"lamp\"/></shape>\n"
+      "<shape type=\"sphere\"><ref id=\"red\"/><float name=\"radius\" value=\"2\"/></shape>\n"
+      "<emitter type=\"area\" id=\"lamp\"><spectrum name=\"radiance\" value=\"2\"/></emitter>\n</scene>\n"));
+  ASSERT_EQ(x.shapes.size(), 2u);
+  const glm::vec3 grey = std::get<Diffuse>(x.materials[static_cast<std::size_t>(x.shapes[0].material)]).albedo;
+  EXPECT_LT(glm::length(grey - glm::vec3(0.5f)), 1e-5f) << grey.x << " " << grey.y << " " << grey.z;
+  const glm::vec3 red = std::get<Diffuse>(x.materials[static_cast<std::size_t>(x.shapes[1].material)]).albedo;
+  EXPECT_GT(red.x, 0.5f);
+  EXPECT_LT(red.z, 0.02f);
+  EXPECT_GT(red.x, 4.0f * red.y);
+  for (int c = 0; c < 3; ++c)  // Mitsuba's sRGB matrix against ours (the sRGB primaries with these tables' D65 white): within 2e-4
+    EXPECT_NEAR(x.shapes[0].emission[c], 2.0f * glm::vec3(1.20494f, 0.948373f, 0.908632f)[c], 4e-4f) << c;
+  EXPECT_EQ(x.shapes[1].emission, glm::vec3(0.0f));
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"400:0.5, 300:0.5", "the spectrum's wavelengths must increase, found 300:0.5 after 400.000000"},
+      {"400:0.5", "a sampled spectrum needs at least two wavelength:value pairs"},
+      {"400:0.5, 500:x", "bad spectrum entry '500:x', expected wavelength:value"},
+      {"400:0.5, 500:-1", "a reflectance spectrum must be non-negative"},
+  };
+  for (const auto& [value, message] : refused) {
+    const Result<Scene> s = load_scene_file(write("bad-spectrum.xml", head + "<emitter type=\"point\"/>\n<shape type=\"sphere\">\n  <bsdf type=\"diffuse\">"
+                                                  "<spectrum name=\"reflectance\" value=\"" + value + "\"/></bsdf>\n</shape>\n</scene>\n"));
+    ASSERT_FALSE(s.ok()) << value;
+    EXPECT_EQ(relative(s.error().where), "bad-spectrum.xml:5:24") << value;
+    EXPECT_EQ(s.error().message, message);
+  }
+}
+
 }  // namespace
 }  // namespace pathex
