@@ -547,6 +547,28 @@ TEST(ClosedForm, MixtureLettersCarryTheirComponentsShare) {
   }
 }
 
+// pt-nee, lt and bdpt (in that order in `runs`) agree on each class of `classes` (or, with none,
+// on the total): every pair within the family-wise tolerance of all its checks (Šidák over
+// Student's t, tests/support/stat_seed.h) plus `rel` of the value; every estimate finite and, for
+// a class, positive (the scene must show it).
+void expect_estimators_agree(const std::vector<Rendered>& runs, std::size_t classes, double rel) {
+  const char* names[] = {"pt-nee", "lt", "bdpt"};
+  const std::size_t rows = std::max<std::size_t>(classes, 1);
+  const double k = test::family_sigmas(static_cast<int>(3 * rows));
+  for (std::size_t c = 0; c < rows; ++c)
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      EXPECT_EQ(runs[i].report.nonfinite_samples, 0u) << names[i];
+      for (std::size_t j = i + 1; j < runs.size(); ++j) {
+        const Estimate& x = classes == 0 ? runs[i].report.total : runs[i].report.classes[c].estimate;
+        const Estimate& y = classes == 0 ? runs[j].report.total : runs[j].report.classes[c].estimate;
+        ASSERT_GT(x.luminance, 0.0) << "class " << c;
+        EXPECT_LE(std::fabs(x.luminance - y.luminance), k * std::hypot(x.std_error, y.std_error) + rel * x.luminance)
+            << "class " << c << ": " << names[i] << " " << x.luminance << " ± " << x.std_error << ", " << names[j] << " "
+            << y.luminance << " ± " << y.std_error;
+      }
+    }
+}
+
 // A floor of two triangles (geometric normal +y) whose vertex normals all lean 25° towards +x,
 // written as an ASCII PLY into the scratch folder; `extra` adds JSON shapes.
 std::string smooth_floor_scene(const std::string& extra) {
@@ -602,18 +624,7 @@ TEST(Agreement, SmoothShadedFloorAndAWallAgreeAcrossEstimators) {
   std::vector<Rendered> runs;
   for (const char* renderer : {"pt-nee", "lt", "bdpt"})
     runs.push_back(render_scene(load_scene_json(scene, test::scratch(), "smooth"), renderer, classes, 256, 0, test::stat_seed(11), {}, 12));
-  const double k = test::family_sigmas(6);  // 3 pairs x 2 classes (a difference of two t-like deviations: close enough)
-  const char* names[] = {"pt-nee", "lt", "bdpt"};
-  for (std::size_t c = 0; c < classes.size(); ++c)
-    for (std::size_t i = 0; i < runs.size(); ++i)
-      for (std::size_t j = i + 1; j < runs.size(); ++j) {
-        const Estimate& x = runs[i].report.classes[c].estimate;
-        const Estimate& y = runs[j].report.classes[c].estimate;
-        ASSERT_GT(x.luminance, 0.0) << classes[c];
-        EXPECT_LE(std::fabs(x.luminance - y.luminance), k * std::hypot(x.std_error, y.std_error) + 0.005 * x.luminance)
-            << classes[c] << ": " << names[i] << " " << x.luminance << " ± " << x.std_error << ", " << names[j] << " "
-            << y.luminance << " ± " << y.std_error;
-      }
+  expect_estimators_agree(runs, classes.size(), 0.005);
 }
 
 // A sphere of radius 1 at the origin as a latitude-longitude mesh (`rings` x 2 `rings` quads, two
@@ -660,20 +671,7 @@ TEST(Agreement, SmoothShadedSphereMeshUnderAnAreaLightAgreesAcrossEstimators) {
   std::vector<Rendered> runs;
   for (const char* renderer : {"pt-nee", "lt", "bdpt"})
     runs.push_back(render_scene(load_scene_json(scene, test::scratch(), "sphere"), renderer, classes, 1024, 0, test::stat_seed(13), {}, 12));
-  const double k = test::family_sigmas(6);
-  const char* names[] = {"pt-nee", "lt", "bdpt"};
-  for (std::size_t c = 0; c < classes.size(); ++c)
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-      EXPECT_EQ(runs[i].report.nonfinite_samples, 0u);
-      for (std::size_t j = i + 1; j < runs.size(); ++j) {
-        const Estimate& x = runs[i].report.classes[c].estimate;
-        const Estimate& y = runs[j].report.classes[c].estimate;
-        ASSERT_GT(x.luminance, 0.0) << classes[c];
-        EXPECT_LE(std::fabs(x.luminance - y.luminance), k * std::hypot(x.std_error, y.std_error) + 0.005 * x.luminance)
-            << classes[c] << ": " << names[i] << " " << x.luminance << " ± " << x.std_error << ", " << names[j] << " "
-            << y.luminance << " ± " << y.std_error;
-      }
-    }
+  expect_estimators_agree(runs, classes.size(), 0.005);
 }
 
 // Absorbing media (trace/media.h). A glass slab (index 1.5, two parallel faces 0.5 apart, its
@@ -721,17 +719,7 @@ TEST(Agreement, AbsorbingRoughGlassAgreesAcrossEstimators) {
   for (const char* renderer : {"pt-nee", "lt", "bdpt"})
     runs.push_back(render_json(scene("[0.3, 0.8, 1.5]"), renderer, {}, 256, 0, test::stat_seed(19)));
   const Rendered clear = render_json(scene("[0, 0, 0]"), "bdpt", {}, 256, 0, test::stat_seed(19));
-  const double k = test::family_sigmas(3);
-  const char* names[] = {"pt-nee", "lt", "bdpt"};
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    EXPECT_EQ(runs[i].report.nonfinite_samples, 0u) << names[i];
-    for (std::size_t j = i + 1; j < runs.size(); ++j) {
-      const Estimate& x = runs[i].report.total;
-      const Estimate& y = runs[j].report.total;
-      EXPECT_LE(std::fabs(x.luminance - y.luminance), k * std::hypot(x.std_error, y.std_error) + 0.002 * x.luminance)
-          << names[i] << " " << x.luminance << " ± " << x.std_error << ", " << names[j] << " " << y.luminance << " ± " << y.std_error;
-    }
-  }
+  expect_estimators_agree(runs, 0, 0.002);
   const Estimate& a = runs[2].report.total;
   EXPECT_GT(clear.report.total.luminance - a.luminance, 10.0 * std::hypot(a.std_error, clear.report.total.std_error))
       << "absorbing " << a.luminance << ", clear " << clear.report.total.luminance;
