@@ -1,7 +1,9 @@
 // The integrator behind render() (trace/render.h): bidirectional path sampling over a profile's
-// strategies, every sampled path labelled by its full-path string. The algorithm is in render.cpp;
-// this header declares it so that tests can drive it (tests/trace/mis_test.cpp checks its MIS
-// weights on re-split paths through IntegratorTestAccess).
+// strategies, every sampled path labelled by its full-path string. Its stages live in their own
+// files: the subpaths and the estimator in render.cpp, the joins in trace/joins/ (each makes one
+// JoinResult from the two subpaths), the MIS weight in mis_weight.cpp over the one routine of
+// trace/mis.h. This header declares it so that tests can drive the stages one at a time
+// (tests/trace/mis_test.cpp checks its MIS weights on re-split paths).
 #pragma once
 
 #include <algorithm>
@@ -191,7 +193,8 @@ class Integrator {
       th.eye_masks[static_cast<std::size_t>(t)] =
           (th.eye_masks[static_cast<std::size_t>(t - 1)] << 1) | letter_bit(th.eye[static_cast<std::size_t>(t - 1)].letter, 0);
   }
-  // The packed full-path string of connection (s, t), as full_path() spells it.
+  // The packed full-path string of connection (s, t): the vertices' letters in light-to-eye order,
+  // the two join letters D (a fresh endpoint `sampled` standing for y0 when s = 1, t != 1).
   // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
   [[gnu::always_inline]] PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
     PathKey m = 0;
@@ -220,8 +223,16 @@ class Integrator {
     for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].flush(images, static_cast<int>(x), y);
   }
 
- private:
-  friend struct IntegratorTestAccess;  // tests/trace/mis_test.cpp: checks the MIS weights on re-split paths
+  // The stages below are public: tests drive them one at a time (tests/trace/mis_test.cpp
+  // re-splits paths and checks their MIS weights); only the state is private.
+  const RenderScene& scene() const { return rs_; }
+  float light_pick() const { return light_pick_; }  // the probability of picking each light
+  bool lens_hits() const { return lens_hits_; }     // light subpaths may end on the lens (t = 0 runs)
+  // Bit s of runs_mask(n): the profile runs the plain join (s, n - s).
+  std::uint64_t runs_mask(int n) const { return runs_mask_[static_cast<std::size_t>(n)]; }
+  const std::string& light_pair(int light) const { return light_pairs_[static_cast<std::size_t>(light)]; }  // c0 c1
+  const std::string& sensor_pair() const { return sensor_pair_; }  // c(k+1) c(k+2)
+
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
   // Densities as the MIS ratios keep them: a Dirac part's is stored as 0.
   static float finite_part(float pdf, bool delta) { return delta ? 0.0f : pdf; }
@@ -402,16 +413,13 @@ class Integrator {
   // The estimator's one consumer of joins: weighs th.join by MIS over every strategy of the
   // profile, then records it, or queues its segments and records it once all are found clear.
   void estimate(Thread& th, int batch) const;
-  // The full-path letters of the path made by s light and t eye vertices (with `sampled`
-  // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
-  // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
-  void full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const;
   void record(Thread& th, const Pending& r) const;
   // A contribution that is not finite (a bug: counted, and the first one kept for the warning).
   // Out of line and cold, so that record()'s code stays small.
   [[gnu::cold, gnu::noinline]] void record_nonfinite(Thread& th, const Pending& r) const;
   void trace_shadows(Thread& th) const;
 
+ private:
   const RenderScene& rs_;
   const RenderSensor& cam_;
   const StrategySet& strategies_;

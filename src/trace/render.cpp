@@ -4,17 +4,19 @@
 // from a light, each extended by local sampling (BSDF sampling, Russian roulette from
 // RenderOptions::rr_depth vertices on, below rr_threshold; at most max_bounces interior vertices
 // on the full path).
-// Then every (s, t) pair the profile runs is evaluated: s = 0 an eye vertex on an area light,
-// s = 1 a fresh light sample (next-event estimation), t = 1 a fresh sensor sample (a splat), t = 0
-// a light vertex on a thin lens, otherwise a shadow ray between y(s-1) and z(t-1).
+// Then every (s, chain, t) the profile runs is joined (trace/joins/: s = 0 an eye vertex on an
+// area light, s = 1 a fresh light sample (next-event estimation), t = 1 a fresh sensor sample (a
+// splat), t = 0 a light vertex on a thin lens, otherwise a shadow ray between y(s-1) and z(t-1);
+// and the connectors), each join weighed by MIS (mis_weight.cpp) and recorded by estimate():
+// subpaths, joins, weight, record.
 //
 // Labels: each vertex keeps the letter of the scattering event sampled there (the component a
 // BSDF chose; a light's and a sensor's two letters). The full-path string of a connection is
 // those letters in light-to-eye order with the two join letters set to D (a join evaluates only
 // finite parts). A strategy (s', t') has nonzero density for that string exactly when the
 // profile runs it and the string's letters c(s') and c(s'+1) are both D; the power heuristic
-// sums over those strategies only, using the pdf-ratio recurrence of pbrt's BDPT with Dirac
-// densities kept symbolic (stored as 0, remapped to 1, and their strategies excluded by letter).
+// sums over those strategies only (trace/mis.h), with Dirac densities kept symbolic (stored as
+// 0, counted as 1, and their strategies excluded by letter).
 #include "trace/render.h"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -244,34 +246,6 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   // MIS weight compares with the eye's.
   if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.light[1].pdf_fwd = parallel_jacobian(th.light[1], y0, r->direction);
   return n;
-}
-
-void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const {
-  const int k = s + t - 1;
-  out.clear();
-  if (k < 1) return;
-  out.assign(static_cast<std::size_t>(k) + 5, 'D');  // L c0 … c(k+2) E: c_i is out[i + 1]
-  out.front() = 'L';
-  out.back() = 'E';
-  auto vertex = [&](int i) -> const Vertex& {  // x_i in light-to-eye order
-    // A fresh sensor sample replaces z0 when t = 1; otherwise a fresh light sample replaces y0 when s = 1.
-    if (i < s) return (s == 1 && t != 1 && i == 0 && sampled) ? *sampled : th.light[static_cast<std::size_t>(i)];
-    const int j = k - i;
-    return (t == 1 && j == 0 && sampled) ? *sampled : th.eye[static_cast<std::size_t>(j)];
-  };
-  auto c = [&](int i) -> char& { return out[static_cast<std::size_t>(i) + 1]; };
-  // Light end: for s = 0 the eye path hit an area light, DD.
-  if (s > 0) {
-    c(0) = vertex(0).pos_letter;
-    c(1) = vertex(0).letter;
-  }
-  for (int i = 1; i <= k - 1; ++i) c(i + 1) = vertex(i).letter;
-  if (t > 0) {
-    c(k + 1) = vertex(k).letter;
-    c(k + 2) = vertex(k).pos_letter;
-  }
-  c(s) = 'D';
-  c(s + 1) = 'D';
 }
 
 void Integrator::record(Thread& th, const Pending& r) const {
