@@ -196,7 +196,7 @@ class Integrator {
   // The packed full-path string of connection (s, t): the vertices' letters in light-to-eye order,
   // the two join letters D (a fresh endpoint `sampled` standing for y0 when s = 1, t != 1).
   // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
-  [[gnu::always_inline]] PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
+  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
     PathKey m = 0;
     if (s > 0) {
       m = th.light_mask & (bit(s + 1) - 1);
@@ -314,14 +314,11 @@ class Integrator {
   }
 
   // --- subpaths ---
-  // Forced inline, as connect() below: each instantiation has one caller, and as out-of-line calls
-  // (the class is shared with the tests, so its members are not local to render.cpp) they cost
-  // about 2 % of pt-nee's instructions.
   // A template on the direction: the walk's tests of its direction are not branches. What the
   // scene cannot have (features_, trace/scene_features.h) it skips.
   template <TransportMode mode>
-  [[gnu::always_inline]] inline int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
-                  float pdf_dir, int max_vertices) const;
+  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d, float pdf_dir,
+                  int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
   // u_ray: the numbers of the light's first direction (Sampler::at2d_now at kLightRayDim).
   int light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const;
