@@ -171,19 +171,16 @@ class Integrator {
   // A vertex's density as the MIS weight reads it, a Dirac's (stored as 0) counting as 1.
   static double remap(float f) { return remap_density(f); }
   // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key().
-  // And each vertex's densities for the MIS weight, a light vertex's eye-over-light ratio and an
-  // eye vertex's light-over-eye (the ones a join's weight reads).
+  // And each vertex's two densities for the MIS weight.
   void set_masks(Thread& th, int ns, int nt) const {
     th.joins_ready = true;
     for (int i = 0; i < ns; ++i) {
       const Vertex& y = th.light[static_cast<std::size_t>(i)];
-      const double light = remap(y.pdf_fwd), eye = remap(y.pdf_rev);
-      th.light_densities[static_cast<std::size_t>(i)] = {light, eye, 1.0, eye / light};
+      th.light_densities[static_cast<std::size_t>(i)] = {remap(y.pdf_fwd), remap(y.pdf_rev)};
     }
     for (int j = 0; j < nt; ++j) {
       const Vertex& z = th.eye[static_cast<std::size_t>(j)];
-      const double light = remap(z.pdf_rev), eye = remap(z.pdf_fwd);
-      th.eye_densities[static_cast<std::size_t>(j)] = {light, eye, light / eye, 1.0};
+      th.eye_densities[static_cast<std::size_t>(j)] = {remap(z.pdf_rev), remap(z.pdf_fwd)};
     }
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
