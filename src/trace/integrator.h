@@ -36,6 +36,11 @@ namespace pathex::tracer {
 using namespace accel;  // PathKey, PathIds
 static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
 
+// Passes go to batches round-robin: every batch covers the whole image, and an interrupted render
+// still spreads what it has over all batches (so its error is defined). Batches are independent:
+// under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
+inline int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % static_cast<std::uint64_t>(batches)); }
+
 class Integrator {
  public:
   Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o)
