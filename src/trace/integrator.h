@@ -1,7 +1,9 @@
 // The integrator behind render() (trace/render.h): bidirectional path sampling over a profile's
-// strategies, every sampled path labelled by its full-path string. The algorithm is in render.cpp;
-// this header declares it so that tests can drive it (tests/trace/mis_test.cpp checks its MIS
-// weights on re-split paths through IntegratorTestAccess).
+// strategies, every sampled path labelled by its full-path string. Its stages live in their own
+// files: the subpaths and the estimator in render.cpp, the joins in trace/joins/ (each makes one
+// JoinResult from the two subpaths), the MIS weight in mis_weight.cpp over the one routine of
+// trace/mis.h. This header declares it so that tests can drive the stages one at a time
+// (tests/trace/mis_test.cpp checks its MIS weights on re-split paths).
 #pragma once
 
 #include <algorithm>
@@ -33,6 +35,11 @@ namespace pathex::tracer {
 
 using namespace accel;  // PathKey, PathIds
 static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
+
+// Passes go to batches round-robin: every batch covers the whole image, and an interrupted render
+// still spreads what it has over all batches (so its error is defined). Batches are independent:
+// under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
+inline int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % static_cast<std::uint64_t>(batches)); }
 
 class Integrator {
  public:
@@ -170,19 +177,16 @@ class Integrator {
   // A vertex's density as the MIS weight reads it, a Dirac's (stored as 0) counting as 1.
   static double remap(float f) { return remap_density(f); }
   // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key().
-  // And each vertex's densities for the MIS weight, a light vertex's eye-over-light ratio and an
-  // eye vertex's light-over-eye (the ones a join's weight reads).
+  // And each vertex's two densities for the MIS weight.
   void set_masks(Thread& th, int ns, int nt) const {
     th.joins_ready = true;
     for (int i = 0; i < ns; ++i) {
       const Vertex& y = th.light[static_cast<std::size_t>(i)];
-      const double light = remap(y.pdf_fwd), eye = remap(y.pdf_rev);
-      th.light_densities[static_cast<std::size_t>(i)] = {light, eye, 1.0, eye / light};
+      th.light_densities[static_cast<std::size_t>(i)] = {remap(y.pdf_fwd), remap(y.pdf_rev)};
     }
     for (int j = 0; j < nt; ++j) {
       const Vertex& z = th.eye[static_cast<std::size_t>(j)];
-      const double light = remap(z.pdf_rev), eye = remap(z.pdf_fwd);
-      th.eye_densities[static_cast<std::size_t>(j)] = {light, eye, light / eye, 1.0};
+      th.eye_densities[static_cast<std::size_t>(j)] = {remap(z.pdf_rev), remap(z.pdf_fwd)};
     }
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
@@ -192,9 +196,10 @@ class Integrator {
       th.eye_masks[static_cast<std::size_t>(t)] =
           (th.eye_masks[static_cast<std::size_t>(t - 1)] << 1) | letter_bit(th.eye[static_cast<std::size_t>(t - 1)].letter, 0);
   }
-  // The packed full-path string of connection (s, t), as full_path() spells it.
+  // The packed full-path string of connection (s, t): the vertices' letters in light-to-eye order,
+  // the two join letters D (a fresh endpoint `sampled` standing for y0 when s = 1, t != 1).
   // (A projection connector's chain keeps its S letter: the caller sets that bit afterwards.)
-  [[gnu::always_inline]] PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
+  PathKey path_key(const Thread& th, int s, int t, const Vertex* sampled) const {
     PathKey m = 0;
     if (s > 0) {
       m = th.light_mask & (bit(s + 1) - 1);
@@ -221,8 +226,16 @@ class Integrator {
     for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].flush(images, static_cast<int>(x), y);
   }
 
- private:
-  friend struct IntegratorTestAccess;  // tests/trace/mis_test.cpp: checks the MIS weights on re-split paths
+  // The stages below are public: tests drive them one at a time (tests/trace/mis_test.cpp
+  // re-splits paths and checks their MIS weights); only the state is private.
+  const RenderScene& scene() const { return rs_; }
+  float light_pick() const { return light_pick_; }  // the probability of picking each light
+  bool lens_hits() const { return lens_hits_; }     // light subpaths may end on the lens (t = 0 runs)
+  // Bit s of runs_mask(n): the profile runs the plain join (s, n - s).
+  std::uint64_t runs_mask(int n) const { return runs_mask_[static_cast<std::size_t>(n)]; }
+  const std::string& light_pair(int light) const { return light_pairs_[static_cast<std::size_t>(light)]; }  // c0 c1
+  const std::string& sensor_pair() const { return sensor_pair_; }  // c(k+1) c(k+2)
+
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
   // Densities as the MIS ratios keep them: a Dirac part's is stored as 0.
   static float finite_part(float pdf, bool delta) { return delta ? 0.0f : pdf; }
@@ -304,14 +317,11 @@ class Integrator {
   }
 
   // --- subpaths ---
-  // Forced inline, as connect() below: each instantiation has one caller, and as out-of-line calls
-  // (the class is shared with the tests, so its members are not local to render.cpp) they cost
-  // about 2 % of pt-nee's instructions.
   // A template on the direction: the walk's tests of its direction are not branches. What the
   // scene cannot have (features_, trace/scene_features.h) it skips.
   template <TransportMode mode>
-  [[gnu::always_inline]] inline int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
-                  float pdf_dir, int max_vertices) const;
+  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d, float pdf_dir,
+                  int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
   // u_ray: the numbers of the light's first direction (Sampler::at2d_now at kLightRayDim).
   int light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const;
@@ -403,16 +413,13 @@ class Integrator {
   // The estimator's one consumer of joins: weighs th.join by MIS over every strategy of the
   // profile, then records it, or queues its segments and records it once all are found clear.
   void estimate(Thread& th, int batch) const;
-  // The full-path letters of the path made by s light and t eye vertices (with `sampled`
-  // replacing y0 for s = 1 or z0 for t = 1), join letters set to D. "" if the path is too short.
-  // Writes into `out`, a per-thread buffer, so that labelling allocates nothing.
-  void full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const;
   void record(Thread& th, const Pending& r) const;
   // A contribution that is not finite (a bug: counted, and the first one kept for the warning).
   // Out of line and cold, so that record()'s code stays small.
   [[gnu::cold, gnu::noinline]] void record_nonfinite(Thread& th, const Pending& r) const;
   void trace_shadows(Thread& th) const;
 
+ private:
   const RenderScene& rs_;
   const RenderSensor& cam_;
   const StrategySet& strategies_;

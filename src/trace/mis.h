@@ -25,17 +25,10 @@
 namespace pathex::tracer::mis {
 
 // Vertex x_i's area densities: as the light walk samples it (`light`) and as the eye walk does
-// (`eye`), Dirac densities counted as 1 (tracer::remap_density()); and their two ratios, which the
-// weight multiplies by going towards the eye (`right` = light / eye) and towards the light (`left`
-// = eye / light). The ratios are kept so that a subpath's vertices divide once per sample, not
-// once per join: a caller may fill only the ratio the weight will read (the one pointing away
-// from the own strategy's split).
+// (`eye`), Dirac densities counted as 1 (tracer::remap_density()).
 struct Densities {
   double light = 1.0;
   double eye = 1.0;
-  double right = 1.0;
-  double left = 1.0;
-  static Densities of(double light, double eye) { return {light, eye, light / eye, eye / light}; }
 };
 
 // A strategy that samples the path: the light walk up to x(split-1), the eye walk from
@@ -108,13 +101,13 @@ inline float weight(const PathDensities& x, const Strategies& st, int lo, int hi
   double plain_sum = 0.0;
   double r = 1.0;
   for (int i = b + 1; i <= hi; ++i) {
-    r *= x[i - 1].right;
+    r *= x[i - 1].light / x[i - 1].eye;
     if (keep) rel[i - lo] = r;
     if ((st.plain >> i) & 1) plain_sum += r * r;
   }
   r = 1.0;
   for (int i = b - 1; i >= lo; --i) {
-    r *= x[i].left;
+    r *= x[i].eye / x[i].light;
     if (keep) rel[i - lo] = r;
     if ((st.plain >> i) & 1) plain_sum += r * r;
   }

@@ -71,24 +71,15 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
   const int s = x.s, t = x.t, n = x.size();
   // The subpaths' own densities, as set_masks() stored them once per sample, are overwritten in
   // place where the join changes them (mis_weight() restores them). A fresh endpoint's: its
-  // forward density, the reverse one set below. The own split is s, so the weight reads a light
-  // vertex's `left` ratio and an eye vertex's `right`.
+  // forward density, the reverse one set below.
   const auto at = [&](int v) -> mis::Densities& {
     return v < s ? th.light_densities[static_cast<std::size_t>(v)] : th.eye_densities[static_cast<std::size_t>(n - 1 - v)];
   };
-  if (x.light0) at(0) = {remap(x.light0->pdf_fwd), 1.0, 1.0, 1.0};
-  if (x.eye0) at(n - 1) = {1.0, remap(x.eye0->pdf_fwd), 1.0, 1.0};
+  if (x.light0) at(0) = {remap(x.light0->pdf_fwd), 1.0};
+  if (x.eye0) at(n - 1) = {1.0, remap(x.eye0->pdf_fwd)};
   const auto needed = [&](int v) { return v >= lo && v < hi; };
-  const auto set_light = [&](int v, float f) {  // an eye-side vertex's light density
-    mis::Densities& d = at(v);
-    d.light = remap(f);
-    d.right = d.light / d.eye;
-  };
-  const auto set_eye = [&](int v, float f) {  // a light-side vertex's eye density
-    mis::Densities& d = at(v);
-    d.eye = remap(f);
-    d.left = d.eye / d.light;
-  };
+  const auto set_light = [&](int v, float f) { at(v).light = remap(f); };  // an eye-side vertex's light density
+  const auto set_eye = [&](int v, float f) { at(v).eye = remap(f); };      // a light-side vertex's eye density
   // --- the four reverse densities the join changes: qs = x(s-1), its predecessor qsm, pt = x_s, ptm ---
   // Every direction is at hand: the join's (w, from qs to pt, at squared distance d2) and each
   // vertex's unit direction to its predecessor (wo, at d2_wo); no normalisation is needed.
@@ -148,7 +139,7 @@ void Integrator::path_densities(Thread& th, const PathView& x, PathKey key, int 
     if (letter_s(v + 2)) return 0.0f;  // x(v+1) is a Dirac
     return pdf(v + 2 <= k ? &x[v + 2] : nullptr, x[v + 1], x[v]);
   };
-  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = mis::Densities::of(remap(lf(v)), remap(ef(v)));
+  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = mis::Densities{remap(lf(v)), remap(ef(v))};
 }
 
 float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const {

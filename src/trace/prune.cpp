@@ -1,3 +1,6 @@
+// The tracer's side of --only (trace/prune.h): whether a sampled path is recorded, and whether a
+// growing subpath can still complete to a requested class, read off the classifier's automata so
+// that what is pruned is exactly what no requested class contains (DESIGN §11).
 #include "trace/prune.h"
 
 #include <algorithm>

@@ -4,26 +4,23 @@
 // from a light, each extended by local sampling (BSDF sampling, Russian roulette from
 // RenderOptions::rr_depth vertices on, below rr_threshold; at most max_bounces interior vertices
 // on the full path).
-// Then every (s, t) pair the profile runs is evaluated: s = 0 an eye vertex on an area light,
-// s = 1 a fresh light sample (next-event estimation), t = 1 a fresh sensor sample (a splat), t = 0
-// a light vertex on a thin lens, otherwise a shadow ray between y(s-1) and z(t-1).
+// Then every (s, chain, t) the profile runs is joined (trace/joins/: s = 0 an eye vertex on an
+// area light, s = 1 a fresh light sample (next-event estimation), t = 1 a fresh sensor sample (a
+// splat), t = 0 a light vertex on a thin lens, otherwise a shadow ray between y(s-1) and z(t-1);
+// and the connectors), each join weighed by MIS (mis_weight.cpp) and recorded by estimate():
+// subpaths, joins, weight, record.
 //
 // Labels: each vertex keeps the letter of the scattering event sampled there (the component a
 // BSDF chose; a light's and a sensor's two letters). The full-path string of a connection is
 // those letters in light-to-eye order with the two join letters set to D (a join evaluates only
 // finite parts). A strategy (s', t') has nonzero density for that string exactly when the
 // profile runs it and the string's letters c(s') and c(s'+1) are both D; the power heuristic
-// sums over those strategies only, using the pdf-ratio recurrence of pbrt's BDPT with Dirac
-// densities kept symbolic (stored as 0, remapped to 1, and their strategies excluded by letter).
+// sums over those strategies only (trace/mis.h), with Dirac densities kept symbolic (stored as
+// 0, counted as 1, and their strategies excluded by letter).
 #include "trace/render.h"
-
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
 
 #include <array>
 #include <bit>
-#include <chrono>
 #include <cmath>
 
 #include "trace/accel/path_ids.h"
@@ -38,30 +35,8 @@
 
 namespace pathex {
 
-// --- strategies the tracer runs ---
-
-Result<StrategySet> runnable_strategies(const Profile& profile) {
-  StrategySet set;
-  for (const Strategy& st : profile.strategies) {
-    // The manifold connector's seed leaves a surface vertex of the eye subpath (trace/joins/manifold.h).
-    if (st.connector == ConnectorKind::kManifold && st.t.contains(1))
-      return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' runs the manifold connector with t = 1 (strategy '" +
-                                               st.name + "'), which the tracer does not run: its eye end must be a surface "
-                                               "vertex of the eye subpath, t >= 2");
-    set.strategies.push_back(st);
-  }
-  return set;
-}
-
 namespace tracer {
 namespace {
-// Passes go to batches round-robin: every batch covers the whole image, and an interrupted render
-// still spreads what it has over all batches (so its error is defined). Batches are independent:
-// under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
-// Paths a thread's histogram has room for before it first regrows (address space only).
-constexpr std::size_t kReservedPaths = std::size_t{1} << 14;
-
-int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % static_cast<std::uint64_t>(batches)); }
 
 // Random-number dimensions (trace/rng.h): each stage of a sample draws from its own block, so that
 // adding a strategy leaves every other strategy's numbers unchanged. The eye and the light subpath
@@ -251,34 +226,6 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   return n;
 }
 
-void Integrator::full_path(const Thread& th, int s, int t, const Vertex* sampled, std::string& out) const {
-  const int k = s + t - 1;
-  out.clear();
-  if (k < 1) return;
-  out.assign(static_cast<std::size_t>(k) + 5, 'D');  // L c0 … c(k+2) E: c_i is out[i + 1]
-  out.front() = 'L';
-  out.back() = 'E';
-  auto vertex = [&](int i) -> const Vertex& {  // x_i in light-to-eye order
-    // A fresh sensor sample replaces z0 when t = 1; otherwise a fresh light sample replaces y0 when s = 1.
-    if (i < s) return (s == 1 && t != 1 && i == 0 && sampled) ? *sampled : th.light[static_cast<std::size_t>(i)];
-    const int j = k - i;
-    return (t == 1 && j == 0 && sampled) ? *sampled : th.eye[static_cast<std::size_t>(j)];
-  };
-  auto c = [&](int i) -> char& { return out[static_cast<std::size_t>(i) + 1]; };
-  // Light end: for s = 0 the eye path hit an area light, DD.
-  if (s > 0) {
-    c(0) = vertex(0).pos_letter;
-    c(1) = vertex(0).letter;
-  }
-  for (int i = 1; i <= k - 1; ++i) c(i + 1) = vertex(i).letter;
-  if (t > 0) {
-    c(k + 1) = vertex(k).letter;
-    c(k + 2) = vertex(k).pos_letter;
-  }
-  c(s) = 'D';
-  c(s + 1) = 'D';
-}
-
 void Integrator::record(Thread& th, const Pending& r) const {
   const Rgb rgb{r.c.x, r.c.y, r.c.z};
   ExactRgb e;
@@ -423,114 +370,5 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
 
 
 }  // namespace tracer
-
-using tracer::Integrator;
-
-Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
-                            const RenderOptions& options) {
-  Result<StrategySet> strategies = runnable_strategies(profile);
-  if (!strategies) return strategies.error();
-  Result<RenderScene> rs = make_render_scene(scene);
-  if (!rs) return rs.error();
-  RenderOptions o = options;
-  // The same rule as the checker's: an explicit bound overrides the profile's own.
-  if (!o.max_bounces) o.max_bounces = profile.max_bounces.value_or(16);
-  HistogramLayout layout;
-  layout.num_batches = o.batches;
-  for (const Strategy& st : strategies->strategies) layout.strategies.push_back(st.name);
-
-  RenderOutput out{Histogram(layout, classifier),
-                   o.images ? ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes)
-                            : ClassImages(0, 0, nullptr, {}),
-                   layout.strategies};
-  Integrator integrator(*rs, *strategies, o);
-  const std::size_t area_lights = rs->lights.size() - scene.lights.size();  // the emissive shapes come first
-  for (std::size_t i = area_lights; i < rs->lights.size(); ++i)
-    if (const std::optional<EmissionCones>& c = integrator.aimed(i))
-      out.aimed.push_back({static_cast<int>(i - area_lights), std::holds_alternative<PointLightParams>(rs->lights[i].params) ? "point" : "spot",
-                           c->size(), c->share()});
-  const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
-  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
-  tbb::enumerable_thread_specific<Integrator::Thread> locals(
-      [&] {
-        Integrator::Thread th{Histogram(layout, classifier),
-                              std::vector<ClassImages::PixelSum>(static_cast<std::size_t>(out.images.width()), ClassImages::PixelSum(out.images)),
-                              {}, {}, 0, {}, {}, {}};
-        // Room for many paths and technique rows at once: the histogram keeps each of its batches'
-        // cells and row sums in a row of its own, and a render finds new paths to the end (the
-        // rare long ones), so regrowing moved every row into fresh pages, again and again (a
-        // quarter of pt-nee's CPU time on the embedded Cornell box at 128 spp went to the copies
-        // and their page faults). Address space only: pages are touched as paths arrive.
-        th.hist.reserve_paths(tracer::kReservedPaths);
-        th.hist.reserve_rows(2 * tracer::kReservedPaths);
-        th.images = &out.images;
-        th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
-        th.connectors.resize(strategies->strategies.size());
-        return th;
-      });
-  const int w = rs->camera.width, h = rs->camera.height;
-  const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-  const auto start = std::chrono::steady_clock::now();
-  // Passes run in chunks: a pixel takes a chunk's passes back to back, so that its camera
-  // contributions reach the shared image once per chunk (and its part of the scene stays in
-  // cache); cancelling stops on a whole chunk, so every finished pass covers the whole image. The
-  // chunks come from a deal (core/pass_deal.h): this render's passes in order, or an MPI job's.
-  ChunkDeal own(o.passes.value_or(PassSet::range(0, o.spp)), kPassesPerChunk);
-  PassDealer& deal = o.dealer != nullptr ? *o.dealer : own;
-  bool dealt_all = false;
-  while (!(o.cancel && o.cancel->load())) {
-    const std::optional<PassRange> chunk = deal.next();
-    if (!chunk) {
-      dealt_all = true;
-      break;
-    }
-    const std::uint64_t first = chunk->first, end = chunk->last;
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& rows) {
-      Integrator::Thread& th = locals.local();
-      for (int y = rows.begin(); y < rows.end(); ++y) {
-        for (int x = 0; x < w; ++x)
-          for (std::uint64_t p = first; p < end; ++p) integrator.sample(th, x, y, p);
-        integrator.finish_row(th, out.images, y);
-      }
-    });
-    for (std::uint64_t p = first; p < end; ++p) out.histogram.add_samples(tracer::batch_of(p, o.batches), pixels);
-    out.passes_done.add(first, end);
-    if (o.progress) o.progress(deal.dealt() * pixels, deal.total() * pixels);
-  }
-  out.spp_done = out.passes_done.count();
-  out.complete = dealt_all;
-  // The threads' histograms are summed into the first of them, which then takes the place of
-  // the output's (holding only the sample counts so far): one fewer copy of every path, and of
-  // its classification. Ids are local to a histogram, so which thread comes first does not show.
-  std::optional<Histogram> summed;
-  for (Integrator::Thread& th : locals) {
-    th.splats.flush(out.images);
-    th.ids.flush(th.hist);
-    if (!summed) {
-      summed.emplace(std::move(th.hist));
-    } else {
-      Result<bool> m = summed->merge(th.hist);
-      if (!m) return m.error();
-    }
-    out.rays += th.rays;
-    if (th.first_nonfinite && (!out.first_nonfinite || th.first_nonfinite->order() < out.first_nonfinite->order()))
-      out.first_nonfinite = th.first_nonfinite;
-  }
-  if (summed) {
-    Result<bool> m = summed->merge(out.histogram);  // the sample counts of every batch
-    if (!m) return m.error();
-    out.histogram = std::move(*summed);
-  }
-  // Connector statistics, in the profile's order (integer sums: the same for every thread count).
-  for (std::size_t i = 0; i < strategies->strategies.size(); ++i) {
-    const Strategy& st = strategies->strategies[i];
-    if (st.connector == ConnectorKind::kNone) continue;
-    ConnectorStats total{st.name, to_string(st.connector)};
-    for (const Integrator::Thread& th : locals) total += th.connectors[i];
-    out.connectors.push_back(total);
-  }
-  out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
-}
 
 }  // namespace pathex

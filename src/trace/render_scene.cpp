@@ -1,3 +1,6 @@
+// make_render_scene() (trace/render_scene.h): a Scene flattened once per render into what the
+// integrator's hot loop reads (the Embree geometry, each shape's material and emitter, the lights
+// and the sensor as handles of the one emitter model), with the scene's refusals located.
 #include "trace/render_scene.h"
 
 #include <algorithm>

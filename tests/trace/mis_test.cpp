@@ -24,7 +24,7 @@
 
 namespace pathex::tracer {
 
-// The test's access to the integrator's internals: drives its subpaths and joins by hand.
+// Drives the integrator's stages by hand (its public interface): subpaths, joins, weights.
 struct IntegratorTestAccess {
   using Thread = Integrator::Thread;
   // One sample's eye and light subpaths, as render() traces them.
@@ -39,9 +39,29 @@ struct IntegratorTestAccess {
     return nt;
   }
   // The full-path string of connection (s, t), spelled out from the vertices.
-  static std::string label(const Integrator& in, const Integrator::Thread& th, int s, int t) {
-    std::string out;
-    in.full_path(th, s, t, nullptr, out);
+  // (The test's oracle for the renderer's packed labels, path_key(): L c0 … c(k+2) E from the
+  // vertices' letters, the two join letters D.)
+  static std::string label(const Integrator&, const Integrator::Thread& th, int s, int t) {
+    const int k = s + t - 1;
+    if (k < 1) return "";
+    std::string out(static_cast<std::size_t>(k) + 5, 'D');
+    out.front() = 'L';
+    out.back() = 'E';
+    const auto vertex = [&](int i) -> const Vertex& {  // x_i in light-to-eye order
+      return i < s ? th.light[static_cast<std::size_t>(i)] : th.eye[static_cast<std::size_t>(k - i)];
+    };
+    const auto c = [&](int i) -> char& { return out[static_cast<std::size_t>(i) + 1]; };
+    if (s > 0) {  // for s = 0 the eye path hit an area light: DD
+      c(0) = vertex(0).pos_letter;
+      c(1) = vertex(0).letter;
+    }
+    for (int i = 1; i <= k - 1; ++i) c(i + 1) = vertex(i).letter;
+    if (t > 0) {
+      c(k + 1) = vertex(k).letter;
+      c(k + 2) = vertex(k).pos_letter;
+    }
+    c(s) = 'D';
+    c(s + 1) = 'D';
     return out;
   }
   // The same string as the renderer records it (packed, then spelled out).
@@ -71,7 +91,7 @@ struct IntegratorTestAccess {
     for (int j = t - 1; j >= 0; --j) path.push_back(th.eye[static_cast<std::size_t>(j)]);
     if (s == 0) {
       path.front().kind = Kind::kLight;
-      path.front().light = in.rs_.light_of_shape[static_cast<std::size_t>(path.front().shape)];
+      path.front().light = in.scene().light_of_shape[static_cast<std::size_t>(path.front().shape)];
     }
     if (t == 0) path.back().kind = Kind::kCamera;
     return path;
@@ -101,7 +121,7 @@ struct IntegratorTestAccess {
     double sum = 0.0;
     *chains = 0;
     for (int s2 = 0; s2 <= n; ++s2)
-      if (((in.runs_mask_[static_cast<std::size_t>(n)] >> s2) & 1) && packed_is_d(key, s2) && packed_is_d(key, s2 + 1))
+      if (((in.runs_mask(n) >> s2) & 1) && packed_is_d(key, s2) && packed_is_d(key, s2 + 1))
         sum += in.mis_weight(th, whole(path, s2, 0), key, ConnectorKind::kNone, nullptr);
     for (int i = 1; i <= k - 1; ++i) {
       int m = 0;
@@ -118,25 +138,25 @@ struct IntegratorTestAccess {
   // no DD join (no light, a Dirac light, z(t-1) not a finite surface).
   static bool nee_join(const Integrator& in, const Thread& th, int t, Sampler& rng, Vertex* y0, JoinDensity* join) {
     const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
-    if (pt.kind != Kind::kSurface || !pt.finite || in.rs_.lights.empty()) return false;
+    if (pt.kind != Kind::kSurface || !pt.finite || in.scene().lights.empty()) return false;
     const std::size_t li = in.pick_light(rng);
-    const RenderLight& l = in.rs_.lights[li];
-    if (in.light_pairs_[li][1] != 'D') return false;
+    const RenderLight& l = in.scene().lights[li];
+    if (in.light_pair(static_cast<int>(li))[1] != 'D') return false;
     vec3 err{0.0f};
     const std::optional<EndpointConnection> c = pathex::connect(l.params, in.sample_point(l, rng, &err), pt.p);
     if (!c) return false;
     *y0 = Vertex{};
     y0->kind = Kind::kLight;
     y0->light = static_cast<int>(li);
-    y0->pos_letter = in.light_pairs_[li][0];
+    y0->pos_letter = in.light_pair(static_cast<int>(li))[0];
     y0->letter = 'D';
     y0->p = c->position;
     y0->n = c->normal;
     y0->ns = y0->n;
     y0->err = err;
-    y0->pdf_fwd = in.light_pick_ * l.pdf_pos;
+    y0->pdf_fwd = in.light_pick() * l.pdf_pos;
     *join = JoinDensity{};
-    bsdf::eval(*in.rs_.material_of_shape[static_cast<std::size_t>(pt.shape)], pt.wo, c->wi, pt.ns, pt.n, &join->at_pt);
+    bsdf::eval(*in.scene().material_of_shape[static_cast<std::size_t>(pt.shape)], pt.wo, c->wi, pt.ns, pt.n, &join->at_pt);
     join->w = -c->wi;
     join->d2 = c->distance * c->distance;
     return true;
@@ -148,19 +168,19 @@ struct IntegratorTestAccess {
   }
   // The density with which next-event estimation draws the point `on_light` of an area light.
   static float light_point_density(const Integrator& in, const Vertex& on_light) {
-    return in.light_pick_ * in.rs_.lights[static_cast<std::size_t>(in.rs_.light_of_shape[static_cast<std::size_t>(on_light.shape)])].pdf_pos;
+    return in.light_pick() * in.scene().lights[static_cast<std::size_t>(in.scene().light_of_shape[static_cast<std::size_t>(on_light.shape)])].pdf_pos;
   }
-  static const Material& material(const Integrator& in, const Vertex& v) { return *in.rs_.material_of_shape[static_cast<std::size_t>(v.shape)]; }
+  static const Material& material(const Integrator& in, const Vertex& v) { return *in.scene().material_of_shape[static_cast<std::size_t>(v.shape)]; }
   // Whether (s, t) joins two vertices that can be joined (s = 0: an eye vertex on an area light;
   // t = 0: a light vertex on the lens; otherwise two surfaces with finite parts).
   static bool joinable(const Integrator& in, const Integrator::Thread& th, int s, int t) {
     const Vertex* qs = s > 0 ? &th.light[static_cast<std::size_t>(s - 1)] : nullptr;
     const Vertex* pt = t > 0 ? &th.eye[static_cast<std::size_t>(t - 1)] : nullptr;
-    if (s == 0) return pt->kind == Kind::kSurface && in.rs_.light_of_shape[static_cast<std::size_t>(pt->shape)] >= 0;
+    if (s == 0) return pt->kind == Kind::kSurface && in.scene().light_of_shape[static_cast<std::size_t>(pt->shape)] >= 0;
     if (t == 0) return qs->kind == Kind::kLens;
     return qs->kind == Kind::kSurface && pt->kind == Kind::kSurface &&
-           bsdf::has_finite_component(*in.rs_.material_of_shape[static_cast<std::size_t>(qs->shape)]) &&
-           bsdf::has_finite_component(*in.rs_.material_of_shape[static_cast<std::size_t>(pt->shape)]);
+           bsdf::has_finite_component(*in.scene().material_of_shape[static_cast<std::size_t>(qs->shape)]) &&
+           bsdf::has_finite_component(*in.scene().material_of_shape[static_cast<std::size_t>(pt->shape)]);
   }
   // For the full path x0 … xk formed by connection (s, t) of the current subpaths: the sum, over
   // every strategy (s', t') with s' + t' = s + t that the profile runs and whose join letters are
@@ -174,9 +194,9 @@ struct IntegratorTestAccess {
     for (int j = t - 1; j >= 0; --j) x.push_back(th.eye[static_cast<std::size_t>(j)]);
     if (s == 0) {  // the eye vertex on the emitter becomes the light vertex
       x[0].kind = Kind::kLight;
-      x[0].light = in.rs_.light_of_shape[static_cast<std::size_t>(x[0].shape)];
-    } else if (in.rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) {
-      x[0].shape = in.rs_.lights[static_cast<std::size_t>(x[0].light)].shape;  // so an eye path may hit it
+      x[0].light = in.scene().light_of_shape[static_cast<std::size_t>(x[0].shape)];
+    } else if (in.scene().lights[static_cast<std::size_t>(x[0].light)].is_area()) {
+      x[0].shape = in.scene().lights[static_cast<std::size_t>(x[0].light)].shape;  // so an eye path may hit it
     }
     const std::string letters = label(in, th, s, t);
     const Thread saved_light_eye = th;  // NOLINT: the subpaths, restored below
@@ -185,8 +205,8 @@ struct IntegratorTestAccess {
       const int t2 = k + 1 - s2;
       const auto letters_at = [&](int i, int count) { return letters.substr(static_cast<std::size_t>(i) + 1, static_cast<std::size_t>(count)); };
       bool plain = in.strategy(s2, t2) >= 0 && letters_at(s2, 2) == "DD";
-      if (t2 == 0 && !in.lens_hits_) plain = false;
-      if (s2 == 0 && x[0].kind == Kind::kLight && !in.rs_.lights[static_cast<std::size_t>(x[0].light)].is_area()) plain = false;
+      if (t2 == 0 && !in.lens_hits()) plain = false;
+      if (s2 == 0 && x[0].kind == Kind::kLight && !in.scene().lights[static_cast<std::size_t>(x[0].light)].is_area()) plain = false;
       const bool distant = s2 == 1 && in.distant_of(t2) >= 0 && letters_at(0, 3) == "DSD";
       const bool ortho = t2 == 1 && in.ortho_of(s2) >= 0 && letters_at(k, 3) == "DSD";
       if (!plain && !distant && !ortho) continue;
@@ -197,7 +217,7 @@ struct IntegratorTestAccess {
       for (int j = 0; j < t2; ++j) th.eye[static_cast<std::size_t>(j)] = x[static_cast<std::size_t>(k - j)];
       if (s2 > 0) {
         th.light[0].kind = Kind::kLight;
-        th.light[0].pdf_fwd = in.light_pick_ * in.rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+        th.light[0].pdf_fwd = in.light_pick() * in.scene().lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
       }
       if (s2 == 0) {
         th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;
@@ -225,7 +245,7 @@ struct IntegratorTestAccess {
             specular(i + 1) ? 0.0f
                             : in.pdf(&th.light[static_cast<std::size_t>(i + 2)], th.light[static_cast<std::size_t>(i + 1)],
                                   th.light[static_cast<std::size_t>(i)]);
-      if (t2 > 0) th.eye[0].pdf_fwd = in.cam_.pdf_pos;
+      if (t2 > 0) th.eye[0].pdf_fwd = in.scene().camera.pdf_pos;
       for (int j = 1; j < t2; ++j)
         th.eye[static_cast<std::size_t>(j)].pdf_fwd =
             specular(k - (j - 1)) ? 0.0f
@@ -238,9 +258,9 @@ struct IntegratorTestAccess {
                                         th.eye[static_cast<std::size_t>(j)]);
       // Parallel beams (a distant light's, an orthographic sensor's) give their first vertex a
       // density per area, as light_subpath() and eye_subpath() set it.
-      if (s2 >= 2 && th.light[0].pdf_fwd > 0.0f && in.light_pairs_[static_cast<std::size_t>(th.light[0].light)][1] == 'S')
+      if (s2 >= 2 && th.light[0].pdf_fwd > 0.0f && in.light_pair(th.light[0].light)[1] == 'S')
         th.light[1].pdf_fwd = Integrator::parallel_jacobian(th.light[1], th.light[0], glm::normalize(th.light[1].p - th.light[0].p));
-      if (t2 >= 2 && in.cam_.pdf_pos > 0.0f && in.sensor_pair_[0] == 'S')
+      if (t2 >= 2 && in.scene().camera.pdf_pos > 0.0f && in.sensor_pair()[0] == 'S')
         th.eye[1].pdf_fwd = Integrator::parallel_jacobian(th.eye[1], th.eye[0], glm::normalize(th.eye[1].p - th.eye[0].p));
       in.set_masks(th, s2, t2);
       sum += in.mis_weight(th, plain_path(th, s2, t2), pack(letters), kind, nullptr);

@@ -17,7 +17,7 @@
 
 namespace pathex::tracer {
 
-// The test's access to the integrator's subpaths (as tests/trace/mis_test.cpp's).
+// The integrator's subpaths, traced by its public stages (as tests/trace/mis_test.cpp drives them).
 struct IntegratorTestAccess {
   static int eye(const Integrator& in, Integrator::Thread& th, Sampler& rng, int px, int py) { return in.eye_subpath(th, rng, px, py); }
   // The light's first direction drawn in advance, after its pick and point (render.cpp's kLightRayDim).

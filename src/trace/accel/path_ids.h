@@ -48,11 +48,12 @@ inline PathKey pack(const std::string& letters) {  // "L c0 … E"
 // Layout, for the hot lookup: a slot is 32 bytes (two per cache line; the key as two words, the
 // count in 32 bits, handed over before it can wrap), and the strings seen so far have a table of
 // their own, read only when a pair is new, so that a string's second technique does not unpack it
-// and hash it as a string again. (FlushAt is the count at which a slot hands its contributions
-// over before its 32 bits wrap; a test lowers it.)
-template <std::uint32_t FlushAt = 0xffffffffu>
-class BasicPathIds {
+// and hash it as a string again. (`flush_at` is the count at which a slot hands its contributions
+// over before its 32 bits wrap: 2^32 - 1 unless given, which a test lowers.)
+class PathIds {
  public:
+  PathIds() = default;
+  explicit PathIds(std::uint32_t flush_at) : flush_at_(flush_at) {}
   struct Ids {
     Histogram::PathId path = -1;
     int row = -1;  // Histogram::technique_row() of the technique
@@ -63,7 +64,7 @@ class BasicPathIds {
     for (std::size_t i = hash(lo, hi, technique) & mask;; i = (i + 1) & mask) {
       Slot& slot = slots_[i];
       if (slot.lo == lo && slot.hi == hi && slot.technique == technique) {
-        if (++slot.contributions >= FlushAt) [[unlikely]]
+        if (++slot.contributions >= flush_at_) [[unlikely]]
           hand_over(hist, slot);
         return slot.ids;
       }
@@ -147,7 +148,7 @@ class BasicPathIds {
   std::size_t used_ = 0;
   std::vector<PathSlot> paths_ = std::vector<PathSlot>(256);
   std::size_t paths_used_ = 0;
+  std::uint32_t flush_at_ = 0xffffffffu;
 };
-using PathIds = BasicPathIds<>;
 
 }  // namespace pathex::accel

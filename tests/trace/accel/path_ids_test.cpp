@@ -60,7 +60,7 @@ TEST(PathIds, GivesTheHistogramsIdsAndRowsAndCountsEveryContributionOnce) {
 TEST(PathIds, HandsCountsOverBeforeTheyWrap) {
   // A slot that reaches its limit hands its count to the histogram at once (the default limit is
   // 2^32 - 1, which a test cannot reach): the totals are the same.
-  BasicPathIds<2> ids;
+  PathIds ids(/*flush_at=*/2);
   check_against_histogram(ids);
 }
 

@@ -1,0 +1,148 @@
+// The tracer's entry point, render() (trace/render.h): which profile strategies the tracer runs,
+// and the run itself: the threads (TBB), the passes dealt in chunks (core/pass_deal.h), each
+// thread's integrator state, and the threads' histograms, images and statistics summed into the
+// output. The estimator it drives, sample by sample, is render.cpp's Integrator.
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+
+#include "trace/integrator.h"
+#include "trace/render.h"
+#include "trace/render_scene.h"
+
+namespace pathex {
+
+// --- strategies the tracer runs ---
+
+Result<StrategySet> runnable_strategies(const Profile& profile) {
+  StrategySet set;
+  for (const Strategy& st : profile.strategies) {
+    // The manifold connector's seed leaves a surface vertex of the eye subpath (trace/joins/manifold.h).
+    if (st.connector == ConnectorKind::kManifold && st.t.contains(1))
+      return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' runs the manifold connector with t = 1 (strategy '" +
+                                               st.name + "'), which the tracer does not run: its eye end must be a surface "
+                                               "vertex of the eye subpath, t >= 2");
+    set.strategies.push_back(st);
+  }
+  return set;
+}
+
+namespace tracer {
+namespace {
+// Paths a thread's histogram has room for before it first regrows (address space only).
+constexpr std::size_t kReservedPaths = std::size_t{1} << 14;
+}  // namespace
+}  // namespace tracer
+
+using tracer::Integrator;
+
+Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
+                            const RenderOptions& options) {
+  Result<StrategySet> strategies = runnable_strategies(profile);
+  if (!strategies) return strategies.error();
+  Result<RenderScene> rs = make_render_scene(scene);
+  if (!rs) return rs.error();
+  RenderOptions o = options;
+  // The same rule as the checker's: an explicit bound overrides the profile's own.
+  if (!o.max_bounces) o.max_bounces = profile.max_bounces.value_or(16);
+  HistogramLayout layout;
+  layout.num_batches = o.batches;
+  for (const Strategy& st : strategies->strategies) layout.strategies.push_back(st.name);
+
+  RenderOutput out{Histogram(layout, classifier),
+                   o.images ? ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes)
+                            : ClassImages(0, 0, nullptr, {}),
+                   layout.strategies};
+  Integrator integrator(*rs, *strategies, o);
+  const std::size_t area_lights = rs->lights.size() - scene.lights.size();  // the emissive shapes come first
+  for (std::size_t i = area_lights; i < rs->lights.size(); ++i)
+    if (const std::optional<EmissionCones>& c = integrator.aimed(i))
+      out.aimed.push_back({static_cast<int>(i - area_lights), std::holds_alternative<PointLightParams>(rs->lights[i].params) ? "point" : "spot",
+                           c->size(), c->share()});
+  const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+  tbb::enumerable_thread_specific<Integrator::Thread> locals(
+      [&] {
+        Integrator::Thread th{Histogram(layout, classifier),
+                              std::vector<ClassImages::PixelSum>(static_cast<std::size_t>(out.images.width()), ClassImages::PixelSum(out.images)),
+                              {}, {}, 0, {}, {}, {}};
+        // Room for many paths and technique rows at once: the histogram keeps each of its batches'
+        // cells and row sums in a row of its own, and a render finds new paths to the end (the
+        // rare long ones), so regrowing moved every row into fresh pages, again and again (a
+        // quarter of pt-nee's CPU time on the embedded Cornell box at 128 spp went to the copies
+        // and their page faults). Address space only: pages are touched as paths arrive.
+        th.hist.reserve_paths(tracer::kReservedPaths);
+        th.hist.reserve_rows(2 * tracer::kReservedPaths);
+        th.images = &out.images;
+        th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
+        th.connectors.resize(strategies->strategies.size());
+        return th;
+      });
+  const int w = rs->camera.width, h = rs->camera.height;
+  const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+  const auto start = std::chrono::steady_clock::now();
+  // Passes run in chunks: a pixel takes a chunk's passes back to back, so that its camera
+  // contributions reach the shared image once per chunk (and its part of the scene stays in
+  // cache); cancelling stops on a whole chunk, so every finished pass covers the whole image. The
+  // chunks come from a deal (core/pass_deal.h): this render's passes in order, or an MPI job's.
+  ChunkDeal own(o.passes.value_or(PassSet::range(0, o.spp)), kPassesPerChunk);
+  PassDealer& deal = o.dealer != nullptr ? *o.dealer : own;
+  bool dealt_all = false;
+  while (!(o.cancel && o.cancel->load())) {
+    const std::optional<PassRange> chunk = deal.next();
+    if (!chunk) {
+      dealt_all = true;
+      break;
+    }
+    const std::uint64_t first = chunk->first, end = chunk->last;
+    tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& rows) {
+      Integrator::Thread& th = locals.local();
+      for (int y = rows.begin(); y < rows.end(); ++y) {
+        for (int x = 0; x < w; ++x)
+          for (std::uint64_t p = first; p < end; ++p) integrator.sample(th, x, y, p);
+        integrator.finish_row(th, out.images, y);
+      }
+    });
+    for (std::uint64_t p = first; p < end; ++p) out.histogram.add_samples(tracer::batch_of(p, o.batches), pixels);
+    out.passes_done.add(first, end);
+    if (o.progress) o.progress(deal.dealt() * pixels, deal.total() * pixels);
+  }
+  out.spp_done = out.passes_done.count();
+  out.complete = dealt_all;
+  // The threads' histograms are summed into the first of them, which then takes the place of
+  // the output's (holding only the sample counts so far): one fewer copy of every path, and of
+  // its classification. Ids are local to a histogram, so which thread comes first does not show.
+  std::optional<Histogram> summed;
+  for (Integrator::Thread& th : locals) {
+    th.splats.flush(out.images);
+    th.ids.flush(th.hist);
+    if (!summed) {
+      summed.emplace(std::move(th.hist));
+    } else {
+      Result<bool> m = summed->merge(th.hist);
+      if (!m) return m.error();
+    }
+    out.rays += th.rays;
+    if (th.first_nonfinite && (!out.first_nonfinite || th.first_nonfinite->order() < out.first_nonfinite->order()))
+      out.first_nonfinite = th.first_nonfinite;
+  }
+  if (summed) {
+    Result<bool> m = summed->merge(out.histogram);  // the sample counts of every batch
+    if (!m) return m.error();
+    out.histogram = std::move(*summed);
+  }
+  // Connector statistics, in the profile's order (integer sums: the same for every thread count).
+  for (std::size_t i = 0; i < strategies->strategies.size(); ++i) {
+    const Strategy& st = strategies->strategies[i];
+    if (st.connector == ConnectorKind::kNone) continue;
+    ConnectorStats total{st.name, to_string(st.connector)};
+    for (const Integrator::Thread& th : locals) total += th.connectors[i];
+    out.connectors.push_back(total);
+  }
+  out.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace pathex
