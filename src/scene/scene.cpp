@@ -97,7 +97,7 @@ Result<glm::vec2> read_alphas(const Reader& r, const json& j, const std::string&
 }
 
 // `component`: inside a mixture, where only basic materials are allowed.
-const std::string kBasicTypes = "diffuse, mirror, dielectric, glossy, conductor, thin_dielectric or diffuse_transmission";
+const std::string kBasicTypes = "diffuse, mirror, dielectric, glossy, conductor, thin_dielectric";
 
 Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::string& ptr, bool component) {
   PATHEX_TRY(type, r.string(j, "type", ptr));
@@ -165,8 +165,8 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     return BasicMaterial{Glossy{refl, static_cast<float>(rough)}};
   }
   if (component)
-    return r.fail(ptr + "/type", "material type '" + type + "' cannot be a mixture's component, expected " + kBasicTypes);
-  return r.fail(ptr + "/type", "unknown material type '" + type + "', expected " + kBasicTypes + " or mixture");
+    return r.fail(ptr + "/type", "material type '" + type + "' cannot be a mixture's component, expected " + kBasicTypes + " or diffuse_transmission");
+  return r.fail(ptr + "/type", "unknown material type '" + type + "', expected " + kBasicTypes + ", diffuse_transmission or mixture");
 }
 
 Result<Material> read_material(const Reader& r, const json& j, const std::string& ptr) {
