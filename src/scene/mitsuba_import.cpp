@@ -512,7 +512,10 @@ class Importer {
         c.alpha_u = a.x;
         c.alpha_v = a.y;
       }
-      m = c;
+      // Smooth with eta 0, k 1 (material none) reflects specular_reflectance at every angle: exactly
+      // a mirror, which the mirror and manifold connectors know.
+      if (c.smooth() && c.eta == vec3(0.0f) && c.k == vec3(1.0f)) m = Mirror{spec};
+      else m = c;
     } else if (type == "dielectric" || type == "roughdielectric" || type == "thindielectric") {
       // letters: S (dielectric, thindielectric), D (roughdielectric, alpha at least 1e-3)
       MI_TRY(eta, relative_ior(p, n, 1.5046));

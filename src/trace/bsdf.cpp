@@ -1,6 +1,7 @@
 // BSDF sampling and evaluation (see bsdf.h for the conventions). Layout: the per-kind pieces in
-// the shading frame (Lambert, GGX, Fresnel), then the public functions, which handle sidedness,
-// the geometric-normal test and mixtures once for all kinds.
+// the shading frame (Lambert, the glossy lobe, the Dirac deltas; the conductor, rough and thin
+// dielectrics and diffuse transmission in their own files, bsdf_kinds.h), then the public
+// functions, which handle sidedness, the geometric-normal test and mixtures once for all kinds.
 #include "trace/bsdf.h"
 
 #include <algorithm>

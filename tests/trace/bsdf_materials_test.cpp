@@ -293,6 +293,31 @@ TEST(MaterialsLetters, EachKindAndAMixture) {
   EXPECT_EQ(letters_of(mix), d | s);
 }
 
+// At cos θ = ±1e-6 and near-delta roughness every new kind stays finite (DESIGN §10).
+TEST(MaterialsGrazing, EveryKindStaysFinite) {
+  std::vector<Case> cases = finite_cases();
+  cases.push_back({"smooth gold", gold(0.0f, 0.0f)});
+  cases.push_back({"thin glass", ThinDielectric{1.5f, glm::vec3(1.0f)}});
+  cases.push_back({"near-delta rough glass", RoughDielectric{1.5f, glm::vec3(1.0f), 1e-3f, 1e-3f}});
+  cases.push_back({"near-delta gold", gold(1e-3f, 2e-3f)});
+  const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  for (const Case& c : cases) {
+    for (float z : {1e-6f, -1e-6f, 0.999999f}) {
+      const glm::vec3 wo = glm::normalize(glm::vec3(std::sqrt(1.0f - z * z), 0.0f, z));
+      for (int i = 0; i < 2000; ++i) {
+        Sampler s(21, 0, static_cast<std::uint64_t>(i));
+        const float uc = s.get1d();
+        for (TransportMode mode : {TransportMode::kRadiance, TransportMode::kImportance}) {
+          const auto r = bsdf::sample(c.material, wo, kUp, kUp, uc, s.get2d(), mode);
+          if (!r) continue;
+          ASSERT_TRUE(finite(r->weight) && finite(r->f) && std::isfinite(r->pdf) && std::isfinite(r->pdf_rev)) << c.name << " z " << z;
+          ASSERT_TRUE(finite(bsdf::eval(c.material, r->wi, wo, kUp, kUp, mode))) << c.name;
+        }
+      }
+    }
+  }
+}
+
 // What numbers_read() says a kind does not read, sample() does not read (bit for bit).
 TEST(MaterialsSample, IgnoresTheNumbersItDoesNotRead) {
   const std::vector<Material> kinds = {gold(0.0f, 0.0f), gold(0.2f, 0.3f), RoughDielectric{}, ThinDielectric{},

@@ -139,7 +139,7 @@ TEST(MaterialsAgreement, EstimatorsAgreeOnASphereOfEachMaterial) {
     for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
       if (!c.finite && std::string(renderer) == "lt") continue;
       std::uint64_t nonfinite = 0;
-      results.emplace_back(renderer, render_total(scene, renderer, 256, 8, &nonfinite));
+      results.emplace_back(renderer, render_total(scene, renderer, 1024, 8, &nonfinite));
       EXPECT_EQ(nonfinite, 0u) << c.name << " " << renderer;
     }
     for (std::size_t i = 0; i < results.size(); ++i) {

@@ -8,6 +8,7 @@
 
 #include "trace/media.h"
 #include "trace/frame.h"
+#include "trace/fresnel.h"
 #include "trace/integrator.h"
 #include "trace/joins/manifold.h"
 #include "trace/prune.h"
@@ -27,6 +28,9 @@ void Integrator::init_manifold() {
     if (const auto* d = std::get_if<Dielectric>(&m); d && d->ior > 0.0f && d->ior != 1.0f) glass_ior_[i] = d->ior;
     // A mirror, or a mixture's mirror components (each weighed by its weight).
     if (const auto* r = std::get_if<Mirror>(&m)) mirror_reflectance_[i] = r->reflectance;
+    // A smooth conductor reflects like a mirror, by its Fresnel (here at normal incidence; the
+    // chain's throughput takes it at the chain's angle).
+    if (const auto* c = std::get_if<Conductor>(&m); c && c->smooth()) mirror_reflectance_[i] = c->tint * fresnel_complex(1.0f, c->eta, c->k);
     if (const auto* mix = std::get_if<Mixture>(&m))
       for (const Mixture::Component& c : mix->components)
         if (const auto* r = std::get_if<Mirror>(&c.material); r && std::isfinite(c.weight) && c.weight > 0.0f)
@@ -261,6 +265,8 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     if (const auto* glass = std::get_if<Dielectric>(rs_.material_of_shape[static_cast<std::size_t>(c.id)])) {
       const float f = bsdf::fresnel_dielectric(cos_prev, glass->ior);
       transmit *= glass->tint * (c.reflect ? f : 1.0f - f);
+    } else if (const auto* metal = std::get_if<Conductor>(rs_.material_of_shape[static_cast<std::size_t>(c.id)])) {
+      transmit *= metal->tint * fresnel_complex(cos_prev, metal->eta, metal->k);
     } else {
       transmit *= mirror_reflectance_[static_cast<std::size_t>(c.id)];
     }
