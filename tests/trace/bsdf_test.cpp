@@ -1016,7 +1016,7 @@ Chi2 chi2_sample_vs_estimated_pdf(const Material& m, const glm::vec3& wo, std::u
       for (int j = 0; j < points; ++j) {
         Sampler s(seed + 1, static_cast<std::uint64_t>(iu * kPhi + ip), static_cast<std::uint64_t>(j));
         const glm::vec2 v = s.get2d();
-        const double u = -1.0 + (iu + v.x) * du, phi = (ip + v.y) * dphi;
+        const double u = -1.0 + (iu + static_cast<double>(v.x)) * du, phi = (ip + static_cast<double>(v.y)) * dphi;
         const double r = std::sqrt(std::max(0.0, 1.0 - u * u));
         const glm::vec3 wi(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(u));
         acc.add(bsdf::pdf(m, wo, wi, kUp));
