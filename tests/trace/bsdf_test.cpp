@@ -1119,6 +1119,22 @@ TEST(CoatedDiffuse, SampledWeightsAgreeWithEval) {
   }
 }
 
+// A mixture holding a coat: the coat's samples carry the walk's weight, the other lobes share
+// their own part by one-sample MIS (bsdf.cpp), so the mean weight is still ∫ eval · cos plus the
+// coat's delta, w · R(θo).
+TEST(CoatedDiffuse, AMixtureWithACoatKeepsItsEnergy) {
+  const Material m = mixture({{0.4f, Diffuse{glm::vec3(0.9f)}}, {0.3f, Glossy{glm::vec3(0.8f), 0.3f}},
+                              {0.3f, coated(0.0f, glm::vec3(0.7f))}});
+  std::uint64_t seed = test::stat_seed(311);
+  for (const double theta : {15.0, 70.0}) {
+    const glm::vec3 wo = polar(theta);
+    const Estimate by_sampling = albedo_by_sampling(m, wo, kUp, seed++, 200'000);
+    Estimate by_eval = albedo_by_uniform_eval(m, wo, kUp, seed++, 400'000);
+    by_eval.mean += bsdf::component_probability(m, wo, kUp, 2, Lobe::kSpecularReflection);  // (w/W) R picks of weight W = 1
+    expect_agree(by_sampling, by_eval, ("mixture at " + std::to_string(theta)).c_str());
+  }
+}
+
 // eval() is reciprocal in expectation: its means over walks from each side agree (the walks
 // differ, so single estimates do not).
 TEST(CoatedDiffuse, EvalIsReciprocalInExpectation) {
