@@ -399,6 +399,31 @@ std::optional<BsdfSample> detail::sample_general(const Material& m, const glm::v
     if (!(s.pdf > 0.0f) || is_black(s.f) || !finite_vec(s.f)) return std::nullopt;
     s.pdf_rev = pdf(m, s.wi, wo, ns, ng);
     s.weight = s.f * (std::abs(glm::dot(s.wi, ns)) / s.pdf);
+    if (const auto* mix = std::get_if<Mixture>(&m)) {
+      // A coat's samples carry their walk's weight without MIS (trace/bsdf_layered.h), so the
+      // other finite lobes of a mixture holding one share only their own part, by one-sample MIS
+      // among themselves; s.f and s.pdf stay those of the whole material.
+      glm::vec3 f_own(0.0f), wo_l2, wi_l2;
+      float p_own = 0.0f;
+      bool coat = false;
+      if (reflection_local(wo, s.wi, ns, ng, &wo_l2, &wi_l2)) {
+        const float total = total_weight(*mix);
+        for (const auto& k : mix->components) {
+          const float w = usable_weight(k.weight);
+          if (w == 0.0f || is_delta_kind(k.material)) continue;
+          if (std::holds_alternative<CoatedDiffuse>(k.material)) {
+            coat = true;
+            continue;
+          }
+          f_own += w * eval_basic(k.material, wo_l2, wi_l2);
+          p_own += (w / total) * pdf_basic(k.material, wo_l2, wi_l2);
+        }
+      }
+      if (coat) {
+        if (!(p_own > 0.0f)) return std::nullopt;
+        s.weight = f_own * (std::abs(glm::dot(s.wi, ns)) / p_own);
+      }
+    }
     s.letter = kD;
     s.is_delta = false;
   }
