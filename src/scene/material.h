@@ -148,6 +148,13 @@ inline LetterMask letters_of(const BasicMaterial& m) {
              : kOnlyD;
 }
 
+// One kind on its own (a Conductor, …): as that basic material.
+template <class Kind>
+  requires(!std::is_same_v<Kind, BasicMaterial> && !std::is_same_v<Kind, Material> && !std::is_same_v<Kind, Mixture>)
+inline LetterMask letters_of(const Kind& k) {
+  return letters_of(BasicMaterial{k});
+}
+
 // The letters a material can give (bit per letter), the union over a mixture's components.
 inline LetterMask letters_of(const Material& m) {
   return std::visit(

@@ -399,7 +399,8 @@ std::optional<BsdfSample> detail::sample_general(const Material& m, const glm::v
       glm::vec3 f_own(0.0f), wo_l2, wi_l2;
       float p_own = 0.0f;
       bool coat = false;
-      if (reflection_local(wo, s.wi, ns, ng, &wo_l2, &wi_l2)) {
+      bool inside = false;
+      if (local_pair(wo, s.wi, ns, ng, &wo_l2, &wi_l2, &inside)) {
         const float total = total_weight(*mix);
         for (const auto& k : mix->components) {
           const float w = usable_weight(k.weight);
@@ -408,8 +409,8 @@ std::optional<BsdfSample> detail::sample_general(const Material& m, const glm::v
             coat = true;
             continue;
           }
-          f_own += w * eval_basic(k.material, wo_l2, wi_l2);
-          p_own += (w / total) * pdf_basic(k.material, wo_l2, wi_l2);
+          f_own += w * eval_basic(k.material, wo_l2, wi_l2, inside, mode);
+          p_own += (w / total) * pdf_basic(k.material, wo_l2, wi_l2, inside);
         }
       }
       if (coat) {

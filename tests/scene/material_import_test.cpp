@@ -59,11 +59,11 @@ TEST(ImportMaterialsPbrt, ConductorsFromNamedSpectraDefaultCopperAndReflectance)
   EXPECT_EQ(au.k, metal("Au", false));
   EXPECT_FLOAT_EQ(au.alpha_u, std::sqrt(0.1f));
   EXPECT_FLOAT_EQ(au.alpha_v, std::sqrt(0.1f));
-  EXPECT_EQ(letter_of(au), kD);
+  EXPECT_EQ(letters_of(Material{au}), static_cast<LetterMask>(1u << kD));
   const auto& cu = std::get<Conductor>(material_of(s, 1));  // pbrt-v4's default: copper, smooth
   EXPECT_EQ(cu.eta, metal("Cu", true));
   EXPECT_EQ(cu.k, metal("Cu", false));
-  EXPECT_EQ(letter_of(cu), kS);
+  EXPECT_EQ(letters_of(Material{cu}), static_cast<LetterMask>(1u << kS));
   const auto& aniso = std::get<Conductor>(material_of(s, 2));
   EXPECT_FLOAT_EQ(aniso.alpha_u, 0.01f);
   EXPECT_FLOAT_EQ(aniso.alpha_v, 0.25f);
@@ -90,17 +90,17 @@ TEST(ImportMaterialsPbrt, DielectricsDiffuseTransmissionAndInterface) {
   const auto& rough = std::get<RoughDielectric>(material_of(s, 0));
   EXPECT_FLOAT_EQ(rough.ior, 1.5f);
   EXPECT_FLOAT_EQ(rough.alpha_u, std::sqrt(0.2f));
-  EXPECT_EQ(letter_of(rough), kD);
+  EXPECT_EQ(letters_of(Material{rough}), static_cast<LetterMask>(1u << kD));
   const auto& smooth = std::get<Dielectric>(material_of(s, 1));
   EXPECT_FLOAT_EQ(smooth.ior, 0.75f);
-  EXPECT_EQ(letter_of(smooth), kS);
+  EXPECT_EQ(letters_of(Material{smooth}), static_cast<LetterMask>(1u << kS));
   const auto& thin = std::get<ThinDielectric>(material_of(s, 2));
   EXPECT_FLOAT_EQ(thin.ior, 1.33f);
-  EXPECT_EQ(letter_of(thin), kS);
+  EXPECT_EQ(letters_of(Material{thin}), static_cast<LetterMask>(1u << kS));
   const auto& dt = std::get<DiffuseTransmission>(material_of(s, 3));  // scale · value, clamped to [0, 1]
   EXPECT_LT(glm::length(dt.reflectance - glm::vec3(0.3f, 0.6f, 0.9f)), 1e-6f);
   EXPECT_LT(glm::length(dt.transmittance - glm::vec3(1.0f, 0.75f, 0.45f)), 1e-6f);
-  EXPECT_EQ(letter_of(dt), kD);
+  EXPECT_EQ(letters_of(Material{dt}), static_cast<LetterMask>(1u << kD));
   const auto& dflt = std::get<DiffuseTransmission>(material_of(s, 4));
   EXPECT_EQ(dflt.reflectance, glm::vec3(0.25f));
   EXPECT_EQ(dflt.transmittance, glm::vec3(0.25f));
@@ -131,12 +131,12 @@ TEST(ImportMaterialsMitsuba, ConductorsAndDielectrics) {
   const auto& au = std::get<Conductor>(material_of(s, 0));
   EXPECT_EQ(au.eta, metal("Au", true));
   EXPECT_EQ(au.k, metal("Au", false));
-  EXPECT_EQ(letter_of(au), kS);
+  EXPECT_EQ(letters_of(Material{au}), static_cast<LetterMask>(1u << kS));
   const auto& brass = std::get<Conductor>(material_of(s, 1));
   EXPECT_EQ(brass.eta, metal("CuZn", true));
   EXPECT_FLOAT_EQ(brass.alpha_u, 0.05f);
   EXPECT_FLOAT_EQ(brass.alpha_v, 0.3f);
-  EXPECT_EQ(letter_of(brass), kD);
+  EXPECT_EQ(letters_of(Material{brass}), static_cast<LetterMask>(1u << kD));
   // material "none" (eta 0, k 1) reflects specular_reflectance at every angle: a mirror.
   EXPECT_EQ(std::get<Mirror>(material_of(s, 2)).reflectance, glm::vec3(0.9f, 0.8f, 0.7f));
   const auto& rough = std::get<RoughDielectric>(material_of(s, 3));
