@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <type_traits>
 #include <variant>
 #include <vector>
@@ -36,9 +37,15 @@ struct Dielectric {
 inline bool valid_ior(double eta) { return eta >= 0.1 && eta <= 10.0 && std::fabs(eta - 1.0) >= 1e-4; }
 inline constexpr const char* kValidIor = "within [0.1, 10] and not 1 (1 is no surface)";
 
+// The microfacet distribution of a rough lobe (trace/microfacet.h): GGX (pbrt-v4's only one, the
+// JSON default) or Beckmann (Mitsuba 3's default). Either is a finite lobe, letter D. Four bytes
+// like the floats beside it: scene_hash.cpp hashes a material's bytes, which must hold no padding.
+enum class MicrofacetKind : std::uint32_t { kGgx, kBeckmann };
+
 struct Glossy {
-  glm::vec3 reflectance{0.8f};  // GGX microfacet reflection with Schlick Fresnel from this colour
-  float roughness = 0.2f;       // GGX alpha; > 0 (finite BSDF, letter D)
+  glm::vec3 reflectance{0.8f};  // microfacet reflection with Schlick Fresnel from this colour
+  float roughness = 0.2f;       // the microfacet alpha; > 0 (finite BSDF, letter D)
+  MicrofacetKind distribution = MicrofacetKind::kGgx;
 };
 
 // pbrt-v4's EffectivelySmooth(): a GGX alpha below this (in both tangent directions) is sampled as
@@ -56,6 +63,7 @@ struct Conductor {
   float alpha_u = 0.0f;
   float alpha_v = 0.0f;
   glm::vec3 tint{1.0f};  // multiplies the Fresnel reflectance (Mitsuba's specular_reflectance; 1 in pbrt)
+  MicrofacetKind distribution = MicrofacetKind::kGgx;
   bool smooth() const { return std::max(alpha_u, alpha_v) < kSmoothAlpha; }
 };
 
@@ -68,6 +76,7 @@ struct RoughDielectric {
   glm::vec3 tint{1.0f};  // multiplies reflection and transmission
   float alpha_u = 0.1f;
   float alpha_v = 0.1f;
+  MicrofacetKind distribution = MicrofacetKind::kGgx;
 };
 
 // A thin dielectric slab (pbrt-v4's ThinDielectricBxDF): the reflection R' = R + T² R / (1 − R²)
@@ -94,12 +103,13 @@ struct DiffuseTransmission {
 struct CoatedDiffuse {
   glm::vec3 reflectance{0.5f};  // the base's Lambertian reflectance in [0, 1]
   glm::vec3 albedo{0.0f};       // the layer medium's single-scattering albedo in [0, 1]
-  float roughness = 0.0f;       // the coat's GGX alpha (pbrt's roughness after remapping); < 1e-3 is smooth
+  float roughness = 0.0f;       // the coat's alpha (pbrt's roughness after remapping); < 1e-3 is smooth
   float eta = 1.5f;             // the coat's index (inside / outside), valid_ior()
   float thickness = 0.01f;      // the layer's optical thickness (σ_t = 1), >= 0
   float g = 0.0f;               // Henyey–Greenstein asymmetry of the medium in (-1, 1)
   int max_depth = 10;           // scattering events of one walk, at least 1
   int samples = 1;              // walks per eval() and pdf() estimate, at least 1
+  MicrofacetKind distribution = MicrofacetKind::kGgx;  // of a rough coat
   bool smooth() const { return roughness < 1e-3f; }
 };
 

@@ -509,8 +509,9 @@ class Importer {
       c.tint = spec;
       if (type == "roughconductor") {
         MI_TRY(a, mitsuba_alphas(p, n));
-        c.alpha_u = a.x;
-        c.alpha_v = a.y;
+        c.alpha_u = a.alpha.x;
+        c.alpha_v = a.alpha.y;
+        c.distribution = a.kind;
       }
       // Smooth with eta 0, k 1 (material none) reflects specular_reflectance at every angle: exactly
       // a mirror, which the mirror and manifold connectors know.
@@ -526,7 +527,7 @@ class Importer {
         m = ThinDielectric{static_cast<float>(eta), refl};
       } else if (type == "roughdielectric") {
         MI_TRY(a, mitsuba_alphas(p, n));
-        if (std::max(a.x, a.y) >= kSmoothAlpha) m = RoughDielectric{static_cast<float>(eta), refl, a.x, a.y};
+        if (std::max(a.alpha.x, a.alpha.y) >= kSmoothAlpha) m = RoughDielectric{static_cast<float>(eta), refl, a.alpha.x, a.alpha.y, a.kind};
         else m = Dielectric{static_cast<float>(eta), refl};
       } else {
         m = Dielectric{static_cast<float>(eta), refl};
@@ -553,8 +554,9 @@ class Importer {
       c.max_depth = 64;  // (ρ R̄)^32 < 1e-7 of the series is left out
       if (type == "roughplastic") {
         MI_TRY(a, mitsuba_alphas(p, n));
-        if (a.x != a.y) return located(where(n), "an anisotropic coat (alpha_u unlike alpha_v) is not supported: pathex's coat is isotropic");
-        c.roughness = a.x < kSmoothAlpha ? 0.0f : a.x;
+        if (a.alpha.x != a.alpha.y) return located(where(n), "an anisotropic coat (alpha_u unlike alpha_v) is not supported: pathex's coat is isotropic");
+        c.roughness = a.alpha.x < kSmoothAlpha ? 0.0f : a.alpha.x;
+        c.distribution = a.kind;
       }
       const float r_bar = bsdf::layered::mean_internal_reflectance(c.eta);
       c.reflectance = nonlinear ? rho : rho / (1.0f - r_bar + rho * r_bar);
@@ -568,19 +570,25 @@ class Importer {
       MI_TRY(b, bsdf(inner[1], depth + 1));
       m = import::blend(a, b, static_cast<float>(w));
     } else {
-      return located(where(n), "bsdf \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, roughconductor (ggx), dielectric, "
-                               "roughdielectric (ggx), thindielectric, plastic, roughplastic (ggx), blendbsdf or twosided");
+      return located(where(n), "bsdf \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, roughconductor, dielectric, "
+                               "roughdielectric, thindielectric, plastic, roughplastic, blendbsdf or twosided");
     }
     if (auto e = p.unused()) return *e;
     return m;
   }
 
-  // GGX alphas of roughconductor and roughdielectric: "alpha" (default 0.1) or "alpha_u" and
-  // "alpha_v", each within [0, 1] (Mitsuba's alphas are GGX alphas: no remapping). Only the ggx
-  // distribution; its tangents are the shading frame's.
-  Result<glm::vec2> mitsuba_alphas(Props& p, pugi::xml_node n) {
+  // The microfacets of roughconductor, roughdielectric and roughplastic: "distribution" beckmann
+  // (Mitsuba's default) or ggx, and "alpha" (default 0.1) or "alpha_u" and "alpha_v", each within
+  // [0, 1] (Mitsuba's alphas are the distribution's own: no remapping). Its tangents are the
+  // shading frame's.
+  struct MitsubaMicrofacet {
+    glm::vec2 alpha;
+    MicrofacetKind kind;
+  };
+  Result<MitsubaMicrofacet> mitsuba_alphas(Props& p, pugi::xml_node n) {
     MI_TRY(dist, p.string("distribution", "beckmann"));
-    if (dist != "ggx") return located(where(n), "microfacet distribution \"" + excerpt(dist) + "\" is not supported: pathex's microfacets are GGX, set <string name=\"distribution\" value=\"ggx\"/>");
+    if (dist != "ggx" && dist != "beckmann")
+      return located(where(p.find("distribution")), "microfacet distribution \"" + excerpt(dist) + "\" is not supported, expected beckmann or ggx");
     p.ignore({"sample_visible"});
     MI_TRY(alpha, p.number("alpha", 0.1));
     MI_TRY(u, p.number("alpha_u", alpha));
@@ -588,7 +596,8 @@ class Importer {
     if (p.find("alpha") && (p.find("alpha_u") || p.find("alpha_v"))) return located(where(p.find("alpha")), "give either alpha or alpha_u and alpha_v");
     for (double a : {u, v})
       if (!(a >= 0.0) || a > 1.0) return located(where(n), "alpha must be within [0, 1]");
-    return glm::vec2(static_cast<float>(u), static_cast<float>(v));
+    return MitsubaMicrofacet{glm::vec2(static_cast<float>(u), static_cast<float>(v)),
+                             dist == "ggx" ? MicrofacetKind::kGgx : MicrofacetKind::kBeckmann};
   }
 
   Result<int> material_of(Props& p, pugi::xml_node shape_node) {

@@ -87,13 +87,22 @@ class Reader : public JsonReader {
   if (!var##_r) return var##_r.error(); \
   auto var = std::move(*var##_r)
 
-// GGX alphas of a conductor or dielectric: "roughness" for both tangents, "roughness_u" and
+// Microfacet alphas of a conductor or dielectric (of the "distribution" read_distribution() reads): "roughness" for both tangents, "roughness_u" and
 // "roughness_v" for each (default: "roughness"), each in [0, 1]; below 1e-3 in both is smooth.
 Result<glm::vec2> read_alphas(const Reader& r, const json& j, const std::string& ptr) {
   PATHEX_TRY(both, r.number(j, "roughness", ptr, 0.0, 1.0, 0.0));
   PATHEX_TRY(u, r.number(j, "roughness_u", ptr, 0.0, 1.0, both));
   PATHEX_TRY(v, r.number(j, "roughness_v", ptr, 0.0, 1.0, both));
   return glm::vec2(static_cast<float>(u), static_cast<float>(v));
+}
+
+// The microfacet distribution of a rough material: "distribution" "ggx" (the default) or "beckmann".
+Result<MicrofacetKind> read_distribution(const Reader& r, const json& j, const std::string& ptr) {
+  if (!j.contains("distribution")) return MicrofacetKind::kGgx;
+  PATHEX_TRY(name, r.string(j, "distribution", ptr));
+  if (name == "ggx") return MicrofacetKind::kGgx;
+  if (name == "beckmann") return MicrofacetKind::kBeckmann;
+  return r.fail(ptr + "/distribution", "unknown microfacet distribution '" + name + "', expected ggx or beckmann");
 }
 
 // `component`: inside a mixture, where only basic materials are allowed.
@@ -116,7 +125,7 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
   if (type == "dielectric" || type == "thin_dielectric") {
     const bool thin = type == "thin_dielectric";
     if (auto k = thin ? r.keys(j, ptr, {"type", "ior", "tint"})
-                      : r.keys(j, ptr, {"type", "ior", "tint", "roughness", "roughness_u", "roughness_v"});
+                      : r.keys(j, ptr, {"type", "ior", "tint", "roughness", "roughness_u", "roughness_v", "distribution"});
         !k)
       return k.error();
     PATHEX_TRY(ior, r.number(j, "ior", ptr, -1e30, 1e30, 1.5));
@@ -124,12 +133,13 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     PATHEX_TRY(tint, r.vector3(j, "tint", ptr, false, vec3(1.0f), true));
     if (thin) return BasicMaterial{ThinDielectric{static_cast<float>(ior), tint}};
     PATHEX_TRY(alpha, read_alphas(r, j, ptr));
+    PATHEX_TRY(dist, read_distribution(r, j, ptr));
     if (std::max(alpha.x, alpha.y) >= kSmoothAlpha)
-      return BasicMaterial{RoughDielectric{static_cast<float>(ior), tint, alpha.x, alpha.y}};
+      return BasicMaterial{RoughDielectric{static_cast<float>(ior), tint, alpha.x, alpha.y, dist}};
     return BasicMaterial{Dielectric{static_cast<float>(ior), tint}};
   }
   if (type == "conductor") {
-    if (auto k = r.keys(j, ptr, {"type", "metal", "eta", "k", "roughness", "roughness_u", "roughness_v"}); !k) return k.error();
+    if (auto k = r.keys(j, ptr, {"type", "metal", "eta", "k", "roughness", "roughness_u", "roughness_v", "distribution"}); !k) return k.error();
     Conductor c;  // pbrt-v4's default: copper
     if (j.contains("metal")) {
       if (j.contains("eta") || j.contains("k")) return r.fail(ptr + "/metal", "expected either metal or eta and k, found both");
@@ -145,8 +155,10 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
       c.k = k;
     }
     PATHEX_TRY(alpha, read_alphas(r, j, ptr));
+    PATHEX_TRY(dist, read_distribution(r, j, ptr));
     c.alpha_u = alpha.x;
     c.alpha_v = alpha.y;
+    c.distribution = dist;
     return BasicMaterial{c};
   }
   if (type == "diffuse_transmission") {
@@ -158,14 +170,15 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     return BasicMaterial{DiffuseTransmission{refl, trans}};
   }
   if (type == "glossy") {
-    if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness"}); !k) return k.error();
+    if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness", "distribution"}); !k) return k.error();
     PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(0.8f), true));
     if (const float hi = max_component(refl); hi > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1], found " + Reader::fmt(hi));
     PATHEX_TRY(rough, r.number(j, "roughness", ptr, 1e-4, 1.0, 0.2));
-    return BasicMaterial{Glossy{refl, static_cast<float>(rough)}};
+    PATHEX_TRY(dist, read_distribution(r, j, ptr));
+    return BasicMaterial{Glossy{refl, static_cast<float>(rough), dist}};
   }
   if (type == "coateddiffuse") {  // pbrt-v4's layered coateddiffuse (scene/material.h CoatedDiffuse)
-    if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness", "eta", "thickness", "albedo", "g", "max_depth", "samples"}); !k)
+    if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness", "distribution", "eta", "thickness", "albedo", "g", "max_depth", "samples"}); !k)
       return k.error();
     CoatedDiffuse c;
     PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(0.5f), true));
@@ -179,6 +192,8 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     PATHEX_TRY(g, r.number(j, "g", ptr, -0.999, 0.999, 0.0));
     PATHEX_TRY(depth, r.integer(j, "max_depth", ptr, 1, kMaxCoatDepth, 10));
     PATHEX_TRY(samples, r.integer(j, "samples", ptr, 1, kMaxCoatSamples, 1));
+    PATHEX_TRY(dist, read_distribution(r, j, ptr));
+    c.distribution = dist;
     c.reflectance = refl;
     c.albedo = albedo;
     c.roughness = static_cast<float>(rough);

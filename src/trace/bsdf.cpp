@@ -42,10 +42,7 @@ float total_weight(const Mixture& mix) {
 
 // --- the glossy lobe: GGX (trace/microfacet.h) with Schlick's Fresnel, in the shading frame ---
 
-Ggx glossy_ggx(const Glossy& g) {
-  const float a = std::clamp(std::isfinite(g.roughness) ? g.roughness : 1.0f, kMinGlossyRoughness, 1.0f);
-  return Ggx{a, a};
-}
+Microfacet glossy_ggx(const Glossy& g) { return kinds::clamped_microfacet(g.distribution, g.roughness, g.roughness); }
 
 glm::vec3 schlick(const glm::vec3& r0, float cos_h) {
   const float m = std::clamp(1.0f - cos_h, 0.0f, 1.0f);
@@ -57,7 +54,7 @@ glm::vec3 schlick(const glm::vec3& r0, float cos_h) {
 // under exchange (IEEE + and * commute; the sums are grouped so that exchange only reorders
 // commuting operands).
 glm::vec3 ggx_eval(const Glossy& g, const glm::vec3& wo, const glm::vec3& wi) {
-  const Ggx ggx = glossy_ggx(g);
+  const Microfacet ggx = glossy_ggx(g);
   const glm::vec3 hs = wo + wi;
   const float len2 = glm::dot(hs, hs);
   if (!(len2 > 0.0f)) return glm::vec3(0.0f);
@@ -72,7 +69,7 @@ glm::vec3 ggx_eval(const Glossy& g, const glm::vec3& wo, const glm::vec3& wi) {
 
 // Density of visible-normal sampling: G1(wo) D(h) / (4 z_o) = D(h) / (4 (z_o + zΛ(wo))).
 float ggx_pdf(const Glossy& g, const glm::vec3& wo, const glm::vec3& wi) {
-  const Ggx ggx = glossy_ggx(g);
+  const Microfacet ggx = glossy_ggx(g);
   const glm::vec3 hs = wo + wi;
   const float len2 = glm::dot(hs, hs);
   if (!(len2 > 0.0f)) return 0.0f;
@@ -193,14 +190,10 @@ std::optional<DeltaSample> sample_delta(const BasicMaterial& m, const glm::vec3&
                        Lobe::kSpecularReflection};
   }
   // Refraction. eta_rel = η_wi / η_wo; the normal on wo's side is ns · sign(cos_o).
-  const bool outside = cos_o > 0.0f;
-  const float eta_rel = outside ? d.ior : 1.0f / d.ior;
-  const float cos_i = std::abs(cos_o);
-  const float sin2_t = std::max(0.0f, 1.0f - cos_i * cos_i) / (eta_rel * eta_rel);
-  if (sin2_t >= 1.0f) return std::nullopt;  // unreachable: fresnel_dielectric returned 1
-  const float cos_t = std::sqrt(1.0f - sin2_t);
-  const glm::vec3 n_side = outside ? ns : -ns;
-  const glm::vec3 wt = glm::normalize(-wo / eta_rel + (cos_i / eta_rel - cos_t) * n_side);
+  float eta_rel;
+  glm::vec3 wt;
+  if (!refract(wo, ns, d.ior, &eta_rel, &wt)) return std::nullopt;  // unreachable: fresnel_dielectric returned 1
+  wt = glm::normalize(wt);
   glm::vec3 weight = d.tint;
   if (mode == TransportMode::kRadiance) weight /= eta_rel * eta_rel;
   const float f_rev = fresnel_dielectric(glm::dot(wt, ns), d.ior);

@@ -6,6 +6,8 @@
 // keeps every dot product, so the outside formulas with eta hold as they are).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include <glm/vec2.hpp>
@@ -23,12 +25,34 @@ struct LocalSample {
   float eta = 1.0f;  // η_wi / η_wo
 };
 
+// The distribution of a rough lobe, alphas clamped to [kMinGlossyRoughness, 1] (NaN or ∞: 1).
+inline Microfacet clamped_microfacet(MicrofacetKind kind, float alpha_u, float alpha_v) {
+  const auto clamp = [](float a) { return std::clamp(std::isfinite(a) ? a : 1.0f, kMinGlossyRoughness, 1.0f); };
+  return Microfacet{clamp(alpha_u), clamp(alpha_v), kind};
+}
+
 // --- conductor (bsdf_conductor.cpp) ---
-Ggx conductor_ggx(const Conductor& c);
 glm::vec3 conductor_eval(const Conductor& c, const glm::vec3& wo, const glm::vec3& wi);
 float conductor_pdf(const Conductor& c, const glm::vec3& wo, const glm::vec3& wi);
 std::optional<LocalSample> conductor_sample(const Conductor& c, const glm::vec3& wo, glm::vec2 u);
 glm::vec3 conductor_reflectance(const Conductor& c, float cos_o);  // the smooth conductor's delta weight
+
+// --- a rough dielectric interface (bsdf_dielectric.cpp): the one copy that the rough dielectric
+// below and the layered coat (bsdf_layered.cpp) evaluate and sample; no tint. wo.z > 0, `eta` =
+// η_far / η_wo. `lobes` restricts sampling and its density to one lobe (the coat's walk asks for
+// only reflection or only transmission at times), as pbrt-v4's BxDFReflTransFlags. ---
+enum class InterfaceLobes { kAll, kReflection, kTransmission };
+float rough_interface_f(const Microfacet& mf, float eta, const glm::vec3& wo, const glm::vec3& wi, TransportMode mode);
+float rough_interface_pdf(const Microfacet& mf, float eta, const glm::vec3& wo, const glm::vec3& wi,
+                          InterfaceLobes lobes = InterfaceLobes::kAll);
+struct InterfaceSample {
+  glm::vec3 wi;  // not yet checked against its lobe's side (a reflection may point below z = 0)
+  bool reflect;
+  float eta;     // η_wi / η_wo
+  float choice;  // the Fresnel share of the chosen lobe at the sampled microfacet (F or 1 − F)
+};
+std::optional<InterfaceSample> rough_interface_sample(const Microfacet& mf, float eta, const glm::vec3& wo, float uc,
+                                                      glm::vec2 u, InterfaceLobes lobes = InterfaceLobes::kAll);
 
 // --- rough and thin dielectrics (bsdf_dielectric.cpp) ---
 glm::vec3 rough_dielectric_eval(const RoughDielectric& d, float eta, const glm::vec3& wo, const glm::vec3& wi,

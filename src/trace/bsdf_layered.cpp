@@ -11,7 +11,10 @@
 #include <glm/geometric.hpp>
 
 #include "trace/bsdf.h"
+#include "trace/bsdf_kinds.h"
 #include "trace/frame.h"
+#include "trace/fresnel.h"
+#include "trace/microfacet.h"
 #include "trace/rng.h"
 
 namespace pathex::bsdf::layered {
@@ -63,82 +66,29 @@ float power_heuristic(float f, float g) {
   return f2 + g2 > 0.0f && std::isfinite(f2 + g2) ? f2 / (f2 + g2) : (std::isinf(f) ? 1.0f : 0.0f);
 }
 
-// --- the coat: a dielectric interface of index eta (inside / outside), smooth or GGX-rough ---
+// --- the coat: a dielectric interface of index eta (inside / outside), smooth, or rough with
+// either microfacet distribution ---
 //
-// pbrt-v4's DielectricBxDF (Walter et al. 2007 for the rough one, visible-normal sampling),
-// restricted to what the walk asks for: both lobes, or only reflection, or only transmission.
-// NOTE for the merge: the `materials` branch writes a rough dielectric of its own (trace/); this
-// one is local to the layered BSDF and can be replaced by it.
+// A rough coat is bsdf_dielectric.cpp's interface (pbrt-v4's DielectricBxDF, Walter et al. 2007,
+// visible-normal sampling), the one copy RoughDielectric uses too, with its lobes restricted as the
+// walk asks: both, or only reflection, or only transmission. That interface wants wo above it; a
+// direction below the coat (inside the slab) is handled by mirroring both directions through the
+// coat's plane, with the index inverted (a reflection of space keeps every dot product).
 
-enum class Lobes { kAll, kReflection, kTransmission };
+using Lobes = kinds::InterfaceLobes;
 
 struct Coat {
   float eta;
-  float alpha;  // GGX alpha; 0 for a smooth coat
+  Microfacet mf;  // of a rough coat
   bool smooth;
 };
 
 Coat coat_of(const CoatedDiffuse& m) {
   const bool smooth = m.smooth() || !std::isfinite(m.roughness);
-  return {m.eta, smooth ? 0.0f : std::min(m.roughness, 1.0f), smooth};
+  return {m.eta, kinds::clamped_microfacet(m.distribution, m.roughness, m.roughness), smooth};
 }
 
-// pbrt's Refract: wt from w across a surface of normal n (unit) with relative index eta; the
-// normal and the index are flipped when w is on n's back side. False for total internal reflection.
-bool refract(const vec3& w, vec3 n, float eta, float* etap, vec3* wt) {
-  float cos_i = glm::dot(n, w);
-  if (cos_i < 0.0f) {
-    eta = 1.0f / eta;
-    cos_i = -cos_i;
-    n = -n;
-  }
-  const float sin2_t = std::max(0.0f, 1.0f - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1.0f) return false;
-  const float cos_t = std::sqrt(1.0f - sin2_t);
-  *wt = -w / eta + (cos_i / eta - cos_t) * n;
-  *etap = eta;
-  return true;
-}
-
-// GGX with isotropic alpha on unit vectors (either side): D, Smith's Λ in the z·Λ form that stays
-// finite at grazing angles, G1 and the height-correlated G.
-float ggx_d(const vec3& h, float alpha) {
-  const float a2 = alpha * alpha;
-  const float t = h.x * h.x + h.y * h.y + a2 * h.z * h.z;
-  return t > 0.0f ? a2 / (kPi * t * t) : 0.0f;
-}
-float ggx_z_lambda(const vec3& w, float alpha) {
-  const float a2r2 = alpha * alpha * (w.x * w.x + w.y * w.y);
-  const float z = std::abs(w.z);
-  return a2r2 / (2.0f * (z + std::sqrt(z * z + a2r2)));
-}
-float ggx_g(const vec3& wo, const vec3& wi, float alpha) {
-  const float zo = std::abs(wo.z), zi = std::abs(wi.z);
-  const float den = zo * zi + zi * ggx_z_lambda(wo, alpha) + zo * ggx_z_lambda(wi, alpha);
-  return den > 0.0f ? zo * zi / den : 0.0f;
-}
-// The density of visible normals D_w(m) = G1(w) |w·m| D(m) / |cos θ_w|.
-float ggx_visible_pdf(const vec3& w, const vec3& m, float alpha) {
-  const float z = std::abs(w.z);
-  const float den = z + ggx_z_lambda(w, alpha);
-  return den > 0.0f ? ggx_d(m, alpha) * std::abs(glm::dot(w, m)) / den : 0.0f;
-}
-// Heitz 2018, for w on either side: the normal is sampled for w mirrored to z > 0 and has z >= 0.
-vec3 ggx_sample_visible(vec3 w, float alpha, vec2 u) {
-  if (w.z < 0.0f) w = -w;
-  const vec3 vh = glm::normalize(vec3(alpha * w.x, alpha * w.y, w.z));
-  const float lensq = vh.x * vh.x + vh.y * vh.y;
-  const vec3 t1 = lensq > 0.0f ? vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : vec3(1.0f, 0.0f, 0.0f);
-  const vec3 t2 = glm::cross(vh, t1);
-  const float r = std::sqrt(u.x);
-  const float phi = 2.0f * kPi * u.y;
-  const float p1 = r * std::cos(phi);
-  float p2 = r * std::sin(phi);
-  const float s = 0.5f * (1.0f + vh.z);
-  p2 = (1.0f - s) * safe_sqrt(1.0f - p1 * p1) + s * p2;
-  const vec3 nh = p1 * t1 + p2 * t2 + safe_sqrt(1.0f - p1 * p1 - p2 * p2) * vh;
-  return glm::normalize(vec3(alpha * nh.x, alpha * nh.y, std::max(1e-6f, nh.z)));
-}
+vec3 mirrored(const vec3& w) { return {w.x, w.y, -w.z}; }
 
 struct CoatSample {
   vec3 wi;
@@ -148,19 +98,13 @@ struct CoatSample {
   bool reflect;
 };
 
-// The reflection / refraction probabilities pr, pt under `lobes` from the Fresnel reflectance r.
-void lobe_probabilities(float r, Lobes lobes, float* pr, float* pt) {
-  *pr = lobes == Lobes::kTransmission ? 0.0f : r;
-  *pt = lobes == Lobes::kReflection ? 0.0f : 1.0f - r;
-}
-
 std::optional<CoatSample> coat_sample(const Coat& c, const vec3& wo, float uc, vec2 u, Lobes lobes,
                                       TransportMode mode) {
   if (wo.z == 0.0f) return std::nullopt;
   if (c.smooth) {
     const float r = fresnel_dielectric(wo.z, c.eta);
-    float pr, pt;
-    lobe_probabilities(r, lobes, &pr, &pt);
+    const float pr = lobes == Lobes::kTransmission ? 0.0f : r;
+    const float pt = lobes == Lobes::kReflection ? 0.0f : 1.0f - r;
     if (!(pr + pt > 0.0f)) return std::nullopt;
     if (uc < pr / (pr + pt)) {
       const vec3 wi(-wo.x, -wo.y, wo.z);
@@ -173,81 +117,26 @@ std::optional<CoatSample> coat_sample(const Coat& c, const vec3& wo, float uc, v
     if (mode == TransportMode::kRadiance) ft /= etap * etap;
     return CoatSample{wi, ft, pt / (pr + pt), 1.0f - r, false};
   }
-  const vec3 wm = ggx_sample_visible(wo, c.alpha, u);
-  const float r = fresnel_dielectric(glm::dot(wo, wm), c.eta);
-  float pr, pt;
-  lobe_probabilities(r, lobes, &pr, &pt);
-  if (!(pr + pt > 0.0f)) return std::nullopt;
-  const float d_vis = ggx_visible_pdf(wo, wm, c.alpha);
-  if (uc < pr / (pr + pt)) {
-    const vec3 wi = 2.0f * glm::dot(wo, wm) * wm - wo;
-    if (!(wo.z * wi.z > 0.0f)) return std::nullopt;
-    const float pdf = d_vis / (4.0f * std::abs(glm::dot(wo, wm))) * pr / (pr + pt);
-    const float f = ggx_d(wm, c.alpha) * ggx_g(wo, wi, c.alpha) * r / (4.0f * std::abs(wi.z * wo.z));
-    return CoatSample{glm::normalize(wi), f, pdf, r, true};
-  }
-  vec3 wi;
-  float etap;
-  if (!refract(wo, wm, c.eta, &etap, &wi) || !(wo.z * wi.z < 0.0f)) return std::nullopt;
-  wi = glm::normalize(wi);
-  const float dot_im = glm::dot(wi, wm), dot_om = glm::dot(wo, wm);
-  const float denom = (dot_im + dot_om / etap) * (dot_im + dot_om / etap);
-  if (!(denom > 0.0f)) return std::nullopt;
-  const float pdf = d_vis * std::abs(dot_im) / denom * pt / (pr + pt);
-  float ft = (1.0f - r) * ggx_d(wm, c.alpha) * ggx_g(wo, wi, c.alpha) *
-             std::abs(dot_im * dot_om / (wi.z * wo.z * denom));
-  if (mode == TransportMode::kRadiance) ft /= etap * etap;
-  return CoatSample{wi, ft, pdf, 1.0f - r, false};
-}
-
-// The generalised half vector of (wo, wi) facing +z, and etap, or false when the pair has no
-// microfacet (or a back-facing one). Rough coats only.
-bool coat_half(const Coat& c, const vec3& wo, const vec3& wi, vec3* wm, float* etap) {
-  const float co = wo.z, ci = wi.z;
-  if (co == 0.0f || ci == 0.0f) return false;
-  const bool reflect = co * ci > 0.0f;
-  *etap = reflect ? 1.0f : (co > 0.0f ? c.eta : 1.0f / c.eta);
-  vec3 h = wi * *etap + wo;
-  const float len2 = glm::dot(h, h);
-  if (!(len2 > 0.0f)) return false;
-  h /= std::sqrt(len2);
-  if (h.z < 0.0f) h = -h;
-  if (glm::dot(h, wi) * ci < 0.0f || glm::dot(h, wo) * co < 0.0f) return false;
-  *wm = h;
-  return true;
+  const bool below = wo.z < 0.0f;
+  const vec3 wo_up = below ? mirrored(wo) : wo;
+  const float eta = below ? 1.0f / c.eta : c.eta;
+  const std::optional<kinds::InterfaceSample> s = kinds::rough_interface_sample(c.mf, eta, wo_up, uc, u, lobes);
+  if (!s || (s->reflect ? !(s->wi.z > 0.0f) : !(s->wi.z < 0.0f))) return std::nullopt;  // below the microsurface
+  const float f = kinds::rough_interface_f(c.mf, eta, wo_up, s->wi, mode);
+  const float pdf = kinds::rough_interface_pdf(c.mf, eta, wo_up, s->wi, lobes);
+  return CoatSample{below ? mirrored(s->wi) : s->wi, f, pdf, s->choice, s->reflect};
 }
 
 float coat_f(const Coat& c, const vec3& wo, const vec3& wi, TransportMode mode) {
-  if (c.smooth) return 0.0f;
-  vec3 wm;
-  float etap;
-  if (!coat_half(c, wo, wi, &wm, &etap)) return 0.0f;
-  const float r = fresnel_dielectric(glm::dot(wo, wm), c.eta);
-  if (wo.z * wi.z > 0.0f)
-    return ggx_d(wm, c.alpha) * ggx_g(wo, wi, c.alpha) * r / std::abs(4.0f * wi.z * wo.z);
-  const float dot_im = glm::dot(wi, wm), dot_om = glm::dot(wo, wm);
-  const float denom = (dot_im + dot_om / etap) * (dot_im + dot_om / etap) * wi.z * wo.z;
-  if (denom == 0.0f) return 0.0f;
-  float ft = ggx_d(wm, c.alpha) * (1.0f - r) * ggx_g(wo, wi, c.alpha) * std::abs(dot_im * dot_om / denom);
-  if (mode == TransportMode::kRadiance) ft /= etap * etap;
-  return ft;
+  if (c.smooth || wo.z == 0.0f) return 0.0f;
+  if (wo.z < 0.0f) return kinds::rough_interface_f(c.mf, 1.0f / c.eta, mirrored(wo), mirrored(wi), mode);
+  return kinds::rough_interface_f(c.mf, c.eta, wo, wi, mode);
 }
 
 float coat_pdf(const Coat& c, const vec3& wo, const vec3& wi, Lobes lobes) {
-  if (c.smooth) return 0.0f;
-  vec3 wm;
-  float etap;
-  if (!coat_half(c, wo, wi, &wm, &etap)) return 0.0f;
-  const float r = fresnel_dielectric(glm::dot(wo, wm), c.eta);
-  float pr, pt;
-  lobe_probabilities(r, lobes, &pr, &pt);
-  if (!(pr + pt > 0.0f)) return 0.0f;
-  const float d_vis = ggx_visible_pdf(wo, wm, c.alpha);
-  if (wo.z * wi.z > 0.0f) return d_vis / (4.0f * std::abs(glm::dot(wo, wm))) * pr / (pr + pt);
-  const float dot_im = glm::dot(wi, wm), dot_om = glm::dot(wo, wm);
-  const float denom = (dot_im + dot_om / etap) * (dot_im + dot_om / etap);
-  if (!(denom > 0.0f)) return 0.0f;
-  return d_vis * std::abs(dot_im) / denom * pt / (pr + pt);
+  if (c.smooth || wo.z == 0.0f) return 0.0f;
+  if (wo.z < 0.0f) return kinds::rough_interface_pdf(c.mf, 1.0f / c.eta, mirrored(wo), mirrored(wi), lobes);
+  return kinds::rough_interface_pdf(c.mf, c.eta, wo, wi, lobes);
 }
 
 // --- the slab's medium: Henyey–Greenstein, pbrt's convention p(wo, wi) = HG(wo·wi) with wo

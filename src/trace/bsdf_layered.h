@@ -1,8 +1,9 @@
 // pbrt-v4's layered BSDF for `coateddiffuse` (scene/material.h CoatedDiffuse): a dielectric coat
-// (smooth, or GGX-rough) over a Lambertian base, with a homogeneous slab between them (extinction
-// 1 per unit thickness, single-scattering `albedo`, Henyey–Greenstein `g`). Light that passes the
-// coat takes a random walk between the two interfaces; pbrt-v4 (Physically Based Rendering, 4th
-// ed., §14.3) samples that walk and estimates the BSDF's value by Monte Carlo, and so do we.
+// (smooth, or rough with GGX or Beckmann microfacets: bsdf_dielectric.cpp's interface) over a
+// Lambertian base, with a homogeneous slab between them (extinction 1 per unit thickness,
+// single-scattering `albedo`, Henyey–Greenstein `g`). Light that passes the coat takes a random
+// walk between the two interfaces; pbrt-v4 (Physically Based Rendering, 4th ed., §14.3) samples
+// that walk and estimates the BSDF's value by Monte Carlo, and so do we.
 //
 // Everything here is in the coat's local frame: z along the normal, the outside at z > 0, wo.z > 0
 // (bsdf.cpp flips both directions to wo's side: the material is two-sided like pbrt's). The coat's

@@ -1,4 +1,4 @@
-// Fresnel reflectance, the one copy every BSDF uses: a dielectric interface (real relative index)
+// Fresnel reflectance and Snell's refraction, the one copy every BSDF uses: a dielectric interface (real relative index)
 // and a conductor (complex index eta + i k, per RGB channel), both exact and unpolarised, as
 // pbrt-v4's FrDielectric and FrComplex (pbrt-v4 book §9.3).
 #pragma once
@@ -7,6 +7,7 @@
 #include <cmath>
 #include <complex>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 namespace pathex {
@@ -26,6 +27,25 @@ inline float fresnel_dielectric(float cos_i, float eta) {
   const float r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
   const float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
   return 0.5f * (r_parl * r_parl + r_perp * r_perp);
+}
+
+// Snell's law, the one copy (pbrt-v4's Refract): the direction *wt refracted from w (pointing away
+// from the surface) across a surface of unit normal n with relative index eta = η_other / η_n's side;
+// the normal and the index are flipped when w is on n's back side (*etap gets the index used,
+// η_wt / η_w). False for total internal reflection.
+inline bool refract(const glm::vec3& w, glm::vec3 n, float eta, float* etap, glm::vec3* wt) {
+  float cos_i = glm::dot(n, w);
+  if (cos_i < 0.0f) {
+    eta = 1.0f / eta;
+    cos_i = -cos_i;
+    n = -n;
+  }
+  const float sin2_t = std::max(0.0f, 1.0f - cos_i * cos_i) / (eta * eta);
+  if (sin2_t >= 1.0f) return false;
+  const float cos_t = std::sqrt(1.0f - sin2_t);
+  *wt = -w / eta + (cos_i / eta - cos_t) * n;
+  *etap = eta;
+  return true;
 }
 
 // Reflectance of a conductor of complex relative index eta + i k, light arriving from the

@@ -118,8 +118,16 @@ TEST(ImportMaterialsMitsuba, ConductorsAndDielectrics) {
           "<float name=\"alpha\" value=\"0.2\"/><float name=\"int_ior\" value=\"1.5\"/><float name=\"ext_ior\" value=\"1\"/></bsdf></shape>\n"
           "<shape type=\"sphere\"><bsdf type=\"thindielectric\"><float name=\"int_ior\" value=\"1.33\"/>"
           "<float name=\"ext_ior\" value=\"1\"/></bsdf></shape>\n"
+          // Mitsuba's default distribution, beckmann, and its default alpha 0.1; given explicitly.
+          "<shape type=\"sphere\"><bsdf type=\"roughconductor\"/></shape>\n"
+          "<shape type=\"sphere\"><bsdf type=\"roughdielectric\"/></shape>\n"
+          "<shape type=\"sphere\"><bsdf type=\"roughplastic\"/></shape>\n"
+          "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"beckmann\"/>"
+          "<float name=\"alpha_u\" value=\"0.2\"/><float name=\"alpha_v\" value=\"0.05\"/></bsdf></shape>\n"
+          "<shape type=\"sphere\"><bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"ggx\"/>"
+          "<float name=\"alpha\" value=\"0.3\"/></bsdf></shape>\n"
           "</scene>\n"));
-  ASSERT_EQ(s.shapes.size(), 5u);
+  ASSERT_EQ(s.shapes.size(), 10u);
   const auto& au = std::get<Conductor>(material_of(s, 0));
   EXPECT_EQ(au.eta, metal("Au", true));
   EXPECT_EQ(au.k, metal("Au", false));
@@ -136,6 +144,27 @@ TEST(ImportMaterialsMitsuba, ConductorsAndDielectrics) {
   EXPECT_FLOAT_EQ(rough.alpha_u, 0.2f);
   EXPECT_FLOAT_EQ(rough.alpha_v, 0.2f);
   EXPECT_FLOAT_EQ(std::get<ThinDielectric>(material_of(s, 4)).ior, 1.33f);
+  EXPECT_EQ(brass.distribution, MicrofacetKind::kGgx);
+  EXPECT_EQ(rough.distribution, MicrofacetKind::kGgx);
+  const auto& conductor = std::get<Conductor>(material_of(s, 5));
+  EXPECT_EQ(conductor.distribution, MicrofacetKind::kBeckmann);
+  EXPECT_EQ(conductor.alpha_u, 0.1f);
+  EXPECT_EQ(conductor.alpha_v, 0.1f);
+  EXPECT_EQ(letters_of(Material{conductor}), static_cast<LetterMask>(1u << kD));
+  const auto& glass = std::get<RoughDielectric>(material_of(s, 6));
+  EXPECT_EQ(glass.distribution, MicrofacetKind::kBeckmann);
+  EXPECT_EQ(glass.alpha_u, 0.1f);
+  EXPECT_FLOAT_EQ(glass.ior, static_cast<float>(1.5046 / 1.000277));  // Mitsuba's defaults: bk7 inside, air outside
+  const auto& plastic = std::get<CoatedDiffuse>(material_of(s, 7));
+  EXPECT_EQ(plastic.distribution, MicrofacetKind::kBeckmann);
+  EXPECT_EQ(plastic.roughness, 0.1f);
+  const auto& aniso = std::get<Conductor>(material_of(s, 8));
+  EXPECT_EQ(aniso.distribution, MicrofacetKind::kBeckmann);
+  EXPECT_EQ(aniso.alpha_u, 0.2f);
+  EXPECT_EQ(aniso.alpha_v, 0.05f);
+  const auto& ggx_plastic = std::get<CoatedDiffuse>(material_of(s, 9));
+  EXPECT_EQ(ggx_plastic.distribution, MicrofacetKind::kGgx);
+  EXPECT_EQ(ggx_plastic.roughness, 0.3f);
 }
 
 TEST(ImportMaterialsJson, NewKindsAndTheirParameters) {
@@ -146,16 +175,26 @@ TEST(ImportMaterialsJson, NewKindsAndTheirParameters) {
                   "rough": {"type": "dielectric", "ior": 1.33, "roughness": 0.3},
                   "smooth": {"type": "dielectric", "ior": 1.33, "roughness": 0.0005},
                   "thin": {"type": "thin_dielectric", "ior": 1.4},
-                  "leaf": {"type": "diffuse_transmission", "reflectance": [0.2, 0.3, 0.1], "transmittance": [0.3, 0.5, 0.2]}},
+                  "leaf": {"type": "diffuse_transmission", "reflectance": [0.2, 0.3, 0.1], "transmittance": [0.3, 0.5, 0.2]},
+                  "beckmann-metal": {"type": "conductor", "roughness": 0.25, "distribution": "beckmann"},
+                  "beckmann-glass": {"type": "dielectric", "ior": 1.5, "roughness": 0.15, "distribution": "beckmann"},
+                  "beckmann-coat": {"type": "coateddiffuse", "roughness": 0.2, "distribution": "beckmann"},
+                  "ggx-glossy": {"type": "glossy", "roughness": 0.2, "distribution": "ggx"},
+                  "beckmann-glossy": {"type": "glossy", "roughness": 0.2, "distribution": "beckmann"}},
     "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "gold"},
                {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "copper"},
                {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "custom"},
                {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "rough"},
                {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "smooth"},
                {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "thin"},
-               {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "leaf"}],
+               {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "leaf"},
+               {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "beckmann-metal"},
+               {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "beckmann-glass"},
+               {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "beckmann-coat"},
+               {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "ggx-glossy"},
+               {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "beckmann-glossy"}],
     "lights": [{"type": "environment", "radiance": [1, 1, 1]}]})"));
-  ASSERT_EQ(s.shapes.size(), 8u);  // and the environment's box
+  ASSERT_EQ(s.shapes.size(), 13u);  // and the environment's box
   const auto& gold = std::get<Conductor>(material_of(s, 0));
   EXPECT_EQ(gold.k, metal("Au", false));
   EXPECT_FLOAT_EQ(gold.alpha_u, 0.2f);
@@ -167,6 +206,20 @@ TEST(ImportMaterialsJson, NewKindsAndTheirParameters) {
   EXPECT_FLOAT_EQ(std::get<Dielectric>(material_of(s, 4)).ior, 1.33f);
   EXPECT_FLOAT_EQ(std::get<ThinDielectric>(material_of(s, 5)).ior, 1.4f);
   EXPECT_EQ(std::get<DiffuseTransmission>(material_of(s, 6)).transmittance, glm::vec3(0.3f, 0.5f, 0.2f));
+  // "distribution": ggx unless given.
+  EXPECT_EQ(gold.distribution, MicrofacetKind::kGgx);
+  EXPECT_EQ(std::get<RoughDielectric>(material_of(s, 3)).distribution, MicrofacetKind::kGgx);
+  const auto& metal_b = std::get<Conductor>(material_of(s, 7));
+  EXPECT_EQ(metal_b.distribution, MicrofacetKind::kBeckmann);
+  EXPECT_EQ(metal_b.alpha_u, 0.25f);
+  const auto& glass_b = std::get<RoughDielectric>(material_of(s, 8));
+  EXPECT_EQ(glass_b.distribution, MicrofacetKind::kBeckmann);
+  EXPECT_EQ(glass_b.alpha_v, 0.15f);
+  const auto& coat_b = std::get<CoatedDiffuse>(material_of(s, 9));
+  EXPECT_EQ(coat_b.distribution, MicrofacetKind::kBeckmann);
+  EXPECT_EQ(coat_b.roughness, 0.2f);
+  EXPECT_EQ(std::get<Glossy>(material_of(s, 10)).distribution, MicrofacetKind::kGgx);
+  EXPECT_EQ(std::get<Glossy>(material_of(s, 11)).distribution, MicrofacetKind::kBeckmann);
 }
 
 struct Refusal {
@@ -217,6 +270,14 @@ TEST(ImportMaterialsRefusals, LocatedWithExactMessages) {
        "expected either metal or eta and k, found both"},
       {"leaf.json", json_head + R"({"type": "diffuse_transmission", "reflectance": [0.6, 0.5, 0.5], "transmittance": [0.6, 0.5, 0.5]}}})",
        "leaf.json:/materials/m/transmittance", "expected reflectance + transmittance within [0, 1], found 1.2"},
+      {"phong.xml", kXmlHead + "<bsdf type=\"roughdielectric\" id=\"x\"><string name=\"distribution\" value=\"phong\"/></bsdf>\n</scene>\n",
+       "phong.xml:3:37", "microfacet distribution \"phong\" is not supported, expected beckmann or ggx"},
+      {"phong.json", json_head + R"({"type": "conductor", "roughness": 0.1, "distribution": "phong"}}})", "phong.json:/materials/m/distribution",
+       "unknown microfacet distribution 'phong', expected ggx or beckmann"},
+      {"number.json", json_head + R"({"type": "coateddiffuse", "distribution": 2}}})", "number.json:/materials/m/distribution",
+       "expected a string, found a number"},
+      {"thin-distribution.json", json_head + R"({"type": "thin_dielectric", "distribution": "ggx"}}})",
+       "thin-distribution.json:/materials/m/distribution", "unknown key 'distribution', expected one of type, ior, tint"},
       {"thin-rough.json", json_head + R"({"type": "thin_dielectric", "roughness": 0.1}}})", "thin-rough.json:/materials/m/roughness",
        "unknown key 'roughness', expected one of type, ior, tint"},
   };

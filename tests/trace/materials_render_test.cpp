@@ -122,6 +122,9 @@ TEST(MaterialsAgreement, EstimatorsAgreeOnASphereOfEachMaterial) {
       {"mixture", R"({"type": "mixture", "components": [
           {"weight": 0.5, "material": {"type": "dielectric", "ior": 1.5, "roughness": 0.3}},
           {"weight": 0.5, "material": {"type": "diffuse_transmission", "reflectance": [0.4, 0.4, 0.4], "transmittance": [0.4, 0.4, 0.4]}}]})", true},
+      {"beckmann gold", R"({"type": "conductor", "metal": "Au", "roughness": 0.3, "distribution": "beckmann"})", true},
+      {"beckmann glass", R"({"type": "dielectric", "ior": 1.5, "roughness": 0.3, "distribution": "beckmann"})", true},
+      {"beckmann coat", R"({"type": "coateddiffuse", "reflectance": [0.6, 0.5, 0.4], "roughness": 0.3, "distribution": "beckmann"})", true},
       {"smooth silver", R"({"type": "conductor", "metal": "Ag"})", false},
       {"thin glass", R"({"type": "thin_dielectric", "ior": 1.5})", false},
   };
