@@ -179,12 +179,14 @@ class Importer {
     std::string word;
     while (in >> word) {
       const std::size_t colon = word.find(':');
+      if (colon == std::string::npos || colon == 0)
+        return located(where(n), "bad spectrum entry '" + excerpt(word) + "', expected wavelength:value");
+      const std::string wavelength = word.substr(0, colon), value = word.substr(colon + 1);
       char* end1 = nullptr;
       char* end2 = nullptr;
-      const double w = colon == std::string::npos ? NAN : std::strtod(word.substr(0, colon).c_str(), &end1);
-      const double v = colon == std::string::npos ? NAN : std::strtod(word.c_str() + colon + 1, &end2);
-      if (colon == std::string::npos || colon == 0 || *end1 != '\0' || end2 == word.c_str() + colon + 1 || *end2 != '\0' ||
-          !std::isfinite(w) || !std::isfinite(v))
+      const double w = std::strtod(wavelength.c_str(), &end1);
+      const double v = std::strtod(value.c_str(), &end2);
+      if (*end1 != '\0' || value.empty() || *end2 != '\0' || !std::isfinite(w) || !std::isfinite(v))
         return located(where(n), "bad spectrum entry '" + excerpt(word) + "', expected wavelength:value");
       if (!wavelengths.empty() && !(w > wavelengths.back()))
         return located(where(n), "the spectrum's wavelengths must increase, found " + excerpt(word) + " after " + std::to_string(wavelengths.back()));
