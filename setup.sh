@@ -10,6 +10,7 @@ fuzz=false
 packages=(build-essential cmake pkg-config
   libembree-dev libtbb-dev libglm-dev libcli11-dev nlohmann-json3-dev
   libtinyobjloader-dev libopenexr-dev libpng-dev zlib1g-dev libzstd-dev libopenmpi-dev openmpi-bin libcairo2-dev
+  libopenimageio-dev
   libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev libpugixml-dev
   groff-base)
 if $fuzz; then packages+=(clang-14 libclang-rt-14-dev python3); fi

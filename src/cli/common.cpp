@@ -100,6 +100,8 @@ void add_scene_limit_options(CLI::App* app, Limits* limits) {
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxMaterialNodesCeiling))->group("Limits");
   app->add_option("--max-mesh-elements", limits->max_mesh_elements, "Most vertices plus triangles of a scene's meshes, summed")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxMeshElementsCeiling))->group("Limits");
+  app->add_option("--max-texels", limits->max_texels, "Most pixels of a scene's images (textures, environment maps), summed")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(std::size_t{1}, kMaxTexelsCeiling))->group("Limits");
 }
 
 void add_notation_options(CLI::App* app, NotationOptions* n) {

@@ -27,6 +27,7 @@ struct Limits {
   int max_scene_depth = 64;                              // --max-scene-depth: nesting of a scene's materials
   std::size_t max_material_nodes = 1000000;              // --max-material-nodes: components its materials expand to
   std::size_t max_mesh_elements = 50000000;              // --max-mesh-elements: vertices + triangles of its meshes
+  std::size_t max_texels = std::size_t{1} << 26;         // --max-texels: pixels of its images (textures, environment maps)
 };
 
 // The ceilings of the options above and of --max-bounces. At kMaxDepthCeiling the syntax tree's
@@ -48,6 +49,8 @@ inline constexpr std::size_t kMaxSceneBytesCeiling = std::size_t{64} << 30;
 inline constexpr int kMaxSceneDepthCeiling = 1000;
 inline constexpr std::size_t kMaxMaterialNodesCeiling = 100000000;
 inline constexpr std::size_t kMaxMeshElementsCeiling = 4000000000;
+// 2^32 texels of linear RGB floats are 48 GiB.
+inline constexpr std::size_t kMaxTexelsCeiling = std::size_t{1} << 32;
 
 // "the DFA exceeds the limit of 100000 states (raise it with --max-states)" and friends.
 std::string limit_message(const std::string& what, std::size_t limit, const std::string& unit,

@@ -493,6 +493,7 @@ SceneLoadOptions scene_load_options(const Limits& limits, bool triangles) {
   o.max_scene_depth = limits.max_scene_depth;
   o.max_material_nodes = limits.max_material_nodes;
   o.max_mesh_elements = limits.max_mesh_elements;
+  o.max_texels = limits.max_texels;
   return o;
 }
 

@@ -156,6 +156,7 @@ struct SceneLoadOptions {
   int max_scene_depth = Limits{}.max_scene_depth;
   std::size_t max_material_nodes = Limits{}.max_material_nodes;
   std::size_t max_mesh_elements = Limits{}.max_mesh_elements;
+  std::size_t max_texels = Limits{}.max_texels;  // pixels of all its images (--max-texels)
 };
 // The options of a command's limits (every command that reads a scene passes them through here).
 SceneLoadOptions scene_load_options(const Limits& limits, bool triangles = true);

@@ -1,0 +1,88 @@
+#include "io/image_read.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <filesystem>
+#include <system_error>
+
+namespace pathex {
+
+namespace {
+
+Error image_error(ErrorCode code, const std::string& path, std::string message) {
+  Error e = make_error(code, std::move(message));
+  e.where = path;
+  return e;
+}
+
+// OpenImageIO's message without its trailing newline, or `fallback` when it has none.
+std::string oiio_message(std::string message, const std::string& fallback) {
+  while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
+  return message.empty() ? fallback : message;
+}
+
+}  // namespace
+
+float srgb_to_linear(float encoded) {
+  return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
+}
+
+Result<LinearImage> read_image(const std::string& path, const ImageReadOptions& options) {
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) return image_error(ErrorCode::kBadFile, path, "cannot read the image: " + ec.message());
+  if (bytes > options.max_file_bytes)
+    return image_error(ErrorCode::kLimit, path, limit_message("the image file", options.max_file_bytes, "bytes", "--max-file-size"));
+
+  // Colour as the file stores it: OpenImageIO would otherwise multiply a PNG's colour by its alpha
+  // (associated alpha), and the colour's decoding and an alpha cut-out each need it alone.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path, &config);
+  if (!in) return image_error(ErrorCode::kBadFile, path, "is not an image OpenImageIO reads: " + oiio_message(OIIO::geterror(), "unknown format"));
+  const OIIO::ImageSpec spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1)
+    return image_error(ErrorCode::kBadFile, path, "has no pixels (expected a two-dimensional image of at least 1 x 1)");
+  if (spec.nchannels < 1 || spec.nchannels > 4)
+    return image_error(ErrorCode::kBadFile, path,
+                       "has " + std::to_string(spec.nchannels) + " channels (expected 1 grey, 2 grey and alpha, 3 RGB or 4 RGBA)");
+  const std::size_t texels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
+  const std::size_t before = options.texels_so_far ? *options.texels_so_far : 0;
+  if (texels > options.max_texels || before + texels > options.max_texels)
+    return image_error(ErrorCode::kLimit, path, limit_message("the size of the scene's images", options.max_texels, "texels", "--max-texels"));
+
+  const int channels = spec.nchannels;
+  std::vector<float> data(texels * static_cast<std::size_t>(channels));
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
+    return image_error(ErrorCode::kBadFile, path, "cannot be decoded: " + oiio_message(in->geterror(), "a read error"));
+  in->close();
+
+  const bool encoded = !spec.format.is_floating_point();
+  auto decode = [&](float v) {
+    if (!encoded || options.encoding == ImageEncoding::kLinear) return v;
+    if (options.encoding == ImageEncoding::kSrgb) return srgb_to_linear(v);
+    return std::pow(v, options.gamma);
+  };
+  LinearImage image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.rgb.resize(texels * 3);
+  const bool has_alpha = channels == 2 || channels == 4;
+  if (has_alpha) image.alpha.resize(texels);
+  for (std::size_t i = 0; i < texels; ++i) {
+    const float* texel = &data[i * static_cast<std::size_t>(channels)];
+    for (int c = 0; c < channels; ++c)
+      if (!std::isfinite(texel[c]))
+        return image_error(ErrorCode::kBadValue, path,
+                           "has a value that is not finite at pixel (" + std::to_string(i % spec.width) + ", " +
+                               std::to_string(i / spec.width) + ") (expected finite values)");
+    const int colour = channels >= 3 ? 3 : 1;
+    for (int c = 0; c < 3; ++c) image.rgb[3 * i + c] = decode(texel[colour == 3 ? c : 0]);
+    if (has_alpha) image.alpha[i] = texel[channels - 1];
+  }
+  if (options.texels_so_far) *options.texels_so_far = before + texels;
+  return image;
+}
+
+}  // namespace pathex
