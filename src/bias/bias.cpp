@@ -1,11 +1,14 @@
 #include "bias/bias.h"
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
+#include <unordered_map>
 #include <utility>
 
 #include "automata/ops.h"
 #include "classify/classifier.h"
+#include "classify/convergence.h"
 #include "io/profile_json.h"
 #include "scene/universe.h"
 
@@ -102,6 +105,43 @@ Witness explained(const std::string& path, const CompiledProfile& why_not) {
   return Witness{path, chain_evidence(path), {}, unreachable_reason(path, why_not)};
 }
 
+int batches_in_use(const Histogram& h) { return static_cast<int>(h.batches_in_use().size()); }
+
+// R's estimates against the reference's, pair by pair (UnderSampled in bias.h). Each difference
+// is a t statistic with the Welch–Satterthwaite degrees of freedom of its two batch-means stderrs
+// (`r_dof`, `ref_dof`): a path R never sampled (0 ± 0) is judged on the reference's stderr alone,
+// with its dof, however few batches R's budget filled.
+UnderSampling compare_estimates(std::vector<UnderSampled> pairs, double rate, double min_difference, int r_dof, int ref_dof) {
+  UnderSampling u;
+  u.rate = rate;
+  u.min_difference = min_difference;
+  u.dof = std::max(std::min(r_dof, ref_dof), 1);
+  std::vector<UnderSampled> compared;
+  for (UnderSampled& p : pairs) {
+    if (!std::isfinite(p.renderer.std_error) || !std::isfinite(p.reference.std_error)) continue;  // no stderr: no claim
+    compared.push_back(std::move(p));
+  }
+  u.comparisons = static_cast<int>(compared.size());
+  u.each = 1 - std::pow(1 - rate, 1.0 / std::max(u.comparisons, 1));
+  u.sigmas = sidak_sigmas(u.comparisons, rate, u.dof);
+  for (UnderSampled& p : compared) {
+    const double vr = p.renderer.std_error * p.renderer.std_error;
+    const double vref = p.reference.std_error * p.reference.std_error;
+    const double rounding = 1e-6 * std::max(std::fabs(p.renderer.luminance), std::fabs(p.reference.luminance));
+    const double sigma = std::sqrt(vr + vref + rounding * rounding);
+    const double diff = p.renderer.luminance - p.reference.luminance;
+    if (sigma == 0 || std::fabs(diff) < min_difference) continue;  // equal, or too little light to matter
+    p.z = diff / sigma;
+    const double welch = (vr + vref) * (vr + vref);
+    const double denominator = vr * vr / std::max(r_dof, 1) + vref * vref / std::max(ref_dof, 1);
+    p.dof = denominator > 0 ? std::clamp(welch / denominator, 1.0, 1e6) : std::max(ref_dof, 1);
+    if (student_two_sided_tail(std::fabs(p.z), static_cast<int>(std::lround(p.dof))) < u.each) u.flagged.push_back(std::move(p));
+  }
+  std::stable_sort(u.flagged.begin(), u.flagged.end(),
+                   [](const UnderSampled& a, const UnderSampled& b) { return std::fabs(a.z) > std::fabs(b.z); });
+  return u;
+}
+
 }  // namespace
 
 Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, const Profile& renderer,
@@ -128,6 +168,15 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
   internal.push_back(language_class(kMissedClass, "paths " + renderer.name + " cannot sample", missed));
   for (const PathClass* c : classes)
     internal.push_back(language_class(kMissedClass + (":" + c->name), c->text, dfa_intersect(c->dfa, missed)));
+  // With a comparison of R's own estimates (UnderSampling): "sampled", the paths R can sample
+  // within the reference's scope, and "sampled" within each user class.
+  const bool compare = o.renderer_spp > 0 || o.renderer_histogram != nullptr;
+  if (compare) {
+    const Dfa sampled = dfa_difference(scope, missed);
+    internal.push_back(language_class("sampled", "paths " + renderer.name + " can sample", sampled));
+    for (const PathClass* c : classes)
+      internal.push_back(language_class("sampled:" + c->name, c->text, dfa_intersect(c->dfa, sampled)));
+  }
   std::vector<const PathClass*> all = classes;
   std::vector<ClassInfo> infos;
   for (const PathClass* c : classes) infos.push_back({c->name, c->text});
@@ -138,6 +187,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
   Result<Classifier> classifier = Classifier::build(all, o.limits);
   if (!classifier) return classifier.error();
   const int n = static_cast<int>(classes.size());  // "missed" is class n, missed in class i is n + 1 + i
+  const std::size_t sampled_class = static_cast<std::size_t>(2 * n + 1);  // then sampled in class i: 2n + 2 + i
 
   // --- the reference render ---
   RenderOptions ro;
@@ -225,6 +275,67 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
                                                   static_cast<std::size_t>(std::max(o.witnesses, 1))))
       rep.neither.push_back(explained(w, *ref));
     rep.neither_finite = is_finite(neither);
+  }
+
+  // --- R's own estimates against the reference's: light R can sample but did not find ---
+  if (compare) {
+    std::optional<HistogramReport> r_report;
+    std::uint64_t r_spp = 0;
+    std::uint64_t r_seed = o.seed;
+    int r_batches = 0;
+    if (o.renderer_spp > 0) {
+      Result<Classifier> r_classifier = Classifier::build(classes, o.limits);
+      if (!r_classifier) return r_classifier.error();
+      RenderOptions rro;
+      rro.spp = o.renderer_spp;
+      rro.seed = r_seed = o.seed + 1;  // independent of the reference's samples
+      rro.threads = o.threads;
+      rro.max_bounces = r_bound ? std::min(*r_bound, *bound) : *bound;  // the light the reference measures
+      rro.images = false;
+      rro.cancel = o.cancel;
+      Result<RenderOutput> r_out = render(scene, renderer, &*r_classifier, rro);
+      if (!r_out) return r_out.error();
+      RunInfo r_info = info;
+      r_info.renderer = renderer.name;
+      r_info.spp = r_spp = r_out->spp_done;
+      r_info.spp_requested = o.renderer_spp;
+      r_info.seed = r_seed;
+      std::vector<ClassInfo> user(infos.begin(), infos.begin() + n);
+      Result<HistogramReport> rr = make_report(r_out->histogram, r_info, &*r_classifier, user);
+      if (!rr) return rr.error();
+      r_report = std::move(*rr);
+      r_batches = batches_in_use(r_out->histogram);
+      rep.complete = rep.complete && r_out->complete;
+    } else {
+      RunInfo r_info = info;
+      r_info.renderer = renderer.name;
+      Result<HistogramReport> rr = make_report(*o.renderer_histogram, r_info, nullptr, {});
+      if (!rr) return rr.error();
+      r_report = std::move(*rr);
+      r_spp = o.spp;
+      r_batches = batches_in_use(*o.renderer_histogram);
+    }
+    std::vector<UnderSampled> pairs;
+    pairs.push_back({"total", false, r_report->total, hist->classes[sampled_class].estimate});
+    if (r_report->classes.size() == static_cast<std::size_t>(n))
+      for (int i = 0; i < n; ++i)
+        pairs.push_back({classes[static_cast<std::size_t>(i)]->name, false, r_report->classes[static_cast<std::size_t>(i)].estimate,
+                         hist->classes[sampled_class + 1 + static_cast<std::size_t>(i)].estimate});
+    std::unordered_map<std::string, const Estimate*> r_paths;
+    for (const PathEstimate& p : r_report->paths) r_paths.emplace(p.path, &p.estimate);
+    for (const PathEstimate& p : hist->paths) {
+      if (!r->reachable.accepts(p.path)) continue;
+      const auto found = r_paths.find(p.path);
+      Estimate never;  // R did not sample it: 0 ± 0
+      never.std_error = 0;
+      pairs.push_back({p.path, true, found != r_paths.end() ? *found->second : never, p.estimate});
+    }
+    rep.undersampled = compare_estimates(std::move(pairs), o.undersampled_rate,
+                                         o.undersampled_share * hist->classes[sampled_class].estimate.luminance,
+                                         r_batches - 1, batches_in_use(out->histogram) - 1);
+    rep.undersampled->min_share = o.undersampled_share;
+    rep.undersampled->spp = r_spp;
+    rep.undersampled->seed = r_seed;
   }
 
   // histogram.json keeps the user's classes and "missed" (the per-class parts are in the report).

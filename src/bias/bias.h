@@ -82,6 +82,18 @@ struct BiasOptions {
   // Rows of the reference histogram's path table (the rest summed into one "other" row, as
   // `trace --max-paths`); the missed paths are listed from these rows.
   std::uint64_t max_paths = 1000;
+  // Light R can sample but did not find (UnderSampling below): R rendered at `renderer_spp` passes
+  // (with seed + 1, independent of the reference's) and compared with the reference, or, when
+  // `renderer_histogram` is given, R's render already made (`trace --missed`: the same spp and seed).
+  // Neither: no comparison.
+  std::uint64_t renderer_spp = 0;
+  const Histogram* renderer_histogram = nullptr;
+  // The false-alarm rate of the comparison over all its checks (a correct R with an honest stderr
+  // is flagged somewhere with this probability).
+  double undersampled_rate = 0.01;
+  // Differences smaller than this share of the light R can sample are not flagged, however
+  // significant (a path of 0.1 % of the image that a short render never met).
+  double undersampled_share = 0.01;
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
   const std::atomic<bool>* cancel = nullptr;
   Limits limits;
@@ -105,6 +117,38 @@ struct MissedClass {
   Estimate missed;                       // the part of it on paths R cannot sample
   std::optional<Witness> witness;        // the shortest path of the class R cannot sample, with why
   std::optional<Witness> neither;        // the shortest one the reference cannot sample either
+};
+
+// Light a renderer R can sample but, at its budget, did not find (issue 36): R's own estimate of a
+// class (of the part of it R can sample), of the image, or of an exact path R can sample, against
+// the reference's estimate of the same light, flagged where they differ by more than `sigmas`
+// combined standard errors, σ = √(σ_R² + σ_ref² + (10⁻⁶ · max(|R|, |ref|))²) (the last term is
+// single precision's rounding, for estimates that are exact), while R's stderr alone claimed the
+// estimate was tight. A path R never sampled counts as 0 ± 0: what a stderr cannot see (a rare,
+// heavy path) is exactly what this finds. Each difference is judged as Student's t with the
+// Welch–Satterthwaite degrees of freedom of the two stderrs, flagged when its two-sided tail is
+// below `each`, the Šidák level that makes all `comparisons` together raise a false alarm with
+// probability `rate`, and when the difference is at least `min_share` of the light R can sample.
+struct UnderSampled {
+  std::string name;     // "total", a class name, or an exact path
+  bool path = false;
+  Estimate renderer;    // R's estimate
+  Estimate reference;   // the reference's estimate of the light R can sample there
+  double z = 0;         // (R − reference) / combined σ
+  double dof = 0;       // its Welch–Satterthwaite degrees of freedom
+};
+
+struct UnderSampling {
+  std::uint64_t spp = 0;         // R's passes
+  std::uint64_t seed = 0;        // R's seed
+  double rate = 0.01;            // the family-wise false-alarm rate
+  int dof = 0;                   // the smaller of R's and the reference's (batches − 1)
+  int comparisons = 0;           // the image, each class, each listed path R can sample
+  double each = 0;               // the two-sided tail below which one comparison is flagged
+  double min_share = 0.01;       // and the smallest difference flagged, as a share of the light R can sample
+  double min_difference = 0;     // that share as a luminance
+  double sigmas = 0;             // that level in σ at `dof` (the largest threshold any comparison has)
+  std::vector<UnderSampled> flagged;  // largest |z| first
 };
 
 struct BiasReport {
@@ -138,6 +182,7 @@ struct BiasReport {
   // not known, which is not 0.
   std::vector<Witness> neither;
   bool neither_finite = true;           // whether there are finitely many
+  std::optional<UnderSampling> undersampled;  // with BiasOptions::renderer_spp or renderer_histogram
 };
 
 struct BiasRun {

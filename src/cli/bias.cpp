@@ -32,6 +32,7 @@ struct BiasArgs {
   std::string out = "pathex-bias";
   std::string resolution;
   BiasOptions options;
+  std::optional<std::uint64_t> renderer_spp;  // default: options.spp; 0: no comparison
   int top_paths = 8;
   bool json = false;
   bool no_images = false;
@@ -79,6 +80,11 @@ void print_text(const BiasReport& r, int top, const std::string& out_dir, bool i
   const std::uint64_t more = r.paths.size() - std::min(r.paths.size(), static_cast<std::size_t>(top)) + r.other_missed_paths;
   if (more > 0) std::cout << "  … " << more << " more (bias.json lists " << r.paths.size() << "; --top, --max-paths)\n";
 
+  if (r.undersampled) {
+    std::cout << "\n";
+    for (const std::string& line : undersampled_lines(r, top)) std::cout << line << "\n";
+  }
+
   std::cout << "\nnot counted\n";
   if (r.neither.empty()) {
     std::cout << "  paths neither can sample: none (" << r.reference << " samples every path " << r.renderer
@@ -109,6 +115,7 @@ int run(BiasArgs a) {
 
   // --- the reference render and what the renderer misses ---
   a.options.images = !a.no_images;
+  a.options.renderer_spp = a.renderer_spp.value_or(a.options.spp);
   Result<BiasRun> run = [&] {
     const RenderWatch watch(!a.quiet);
     a.options.progress = watch.progress();
@@ -148,7 +155,8 @@ Command add_bias(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("bias", "How much light a renderer misses in a scene, by class, by exact path and per pixel");
   sub->footer("Example:\n  pathex bias samples/scenes/point-mirror-caustic.json --renderer pt-nee --spp 64\n"
               "Renders the scene once with the reference (default: bdpt plus every connector the scene's universe\n"
-              "needs) and reports the light the renderer cannot sample, with the checker's reasons. Writes\n"
+              "needs) and reports the light the renderer cannot sample, with the checker's reasons; then renders the\n"
+              "renderer itself (--renderer-spp) and reports light it can sample but under-samples. Writes\n"
               "DIR/bias.json, DIR/histogram.json, DIR/classes.exr, DIR/missed.exr and DIR/<layer>.png (missed.png\n"
               "on the total's exposure). Ctrl-C stops early and writes what was rendered (exit 1).");
   sub->add_option("SCENE", args->scene, "Scene file (grammar/scene.schema.json)")->required();
@@ -156,6 +164,13 @@ Command add_bias(CLI::App& app) {
   sub->add_option("--reference", args->reference,
                   "The profile that renders the scene; default: bdpt plus every connector the scene's universe needs");
   sub->add_option("--spp", args->options.spp, "Samples per pixel of the reference render")->capture_default_str()->check(CLI::Range(1, 1 << 24));
+  sub->add_option("--renderer-spp", args->renderer_spp,
+                  "Also render the renderer at this budget and report light it can sample but under-samples there "
+                  "(0: skip); default: --spp")
+      ->check(CLI::Range(std::uint64_t{0}, std::uint64_t{1} << 24));
+  sub->add_option("--undersampled-share", args->options.undersampled_share,
+                  "Smallest difference reported as under-sampled, as a share of the light the renderer can sample")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   sub->add_option("--classes", args->classes_file, "Class file; default: the built-in classes");
   sub->add_option("--seed", args->options.seed, "Random seed (0 to 2^64 - 1)")->capture_default_str()->check(non_negative());
   sub->add_option("--threads", args->options.threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));

@@ -108,6 +108,18 @@ nlohmann::ordered_json to_json(const BiasReport& r) {
   j["other_missed_paths"] = r.other_missed_paths;
   J neither = J::array();
   for (const Witness& w : r.neither) neither.push_back(J(to_json(w)));
+  if (r.undersampled) {
+    const UnderSampling& u = *r.undersampled;
+    J flagged = J::array();
+    for (const UnderSampled& f : u.flagged)
+      flagged.push_back({{f.path ? "path" : "class", f.name}, {"renderer", estimate_json(f.renderer)},
+                         {"reference", estimate_json(f.reference)}, {"z", f.z}, {"dof", f.dof}});
+    j["undersampled"] = {{"spp", u.spp}, {"seed", u.seed}, {"sigmas", u.sigmas}, {"false_alarm_rate", u.rate},
+                         {"dof", u.dof}, {"comparisons", u.comparisons}, {"each", u.each}, {"min_share", u.min_share},
+                         {"min_difference", u.min_difference}, {"flagged", flagged}};
+  } else {
+    j["undersampled"] = nullptr;
+  }
   j["not_counted"] = {
       {"neither", {{"witnesses", neither}, {"finite", r.neither_finite},
                    {"note", "paths neither " + r.renderer + " nor " + r.reference +
@@ -123,6 +135,32 @@ std::string missed_line(const BiasReport& r) {
            std::to_string(r.reference_bounces) + " interior vertices (exact, by the checker)";
   return r.renderer + " cannot sample " + percent(r.share) + " ± " + percent(r.share_std_error, 2) + " of what " +
          r.reference + " finds (luminance " + absolute(r.missed) + " of " + absolute(r.total) + ")";
+}
+
+std::vector<std::string> undersampled_lines(const BiasReport& r, int top) {
+  std::vector<std::string> lines;
+  if (!r.undersampled) return lines;
+  const UnderSampling& u = *r.undersampled;
+  char each[32];
+  std::snprintf(each, sizeof each, "%.2g", u.each);
+  lines.push_back("under-sampled: light " + r.renderer + " can sample where its estimate at " + std::to_string(u.spp) +
+                  " spp and " + r.reference + "'s differ beyond their combined stderr (two-sided p < " + each + ": " +
+                  percent(u.rate, 0) + " false alarms over " + std::to_string(u.comparisons) +
+                  " comparisons, Šidák; Student's t, Welch's dof) by at least " + percent(u.min_share) +
+                  " of the light it can sample:");
+  if (u.flagged.empty())
+    lines.push_back("  none: its estimates of the image, each class and each listed path it can sample agree with the reference's");
+  for (std::size_t i = 0; i < u.flagged.size() && static_cast<int>(i) < top; ++i) {
+    const UnderSampled& f = u.flagged[i];
+    char z[32];
+    std::snprintf(z, sizeof z, "%.1f", f.z);
+    lines.push_back("  " + std::string(f.path ? "path " : "") + f.name + ": reachable, under-sampled at " +
+                    std::to_string(u.spp) + " spp: estimate " + absolute(f.renderer) + ", reference " +
+                    absolute(f.reference) + " (z " + z + ")");
+  }
+  if (u.flagged.size() > static_cast<std::size_t>(std::max(top, 0)))
+    lines.push_back("  … " + std::to_string(u.flagged.size() - static_cast<std::size_t>(top)) + " more (\"undersampled\" in the JSON)");
+  return lines;
 }
 
 std::string witness_line(const Witness& w) {

@@ -34,10 +34,18 @@ struct CheckArgs {
 
 // {"missed": {"max_share": 0.01, "spp": 64, "reference": "bdpt"}}: the renderer misses at most
 // max_share of the scene's light as a reference render at spp finds it (pathex bias).
+//
+// {"undersampled": {"spp": 4, "reference_spp": 64, "max_flagged": 0}}: the same reference render
+// and one of the renderer at spp; passes when at most max_flagged of the image, its classes and
+// its listed paths hold light the renderer can sample but under-samples (BiasReport::undersampled).
 struct MissedRequirement {
   double max_share = 0;
-  std::uint64_t spp = 64;
-  std::string reference;  // empty: bias's default reference
+  std::uint64_t spp = 64;  // the reference's
+  std::string reference;   // empty: bias's default reference
+  bool undersampled = false;
+  std::uint64_t renderer_spp = 16;
+  std::uint64_t max_flagged = 0;
+  double min_share = 0.01;
 };
 
 // {"finite": true, "spp": N, "seed": N}: a render of the case's scene with its renderer has no
@@ -54,6 +62,9 @@ struct Requirement {
   std::string cls;
   std::string verdict;  // reachable, not-unreachable, unreachable, partial, empty
   std::string describe() const {
+    if (missed && missed->undersampled)
+      return "under-samples at most " + std::to_string(missed->max_flagged) + " classes or paths at " +
+             std::to_string(missed->renderer_spp) + " spp";
     if (missed) return "misses at most " + percent(missed->max_share, 2) + " of the scene's light";
     if (finite) return "renders finite (" + std::to_string(finite->spp) + " spp, seed " + std::to_string(finite->seed) + ")";
     return covers_scene ? "covers the scene" : cls + " is " + verdict;
@@ -115,6 +126,34 @@ Result<MissedRequirement> parse_missed(const nlohmann::json& jm, const std::stri
   return m;
 }
 
+// The value of a requirement's "undersampled" key.
+Result<MissedRequirement> parse_undersampled(const nlohmann::json& ju, const std::string& file, const std::string& ptr) {
+  const JsonReader reader(file);
+  if (!ju.is_object())
+    return reader.fail(ptr, "expected {\"spp\": the renderer's samples per pixel, \"reference_spp\": the reference's, \"max_flagged\": a count}");
+  if (Result<bool> k = reader.keys(ju, ptr, {"spp", "reference_spp", "max_flagged", "min_share", "reference"}); !k) return k.error();
+  MissedRequirement m;
+  m.undersampled = true;
+  Result<long long> spp = reader.integer(ju, "spp", ptr, 1, 1 << 24, 16);
+  if (!spp) return spp.error();
+  m.renderer_spp = static_cast<std::uint64_t>(*spp);
+  Result<long long> ref_spp = reader.integer(ju, "reference_spp", ptr, 1, 1 << 24, 64);
+  if (!ref_spp) return ref_spp.error();
+  m.spp = static_cast<std::uint64_t>(*ref_spp);
+  Result<long long> flagged = reader.integer(ju, "max_flagged", ptr, 0, std::numeric_limits<long long>::max(), 0);
+  if (!flagged) return flagged.error();
+  m.max_flagged = static_cast<std::uint64_t>(*flagged);
+  Result<double> share = reader.number(ju, "min_share", ptr, 0.0, 1.0, 0.01);
+  if (!share) return share.error();
+  m.min_share = *share;
+  if (ju.contains("reference")) {
+    Result<std::string> ref = reader.string(ju, "reference", ptr);
+    if (!ref) return ref.error();
+    m.reference = *ref;
+  }
+  return m;
+}
+
 Result<std::vector<Case>> parse_check(const std::string& text, const std::string& file) {
   Result<nlohmann::json> parsed = parse_json(text, file);
   if (!parsed) return parsed.error();
@@ -169,7 +208,7 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
       const auto& jr = reqs[j];
       if (!jr.is_object())
         return bad(file, rp,
-                   "expected {\"class\": …, \"verdict\": …}, {\"covers-scene\": true}, {\"missed\": {…}} or {\"finite\": true}");
+                   "expected {\"class\": …, \"verdict\": …}, {\"covers-scene\": true}, {\"missed\": {…}}, {\"undersampled\": {…}} or {\"finite\": true}");
       Requirement r;
       r.pointer = rp;
       if (jr.contains("finite")) {
@@ -187,10 +226,16 @@ Result<std::vector<Case>> parse_check(const std::string& text, const std::string
         continue;
       }
       for (const auto& [k, v] : jr.items())
-        if (k != "class" && k != "verdict" && k != "covers-scene" && k != "missed")
+        if (k != "class" && k != "verdict" && k != "covers-scene" && k != "missed" && k != "undersampled")
           return bad(file, rp + "/" + pointer_token(k),
-                     "unknown key '" + k + "', expected class and verdict, or covers-scene, or missed, or finite");
-      if (jr.contains("missed")) {
+                     "unknown key '" + k + "', expected class and verdict, or covers-scene, or missed, or undersampled, or finite");
+      if (jr.contains("undersampled")) {
+        if (jr.size() != 1) return bad(file, rp, "undersampled stands alone: no other key beside it");
+        if (c.scene.empty()) return bad(file, rp + "/undersampled", "an undersampled requirement needs the case's scene");
+        Result<MissedRequirement> m = parse_undersampled(jr.at("undersampled"), file, rp + "/undersampled");
+        if (!m) return m.error();
+        r.missed = *m;
+      } else if (jr.contains("missed")) {
         if (jr.size() != 1) return bad(file, rp, "missed stands alone: no other key beside it");
         if (c.scene.empty()) return bad(file, rp + "/missed", "a missed requirement needs the case's scene");
         Result<MissedRequirement> m = parse_missed(jr.at("missed"), file, rp + "/missed");
@@ -276,15 +321,28 @@ Result<bool> decide_missed(const CheckArgs& a, ReachCache& cache, const Case& c,
   if (!renderer) return at_case_key(renderer.error(), a.file, c.pointer + "/renderer", c.renderer);
   BiasOptions bo;
   bo.spp = r.missed->spp;
+  if (r.missed->undersampled) {
+    bo.renderer_spp = r.missed->renderer_spp;
+    bo.undersampled_share = r.missed->min_share;
+  }
   bo.renderer_bounces = c.max_bounces;
   bo.images = false;
   bo.limits = a.limits;
   const std::string reference = r.missed->reference.empty() || r.missed->reference.find('/') == std::string::npos
                                     ? r.missed->reference
                                     : resolve(a.file, r.missed->reference);
+  const std::string key = r.missed->undersampled ? "/undersampled" : "/missed";
   Result<BiasRun> run = measure_missed(*scene, c.scene, **renderer, reference, {}, bo);
-  if (!run) return at_case_key(run.error(), a.file, r.pointer + "/missed", reference);
+  if (!run) return at_case_key(run.error(), a.file, r.pointer + key, reference);
   const BiasReport& b = run->report;
+  if (b.undersampled) {
+    const UnderSampling& u = *b.undersampled;
+    o->passed = u.flagged.size() <= r.missed->max_flagged;
+    o->verdict = std::to_string(u.flagged.size()) + " under-sampled of " + std::to_string(u.comparisons) +
+                 " compared with " + b.reference;
+    o->missed = b;
+    return true;
+  }
   o->passed = b.share <= r.missed->max_share;
   o->verdict = percent(b.share, 2) + " ± " + percent(b.share_std_error, 2) + " of what " + b.reference + " finds";
   if (!o->passed && b.shortest) o->counterexample = b.shortest;
@@ -405,7 +463,10 @@ int run(const CheckArgs& a) {
     } else if (!o.passed && o.verdict == "empty") {
       details = "the class has no path in this universe";
     }
-    if (!o.passed && o.missed && !o.missed->paths.empty()) {
+    if (!o.passed && o.missed && o.missed->undersampled) {
+      const std::vector<std::string> lines = undersampled_lines(*o.missed, 3);
+      for (std::size_t i = 1; i < lines.size(); ++i) details += (details.empty() ? "" : "\n      ") + lines[i].substr(2);
+    } else if (!o.passed && o.missed && !o.missed->paths.empty()) {
       const MissedPath& p = o.missed->paths.front();
       details += "\n      largest missed path " + p.estimate.path + ", " + percent(p.share, 2) + " of the image, chains " +
                  chains_text(p.chains) + "; " + p.reason;
@@ -423,7 +484,9 @@ int run(const CheckArgs& a) {
         if (o.counterexample->reason.empty()) jr["counterexample"]["strategies"] = o.counterexample->strategies;
         else jr["counterexample"]["reason"] = o.counterexample->reason;
       }
-      if (o.missed) {
+      if (o.missed && o.missed->undersampled) {
+        jr["undersampled"] = nlohmann::json::parse(to_json(*o.missed)["undersampled"].dump());
+      } else if (o.missed) {
         const BiasReport& b = *o.missed;
         jr["missed"] = {{"share", b.share}, {"stderr", b.share_std_error}, {"max_share", o.r->missed->max_share},
                         {"reference", b.reference}, {"spp", b.spp}, {"luminance", b.missed.luminance},

@@ -396,6 +396,7 @@ int run(const TraceArgs& a) {
     bo.seed = id.seed;
     bo.threads = a.threads;
     bo.renderer_bounces = id.max_bounces;  // what this render could sample: its own bound
+    bo.renderer_histogram = &out->histogram;  // and what it found, against the reference
     bo.images = false;
     bo.limits = a.limits;
     const RenderWatch watch(!a.quiet);
@@ -507,7 +508,10 @@ int run(const TraceArgs& a) {
   }
   for (const PrunedStrategy& p : pruning->changes)
     std::cout << (p.now.empty() ? "not run: " : "narrowed: ") << p.strategy << " " << p.was << (p.now.empty() ? "" : " to " + p.now) << ": " << p.reason << "\n";
-  if (missed) std::cout << "this renderer " << missed_line(*missed).substr(missed->renderer.size() + 1) << "\n";
+  if (missed) {
+    std::cout << "this renderer " << missed_line(*missed).substr(missed->renderer.size() + 1) << "\n";
+    for (const std::string& line : undersampled_lines(*missed, 8)) std::cout << line << "\n";
+  }
   std::cout << "\n";
   for (std::size_t i = 0; i < rep->classes.size(); ++i) {
     const ClassEstimate& c = rep->classes[i];

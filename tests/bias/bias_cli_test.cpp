@@ -134,6 +134,70 @@ TEST(BiasCli, TraceMissedLine) {
   EXPECT_EQ(run_pathex("trace --reference bdpt --out " + out_dir("trace4")).code, 2);  // --reference needs --missed
 }
 
+TEST(BiasCli, UnderSampledLightIsReportedWithItsLevel) {
+  // samples/scenes/small-light-caustic.json: pt-nee at 4 spp never finds the lamp's caustic through
+  // the glass ball (reachable for it), and its stderr says 0 ± 0.
+  const std::string dir = out_dir("lamp");
+  const CliRun r = run_pathex("bias samples/scenes/small-light-caustic.json --renderer pt-nee --reference bdpt --spp 64 "
+                              "--renderer-spp 4 --no-images --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const nlohmann::json j = nlohmann::json::parse(pathex::test::read_file(dir + "/bias.json"));
+  const nlohmann::json& u = j["undersampled"];
+  EXPECT_EQ(u["spp"], 4);
+  EXPECT_EQ(u["seed"], 2);
+  EXPECT_EQ(u["dof"], 3);
+  EXPECT_EQ(u["false_alarm_rate"], 0.01);
+  EXPECT_EQ(u["min_share"], 0.01);
+  const int n = u["comparisons"];
+  char each[32];
+  std::snprintf(each, sizeof each, "%.2g", 1 - std::pow(0.99, 1.0 / n));
+  EXPECT_NE(r.out.find("\nunder-sampled: light pt-nee can sample where its estimate at 4 spp and bdpt's differ beyond their "
+                       "combined stderr (two-sided p < " + std::string(each) + ": 1 % false alarms over " + std::to_string(n) +
+                       " comparisons, Šidák; Student's t, Welch's dof) by at least 1.0 % of the light it can sample:\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("\n  caustic: reachable, under-sampled at 4 spp: estimate 0.00000 ± 0.00000, reference 0.0"), std::string::npos)
+      << r.out;
+  bool path = false;
+  for (const nlohmann::json& f : u["flagged"])
+    if (f.contains("path") && f["path"] == "LDDSSDDSE") {
+      path = true;
+      EXPECT_EQ(f["renderer"]["luminance"], 0.0);
+      EXPECT_LT(f["z"].get<double>(), -4.0);
+    }
+  EXPECT_TRUE(path) << u.dump(1);
+  // --renderer-spp 0: no comparison, and bias.json says so.
+  const CliRun none = run_pathex("bias samples/scenes/small-light-caustic.json --renderer pt-nee --reference bdpt --spp 4 "
+                                 "--renderer-spp 0 --no-images --out " + out_dir("lamp0"));
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_EQ(none.out.find("under-sampled"), std::string::npos) << none.out;
+  EXPECT_TRUE(nlohmann::json::parse(pathex::test::read_file(out_dir("lamp0") + "/bias.json"))["undersampled"].is_null());
+  // trace --missed compares the render it made (same spp and seed as its reference).
+  const CliRun trace = run_pathex("trace samples/scenes/small-light-caustic.json --renderer pt-nee --spp 4 --missed "
+                                  "--reference bdpt --no-images --out " + out_dir("lamp-trace"));
+  ASSERT_EQ(trace.code, 0) << trace.err;
+  EXPECT_NE(trace.out.find("\nunder-sampled: light pt-nee can sample where its estimate at 4 spp and bdpt's differ"),
+            std::string::npos)
+      << trace.out;
+  const nlohmann::json m = nlohmann::json::parse(pathex::test::read_file(out_dir("lamp-trace") + "/missed.json"));
+  EXPECT_EQ(m["undersampled"]["seed"], 1);  // trace's own render
+}
+
+TEST(CheckMissed, UndersampledRequirementPassesAndFails) {
+  const CliRun r = run_pathex("check tests/bias/checks/undersampled.json");
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("PASS  lamp-bdpt: under-samples at most 0 classes or paths at 16 spp (0 under-sampled of "),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("FAIL  lamp-pt-nee: under-samples at most 0 classes or paths at 4 spp ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\n      path LDDSSDDSE: reachable, under-sampled at 4 spp: estimate 0.00000 ± 0.00000, reference "),
+            std::string::npos)
+      << r.out;
+  const nlohmann::json j = nlohmann::json::parse(run_pathex("check --json tests/bias/checks/undersampled.json").out);
+  EXPECT_EQ(j["requirements"][1]["undersampled"]["spp"], 4);
+  EXPECT_EQ(j["requirements"][1]["undersampled"]["flagged"][0]["path"], "LDDSSDDSE");
+}
+
 TEST(CheckMissed, PassingFileExitsZero) {
   const std::string junit = out_dir("pass.xml");
   const CliRun r = run_pathex("check tests/bias/checks/pass.json --junit " + junit);
@@ -194,6 +258,21 @@ TEST(CheckMissed, BadRequirementsAreLocated) {
             R"(", "require": [{"missed": {"max_share": 0.1, "sp": 4}}]}]})");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(f + ":/cases/0/require/0/missed/sp: "), std::string::npos) << r.err;
+  r = check(R"({"cases": [{"name": "a", "renderer": "pt", "require": [{"undersampled": {"spp": 4}}]}]})");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "pathex: error: " + f + ":/cases/0/require/0/undersampled: an undersampled requirement needs the case's scene\n");
+  r = check(R"({"cases": [{"name": "a", "renderer": "pt", "scene": ")" + scene +
+            R"(", "require": [{"undersampled": {"spp": 4}, "missed": {"max_share": 0.1}}]}]})");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "pathex: error: " + f + ":/cases/0/require/0: undersampled stands alone: no other key beside it\n");
+  r = check(R"({"cases": [{"name": "a", "renderer": "pt", "scene": ")" + scene +
+            R"(", "require": [{"undersampled": {"spp": 0}}]}]})");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(f + ":/cases/0/require/0/undersampled/spp: "), std::string::npos) << r.err;
+  r = check(R"({"cases": [{"name": "a", "renderer": "pt", "scene": ")" + scene +
+            R"(", "require": [{"undersampled": {"min_share": 3}}]}]})");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(f + ":/cases/0/require/0/undersampled/min_share: "), std::string::npos) << r.err;
 }
 
 }  // namespace

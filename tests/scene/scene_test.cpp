@@ -246,6 +246,7 @@ TEST(SampleScenes, TypesAndUniverses) {
       {"sun-window.json", {LightType::kDistant}, SensorType::kPinhole, d, "LDSD*DSE"},
       {"sky-glass.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // the sky is an area light
       {"materials.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // issue 35's materials
+      {"small-light-caustic.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // issue 36
       {"laser.json", {LightType::kLaser}, SensorType::kPinhole, sd, "LSS[SD]*DSE"},
       {"closed-sphere-point.json", {LightType::kPoint}, SensorType::kPinhole, d, "LSDD*DSE"},
       {"closed-sphere-emitting.json", {LightType::kArea}, SensorType::kPinhole, d, "LDDD*DSE"},

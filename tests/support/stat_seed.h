@@ -16,6 +16,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "classify/convergence.h"
+
 namespace pathex::test {
 
 // `fixed`, or PATHEX_STAT_SEED when it is set.
@@ -30,31 +32,12 @@ inline void stat_log(const std::string& what, double value, double tolerance) {
   if (on) std::printf("stat-log %s\t%.6g\t%.6g\n", what.c_str(), value, tolerance);
 }
 
-// P(|T| > x) for Student's t with `dof` degrees of freedom (the batch-means z of an estimate from
-// B batches has B − 1), by Simpson's rule over [0, x] of its density: plenty for tolerances.
-inline double student_two_sided_tail(double x, int dof) {
-  const double nu = dof;
-  const double c = std::exp(std::lgamma((nu + 1) / 2) - std::lgamma(nu / 2)) / std::sqrt(nu * 3.14159265358979323846);
-  auto f = [&](double t) { return c * std::pow(1 + t * t / nu, -(nu + 1) / 2); };
-  const int n = 4000;  // even
-  const double h = x / n;
-  double sum = f(0) + f(x);
-  for (int i = 1; i < n; ++i) sum += f(i * h) * (i % 2 ? 4 : 2);
-  return std::max(0.0, 1 - 2 * sum * h / 3);
-}
-
 // The tolerance, in standard errors, that makes `checks` independent two-sided checks fail
-// together with probability `family_rate` (Šidák: each at 1 − (1 − rate)^(1/checks)), for
-// standardised deviations distributed as Student's t with `dof` degrees of freedom (31 for the
-// default 32 batches). One place that states a statistical test's false-failure rate.
+// together with probability `family_rate` (Šidák over Student's t with `dof` degrees of freedom,
+// 31 for the default 32 batches: classify/convergence.h's sidak_sigmas, the library's one copy).
+// One place that states a statistical test's false-failure rate.
 inline double family_sigmas(int checks, double family_rate = 1e-3, int dof = 31) {
-  const double each = 1 - std::pow(1 - family_rate, 1.0 / std::max(checks, 1));
-  double lo = 0, hi = 60;
-  for (int i = 0; i < 100; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (student_two_sided_tail(mid, dof) > each ? lo : hi) = mid;
-  }
-  return hi;
+  return sidak_sigmas(checks, family_rate, dof);
 }
 
 }  // namespace pathex::test

@@ -31,7 +31,7 @@ constexpr int kBounces = 6;
 HistogramReport render_scene(const Scene& scene, const Profile& profile, std::uint64_t spp) {
   RenderOptions o;
   o.spp = spp;
-  o.seed = 3;
+  o.seed = test::stat_seed(3);
   o.max_bounces = kBounces;
   Result<RenderOutput> out = render(scene, profile, nullptr, o);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
@@ -65,6 +65,10 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
   };
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".json") continue;
+    // Made to be under-sampled (issue 36): pt meets its lamp of radius 0.03 by chance only, so
+    // "every profile finds every path above 1 % at 128 spp" does not hold there by design;
+    // tests/bias/bias_test.cpp measures that scene with pathex bias's under-sampling check.
+    if (entry.path().filename() == "small-light-caustic.json") continue;
     Result<Scene> loaded = load_scene_file(entry.path().string());
     ASSERT_TRUE(loaded.ok()) << loaded.error().render();
     Scene scene = *loaded;
