@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "support/stat_seed.h"
 #include "io/profile_json.h"
 #include "scene/scene.h"
 #include "trace/differential.h"
@@ -351,7 +352,7 @@ TEST(ManifoldRender, MirrorSphereImageOnTheFloorIsTheClosedForm) {
   const double expected = rho / M_PI * intensity * refl * mirror_sphere_image(light, centre, 0.5, b, dvec3(0, 1, 0)).dw_db;
   RenderOptions o;
   o.spp = 16;
-  o.seed = 5;
+  o.seed = test::stat_seed(5);
   o.max_bounces = 4;
   o.images = false;
   RunInfo info;
@@ -387,7 +388,7 @@ HistogramReport render_point_glass(const std::string& renderer, std::uint64_t sp
   }
   RenderOptions o;
   o.spp = spp;
-  o.seed = 7;
+  o.seed = test::stat_seed(7);
   o.max_bounces = 6;
   o.images = false;
   Result<RenderOutput> out = render(scene, resolve_profile(renderer, Limits{}).expect("built in"), nullptr, o);
@@ -464,7 +465,7 @@ TEST(ManifoldRender, TenInterfacesStayFiniteAndAreFound) {
   const Scene scene = load_scene_json(json, ".", "stack.json").expect("a valid scene");
   RenderOptions o;
   o.spp = 8;
-  o.seed = 3;
+  o.seed = test::stat_seed(3);
   o.max_bounces = 14;
   o.images = false;
   Result<RenderOutput> out = render(scene, resolve_profile("pt-nee+manifold", Limits{}).expect("built in"), nullptr, o);
