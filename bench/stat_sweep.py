@@ -40,6 +40,9 @@ STATISTICAL_TESTS = [
     ("import_test", "ImportCornell.ImagesMatchTheJsonSceneWithin3Sigma"),
     ("materials_render_test", "*"),
     ("bsdf_test", "CoatedDiffuse.*"),
+    ("hard_cases_test", "*"),
+    ("only_test", "Only.AgreesWithTheClassOfAFullRender"),
+    ("emission_cones_test", "AimedEmission.*"),
 ]
 
 

@@ -16,6 +16,7 @@
 #include "reach/prune.h"
 #include "scene/scene.h"
 #include "scene/universe.h"
+#include "support/stat_seed.h"
 #include "trace/emission_cones.h"
 #include "trace/prune.h"
 #include "trace/render.h"
@@ -160,8 +161,8 @@ Scene scene_at(const std::string& name, int size) {
 // shapes with a specular component); the caustic keeps its value (4σ) and its variance falls.
 TEST(AimedEmission, PointLightCausticKeepsItsValueWithLessVariance) {
   const Scene scene = scene_at("point-glass.json", 24);
-  const ClassRender full = render_class(scene, "bdpt", "$caustic", false, 21, 32);
-  const ClassRender only = render_class(scene, "bdpt", "$caustic", true, 22, 32);
+  const ClassRender full = render_class(scene, "bdpt", "$caustic", false, test::stat_seed(21), 32);
+  const ClassRender only = render_class(scene, "bdpt", "$caustic", true, test::stat_seed(21) + 1, 32);
   EXPECT_TRUE(full.aimed.empty());
   ASSERT_EQ(only.aimed.size(), 1u);
   EXPECT_EQ(only.aimed[0].light, 0);
@@ -186,8 +187,8 @@ TEST(AimedEmission, SpotLightCausticKeepsItsValue) {
   spot.intensity = p.intensity;
   spot.cone_degrees = 30.0f;
   scene.lights = {spot};
-  const ClassRender full = render_class(scene, "bdpt", "$caustic", false, 31, 32);
-  const ClassRender only = render_class(scene, "bdpt", "$caustic", true, 32, 32);
+  const ClassRender full = render_class(scene, "bdpt", "$caustic", false, test::stat_seed(31), 32);
+  const ClassRender only = render_class(scene, "bdpt", "$caustic", true, test::stat_seed(31) + 1, 32);
   ASSERT_EQ(only.aimed.size(), 1u);
   EXPECT_EQ(only.aimed[0].kind, "spot");
   EXPECT_GT(full.luminance, 0.0);

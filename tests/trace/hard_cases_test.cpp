@@ -18,6 +18,7 @@
 #include "io/profile_json.h"
 #include "scene/scene.h"
 #include "support/cli_run.h"
+#include "support/stat_seed.h"
 #include "trace/render.h"
 
 namespace pathex {
@@ -34,7 +35,7 @@ struct Rendered {
 
 // Renders a scene file with `renderer`, classifying by `classes` (full notation).
 Rendered render_file(const std::string& file, const std::string& renderer, const std::vector<std::string>& classes,
-                     std::uint64_t spp, std::optional<int> max_bounces = std::nullopt, std::uint64_t seed = 7) {
+                     std::uint64_t spp, std::optional<int> max_bounces = std::nullopt, std::uint64_t seed = test::stat_seed(7)) {
   Result<Scene> scene = load_scene_file(file);
   EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().render());
   if (!scene) return {};
@@ -68,6 +69,8 @@ Rendered render_file(const std::string& file, const std::string& renderer, const
 }
 
 // |estimate - expected| within `sigmas` standard errors plus `rel` of expected; finite throughout.
+// Each test passes test::family_sigmas(its number of checks): a family-wise false-failure rate of
+// 0.1 % (Šidák over Student's t with 31 dof), and its seed comes from test::stat_seed.
 void expect_close(const Estimate& e, double expected, double sigmas, double rel, const std::string& what) {
   EXPECT_TRUE(std::isfinite(e.luminance)) << what;
   EXPECT_TRUE(std::isfinite(e.std_error)) << what;
@@ -147,7 +150,7 @@ TEST(GgxPlane, AgreesWithQuadratureAtEveryAlpha) {
       const Rendered r = render_file(hard("ggx-point-" + alpha_name(alpha) + ".json"), renderer, {"LSDDDSE"}, 64);
       EXPECT_EQ(r.nonfinite, 0u);
       ASSERT_EQ(r.report.classes.size(), 1u);
-      expect_close(r.report.classes[0].estimate, expected, 3.0, 1e-3, std::string(renderer) + " alpha " + alpha_name(alpha));
+      expect_close(r.report.classes[0].estimate, expected, test::family_sigmas(8), 1e-3, std::string(renderer) + " alpha " + alpha_name(alpha));
     }
   }
 }
@@ -165,7 +168,7 @@ TEST(GgxPlane, ConvergesToTheMirrorAsAlphaVanishes) {
   EXPECT_GT(fraction_4, 0.98);  // the r^-4 tails beyond 10 alpha
   // And the render at alpha = 1e-4 is that fraction of the mirror's image.
   const Rendered r = render_file(hard("ggx-point-0.0001.json"), "pt-nee", {"LSDDDSE"}, 64);
-  expect_close(r.report.classes[0].estimate, fraction_4 * mirror / 4e-6, 3.0, 1e-3, "alpha 1e-4 against the mirror");
+  expect_close(r.report.classes[0].estimate, fraction_4 * mirror / 4e-6, test::family_sigmas(1), 1e-3, "alpha 1e-4 against the mirror");
 }
 
 // The near-delta scene that `pathex converge` flags declares its reference: this quadrature.
@@ -190,7 +193,7 @@ TEST(Grazing, PointLightJustAboveThePlane) {
   for (const char* renderer : {"pt-nee", "bdpt"}) {
     const Rendered r = render_file(hard("grazing-light.json"), renderer, {"LSDDDSE"}, 32);
     EXPECT_EQ(r.nonfinite, 0u);
-    expect_close(r.report.classes[0].estimate, expected, 3.0, 1e-3, renderer);
+    expect_close(r.report.classes[0].estimate, expected, test::family_sigmas(2), 1e-3, renderer);
   }
 }
 
@@ -202,7 +205,7 @@ TEST(Grazing, SunlightAtTheSurface) {
   for (const char* renderer : {"pt-nee+distant", "pbrt-v4-path"}) {
     const Rendered r = render_file(hard("grazing-surface.json"), renderer, {"LDSDDSE"}, 16);
     EXPECT_EQ(r.nonfinite, 0u);
-    expect_close(r.report.classes[0].estimate, expected, 3.0, 1e-3, renderer);
+    expect_close(r.report.classes[0].estimate, expected, test::family_sigmas(2), 1e-3, renderer);
   }
 }
 
@@ -214,7 +217,7 @@ TEST(Grazing, SensorJustAboveThePlane) {
   for (const char* renderer : {"pt-nee+distant", "pbrt-v4-path"}) {
     const Rendered r = render_file(hard("grazing-sensor.json"), renderer, {"LDSDDSE"}, 16);
     EXPECT_EQ(r.nonfinite, 0u);
-    expect_close(r.report.classes[0].estimate, expected, 3.0, 1e-4, renderer);
+    expect_close(r.report.classes[0].estimate, expected, test::family_sigmas(2), 1e-4, renderer);
   }
 }
 
@@ -230,9 +233,9 @@ TEST(NearlyTouching, WhiteFurnaceBoxWithGapsOfOneMillionth) {
     const Rendered r = render_file(hard("white-box-gaps.json"), renderer, classes, 64, 4);
     EXPECT_EQ(r.nonfinite, 0u);
     for (int n = 0; n <= 4; ++n)
-      expect_close(r.report.classes[static_cast<std::size_t>(n)].estimate, 1.0, 3.0, 1e-4,
+      expect_close(r.report.classes[static_cast<std::size_t>(n)].estimate, 1.0, test::family_sigmas(18), 1e-4,
                    std::string(renderer) + " n=" + std::to_string(n));
-    expect_close(r.report.total, 5.0, 3.0, 1e-4, std::string(renderer) + " total");
+    expect_close(r.report.total, 5.0, test::family_sigmas(18), 1e-4, std::string(renderer) + " total");
   }
 }
 
@@ -249,7 +252,7 @@ TEST(ScaleAndPosition, CornellBoxIsTheSameImage) {
     for (std::size_t i = 0; i <= classes.size(); ++i) {
       const Estimate& a = i < classes.size() ? unit.report.classes[i].estimate : unit.report.total;
       const Estimate& b = i < classes.size() ? r.report.classes[i].estimate : r.report.total;
-      EXPECT_LE(std::fabs(a.luminance - b.luminance), 3.0 * std::hypot(a.std_error, b.std_error))
+      EXPECT_LE(std::fabs(a.luminance - b.luminance), test::family_sigmas(15) * std::hypot(a.std_error, b.std_error))
           << name << " " << (i < classes.size() ? classes[i] : "total") << ": " << b.luminance << " against " << a.luminance;
     }
   }
@@ -267,7 +270,7 @@ TEST(Degenerate, TrianglesZeroAreaAndZeroPowerLightsChangeNothing) {
     const Rendered r = render_file(hard("degenerate.json"), renderer, classes, 64);
     EXPECT_EQ(r.nonfinite, 0u);
     for (int n = 1; n <= 3; ++n)
-      expect_close(r.report.classes[static_cast<std::size_t>(n - 1)].estimate, std::pow(0.5, n) / kPi, 3.0, 1e-3,
+      expect_close(r.report.classes[static_cast<std::size_t>(n - 1)].estimate, std::pow(0.5, n) / kPi, test::family_sigmas(6), 1e-3,
                    std::string(renderer) + " n=" + std::to_string(n));
   }
 }
@@ -281,7 +284,7 @@ TEST(SpecularChains, TenGlassInterfacesTransmitTToTheTenth) {
   for (const char* renderer : {"pt", "bdpt"}) {
     const Rendered r = render_file(hard("ten-glass-interfaces.json"), renderer, {"LDDS{10}DSE"}, 64, 16);
     EXPECT_EQ(r.nonfinite, 0u);
-    expect_close(r.report.classes[0].estimate, std::pow(0.96, 10), 3.0, 1e-4, renderer);
+    expect_close(r.report.classes[0].estimate, std::pow(0.96, 10), test::family_sigmas(2), 1e-4, renderer);
   }
 }
 
@@ -294,8 +297,8 @@ TEST(SpecularChains, TotalInternalReflectionReflectsAllAndTransmitsNothing) {
   for (const char* renderer : {"pt", "pt-nee", "bdpt"}) {
     const Rendered r = render_file(hard("total-internal-reflection.json"), renderer, {"LDDSDSE"}, 16);
     EXPECT_EQ(r.nonfinite, 0u) << renderer;
-    expect_close(r.report.classes[0].estimate, 0.5, 3.0, 1e-6, renderer);
-    expect_close(r.report.total, 0.5, 3.0, 1e-6, renderer);
+    expect_close(r.report.classes[0].estimate, 0.5, test::family_sigmas(6), 1e-6, renderer);
+    expect_close(r.report.total, 0.5, test::family_sigmas(6), 1e-6, renderer);
   }
 }
 
