@@ -559,16 +559,19 @@ constexpr const char* kScript = R"js(
     layers[l.name]=new Float32Array(bytes.buffer);
   });
   var box=document.getElementById('hover');
+  function h(s){return s.replace(/[&<>"']/g,function(c){return '&#'+c.charCodeAt(0)+';';});}
   function fmt(v){return Math.abs(v)>=1e-3||v===0?v.toPrecision(4):v.toExponential(3);}
   function show(ev){
     var img=ev.currentTarget,r=img.getBoundingClientRect();
-    var px=Math.floor((ev.clientX-r.left)/r.width*meta.width),py=Math.floor((ev.clientY-r.top)/r.height*meta.height);
+    pixel(Math.floor((ev.clientX-r.left)/r.width*meta.width),Math.floor((ev.clientY-r.top)/r.height*meta.height));
+  }
+  function pixel(px,py){
     px=Math.min(Math.max(px,0),meta.width-1);py=Math.min(Math.max(py,0),meta.height-1);
     var c=Math.floor(py/meta.factor)*meta.grid[0]+Math.floor(px/meta.factor);
     var total=layers.total?layers.total[c]:0,rows='';
     meta.layers.forEach(function(l){
       var v=layers[l.name][c];
-      rows+='<tr><td>'+l.name+'</td><td class="n">'+fmt(v)+'</td><td class="n">'+(total>0?(100*v/total).toFixed(1)+' %':'')+'</td></tr>';
+      rows+='<tr data-layer="'+h(l.name)+'"><td>'+h(l.name)+'</td><td class="n">'+fmt(v)+'</td><td class="n">'+(total>0?(100*v/total).toFixed(1)+' %':'')+'</td></tr>';
     });
     box.innerHTML='<b>pixel ('+px+', '+py+')</b>'+(meta.factor>1?' (cell of '+meta.factor+'×'+meta.factor+')':'')+
       '<table><tr><th>layer</th><th>luminance</th><th>of total</th></tr>'+rows+'</table>';
@@ -577,6 +580,8 @@ constexpr const char* kScript = R"js(
     img.addEventListener('mousemove',show);
   });
   box.textContent='hover a pixel of any image: its luminance per class';
+  var m=/^#pixel=(\d+),(\d+)$/.exec(location.hash);  // a link to a pixel: report.html#pixel=X,Y
+  if(m)pixel(+m[1],+m[2]);
   document.body.setAttribute('data-hover','ready');
   document.body.setAttribute('data-hover-layers',String(meta.layers.length));
 })();
