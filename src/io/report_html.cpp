@@ -367,6 +367,15 @@ Result<bool> read_images(const std::string& dir, const std::string& exr_name, co
     for (ImageLayer& l : *read) layers.push_back(std::move(l));
   }
   if (layers.empty()) return true;
+  // The order of the page: the total, the classes as histogram.json lists them, then the rest.
+  const auto rank = [&](const ImageLayer& l) -> std::size_t {
+    if (l.name == "total") return 0;
+    if (d->histogram)
+      for (std::size_t i = 0; i < d->histogram->classes.size(); ++i)
+        if (d->histogram->classes[i].name == l.name) return 1 + i;
+    return SIZE_MAX;
+  };
+  std::stable_sort(layers.begin(), layers.end(), [&](const ImageLayer& a, const ImageLayer& b) { return rank(a) < rank(b); });
   const auto total = std::find_if(layers.begin(), layers.end(), [](const ImageLayer& l) { return l.name == "total"; });
   const RgbImage& reference = total != layers.end() ? total->image : layers.front().image;
   d->exposure = preview_exposure(reference);
@@ -531,10 +540,11 @@ constexpr const char* kStyle = R"css(
 body{font-family:system-ui,sans-serif;margin:1.5em;max-width:1200px;color:#222;background:#fff}
 h1{font-size:1.4em}h2{font-size:1.15em;margin-top:1.6em;border-bottom:1px solid #ccc}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:.2em .5em;text-align:left;vertical-align:top}
-td.n,th.n{text-align:right;font-variant-numeric:tabular-nums}
+td.n,th.n{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+.top{display:flex;flex-wrap:wrap;gap:1.5em;align-items:flex-start}figure{margin:0}
 code,.mono{font-family:ui-monospace,monospace}
 img.px{width:256px;height:auto;image-rendering:pixelated;background:#000;display:block}
-.render img.px{width:384px}
+.render img.px{width:384px}.render figcaption{max-width:384px;font-size:.85em}
 .tiles{display:flex;flex-wrap:wrap;gap:12px}
 .tile{border:1px solid #ccc;padding:8px;width:258px;font-size:.9em}
 .tile h3{margin:.1em 0 .3em;font-size:1em}
@@ -560,7 +570,7 @@ constexpr const char* kScript = R"js(
   });
   var box=document.getElementById('hover');
   function h(s){return s.replace(/[&<>"']/g,function(c){return '&#'+c.charCodeAt(0)+';';});}
-  function fmt(v){return Math.abs(v)>=1e-3||v===0?v.toPrecision(4):v.toExponential(3);}
+  function fmt(v){return v===0?'0':Math.abs(v)>=1e-3?v.toPrecision(4):v.toExponential(3);}
   function show(ev){
     var img=ev.currentTarget,r=img.getBoundingClientRect();
     pixel(Math.floor((ev.clientX-r.left)/r.width*meta.width),Math.floor((ev.clientY-r.top)/r.height*meta.height));
@@ -589,7 +599,7 @@ constexpr const char* kScript = R"js(
 
 void render_section(std::ostringstream& h, const ReportData& d) {
   const HistogramReport& rep = *d.histogram;
-  h << "<section id=\"render\" class=\"render\"><h2>The render</h2>\n";
+  h << "<section id=\"render\" class=\"render\"><h2>The render</h2>\n<div class=\"top\">\n";
   if (d.png.count("total")) {
     h << "<figure>" << img(d, "total", "the rendered image, tone-mapped");
     h << "<figcaption>tone-mapped: linear values × " << fixed(*d.exposure, "%.4g")
@@ -620,7 +630,7 @@ void render_section(std::ostringstream& h, const ReportData& d) {
   row(d.only.empty() ? "image mean luminance" : "luminance of the requested paths", esc(lum(rep.total)),
       " data-luminance=\"" + exact(rep.total.luminance) + "\" data-stderr=\"" + exact(rep.total.std_error) + "\"");
   row("distinct paths", std::to_string(rep.distinct_paths));
-  h << "</tbody></table>\n";
+  h << "</tbody></table>\n</div>\n";
   if (!d.command.empty())
     h << "<p>The command that reproduces it:</p><pre class=\"cmd\" id=\"command\">" << esc(d.command) << "</pre>\n";
   h << "</section>\n";
