@@ -20,6 +20,7 @@
 #include "io/input_file.h"
 #include "io/json_reader.h"
 #include "io/output_set.h"
+#include "io/profile_json.h"
 #include "io/shard.h"
 
 namespace pathex {
@@ -465,9 +466,14 @@ Result<ReportData> load_report_folder(const std::string& dir, const ReportOption
     }
   if (d.kind == "bias" && d.missed && d.histogram) {
     // bias's own command line, from what bias.json and histogram.json record
+    // The reference by name when it is a built-in profile; otherwise it was bias's default (made
+    // for the scene, named after its strategies, chosen again the same way) or a file bias.json does
+    // not name.
+    const bool builtin = std::any_of(builtin_profile_texts().begin(), builtin_profile_texts().end(),
+                                     [&](const BuiltinProfileText& t) { return d.missed->reference == t.name; });
     d.command = "pathex bias " + shell_word(d.histogram->run.scene) + " --renderer " + shell_word(d.missed->renderer) +
-                " --reference " + shell_word(d.missed->reference) + " --spp " + std::to_string(d.histogram->run.spp) +
-                " --seed " + std::to_string(d.histogram->run.seed);
+                (builtin ? " --reference " + shell_word(d.missed->reference) : "") + " --spp " +
+                std::to_string(d.histogram->run.spp) + " --seed " + std::to_string(d.histogram->run.seed);
   }
   if (converge)
     if (Result<bool> r = read_converge(dir, o, &d); !r) return r.error();

@@ -176,6 +176,20 @@ TEST(ReportContent, TraceReportIsThePageReportMakesFromTheFiles) {
   EXPECT_EQ(read_file(dir / "report.html"), made);
 }
 
+TEST(ReportContent, TheCommandOnThePageReproducesTheRender) {
+  const fs::path dir = default_render();
+  const std::string html = read_file(dir / "report.html");
+  const std::string open = "<pre class=\"cmd\" id=\"command\">pathex ";
+  const std::size_t at = html.find(open);
+  ASSERT_NE(at, std::string::npos);
+  const std::string command = html.substr(at + open.size(), html.find("</pre>", at) - at - open.size());
+  ASSERT_EQ(command.find('&'), std::string::npos) << command;  // no entity to undo here
+  const fs::path again = scratch_dir() / "again";
+  const CliRun r = run_pathex(command + " --quiet --out " + again.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(read_file(again / "histogram.json"), read_file(dir / "histogram.json"));
+}
+
 TEST(ReportContent, ReportJoinsTheOutputSetAndTheNextRunReplacesIt) {
   const fs::path dir = scratch_dir() / "set";
   CliRun r = run_pathex_args({"trace", "--out", dir.string(), "--quiet", "--resolution", "16x16", "--spp", "2"});
