@@ -256,6 +256,28 @@ TEST(ReportContent, ConvergeReportShowsThePlotAndTheTable) {
   EXPECT_NE(html.find("pathex converge samples/scenes/closed-sphere-point.json --renderer pt-nee --spp 2,4 --seed 1"), std::string::npos);
 }
 
+TEST(ReportContent, ConnectorStatisticsAreHistogramJsons) {
+  const fs::path dir = scratch_dir() / "connectors";
+  const CliRun r = run_pathex_args({"trace", "samples/scenes/point-mirror-caustic.json", "--renderer", "bdpt+mirror", "--spp", "2",
+                                    "--resolution", "16x16", "--quiet", "--out", dir.string(), "--report"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string html = read_file(dir / "report.html");
+  const auto doc = nlohmann::json::parse(read_file(dir / "histogram.json"));
+  ASSERT_EQ(doc["connectors"].size(), 1u);
+  const auto& c = doc["connectors"][0];
+  ASSERT_GT(c["attempts"].get<std::uint64_t>(), 0u);
+  // columns: attempts, successes, then the failure reasons by name (no_transport, occluded, outside)
+  EXPECT_NE(html.find("<tr><td>" + c["strategy"].get<std::string>() + "</td><td>mirror</td><td class=\"n\">" + c["attempts"].dump() +
+                      "</td><td class=\"n\">" + c["successes"].dump() + "</td><td class=\"n\">" + c["failures"]["no_transport"].dump() +
+                      "</td><td class=\"n\">" + c["failures"]["occluded"].dump() + "</td><td class=\"n\">" +
+                      c["failures"]["outside"].dump() + "</td></tr>"),
+            std::string::npos);
+  // and pathex report, reading histogram.json, makes the same page
+  const std::string made = html;
+  ASSERT_EQ(run_pathex_args({"report", dir.string()}).code, 0);
+  EXPECT_EQ(read_file(dir / "report.html"), made);
+}
+
 TEST(ReportContent, EscapesWhatItShows) {
   pathex::ReportData d;
   d.folder = "a<b";
