@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <set>
 #include <sstream>
 
@@ -74,6 +75,14 @@ std::optional<double> optional_number(const json& j, const char* key) {
   return j[key].get<double>();
 }
 
+// Each of `keys` of `j` is absent, null (unknown) or a number: anything else is refused, naming it.
+Result<bool> numbers_or_null(const JsonReader& r, const json& j, const std::string& ptr, std::initializer_list<const char*> keys) {
+  for (const char* key : keys)
+    if (j.is_object() && j.contains(key) && !j[key].is_null() && !j[key].is_number())
+      return r.fail(ptr + "/" + key, "found " + JsonReader::kind(j[key]) + ", expected a number or null");
+  return true;
+}
+
 Result<std::string> optional_string(const JsonReader& r, const json& j, const char* key, const std::string& ptr) {
   if (!j.is_object() || !j.contains(key) || j[key].is_null()) return std::string();
   return r.string(j, key, ptr);
@@ -99,6 +108,7 @@ Result<bool> read_run(const std::string& path, const ReportOptions& o, ReportDat
   if (!doc) return doc.error();
   const JsonReader r(path);
   if (!doc->is_object()) return r.fail("", "found " + JsonReader::kind(*doc) + ", expected an object");
+  if (Result<bool> ok = numbers_or_null(r, *doc, "", {"time_s", "cpu_s", "threads"}); !ok) return ok;
   d->time_s = optional_number(*doc, "time_s");
   d->cpu_s = optional_number(*doc, "cpu_s");
   if (const auto t = optional_number(*doc, "threads")) d->threads = static_cast<int>(*t);
@@ -146,6 +156,7 @@ Result<bool> read_missed(const std::string& path, const ReportOptions& o, Report
   if (!share) return share.error();
   m.luminance = *lum;
   m.share = *share;
+  if (Result<bool> ok = numbers_or_null(r, jm, "/missed", {"share_stderr"}); !ok) return ok;
   m.share_stderr = optional_number(jm, "share_stderr").value_or(0.0);
   m.exact = jm.contains("exact") && jm["exact"].is_boolean() && jm["exact"].get<bool>();
   Result<const json*> classes = array_of(r, j, "classes", "");
@@ -160,6 +171,7 @@ Result<bool> read_missed(const std::string& path, const ReportOptions& o, Report
     if (!verdict) return verdict.error();
     mc.name = *name;
     mc.verdict = *verdict;
+    if (Result<bool> ok = numbers_or_null(r, c, ptr, {"missed_share_of_class", "missed_share_of_image"}); !ok) return ok;
     if (c.contains("missed") && c["missed"].is_object()) mc.missed = optional_number(c["missed"], "luminance").value_or(0.0);
     mc.share_of_class = optional_number(c, "missed_share_of_class").value_or(0.0);
     mc.share_of_image = optional_number(c, "missed_share_of_image").value_or(0.0);
@@ -184,6 +196,7 @@ Result<bool> read_missed(const std::string& path, const ReportOptions& o, Report
     if (!path_text) return path_text.error();
     Result<std::string> reason = optional_string(r, p, "reason", ptr);
     if (!reason) return reason.error();
+    if (Result<bool> ok = numbers_or_null(r, p, ptr, {"share", "luminance"}); !ok) return ok;
     m.paths.push_back({*path_text, optional_number(p, "share").value_or(0.0), optional_number(p, "luminance").value_or(0.0), *reason});
   }
   d->missed = std::move(m);
@@ -214,13 +227,17 @@ Result<bool> read_converge(const std::string& dir, const ReportOptions& o, Repor
       const std::string cptr = rptr + "/classes/" + std::to_string(i);
       Result<std::string> cname = r.string(jc, "name", cptr);
       if (!cname) return cname.error();
+      if (Result<bool> ok = numbers_or_null(r, jc, cptr, {"slope", "efficiency"}); !ok) return ok;
       ReportData::ConvergeRow row{*name, *cname, {}, optional_number(jc, "slope"), optional_number(jc, "efficiency"), {}};
       Result<std::string> warning = optional_string(r, jc, "warning", cptr);
       if (!warning) return warning.error();
       row.warning = *warning;
       Result<const json*> rungs = array_of(r, jc, "rungs", cptr);
       if (!rungs) return rungs.error();
-      for (const json& g : **rungs) {
+      for (std::size_t g_i = 0; g_i < (*rungs)->size(); ++g_i) {
+        const json& g = (**rungs)[g_i];
+        if (Result<bool> ok = numbers_or_null(r, g, cptr + "/rungs/" + std::to_string(g_i), {"budget", "spp", "cpu_s", "estimate", "stderr", "error"}); !ok)
+          return ok;
         ReportData::Rung rung;
         const double spp = optional_number(g, "spp").value_or(0.0);
         std::ostringstream budget;

@@ -4,6 +4,7 @@
 // makes from the files, the file joins the output set, and bad folders get one located message.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -322,6 +323,31 @@ TEST(ReportErrors, NotAFolderMissingOrCorruptHistogram) {
     EXPECT_EQ(r.out, "") << c.dir;
     EXPECT_EQ(r.err, "pathex: error: " + c.message + "\n") << c.dir;
     EXPECT_FALSE(fs::exists(fs::path(c.dir) / "report.html")) << c.dir;
+  }
+}
+
+TEST(ReportErrors, TheFolderOtherFilesAreCheckedToo) {
+  // a trace folder whose run.json, missed.json or classes.exr is damaged: one message naming it
+  const fs::path dir = default_render();
+  struct Case {
+    std::string file, bytes, message;
+  } cases[] = {
+      {"run.json", "{\"time_s\": \"x\"}", "/run.json:/time_s: found a string, expected a number or null"},
+      {"run.json", "{\"pruned\": 3}", "/run.json:/pruned: found a number, expected an array"},
+      {"missed.json", "{\"renderer\": 1}", "/missed.json:/renderer: expected a string, found a number"},
+      {"classes.exr", "not an exr", "/classes.exr: cannot read the EXR file: "},
+  };
+  int i = 0;
+  for (const Case& c : cases) {
+    const fs::path copy = scratch_dir() / ("damaged-" + std::to_string(i++));
+    fs::copy(dir, copy);
+    fs::remove(copy / "report.html");
+    std::ofstream(copy / c.file, std::ios::binary | std::ios::trunc) << c.bytes;
+    const CliRun r = run_pathex_args({"report", copy.string()});
+    EXPECT_EQ(r.code, 2) << c.file;
+    EXPECT_EQ(r.err.rfind("pathex: error: " + copy.string() + c.message, 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(copy / "report.html")) << c.file;
   }
 }
 
