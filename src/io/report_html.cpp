@@ -682,7 +682,10 @@ void class_tiles(std::ostringstream& h, const ReportData& d) {
     h << "<dl><dt>share</dt><dd>" << pct(c.share) << " ± " << pct(err, 2) << "</dd>"
       << "<dt>luminance</dt><dd>" << esc(lum(c.estimate)) << "</dd>"
       << "<dt>verdict</dt><dd class=\"verdict-" << (v != d.verdicts.end() ? esc(v->second) : "unknown") << "\">"
-      << (v != d.verdicts.end() ? esc(v->second) : "not known (the scene could not be read)") << "</dd>"
+      << (v != d.verdicts.end() ? esc(v->second)
+          : d.verdicts.empty()   ? "not known (the scene could not be read)"
+                                 : "— (not a class the checker was asked about)")
+      << "</dd>"
       << "<dt>strategies</dt><dd>" << esc(top_strategies(c.strategies, 3)) << "</dd></dl>\n</div>\n";
   }
   h << "</div>\n</section>\n";
