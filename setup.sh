@@ -12,7 +12,8 @@ packages=(build-essential cmake pkg-config
   libtinyobjloader-dev libopenexr-dev libpng-dev zlib1g-dev libzstd-dev libopenmpi-dev openmpi-bin libcairo2-dev
   libopenimageio-dev
   libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev libpugixml-dev
-  groff-base)
+  groff-base
+  chromium)  # the browser test of report.html (tests/io/report_browser_test.cpp)
 if $fuzz; then packages+=(clang-14 libclang-rt-14-dev python3); fi
 missing=()
 for p in "${packages[@]}"; do

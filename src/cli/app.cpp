@@ -54,7 +54,7 @@ int run_command_line(int argc, char** argv) {
   app.add_flag("--bash-completion", completion, "Print the bash completion script")->group("");
   std::vector<Command> commands = {add_explain(app), add_match(app),     add_classify(app), add_query(app),
                                    add_check(app),   add_renderers(app), add_trace(app),    add_merge(app),
-                                   add_converge(app), add_bias(app)};
+                                   add_converge(app), add_bias(app), add_report(app)};
   if (const char* word = unknown_command(app, argc, argv)) {
     std::cerr << "pathex: error: unknown command '" << word << "'; the commands are " << command_list(app)
               << " (pathex --help describes them)\n";

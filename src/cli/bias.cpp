@@ -12,6 +12,7 @@
 #include "cli/bias_common.h"
 #include "cli/common.h"
 #include "cli/estimate_text.h"
+#include "cli/folder_report.h"
 #include "cli/render_watch.h"
 #include "cli/trace_checks.h"
 #include "cli/witness_text.h"
@@ -37,6 +38,8 @@ struct BiasArgs {
   bool json = false;
   bool no_images = false;
   bool quiet = false;
+  bool report_html = false;  // --report
+  ReportOptions report_options;
 };
 
 void print_text(const BiasReport& r, int top, const std::string& out_dir, bool images) {
@@ -132,19 +135,27 @@ int run(BiasArgs a) {
     Result<bool> written = out_set->write([&](const std::string& dir) -> Result<bool> {
       if (Result<bool> w = write_file_atomic(dir + "/bias.json", bias_text); !w) return w;
       if (Result<bool> w = write_file_atomic(dir + "/histogram.json", histogram_json_text(run->histogram)); !w) return w;
-      if (a.no_images) return true;
-      const double scale = run->render.spp_done ? 1.0 / static_cast<double>(run->render.spp_done) : 0.0;
-      std::vector<ImageLayer> layers = run->render.images.layers(scale);  // total, the classes, missed
-      const std::vector<ImageLayer> missed(layers.end() - 1, layers.end());
-      if (Result<bool> w = write_exr(dir + "/missed.exr", missed); !w) return w;
-      if (Result<bool> w = write_previews(dir, layers); !w) return w;  // one exposure: the total's
-      layers.pop_back();
-      return write_exr(dir + "/classes.exr", layers);
+      if (!a.no_images) {
+        const double scale = run->render.spp_done ? 1.0 / static_cast<double>(run->render.spp_done) : 0.0;
+        std::vector<ImageLayer> layers = run->render.images.layers(scale);  // total, the classes, missed
+        const std::vector<ImageLayer> missed(layers.end() - 1, layers.end());
+        if (Result<bool> w = write_exr(dir + "/missed.exr", missed); !w) return w;
+        if (Result<bool> w = write_previews(dir, layers); !w) return w;  // one exposure: the total's
+        layers.pop_back();
+        if (Result<bool> w = write_exr(dir + "/classes.exr", layers); !w) return w;
+      }
+      if (a.report_html) {  // a file of the set, read from the files just staged
+        KnownRender known;
+        known.folder = a.out;
+        if (Result<std::string> w = write_folder_report(dir, a.report_options, a.options.limits, &known); !w) return w.error();
+      }
+      return true;
     });
     if (!written) return report(written.error());
   }
   if (a.json) std::cout << bias_text;
   else print_text(run->report, a.top_paths, a.out, !a.no_images);
+  if (!a.json && a.report_html) std::cout << "wrote " << a.out << "/" << kReportName << " (open it in a browser)\n";
   return run->report.complete ? kExitOk : kExitNo;
 }
 
@@ -190,6 +201,8 @@ Command add_bias(CLI::App& app) {
   sub->add_flag("--json", args->json, "Print bias.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs (the numbers are the same)");
+  sub->add_flag("--report", args->report_html, "Also write DIR/report.html, the result as one self-contained web page (pathex report)");
+  add_report_options(sub, &args->report_options);
   add_limit_options(sub, &args->options.limits);
   add_scene_limit_options(sub, &args->options.limits);
   return {sub, [args] { return run(*args); }};

@@ -88,5 +88,6 @@ Command add_trace(CLI::App& app);
 Command add_merge(CLI::App& app);
 Command add_converge(CLI::App& app);
 Command add_bias(CLI::App& app);
+Command add_report(CLI::App& app);
 
 }  // namespace pathex::cli

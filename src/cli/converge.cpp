@@ -37,6 +37,7 @@
 #include "bias/bias.h"
 #include "classify/convergence.h"
 #include "cli/common.h"
+#include "cli/folder_report.h"
 #include "cli/converge_plot.h"
 #include "cli/render_job.h"
 #include "cli/trace_checks.h"
@@ -73,6 +74,8 @@ struct ConvergeArgs {
   bool json = false;
   bool quiet = false;
   Limits limits;
+  bool report_html = false;  // --report
+  ReportOptions report_options;
 };
 
 // --- budgets ---
@@ -847,7 +850,14 @@ int run(const ConvergeArgs& a) {
       if (Result<bool> w = write_file_atomic(dir + "/converge.json", json_text); !w) return w;
       if (Result<bool> w = write_file_atomic(dir + "/converge.svg", plot->svg); !w) return w;
       if (Result<bool> w = write_file_atomic(dir + "/converge.png", plot->png); !w) return w;
-      if (!ref_run) return true;
+      const auto with_report = [&]() -> Result<bool> {  // --report: a file of the set, from the files staged
+        if (!a.report_html) return true;
+        KnownRender known;
+        known.folder = a.out;
+        if (Result<std::string> w = write_folder_report(dir, a.report_options, a.limits, &known); !w) return w.error();
+        return true;
+      };
+      if (!ref_run) return with_report();
       RunInfo info;
       info.scene = a.scene;
       info.renderer = ref_profile->name;
@@ -859,7 +869,8 @@ int run(const ConvergeArgs& a) {
       Result<HistogramReport> rep = make_report(ref_run->output->histogram, info, &*classifier, infos, std::uint64_t{1000});
       if (!rep) return rep.error();
       if (Result<bool> w = write_file_atomic(dir + "/reference.json", histogram_json_text(*rep)); !w) return w;
-      return write_exr(dir + "/reference.exr", ref_run->output->images.layers(1.0 / static_cast<double>(ref_run->spp)));
+      if (Result<bool> w = write_exr(dir + "/reference.exr", ref_run->output->images.layers(1.0 / static_cast<double>(ref_run->spp))); !w) return w;
+      return with_report();
     });
     if (!written) return report(written.error());
   }
@@ -913,7 +924,7 @@ int run(const ConvergeArgs& a) {
     for (const std::string& w : warnings) std::cout << "  " << w << "\n";
   }
   std::cout << "\nwrote " << a.out << "/converge.json, converge.svg and converge.png" << (ref_run ? ", reference.json and reference.exr" : "")
-            << "\n\nmost efficient renderer per class (1 / mean(error^2 x CPU time) over the ladder)\n";
+            << (a.report_html ? ", report.html" : "") << "\n\nmost efficient renderer per class (1 / mean(error^2 x CPU time) over the ladder)\n";
   for (const std::string& l : best_lines) std::cout << "  " << l << "\n";
   return complete ? kExitOk : kExitNo;
 }
@@ -950,6 +961,8 @@ Command add_converge(CLI::App& app) {
   sub->add_option("--out", args->out, "Output folder")->capture_default_str();
   sub->add_flag("--json", args->json, "Print converge.json to stdout instead of the table");
   sub->add_flag("--quiet", args->quiet, "No progress lines");
+  sub->add_flag("--report", args->report_html, "Also write DIR/report.html, the plot and table as one self-contained web page (pathex report)");
+  add_report_options(sub, &args->report_options);
   add_limit_options(sub, &args->limits);
   add_scene_limit_options(sub, &args->limits);
   return {sub, [args] { return run(*args); }};

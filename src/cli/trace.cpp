@@ -15,6 +15,7 @@
 #include "cli/bias_common.h"
 #include "cli/common.h"
 #include "cli/estimate_text.h"
+#include "cli/folder_report.h"
 #include "cli/reach_common.h"
 #include "cli/render_job.h"
 #include "cli/render_watch.h"
@@ -71,6 +72,8 @@ struct TraceArgs {
   std::string reference;     // the reference for --missed; empty: bias's default
   std::vector<std::string> settings_given;  // render settings named on the command line (refused with --resume)
   Limits limits;
+  bool report_html = false;  // --report: also write DIR/report.html (pathex report)
+  ReportOptions report_options;
 };
 
 std::string gib(std::uint64_t bytes) {
@@ -453,6 +456,7 @@ int run(const TraceArgs& a) {
   // --- outputs (rank 0): one set, whole or not at all, shielded from signals (io/output_set.h) ---
   std::optional<WrittenReport> written;
   std::optional<Error> failure;
+  double report_ms = 0;  // --report: the time report.html took
   if (rank == 0) {
     const SignalShield shield;
     Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
@@ -461,6 +465,18 @@ int run(const TraceArgs& a) {
       written = std::move(*r);
       if (missed)  // what pathex bias writes to bias.json, without images
         if (Result<bool> m = write_file_atomic(dir + "/missed.json", to_json(*missed).dump(2) + "\n"); !m) return m;
+      if (a.report_html) {  // a file of the set, from the files just staged and what is in memory
+        const auto start = std::chrono::steady_clock::now();
+        KnownRender known;  // histogram.json and render.shard's header as written, not read back
+        known.folder = job.out;
+        known.histogram = &written->report;
+        known.connectors = report_connectors(sums.connectors);
+        for (const PathClass* c : job.classes->requested) known.only.emplace_back(c->name, c->text);
+        known.identity = &header.identity;
+        known.spp = header.spp;
+        if (Result<std::string> rw = write_folder_report(dir, a.report_options, a.limits, &known); !rw) return rw.error();
+        report_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      }
       return true;
     });
     if (!w) failure = w.error();
@@ -554,6 +570,8 @@ int run(const TraceArgs& a) {
   }
   std::cout << "\nwrote " << job.out << "/histogram.json" << (id.images ? ", classes.exr and PNG previews" : "") << ", "
             << kRenderShardName << (missed ? ", missed.json" : "") << "\n";
+  if (a.report_html)
+    std::cout << "wrote " << job.out << "/" << kReportName << " in " << std::fixed << std::setprecision(1) << report_ms << " ms (open it in a browser)\n";
   if (!complete)
     std::cout << "interrupted: 'pathex trace --resume " << job.out << "' renders the missing passes "
               << job.header.share.minus(header.passes).to_string() << "\n";
@@ -614,6 +632,8 @@ Command add_trace(CLI::App& app) {
                 "sample; writes DIR/missed.json");
   sub->add_option("--reference", args->reference, "The reference of --missed; default: bdpt plus the connectors the scene needs")
       ->needs("--missed");
+  sub->add_flag("--report", args->report_html, "Also write DIR/report.html, the render as one self-contained web page (pathex report)");
+  add_report_options(sub, &args->report_options);
   sub->add_flag("--no-images", args->no_images, "Skip the EXR and PNG outputs and the per-pixel sums behind them (the histogram is the same)");
   sub->add_option("--max-memory", args->max_memory,
                   "Refuse a render whose images (and their writing) would take more, estimated before rendering; e.g. 512M, 16G")

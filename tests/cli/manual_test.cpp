@@ -67,7 +67,7 @@ TEST(ManPage, DocumentsEverySubcommandAndEveryOptionOfItsHelp) {
   EXPECT_NE(man.out.find(".SH NAME\npathex \\- full\\-path regular expressions for light transport"), std::string::npos);
   EXPECT_NE(man.out.find(".SH EXIT STATUS\n.nf\nExit codes: 0 success;"), std::string::npos);
   const std::vector<std::string> subs = subcommands();
-  ASSERT_EQ(subs.size(), 10u);  // explain … merge, converge, bias
+  ASSERT_EQ(subs.size(), 11u);  // explain … merge, converge, bias, report
   for (const std::string& sub : subs) {
     const std::string text = section(man.out, sub);
     ASSERT_FALSE(text.empty()) << sub;
@@ -117,7 +117,7 @@ std::string complete(const std::string& words) {
 TEST(BashCompletion, CompletesCommandsOptionsAndChoices) {
   EXPECT_EQ(complete("pathex tr"), "trace\n");
   EXPECT_EQ(complete("pathex c"), "classify\ncheck\nconverge\n");
-  EXPECT_EQ(complete("pathex trace --re"), "--renderer\n--resolution\n--reference\n--resume\n");
+  EXPECT_EQ(complete("pathex trace --re"), "--renderer\n--resolution\n--reference\n--report\n--resume\n");
   EXPECT_EQ(complete("pathex trace --renderer pt"), "pt\npt-nee\npt-nee+distant\npt-nee+mirror\npt-nee+manifold\n");
   EXPECT_EQ(complete("pathex query --notation ''"), "full\nheckbert\nlpe\n");
   EXPECT_EQ(complete("pathex explain --light p"), "point\n");

@@ -92,12 +92,12 @@ TEST(NewUser, UnknownCommandIsNamedAndTheCommandsListed) {
   EXPECT_EQ(r.out, "");
   EXPECT_EQ(r.err,
             "pathex: error: unknown command 'render'; the commands are explain, match, classify, query, check, "
-            "renderers, trace, merge, converge, bias (pathex --help describes them)\n");
+            "renderers, trace, merge, converge, bias, report (pathex --help describes them)\n");
   const CliRun none = pathex_cli({});
   EXPECT_EQ(none.code, 2);
   EXPECT_EQ(none.err,
             "pathex: error: a command is required; the commands are explain, match, classify, query, check, "
-            "renderers, trace, merge, converge, bias (pathex --help describes them)\n");
+            "renderers, trace, merge, converge, bias, report (pathex --help describes them)\n");
   EXPECT_EQ(pathex_cli({"--version"}).code, 0);
 }
 
