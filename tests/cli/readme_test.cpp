@@ -25,26 +25,35 @@ std::string source_file(const std::string& name) {
 
 std::string readme() { return source_file("README.md"); }
 
+// The lines of `text`, each without trailing spaces (a table's padding, which a README line does
+// not keep).
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
   std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) out.push_back(line);
+  for (std::string line; std::getline(in, line);) out.push_back(line.substr(0, line.find_last_not_of(' ') + 1));
   return out;
 }
 
-// The README's indented blocks (four spaces), each without its indentation.
+// The README's indented blocks (four spaces), each without its indentation. As in Markdown, an
+// empty line between two indented lines belongs to the block.
 std::vector<std::vector<std::string>> indented_blocks(const std::string& text) {
   std::vector<std::vector<std::string>> blocks;
   std::vector<std::string> block;
+  const auto end_block = [&] {
+    while (!block.empty() && block.back().empty()) block.pop_back();
+    if (!block.empty()) blocks.push_back(block);
+    block.clear();
+  };
   for (const std::string& line : lines_of(text)) {
     if (line.rfind("    ", 0) == 0) {
       block.push_back(line.substr(4));
-    } else if (!block.empty()) {
-      blocks.push_back(block);
-      block.clear();
+    } else if (line.empty() && !block.empty()) {
+      block.push_back("");
+    } else {
+      end_block();
     }
   }
-  if (!block.empty()) blocks.push_back(block);
+  end_block();
   return blocks;
 }
 
