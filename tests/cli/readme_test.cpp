@@ -1,5 +1,5 @@
-// The README as a user reads it (issue 38): every `$ build/pathex …` example runs as printed and
-// prints what the README shows, the check-file example is the file it names, and the README's
+// The README as a user reads it (issue 38): every `$ build/pathex …` example of the README and of
+// the docs/ files it links runs as printed and prints what the text shows, the check-file example is the file it names, and the README's
 // test command is the one CI runs. The README is read here and nowhere else among the tests.
 #include <gtest/gtest.h>
 
@@ -24,6 +24,14 @@ std::string source_file(const std::string& name) {
 }
 
 std::string readme() { return source_file("README.md"); }
+
+// The manual: the README and the files it sends the reader to for the explanations.
+std::vector<std::string> manual_files() {
+  std::vector<std::string> out = {"README.md", "CONTRIBUTING.md"};
+  for (const fs::directory_entry& e : fs::directory_iterator(fs::path(PATHEX_SOURCE_DIR) / "docs"))
+    if (e.path().extension() == ".md") out.push_back("docs/" + e.path().filename().string());
+  return out;
+}
 
 // The lines of `text`, each without trailing spaces (a table's padding, which a README line does
 // not keep).
@@ -69,28 +77,31 @@ std::string readme_block_after(const std::string& first_line) {
   return "";
 }
 
-// One example: a command as printed after `$ ` and the lines the README shows it printing.
+// One example: a command as printed after `$ `, the lines the manual shows it printing, and the
+// file it is in.
 struct Example {
   std::string command;
   std::vector<std::string> shown;
+  std::string file;
 };
 
-// Every `$ ` line of the README that runs `build/pathex` from the source directory (not the ones
+// Every `$ ` line of the manual that runs `build/pathex` from the source directory (not the ones
 // that first write a file of their own: they name /tmp), with the lines under it up to the next
 // `$ ` line or the end of the block.
-std::vector<Example> readme_examples() {
+std::vector<Example> manual_examples() {
   std::vector<Example> out;
-  for (const std::vector<std::string>& block : indented_blocks(readme())) {
-    bool in_example = false;
-    for (const std::string& line : block) {
-      if (line.rfind("$ ", 0) == 0) {
-        out.push_back({line.substr(2), {}});
-        in_example = true;
-      } else if (in_example) {
-        out.back().shown.push_back(line);
+  for (const std::string& file : manual_files())
+    for (const std::vector<std::string>& block : indented_blocks(source_file(file))) {
+      bool in_example = false;
+      for (const std::string& line : block) {
+        if (line.rfind("$ ", 0) == 0) {
+          out.push_back({line.substr(2), {}, file});
+          in_example = true;
+        } else if (in_example) {
+          out.back().shown.push_back(line);
+        }
       }
     }
-  }
   std::vector<Example> runnable;
   for (const Example& e : out) {
     const bool pathex_first = e.command.rfind("build/pathex ", 0) == 0 ||
@@ -131,10 +142,11 @@ std::string runnable_command(const std::string& command, int n) {
 }
 
 TEST(ReadmeExamples, QuickCommandsPrintWhatTheReadmeShows) {
-  const std::vector<Example> examples = readme_examples();
-  // The quick start's commands are among them, each with output shown.
+  const std::vector<Example> examples = manual_examples();
+  // The quick start's commands are among the README's, each with output shown.
   std::set<std::string> subcommands;
   for (const Example& e : examples) {
+    if (e.file != "README.md") continue;
     const std::size_t at = e.command.find("build/pathex ") + 13;
     subcommands.insert(e.command.substr(at, e.command.find(' ', at) - at));
     EXPECT_FALSE(e.shown.empty()) << e.command;
@@ -149,7 +161,7 @@ TEST(ReadmeExamples, QuickCommandsPrintWhatTheReadmeShows) {
     const std::vector<std::string> lines = lines_of(r.out);
     std::string shown;
     for (const std::string& s : e.shown) shown += s + "\n";
-    EXPECT_TRUE(matches(lines, 0, e.shown, 0)) << "$ " << e.command << "\nthe README shows\n" << shown << "it prints\n" << r.out;
+    EXPECT_TRUE(matches(lines, 0, e.shown, 0)) << e.file << ": $ " << e.command << "\nthe README shows\n" << shown << "it prints\n" << r.out;
   }
 }
 
