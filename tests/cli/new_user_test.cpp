@@ -295,48 +295,4 @@ TEST(NewUser, ACompleteRenderRecordsTheRequestedSppToo) {
   EXPECT_EQ(j["spp_requested"], 3);
 }
 
-// --- the README ---
-
-std::string readme() { return pathex::test::read_file(fs::path(PATHEX_SOURCE_DIR) / "README.md"); }
-
-// The indented block that follows `first_line` in the README, without the indentation.
-std::string readme_block_after(const std::string& first_line) {
-  const std::string text = readme();
-  std::size_t at = text.find("    " + first_line + "\n");
-  if (at == std::string::npos) return "";
-  at += first_line.size() + 5;
-  std::string block;
-  for (std::size_t end; at < text.size() && text.compare(at, 4, "    ") == 0; at = end + 1) {
-    end = text.find('\n', at);
-    block += text.substr(at + 4, end - at - 4) + "\n";
-  }
-  return block;
-}
-
-// The README's check-file example fails on purpose, says so, and prints what the README shows.
-TEST(ReadmeExamples, CheckFileFailsAsShown) {
-  const std::string shown = readme_block_after("$ build/pathex check samples/checks/fails-on-purpose.json; echo \"exit $?\"");
-  ASSERT_FALSE(shown.empty());
-  const CliRun r = pathex_cli({"check", "samples/checks/fails-on-purpose.json"});
-  EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(r.out + "exit " + std::to_string(r.code) + "\n", shown);
-  EXPECT_NE(readme().find("**fails on purpose (exit 1)**"), std::string::npos);
-  // The JSON shown is the file's cases.
-  const std::string text = readme();
-  const std::size_t json_at = text.find("    {\"cases\": [{\"name\": \"ptnee-ortho\"");
-  ASSERT_NE(json_at, std::string::npos);
-  const nlohmann::json file = read_json(std::string(PATHEX_SOURCE_DIR) + "/samples/checks/fails-on-purpose.json");
-  EXPECT_EQ(nlohmann::json::parse(text.substr(json_at, text.find("\n\n", json_at) - json_at))["cases"], file["cases"]);
-  // And the passing gate passes.
-  EXPECT_EQ(pathex_cli({"check", "samples/checks/samples.json"}).code, 0);
-}
-
-TEST(ReadmeExamples, TheUnreachableLightWarningIsTheOneShown) {
-  const std::string shown = readme_block_after("$ build/pathex trace samples/scenes/point-mirror-caustic.json --renderer pt");
-  const CliRun r = pathex_cli({"trace", "samples/scenes/point-mirror-caustic.json", "--renderer", "pt", "--spp", "1",
-                               "--no-images", "--quiet", "--out", out_dir("readme-warning")});
-  EXPECT_EQ(r.code, 0);
-  EXPECT_EQ(r.err, shown);
-}
-
 }  // namespace
