@@ -76,7 +76,7 @@ TEST(ImportPbrtImageLight, IlluminanceIsPbrtsNormalisation) {
   double cos_sum = 0.0;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {
-      const glm::vec3 w = equal_area_square_to_sphere({(x + 0.5f) / 64.0f, (y + 0.5f) / 64.0f});
+      const glm::vec3 w = equal_area_square_to_sphere({(static_cast<float>(x) + 0.5f) / 64.0f, (static_cast<float>(y) + 0.5f) / 64.0f});
       if (w.z > 0.0f) cos_sum += w.z;
     }
   const double k = 0.2126 * 2.0 * cos_sum * 2.0 * std::numbers::pi / (64.0 * 64.0);
@@ -172,7 +172,7 @@ TEST(ImageLightRefusals, LocatedWithWhatWasExpected) {
        R"({"camera": {"type": "pinhole", "position": [0, 0, -3], "look_at": [0, 0, 0]}, "materials": {"m": {"type": "diffuse"}},
            "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
            "lights": [{"type": "environment", "image": "nowhere.exr"}]})",
-       "missing.json: /lights/0/image", "the image 'nowhere.exr': cannot read the image: No such file or directory"},
+       "missing.json:/lights/0/image", "the image 'nowhere.exr': cannot read the image: No such file or directory"},
   };
   for (const Refusal& r : refusals) {
     const Result<Scene> s = load_scene_file(write(r.file, r.text));

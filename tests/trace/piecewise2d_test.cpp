@@ -30,7 +30,7 @@ TEST(Piecewise2D, DensityIntegratesToOne) {
   // And pdf() on a fine grid of points (midpoint rule, 10 x 10 points per cell).
   double grid = 0.0;
   for (int y = 0; y < 40; ++y)
-    for (int x = 0; x < 60; ++x) grid += d.pdf({(x + 0.5f) / 60.0f, (y + 0.5f) / 40.0f}) / 2400.0;
+    for (int x = 0; x < 60; ++x) grid += d.pdf({(static_cast<float>(x) + 0.5f) / 60.0f, (static_cast<float>(y) + 0.5f) / 40.0f}) / 2400.0;
   EXPECT_NEAR(grid, 1.0, 1e-6);
 }
 
