@@ -531,8 +531,15 @@ Result<Scene> SceneBuilder::finish(const std::string& file, const std::vector<st
   // --- handedness: mirror a left-handed camera's world through its vertical plane ---
   const glm::vec3 fwd = glm::normalize(s.camera.look_at - s.camera.position);
   const glm::vec3 right_handed = glm::cross(fwd, glm::normalize(s.camera.up));
-  if (glm::dot(right_handed, image_right_) < 0.0f) mirror_scene(&s, Mirror3{s.camera.position, glm::normalize(right_handed)});
+  if (glm::dot(right_handed, image_right_) < 0.0f) {
+    mirror_scene(&s, Mirror3{s.camera.position, glm::normalize(right_handed)});
+    if (environment_image_) {  // the image's directions are mirrored with the world
+      const glm::vec3 n = glm::normalize(right_handed);
+      environment_image_->first.to_world = (glm::mat3(1.0f) - 2.0f * glm::outerProduct(n, n)) * environment_image_->first.to_world;
+    }
+  }
   // --- uniform infinite lights: the box around the finished scene (apertures and camera included) ---
+  if (environment_image_) add_image_environment(&s, std::move(environment_image_->first), environment_image_->second);
   for (const auto& [radiance, where] : environment_) add_uniform_environment(&s, radiance, where);
   if (std::optional<SceneRuleViolation> v = check_scene_rules(s)) {
     std::string message = v->message;

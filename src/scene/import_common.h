@@ -163,6 +163,11 @@ class SceneBuilder {
   // A uniform infinite light (add_uniform_environment in scene.h, called by finish() once the
   // scene is complete); `where` names it in messages.
   void add_environment(glm::vec3 radiance, std::string where) { environment_.push_back({radiance, std::move(where)}); }
+  // An image infinite light (add_image_environment in scene.h, by finish(); at most one).
+  void add_environment_image(EnvironmentImage image, std::string where) { environment_image_.emplace(std::move(image), std::move(where)); }
+  bool has_environment_image() const { return environment_image_.has_value(); }
+  // The texels of the scene's images read so far (--max-texels).
+  std::size_t* texels() { return &texels_; }
   // A distant light covering the whole scene (its aperture is placed by finish()).
   void add_distant(glm::vec3 direction, glm::vec3 irradiance);
   // `camera` holds position, look_at (position + forward), up (the image's up) and the optics;
@@ -179,6 +184,8 @@ class SceneBuilder {
   };
   std::vector<Distant> distant_;
   std::vector<std::pair<glm::vec3, std::string>> environment_;
+  std::optional<std::pair<EnvironmentImage, std::string>> environment_image_;
+  std::size_t texels_ = 0;
   glm::vec3 image_right_{1.0f, 0.0f, 0.0f};
   bool has_camera_ = false;
 };

@@ -771,8 +771,29 @@ class Importer {
       area_emitters_[id] = n;
       return std::nullopt;
     }
-    if (type == "envmap")
-      return located(where(n), "emitter \"envmap\" (an image infinite light) is not supported: pathex renders a uniform infinite light (constant) only");
+    if (type == "envmap") {  // a latitude-longitude image, +Y up (docs/lights.md)
+      p.ignore({"mis_compensation"});  // how Mitsuba samples it, not the light
+      if (builder_.has_environment_image()) return located(where(n), "a second envmap is not supported: a scene has at most one image infinite light");
+      MI_TRY(file, p.string("filename", ""));
+      if (file.empty()) return located(where(n), "the envmap has no filename");
+      MI_TRY(scale, p.number("scale", 1.0));
+      if (!(scale >= 0.0)) return located(where(n), "scale must not be negative");
+      MI_TRY(m, p.transform("to_world"));
+      float s = 1.0f;
+      if (!import::is_similarity(m, &s)) return located(where(n), "an envmap whose to_world scales non-uniformly or shears is not supported");
+      Result<EnvironmentImage> img =
+          load_environment_image(files_.resolve(file), file, /*equal_area=*/false, vec3(static_cast<float>(scale)), options_, builder_.texels());
+      if (!img) {
+        Error e = located(where(n), "the image '" + excerpt(file, kMaxPathBytes) + "': " + img.error().message);
+        e.code = img.error().code;
+        return e;
+      }
+      if (std::optional<std::string> bad = settle_environment_values(&*img)) return located(where(n), *bad);
+      img->to_world = glm::mat3(m) / s;
+      if (auto u = p.unused()) return u;
+      builder_.add_environment_image(std::move(*img), where(n).str());
+      return std::nullopt;
+    }
     if (type == "constant") {  // the same radiance from every direction
       MI_TRY(radiance, p.color("radiance", vec3(1.0f)));
       if (auto bad = import::check_light_value(radiance, where(n))) return bad;
@@ -871,12 +892,29 @@ class Importer {
       float scale = 1.0f;
       if (!import::is_similarity(m, &scale) || std::fabs(scale - 1.0f) > 1e-3f)
         return located(where(n), "a perspective sensor's to_world must be rigid (no scale)");
-      if (p.find("focal_length")) return located(where(n), "focal_length is not supported, give fov");
+      // Mitsuba 3's parse_fov: `fov` along `fov_axis` (x by default), or else `focal_length` ("50mm"
+      // by default) on a 36 x 24 mm film, its fov along the diagonal.
       pugi::xml_node fov_node = p.find("fov");
-      if (!fov_node) return located(where(n), "the sensor needs a fov");
-      MI_TRY(fov, p.number("fov", 0.0));
-      MI_TRY(axis, p.string("fov_axis", "x"));
-      if (!(fov > 0 && fov < 180)) return located(where(fov_node), "fov must be within (0, 180)");
+      pugi::xml_node focal_node = p.find("focal_length");
+      if (fov_node && focal_node) return located(where(focal_node), "give fov or focal_length, not both (as Mitsuba 3)");
+      double fov = 0.0;
+      std::string axis = "diagonal";
+      if (fov_node) {
+        MI_TRY(f, p.number("fov", 0.0));
+        MI_TRY(a, p.string("fov_axis", "x"));
+        fov = f;
+        axis = a;
+      } else {
+        p.ignore({"fov_axis"});  // Mitsuba 3 reads no fov_axis with a focal length
+        MI_TRY(focal, p.string("focal_length", "50mm"));
+        std::string digits = focal.size() > 2 && focal.substr(focal.size() - 2) == "mm" ? focal.substr(0, focal.size() - 2) : focal;
+        char* end = nullptr;
+        const double mm = std::strtod(digits.c_str(), &end);
+        if (digits.empty() || end != digits.c_str() + digits.size() || !(mm > 0.0) || !std::isfinite(mm))
+          return located(focal_node ? where(focal_node) : where(n), "focal_length \"" + excerpt(focal) + "\" must be of the form <x>mm with x > 0");
+        fov = glm::degrees(2.0 * std::atan(std::sqrt(36.0 * 36.0 + 24.0 * 24.0) / (2.0 * mm)));
+      }
+      if (!(fov > 0 && fov < 180)) return located(fov_node ? where(fov_node) : where(n), "fov must be within (0, 180)");
       const float t = std::tan(glm::radians(static_cast<float>(fov)) * 0.5f);
       float tan_y = 0.0f;
       if (axis == "x" || (axis == "smaller" && aspect <= 1.0f) || (axis == "larger" && aspect > 1.0f)) tan_y = t / aspect;

@@ -20,6 +20,8 @@
 #include <set>
 #include <sstream>
 
+#include <numbers>
+
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -860,25 +862,59 @@ class Importer {
   }
 
   // --- lights ---
+  // pbrt-v4's ImageInfiniteLight (docs/lights.md): an equal-area square image in the light's
+  // space (the CTM at the LightSource), times scale, scaled to `illuminance` when given.
+  std::optional<Error> image_infinite_light(Params& ps, Param& filename, const Location& at) {
+    if (Param* l = ps.find("L")) return located(l->at, "give \"L\" or \"filename\", not both (as pbrt-v4)");
+    if (builder_.has_environment_image()) return located(at, "a second image infinite light is not supported: a scene has at most one");
+    PBRT_TRY(file, ps.string("filename", ""));
+    PBRT_TRY(scale, ps.number("scale", 1.0));
+    PBRT_TRY(illuminance, ps.number("illuminance", -1.0));
+    float s = 1.0f;
+    if (!import::is_similarity(gs_.ctm, &s)) return located(at, "an image infinite light under a non-uniform scale or shear is not supported");
+    Result<EnvironmentImage> img =
+        load_environment_image(files_.resolve(file), file, /*equal_area=*/true, vec3(static_cast<float>(scale)), options_, builder_.texels());
+    if (!img) {
+      Error e = located(filename.at, "the image '" + excerpt(file, kMaxPathBytes) + "': " + img.error().message);
+      e.code = img.error().code;
+      return e;
+    }
+    if (illuminance > 0.0) {
+      const double k = pbrt_image_illuminance(*img);
+      if (!(k > 0.0)) return located(at, "illuminance is given but the image's upper hemisphere is black: nothing to scale");
+      for (vec3& t : img->texels) t *= static_cast<float>(illuminance / k);
+    }
+    if (std::optional<std::string> bad = settle_environment_values(&*img)) return located(at, *bad);
+    img->to_world = glm::mat3(gs_.ctm) / s;
+    builder_.add_environment_image(std::move(*img), at.str());
+    return std::nullopt;
+  }
+
   std::optional<Error> light(const std::string& type, Params& ps, const Location& at) {
-    for (const char* p : {"power", "illuminance"})
-      if (Param* q = ps.find(p)) return located(q->at, "parameter '" + std::string(p) + "' is not supported: give the light's I or L and scale");
     const bool point = type == "point", spot = type == "spot", distant = type == "distant", infinite = type == "infinite";
+    for (const char* p : {"power", "illuminance"})
+      if (Param* q = ps.find(p); q && !(infinite && std::string(p) == "illuminance"))
+        return located(q->at, "parameter '" + std::string(p) + "' is not supported: give the light's I or L and scale");
     if (!point && !spot && !distant && !infinite)
       return located(at, "light \"" + excerpt(type) + "\" is not supported, expected point, spot, distant, infinite or an AreaLightSource");
     if (infinite) {
-      if (Param* f = ps.find("filename"))
-        return located(f->at, "an image infinite light (filename) is not supported: pathex renders a uniform infinite light (\"rgb L\") only");
-      if (Param* q = ps.find("portal")) return located(q->at, "portals are not supported (pbrt-v4 uses them with image infinite lights only)");
+      if (Param* q = ps.find("portal"))
+        return located(q->at, "portals are not supported: render the light without its portal (pbrt-v4 uses the portal only to sample it)");
+      if (Param* f = ps.find("filename")) return image_infinite_light(ps, *f, at);
     }
     PBRT_TRY(value, ps.rgb(distant || infinite ? "L" : "I", vec3(1.0f), false));
     PBRT_TRY(scale, ps.number("scale", 1.0));
-    const vec3 emitted = value * static_cast<float>(scale);
-    if (auto e = import::check_light_value(emitted, at)) return e;
+    vec3 emitted = value * static_cast<float>(scale);
     if (infinite) {  // the same radiance from every direction: no transform changes it
+      PBRT_TRY(illuminance, ps.number("illuminance", -1.0));
+      // pbrt-v4: the upper hemisphere's illuminance of a uniform L is π L (in luminance).
+      const double lum = 0.2126 * emitted.x + 0.7152 * emitted.y + 0.0722 * emitted.z;
+      if (illuminance > 0.0 && lum > 0.0) emitted *= static_cast<float>(illuminance / (std::numbers::pi * lum));
+      if (auto e = import::check_light_value(emitted, at)) return e;
       builder_.add_environment(emitted, at.str());
       return std::nullopt;
     }
+    if (auto e = import::check_light_value(emitted, at)) return e;
     PBRT_TRY(from, ps.point("from", vec3(0.0f)));
     if (point) {
       builder_.add_light(PointLight{import::apply_point(gs_.ctm, from), emitted});

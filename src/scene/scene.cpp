@@ -853,7 +853,19 @@ Result<ClosedFormReference> read_reference(const Reader& r, const nlohmann::json
 // environment's radiance.
 constexpr const char* kEnvironmentMaterial = "environment (absorbs)";
 
+namespace {
+
+// The box of the infinite lights (scene.h): its index among the shapes.
+int add_environment_box(Scene* scene, glm::vec3 emission, const std::string& pointer);
+
+}  // namespace
+
 void add_uniform_environment(Scene* scene, glm::vec3 radiance, const std::string& pointer) {
+  if (scene->environment_image) {  // an image light's box: the radiance joins every texel
+    for (glm::vec3& t : scene->environment_image->texels) t += radiance;
+    scene->environment = scene->environment.value_or(vec3(0.0f)) + radiance;
+    return;
+  }
   if (scene->environment) {  // a second infinite light: one box emitting the sum
     for (Shape& s : scene->shapes)
       if (scene->material_names[static_cast<std::size_t>(s.material)] == kEnvironmentMaterial && s.emission == *scene->environment)
@@ -861,6 +873,27 @@ void add_uniform_environment(Scene* scene, glm::vec3 radiance, const std::string
     *scene->environment += radiance;
     return;
   }
+  add_environment_box(scene, radiance, pointer);
+  scene->environment = radiance;
+}
+
+void add_image_environment(Scene* scene, EnvironmentImage image, const std::string& pointer) {
+  if (scene->environment) {  // a uniform light's box becomes the image's, its radiance in every texel
+    for (glm::vec3& t : image.texels) t += *scene->environment;
+    for (std::size_t i = 0; i < scene->shapes.size(); ++i)
+      if (scene->material_names[static_cast<std::size_t>(scene->shapes[i].material)] == kEnvironmentMaterial) image.shape = static_cast<int>(i);
+  } else {
+    image.shape = add_environment_box(scene, vec3(1.0f), pointer);
+  }
+  // The shape's emission only marks it as a light (the radiance is the image's); the image is its pointer.
+  scene->shapes[static_cast<std::size_t>(image.shape)].emission = vec3(1.0f);
+  scene->shapes[static_cast<std::size_t>(image.shape)].pointer = pointer;
+  scene->environment_image = std::move(image);
+}
+
+namespace {
+
+int add_environment_box(Scene* scene, glm::vec3 emission, const std::string& pointer) {
   // --- what the box must hold ---
   Box b;
   for (const Shape& s : scene->shapes) {
@@ -911,11 +944,13 @@ void add_uniform_environment(Scene* scene, glm::vec3 radiance, const std::string
   Shape s;
   s.geometry = std::move(box);
   s.material = static_cast<int>(scene->materials.size()) - 1;
-  s.emission = radiance;
+  s.emission = emission;
   s.pointer = pointer;
   scene->shapes.push_back(std::move(s));
-  scene->environment = radiance;
+  return static_cast<int>(scene->shapes.size()) - 1;
 }
+
+}  // namespace
 
 Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir, const std::string& name,
                               const SceneLoadOptions& options) {
@@ -942,12 +977,46 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   }
   // --- lights ---
   std::vector<std::pair<vec3, std::string>> environments;  // uniform infinite lights
+  std::optional<std::pair<EnvironmentImage, std::string>> environment_image;  // an image one
   if (doc.contains("lights")) {
     if (!doc["lights"].is_array()) return r.fail("/lights", "expected an array of lights");
     for (std::size_t i = 0; i < doc["lights"].size(); ++i) {
       const std::string ptr = "/lights/" + std::to_string(i);
       const json& lj = doc["lights"][i];
       if (!lj.is_object()) return r.fail(ptr, "expected a light object");
+      if (lj.contains("type") && lj["type"] == "environment" && lj.contains("image")) {  // docs/lights.md
+        if (auto k = r.keys(lj, ptr, {"type", "image", "mapping", "scale", "rotate", "sampling"}); !k) return k.error();
+        if (environment_image) return r.fail(ptr, "a second image environment: a scene has at most one");
+        PATHEX_TRY(file, r.string(lj, "image", ptr));
+        bool equal_area = false;
+        if (lj.contains("mapping")) {
+          if (lj["mapping"] == "equal-area") equal_area = true;
+          else if (lj["mapping"] != "latlong")
+            return r.fail(ptr + "/mapping", "expected \"latlong\" (Mitsuba 3's envmap, +Y up) or \"equal-area\" (pbrt-v4's square)");
+        }
+        PATHEX_TRY(scale, r.vector3(lj, "scale", ptr, false, vec3(1.0f), /*nonneg=*/true));
+        std::size_t texels = 0;
+        Result<EnvironmentImage> img =
+            load_environment_image((std::filesystem::path(base_dir) / file).string(), file, equal_area, scale, options, &texels);
+        if (!img) {
+          Error e = img.error();
+          return r.fail(ptr + "/image", "the image '" + excerpt(file, kMaxPathBytes) + "': " + e.message);
+        }
+        if (lj.contains("rotate")) {  // {"axis": [x, y, z], "degrees": d}, as a shape's transform
+          bool uniform = true;
+          float sc = 1.0f;
+          PATHEX_TRY(t, read_transform(r, json{{"rotate", lj["rotate"]}}, ptr, &uniform, &sc));
+          img->to_world = glm::mat3(t);
+        }
+        if (lj.contains("sampling")) {
+          if (lj["sampling"] == "uniform") img->uniform_sampling = true;
+          else if (lj["sampling"] != "importance")
+            return r.fail(ptr + "/sampling", "expected \"importance\" (by the image's values, the default) or \"uniform\"");
+        }
+        if (std::optional<std::string> bad = settle_environment_values(&*img)) return r.fail(ptr + "/image", *bad);
+        environment_image.emplace(std::move(*img), ptr);
+        continue;
+      }
       if (lj.contains("type") && lj["type"] == "environment") {  // added once the camera is known
         if (auto k = r.keys(lj, ptr, {"type", "radiance"}); !k) return k.error();
         PATHEX_TRY(radiance, r.light_value(lj, "radiance", ptr, true));
@@ -958,11 +1027,12 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
       scene.lights.push_back(std::move(l));
     }
   }
-  if (!has_light(scene) && environments.empty()) return r.fail("/lights", kNoLight);
+  if (!has_light(scene) && environments.empty() && !environment_image) return r.fail("/lights", kNoLight);
   // --- camera ---
   if (!doc.contains("camera")) return r.fail("/camera", "missing camera, expected {type, position, look_at, …}");
   PATHEX_TRY(cam, read_camera(r, doc["camera"], "/camera"));
   scene.camera = cam;
+  if (environment_image) add_image_environment(&scene, std::move(environment_image->first), environment_image->second);
   for (const auto& [radiance, ptr] : environments) add_uniform_environment(&scene, radiance, ptr);
   if (!camera_sees_geometry(scene)) return r.fail("/camera", kSeesNothing);
   if (doc.contains("reference")) {

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/mat3x3.hpp>
 
 #include "alphabet/alphabet.h"
 #include "core/error.h"
@@ -116,6 +117,21 @@ struct ClosedFormReference {
   std::vector<ReferenceClass> classes;
 };
 
+// An image infinite light (docs/lights.md): radiance from every direction, read from an image.
+// pbrt-v4's `infinite` with a filename (an equal-area octahedral square), Mitsuba 3's `envmap` and
+// the JSON {"type": "environment", "image": …} (latitude-longitude, +Y up; or "equal-area").
+struct EnvironmentImage {
+  std::string file;         // as given, for messages
+  bool equal_area = false;  // pbrt-v4's square; else latitude-longitude (Mitsuba 3)
+  int width = 0, height = 0;
+  std::vector<glm::vec3> texels;  // linear radiance ≥ 0, row-major from the top row, scale applied
+  glm::mat3 to_world{1.0f};       // light space → world: orthogonal (a rotation, or with a mirror)
+  int shape = -1;                 // the emitting box (add_image_environment())
+  // Directions drawn uniformly over the image instead of by its values (JSON "sampling":
+  // "uniform"): the same light, sampled worse; the tests compare the two.
+  bool uniform_sampling = false;
+};
+
 struct Scene {
   std::string name;
   std::vector<std::string> material_names;
@@ -127,6 +143,9 @@ struct Scene {
   // A uniform infinite light's radiance (pbrt-v4 `infinite` with `L`, Mitsuba 3 `constant`, JSON
   // {"type": "environment"}), when the scene has one; add_uniform_environment() has made it a shape.
   std::optional<glm::vec3> environment;
+  // An image infinite light, when the scene has one; add_image_environment() has made its box. A
+  // uniform infinite light in the same scene is added to its texels (one box).
+  std::optional<EnvironmentImage> environment_image;
 };
 
 // A uniform infinite light of radiance L (DESIGN §1: an area light, letters LDD): light of the same
@@ -141,6 +160,26 @@ struct Scene {
 // shapes, lights and camera are complete; several calls add their radiances into one box.
 // `pointer` names the light in messages ("/lights/2", "scene.pbrt:14:1").
 void add_uniform_environment(Scene* scene, glm::vec3 radiance, const std::string& pointer);
+// An image infinite light, rendered as the same box (its faces emit the image's radiance of each
+// direction; trace/environment.h samples it). Call it as add_uniform_environment(); a scene holds
+// at most one image light (the importers refuse a second, located).
+void add_image_environment(Scene* scene, EnvironmentImage image, const std::string& pointer);
+
+struct SceneLoadOptions;
+// An image infinite light's image at `path` (as given: `file`), read by read_image (io/image_read.h:
+// linear RGB; integer data decoded as sRGB) with its texels counted in *texels_so_far against
+// options.max_texels, negative values clamped to 0 (pbrt-v4's ClampZero), times `scale`. An
+// equal-area image must be square. Errors name the file; the caller says where it was asked for.
+Result<EnvironmentImage> load_environment_image(const std::string& path, const std::string& file, bool equal_area, glm::vec3 scale,
+                                                const SceneLoadOptions& options, std::size_t* texels_so_far);
+// pbrt-v4's `illuminance` of an equal-area image: the sum over the texels of the upper hemisphere
+// (+z in light space) of luminance × cos θ, times 2π / texels — pbrt-v4's own normalisation (which is
+// half the hemisphere's illuminance, the texels subtending 4π / texels each; docs/lights.md).
+double pbrt_image_illuminance(const EnvironmentImage& image);
+// The light-value rule (kMaxLightValue, kMinLightValue below) for an image's texels: components
+// below kMinLightValue become 0 (a dark texel, not a refusal), one above kMaxLightValue is refused
+// with the message returned.
+std::optional<std::string> settle_environment_values(EnvironmentImage* image);
 
 // How much of a scene to load.
 struct SceneLoadOptions {

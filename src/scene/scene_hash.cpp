@@ -82,6 +82,14 @@ std::string scene_content_hash(const Scene& scene) {
   h.add(c.film_height);
   h.add(c.width);
   h.add(c.height);
+  if (const auto& e = scene.environment_image) {  // only then: the hashes of scenes without one stay as they were
+    h.add(static_cast<std::uint64_t>(e->texels.size()));
+    for (const glm::vec3& t : e->texels) h.add(t);
+    h.add(e->equal_area);
+    h.add(e->width);
+    for (int i = 0; i < 3; ++i) h.add(e->to_world[i]);
+    h.add(e->uniform_sampling);
+  }
   return h.hex();
 }
 

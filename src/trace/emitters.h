@@ -13,6 +13,7 @@
 //   spot light  S D   intensity I times a cone falloff (smoothstep, or a hard edge)
 //   distant     D S   irradiance E [W/m²] in one direction, entering through an aperture
 //   laser       S S   power Φ [W] along one ray
+//   environment D D   an image infinite light: a box around the scene emitting L(−ω) inwards
 //   thin lens   D D   pinhole  D S   orthographic  S D   spot meter  S S   (sensors: dir, pos)
 //
 // Each kind offers
@@ -43,6 +44,8 @@
 // loader validates them).
 #pragma once
 
+#include <memory>
+#include <numbers>
 #include <optional>
 #include <variant>
 
@@ -50,6 +53,7 @@
 #include <glm/vec3.hpp>
 
 #include "alphabet/alphabet.h"
+#include "trace/environment.h"
 
 namespace pathex {
 
@@ -193,6 +197,31 @@ RayPdf pdf_ray(const LaserParams& p);
 std::optional<EndpointConnection> connect(const LaserParams& p, const glm::vec3& ref);
 glm::vec3 power(const LaserParams& p);
 
+// Image infinite light, LDD (trace/environment.h): the box around the scene, each point emitting
+// the image's radiance L(−ω) towards every direction ω into the box. Its points are not chosen by
+// area: next-event estimation draws a direction from the image (connect), emission a direction
+// and a point of the disk covering the box (sample_ray); the handles below do not serve it (the
+// integrator calls these, with its own random numbers).
+struct EnvironmentLightParams {
+  std::shared_ptr<const EnvironmentMap> map;
+  static constexpr Letter kPosLetter = kD;
+  static constexpr Letter kDirLetter = kD;
+};
+// A direction ω drawn from the image by u_dir (travelling into the scene: the image's −ω), a point
+// of the disk by u_disk, and the box point where that line enters: pdf.pos = |cos θ_x| / (π R²),
+// pdf.dir = p(−ω), weight = L π R² / p(−ω). nullopt when the line misses the box.
+std::optional<EndpointRay> sample_ray(const EnvironmentLightParams& p, glm::vec2 u_dir, glm::vec2 u_disk);
+// Next-event estimation from ref: a direction drawn from the image by u, the box point where it
+// leaves; value L, pdf_dir its solid-angle density, weight L / pdf_dir.
+std::optional<EndpointConnection> connect(const EnvironmentLightParams& p, glm::vec2 u, const glm::vec3& ref);
+// The area density of the box point x (inward normal n) as connect() from `ref` draws it:
+// p(x − ref) |n · w| / d². It is the light density the integrator keeps for x0.
+float connect_area_density(const EnvironmentLightParams& p, const glm::vec3& x, const glm::vec3& n, const glm::vec3& ref);
+// The density of x1 that completes the emission's joint density: |cos θ_1| / (π R²).
+inline float emission_step_density(const EnvironmentLightParams& p, float abs_cos_next) {
+  return abs_cos_next / (std::numbers::pi_v<float> * p.map->radius * p.map->radius);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Sensors. raster (x, y) ∈ [0,1)^2 maps to the film point (2x − 1, 1 − 2y) in units of the half
 // extents along (right, up): x grows to the right, y grows downwards.
@@ -281,8 +310,8 @@ std::optional<EndpointConnection> connect(const SpotMeterParams& p, const glm::v
 // laser, the importance of a Dirac direction) answer nullopt or zero.
 // ---------------------------------------------------------------------------------------------
 
-using LightParams =
-    std::variant<AreaLightParams, PointLightParams, SpotLightParams, DistantLightParams, LaserParams>;
+using LightParams = std::variant<AreaLightParams, PointLightParams, SpotLightParams, DistantLightParams, LaserParams,
+                                 EnvironmentLightParams>;
 using SensorParams = std::variant<PinholeParams, ThinLensParams, OrthographicParams, SpotMeterParams>;
 
 Letter pos_letter(const LightParams& l);   // c0
@@ -300,9 +329,13 @@ std::optional<EndpointConnection> connect(const LightParams& l, const SurfacePoi
 // Veach's split L_e = L_e⁽⁰⁾ L_e⁽¹⁾ for the finite directional part: the spatial factor (Le for an
 // area light, I for point and spot lights, E, Φ) and the directional factor towards w from a
 // point with normal n (area: 1 on an emitting side, else 0; point: 1; spot: the falloff). A Dirac
-// direction (distant, laser) has no finite directional part: 0.
+// direction (distant, laser) has no finite directional part: 0. An image infinite light's
+// radiance is all directional: spatial 1, directional 1 into the box (its value is looked up by
+// environment_radiance() where a path meets it, or carried by the vertex's throughput).
+// emitted(): the product, with an image light's radiance looked up (towards −w).
 glm::vec3 spatial_emission(const LightParams& l);
 float directional_emission(const LightParams& l, const glm::vec3& n, const glm::vec3& w);
+glm::vec3 emitted(const LightParams& l, const glm::vec3& n, const glm::vec3& w);
 
 // Sensors. `raster` ∈ [0,1)² as above; u_lens is read by the thin lens only.
 inline bool reads_lens_numbers(const SensorParams& s) { return std::holds_alternative<ThinLensParams>(s); }

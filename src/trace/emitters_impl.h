@@ -593,6 +593,7 @@ inline Letter dir_letter(const SensorParams& s) {
 inline std::optional<EndpointRay> sample_ray(const LightParams& l, const SurfacePoint& x, glm::vec2 u) {
   return emitter_detail::visit(emitter_detail::Overloaded{[&](const AreaLightParams& p) { return sample_ray(p, x, u); },
                                [&](const LaserParams& p) { return sample_ray(p); },
+                               [](const EnvironmentLightParams&) { return std::optional<EndpointRay>(); },
                                [&](const auto& p) { return sample_ray(p, u); }},
                     l);
 }
@@ -601,6 +602,7 @@ inline RayPdf pdf_ray(const LightParams& l, const SurfacePoint& x, const glm::ve
   return emitter_detail::visit(emitter_detail::Overloaded{[&](const AreaLightParams& p) { return pdf_ray(p, x, direction); },
                                [&](const DistantLightParams& p) { return pdf_ray(p, x.position); },
                                [&](const LaserParams& p) { return pdf_ray(p); },
+                               [&](const EnvironmentLightParams& p) { return RayPdf{0.0f, environment_pdf(*p.map, -direction), false, false}; },
                                [&](const auto& p) { return pdf_ray(p, direction); }},
                     l);
 }
@@ -608,6 +610,7 @@ inline RayPdf pdf_ray(const LightParams& l, const SurfacePoint& x, const glm::ve
 inline std::optional<EndpointConnection> connect(const LightParams& l, const SurfacePoint& x,
                                           const glm::vec3& ref) {
   return emitter_detail::visit(emitter_detail::Overloaded{[&](const AreaLightParams& p) { return connect(p, x, ref); },
+                               [](const EnvironmentLightParams&) { return std::optional<EndpointConnection>(); },
                                [&](const auto& p) { return connect(p, ref); }},
                     l);
 }
@@ -617,7 +620,8 @@ inline glm::vec3 spatial_emission(const LightParams& l) {
                                [](const PointLightParams& p) { return p.intensity; },
                                [](const SpotLightParams& p) { return p.intensity; },
                                [](const DistantLightParams& p) { return p.irradiance; },
-                               [](const LaserParams& p) { return p.power; }},
+                               [](const LaserParams& p) { return p.power; },
+                               [](const EnvironmentLightParams&) { return glm::vec3(1.0f); }},
                     l);
 }
 
@@ -626,8 +630,14 @@ inline float directional_emission(const LightParams& l, const glm::vec3& n, cons
       emitter_detail::Overloaded{[&](const AreaLightParams& p) { return emitter_detail::is_black(emitted_radiance(p, n, w)) ? 0.0f : 1.0f; },
                  [](const PointLightParams&) { return 1.0f; },
                  [&](const SpotLightParams& p) { return spot_falloff(p, glm::dot(w, p.axis)); },
+                 [&](const EnvironmentLightParams&) { return glm::dot(n, w) > 0.0f ? 1.0f : 0.0f; },
                  [](const auto&) { return 0.0f; }},
       l);
+}
+
+inline glm::vec3 emitted(const LightParams& l, const glm::vec3& n, const glm::vec3& w) {
+  if (const auto* e = std::get_if<EnvironmentLightParams>(&l)) return environment_radiance(*e->map, -w);
+  return spatial_emission(l) * directional_emission(l, n, w);
 }
 
 inline std::optional<EndpointRay> sample_ray(const SensorParams& s, glm::vec2 raster, glm::vec2 u_lens) {

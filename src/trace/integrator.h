@@ -275,6 +275,20 @@ class Integrator {
     const auto* d = std::get_if<DistantLightParams>(&l.params);
     return d ? parallelogram_error(d->corner, d->edge1, d->edge2) : vec3(0.0f);
   }
+  // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
+  // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
+  // emission_step_density() after it: their product is its emission's joint density.
+  const EnvironmentLightParams* environment_of(int light) const {
+    return std::get_if<EnvironmentLightParams>(&rs_.lights[static_cast<std::size_t>(light)].params);
+  }
+  // v is a point of an image infinite light (a light vertex, or an eye vertex that hit its box).
+  bool on_environment(const Vertex& v) const {
+    const int li = v.kind == Kind::kLight ? v.light : v.kind == Kind::kSurface ? rs_.light_of_shape[static_cast<std::size_t>(v.shape)] : -1;
+    return li >= 0 && environment_of(li) != nullptr;
+  }
+  float env_origin_density(const EnvironmentLightParams& e, const vec3& x0, const vec3& n0, const vec3& x1) const {
+    return light_pick_ * connect_area_density(e, x0, n0, x1);
+  }
   // Where a point or spot light is (the integrator picks an area light's points itself).
   static vec3 light_position(const LightParams& l) {
     if (const auto* p = std::get_if<PointLightParams>(&l)) return p->position;
@@ -307,12 +321,15 @@ class Integrator {
     const float d2 = glm::dot(d, d);
     if (d2 == 0.0f) return 0.0f;
     const vec3 wn = d / std::sqrt(d2);
+    if (v.kind == Kind::kLight)
+      if (const EnvironmentLightParams* e = environment_of(v.light)) return emission_step_density(*e, abs_cos(next, wn));
     const vec3 wp = prev ? glm::normalize(prev->p - v.p) : vec3(0.0f);
     return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
   }
   // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
   float pdf_light_origin(const Vertex& v) const {
     const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
+    if (const EnvironmentLightParams* e = environment_of(li)) return env_origin_density(*e, v.p, v.n, v.p + v.wo * std::sqrt(v.d2_wo));
     return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
   }
 

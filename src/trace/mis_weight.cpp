@@ -52,15 +52,18 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
   st.connectors = out;
   if (self != ConnectorKind::kDistantProjection && n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && light_pos() > 0.0)
     out[count++] = {1, 0, 1.0 / light_pos()};
-  if (self != ConnectorKind::kOrthoProjection && n - 1 >= 1 && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f)
+  // An image infinite light's x0 is never projected (join_sensor()), nor a connector's fresh light
+  // end, split 1 (fresh_light_end()): its points are drawn towards the point they join.
+  const bool env = on_environment(x[0]);
+  if (self != ConnectorKind::kOrthoProjection && n - 1 >= 1 + env && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f)
     out[count++] = {n - 1, 0, 1.0 / cam_.pdf_pos};
   if (has_mirror_)
-    for (int m = 1; m <= k - 1; ++m)
+    for (int m = 1 + env; m <= k - 1; ++m)
       if (!(self == ConnectorKind::kMirror && m == s) && dsd_at(m) && mirror_of(m, k - m) >= 0 && x[m].kind == Kind::kSurface &&
           mirror_shape_[static_cast<std::size_t>(x[m].shape)])
         out[count++] = {m, 1, 1.0};
   if (has_manifold_)
-    for (int i = 1; i <= k - 1; ++i) {
+    for (int i = 1 + env; i <= k - 1; ++i) {
       const int m = s_run(i);
       if (m > 0 && !letter_s(i) && !(self == ConnectorKind::kManifold && i == s) && manifold_at(x, key, i, m)) out[count++] = {i, m, 1.0};
     }
@@ -103,7 +106,9 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
     const bsdf::JoinPdfs& at_qs = join->at_qs;
     const bsdf::JoinPdfs& at_pt = join->at_pt;
     // A projected endpoint sends a parallel beam: the density at the other end is per area.
+    const EnvironmentLightParams* env = qs->kind == Kind::kLight ? environment_of(qs->light) : nullptr;
     if (self == ConnectorKind::kDistantProjection) set_light(s, parallel_jacobian(*pt, *qs, w));
+    else if (env && needed(s)) set_light(s, emission_step_density(*env, abs_cos(*pt, w)));
     else if (needed(s)) set_light(s, area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2));
     if (self == ConnectorKind::kOrthoProjection) set_eye(s - 1, parallel_jacobian(*qs, *pt, w));
     else if (needed(s - 1)) set_eye(s - 1, area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2));
@@ -112,8 +117,10 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
   } else if (pt) {  // s = 0: pt lies on an area light
     set_light(0, pdf_light_origin(*pt));
     if (ptm && needed(1)) {
-      const RenderLight& l = rs_.lights[static_cast<std::size_t>(rs_.light_of_shape[static_cast<std::size_t>(pt->shape)])];
-      set_light(1, area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo));
+      const int li = rs_.light_of_shape[static_cast<std::size_t>(pt->shape)];
+      const RenderLight& l = rs_.lights[static_cast<std::size_t>(li)];
+      if (const EnvironmentLightParams* e = environment_of(li)) set_light(1, emission_step_density(*e, abs_cos(*ptm, pt->wo)));
+      else set_light(1, area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo));
     }
   } else if (qs) {  // t = 0: qs is the lens point
     set_eye(n - 1, cam_.pdf_pos);
@@ -127,7 +134,10 @@ void Integrator::path_densities(Thread& th, const PathView& x, PathKey key, int 
   const int k = x.size() - 1;
   const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
   const auto lf = [&](int v) -> float {
-    if (v == 0) return light_pick_ * rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+    if (v == 0) {
+      if (const EnvironmentLightParams* e = environment_of(x[0].light)) return env_origin_density(*e, x[0].p, x[0].n, x[1].p);
+      return light_pick_ * rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+    }
     if (v == 1 && letter_s(1) && rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos > 0.0f)
       return parallel_jacobian(x[1], x[0], glm::normalize(x[1].p - x[0].p));  // a distant light's parallel beam
     if (letter_s(v)) return 0.0f;  // x(v-1) is a Dirac

@@ -188,9 +188,13 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   y0.light = static_cast<int>(li);
   y0.pos_letter = light_pairs_[li][0];
   y0.letter = light_pairs_[li][1];
-  const SurfacePoint x = sample_point(l, rng, &y0.err);
+  // An image infinite light draws its disk point from the numbers an area light's point takes.
+  const EnvironmentLightParams* env = environment_of(static_cast<int>(li));
+  const glm::vec2 u_disk = env ? rng.get2d() : glm::vec2(0.0f);
+  const SurfacePoint x = env ? SurfacePoint{} : sample_point(l, rng, &y0.err);
   rng.skip(2);  // u_ray, drawn in advance
-  std::optional<EndpointRay> r = sample_ray(l.params, x, u_ray);
+  std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : sample_ray(l.params, x, u_ray);
+  if (env && r) y0.err = box_point_error(r->origin);
   if (const std::optional<EmissionCones>& cones = aimed_[li]; cones && r) {
     // --only: the first direction drawn within the cones instead (trace/emission_cones.h).
     float pdf = 0.0f;
@@ -223,6 +227,12 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   // its first vertex has a finite density per area, which the distant-projection connector's
   // MIS weight compares with the eye's.
   if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.light[1].pdf_fwd = parallel_jacobian(th.light[1], y0, r->direction);
+  // An image infinite light's two densities (Integrator::environment_of): y0's as next-event
+  // estimation from y1 would draw it, y1's the rest of the emission's joint density.
+  if (env) {
+    y0.pdf_fwd = n >= 2 ? env_origin_density(*env, y0.p, y0.n, th.light[1].p) : 0.0f;
+    if (n >= 2) th.light[1].pdf_fwd = emission_step_density(*env, abs_cos(th.light[1], r->direction));
+  }
   return n;
 }
 

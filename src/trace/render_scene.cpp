@@ -34,6 +34,26 @@ BoundingSphere bounding_sphere(const ShapeGeometry& g) {
   return {c, std::sqrt(r2)};
 }
 
+// The image infinite light of `image`, whose box is `box` (trace/environment.h).
+EnvironmentLightParams environment_light(const EnvironmentImage& image, const Shape& box) {
+  auto m = std::make_shared<EnvironmentMap>();
+  m->equal_area = image.equal_area;
+  m->width = image.width;
+  m->height = image.height;
+  m->texels = image.texels;
+  m->to_world = image.to_world;
+  m->build_distribution(image.uniform_sampling);
+  const std::vector<glm::vec3>& p = std::get<MeshShape>(box.geometry).positions;
+  m->box_lo = m->box_hi = p[0];
+  for (const glm::vec3& v : p) {
+    m->box_lo = glm::min(m->box_lo, v);
+    m->box_hi = glm::max(m->box_hi, v);
+  }
+  m->center = 0.5f * (m->box_lo + m->box_hi);
+  m->radius = 0.5f * glm::length(m->box_hi - m->box_lo) * 1.0001f;  // the disk covers the box
+  return EnvironmentLightParams{std::move(m)};
+}
+
 }  // namespace
 
 Result<RenderScene> make_render_scene(const Scene& scene) {
@@ -61,6 +81,7 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     if (!s.emissive() || !(rs.geometry->shape_area(static_cast<int>(i)) > 0.0f)) continue;
     RenderLight l;
     l.params = AreaLightParams{s.emission, s.two_sided};
+    if (scene.environment_image && scene.environment_image->shape == static_cast<int>(i)) l.params = environment_light(*scene.environment_image, s);
     l.shape = static_cast<int>(i);
     l.pdf_pos = 1.0f / rs.geometry->shape_area(l.shape);
     rs.light_of_shape[i] = static_cast<int>(rs.lights.size());

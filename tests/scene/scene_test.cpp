@@ -245,6 +245,7 @@ TEST(SampleScenes, TypesAndUniverses) {
       {"point-glass.json", {LightType::kPoint}, SensorType::kPinhole, sd, "LSD[SD]*DSE"},
       {"sun-window.json", {LightType::kDistant}, SensorType::kPinhole, d, "LDSD*DSE"},
       {"sky-glass.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // the sky is an area light
+      {"sky-image.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // an image sky too (docs/lights.md)
       {"materials.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // issue 35's materials
       {"small-light-caustic.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // issue 36
       {"laser.json", {LightType::kLaser}, SensorType::kPinhole, sd, "LSS[SD]*DSE"},

@@ -218,6 +218,10 @@ struct IntegratorTestAccess {
       if (s2 > 0) {
         th.light[0].kind = Kind::kLight;
         th.light[0].pdf_fwd = in.light_pick() * in.scene().lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+        // An image infinite light's x0: the density next-event estimation from x1 draws it with
+        // (Integrator::environment_of; x1's own density follows from in.pdf()).
+        if (const EnvironmentLightParams* e = in.environment_of(x[0].light); e && k >= 1)
+          th.light[0].pdf_fwd = in.env_origin_density(*e, x[0].p, x[0].n, x[1].p);
       }
       if (s2 == 0) {
         th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;

@@ -96,6 +96,7 @@ const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinB
   const std::size_t li = pick_light(rng);
   const RenderLight& light = rs_.lights[li];
   if (light_pairs_[li][1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
+  if (environment_of(static_cast<int>(li))) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
   vec3 err{0.0f};
   const SurfacePoint x = sample_point(light, rng, &err);
   Vertex& y0 = fresh_light_vertex(th, li, light.is_area() ? x.position : light_position(light.params),

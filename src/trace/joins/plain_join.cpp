@@ -101,8 +101,7 @@ bool Integrator::join_emitter(Thread& th, int t) const {
   const int hit_light = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];
   if (hit_light < 0) return false;
   begin_join(th, ConnectorKind::kNone, 0, t, strategy(0, t));
-  const LightParams& l = rs_.lights[static_cast<std::size_t>(hit_light)].params;
-  return end_join(th, pt.beta * spatial_emission(l) * directional_emission(l, pt.n, pt.wo), 0, nullptr, nullptr);
+  return end_join(th, pt.beta * emitted(rs_.lights[static_cast<std::size_t>(hit_light)].params, pt.n, pt.wo), 0, nullptr, nullptr);
 }
 
 // --- t = 0: the light subpath's last vertex lies on the lens ---
@@ -122,14 +121,32 @@ bool Integrator::join_lens(Thread& th, int s) const {
 // --- a light vertex joined to a sensor point: a fresh one (the splat, t = 1) or, for
 //     ortho-projection, the film point on the line of sight through y(s-1) ---
 bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind) const {
-  const Vertex& qs = th.light[static_cast<std::size_t>(s - 1)];
-  if (qs.kind == Kind::kLens || !qs.finite) return false;
+  const Vertex* q = &th.light[static_cast<std::size_t>(s - 1)];
+  if (q->kind == Kind::kLens || !q->finite) return false;
   const bool ortho = kind == ConnectorKind::kOrthoProjection;
   join_numbers(rng, ortho ? JoinBlock::kOrtho : JoinBlock::kSplat, s);
   std::optional<EndpointConnection> c;
-  if (!ortho) {
+  const EnvironmentLightParams* env = q->kind == Kind::kLight ? environment_of(q->light) : nullptr;
+  if (env) {
+    // An image infinite light seen directly: its point is drawn towards the sensor point, as
+    // next-event estimation draws it (the light density its x0 has), not the light subpath's y0.
+    if (ortho || sensor_pair_[0] != 'D') return false;  // (mis_weight.cpp: no projection of an image light)
+    const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(cam_.params));
+    const auto* lens = std::get_if<ThinLensParams>(&cam_.params);
+    const vec3 z = lens ? lens_point(*lens, ul) : std::get<PinholeParams>(cam_.params).position;
+    const std::optional<EndpointConnection> e = pathex::connect(*env, rng.get2d(), z);
+    if (!e) return false;
+    c = connect_finite(cam_.params, ul, e->position);
+    if (!c) return false;
+    begin_join(th, kind, s, 1, strategy(s, 1));
+    Vertex& y0 = fresh_light_vertex(th, static_cast<std::size_t>(q->light), e->position, e->normal, box_point_error(e->position), 'D');
+    y0.pdf_fwd = env_origin_density(*env, y0.p, y0.n, z);
+    // L / (pick p |cos θ_x| / d²): the join's |cos θ_x| and We cos / d² complete L We cos / (pick p).
+    y0.beta = y0.pdf_fwd > 0.0f ? e->value / y0.pdf_fwd : vec3(0.0f);
+    q = &y0;
+  } else if (!ortho) {
     if (sensor_pair_[0] != 'D') return false;  // a Dirac direction (orthographic, spot meter): no DD join
-    c = connect_finite(cam_.params, rng.get2d_if(reads_lens_numbers(cam_.params)), qs.p);
+    c = connect_finite(cam_.params, rng.get2d_if(reads_lens_numbers(cam_.params)), q->p);
     if (!c) return false;
     begin_join(th, kind, s, 1, strategy(s, 1));
   } else {
@@ -138,13 +155,14 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
     begin_join(th, kind, s, 1, ortho_of(s));
     ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
     ++stats.attempts;
-    c = pathex::connect(*film, qs.p);
+    c = pathex::connect(*film, q->p);
     if (!c) {
       ++stats.outside;
       return false;
     }
   }
   JoinResult& jr = th.join;
+  const Vertex& qs = *q;
   const Vertex& z0 = fresh_sensor_vertex(th, *c, ortho ? sensor_pair_[0] : 'D');
   const vec3 w = c->wi;  // from qs to the sensor
   to_pixels(c->raster, &jr.rx, &jr.ry);
@@ -168,7 +186,13 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   const RenderLight& l = rs_.lights[li];
   std::optional<EndpointConnection> c;
   vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
-  if (!distant) {
+  const EnvironmentLightParams* env = environment_of(static_cast<int>(li));
+  if (env && !distant) {  // an image infinite light: a direction drawn from its image
+    c = pathex::connect(*env, rng.get2d(), pt.p);
+    if (!c) return false;
+    err = box_point_error(c->position);
+    begin_join(th, kind, 1, t, strategy(1, t));
+  } else if (!distant) {
     if (light_pairs_[li][1] != 'D') return false;  // Dirac directions (distant, laser): no DD join
     c = pathex::connect(l.params, sample_point(l, rng, &err), pt.p);
     if (!c) return false;
@@ -186,7 +210,8 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
     err = aperture_error(l);
   }
   JoinResult& jr = th.join;
-  const Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? light_pairs_[li][1] : 'D');
+  Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? light_pairs_[li][1] : 'D');
+  if (env) y0.pdf_fwd = env_origin_density(*env, y0.p, y0.n, pt.p);
   const vec3 w = c->wi;  // from pt to the light
   const vec3 f = end_f(pt, w, TransportMode::kRadiance, &jr.density.at_pt);
   jr.density.w = -w;  // w runs from pt to the light, the join's from the light to pt
