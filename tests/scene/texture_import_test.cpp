@@ -112,7 +112,7 @@ TEST(ImportTexturesMitsuba, BitmapCheckerboardBlendWeightAndMask) {
   write_black_white();
   const std::string xml =
       kXmlHead +
-      "<sensor type=\"perspective\"><transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>\n"
+      "<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>\n"
       "<texture type=\"bitmap\" id=\"shared\"><string name=\"filename\" value=\"bw.png\"/><boolean name=\"raw\" value=\"true\"/></texture>\n"
       "<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"bw.png\"/>"
       "<string name=\"wrap_mode\" value=\"clamp\"/><transform name=\"to_uv\"><scale x=\"2\" y=\"4\"/><translate x=\"0.5\"/></transform>"
@@ -149,6 +149,32 @@ TEST(ImportTexturesMitsuba, BitmapCheckerboardBlendWeightAndMask) {
   EXPECT_EQ(textures_of(s, 3).bindings.size(), 1u);
 }
 
+TEST(ImportTexturesJson, TextureObjectsForColours) {
+  write_black_white();
+  const std::string json =
+      R"({"camera": {"type": "pinhole", "position": [0, 0, -3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 40, "width": 4, "height": 4},
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}],
+    "materials": {"img": {"type": "diffuse", "albedo": {"image": "bw.png", "wrap": "clamp", "uv_scale": [2, 1], "uv_offset": [0.25, 0]}},
+                  "mix": {"type": "mixture", "components": [{"weight": 0.5, "material": {"type": "diffuse"}},
+                    {"weight": 0.5, "material": {"type": "diffuse_transmission", "transmittance": {"checkerboard": [[0.5, 0, 0], [0, 0, 0.5]]}}}]}},
+    "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "img"},
+               {"type": "sphere", "center": [0, 3, 0], "radius": 1, "material": "mix"}]})";
+  const Scene s = load(write("tex.json", json));
+  ASSERT_EQ(s.shapes.size(), 3u);  // and the environment's box
+  ASSERT_EQ(s.images.size(), 1u);
+  const TextureBinding& b = textures_of(s, 0).bindings.at(0);
+  const Texture& t = s.textures.at(static_cast<std::size_t>(b.texture));
+  EXPECT_EQ(t.wrap, TextureWrap::kClamp);
+  EXPECT_TRUE(t.flip_t);
+  EXPECT_EQ(std::vector<float>(t.uv.m, t.uv.m + 6), (std::vector<float>{2, 0, 0.25f, 0, 1, 0}));
+  EXPECT_EQ(eval_texture(s, b.texture, {0.25f, 0.5f}), vec3(1.0f));  // s = 0.75: the white texel
+  const TextureBinding& c = textures_of(s, 1).bindings.at(0);
+  EXPECT_EQ(c.component, 1);
+  EXPECT_EQ(c.param, TexturedParam::kTransmittance);
+  EXPECT_EQ(eval_texture(s, c.texture, {0.5f, 0.5f}), vec3(0.5f, 0, 0));
+  EXPECT_EQ(eval_texture(s, c.texture, {1.5f, 0.5f}), vec3(0, 0, 0.5f));
+}
+
 struct Refusal {
   const char* file;
   std::string text;
@@ -158,6 +184,9 @@ struct Refusal {
 
 TEST(ImportTexturesRefusals, LocatedWithExactMessages) {
   write_black_white();
+  const std::string json_head =
+      R"({"camera": {"type": "pinhole", "position": [0, 0, -3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 40, "width": 4, "height": 4},
+    "lights": [{"type": "environment", "radiance": [1, 1, 1]}], "shapes": [], "materials": {"m": )";
   const std::string bitmap = "<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\">"
                              "<string name=\"filename\" value=\"bw.png\"/>";
   const std::vector<Refusal> refusals = {
@@ -167,15 +196,15 @@ TEST(ImportTexturesRefusals, LocatedWithExactMessages) {
        "texture \"ptex\" is not supported, expected imagemap, checkerboard, scale, mix or constant"},
       {"bump.pbrt", kPbrtHead + "Texture \"t\" \"normal\" \"imagemap\"\n", "bump.pbrt:5:1",
        "texture type \"normal\" is not supported, expected \"spectrum\" or \"float\""},
-      {"spherical.pbrt", kPbrtHead + "Texture \"t\" \"float\" \"checkerboard\" \"string mapping\" \"spherical\"\n", "spherical.pbrt:5:38",
+      {"spherical.pbrt", kPbrtHead + "Texture \"t\" \"float\" \"checkerboard\" \"string mapping\" \"spherical\"\n", "spherical.pbrt:5:36",
        "texture mapping \"spherical\" is not supported: pathex's textures use the surface's (u, v) (mapping \"uv\")"},
-      {"solid.pbrt", kPbrtHead + "Texture \"t\" \"float\" \"checkerboard\" \"integer dimension\" 3\n", "solid.pbrt:5:38",
+      {"solid.pbrt", kPbrtHead + "Texture \"t\" \"float\" \"checkerboard\" \"integer dimension\" 3\n", "solid.pbrt:5:36",
        "checkerboard dimension 3 is not supported: pathex's textures use the surface's (u, v) (dimension 2)"},
       {"encoding.pbrt", kPbrtHead + "Texture \"t\" \"float\" \"imagemap\" \"string filename\" \"bw.png\" \"string encoding\" \"gamma x\"\n",
-       "encoding.pbrt:5:66", "imagemap encoding \"gamma x\" is not supported, expected \"sRGB\", \"linear\" or \"gamma g\" with g in (0, 10]"},
+       "encoding.pbrt:5:59", "imagemap encoding \"gamma x\" is not supported, expected \"sRGB\", \"linear\" or \"gamma g\" with g in (0, 10]"},
       {"octa.pbrt", kPbrtHead + "Texture \"t\" \"float\" \"imagemap\" \"string filename\" \"bw.png\" \"string wrap\" \"octahedralsphere\"\n",
-       "octa.pbrt:5:66", "imagemap wrap \"octahedralsphere\" is not supported, expected repeat, clamp or black"},
-      {"missing.pbrt", kPbrtHead + "Texture \"t\" \"float\" \"imagemap\" \"string filename\" \"none.png\"\n", "missing.pbrt:5:36",
+       "octa.pbrt:5:59", "imagemap wrap \"octahedralsphere\" is not supported, expected repeat, clamp or black"},
+      {"missing.pbrt", kPbrtHead + "Texture \"t\" \"float\" \"imagemap\" \"string filename\" \"none.png\"\n", "missing.pbrt:5:32",
        "image \"none.png\" cannot read the image: No such file or directory"},
       {"unknown.pbrt", kPbrtHead + "Material \"diffuse\" \"texture reflectance\" \"nope\"\n", "unknown.pbrt:5:20", "unknown texture \"nope\""},
       {"kind.pbrt", kPbrtHead + "Texture \"f\" \"float\" \"constant\"\nMaterial \"diffuse\" \"texture reflectance\" \"f\"\n", "kind.pbrt:6:20",
@@ -191,8 +220,8 @@ TEST(ImportTexturesRefusals, LocatedWithExactMessages) {
        "an alpha cut-out on an area light is not supported"},
       {"alpha2.pbrt", kPbrtHead + "Shape \"sphere\" \"float alpha\" 2\n", "alpha2.pbrt:5:16", "alpha must be within [0, 1]"},
       {"perlin.xml", kXmlHead + bitmap.substr(0, bitmap.find("<texture")) + "<texture type=\"perlin\" name=\"reflectance\"/></bsdf></shape>\n</scene>\n",
-       "perlin.xml:3:44", "texture \"perlin\" is not supported, expected bitmap or checkerboard"},
-      {"mirror.xml", kXmlHead + bitmap + "<string name=\"wrap_mode\" value=\"mirror\"/></texture></bsdf></shape>\n</scene>\n", "mirror.xml:3:132",
+       "perlin.xml:3:43", "texture \"perlin\" is not supported, expected bitmap or checkerboard"},
+      {"mirror.xml", kXmlHead + bitmap + "<string name=\"wrap_mode\" value=\"mirror\"/></texture></bsdf></shape>\n</scene>\n", "mirror.xml:3:125",
        "wrap_mode \"mirror\" is not supported, expected repeat or clamp"},
       {"lit.xml",
        kXmlHead + "<shape type=\"sphere\"><bsdf type=\"mask\"><bsdf type=\"diffuse\"/></bsdf><emitter type=\"area\"/></shape>\n</scene>\n",
@@ -200,9 +229,15 @@ TEST(ImportTexturesRefusals, LocatedWithExactMessages) {
       {"eta.xml",
        kXmlHead + "<bsdf type=\"roughconductor\" id=\"x\"><texture type=\"bitmap\" name=\"specular_reflectance\"><string name=\"filename\" "
                   "value=\"bw.png\"/></texture></bsdf>\n</scene>\n",
-       "eta.xml:3:37",
+       "eta.xml:3:36",
        "a texture for 'specular_reflectance' is not supported here (pathex reads textures for reflectances, a blendbsdf's weight and a "
        "mask's opacity), give an <rgb>"},
+      {"both.json", json_head + R"({"type": "diffuse", "albedo": {"image": "bw.png", "checkerboard": [[1, 1, 1], [0, 0, 0]]}}}})",
+       "both.json:/materials/m/albedo", "expected a texture with either \"image\" or \"checkerboard\""},
+      {"wrap.json", json_head + R"({"type": "diffuse", "albedo": {"image": "bw.png", "wrap": "mirror"}}}})", "wrap.json:/materials/m/albedo/wrap",
+       "unknown wrap 'mirror', expected repeat, clamp or black"},
+      {"nofile.json", json_head + R"({"type": "diffuse", "albedo": {"image": "none.png"}}}})", "nofile.json:/materials/m/albedo/image",
+       "image 'none.png' cannot read the image: No such file or directory"},
   };
   for (const Refusal& r : refusals) {
     const Result<Scene> s = load_scene_file(write(r.file, r.text));

@@ -76,7 +76,7 @@ TEST(TextureRender, ACheckerboardWallInAFurnaceAveragesItsAlbedos) {
                                                         kWall + "\n");
   const double z = test::family_sigmas(3);
   for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
-    const Estimate e = render_total(path, renderer, 64);
+    const Estimate e = render_total(path, renderer, 1024);
     test::stat_log(std::string("checker wall ") + renderer, std::fabs(e.luminance - 0.7) / e.std_error, z);
     EXPECT_LE(std::fabs(e.luminance - 0.7), z * e.std_error + 1e-4) << renderer << ": " << e.luminance << " ± " << e.std_error;
   }
@@ -106,7 +106,7 @@ TEST(AlphaRender, CutOutsLetTheClosedFormFractionThrough) {
   const double z = test::family_sigmas(6);
   for (const std::string& path : {checker, half}) {
     for (const char* renderer : {"pt-nee", "lt", "bdpt"}) {
-      const Estimate e = render_total(path, renderer, 64);
+      const Estimate e = render_total(path, renderer, 1024);
       test::stat_log(std::string("alpha ") + renderer, std::fabs(e.luminance - 0.75) / e.std_error, z);
       EXPECT_LE(std::fabs(e.luminance - 0.75), z * e.std_error + 1e-4) << path << " " << renderer << ": " << e.luminance << " ± " << e.std_error;
     }
