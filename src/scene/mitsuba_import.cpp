@@ -825,6 +825,10 @@ class Importer {
         if (auto e = check_mesh_elements(mesh_elements_, options_, where(n).str())) return e;
       }
       mesh.file = file;
+      // Mitsuba's OBJ and PLY loaders flip v (flip_tex_coords, default true): its bitmaps look v up from the top row.
+      MI_TRY(flip_uv, p.boolean("flip_tex_coords", true));
+      if (flip_uv)
+        for (glm::vec2& uv : mesh.uvs) uv.y = 1.0f - uv.y;
       // Smooth unless face_normals: the file's normals, or (none, or an OBJ's, which pathex does not
       // read) Mitsuba's own angle-weighted ones, computed in world space as Mitsuba does.
       const bool compute = !face_normals && (type == "obj" || mesh.normals.empty());
