@@ -537,6 +537,42 @@ Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& opti
       e.where = excerpt(path, kMaxPathBytes);
       return e;
     }
+  // Texture coordinates (`vt`, scene/texture.h): an OBJ corner names its position and its uv
+  // separately, so the vertices are split per (position, uv) pair, when every corner has a uv
+  // (else none is kept). The split vertices count towards --max-mesh-elements.
+  const auto& tc = reader.GetAttrib().texcoords;
+  bool every = !tc.empty();
+  for (const auto& shape : reader.GetShapes())
+    for (const auto& idx : shape.mesh.indices)
+      every = every && idx.texcoord_index >= 0 && 2 * static_cast<std::size_t>(idx.texcoord_index) + 1 < tc.size();
+  if (every) {
+    std::map<std::pair<int, int>, unsigned> split;
+    std::vector<vec3> positions;
+    std::vector<glm::vec2> uvs;
+    std::vector<glm::uvec3> triangles;
+    for (const auto& shape : reader.GetShapes())
+      for (std::size_t i = 0; i + 2 < shape.mesh.indices.size(); i += 3) {
+        unsigned corner[3];
+        for (std::size_t k = 0; k < 3; ++k) {
+          const tinyobj::index_t& idx = shape.mesh.indices[i + k];
+          const auto [it, fresh] = split.emplace(std::make_pair(idx.vertex_index, idx.texcoord_index), static_cast<unsigned>(positions.size()));
+          if (fresh) {
+            positions.push_back(mesh.positions[static_cast<std::size_t>(idx.vertex_index)]);
+            const std::size_t t = 2 * static_cast<std::size_t>(idx.texcoord_index);
+            uvs.emplace_back(tc[t], tc[t + 1]);
+          }
+          corner[k] = it->second;
+        }
+        triangles.emplace_back(corner[0], corner[1], corner[2]);
+      }
+    if (positions.size() > mesh.positions.size()) {
+      *elements += positions.size() - mesh.positions.size();
+      if (auto e = check_mesh_elements(*elements, options, excerpt(path, kMaxPathBytes))) return *e;
+    }
+    mesh.positions = std::move(positions);
+    mesh.uvs = std::move(uvs);
+    mesh.triangles = std::move(triangles);
+  }
   return mesh;
 }
 

@@ -175,6 +175,24 @@ TEST(ImportTexturesJson, TextureObjectsForColours) {
   EXPECT_EQ(eval_texture(s, c.texture, {1.5f, 0.5f}), vec3(0, 0, 0.5f));
 }
 
+// OBJ texture coordinates: vertices split per (position, uv) pair, so one position with two uvs
+// becomes two vertices.
+TEST(ImportTexturesObj, VtCoordinatesSplitVertices) {
+  const std::string path = write("uv.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0.5\n"
+                                           "f 1/1 2/2 3/3\nf 1/5 3/3 4/4\n");
+  std::size_t elements = 0;
+  Result<MeshShape> m = load_obj_mesh(path, {}, &elements);
+  ASSERT_TRUE(m.ok()) << m.error().render();
+  EXPECT_EQ(m->positions, (std::vector<vec3>{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 0, 0}, {0, 1, 0}}));
+  EXPECT_EQ(m->uvs, (std::vector<vec2>{{0, 0}, {1, 0}, {1, 1}, {0.5f, 0.5f}, {0, 1}}));
+  EXPECT_EQ(m->triangles, (std::vector<glm::uvec3>{{0, 1, 2}, {3, 2, 4}}));
+  // Without a uv at every corner, none is kept.
+  Result<MeshShape> partial = load_obj_mesh(write("part.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2 3\n"));
+  ASSERT_TRUE(partial.ok());
+  EXPECT_TRUE(partial->uvs.empty());
+  EXPECT_EQ(partial->positions.size(), 3u);
+}
+
 struct Refusal {
   const char* file;
   std::string text;
