@@ -366,10 +366,69 @@ MeshShape tube_mesh(float radius, float z0, float z1) {
 
 // --- the builder ---
 
-int SceneBuilder::add_material(std::string name, Material m) {
+int SceneBuilder::add_material(std::string name, Material m, MaterialTextures textures) {
   scene_.material_names.push_back(std::move(name));
   scene_.materials.push_back(std::move(m));
+  if (!textures.empty() || !scene_.material_textures.empty()) scene_.material_textures.resize(scene_.materials.size());
+  if (!textures.empty()) scene_.material_textures.back() = std::move(textures);
   return static_cast<int>(scene_.materials.size()) - 1;
+}
+
+int SceneBuilder::add_texture(const Texture& t) {
+  scene_.textures.push_back(t);
+  return static_cast<int>(scene_.textures.size()) - 1;
+}
+
+Result<int> SceneBuilder::add_image(const std::string& path, ImageReadOptions options, const Location& at) {
+  const auto key = std::make_tuple(path, static_cast<int>(options.encoding), options.encoding == ImageEncoding::kGamma ? options.gamma : 0.0f);
+  if (auto it = images_.find(key); it != images_.end()) return it->second;
+  options.texels_so_far = &texels_;
+  Result<LinearImage> image = read_image(path, options);
+  if (!image) {
+    Error e = located(at, "image \"" + path + "\" " + image.error().message);
+    e.code = image.error().code;
+    return e;
+  }
+  scene_.images.push_back(std::move(*image));
+  const int index = static_cast<int>(scene_.images.size()) - 1;
+  images_[key] = index;
+  return index;
+}
+
+std::pair<Material, MaterialTextures> blend_textured(const Material& a, const MaterialTextures& ta, const Material& b,
+                                                     const MaterialTextures& tb, float w, int amount) {
+  if (ta.empty() && tb.empty() && amount < 0) return {blend(a, b, w), {}};
+  // No merging of equal components here: a texture binds one component by its index.
+  Mixture mix;
+  MaterialTextures out;
+  out.amount = amount;
+  auto add = [&](const Material& m, const MaterialTextures& t, bool second) {
+    const int offset = static_cast<int>(mix.components.size());
+    auto push = [&](float weight, const BasicMaterial& basic) {
+      const float w0 = second ? 0.0f : weight, w1 = second ? weight : 0.0f;
+      out.weight0.push_back(w0);
+      out.weight1.push_back(w1);
+      mix.components.push_back({amount >= 0 ? 0.5f * (w0 + w1) : (second ? w : 1.0f - w) * weight, basic});
+    };
+    if (const auto* inner = std::get_if<Mixture>(&m)) {
+      for (const Mixture::Component& c : inner->components) push(c.weight, c.material);
+    } else {
+      std::visit([&](const auto& k) {
+        if constexpr (!std::is_same_v<std::decay_t<decltype(k)>, Mixture>) push(1.0f, BasicMaterial{k});
+      }, m);
+    }
+    for (TextureBinding binding : t.bindings) {
+      binding.component = offset + std::max(binding.component, 0);
+      out.bindings.push_back(binding);
+    }
+  };
+  add(a, ta, false);
+  add(b, tb, true);
+  if (amount < 0) {
+    out.weight0.clear();
+    out.weight1.clear();
+  }
+  return {Material{std::move(mix)}, std::move(out)};
 }
 
 void SceneBuilder::add_distant(glm::vec3 direction, glm::vec3 irradiance) {

@@ -16,7 +16,9 @@
 // - The scene rules of scene.h (a shape, a light, a camera that sees a shape), reported at the file.
 #pragma once
 
+#include <map>
 #include <optional>
+#include <tuple>
 #include <string>
 #include <utility>
 #include <vector>
@@ -157,7 +159,14 @@ bool is_similarity(const glm::mat4& m, float* scale);
 class SceneBuilder {
  public:
   // Materials are referenced by index in Shape::material.
-  int add_material(std::string name, Material m);
+  int add_material(std::string name, Material m, MaterialTextures textures = {});
+  // Textures (scene/texture.h): a node, returning its index in Scene::textures; an image file
+  // (resolved) read through io/image_read.h with `options` (the builder counts the scene's
+  // texels), once per scene for each path and decoding; refused at `at` (kBadFile, kLimit).
+  int add_texture(const Texture& t);
+  int constant_texture(glm::vec3 value) { return add_texture(constant(value)); }
+  Result<int> add_image(const std::string& path, ImageReadOptions options, const Location& at);
+  const Texture& texture(int index) const { return scene_.textures[static_cast<std::size_t>(index)]; }
   void add_shape(Shape s) { scene_.shapes.push_back(std::move(s)); }
   void add_light(Light l) { scene_.lights.push_back(std::move(l)); }
   // A uniform infinite light (add_uniform_environment in scene.h, called by finish() once the
@@ -185,9 +194,16 @@ class SceneBuilder {
   std::vector<Distant> distant_;
   std::vector<std::pair<glm::vec3, std::string>> environment_;
   std::optional<std::pair<EnvironmentImage, std::string>> environment_image_;
-  std::size_t texels_ = 0;
+  std::size_t texels_ = 0;  // of every image the scene reads: textures (add_image) and its environment
   glm::vec3 image_right_{1.0f, 0.0f, 0.0f};
   bool has_camera_ = false;
+  std::map<std::tuple<std::string, int, float>, int> images_;  // (path, encoding, gamma) -> Scene::images index
 };
+
+// A mix of two materials, each with its textured parameters (blend() when none has any):
+// (1 − w) a + w b, or with `amount` >= 0 a float texture's lerp (MaterialTextures::amount). A mix
+// of a part that is itself a mix by a texture is refused by the callers.
+std::pair<Material, MaterialTextures> blend_textured(const Material& a, const MaterialTextures& ta, const Material& b,
+                                                     const MaterialTextures& tb, float w, int amount);
 
 }  // namespace pathex::import

@@ -273,6 +273,16 @@ class Importer {
  private:
   friend class Props;
   bool is_area_emitter(const std::string& id) const { return area_emitters_.count(id) != 0; }
+  bool is_texture(const std::string& id) const {
+    auto it = ids_.find(id);
+    return it != ids_.end() && std::string(it->second.name()) == "texture";
+  }
+  // What make_bsdf() found textured beside the Material it returns, and a mask's opacity texture
+  // (-1: none), for the shape (docs/textures.md); the same for each top-level <bsdf id>.
+  MaterialTextures material_textures_;
+  int mask_alpha_ = -1;
+  std::map<std::string, std::pair<MaterialTextures, int>> bsdf_textures_;
+  std::map<std::pair<std::string, bool>, int> texture_ids_;  // (top-level <texture id>, as a float) -> Scene::textures
   std::string main_;
   SceneLoadOptions options_;
   import::SceneFiles files_;
@@ -409,6 +419,11 @@ class Importer {
       defining_.clear();
       if (!m) return m.error();
       bsdf_materials_.emplace(id, std::move(*m));
+      bsdf_textures_[id] = {std::move(material_textures_), mask_alpha_};
+      return std::nullopt;
+    }
+    if (tag == "texture") {  // made where it is used (as a colour or a float)
+      if (n.attribute("id").value() == std::string()) return located(where(n), "a top-level <texture> needs an id");
       return std::nullopt;
     }
     if (tag == "shape") return shape(n);
@@ -465,13 +480,24 @@ class Importer {
         return located(where(n), "<ref id=\"" + excerpt(id) + "\"> inside the bsdf it names: a bsdf cannot contain itself");
       auto it = bsdf_materials_.find(id);
       if (it == bsdf_materials_.end()) return located(where(n), "unknown bsdf id \"" + excerpt(id) + "\"");
+      std::tie(material_textures_, mask_alpha_) = bsdf_textures_[id];
       return it->second;
     }
     MI_TRY(type, attr(n, "type"));
     Props p(this, n, "<bsdf type=\"" + excerpt(type) + "\">");
     p.ignore({"id"});
     Material m;
-    if (type == "twosided") {
+    material_textures_ = {};
+    mask_alpha_ = -1;
+    if (type == "mask") {  // an opacity cut-out over a nested bsdf: the shape's alpha (docs/textures.md)
+      const std::vector<pugi::xml_node> inner = p.nested("bsdf");
+      if (inner.size() != 1) return located(where(n), "mask with " + std::to_string(inner.size()) + " nested BSDFs is not supported, expected one");
+      MI_TRY(alpha, operand(p, "opacity", vec3(0.5f), true));
+      MI_TRY(x, bsdf(inner[0], depth + 1));
+      if (mask_alpha_ >= 0) return located(where(n), "a mask inside a mask is not supported");
+      mask_alpha_ = alpha;
+      m = x;
+    } else if (type == "twosided") {
       // pathex's reflective materials are two-sided already.
       const std::vector<pugi::xml_node> inner = p.nested("bsdf");
       if (inner.size() != 1) return located(where(n), "twosided with " + std::to_string(inner.size()) + " nested BSDFs is not supported, expected one");
@@ -480,7 +506,7 @@ class Importer {
         return located(where(n), "a twosided dielectric is not supported");
       m = x;
     } else if (type == "diffuse") {
-      MI_TRY(r, p.color("reflectance", vec3(0.5f)));
+      MI_TRY(r, spectrum(p, "reflectance", vec3(0.5f), TexturedParam::kReflectance));
       if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
         return located(where(n), "diffuse reflectance must be within [0, 1]");
       m = Diffuse{r};
@@ -564,16 +590,31 @@ class Importer {
       c.reflectance = nonlinear ? rho : rho / (1.0f - r_bar + rho * r_bar);
       m = c;
     } else if (type == "blendbsdf") {
-      MI_TRY(w, p.number("weight", 0.5));
+      int weight_texture = -1;
+      if (pugi::xml_node wn = p.find("weight"); wn && (std::string(wn.name()) == "texture" || std::string(wn.name()) == "ref")) {
+        MI_TRY(index, operand(p, "weight", vec3(0.5f), true));
+        weight_texture = index;
+      }
+      MI_TRY(w, weight_texture >= 0 ? Result<double>(0.5) : p.number("weight", 0.5));
       if (w < 0 || w > 1) return located(where(n), "weight must be within [0, 1]");
       const std::vector<pugi::xml_node> inner = p.nested("bsdf");
       if (inner.size() != 2) return located(where(n), "blendbsdf needs two nested BSDFs, found " + std::to_string(inner.size()));
-      MI_TRY(a, bsdf(inner[0], depth + 1));
-      MI_TRY(b, bsdf(inner[1], depth + 1));
-      m = import::blend(a, b, static_cast<float>(w));
+      MaterialTextures parts[2];
+      Material a, b;
+      for (int i = 0; i < 2; ++i) {
+        MI_TRY(x, bsdf(inner[static_cast<std::size_t>(i)], depth + 1));
+        (i == 0 ? a : b) = x;
+        if (mask_alpha_ >= 0) return located(where(inner[static_cast<std::size_t>(i)]), "a mask inside a blendbsdf is not supported");
+        if (material_textures_.amount >= 0)
+          return located(where(inner[static_cast<std::size_t>(i)]), "a blendbsdf inside a blendbsdf whose weight is a texture is not supported");
+        parts[i] = std::move(material_textures_);
+      }
+      auto [mixed, textures] = import::blend_textured(a, parts[0], b, parts[1], static_cast<float>(w), weight_texture);
+      m = std::move(mixed);
+      material_textures_ = std::move(textures);
     } else {
       return located(where(n), "bsdf \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, roughconductor, dielectric, "
-                               "roughdielectric, thindielectric, plastic, roughplastic, blendbsdf or twosided");
+                               "roughdielectric, thindielectric, plastic, roughplastic, blendbsdf, mask or twosided");
     }
     if (auto e = p.unused()) return *e;
     return m;
@@ -602,7 +643,84 @@ class Importer {
                              dist == "ggx" ? MicrofacetKind::kGgx : MicrofacetKind::kBeckmann};
   }
 
-  Result<int> material_of(Props& p, pugi::xml_node shape_node) {
+  // A texture operand `name` of a bsdf or texture: a nested <texture>, a <ref> to a top-level one,
+  // or a value (<rgb>, <float>, <spectrum>) made a constant texture; absent: `fallback`.
+  Result<int> operand(Props& p, const std::string& name, vec3 fallback, bool is_float) {
+    pugi::xml_node t = p.find(name);
+    if (t && std::string(t.name()) == "ref" && is_texture(t.attribute("id").value())) {
+      const std::string id = t.attribute("id").value();
+      if (auto it = texture_ids_.find({id, is_float}); it != texture_ids_.end()) return it->second;
+      MI_TRY(index, texture(ids_.at(id), is_float));
+      return texture_ids_[{id, is_float}] = index;
+    }
+    if (t && std::string(t.name()) == "texture") return texture(t, is_float);
+    if (is_float) {
+      MI_TRY(x, p.number(name, fallback.x));
+      return builder_.constant_texture(vec3(static_cast<float>(x)));
+    }
+    MI_TRY(v, p.color(name, fallback));
+    return builder_.constant_texture(v);
+  }
+
+  // A bsdf's colour that may be a texture: its value, or for a texture a placeholder `fallback`
+  // and a binding in material_textures_.
+  Result<vec3> spectrum(Props& p, const std::string& name, vec3 fallback, TexturedParam param) {
+    pugi::xml_node t = p.find(name);
+    if (!t || !(std::string(t.name()) == "texture" || (std::string(t.name()) == "ref" && is_texture(t.attribute("id").value()))))
+      return p.color(name, fallback);
+    MI_TRY(index, operand(p, name, fallback, false));
+    material_textures_.bindings.push_back(TextureBinding{-1, param, index, 1.0f});
+    return fallback;
+  }
+
+  // Mitsuba 3's bitmap and checkerboard textures (docs/textures.md).
+  Result<int> texture(pugi::xml_node n, bool is_float) {
+    MI_TRY(type, attr(n, "type"));
+    Props p(this, n, "<texture type=\"" + excerpt(type) + "\">");
+    p.ignore({"id", "name"});
+    Texture t;
+    if (type != "bitmap" && type != "checkerboard")
+      return located(where(n), "texture \"" + excerpt(type) + "\" is not supported, expected bitmap or checkerboard");
+    MI_TRY(to_uv, p.transform("to_uv"));  // 2D affine: the x and y rows of the 4 x 4, translation from its last column
+    t.uv = UvTransform{{to_uv[0][0], to_uv[1][0], to_uv[3][0], to_uv[0][1], to_uv[1][1], to_uv[3][1]}};
+    if (type == "bitmap") {
+      MI_TRY(file, p.string("filename", ""));
+      if (file.empty()) return located(where(n), "bitmap needs a <string name=\"filename\">");
+      MI_TRY(raw, p.boolean("raw", false));
+      ImageReadOptions options;
+      options.encoding = raw ? ImageEncoding::kLinear : ImageEncoding::kSrgb;
+      options.max_file_bytes = options_.max_file_bytes;
+      options.max_texels = options_.max_texels;
+      // Every filter is the bilinear lookup: what a converged pixel averages anyway.
+      MI_TRY(filter, p.string("filter_type", "bilinear"));
+      if (filter != "bilinear" && filter != "nearest")
+        return located(where(p.find("filter_type")), "filter_type \"" + excerpt(filter) + "\" is not supported, expected bilinear or nearest");
+      MI_TRY(wrap, p.string("wrap_mode", "repeat"));
+      if (wrap == "repeat") t.wrap = TextureWrap::kRepeat;
+      else if (wrap == "clamp") t.wrap = TextureWrap::kClamp;
+      else return located(where(p.find("wrap_mode")), "wrap_mode \"" + excerpt(wrap) + "\" is not supported, expected repeat or clamp");
+      p.ignore({"format"});
+      MI_TRY(image, builder_.add_image(files_.resolve(file), options, where(p.find("filename"))));
+      t.kind = TextureKind::kImage;
+      t.image = image;
+      t.channel = is_float ? FloatChannel::kLuminance : FloatChannel::kNone;
+    } else {
+      // Mitsuba's cells are halves of the unit square: color0 where the fractional parts of (s, t)
+      // are on the same side of ½, i.e. ⌊2s⌋ + ⌊2t⌋ even.
+      for (float& x : t.uv.m) x *= 2.0f;
+      MI_TRY(a, operand(p, "color0", vec3(0.4f), is_float));
+      MI_TRY(b, operand(p, "color1", vec3(0.2f), is_float));
+      t.kind = TextureKind::kCheckerboard;
+      t.a = a;
+      t.b = b;
+    }
+    if (auto e = p.unused()) return *e;
+    return builder_.add_texture(t);
+  }
+
+  // The shape's material; `*alpha`: its mask's opacity texture, -1 for none.
+  Result<int> material_of(Props& p, pugi::xml_node shape_node, int* alpha) {
+    *alpha = -1;
     const std::vector<pugi::xml_node> b = p.nested("bsdf");
     if (b.size() > 1) return located(where(shape_node), "a shape with more than one BSDF");
     if (b.empty()) {
@@ -611,12 +729,14 @@ class Importer {
     }
     if (std::string(b[0].name()) == "ref") {
       MI_TRY(id, attr(b[0], "id"));
-      if (auto it = bsdf_index_.find(id); it != bsdf_index_.end()) return it->second;
       MI_TRY(m, bsdf(b[0], 1));
-      return bsdf_index_[id] = builder_.add_material(id, m);
+      *alpha = mask_alpha_;
+      if (auto it = bsdf_index_.find(id); it != bsdf_index_.end()) return it->second;
+      return bsdf_index_[id] = builder_.add_material(id, m, std::move(material_textures_));
     }
     MI_TRY(m, bsdf(b[0], 1));
-    return builder_.add_material(where(b[0]).str(), m);
+    *alpha = mask_alpha_;
+    return builder_.add_material(where(b[0]).str(), m, std::move(material_textures_));
   }
 
   // --- shapes ---
@@ -626,7 +746,7 @@ class Importer {
     p.ignore({"id"});
     Shape s;
     s.pointer = where(n).str();
-    MI_TRY(mat, material_of(p, n));
+    MI_TRY(mat, material_of(p, n, &s.alpha));
     s.material = mat;
     std::vector<pugi::xml_node> emitters = p.nested("emitter");
     if (emitters.size() > 1) return located(where(n), "a shape with more than one emitter");
@@ -705,6 +825,10 @@ class Importer {
         if (auto e = check_mesh_elements(mesh_elements_, options_, where(n).str())) return e;
       }
       mesh.file = file;
+      // Mitsuba's OBJ and PLY loaders flip v (flip_tex_coords, default true): its bitmaps look v up from the top row.
+      MI_TRY(flip_uv, p.boolean("flip_tex_coords", true));
+      if (flip_uv)
+        for (glm::vec2& uv : mesh.uvs) uv.y = 1.0f - uv.y;
       // Smooth unless face_normals: the file's normals, or (none, or an OBJ's, which pathex does not
       // read) Mitsuba's own angle-weighted ones, computed in world space as Mitsuba does.
       const bool compute = !face_normals && (type == "obj" || mesh.normals.empty());
@@ -756,6 +880,7 @@ class Importer {
       return located(where(n), "shape \"" + excerpt(type) + "\" is not supported, expected obj, ply, serialized, sphere, rectangle, disk, cube or cylinder");
     }
     if (auto e = p.unused()) return e;
+    if (s.alpha >= 0 && s.emissive()) return located(where(n), "a mask (an opacity cut-out) on an area light is not supported");
     builder_.add_shape(std::move(s));
     return std::nullopt;
   }
@@ -981,7 +1106,8 @@ std::vector<pugi::xml_node> Props::nested(const std::string& tag) {
   for (Child& c : children_) {
     const bool ref = std::string(c.node.name()) == "ref";
     const bool emitter_ref = ref && im_->is_area_emitter(c.node.attribute("id").value());
-    if (c.node.name() == tag || (ref && tag == "bsdf" && !emitter_ref) || (emitter_ref && tag == "emitter")) {
+    const bool texture_ref = ref && im_->is_texture(c.node.attribute("id").value());
+    if (c.node.name() == tag || (ref && tag == "bsdf" && !emitter_ref && !texture_ref) || (emitter_ref && tag == "emitter")) {
       c.used = true;
       out.push_back(c.node);
     }
@@ -993,7 +1119,9 @@ Result<vec3> Props::color(const std::string& name, vec3 fallback) {
   pugi::xml_node n = find(name);
   if (!n) return fallback;
   const std::string tag = n.name();
-  if (tag == "texture") return located(im_->where(n), "textures are not supported ('" + name + "'), give an <rgb>");
+  if (tag == "texture" || (tag == "ref" && im_->is_texture(n.attribute("id").value())))
+    return located(im_->where(n), "a texture for '" + name + "' is not supported here (pathex reads textures for reflectances, a blendbsdf's "
+                                  "weight and a mask's opacity), give an <rgb>");
   if (tag != "rgb" && tag != "float" && tag != "spectrum") return located(im_->where(n), "'" + name + "' must be an <rgb>");
   // An emitter's spectrum is light, every other one a reflectance (Mitsuba's Properties::get_texture).
   const bool emission = what_.rfind("<emitter", 0) == 0;

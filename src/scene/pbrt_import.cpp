@@ -164,6 +164,9 @@ class Params {
   Result<double> number(const std::string& name, double fallback, std::initializer_list<const char*> types = {"float"}) {
     Param* p = find(name);
     if (!p) return fallback;
+    if (p->type == "texture")
+      return located(p->at, "a texture for parameter '" + name + "' is not supported (pathex reads textures for reflectance, "
+                            "transmittance, a mix's amount and a shape's alpha), give \"float " + name + "\" value");
     bool ok = false;
     for (const char* t : types) ok = ok || p->type == t;
     if (!ok || p->numbers.size() != 1) return located(p->at, "parameter '" + name + "' expects one " + *types.begin() + " value");
@@ -212,7 +215,9 @@ class Params {
     if (allow_float && p->type == "float" && p->numbers.size() == 1) return vec3(static_cast<float>(p->numbers[0]));
     if (p->type == "spectrum" || p->type == "blackbody")
       return located(p->at, "parameter \"" + p->type + " " + name + "\" is not supported: pathex renders in RGB, give \"rgb " + name + "\" [r g b]");
-    if (p->type == "texture") return located(p->at, "textures are not supported (parameter \"texture " + name + "\"), give \"rgb " + name + "\" [r g b]");
+    if (p->type == "texture")
+      return located(p->at, "a texture for parameter \"" + name + "\" is not supported here (pathex reads textures for reflectance, "
+                            "transmittance, a mix's amount and a shape's alpha), give \"rgb " + name + "\" [r g b]");
     return located(p->at, "parameter '" + name + "' expects \"rgb " + name + "\" [r g b]");
   }
   // Triples of a point3 (`kind` "point") or normal3 (`kind` "normal") parameter; pbrt-v4 also takes the type without the 3.
@@ -295,6 +300,14 @@ class Importer {
   bool in_world_ = false;
   std::map<std::string, glm::mat4> coordinate_systems_;
   std::map<std::string, Material> named_materials_;
+  std::map<std::string, MaterialTextures> named_material_textures_;  // of the named materials that have any
+  // What material() found textured, beside the Material it returns (docs/textures.md).
+  MaterialTextures material_textures_;
+  struct NamedTexture {
+    int index;
+    bool is_float;
+  };
+  std::map<std::string, NamedTexture> named_textures_;
   std::set<std::string> interface_names_;  // named materials of type "interface"
   std::map<std::string, vec3> media_;       // MakeNamedMedium: σa × scale of each absorbing medium
   std::map<std::string, int> named_material_index_;
@@ -570,6 +583,19 @@ class Importer {
       media_[medium] = absorption;
       return std::nullopt;
     }
+    if (name == "Texture") {  // Texture "name" "spectrum" | "float" "class" parameters (docs/textures.md)
+      PBRT_TRY(tname, quoted(s, at, name));
+      PBRT_TRY(ttype, quoted(s, at, name));
+      PBRT_TRY(tclass, quoted(s, at, name));
+      PBRT_TRY(ps, params(s));
+      if (!in_world_) return located(at, "Texture must come after WorldBegin");
+      if (ttype != "spectrum" && ttype != "float")
+        return located(at, "texture type \"" + excerpt(ttype) + "\" is not supported, expected \"spectrum\" or \"float\"");
+      PBRT_TRY(index, texture(tclass, ttype == "float", ps, at));
+      if (auto e = ps.unused("Texture \"" + excerpt(tname) + "\"")) return e;
+      named_textures_[tname] = NamedTexture{index, ttype == "float"};
+      return std::nullopt;
+    }
     // --- directives with a type and parameters ---
     static const char* const kTyped[] = {"Camera", "Film", "Sampler", "Integrator", "PixelFilter", "Accelerator", "Shape",
                                          "LightSource", "AreaLightSource", "Material", "MakeNamedMaterial", "NamedMaterial"};
@@ -623,6 +649,7 @@ class Importer {
       interface_names_.erase(type);
       if (mtype == "interface") {
         named_materials_.erase(type);
+        named_material_textures_.erase(type);
         named_material_index_.erase(type);
         interface_names_.insert(type);
         return ps.unused("material \"interface\"");
@@ -631,6 +658,7 @@ class Importer {
       if (auto e = ps.unused("material \"" + excerpt(mtype) + "\"")) return e;
       if (auto e = materials_budget_.charge(m, at)) return e;
       named_materials_[type] = m;
+      named_material_textures_[type] = std::move(material_textures_);
       named_material_index_.erase(type);
       return std::nullopt;
     }
@@ -651,7 +679,7 @@ class Importer {
       PBRT_TRY(m, material(type, ps, at));
       if (auto e = ps.unused(what)) return e;
       if (auto e = materials_budget_.charge(m, at)) return e;
-      gs_.material = builder_.add_material(at.str(), m);
+      gs_.material = builder_.add_material(at.str(), m, std::move(material_textures_));
       return std::nullopt;
     }
     if (name == "AreaLightSource") {
@@ -679,7 +707,8 @@ class Importer {
     if (auto it = named_material_index_.find(n); it != named_material_index_.end()) return it->second;
     auto it = named_materials_.find(n);
     if (it == named_materials_.end()) return located(at, "unknown named material \"" + excerpt(n) + "\"");
-    const int index = builder_.add_material(n, it->second);
+    auto t = named_material_textures_.find(n);
+    const int index = builder_.add_material(n, it->second, t == named_material_textures_.end() ? MaterialTextures{} : t->second);
     named_material_index_[n] = index;
     return index;
   }
@@ -739,9 +768,135 @@ class Importer {
     return vec3(v[0], v[1], v[2]);
   }
 
+  // A texture operand `name` of a texture or material: "texture name" "tex" (a named texture of
+  // the same kind, float or spectrum), or a value ("float", or "rgb" for a spectrum texture)
+  // made a constant texture; absent: `fallback`.
+  Result<int> operand(Params& ps, const std::string& name, vec3 fallback, bool is_float) {
+    Param* p = ps.find(name);
+    if (p && p->type == "texture") {
+      if (p->strings.size() != 1) return located(p->at, "parameter '" + name + "' expects one texture name");
+      auto it = named_textures_.find(p->strings[0]);
+      if (it == named_textures_.end()) return located(p->at, "unknown texture \"" + excerpt(p->strings[0]) + "\"");
+      if (it->second.is_float != is_float)
+        return located(p->at, "texture \"" + excerpt(p->strings[0]) + "\" is a " + (it->second.is_float ? "float" : "spectrum") + " texture, parameter '" +
+                                  name + "' expects a " + (is_float ? "float" : "spectrum") + " one");
+      return it->second.index;
+    }
+    if (is_float) {
+      PBRT_TRY(x, ps.number(name, fallback.x));
+      return builder_.constant_texture(vec3(static_cast<float>(x)));
+    }
+    PBRT_TRY(v, ps.rgb(name, fallback, true));
+    return builder_.constant_texture(v);
+  }
+
+  // A material's RGB parameter that may be a texture: its value, or for "texture name" a
+  // placeholder `fallback` and a binding in material_textures_ (`scale`: what the value is multiplied by).
+  Result<vec3> spectrum(Params& ps, const std::string& name, vec3 fallback, TexturedParam param, float scale = 1.0f) {
+    Param* p = ps.find(name);
+    if (!p || p->type != "texture") return ps.rgb(name, fallback, true);
+    PBRT_TRY(index, operand(ps, name, fallback, false));
+    material_textures_.bindings.push_back(TextureBinding{-1, param, index, scale});
+    return fallback;
+  }
+
+  // pbrt-v4's textures that pathex reads (docs/textures.md): imagemap, checkerboard (2D), scale,
+  // mix, constant, all with the "uv" mapping.
+  Result<int> texture(const std::string& cls, bool is_float, Params& ps, const Location& at) {
+    const vec3 one(1.0f), zero(0.0f);
+    Texture t;
+    if (cls == "imagemap" || cls == "checkerboard") {
+      PBRT_TRY(mapping, ps.string("mapping", "uv"));
+      if (mapping != "uv")
+        return located(ps.find("mapping")->at, "texture mapping \"" + excerpt(mapping) + "\" is not supported: pathex's textures use the "
+                                                 "surface's (u, v) (mapping \"uv\")");
+      PBRT_TRY(su, ps.number("uscale", 1.0));
+      PBRT_TRY(sv, ps.number("vscale", 1.0));
+      PBRT_TRY(du, ps.number("udelta", 0.0));
+      PBRT_TRY(dv, ps.number("vdelta", 0.0));
+      t.uv = UvTransform{{static_cast<float>(su), 0.0f, static_cast<float>(du), 0.0f, static_cast<float>(sv), static_cast<float>(dv)}};
+    }
+    if (cls == "imagemap") {
+      PBRT_TRY(file, ps.string("filename", ""));
+      if (file.empty()) return located(at, "imagemap needs a \"string filename\"");
+      PBRT_TRY(encoding, ps.string("encoding", "sRGB"));
+      ImageReadOptions options;
+      options.max_file_bytes = options_.max_file_bytes;
+      options.max_texels = options_.max_texels;
+      if (encoding == "sRGB") {
+        options.encoding = ImageEncoding::kSrgb;
+      } else if (encoding == "linear") {
+        options.encoding = ImageEncoding::kLinear;
+      } else {
+        double g = 0.0;
+        if (encoding.rfind("gamma ", 0) != 0 || !parse_number(encoding.substr(6), &g) || !(g > 0.0 && g <= 10.0))
+          return located(ps.find("encoding")->at, "imagemap encoding \"" + excerpt(encoding) + "\" is not supported, expected \"sRGB\", "
+                                                    "\"linear\" or \"gamma g\" with g in (0, 10]");
+        options.encoding = ImageEncoding::kGamma;
+        options.gamma = static_cast<float>(g);
+      }
+      // Every filter is the bilinear lookup (no mip-mapping): what a converged pixel averages anyway.
+      PBRT_TRY(filter, ps.string("filter", "bilinear"));
+      if (filter != "bilinear" && filter != "point" && filter != "trilinear" && filter != "ewa" && filter != "EWA")
+        return located(ps.find("filter")->at, "imagemap filter \"" + excerpt(filter) + "\" is not supported, expected bilinear, point, trilinear or ewa");
+      PBRT_TRY(wrap, ps.string("wrap", "repeat"));
+      if (wrap == "repeat") t.wrap = TextureWrap::kRepeat;
+      else if (wrap == "clamp") t.wrap = TextureWrap::kClamp;
+      else if (wrap == "black") t.wrap = TextureWrap::kBlack;
+      else return located(ps.find("wrap")->at, "imagemap wrap \"" + excerpt(wrap) + "\" is not supported, expected repeat, clamp or black");
+      PBRT_TRY(scale, ps.number("scale", 1.0));
+      PBRT_TRY(invert, ps.boolean("invert", false));
+      ps.ignore({"maxanisotropy"});
+      PBRT_TRY(image, builder_.add_image(files_.resolve(file), options, ps.find("filename")->at));
+      t.kind = TextureKind::kImage;
+      t.image = image;
+      t.flip_t = true;  // pbrt-v4 looks up t = 1 − v
+      t.channel = is_float ? FloatChannel::kPbrt : FloatChannel::kNone;
+      t.scale = static_cast<float>(scale);
+      t.invert = invert;
+      return builder_.add_texture(t);
+    }
+    if (cls == "checkerboard") {
+      PBRT_TRY(dimension, ps.integer("dimension", 2));
+      if (dimension != 2)
+        return located(ps.find("dimension")->at, "checkerboard dimension " + std::to_string(dimension) + " is not supported: pathex's "
+                                                   "textures use the surface's (u, v) (dimension 2)");
+      PBRT_TRY(a, operand(ps, "tex1", one, is_float));
+      PBRT_TRY(b, operand(ps, "tex2", zero, is_float));
+      t.kind = TextureKind::kCheckerboard;
+      t.a = a;
+      t.b = b;
+      return builder_.add_texture(t);
+    }
+    if (cls == "scale") {
+      PBRT_TRY(a, operand(ps, "tex", one, is_float));
+      PBRT_TRY(b, operand(ps, "scale", one, true));
+      t.kind = TextureKind::kScale;
+      t.a = a;
+      t.b = b;
+      return builder_.add_texture(t);
+    }
+    if (cls == "mix") {
+      PBRT_TRY(a, operand(ps, "tex1", zero, is_float));
+      PBRT_TRY(b, operand(ps, "tex2", one, is_float));
+      PBRT_TRY(amount, operand(ps, "amount", vec3(0.5f), true));
+      t.kind = TextureKind::kMix;
+      t.a = a;
+      t.b = b;
+      t.amount = amount;
+      return builder_.add_texture(t);
+    }
+    if (cls == "constant") {
+      PBRT_TRY(v, operand(ps, "value", one, is_float));
+      return v;
+    }
+    return located(at, "texture \"" + excerpt(cls) + "\" is not supported, expected imagemap, checkerboard, scale, mix or constant");
+  }
+
   Result<Material> material(const std::string& type, Params& ps, const Location& at) {
+    material_textures_ = {};
     if (type == "diffuse") {
-      PBRT_TRY(r, ps.rgb("reflectance", vec3(0.5f), true));
+      PBRT_TRY(r, spectrum(ps, "reflectance", vec3(0.5f), TexturedParam::kReflectance));
       if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
         return located(at, "diffuse reflectance must be within [0, 1]");
       return Material{Diffuse{r}};
@@ -782,9 +937,9 @@ class Importer {
       return Material{Dielectric{static_cast<float>(eta), vec3(1.0f)}};
     }
     if (type == "diffusetransmission") {  // letters: D
-      PBRT_TRY(r, ps.rgb("reflectance", vec3(0.25f), true));
-      PBRT_TRY(t, ps.rgb("transmittance", vec3(0.25f), true));
       PBRT_TRY(scale, ps.number("scale", 1.0));
+      PBRT_TRY(r, spectrum(ps, "reflectance", vec3(0.25f), TexturedParam::kReflectance, static_cast<float>(scale)));
+      PBRT_TRY(t, spectrum(ps, "transmittance", vec3(0.25f), TexturedParam::kTransmittance, static_cast<float>(scale)));
       // pbrt-v4 clamps each of scale · reflectance and scale · transmittance to [0, 1].
       const vec3 rs = glm::clamp(r * static_cast<float>(scale), vec3(0.0f), vec3(1.0f));
       const vec3 ts = glm::clamp(t * static_cast<float>(scale), vec3(0.0f), vec3(1.0f));
@@ -801,7 +956,7 @@ class Importer {
                          "does not have");
     if (type == "coateddiffuse") {  // pbrt-v4's layered model (trace/bsdf_layered.h), its defaults
       CoatedDiffuse c;
-      PBRT_TRY(r, ps.rgb("reflectance", vec3(0.5f), true));
+      PBRT_TRY(r, spectrum(ps, "reflectance", vec3(0.5f), TexturedParam::kReflectance));
       if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
         return located(ps.find("reflectance")->at, "coateddiffuse reflectance must be within [0, 1]");
       PBRT_TRY(albedo, ps.rgb("albedo", vec3(0.0f), true));
@@ -838,9 +993,15 @@ class Importer {
     if (type == "mix") {
       Param* m = ps.find("materials");
       if (!m || m->type != "string" || m->strings.size() != 2) return located(m ? m->at : at, "mix needs \"string materials\" [\"a\" \"b\"]");
-      PBRT_TRY(amount, ps.number("amount", 0.5));
+      int amount_texture = -1;
+      if (Param* a = ps.find("amount"); a && a->type == "texture") {
+        PBRT_TRY(index, operand(ps, "amount", vec3(0.5f), true));
+        amount_texture = index;
+      }
+      PBRT_TRY(amount, amount_texture >= 0 ? Result<double>(0.5) : ps.number("amount", 0.5));
       if (amount < 0 || amount > 1) return located(at, "mix amount must be within [0, 1]");
       Material parts[2];
+      MaterialTextures part_textures[2];
       for (int i = 0; i < 2; ++i) {
         if (interface_names_.count(m->strings[static_cast<std::size_t>(i)]) != 0)
           return located(m->at, "mix with the interface material \"" + excerpt(m->strings[static_cast<std::size_t>(i)]) +
@@ -848,8 +1009,13 @@ class Importer {
         auto it = named_materials_.find(m->strings[static_cast<std::size_t>(i)]);
         if (it == named_materials_.end()) return located(m->at, "unknown named material \"" + excerpt(m->strings[static_cast<std::size_t>(i)]) + "\"");
         parts[i] = it->second;
+        if (auto t = named_material_textures_.find(it->first); t != named_material_textures_.end()) part_textures[i] = t->second;
+        if (part_textures[i].amount >= 0)
+          return located(m->at, "a mix of \"" + excerpt(it->first) + "\", itself a mix by a texture amount, is not supported");
       }
-      return import::blend(parts[0], parts[1], static_cast<float>(amount));
+      auto [mixed, textures] = import::blend_textured(parts[0], part_textures[0], parts[1], part_textures[1], static_cast<float>(amount), amount_texture);
+      material_textures_ = std::move(textures);
+      return mixed;
     }
     return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, coateddiffuse, conductor, dielectric, "
                        "thindielectric, diffusetransmission, interface or mix");
@@ -956,8 +1122,14 @@ class Importer {
       ps.ignore_all();
       return std::nullopt;
     }
-    if (Param* p = ps.find("alpha")) return located(p->at, "alpha cut-outs are not supported");
     Shape s;
+    if (Param* p = ps.find("alpha")) {  // an alpha cut-out: a float texture or value (docs/textures.md)
+      if (gs_.area) return located(p->at, "an alpha cut-out on an area light is not supported");
+      PBRT_TRY(alpha, operand(ps, "alpha", vec3(1.0f), true));
+      const Texture& t = builder_.texture(alpha);
+      if (t.kind == TextureKind::kConstant && !(t.value.x >= 0.0f && t.value.x <= 1.0f)) return located(p->at, "alpha must be within [0, 1]");
+      if (t.kind != TextureKind::kConstant || t.value.x < 1.0f) s.alpha = alpha;
+    }
     s.pointer = at.str();
     s.material = current_material();
     if (!gs_.interior.empty()) s.absorption = media_.at(gs_.interior);  // defined: checked by MediumInterface

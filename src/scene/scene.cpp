@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -105,14 +106,108 @@ Result<MicrofacetKind> read_distribution(const Reader& r, const json& j, const s
   return r.fail(ptr + "/distribution", "unknown microfacet distribution '" + name + "', expected ggx or beckmann");
 }
 
+// What the JSON reader needs to make textures (scene/texture.h, docs/textures.md): the scene
+// that receives them, where image files are, the images read so far (once per file and
+// encoding), and the bindings of the material being read (`component`: its index in a mixture).
+struct JsonTextures {
+  Scene* scene = nullptr;
+  std::string base_dir;
+  SceneLoadOptions options;
+  std::size_t texels = 0;
+  std::map<std::pair<std::string, int>, int> images;
+  MaterialTextures current;
+  int component = -1;
+};
+
+// A texture object: {"image": "file.png", "encoding": "srgb" | "linear", "wrap": "repeat" |
+// "clamp" | "black", "uv_scale": [su, sv], "uv_offset": [du, dv]} (pbrt-v4's lookup: v runs up the
+// image) or {"checkerboard": [even, odd], "uv_scale", "uv_offset"} (colours in [0, 1]).
+Result<int> read_texture(const Reader& r, const json& j, const std::string& ptr, JsonTextures* tx) {
+  if (auto k = r.keys(j, ptr, {"image", "encoding", "wrap", "uv_scale", "uv_offset", "checkerboard"}); !k) return k.error();
+  Texture t;
+  float m[4] = {1, 1, 0, 0};
+  for (int i = 0; i < 2; ++i) {
+    const char* key = i == 0 ? "uv_scale" : "uv_offset";
+    if (!j.contains(key)) continue;
+    const json& v = j[key];
+    if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number() || !std::isfinite(v[0].get<double>()) ||
+        !std::isfinite(v[1].get<double>()) || std::fabs(v[0].get<double>()) > 1e30 || std::fabs(v[1].get<double>()) > 1e30)
+      return r.fail(ptr + "/" + key, "expected an array of 2 finite numbers");
+    m[2 * i] = v[0].get<float>();
+    m[2 * i + 1] = v[1].get<float>();
+  }
+  t.uv = UvTransform{{m[0], 0.0f, m[2], 0.0f, m[1], m[3]}};
+  if (j.contains("checkerboard") == j.contains("image")) return r.fail(ptr, "expected a texture with either \"image\" or \"checkerboard\"");
+  if (j.contains("checkerboard")) {
+    for (const char* key : {"encoding", "wrap"})
+      if (j.contains(key)) return r.fail(ptr + "/" + key, std::string(key) + " is a key of an image texture, not of a checkerboard");
+    const json& c = j["checkerboard"];
+    if (!c.is_array() || c.size() != 2) return r.fail(ptr + "/checkerboard", "expected [even colour, odd colour]");
+    const json pair = {{"0", c[0]}, {"1", c[1]}};
+    int cells[2];
+    for (int i = 0; i < 2; ++i) {
+      PATHEX_TRY(v, r.vector3(pair, std::to_string(i), ptr + "/checkerboard", true, vec3(0.0f), true));
+      tx->scene->textures.push_back(constant(v));
+      cells[i] = static_cast<int>(tx->scene->textures.size()) - 1;
+    }
+    t.kind = TextureKind::kCheckerboard;
+    t.a = cells[0];
+    t.b = cells[1];
+  } else {
+    PATHEX_TRY(file, r.string(j, "image", ptr));
+    ImageReadOptions o;
+    o.max_file_bytes = tx->options.max_file_bytes;
+    o.max_texels = tx->options.max_texels;
+    o.texels_so_far = &tx->texels;
+    if (j.contains("encoding")) {
+      PATHEX_TRY(e, r.string(j, "encoding", ptr));
+      if (e != "srgb" && e != "linear") return r.fail(ptr + "/encoding", "unknown encoding '" + e + "', expected srgb or linear");
+      o.encoding = e == "srgb" ? ImageEncoding::kSrgb : ImageEncoding::kLinear;
+    }
+    if (j.contains("wrap")) {
+      PATHEX_TRY(w, r.string(j, "wrap", ptr));
+      if (w != "repeat" && w != "clamp" && w != "black") return r.fail(ptr + "/wrap", "unknown wrap '" + w + "', expected repeat, clamp or black");
+      t.wrap = w == "repeat" ? TextureWrap::kRepeat : w == "clamp" ? TextureWrap::kClamp : TextureWrap::kBlack;
+    }
+    const std::string path = (std::filesystem::path(tx->base_dir) / file).string();
+    const auto key = std::make_pair(path, static_cast<int>(o.encoding));
+    auto it = tx->images.find(key);
+    if (it == tx->images.end()) {
+      Result<LinearImage> image = read_image(path, o);
+      if (!image) {
+        Error e = r.fail(ptr + "/image", "image '" + file + "' " + image.error().message);
+        e.code = image.error().code;
+        return e;
+      }
+      tx->scene->images.push_back(std::move(*image));
+      it = tx->images.emplace(key, static_cast<int>(tx->scene->images.size()) - 1).first;
+    }
+    t.kind = TextureKind::kImage;
+    t.image = it->second;
+    t.flip_t = true;
+  }
+  tx->scene->textures.push_back(t);
+  return static_cast<int>(tx->scene->textures.size()) - 1;
+}
+
+// A colour parameter that may be a texture object: its value, or for a texture `fallback` as the
+// material's placeholder and a binding in tx->current.
+Result<vec3> read_colour(const Reader& r, const json& j, const std::string& key, const std::string& ptr, vec3 fallback, TexturedParam param,
+                         JsonTextures* tx) {
+  if (!tx || !j.contains(key) || !j[key].is_object()) return r.vector3(j, key, ptr, false, fallback, true);
+  PATHEX_TRY(index, read_texture(r, j[key], ptr + "/" + key, tx));
+  tx->current.bindings.push_back(TextureBinding{tx->component, param, index, 1.0f});
+  return fallback;
+}
+
 // `component`: inside a mixture, where only basic materials are allowed.
 const std::string kBasicTypes = "diffuse, mirror, dielectric, glossy, conductor, thin_dielectric, diffuse_transmission, coateddiffuse";
 
-Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::string& ptr, bool component) {
+Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::string& ptr, bool component, JsonTextures* tx) {
   PATHEX_TRY(type, r.string(j, "type", ptr));
   if (type == "diffuse") {
     if (auto k = r.keys(j, ptr, {"type", "albedo"}); !k) return k.error();
-    PATHEX_TRY(albedo, r.vector3(j, "albedo", ptr, false, vec3(0.8f), true));
+    PATHEX_TRY(albedo, read_colour(r, j, "albedo", ptr, vec3(0.8f), TexturedParam::kReflectance, tx));
     if (const float hi = max_component(albedo); hi > 1.0f) return r.fail(ptr + "/albedo", "expected values in [0, 1], found " + Reader::fmt(hi));
     return BasicMaterial{Diffuse{albedo}};
   }
@@ -163,8 +258,8 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
   }
   if (type == "diffuse_transmission") {
     if (auto k = r.keys(j, ptr, {"type", "reflectance", "transmittance"}); !k) return k.error();
-    PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(0.25f), true));
-    PATHEX_TRY(trans, r.vector3(j, "transmittance", ptr, false, vec3(0.25f), true));
+    PATHEX_TRY(refl, read_colour(r, j, "reflectance", ptr, vec3(0.25f), TexturedParam::kReflectance, tx));
+    PATHEX_TRY(trans, read_colour(r, j, "transmittance", ptr, vec3(0.25f), TexturedParam::kTransmittance, tx));
     if (const float hi = max_component(refl + trans); hi > 1.0f)
       return r.fail(ptr + "/transmittance", "expected reflectance + transmittance within [0, 1], found " + Reader::fmt(hi));
     return BasicMaterial{DiffuseTransmission{refl, trans}};
@@ -181,7 +276,7 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness", "distribution", "eta", "thickness", "albedo", "g", "max_depth", "samples"}); !k)
       return k.error();
     CoatedDiffuse c;
-    PATHEX_TRY(refl, r.vector3(j, "reflectance", ptr, false, vec3(0.5f), true));
+    PATHEX_TRY(refl, read_colour(r, j, "reflectance", ptr, vec3(0.5f), TexturedParam::kReflectance, tx));
     if (const float hi = max_component(refl); hi > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1], found " + Reader::fmt(hi));
     PATHEX_TRY(albedo, r.vector3(j, "albedo", ptr, false, vec3(0.0f), true));
     if (const float hi = max_component(albedo); hi > 1.0f) return r.fail(ptr + "/albedo", "expected values in [0, 1], found " + Reader::fmt(hi));
@@ -209,11 +304,11 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
   return r.fail(ptr + "/type", "unknown material type '" + type + "', expected " + kBasicTypes + " or mixture");
 }
 
-Result<Material> read_material(const Reader& r, const json& j, const std::string& ptr) {
+Result<Material> read_material(const Reader& r, const json& j, const std::string& ptr, JsonTextures* tx) {
   if (!j.is_object()) return r.fail(ptr, "expected a material object, found " + Reader::kind(j));
   PATHEX_TRY(type, r.string(j, "type", ptr));
   if (type != "mixture") {
-    PATHEX_TRY(basic, read_basic(r, j, ptr, /*component=*/false));
+    PATHEX_TRY(basic, read_basic(r, j, ptr, /*component=*/false, tx));
     return std::visit([](const auto& b) { return Material{b}; }, basic);
   }
   if (auto k = r.keys(j, ptr, {"type", "components"}); !k) return k.error();
@@ -228,7 +323,8 @@ Result<Material> read_material(const Reader& r, const json& j, const std::string
     PATHEX_TRY(weight, r.number(c, "weight", cp, 0.0, 1.0));
     if (!c.contains("material")) return r.fail(cp + "/material", "missing material, expected a basic material object");
     if (!c["material"].is_object()) return r.fail(cp + "/material", "expected a basic material object");
-    PATHEX_TRY(basic, read_basic(r, c["material"], cp + "/material", /*component=*/true));
+    tx->component = static_cast<int>(i);
+    PATHEX_TRY(basic, read_basic(r, c["material"], cp + "/material", /*component=*/true, tx));
     mix.components.push_back({static_cast<float>(weight), basic});
     total += weight;
   }
@@ -441,6 +537,42 @@ Result<MeshShape> read_obj(const std::string& path, const SceneLoadOptions& opti
       e.where = excerpt(path, kMaxPathBytes);
       return e;
     }
+  // Texture coordinates (`vt`, scene/texture.h): an OBJ corner names its position and its uv
+  // separately, so the vertices are split per (position, uv) pair, when every corner has a uv
+  // (else none is kept). The split vertices count towards --max-mesh-elements.
+  const auto& tc = reader.GetAttrib().texcoords;
+  bool every = !tc.empty();
+  for (const auto& shape : reader.GetShapes())
+    for (const auto& idx : shape.mesh.indices)
+      every = every && idx.texcoord_index >= 0 && 2 * static_cast<std::size_t>(idx.texcoord_index) + 1 < tc.size();
+  if (every) {
+    std::map<std::pair<int, int>, unsigned> split;
+    std::vector<vec3> positions;
+    std::vector<glm::vec2> uvs;
+    std::vector<glm::uvec3> triangles;
+    for (const auto& shape : reader.GetShapes())
+      for (std::size_t i = 0; i + 2 < shape.mesh.indices.size(); i += 3) {
+        unsigned corner[3];
+        for (std::size_t k = 0; k < 3; ++k) {
+          const tinyobj::index_t& idx = shape.mesh.indices[i + k];
+          const auto [it, fresh] = split.emplace(std::make_pair(idx.vertex_index, idx.texcoord_index), static_cast<unsigned>(positions.size()));
+          if (fresh) {
+            positions.push_back(mesh.positions[static_cast<std::size_t>(idx.vertex_index)]);
+            const std::size_t t = 2 * static_cast<std::size_t>(idx.texcoord_index);
+            uvs.emplace_back(tc[t], tc[t + 1]);
+          }
+          corner[k] = it->second;
+        }
+        triangles.emplace_back(corner[0], corner[1], corner[2]);
+      }
+    if (positions.size() > mesh.positions.size()) {
+      *elements += positions.size() - mesh.positions.size();
+      if (auto e = check_mesh_elements(*elements, options, excerpt(path, kMaxPathBytes))) return *e;
+    }
+    mesh.positions = std::move(positions);
+    mesh.uvs = std::move(uvs);
+    mesh.triangles = std::move(triangles);
+  }
   return mesh;
 }
 
@@ -962,10 +1094,18 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   // --- materials ---
   if (!doc.contains("materials") || !doc["materials"].is_object() || doc["materials"].empty())
     return r.fail("/materials", "expected an object of named materials, e.g. {\"white\": {\"type\": \"diffuse\"}}");
+  JsonTextures textures;
+  textures.scene = &scene;
+  textures.base_dir = base_dir;
+  textures.options = options;
   for (const auto& [mname, mj] : doc["materials"].items()) {
-    PATHEX_TRY(m, read_material(r, mj, "/materials/" + pointer_token(mname)));
+    textures.current = {};
+    textures.component = -1;
+    PATHEX_TRY(m, read_material(r, mj, "/materials/" + pointer_token(mname), &textures));
     scene.material_names.push_back(mname);
     scene.materials.push_back(std::move(m));
+    if (!textures.current.empty() || !scene.material_textures.empty()) scene.material_textures.resize(scene.materials.size());
+    if (!textures.current.empty()) scene.material_textures.back() = std::move(textures.current);
   }
   // --- shapes ---
   if (!doc.contains("shapes") || !doc["shapes"].is_array()) return r.fail("/shapes", "expected an array of shapes");
@@ -995,9 +1135,9 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
             return r.fail(ptr + "/mapping", "expected \"latlong\" (Mitsuba 3's envmap, +Y up) or \"equal-area\" (pbrt-v4's square)");
         }
         PATHEX_TRY(scale, r.vector3(lj, "scale", ptr, false, vec3(1.0f), /*nonneg=*/true));
-        std::size_t texels = 0;
-        Result<EnvironmentImage> img =
-            load_environment_image((std::filesystem::path(base_dir) / file).string(), file, equal_area, scale, options, &texels);
+        Result<EnvironmentImage> img = load_environment_image((std::filesystem::path(base_dir) / file).string(), file,
+                                                              equal_area, scale, options, &textures.texels);  // one count with the textures'
+
         if (!img) {
           Error e = img.error();
           return r.fail(ptr + "/image", "the image '" + excerpt(file, kMaxPathBytes) + "': " + e.message);

@@ -29,6 +29,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "scene/material.h"
+#include "scene/texture.h"
 
 namespace pathex {
 
@@ -38,7 +39,7 @@ struct MeshShape {
   std::vector<glm::uvec3> triangles;
   // Per vertex, or empty. `normals` (unit): the mesh is smooth-shaded with their interpolation,
   // and each triangle is wound to face their side (import::place_mesh). `uvs`: read for the
-  // textures to come; nothing renders with them yet.
+  // textures (scene/texture.h).
   std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uvs;
 };
@@ -64,6 +65,10 @@ struct Shape {
   // entering the shape through a transmissive surface crosses (trace/media.h); zero: vacuum.
   glm::vec3 absorption{0.0f};
   std::string pointer;          // "/shapes/3", for messages
+  // A float texture (Scene::textures) giving the surface's coverage in [0, 1] (an alpha cut-out,
+  // trace/texture_eval.h): rays pass where it is 0, and a fraction 1 − alpha of them where it is
+  // between; -1: opaque. A passed-through surface is no vertex (no letter).
+  int alpha = -1;
   bool emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
 };
 
@@ -146,6 +151,11 @@ struct Scene {
   // An image infinite light, when the scene has one; add_image_environment() has made its box. A
   // uniform infinite light in the same scene is added to its texels (one box).
   std::optional<EnvironmentImage> environment_image;
+  // Textures (scene/texture.h): their nodes, the images they read (each file once per scene), and
+  // beside each material the parameters textures give it (empty when no material has any).
+  std::vector<Texture> textures;
+  std::vector<LinearImage> images;
+  std::vector<MaterialTextures> material_textures;
 };
 
 // A uniform infinite light of radiance L (DESIGN §1: an area light, letters LDD): light of the same

@@ -64,6 +64,27 @@ std::string scene_content_hash(const Scene& scene) {
     h.add(s.emission);
     h.add(s.two_sided);
     if (s.absorption != glm::vec3(0.0f)) h.add(s.absorption);  // only then: the hashes of scenes without media stay as they were
+    if (s.alpha >= 0) h.add(s.alpha);                            // likewise without cut-outs
+  }
+  if (!scene.textures.empty()) {  // likewise without textures
+    h.add(static_cast<std::uint64_t>(scene.textures.size()));
+    for (const Texture& t : scene.textures) h.add(t);
+    h.add(static_cast<std::uint64_t>(scene.images.size()));
+    for (const LinearImage& im : scene.images) {
+      h.add(im.width);
+      h.add(im.height);
+      h.bytes(im.rgb.data(), im.rgb.size() * sizeof(float));
+      h.add(static_cast<std::uint64_t>(im.alpha.size()));
+      h.bytes(im.alpha.data(), im.alpha.size() * sizeof(float));
+    }
+    h.add(static_cast<std::uint64_t>(scene.material_textures.size()));
+    for (const MaterialTextures& m : scene.material_textures) {
+      h.add(static_cast<std::uint64_t>(m.bindings.size()));
+      for (const TextureBinding& b : m.bindings) h.add(b);
+      h.add(m.amount);
+      h.bytes(m.weight0.data(), m.weight0.size() * sizeof(float));
+      h.bytes(m.weight1.data(), m.weight1.size() * sizeof(float));
+    }
   }
   h.add(static_cast<std::uint64_t>(scene.lights.size()));
   for (const Light& l : scene.lights) {

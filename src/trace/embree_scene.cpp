@@ -13,12 +13,16 @@
 
 #include "trace/frame.h"
 #include "trace/rng.h"
+#include "trace/texture_eval.h"
 
 namespace pathex {
 
+// A sphere or disk (Embree user geometry), or a shape with an alpha cut-out (the filter's data).
 struct EmbreeScene::AnalyticRecord {
   const Shape* shape;
   bool sphere;
+  const Scene* scene = nullptr;  // with an alpha cut-out (Shape::alpha): the scene and the shape's index
+  int index = -1;
 };
 
 // The device's one error callback writes here; build() turns the first message into an Error.
@@ -102,9 +106,67 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
   args->bounds_o->upper_z = hi.z;
 }
 
+float unit_angle(float y, float x) {  // atan2 mapped to [0, 1)
+  const float u = std::atan2(y, x) / (2.0f * kPi);
+  return u < 0.0f ? u + 1.0f : u;
+}
+
+// (u, v) with p - corner = u e1 + v e2, for p in the parallelogram's plane.
+glm::vec2 quad_uv(const QuadShape& q, const vec3& p) {
+  const vec3 w = p - q.corner;
+  const float e11 = glm::dot(q.edge1, q.edge1), e12 = glm::dot(q.edge1, q.edge2), e22 = glm::dot(q.edge2, q.edge2);
+  const float w1 = glm::dot(w, q.edge1), w2 = glm::dot(w, q.edge2);
+  const float det = e11 * e22 - e12 * e12;
+  return {(w1 * e22 - w2 * e12) / det, (w2 * e11 - w1 * e12) / det};
+}
+
+// The surface parameters (Hit::uv) of the point p of `shape` that Embree reported on primitive
+// `prim` at barycentrics (w1, w2) (meshes; p is used by the other kinds).
+glm::vec2 shape_uv(const Shape& shape, unsigned prim, float w1, float w2, const vec3& p) {
+  if (const auto* m = std::get_if<MeshShape>(&shape.geometry)) {  // the mesh's uv, or pbrt-v4's default (0, 0), (1, 0), (1, 1) per triangle
+    const glm::uvec3 t = m->triangles[prim];
+    return m->uvs.empty() ? glm::vec2(w1 + w2, w2) : (1.0f - w1 - w2) * m->uvs[t.x] + w1 * m->uvs[t.y] + w2 * m->uvs[t.z];
+  }
+  if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) return glm::clamp(quad_uv(*q, p), 0.0f, 1.0f);
+  if (const auto* s = std::get_if<SphereShape>(&shape.geometry)) {
+    const vec3 n = glm::normalize(p - s->center);
+    return {unit_angle(n.y, n.x), std::acos(std::clamp(n.z, -1.0f, 1.0f)) / kPi};
+  }
+  const DiskShape& k = std::get<DiskShape>(shape.geometry);
+  const vec3 local = Frame::from_normal(k.normal).to_local(p - k.center);
+  return {unit_angle(local.y, local.x), std::min(std::sqrt(local.x * local.x + local.y * local.y) / k.radius, 1.0f)};
+}
+
+// Whether a ray from o along d passes through the point p (at barycentrics w1, w2 of primitive
+// prim) of a shape with an alpha cut-out (trace/texture_eval.h's alpha_passes).
+bool passes(const Analytic* a, unsigned prim, float w1, float w2, const vec3& o, const vec3& d, const vec3& p) {
+  if (!a || a->index < 0) return false;
+  return alpha_passes(shape_alpha(*a->scene, a->index, shape_uv(*a->shape, prim, w1, w2, p)), o, d);
+}
+
+// Embree's filter for triangles and quads with a cut-out: a hit the cut-out lets pass is no hit.
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const Analytic* a = static_cast<const Analytic*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const vec3 o(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i), RTCRayN_org_z(args->ray, args->N, i));
+    const vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i));
+    const vec3 p = o + RTCRayN_tfar(args->ray, args->N, i) * d;
+    if (passes(a, RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i), o, d, p))
+      args->valid[i] = 0;
+  }
+}
+
+// The nearest point in (tmin, tmax) of a sphere or disk that a ray meets (past the points its
+// cut-out lets the ray through: a sphere has two).
 bool analytic_t(const Analytic* a, const vec3& o, const vec3& d, float tmin, float tmax, float* t) {
-  return a->sphere ? sphere_t(std::get<SphereShape>(a->shape->geometry), o, d, tmin, tmax, t)
-                   : disk_t(std::get<DiskShape>(a->shape->geometry), o, d, tmin, tmax, t);
+  for (int tries = 0; tries < 3; ++tries) {
+    const bool hit = a->sphere ? sphere_t(std::get<SphereShape>(a->shape->geometry), o, d, tmin, tmax, t)
+                               : disk_t(std::get<DiskShape>(a->shape->geometry), o, d, tmin, tmax, t);
+    if (!hit || !passes(a, 0, 0.0f, 0.0f, o, d, o + *t * d)) return hit;
+    tmin = std::nextafter(*t, std::numeric_limits<float>::infinity());
+  }
+  return false;
 }
 
 void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
@@ -142,19 +204,6 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
 }
 
 
-float unit_angle(float y, float x) {  // atan2 mapped to [0, 1)
-  const float u = std::atan2(y, x) / (2.0f * kPi);
-  return u < 0.0f ? u + 1.0f : u;
-}
-
-// (u, v) with p - corner = u e1 + v e2, for p in the parallelogram's plane.
-glm::vec2 quad_uv(const QuadShape& q, const vec3& p) {
-  const vec3 w = p - q.corner;
-  const float e11 = glm::dot(q.edge1, q.edge1), e12 = glm::dot(q.edge1, q.edge2), e22 = glm::dot(q.edge2, q.edge2);
-  const float w1 = glm::dot(w, q.edge1), w2 = glm::dot(w, q.edge2);
-  const float det = e11 * e22 - e12 * e12;
-  return {(w1 * e22 - w2 * e12) / det, (w2 * e11 - w1 * e12) / det};
-}
 
 // --- positions and their error bounds ---
 
@@ -278,7 +327,7 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
     } else {
       // --- sphere or disk: exact user geometry ---
       const bool sphere = std::holds_alternative<SphereShape>(shape.geometry);
-      es->analytic_.push_back(std::make_unique<Analytic>(Analytic{&shape, sphere}));
+      es->analytic_.push_back(std::make_unique<Analytic>(Analytic{&shape, sphere, &scene, shape.alpha >= 0 ? static_cast<int>(si) : -1}));
       g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
       rtcSetGeometryUserPrimitiveCount(g, 1);
       rtcSetGeometryUserData(g, es->analytic_.back().get());
@@ -293,6 +342,13 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
         es->areas_[si] = kPi * s.radius * s.radius;
         es->shape_errors_[si] = disk_error(s);
       }
+    }
+    if (shape.alpha >= 0 && !std::holds_alternative<SphereShape>(shape.geometry) && !std::holds_alternative<DiskShape>(shape.geometry)) {
+      // a cut-out triangle mesh or quad: Embree's filter drops the hits it lets through
+      es->analytic_.push_back(std::make_unique<Analytic>(Analytic{&shape, false, &scene, static_cast<int>(si)}));
+      rtcSetGeometryUserData(g, es->analytic_.back().get());
+      rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
     }
     rtcCommitGeometry(g);
     const unsigned id = rtcAttachGeometry(es->scene_.get(), g);
@@ -331,10 +387,7 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
   if (const auto* m = std::get_if<MeshShape>(&shape.geometry)) {
     const glm::uvec3 t = m->triangles[rh.hit.primID];
     const vec3 p0 = m->positions[t.x], p1 = m->positions[t.y], p2 = m->positions[t.z];
-    if (detail == HitDetail::kFull) {  // the mesh's uv, or pbrt-v4's default (0, 0), (1, 0), (1, 1) per triangle
-      const float w1 = rh.hit.u, w2 = rh.hit.v;
-      h.uv = m->uvs.empty() ? glm::vec2(w1 + w2, w2) : (1.0f - w1 - w2) * m->uvs[t.x] + w1 * m->uvs[t.y] + w2 * m->uvs[t.z];
-    }
+    if (detail == HitDetail::kFull) h.uv = shape_uv(shape, rh.hit.primID, rh.hit.u, rh.hit.v, p);
     h.position = triangle_point(p0, p1, p2, 1.0f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v, &h.error);
     const vec3 n = glm::cross(p1 - p0, p2 - p0);
     const float len = glm::length(n);
@@ -345,7 +398,7 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
     h.normal = quad_normals_[static_cast<std::size_t>(h.shape)];
     h.error = shape_errors_[static_cast<std::size_t>(h.shape)];  // the projection too: p lies within the quad
     if (detail == HitDetail::kFull) {
-      h.uv = glm::clamp(quad_uv(*q, p), 0.0f, 1.0f);
+      h.uv = shape_uv(shape, 0, 0.0f, 0.0f, p);
       h.position = q->corner + h.uv.x * q->edge1 + h.uv.y * q->edge2;
     } else {
       h.position = p - glm::dot(p - q->corner, h.normal) * h.normal;  // onto the plane
@@ -354,16 +407,14 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
     h.normal = glm::normalize(p - s->center);
     h.position = s->center + s->radius * h.normal;
     h.error = sphere_error(*s, h.normal);
-    if (detail == HitDetail::kFull)
-      h.uv = {unit_angle(h.normal.y, h.normal.x), std::acos(std::clamp(h.normal.z, -1.0f, 1.0f)) / kPi};
+    if (detail == HitDetail::kFull) h.uv = shape_uv(shape, 0, 0.0f, 0.0f, h.position);
   } else {
     const DiskShape& k = std::get<DiskShape>(shape.geometry);
     h.normal = k.normal;
     const vec3 local = Frame::from_normal(k.normal).to_local(p - k.center);
     h.position = p - local.z * k.normal;
     h.error = shape_errors_[static_cast<std::size_t>(h.shape)];
-    if (detail == HitDetail::kFull)
-      h.uv = {unit_angle(local.y, local.x), std::min(std::sqrt(local.x * local.x + local.y * local.y) / k.radius, 1.0f)};
+    if (detail == HitDetail::kFull) h.uv = shape_uv(shape, 0, 0.0f, 0.0f, p);
   }
   h.shading_normal = h.normal;
   return out;

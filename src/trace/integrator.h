@@ -29,6 +29,7 @@
 #include "trace/rng.h"
 #include "trace/scene_features.h"
 #include "trace/strategy_table.h"
+#include "trace/texture_eval.h"
 #include "trace/vertex.h"
 
 namespace pathex::tracer {
@@ -302,6 +303,16 @@ class Integrator {
     *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
   }
 
+  // The material at surface vertex `v`: its shape's, with its textured parameters evaluated at
+  // v.uv into `*scratch` when it has any (trace/texture_eval.h).
+  const Material& material_at(const Vertex& v, Material* scratch) const {
+    const Material& base = *rs_.material_of_shape[static_cast<std::size_t>(v.shape)];
+    const MaterialTextures* tex = rs_.textures_of_shape[static_cast<std::size_t>(v.shape)];
+    if (!tex) return base;
+    textured_material(*rs_.scene, base, *tex, v.uv, scratch);
+    return *scratch;
+  }
+
   // --- densities used by MIS ---
   // Solid-angle density at `v` of sampling the unit direction `wn`, given the unit direction
   // `wp` to v's other neighbour (null when it has none: a surface then has no density).
@@ -309,8 +320,11 @@ class Integrator {
     switch (v.kind) {
       case Kind::kCamera: return sensor_pdf_dir(v, wn);
       case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
-      case Kind::kSurface:
-        return wp ? bsdf::pdf(*rs_.material_of_shape[static_cast<std::size_t>(v.shape)], *wp, wn, v.ns, v.n) : 0.0f;
+      case Kind::kSurface: {
+        if (!wp) return 0.0f;
+        Material textured;
+        return bsdf::pdf(material_at(v, &textured), *wp, wn, v.ns, v.n);
+      }
       case Kind::kLens: return 0.0f;
     }
     return 0.0f;

@@ -70,7 +70,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // before the ray is traced: they do not depend on the hit, and so their computation overlaps
     // the intersection instead of delaying the scattering (Sampler::at2d_now).
     const glm::vec2 u_dir = rng.at2d_now(rng.dimension() + 1);
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, HitDetail::kNoUv);  // zero for points: no offset
+    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, rs_.textured ? HitDetail::kFull : HitDetail::kNoUv);  // zero for points: no offset
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
       const std::optional<EndpointConnection> lens = hit_lens(cam_.params, o, d);
@@ -98,6 +98,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.err = hit->error;
     v.ns = hit->shading_normal;
     v.shape = hit->shape;
+    v.uv = hit->uv;
     v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;
     v.wo = -d;
     const vec3 e = v.p - prev.p;
@@ -115,7 +116,8 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     ++count;
     if (count >= max_vertices) break;
     // --- scatter ---
-    const Material& m = *rs_.material_of_shape[static_cast<std::size_t>(v.shape)];
+    Material textured;
+    const Material& m = material_at(v, &textured);
     const vec3 wo = -d;
     const bsdf::NumbersRead reads = bsdf::numbers_read(m);  // the others are not computed
     const float u_comp = rng.get1d_if(reads.component);

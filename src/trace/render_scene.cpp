@@ -61,10 +61,16 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
   Result<std::unique_ptr<EmbreeScene>> geometry = EmbreeScene::build(scene);
   if (!geometry) return geometry.error();
   rs.geometry = std::move(*geometry);
+  rs.scene = &scene;
   rs.light_of_shape.assign(scene.shapes.size(), -1);
   for (std::size_t i = 0; i < scene.shapes.size(); ++i) {
     const Shape& s = scene.shapes[i];
     rs.material_of_shape.push_back(&scene.materials[static_cast<std::size_t>(s.material)]);
+    const MaterialTextures* tex = static_cast<std::size_t>(s.material) < scene.material_textures.size()
+                                      ? &scene.material_textures[static_cast<std::size_t>(s.material)]
+                                      : nullptr;
+    rs.textures_of_shape.push_back(tex && !tex->empty() ? tex : nullptr);
+    rs.textured = rs.textured || rs.textures_of_shape.back() != nullptr;
     rs.emission_of_shape.push_back(s.emission);
     rs.absorption_of_shape.push_back(s.absorption);
     rs.absorbing = rs.absorbing || s.absorption != glm::vec3(0.0f);

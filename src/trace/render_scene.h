@@ -52,6 +52,11 @@ struct RenderSensor {
 struct RenderScene {
   std::unique_ptr<EmbreeScene> geometry;
   std::vector<const Material*> material_of_shape;
+  // The textured parameters of each shape's material (scene/texture.h), null for none; `scene`
+  // holds the textures. `textured`: some shape has them, so hits carry uv (trace/texture_eval.h).
+  std::vector<const MaterialTextures*> textures_of_shape;
+  const Scene* scene = nullptr;
+  bool textured = false;
   std::vector<glm::vec3> emission_of_shape;  // Le, zero for non-emitters
   std::vector<int> light_of_shape;           // index into lights, -1 for non-emitters
   std::vector<glm::vec3> absorption_of_shape;  // σa of the shape's interior (trace/media.h), zero for none

@@ -11,27 +11,14 @@
 #include <vector>
 
 #include "support/scratch_files.h"
+#include "support/test_images.h"
 
 namespace pathex {
 namespace {
 
 using test::relative;
 using test::scratch;
-
-// Writes `values` (width x height x channels, row-major from the top) to scratch()/name in the
-// file's own format: 8-bit codes for PNG, floats for EXR.
-template <class T>
-std::string write_image(const std::string& name, int width, int height, int channels, const std::vector<T>& values) {
-  const std::string path = scratch() + "/" + name;
-  const OIIO::TypeDesc type = std::is_same_v<T, float> ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8;
-  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(path);
-  EXPECT_TRUE(out) << OIIO::geterror();
-  OIIO::ImageSpec spec(width, height, channels, type);
-  EXPECT_TRUE(out->open(path, spec));
-  EXPECT_TRUE(out->write_image(type, values.data()));
-  out->close();
-  return path;
-}
+using test::write_image;
 
 std::string message_of(const Result<LinearImage>& r) { return r.ok() ? "(read)" : relative(r.error().render()); }
 

@@ -1,0 +1,154 @@
+#include "trace/texture_eval.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <variant>
+
+#include "trace/rng.h"
+
+namespace pathex {
+namespace {
+
+// Texel (x, y) of `image` after wrapping; false: outside a kBlack image.
+bool wrap_texel(int* x, int* y, int width, int height, TextureWrap wrap) {
+  if (wrap == TextureWrap::kRepeat) {
+    *x %= width;
+    *y %= height;
+    if (*x < 0) *x += width;
+    if (*y < 0) *y += height;
+    return true;
+  }
+  if (wrap == TextureWrap::kClamp) {
+    *x = std::clamp(*x, 0, width - 1);
+    *y = std::clamp(*y, 0, height - 1);
+    return true;
+  }
+  return *x >= 0 && *x < width && *y >= 0 && *y < height;
+}
+
+glm::vec3 texel(const LinearImage& im, int x, int y, TextureWrap wrap, FloatChannel channel) {
+  if (!wrap_texel(&x, &y, im.width, im.height, wrap)) return glm::vec3(0.0f);
+  const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(im.width) + static_cast<std::size_t>(x);
+  const glm::vec3 rgb(im.rgb[3 * i], im.rgb[3 * i + 1], im.rgb[3 * i + 2]);
+  switch (channel) {
+    case FloatChannel::kNone: return rgb;
+    case FloatChannel::kPbrt: return glm::vec3(im.alpha.empty() ? (rgb.x + rgb.y + rgb.z) / 3.0f : im.alpha[i]);
+    case FloatChannel::kLuminance: return glm::vec3(0.212671f * rgb.x + 0.715160f * rgb.y + 0.072169f * rgb.z);
+  }
+  return rgb;
+}
+
+// Pixel coordinates far outside any image (a huge uscale, a far uv) are folded before the float to
+// int conversion, which would overflow: repeat keeps them modulo the size (in double), clamp and
+// black need only their side.
+double fold(double x, int size, TextureWrap wrap) {
+  if (std::fabs(x) < 1e9) return x;
+  if (wrap == TextureWrap::kRepeat) return std::fmod(x, static_cast<double>(size)) + (x < 0 ? static_cast<double>(size) : 0.0);
+  return x < 0 ? -2.0 : static_cast<double>(size) + 1.0;
+}
+
+float channel0(const glm::vec3& v) { return v.x; }
+
+}  // namespace
+
+glm::vec3 image_bilerp(const LinearImage& image, glm::vec2 st, TextureWrap wrap, FloatChannel channel) {
+  if (!std::isfinite(st.x) || !std::isfinite(st.y)) return glm::vec3(0.0f);
+  const double x = fold(static_cast<double>(st.x) * image.width - 0.5, image.width, wrap);
+  const double y = fold(static_cast<double>(st.y) * image.height - 0.5, image.height, wrap);
+  const double fx = std::floor(x), fy = std::floor(y);
+  const int xi = static_cast<int>(fx), yi = static_cast<int>(fy);
+  const float dx = static_cast<float>(x - fx), dy = static_cast<float>(y - fy);
+  // Lerps as a + d (b − a): exact where neighbouring texels are equal (a constant image is its value).
+  const glm::vec3 t00 = texel(image, xi, yi, wrap, channel), t10 = texel(image, xi + 1, yi, wrap, channel);
+  const glm::vec3 t01 = texel(image, xi, yi + 1, wrap, channel), t11 = texel(image, xi + 1, yi + 1, wrap, channel);
+  const glm::vec3 top = t00 + dx * (t10 - t00), bottom = t01 + dx * (t11 - t01);
+  return top + dy * (bottom - top);
+}
+
+glm::vec3 eval_texture(const Scene& scene, int index, glm::vec2 uv) {
+  const Texture& t = scene.textures[static_cast<std::size_t>(index)];
+  switch (t.kind) {
+    case TextureKind::kConstant: return t.value;
+    case TextureKind::kImage: {
+      glm::vec2 st = t.uv.apply(uv);
+      if (t.flip_t) st.y = 1.0f - st.y;
+      glm::vec3 v = t.scale * image_bilerp(scene.images[static_cast<std::size_t>(t.image)], st, t.wrap, t.channel);
+      if (t.invert) v = glm::vec3(1.0f) - v;
+      return glm::max(v, glm::vec3(0.0f));
+    }
+    case TextureKind::kCheckerboard: {
+      const glm::vec2 st = t.uv.apply(uv);
+      if (!std::isfinite(st.x) || !std::isfinite(st.y)) return eval_texture(scene, t.a, uv);
+      const double cells = std::floor(static_cast<double>(st.x)) + std::floor(static_cast<double>(st.y));
+      return eval_texture(scene, std::fmod(cells, 2.0) == 0.0 ? t.a : t.b, uv);
+    }
+    case TextureKind::kScale: return eval_texture(scene, t.a, uv) * eval_texture(scene, t.b, uv);
+    case TextureKind::kMix: {
+      const float amount = channel0(eval_texture(scene, t.amount, uv));
+      return (1.0f - amount) * eval_texture(scene, t.a, uv) + amount * eval_texture(scene, t.b, uv);
+    }
+  }
+  return glm::vec3(0.0f);
+}
+
+namespace {
+
+void bind(BasicMaterial* m, const TextureBinding& b, glm::vec3 value) {
+  value = glm::clamp(value * b.scale, glm::vec3(0.0f), glm::vec3(1.0f));
+  if (auto* d = std::get_if<Diffuse>(m)) {
+    d->albedo = value;
+  } else if (auto* c = std::get_if<CoatedDiffuse>(m)) {
+    c->reflectance = value;
+  } else if (auto* t = std::get_if<DiffuseTransmission>(m)) {
+    (b.param == TexturedParam::kTransmittance ? t->transmittance : t->reflectance) = value;
+  }
+}
+
+void bind(Material* m, const TextureBinding& b, glm::vec3 value) {
+  std::visit(
+      [&](auto& k) {
+        using K = std::decay_t<decltype(k)>;
+        if constexpr (std::is_same_v<K, Mixture>) {
+          if (b.component >= 0 && static_cast<std::size_t>(b.component) < k.components.size())
+            bind(&k.components[static_cast<std::size_t>(b.component)].material, b, value);
+        } else {
+          BasicMaterial basic{k};
+          bind(&basic, b, value);
+          k = std::get<K>(basic);
+        }
+      },
+      *m);
+}
+
+}  // namespace
+
+void textured_material(const Scene& scene, const Material& base, const MaterialTextures& textures, glm::vec2 uv, Material* out) {
+  *out = base;
+  for (const TextureBinding& b : textures.bindings) bind(out, b, eval_texture(scene, b.texture, uv));
+  if (textures.amount >= 0) {
+    if (auto* mix = std::get_if<Mixture>(out)) {
+      const float a = std::clamp(channel0(eval_texture(scene, textures.amount, uv)), 0.0f, 1.0f);
+      for (std::size_t i = 0; i < mix->components.size() && i < textures.weight0.size(); ++i)
+        mix->components[i].weight = (1.0f - a) * textures.weight0[i] + a * textures.weight1[i];
+    }
+  }
+}
+
+float shape_alpha(const Scene& scene, int shape, glm::vec2 uv) {
+  const int t = scene.shapes[static_cast<std::size_t>(shape)].alpha;
+  return t < 0 ? 1.0f : std::clamp(channel0(eval_texture(scene, t, uv)), 0.0f, 1.0f);
+}
+
+bool alpha_passes(float alpha, const glm::vec3& origin, const glm::vec3& direction) {
+  if (alpha >= 1.0f) return false;
+  if (alpha <= 0.0f) return true;
+  std::uint64_t h = 0x243f6a8885a308d3ULL;
+  for (float x : {origin.x, origin.y, origin.z, direction.x, direction.y, direction.z})
+    h = mix64(h ^ (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(x)) + 0x9e3779b97f4a7c15ULL));
+  const float u = static_cast<float>(h >> 40) * 0x1p-24f;
+  return u >= alpha;
+}
+
+}  // namespace pathex
