@@ -528,6 +528,13 @@ Result<Scene> SceneBuilder::finish(const std::string& file, const std::vector<st
         shape.geometry);
     if (out_of_range) return located(Location{shape.pointer}, "the shape's transformed coordinates are not finite (or beyond 1e30)");
   }
+  for (std::size_t i = 0; i < s.instances.size(); ++i) {  // the instance's transform too (Embree needs finite ones)
+    const glm::mat4& m = s.instances[i].to_world;
+    if (bad(glm::vec3(m[0])) || bad(glm::vec3(m[1])) || bad(glm::vec3(m[2])) || bad(glm::vec3(m[3])))
+      return located(Location{s.instances[i].pointer}, "the instance's transform is not finite (or beyond 1e30)");
+  }
+  for (const auto& [lo, hi] : instance_boxes(s))
+    if (bad(lo) || bad(hi)) return fail("an instance's transformed coordinates are not finite (or beyond 1e30)");
   for (const Light& light : s.lights) {
     const bool out_of_range = std::visit([&](const auto& l) {
       using T = std::decay_t<decltype(l)>;

@@ -648,10 +648,10 @@ std::vector<std::pair<vec3, vec3>> instance_boxes(const Scene& scene) {
   std::vector<std::pair<vec3, vec3>> out;
   for (const ShapeInstance& inst : scene.instances) {
     const Box& g = group_box[static_cast<std::size_t>(inst.group)];
+    if (!(g.lo.x <= g.hi.x)) continue;  // an empty group draws nothing
     Box b;
-    if (g.lo.x <= g.hi.x)
-      for (int c = 0; c < 8; ++c)
-        b.add(apply_point(inst.to_world, vec3(c & 1 ? g.hi.x : g.lo.x, c & 2 ? g.hi.y : g.lo.y, c & 4 ? g.hi.z : g.lo.z)));
+    for (int c = 0; c < 8; ++c)
+      b.add(apply_point(inst.to_world, vec3(c & 1 ? g.hi.x : g.lo.x, c & 2 ? g.hi.y : g.lo.y, c & 4 ? g.hi.z : g.lo.z)));
     out.emplace_back(b.lo, b.hi);
   }
   return out;

@@ -181,7 +181,7 @@ struct SceneLoadOptions {
 };
 // The options of a command's limits (every command that reads a scene passes them through here).
 SceneLoadOptions scene_load_options(const Limits& limits, bool triangles = true);
-// The world-space axis-aligned box of each instance (Scene::instances, in order): its group's
+// The world-space axis-aligned box of each instance of a non-empty group: its group's
 // members' boxes, their corners moved by the instance's transform. For the scene-level code that
 // needs world extents (the camera rule, the environment box, distant lights' apertures).
 std::vector<std::pair<glm::vec3, glm::vec3>> instance_boxes(const Scene& scene);

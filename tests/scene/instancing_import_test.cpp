@@ -96,6 +96,24 @@ TEST(InstancingImport, MitsubaShapegroupAndInstances) {
   expect_near(moved(s.instances[1], vec3(1, 1, 1)), vec3(1, 1, 1), "in place");
 }
 
+// An instance may come before its shapegroup (made when first named), and an empty object draws nothing.
+TEST(InstancingImport, InstanceBeforeItsShapegroupAndEmptyObjects) {
+  const Scene x = load(write("inst-late.xml",
+                             "<scene version=\"3.0.0\">\n"
+                             "  <sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><transform name=\"to_world\"><lookat origin=\"0, 0, 9\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>\n"
+                             "  <emitter type=\"point\"><point name=\"position\" value=\"0, 0, 5\"/></emitter>\n"
+                             "  <shape type=\"instance\"><ref id=\"g\"/></shape>\n"
+                             "  <shape type=\"shapegroup\" id=\"g\"><shape type=\"cube\"/></shape>\n"
+                             "</scene>\n"));
+  EXPECT_EQ(x.groups.size(), 1u);
+  EXPECT_EQ(x.shapes.size(), 1u);
+  EXPECT_EQ(x.instances.size(), 1u);
+  const Scene p = load(write("inst-empty.pbrt", kPbrt + "ObjectBegin \"none\"\nObjectEnd\nObjectInstance \"none\"\nShape \"sphere\"\n"));
+  EXPECT_EQ(p.groups.size(), 1u);
+  EXPECT_EQ(p.instances.size(), 1u);
+  EXPECT_TRUE(instance_boxes(p).empty());
+}
+
 TEST(InstancingImport, JsonGroupsAndInstances) {
   write("inst-tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   const Scene s = load(write("inst.json", R"({"camera": {"type": "pinhole", "position": [0, 0, 9], "look_at": [0, 0, 0]},
