@@ -441,6 +441,22 @@ void SceneBuilder::set_camera(const Camera& camera, glm::vec3 image_right) {
   has_camera_ = true;
 }
 
+std::optional<std::string> make_group_member(Shape* s, int group) {
+  if (s->emissive()) return std::string("an area light in an instanced object is not supported (pbrt-v4 refuses them too): place the emitting shape in the world");
+  if (s->alpha >= 0) return std::string("an alpha cut-out in an instanced object is not supported: place the cut-out shape in the world");
+  if (const auto* q = std::get_if<QuadShape>(&s->geometry)) {
+    MeshShape m;
+    m.positions = {q->corner, q->corner + q->edge1, q->corner + q->edge1 + q->edge2, q->corner + q->edge2};
+    m.triangles = {{0u, 1u, 2u}, {0u, 2u, 3u}};
+    s->geometry = std::move(m);
+  } else if (!std::holds_alternative<MeshShape>(s->geometry)) {
+    return std::string(std::holds_alternative<SphereShape>(s->geometry) ? "a sphere" : "a disk") +
+           " in an instanced object is not supported (an instance's transform need not keep it one): instanced objects hold meshes";
+  }
+  s->group = group;
+  return std::nullopt;
+}
+
 namespace {
 
 // The reflection through the plane through `c` with unit normal `n`.
@@ -451,7 +467,13 @@ struct Mirror3 {
 };
 
 void mirror_scene(Scene* s, const Mirror3& r) {
+  // An instance's members stay in their group's space; the reflection joins its transform (whose
+  // determinant then changes sign, which turns the members' front sides as the swaps below do).
+  const glm::mat4 reflect(glm::vec4(r.vector({1, 0, 0}), 0), glm::vec4(r.vector({0, 1, 0}), 0), glm::vec4(r.vector({0, 0, 1}), 0),
+                          glm::vec4(r.point(glm::vec3(0.0f)), 1));
+  for (ShapeInstance& inst : s->instances) inst.to_world = reflect * inst.to_world;
   for (Shape& shape : s->shapes) {
+    if (shape.group >= 0) continue;
     std::visit(
         [&](auto& g) {
           using T = std::decay_t<decltype(g)>;
@@ -503,7 +525,12 @@ std::pair<glm::vec3, float> bounding_sphere(const Scene& s) {
     lo = glm::min(lo, p);
     hi = glm::max(hi, p);
   };
+  for (const auto& [blo, bhi] : instance_boxes(s)) {
+    add(blo);
+    add(bhi);
+  }
   for (const Shape& shape : s.shapes) {
+    if (shape.group >= 0) continue;  // the instances' boxes above
     std::visit(
         [&](const auto& g) {
           using T = std::decay_t<decltype(g)>;
@@ -561,6 +588,13 @@ Result<Scene> SceneBuilder::finish(const std::string& file, const std::vector<st
         shape.geometry);
     if (out_of_range) return located(Location{shape.pointer}, "the shape's transformed coordinates are not finite (or beyond 1e30)");
   }
+  for (std::size_t i = 0; i < s.instances.size(); ++i) {  // the instance's transform too (Embree needs finite ones)
+    const glm::mat4& m = s.instances[i].to_world;
+    if (bad(glm::vec3(m[0])) || bad(glm::vec3(m[1])) || bad(glm::vec3(m[2])) || bad(glm::vec3(m[3])))
+      return located(Location{s.instances[i].pointer}, "the instance's transform is not finite (or beyond 1e30)");
+  }
+  for (const auto& [lo, hi] : instance_boxes(s))
+    if (bad(lo) || bad(hi)) return fail("an instance's transformed coordinates are not finite (or beyond 1e30)");
   for (const Light& light : s.lights) {
     const bool out_of_range = std::visit([&](const auto& l) {
       using T = std::decay_t<decltype(l)>;

@@ -148,6 +148,14 @@ MeshShape cube_mesh();
 inline constexpr int kCylinderSegments = 256;
 MeshShape tube_mesh(float radius, float z0, float z1);
 
+// --- instancing (Scene::groups, Scene::instances) ---
+// Makes `s` a member of group `group`: a quad becomes its two triangles (corner, +edge1, +edge1+edge2
+// and corner, +edge1+edge2, +edge2: the same surface and front side), a mesh stays. Why it cannot
+// be one, for the caller to locate: an emitting shape (pbrt-v4: "area lights not supported with
+// object instancing"), a sphere or a disk (an instance's transform may not keep one a sphere or a
+// disk; tessellate it).
+std::optional<std::string> make_group_member(Shape* s, int group);
+
 // Affine transform helpers.
 glm::vec3 apply_point(const glm::mat4& m, glm::vec3 p);
 glm::vec3 apply_vector(const glm::mat4& m, glm::vec3 v);
@@ -168,6 +176,12 @@ class SceneBuilder {
   Result<int> add_image(const std::string& path, ImageReadOptions options, const Location& at);
   const Texture& texture(int index) const { return scene_.textures[static_cast<std::size_t>(index)]; }
   void add_shape(Shape s) { scene_.shapes.push_back(std::move(s)); }
+  // Instancing: a group (its index, for Shape::group and ShapeInstance::group) and an instance of one.
+  int add_group(std::string name, std::string pointer) {
+    scene_.groups.push_back({std::move(name), std::move(pointer)});
+    return static_cast<int>(scene_.groups.size()) - 1;
+  }
+  void add_instance(ShapeInstance i) { scene_.instances.push_back(std::move(i)); }
   void add_light(Light l) { scene_.lights.push_back(std::move(l)); }
   // A uniform infinite light (add_uniform_environment in scene.h, called by finish() once the
   // scene is complete); `where` names it in messages.

@@ -291,6 +291,7 @@ class Importer {
   std::deque<Doc> docs_;
   std::map<std::string, std::string> defaults_;
   std::map<std::string, pugi::xml_node> ids_;       // every element with an id, in every file: ids are unique
+  std::map<std::string, int> groups_;               // shapegroups made, by id
   std::map<std::string, Material> bsdf_materials_;  // top-level <bsdf id>, each made once; <ref>s share it
   std::string defining_;                            // the id of the top-level <bsdf> being made
   std::map<std::string, int> bsdf_index_;
@@ -740,8 +741,60 @@ class Importer {
   }
 
   // --- shapes ---
-  std::optional<Error> shape(pugi::xml_node n) {
+  // --- instancing: <shape type="shapegroup" id=…> and <shape type="instance"> (scene.h ShapeGroup) ---
+  // A shapegroup's shapes are placed by their own to_world, an instance by its to_world on top.
+  Result<int> shapegroup(pugi::xml_node n) {
+    const std::string id = n.attribute("id").value();
+    if (auto it = groups_.find(id); it != groups_.end()) return it->second;  // made when an instance came first
+    if (id.empty()) return located(where(n), "a shapegroup needs an id (instances <ref> it)");
+    const int group = builder_.add_group(id, where(n).str());
+    groups_[id] = group;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      if (std::string(c.name()) != "shape")
+        return located(where(c), "<" + excerpt(c.name()) + "> in a shapegroup is not supported, expected shapes");
+      const std::string type = c.attribute("type").value();
+      if (type == "shapegroup" || type == "instance")
+        return located(where(c), "a " + type + " inside a shapegroup is not supported: shapegroups do not nest");
+      if (auto e = shape(c, group)) return *e;
+    }
+    return group;
+  }
+
+  std::optional<Error> instance(pugi::xml_node n) {
+    pugi::xml_node ref;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      if (std::string(c.name()) == "ref" && !ref) ref = c;
+      else if (!(std::string(c.name()) == "transform" && std::string(c.attribute("name").value()) == "to_world"))
+        return located(where(c), "<" + excerpt(c.name()) + "> in an instance is not supported, expected one <ref> to a shapegroup and a to_world");
+    }
+    if (!ref) return located(where(n), "an instance needs a <ref id=…> to a shapegroup");
+    MI_TRY(id, attr(ref, "id"));
+    auto it = ids_.find(id);
+    if (it == ids_.end()) return located(where(ref), "unknown id \"" + excerpt(id) + "\"");
+    if (std::string(it->second.name()) != "shape" || std::string(it->second.attribute("type").value()) != "shapegroup")
+      return located(where(ref), "the instance's <ref id=\"" + excerpt(id) + "\"> names a <" + excerpt(it->second.name()) +
+                                     (it->second.attribute("type") ? " type=\"" + excerpt(it->second.attribute("type").value()) + "\"" : std::string()) +
+                                     "> (at " + where(it->second).str() + "), expected a shapegroup");
+    MI_TRY(group, shapegroup(it->second));
+    Props p(this, n, "<shape type=\"instance\">");
+    p.ignore({"ref", "id"});
+    MI_TRY(m, p.transform("to_world"));
+    builder_.add_instance(ShapeInstance{group, m, where(n).str()});
+    return std::nullopt;
+  }
+
+  // `group`: the shapegroup the shape is a member of (-1: the world's).
+  std::optional<Error> shape(pugi::xml_node n, int group = -1) {
     MI_TRY(type, attr(n, "type"));
+    if (type == "shapegroup") {
+      if (group >= 0) return located(where(n), "a shapegroup inside a shapegroup is not supported: shapegroups do not nest");
+      Result<int> made = shapegroup(n);
+      if (!made) return made.error();
+      return std::nullopt;
+    }
+    if (type == "instance") return instance(n);
     Props p(this, n, "<shape type=\"" + excerpt(type) + "\">");
     p.ignore({"id"});
     Shape s;
@@ -881,6 +934,8 @@ class Importer {
     }
     if (auto e = p.unused()) return e;
     if (s.alpha >= 0 && s.emissive()) return located(where(n), "a mask (an opacity cut-out) on an area light is not supported");
+    if (group >= 0)
+      if (std::optional<std::string> why = import::make_group_member(&s, group)) return located(where(n), *why);
     builder_.add_shape(std::move(s));
     return std::nullopt;
   }

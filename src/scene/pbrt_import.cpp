@@ -282,6 +282,7 @@ class Importer {
 
   Result<Scene> run() {
     if (auto e = parse_file(main_file_, Location{main_file_}, 0)) return *e;
+    if (auto e = resolve_instances()) return *e;
     if (auto e = make_camera()) return *e;
     return builder_.finish(main_file_, files_.included());
   }
@@ -298,6 +299,20 @@ class Importer {
   std::vector<Location> stack_at_;
   std::vector<bool> stack_is_attribute_;
   bool in_world_ = false;
+  // --- instancing: ObjectBegin/ObjectEnd/ObjectInstance (scene.h ShapeGroup) ---
+  struct Object {
+    int group = -1;  // builder group index
+    Location at;     // its ObjectBegin
+  };
+  std::map<std::string, Object> objects_;
+  std::string object_;              // the object being defined ("" outside ObjectBegin/ObjectEnd)
+  std::size_t object_depth_ = 0;    // stack_.size() inside it (ObjectBegin pushes the state, as pbrt-v4)
+  struct Use {
+    std::string name;
+    glm::mat4 ctm;
+    Location at;
+  };
+  std::vector<Use> uses_;  // ObjectInstance, resolved once the file is read (pbrt-v4 allows a use before the definition)
   std::map<std::string, glm::mat4> coordinate_systems_;
   std::map<std::string, Material> named_materials_;
   std::map<std::string, MaterialTextures> named_material_textures_;  // of the named materials that have any
@@ -402,6 +417,8 @@ class Importer {
       if (auto e = directive(t.text, t.at, s, depth)) return s.error() ? s.error() : e;
     }
     if (s.error()) return s.error();
+    if (depth == 0 && !object_.empty())
+      return located(objects_.at(object_).at, "ObjectBegin \"" + excerpt(object_) + "\" has no matching ObjectEnd");
     if (depth == 0 && !stack_.empty())
       return located(stack_at_.back(), std::string(stack_is_attribute_.back() ? "AttributeBegin" : "TransformBegin") + " has no matching End");
     return std::nullopt;
@@ -478,7 +495,7 @@ class Importer {
     }
     if (name == "AttributeEnd" || name == "TransformEnd") {
       const bool attribute = name == "AttributeEnd";
-      if (stack_.empty() || stack_is_attribute_.back() != attribute)
+      if (stack_.empty() || stack_is_attribute_.back() != attribute || (!object_.empty() && stack_.size() == object_depth_))
         return located(at, name + " has no matching " + (attribute ? "AttributeBegin" : "TransformBegin"));
       if (attribute) gs_ = stack_.back();
       else gs_.ctm = stack_.back().ctm;
@@ -487,6 +504,7 @@ class Importer {
       stack_is_attribute_.pop_back();
       return std::nullopt;
     }
+    if (name == "ObjectBegin" || name == "ObjectEnd" || name == "ObjectInstance") return object_directive(name, at, s);
     if (name == "Include" || name == "Import") {
       PBRT_TRY(file, quoted(s, at, name));
       PBRT_TRY(path, files_.include(file, at, name));
@@ -700,6 +718,60 @@ class Importer {
     // Shape
     if (auto e = shape(type, ps, at)) return e;
     return ps.unused(what);
+  }
+
+  // --- instancing (pbrt-v4's ObjectBegin "name" … ObjectEnd, ObjectInstance "name") ---
+  // An object's shapes are placed by the CTM at each shape (inside the object) and each instance
+  // by the CTM at its ObjectInstance: world = CTM(instance) * CTM(shape), as pbrt-v4 composes
+  // them (renderFromInstance * renderFromObject). Moving transforms are refused everywhere
+  // (ActiveTransform), so neither CTM can be animated.
+  std::optional<Error> object_directive(const std::string& name, const Location& at, Stream& s) {
+    if (!in_world_) return located(at, name + " must come after WorldBegin");
+    if (name == "ObjectEnd") {
+      if (object_.empty()) return located(at, "ObjectEnd has no matching ObjectBegin");
+      if (stack_.size() != object_depth_)
+        return located(at, "ObjectEnd inside the AttributeBegin at " + stack_at_.back().str() + " (which needs its AttributeEnd first)");
+      gs_ = stack_.back();
+      stack_.pop_back();
+      stack_at_.pop_back();
+      stack_is_attribute_.pop_back();
+      object_.clear();
+      return std::nullopt;
+    }
+    PBRT_TRY(n, quoted(s, at, name));
+    if (!object_.empty())
+      return located(at, name + " inside the definition of object \"" + excerpt(object_) + "\" (ObjectBegin at " +
+                             objects_.at(object_).at.str() + "): objects do not nest");
+    if (name == "ObjectInstance") {
+      uses_.push_back({n, gs_.ctm, at});
+      return std::nullopt;
+    }
+    if (auto it = objects_.find(n); it != objects_.end())
+      return located(at, "object \"" + excerpt(n) + "\" is defined twice (first at " + it->second.at.str() + ")");
+    objects_[n] = Object{builder_.add_group(n, at.str()), at};
+    object_ = n;
+    stack_.push_back(gs_);  // ObjectBegin is an AttributeBegin too
+    stack_at_.push_back(at);
+    stack_is_attribute_.push_back(true);
+    object_depth_ = stack_.size();
+    return std::nullopt;
+  }
+
+  std::optional<Error> resolve_instances() {
+    for (const Use& u : uses_) {
+      auto it = objects_.find(u.name);
+      if (it == objects_.end()) return located(u.at, "ObjectInstance of unknown object \"" + excerpt(u.name) + "\" (no ObjectBegin defines it)");
+      builder_.add_instance(ShapeInstance{it->second.group, u.ctm, u.at.str()});
+    }
+    return std::nullopt;
+  }
+
+  // A shape into the world, or into the object being defined (import::make_group_member).
+  std::optional<Error> place(Shape s, const Location& at) {
+    if (!object_.empty())
+      if (std::optional<std::string> why = import::make_group_member(&s, objects_.at(object_).group)) return located(at, *why);
+    builder_.add_shape(std::move(s));
+    return std::nullopt;
   }
 
   // --- materials ---
@@ -1162,8 +1234,7 @@ class Importer {
         s.geometry = DiskShape{import::apply_point(m, vec3(0, 0, static_cast<float>(height))), flip ? -n : n,
                                static_cast<float>(radius) * scale};
       }
-      builder_.add_shape(std::move(s));
-      return std::nullopt;
+      return place(std::move(s), at);
     }
     if (type == "trianglemesh" || type == "bilinearmesh" || type == "plymesh") {
       // "S" (per-vertex tangents) orients anisotropic BSDFs only, which pathex's meshes take from the normal.
@@ -1235,7 +1306,7 @@ class Importer {
                 for (glm::uvec3& t : tri.triangles) std::swap(t.y, t.z);
               q.geometry = std::move(tri);
             }
-            builder_.add_shape(std::move(q));
+            if (auto e = place(std::move(q), at)) return e;
           }
           return std::nullopt;
         }
@@ -1264,8 +1335,7 @@ class Importer {
   std::optional<Error> add_mesh(Shape s, MeshShape mesh, const glm::mat4& m, bool flip, const import::Location& at) {
     if (auto e = import::place_mesh(&mesh, m, /*flip_normals=*/gs_.reverse, /*flip_winding=*/flip, at)) return e;
     s.geometry = std::move(mesh);
-    builder_.add_shape(std::move(s));
-    return std::nullopt;
+    return place(std::move(s), at);
   }
 
   // --- the camera, once the film is known ---

@@ -761,9 +761,35 @@ bool has_light(const Scene& scene) {
 bool camera_sees_geometry(const Scene& scene) {
   const ViewRegion view = view_region(scene.camera);
   for (const Shape& s : scene.shapes)
-    if (region_meets_box(view, shape_bounds(s))) return true;
+    if (s.group < 0 && region_meets_box(view, shape_bounds(s))) return true;
+  for (const auto& [lo, hi] : instance_boxes(scene))
+    if (region_meets_box(view, Box{lo, hi})) return true;
   return false;
 }
+
+}  // namespace
+
+std::vector<std::pair<vec3, vec3>> instance_boxes(const Scene& scene) {
+  std::vector<Box> group_box(scene.groups.size());
+  for (const Shape& s : scene.shapes)
+    if (s.group >= 0) {
+      const Box sb = shape_bounds(s);
+      group_box[static_cast<std::size_t>(s.group)].add(sb.lo);
+      group_box[static_cast<std::size_t>(s.group)].add(sb.hi);
+    }
+  std::vector<std::pair<vec3, vec3>> out;
+  for (const ShapeInstance& inst : scene.instances) {
+    const Box& g = group_box[static_cast<std::size_t>(inst.group)];
+    if (!(g.lo.x <= g.hi.x)) continue;  // an empty group draws nothing
+    Box b;
+    for (int c = 0; c < 8; ++c)
+      b.add(apply_point(inst.to_world, vec3(c & 1 ? g.hi.x : g.lo.x, c & 2 ? g.hi.y : g.lo.y, c & 4 ? g.hi.z : g.lo.z)));
+    out.emplace_back(b.lo, b.hi);
+  }
+  return out;
+}
+
+namespace {
 
 Result<Camera> read_camera(const Reader& r, const json& j, const std::string& ptr) {
   if (!j.is_object()) return r.fail(ptr, "expected a camera object, found " + Reader::kind(j));
@@ -1029,9 +1055,14 @@ int add_environment_box(Scene* scene, glm::vec3 emission, const std::string& poi
   // --- what the box must hold ---
   Box b;
   for (const Shape& s : scene->shapes) {
+    if (s.group >= 0) continue;  // instances' members: where the instances put them, below
     const Box sb = shape_bounds(s);
     b.add(sb.lo);
     b.add(sb.hi);
+  }
+  for (const auto& [lo, hi] : instance_boxes(*scene)) {
+    b.add(lo);
+    b.add(hi);
   }
   const Camera& c = scene->camera;
   const float camera_reach = c.type == SensorType::kLens          ? c.aperture_radius
@@ -1088,7 +1119,7 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
                               const SceneLoadOptions& options) {
   const Reader r(name);
   PATHEX_TRY(doc, parse_json(text, name));
-  if (auto k = r.keys(doc, "", {"camera", "materials", "shapes", "lights", "reference"}); !k) return k.error();
+  if (auto k = r.keys(doc, "", {"camera", "materials", "groups", "shapes", "lights", "reference"}); !k) return k.error();
   Scene scene;
   scene.name = name;
   // --- materials ---
@@ -1111,8 +1142,46 @@ Result<Scene> load_scene_json(std::string_view text, const std::string& base_dir
   if (!doc.contains("shapes") || !doc["shapes"].is_array()) return r.fail("/shapes", "expected an array of shapes");
   if (doc["shapes"].empty()) return r.fail("/shapes", "the scene is empty: expected at least one shape");
   std::size_t mesh_elements = 0;  // of all the meshes so far (--max-mesh-elements)
+  // --- groups (instancing, scene.h ShapeGroup): {"name": [shape, …]}, members in the group's space ---
+  if (doc.contains("groups")) {
+    if (!doc["groups"].is_object()) return r.fail("/groups", "expected an object of named groups, e.g. {\"tree\": [shapes]}");
+    for (const auto& [gname, gj] : doc["groups"].items()) {
+      const std::string gp = "/groups/" + pointer_token(gname);
+      if (!gj.is_array() || gj.empty()) return r.fail(gp, "expected a non-empty array of shapes");
+      const int group = static_cast<int>(scene.groups.size());
+      scene.groups.push_back({gname, gp});
+      for (std::size_t i = 0; i < gj.size(); ++i) {
+        const std::string sp = gp + "/" + std::to_string(i);
+        if (gj[i].is_object() && gj[i].contains("type") && gj[i]["type"] == "instance")
+          return r.fail(sp + "/type", "an instance inside a group is not supported: groups do not nest");
+        PATHEX_TRY(s, read_shape(r, gj[i], sp, scene, base_dir, options, &mesh_elements));
+        if (std::optional<std::string> why = import::make_group_member(&s, group)) return r.fail(sp, *why);
+        scene.shapes.push_back(std::move(s));
+      }
+    }
+  }
   for (std::size_t i = 0; i < doc["shapes"].size(); ++i) {
-    PATHEX_TRY(s, read_shape(r, doc["shapes"][i], "/shapes/" + std::to_string(i), scene, base_dir, options, &mesh_elements));
+    const std::string sp = "/shapes/" + std::to_string(i);
+    const json& sj = doc["shapes"][i];
+    if (sj.is_object() && sj.contains("type") && sj["type"] == "instance") {  // {"type": "instance", "group": name, "transform": …}
+      if (auto k = r.keys(sj, sp, {"type", "group", "transform", "description"}); !k) return k.error();
+      PATHEX_TRY(gname, r.string(sj, "group", sp));
+      ShapeInstance inst;
+      inst.group = -1;
+      for (std::size_t g = 0; g < scene.groups.size(); ++g)
+        if (scene.groups[g].name == gname) inst.group = static_cast<int>(g);
+      if (inst.group < 0) return r.fail(sp + "/group", "unknown group '" + gname + "', expected a name defined in /groups");
+      if (sj.contains("transform")) {
+        bool uniform = true;
+        float scale = 1.0f;
+        PATHEX_TRY(t, read_transform(r, sj["transform"], sp + "/transform", &uniform, &scale));
+        inst.to_world = t;
+      }
+      inst.pointer = sp;
+      scene.instances.push_back(std::move(inst));
+      continue;
+    }
+    PATHEX_TRY(s, read_shape(r, sj, sp, scene, base_dir, options, &mesh_elements));
     scene.shapes.push_back(std::move(s));
   }
   // --- lights ---
@@ -1217,7 +1286,10 @@ SceneTypes scene_types(const Scene& scene) {
         },
         l);
   }
+  std::vector<bool> instanced(scene.groups.size(), false);  // a group no instance places draws nothing
+  for (const ShapeInstance& inst : scene.instances) instanced[static_cast<std::size_t>(inst.group)] = true;
   for (const Shape& s : scene.shapes) {
+    if (s.group >= 0 && !instanced[static_cast<std::size_t>(s.group)]) continue;
     if (s.emissive()) t.lights.insert(LightType::kArea);
     t.interior = static_cast<LetterMask>(t.interior | letters_of(scene.materials[static_cast<std::size_t>(s.material)]));
   }

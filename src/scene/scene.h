@@ -19,6 +19,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -69,7 +70,25 @@ struct Shape {
   // trace/texture_eval.h): rays pass where it is 0, and a fraction 1 − alpha of them where it is
   // between; -1: opaque. A passed-through surface is no vertex (no letter).
   int alpha = -1;
+  // -1: placed in the world (the model's world-space geometry). >= 0: a member of
+  // Scene::groups[group], in the group's own space, drawn only where Scene::instances place it.
+  int group = -1;
   bool emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
+};
+
+// Instancing (pbrt-v4 ObjectBegin/ObjectInstance, Mitsuba 3 shapegroup/instance, JSON "groups"):
+// a group's member shapes (Shape::group) are stored once, in the group's space, and each instance
+// draws them all through its transform (an Embree instance: memory grows with the unique geometry,
+// not with the instances). Members are meshes without emission (area lights in instances are
+// refused, as pbrt-v4 refuses them).
+struct ShapeGroup {
+  std::string name;
+  std::string pointer;  // where it is defined, for messages
+};
+struct ShapeInstance {
+  int group = 0;              // index into Scene::groups
+  glm::mat4 to_world{1.0f};   // affine, invertible: world = to_world * group space
+  std::string pointer;        // where it is placed, for messages
 };
 
 struct PointLight {   // LSD
@@ -142,6 +161,8 @@ struct Scene {
   std::vector<std::string> material_names;
   std::vector<Material> materials;
   std::vector<Shape> shapes;
+  std::vector<ShapeGroup> groups;          // instancing: see ShapeGroup
+  std::vector<ShapeInstance> instances;
   std::vector<Light> lights;
   Camera camera;
   std::optional<ClosedFormReference> reference;  // "reference", when the scene declares one
@@ -209,6 +230,11 @@ struct SceneLoadOptions {
 };
 // The options of a command's limits (every command that reads a scene passes them through here).
 SceneLoadOptions scene_load_options(const Limits& limits, bool triangles = true);
+// The world-space axis-aligned box of each instance of a non-empty group: its group's
+// members' boxes, their corners moved by the instance's transform. For the scene-level code that
+// needs world extents (the camera rule, the environment box, distant lights' apertures).
+std::vector<std::pair<glm::vec3, glm::vec3>> instance_boxes(const Scene& scene);
+
 // An OBJ face may have at most this many corners (tinyobjloader's triangulation of one polygon
 // is quadratic in its corners; a modeller's n-gons are far smaller).
 inline constexpr std::size_t kMaxFaceCorners = 1024;

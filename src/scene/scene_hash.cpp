@@ -65,6 +65,7 @@ std::string scene_content_hash(const Scene& scene) {
     h.add(s.two_sided);
     if (s.absorption != glm::vec3(0.0f)) h.add(s.absorption);  // only then: the hashes of scenes without media stay as they were
     if (s.alpha >= 0) h.add(s.alpha);                            // likewise without cut-outs
+    if (s.group >= 0) h.add(s.group);                            // likewise for instancing
   }
   if (!scene.textures.empty()) {  // likewise without textures
     h.add(static_cast<std::uint64_t>(scene.textures.size()));
@@ -84,6 +85,13 @@ std::string scene_content_hash(const Scene& scene) {
       h.add(m.amount);
       h.bytes(m.weight0.data(), m.weight0.size() * sizeof(float));
       h.bytes(m.weight1.data(), m.weight1.size() * sizeof(float));
+    }
+  }
+  if (!scene.instances.empty()) {
+    h.add(static_cast<std::uint64_t>(scene.instances.size()));
+    for (const ShapeInstance& i : scene.instances) {
+      h.add(i.group);
+      for (int c = 0; c < 4; ++c) h.add(glm::vec4(i.to_world[c]));
     }
   }
   h.add(static_cast<std::uint64_t>(scene.lights.size()));

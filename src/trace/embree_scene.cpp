@@ -272,6 +272,13 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
   es->quad_normals_.assign(scene.shapes.size(), vec3(0.0f));
   es->shape_errors_.assign(scene.shapes.size(), vec3(0.0f));
   es->triangle_cdf_.resize(scene.shapes.size());
+  // Instancing: each group's members go into an Embree scene of their own, which every instance
+  // of the group references with its transform (one copy of the geometry however many instances).
+  es->group_geom_to_shape_.resize(scene.groups.size());
+  for (std::size_t g = 0; g < scene.groups.size(); ++g) {
+    es->groups_.emplace_back(rtcNewScene(device));
+    rtcSetSceneFlags(es->groups_.back().get(), RTC_SCENE_FLAG_ROBUST);
+  }
   for (std::size_t si = 0; si < scene.shapes.size(); ++si) {
     const Shape& shape = scene.shapes[si];
     RTCGeometry g = nullptr;
@@ -292,7 +299,7 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
         v[3 * i + 2] = m->positions[i].z;
       }
       std::vector<double>& cdf = es->triangle_cdf_[si];
-      cdf.reserve(m->triangles.size());
+      if (shape.group < 0) cdf.reserve(m->triangles.size());  // members are never sampled (no emitters in instances)
       double total = 0.0;
       for (std::size_t i = 0; i < m->triangles.size(); ++i) {
         const glm::uvec3 t = m->triangles[i];
@@ -301,7 +308,7 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
         idx[3 * i + 2] = t.z;
         const glm::dvec3 p0(m->positions[t.x]), p1(m->positions[t.y]), p2(m->positions[t.z]);
         total += 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
-        cdf.push_back(total);
+        if (shape.group < 0) cdf.push_back(total);
       }
       es->areas_[si] = static_cast<float>(total);
       es->triangles_ += m->triangles.size();
@@ -351,11 +358,44 @@ Result<std::unique_ptr<EmbreeScene>> EmbreeScene::build(const Scene& scene) {
       rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
     }
     rtcCommitGeometry(g);
+    const bool member = shape.group >= 0;
+    const unsigned id = rtcAttachGeometry(member ? es->groups_[static_cast<std::size_t>(shape.group)].get() : es->scene_.get(), g);
+    rtcReleaseGeometry(g);
+    if (id == RTC_INVALID_GEOMETRY_ID) break;
+    std::vector<unsigned>& to_shape = member ? es->group_geom_to_shape_[static_cast<std::size_t>(shape.group)] : es->geom_to_shape_;
+    if (to_shape.size() <= id) to_shape.resize(id + 1, 0);
+    to_shape[id] = static_cast<unsigned>(si);
+  }
+  // --- instances: Embree instance geometry referencing the group's scene ---
+  if (es->errors_->first.empty())
+    for (const auto& group : es->groups_) rtcCommitScene(group.get());
+  for (std::size_t ii = 0; ii < scene.instances.size() && es->errors_->first.empty(); ++ii) {
+    const ShapeInstance& inst = scene.instances[ii];
+    InstanceTransform x;
+    x.to_world = inst.to_world;
+    const glm::mat3 linear(inst.to_world);
+    const glm::mat3 inverse = glm::inverse(linear);
+    x.normal_matrix = glm::transpose(inverse);
+    x.flips = glm::determinant(linear) < 0.0f;
+    // Embree moves the ray's origin o to the group's space (inverse * (o - translation), about
+    // four roundings a component) and the hit back is computed here from corners moved by
+    // to_world (three more): |linear| |inverse| (|x| + |translation|) times gamma(8) bounds both.
+    const glm::mat3 abs_linear(abs3(linear[0]), abs3(linear[1]), abs3(linear[2]));
+    const glm::mat3 abs_inverse(abs3(inverse[0]), abs3(inverse[1]), abs3(inverse[2]));
+    // The identity moves nothing and Embree's multiply by it is exact: no term (an instance in
+    // place then offsets its rays exactly as the flattened mesh does).
+    if (inst.to_world != glm::mat4(1.0f)) x.error_scale = error_gamma(8) * (abs_linear * abs_inverse);
+    x.abs_translation = abs3(glm::vec3(inst.to_world[3]));
+    es->instances_.push_back(x);
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(g, es->groups_[static_cast<std::size_t>(inst.group)].get());
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &inst.to_world[0][0]);
+    rtcCommitGeometry(g);
     const unsigned id = rtcAttachGeometry(es->scene_.get(), g);
     rtcReleaseGeometry(g);
     if (id == RTC_INVALID_GEOMETRY_ID) break;
-    if (es->geom_to_shape_.size() <= id) es->geom_to_shape_.resize(id + 1, 0);
-    es->geom_to_shape_[id] = static_cast<unsigned>(si);
+    if (es->geom_to_instance_.size() <= id) es->geom_to_instance_.resize(id + 1, 0);
+    es->geom_to_instance_[id] = static_cast<unsigned>(ii);
   }
   if (es->errors_->first.empty()) rtcCommitScene(es->scene_.get());
   if (!es->errors_->first.empty())
@@ -379,8 +419,12 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return out;
   Hit& h = out.emplace();
   h.t = rh.ray.tfar;
-  h.shape = static_cast<int>(geom_to_shape_[rh.hit.geomID]);
   h.primitive = static_cast<int>(rh.hit.primID);
+  if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
+    instance_hit(rh.hit.instID[0], rh.hit.geomID, rh.hit.u, rh.hit.v, d, detail, &h);
+    return out;
+  }
+  h.shape = static_cast<int>(geom_to_shape_[rh.hit.geomID]);
   const vec3 p = o + h.t * d;
   // Each branch puts the position back onto the exact surface and computes the normal and uv.
   const Shape& shape = source_->shapes[static_cast<std::size_t>(h.shape)];
@@ -418,6 +462,38 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
   }
   h.shading_normal = h.normal;
   return out;
+}
+
+// A hit on an instance's member (a mesh: make_group_member): computed exactly as the flattened
+// mesh's hit would be, from the triangle's corners moved to the world by the instance's
+// transform as flattening moves them (apply_point: to_world * (p, 1)), with Embree's barycentrics
+// from its test in the group's space. The normal is that of the moved corners (turned when the
+// transform mirrors, as flattening swaps the winding), the shading normal the group-space one by
+// the inverse transpose. The error bound adds the rounding of the way to the group's space and back.
+void EmbreeScene::instance_hit(unsigned inst_geom, unsigned geom, float u, float v, const vec3& d, HitDetail detail, Hit* h) const {
+  const unsigned ii = geom_to_instance_[inst_geom];
+  const InstanceTransform& x = instances_[ii];
+  const ShapeInstance& inst = source_->instances[ii];
+  h->instance = static_cast<int>(ii);
+  h->shape = static_cast<int>(group_geom_to_shape_[static_cast<std::size_t>(inst.group)][geom]);
+  const MeshShape& m = std::get<MeshShape>(source_->shapes[static_cast<std::size_t>(h->shape)].geometry);
+  const glm::uvec3 t = m.triangles[static_cast<std::size_t>(h->primitive)];
+  const auto place = [&](const vec3& p) { return vec3(x.to_world * glm::vec4(p, 1.0f)); };
+  const vec3 p0 = place(m.positions[t.x]), p1 = place(m.positions[t.y]), p2 = place(m.positions[t.z]);
+  if (detail == HitDetail::kFull)
+    h->uv = m.uvs.empty() ? glm::vec2(u + v, v) : (1.0f - u - v) * m.uvs[t.x] + u * m.uvs[t.y] + v * m.uvs[t.z];
+  h->position = triangle_point(p0, p1, p2, 1.0f - u - v, u, v, &h->error);
+  h->error += x.error_scale * (abs3(h->position) + x.abs_translation);
+  const vec3 n = glm::cross(p1 - p0, p2 - p0);
+  const float len = glm::length(n);
+  h->normal = len > 0.0f ? (x.flips ? -n : n) / len : -glm::normalize(d);
+  if (m.normals.empty()) {
+    h->shading_normal = h->normal;
+  } else {
+    const vec3 ns = x.normal_matrix * mesh_shading_normal(m, t, u, v, vec3(0.0f));
+    const float ls = glm::length(ns);
+    h->shading_normal = ls > 0.0f ? ns / ls : h->normal;
+  }
 }
 
 bool EmbreeScene::occluded(const vec3& o, const vec3& d, float tmin, float tmax) const {

@@ -48,8 +48,9 @@ struct Hit {
   glm::vec3 normal{0.0f};          // geometric, unit, the shape's outward side (whichever side was hit)
   glm::vec3 shading_normal{0.0f};  // unit: a mesh's interpolated vertex normals where it has them, else `normal`
   glm::vec3 error{0.0f};           // bound on |position - the exact surface point|, per component
-  int shape = -1;                  // index into Scene::shapes
+  int shape = -1;                  // index into Scene::shapes (an instance's hit: the group member's)
   int primitive = -1;              // triangle index for meshes, 0 otherwise
+  int instance = -1;               // index into Scene::instances, -1 for shapes placed in the world
   // Surface parameters (HitDetail::kFull only; zero otherwise), the textures' coordinates: mesh,
   // its per-vertex uv interpolated, or without them pbrt-v4's default (0, 0), (1, 0), (1, 1) at the
   // triangle's corners, (w1 + w2, w2) for Embree's barycentrics w1, w2; quad, position = corner + u edge1 + v edge2; sphere, u = phi / 2pi with
@@ -214,6 +215,21 @@ class EmbreeScene {
     return surface_derivatives(shape_geometry(h.shape), h.primitive, glm::dvec3(h.position));
   }
 
+  // An instance's transform as the hits use it (EmbreeScene::intersect): the member's triangle
+  // corners are moved to the world by `to_world` (as flattening would place them) and the hit is
+  // computed from them; shading normals by `normal_matrix` (the inverse transpose). `flips`: the
+  // transform mirrors (negative determinant), so the front side is the other one. `error_scale`
+  // bounds the rounding of Embree's ray transform to the group's space and back: a per-component
+  // multiple of (|x| + |translation|) (see intersect()).
+  struct InstanceTransform {
+    glm::mat4 to_world{1.0f};
+    glm::mat3 normal_matrix{1.0f};
+    glm::mat3 error_scale{0.0f};
+    glm::vec3 abs_translation{0.0f};
+    bool flips = false;
+  };
+  const InstanceTransform& instance_transform(int instance) const { return instances_[static_cast<std::size_t>(instance)]; }
+
   RTCScene handle() const { return scene_.get(); }
   std::size_t triangle_count() const { return triangles_; }
 
@@ -233,7 +249,10 @@ class EmbreeScene {
   std::unique_ptr<ErrorSink> errors_;
   std::unique_ptr<RTCDeviceTy, DeviceRelease> device_;
   std::vector<std::unique_ptr<AnalyticRecord>> analytic_;
+  std::vector<std::unique_ptr<RTCSceneTy, SceneRelease>> groups_;  // one Embree scene per ShapeGroup
   std::unique_ptr<RTCSceneTy, SceneRelease> scene_;
+
+  void instance_hit(unsigned inst_geom, unsigned geom, float u, float v, const glm::vec3& d, HitDetail detail, Hit* h) const;
 
   const Scene* source_ = nullptr;
   std::vector<float> areas_;
@@ -243,6 +262,9 @@ class EmbreeScene {
   std::vector<glm::vec3> shape_errors_;
   std::vector<std::vector<double>> triangle_cdf_;  // meshes: cumulative triangle areas
   std::vector<unsigned> geom_to_shape_;
+  std::vector<std::vector<unsigned>> group_geom_to_shape_;  // per group: its scene's geomID -> shape
+  std::vector<InstanceTransform> instances_;                // per Scene::instances
+  std::vector<unsigned> geom_to_instance_;                  // the top scene's geomID -> instance
   std::size_t triangles_ = 0;
 };
 

@@ -71,11 +71,12 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
                                       : nullptr;
     rs.textures_of_shape.push_back(tex && !tex->empty() ? tex : nullptr);
     rs.textured = rs.textured || rs.textures_of_shape.back() != nullptr;
+    rs.in_group.push_back(s.group >= 0 ? 1 : 0);
     rs.emission_of_shape.push_back(s.emission);
     rs.absorption_of_shape.push_back(s.absorption);
     rs.absorbing = rs.absorbing || s.absorption != glm::vec3(0.0f);
     // Planar mirrors, for the mirror connector: quads of a pure mirror material.
-    const auto* quad = std::get_if<QuadShape>(&s.geometry);
+    const auto* quad = s.group < 0 ? std::get_if<QuadShape>(&s.geometry) : nullptr;
     const auto* mirror = std::get_if<Mirror>(rs.material_of_shape.back());
     if (quad && mirror && !s.emissive()) {
       const glm::vec3 n = glm::cross(quad->edge1, quad->edge2);
@@ -95,7 +96,20 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
   }
   rs.features = scene_features(rs.material_of_shape);
   for (std::size_t i = 0; i < scene.shapes.size(); ++i)
-    if (scene_features({rs.material_of_shape[i]}).specular) rs.specular_bounds.push_back(bounding_sphere(scene.shapes[i].geometry));
+    if (scene.shapes[i].group < 0 && scene_features({rs.material_of_shape[i]}).specular)
+      rs.specular_bounds.push_back(bounding_sphere(scene.shapes[i].geometry));
+  // An instance's specular members: their spheres moved by its transform, the radius scaled by
+  // the transform's largest stretch (bounded by the Frobenius norm of its linear part).
+  std::vector<std::vector<BoundingSphere>> specular_members(scene.groups.size());
+  for (std::size_t i = 0; i < scene.shapes.size(); ++i)
+    if (scene.shapes[i].group >= 0 && scene_features({rs.material_of_shape[i]}).specular)
+      specular_members[static_cast<std::size_t>(scene.shapes[i].group)].push_back(bounding_sphere(scene.shapes[i].geometry));
+  for (const ShapeInstance& inst : scene.instances) {
+    const glm::mat3 l(inst.to_world);
+    const float stretch = std::sqrt(glm::dot(l[0], l[0]) + glm::dot(l[1], l[1]) + glm::dot(l[2], l[2]));
+    for (const BoundingSphere& b : specular_members[static_cast<std::size_t>(inst.group)])
+      rs.specular_bounds.push_back({glm::vec3(inst.to_world * glm::vec4(b.center, 1.0f)), b.radius * stretch * 1.0001f});
+  }
   for (const Light& light : scene.lights) {
     RenderLight l;
     if (const auto* p = std::get_if<PointLight>(&light)) {

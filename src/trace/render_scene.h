@@ -68,6 +68,9 @@ struct RenderScene {
   // A sphere around each shape whose material has a specular (Dirac) component: where a path whose
   // first surface vertex scatters specularly can start (trace/emission_cones.h).
   std::vector<BoundingSphere> specular_bounds;
+  // 1 for a shape that is a group member, drawn by instances (scene.h ShapeInstance); the manifold
+  // connector's walks know world-space shapes only and treat these as opaque.
+  std::vector<std::uint8_t> in_group;
 };
 
 Result<RenderScene> make_render_scene(const Scene& scene);

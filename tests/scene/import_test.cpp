@@ -466,8 +466,7 @@ const char* sixty_five_attributes() {
 std::vector<Refusal> refusals() {
   return {
       // pbrt-v4
-      {"object.pbrt", "ObjectBegin \"thing\"\n", "object.pbrt:4:1",
-       "directive 'ObjectBegin' is not supported (pathex imports shapes, materials, lights, a camera, transforms and Include/Import)"},
+      {"object.pbrt", "ObjectBegin \"thing\"\n", "object.pbrt:4:1", "ObjectBegin \"thing\" has no matching ObjectEnd"},
       {"medium.pbrt", "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n", "medium.pbrt:4:1",
        "medium \"fog\" scatters (pbrt-v4's default sigma_s is not 0): a scattering medium needs a volume letter that pathex's alphabet "
        "does not have; give \"rgb sigma_s\" [0 0 0] for an absorbing one"},
@@ -624,7 +623,7 @@ TEST(ImportRefusals, CliPrintsTheSameLineAndExits2) {
   // query --scene and check read scenes through the same entry point.
   const pathex::test::CliRun q = pathex::test::run_pathex("query --scene " + write("object.pbrt", kPbrtHead + "ObjectBegin \"thing\"\n") + " 'L.*E'");
   EXPECT_EQ(q.code, 2);
-  EXPECT_NE(q.err.find("object.pbrt:4:1: directive 'ObjectBegin' is not supported"), std::string::npos) << q.err;
+  EXPECT_NE(q.err.find("object.pbrt:4:1: ObjectBegin \"thing\" has no matching ObjectEnd"), std::string::npos) << q.err;
 }
 
 // pbrt-v4's hints are accepted and change nothing; Attribute defaults are honoured, scoped by

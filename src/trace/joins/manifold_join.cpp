@@ -23,7 +23,7 @@ void Integrator::init_manifold() {
   mirror_reflectance_.assign(rs_.material_of_shape.size(), vec3(0.0f));
   specular_shapes_.clear();
   for (std::size_t i = 0; i < rs_.material_of_shape.size(); ++i) {
-    if (rs_.light_of_shape[i] >= 0) continue;
+    if (rs_.light_of_shape[i] >= 0 || rs_.in_group[i]) continue;  // instanced members: opaque to the walks (RenderScene::in_group)
     const Material& m = *rs_.material_of_shape[i];
     if (const auto* d = std::get_if<Dielectric>(&m); d && d->ior > 0.0f && d->ior != 1.0f) glass_ior_[i] = d->ior;
     // A mirror, or a mixture's mirror components (each weighed by its weight).
