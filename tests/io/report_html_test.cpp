@@ -215,7 +215,7 @@ TEST(ReportContent, OnlyAndNotRenderedClasses) {
   EXPECT_EQ(attr(html, "data-class=\"direct\"", "data-rendered"), "false");
   EXPECT_EQ(attr(html, "data-class=\"caustic\"", "data-rendered"), "true");
   EXPECT_NE(html.find("<tr><th>luminance of the requested paths"), std::string::npos);
-  EXPECT_NE(html.find(" --only &#39;$caustic&#39; "), std::string::npos);
+  EXPECT_NE(html.find(" --only &apos;$caustic&apos; "), std::string::npos);
 }
 
 TEST(ReportContent, BiasReportShowsTheMissedLightWithTheCheckersReasons) {
@@ -227,7 +227,7 @@ TEST(ReportContent, BiasReportShowsTheMissedLightWithTheCheckersReasons) {
   const std::string html = read_file(dir / "report.html");
   const auto bias = nlohmann::json::parse(read_file(dir / "bias.json"));
   EXPECT_NE(html.find("<section id=\"missed\"><h2>The light pt-nee misses</h2>"), std::string::npos);
-  EXPECT_NE(html.find("alt=\"the missed light alone, on the render&#39;s exposure\""), std::string::npos);
+  EXPECT_NE(html.find("alt=\"the missed light alone, on the render&apos;s exposure\""), std::string::npos);
   for (const auto& c : bias["classes"]) {
     const std::string name = c["name"];
     EXPECT_NE(html.find("<tr data-class=\"" + name + "\"><td>" + name + "</td>"), std::string::npos) << name;
