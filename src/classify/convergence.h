@@ -56,16 +56,6 @@ double variance_relative_error(const std::vector<double>& batch_means);
 // P(χ²_dof > x) = alpha (the survival function in closed form for integer dof, solved by bisection).
 double chi2_upper_quantile(int dof, double alpha);
 
-// P(|T| > x) for Student's t with `dof` ≥ 1 degrees of freedom (the batch-means z of an estimate
-// from B batches has B − 1), by Simpson's rule over [0, x] of its density.
-double student_two_sided_tail(double x, int dof);
-// The tolerance, in standard errors, at which `checks` independent two-sided checks of
-// t-distributed deviations (`dof` degrees of freedom) fail together with probability
-// `family_rate` when nothing is wrong (Šidák: each at 1 − (1 − family_rate)^(1/checks)). The one
-// place that turns a false-alarm rate into a number of σ: `pathex bias`'s under-sampling check and
-// the statistical tests (tests/support/stat_seed.h).
-double sidak_sigmas(int checks, double family_rate, int dof);
-
 // One rung as the checks see it.
 struct RungError {
   double estimate = 0.0;

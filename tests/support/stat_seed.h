@@ -16,7 +16,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "classify/convergence.h"
+#include "classify/significance.h"
 
 namespace pathex::test {
 

@@ -21,6 +21,7 @@
 #include "scene/scene.h"
 #include "support/env_images.h"
 #include "support/stat_seed.h"
+#include "support/test_classes.h"
 #include "trace/environment.h"
 #include "trace/render.h"
 #include "trace/rng.h"
@@ -119,38 +120,24 @@ Rendered render_json(const std::string& scene_json, const std::string& renderer,
   EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().render());
   Result<Profile> profile = resolve_profile(renderer, Limits{});
   EXPECT_TRUE(profile.ok());
-  static std::vector<std::unique_ptr<PathClass>> keep;
-  std::vector<const PathClass*> pcs;
-  std::vector<ClassInfo> infos;
-  for (const std::string& c : classes) {
-    Result<PathClass> pc = compile_class(c, ClassOptions{});
-    EXPECT_TRUE(pc.ok()) << c;
-    keep.push_back(std::make_unique<PathClass>(std::move(*pc)));
-    keep.back()->name = c;
-    pcs.push_back(keep.back().get());
-    infos.push_back({c, c});
-  }
-  static std::vector<std::unique_ptr<Classifier>> keep_cl;
-  keep_cl.push_back(std::make_unique<Classifier>(Classifier::build(pcs, Limits{}).expect("a test input")));
+  static std::vector<std::unique_ptr<test::TestClasses>> keep;  // the reports outlive this call
+  keep.push_back(test::test_classes(classes));
+  const std::vector<ClassInfo>& infos = keep.back()->infos;
   RenderOptions o;
   o.spp = spp;
   o.seed = seed;
   o.max_bounces = 8;
-  Result<RenderOutput> out = render(*scene, *profile, keep_cl.back().get(), o);
+  Result<RenderOutput> out = render(*scene, *profile, keep.back()->classifier.get(), o);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
   RunInfo info;
   info.spp = spp;
-  Result<HistogramReport> rep = make_report(out->histogram, info, keep_cl.back().get(), infos);
+  Result<HistogramReport> rep = make_report(out->histogram, info, keep.back()->classifier.get(), infos);
   EXPECT_TRUE(rep.ok());
   EXPECT_EQ(rep->nonfinite_samples, 0u) << renderer;
   return Rendered{std::move(*rep)};
 }
 
-void expect_close(const Estimate& e, double expected, double sigmas, double rel, const std::string& what) {
-  EXPECT_TRUE(std::isfinite(e.std_error)) << what;
-  EXPECT_LE(std::fabs(e.luminance - expected), sigmas * e.std_error + rel * expected)
-      << what << ": estimate " << e.luminance << " ± " << e.std_error << ", expected " << expected;
-}
+using test::expect_close;
 
 // Two estimates of one value: their difference within `sigmas` standard errors of the difference.
 void expect_agree(const Estimate& a, const Estimate& b, double sigmas, const std::string& what) {

@@ -19,6 +19,7 @@
 #include "scene/scene.h"
 #include "support/cli_run.h"
 #include "support/stat_seed.h"
+#include "support/test_classes.h"
 #include "trace/render.h"
 
 namespace pathex {
@@ -41,18 +42,9 @@ Rendered render_file(const std::string& file, const std::string& renderer, const
   if (!scene) return {};
   Result<Profile> profile = resolve_profile(renderer, Limits{});
   EXPECT_TRUE(profile.ok());
-  std::vector<std::unique_ptr<PathClass>> keep;
-  std::vector<const PathClass*> pcs;
-  std::vector<ClassInfo> infos;
-  for (const std::string& c : classes) {
-    Result<PathClass> pc = compile_class(c, ClassOptions{});
-    EXPECT_TRUE(pc.ok()) << c;
-    keep.push_back(std::make_unique<PathClass>(std::move(*pc)));
-    keep.back()->name = c;
-    pcs.push_back(keep.back().get());
-    infos.push_back({c, c});
-  }
-  const Classifier classifier = Classifier::build(pcs, Limits{}).expect("a test input");
+  const std::unique_ptr<test::TestClasses> tc = test::test_classes(classes);
+  const std::vector<ClassInfo>& infos = tc->infos;
+  const Classifier& classifier = *tc->classifier;
   RenderOptions o;
   o.spp = spp;
   o.seed = seed;
@@ -68,15 +60,10 @@ Rendered render_file(const std::string& file, const std::string& renderer, const
   return Rendered{std::move(*rep), out->histogram.nonfinite()};
 }
 
-// |estimate - expected| within `sigmas` standard errors plus `rel` of expected; finite throughout.
+// test::expect_close: |estimate − expected| within `sigmas` standard errors plus `rel` of expected.
 // Each test passes test::family_sigmas(its number of checks): a family-wise false-failure rate of
 // 0.1 % (Šidák over Student's t with 31 dof), and its seed comes from test::stat_seed.
-void expect_close(const Estimate& e, double expected, double sigmas, double rel, const std::string& what) {
-  EXPECT_TRUE(std::isfinite(e.luminance)) << what;
-  EXPECT_TRUE(std::isfinite(e.std_error)) << what;
-  EXPECT_LE(std::fabs(e.luminance - expected), sigmas * e.std_error + rel * std::fabs(expected))
-      << what << ": estimate " << e.luminance << " ± " << e.std_error << ", expected " << expected;
-}
+using test::expect_close;
 
 // The mean over a square film of half-width w (tangent units) of f(x, y), with the substitution
 // x = c sinh(s) per axis, which puts most nodes where a peak of width c at the film's centre is:

@@ -15,6 +15,7 @@
 #include "trace/render.h"
 #include "support/scratch_files.h"
 #include "support/stat_seed.h"
+#include "support/test_classes.h"
 
 namespace pathex {
 namespace {
@@ -53,19 +54,9 @@ Rendered render_scene(Result<Scene> scene, const std::string& renderer, const st
   EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().render());
   Result<Profile> profile = resolve_profile(renderer, Limits{});
   EXPECT_TRUE(profile.ok());
-  static std::vector<std::unique_ptr<PathClass>> keep;
-  std::vector<const PathClass*> pcs;
-  std::vector<ClassInfo> infos;
-  for (const std::string& c : classes) {
-    Result<PathClass> pc = compile_class(c, ClassOptions{});
-    EXPECT_TRUE(pc.ok()) << c;
-    keep.push_back(std::make_unique<PathClass>(std::move(*pc)));
-    keep.back()->name = c;
-    pcs.push_back(keep.back().get());
-    infos.push_back({c, c});
-  }
-  static std::vector<std::unique_ptr<Classifier>> keep_cl;
-  keep_cl.push_back(std::make_unique<Classifier>(Classifier::build(pcs, Limits{}).expect("a test input")));
+  static std::vector<std::unique_ptr<test::TestClasses>> keep;  // the reports outlive this call
+  keep.push_back(test::test_classes(classes));
+  const std::vector<ClassInfo>& infos = keep.back()->infos;
   RenderOptions o;
   o.spp = spp;
   o.seed = seed;
@@ -74,21 +65,16 @@ Rendered render_scene(Result<Scene> scene, const std::string& renderer, const st
   o.sampler = sampling.sampler;
   o.rr_depth = sampling.rr_depth;
   o.rr_threshold = sampling.rr_threshold;
-  Result<RenderOutput> out = render(*scene, *profile, keep_cl.back().get(), o);
+  Result<RenderOutput> out = render(*scene, *profile, keep.back()->classifier.get(), o);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
   RunInfo info;
   info.spp = spp;
-  Result<HistogramReport> rep = make_report(out->histogram, info, keep_cl.back().get(), infos);
+  Result<HistogramReport> rep = make_report(out->histogram, info, keep.back()->classifier.get(), infos);
   EXPECT_TRUE(rep.ok());
   return Rendered{std::move(*rep), std::move(*out)};
 }
 
-// |estimate - expected| within `sigmas` standard errors plus `rel` of expected.
-void expect_close(const Estimate& e, double expected, double sigmas, double rel, const std::string& what) {
-  EXPECT_TRUE(std::isfinite(e.std_error)) << what;
-  EXPECT_LE(std::fabs(e.luminance - expected), sigmas * e.std_error + rel * expected)
-      << what << ": estimate " << e.luminance << " ± " << e.std_error << ", expected " << expected;
-}
+using test::expect_close;
 
 std::string closed_sphere_point(double rho, double intensity) {
   return R"({"camera": {"type": "pinhole", "position": [0.1, 0.05, 0], "look_at": [0.1, 0.05, 1], "up": [0, 1, 0],

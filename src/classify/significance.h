@@ -1,0 +1,17 @@
+// Significance levels for many checks at once: Student's t tails and the Šidák tolerance. The one
+// place that turns a false-alarm rate into a number of σ, for `pathex bias`'s under-sampling check
+// (bias/bias.h) and the statistical tests (tests/support/stat_seed.h).
+#pragma once
+
+namespace pathex {
+
+// P(|T| > x) for Student's t with `dof` ≥ 1 degrees of freedom (the batch-means z of an estimate
+// from B batches has B − 1), by Simpson's rule over [0, x] of its density.
+double student_two_sided_tail(double x, int dof);
+
+// The tolerance, in standard errors, at which `checks` independent two-sided checks of
+// t-distributed deviations (`dof` degrees of freedom) fail together with probability
+// `family_rate` when nothing is wrong (Šidák: each at 1 − (1 − family_rate)^(1/checks)).
+double sidak_sigmas(int checks, double family_rate, int dof);
+
+}  // namespace pathex
