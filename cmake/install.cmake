@@ -20,6 +20,7 @@ endforeach()
 add_custom_target(pathex_docs ALL DEPENDS ${pathex_generated_docs})
 
 install(TARGETS pathex RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(TARGETS pathex_image LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/pathex)  # src/io/image_file.h
 install(TARGETS pathex_lib EXPORT pathexTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/pathex DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${PROJECT_BINARY_DIR}/share/pathex.man DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 RENAME pathex.1)

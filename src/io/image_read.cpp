@@ -1,10 +1,13 @@
 #include "io/image_read.h"
 
-#include <OpenImageIO/imageio.h>
+#include <dlfcn.h>
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <system_error>
+
+#include "io/image_file.h"
 
 namespace pathex {
 
@@ -16,10 +19,31 @@ Error image_error(ErrorCode code, const std::string& path, std::string message) 
   return e;
 }
 
-// OpenImageIO's message without its trailing newline, or `fallback` when it has none.
-std::string oiio_message(std::string message, const std::string& fallback) {
-  while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
-  return message.empty() ? fallback : message;
+// The decoding module (io/image_file.h), loaded once per process and never closed. Where it is: the
+// build tree's copy while that exists, else the installed one (cmake/install.cmake).
+struct ImageModule {
+  PathexOpenImageFileFn open = nullptr;
+  std::string error;  // why it could not be loaded, when `open` is null
+};
+
+const ImageModule& image_module() {
+  static const ImageModule module = [] {
+    ImageModule m;
+    std::string tried;
+    for (const char* path : {PATHEX_IMAGE_MODULE_BUILD, PATHEX_IMAGE_MODULE_INSTALLED}) {
+      void* lib = ::dlopen(path, RTLD_NOW | RTLD_LOCAL);
+      if (lib == nullptr) {
+        tried += std::string(tried.empty() ? "" : "; ") + ::dlerror();
+        continue;
+      }
+      m.open = reinterpret_cast<PathexOpenImageFileFn>(::dlsym(lib, "pathex_open_image_file"));
+      if (m.open != nullptr) return m;
+      tried += std::string(tried.empty() ? "" : "; ") + path + ": has no pathex_open_image_file";
+    }
+    m.error = "cannot load pathex's image decoder libpathex_image.so (" + tried + ")";
+    return m;
+  }();
+  return module;
 }
 
 }  // namespace
@@ -35,30 +59,28 @@ Result<LinearImage> read_image(const std::string& path, const ImageReadOptions& 
   if (bytes > options.max_file_bytes)
     return image_error(ErrorCode::kLimit, path, limit_message("the image file", options.max_file_bytes, "bytes", "--max-file-size"));
 
-  // Colour as the file stores it: OpenImageIO would otherwise multiply a PNG's colour by its alpha
-  // (associated alpha), and the colour's decoding and an alpha cut-out each need it alone.
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path, &config);
-  if (!in) return image_error(ErrorCode::kBadFile, path, "is not an image OpenImageIO reads: " + oiio_message(OIIO::geterror(), "unknown format"));
-  const OIIO::ImageSpec spec = in->spec();
+  const ImageModule& module = image_module();
+  if (module.open == nullptr) return image_error(ErrorCode::kBadFile, path, module.error);
+  std::string message;
+  std::unique_ptr<ImageFile> in(module.open(path.c_str(), &message));
+  if (!in) return image_error(ErrorCode::kBadFile, path, "is not an image OpenImageIO reads: " + message);
+  const ImageFileInfo spec = in->info();
   if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1)
     return image_error(ErrorCode::kBadFile, path, "has no pixels (expected a two-dimensional image of at least 1 x 1)");
-  if (spec.nchannels < 1 || spec.nchannels > 4)
+  if (spec.channels < 1 || spec.channels > 4)
     return image_error(ErrorCode::kBadFile, path,
-                       "has " + std::to_string(spec.nchannels) + " channels (expected 1 grey, 2 grey and alpha, 3 RGB or 4 RGBA)");
+                       "has " + std::to_string(spec.channels) + " channels (expected 1 grey, 2 grey and alpha, 3 RGB or 4 RGBA)");
   const std::size_t texels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
   const std::size_t before = options.texels_so_far ? *options.texels_so_far : 0;
   if (texels > options.max_texels || before + texels > options.max_texels)
     return image_error(ErrorCode::kLimit, path, limit_message("the size of the scene's images", options.max_texels, "texels", "--max-texels"));
 
-  const int channels = spec.nchannels;
+  const int channels = spec.channels;
   std::vector<float> data(texels * static_cast<std::size_t>(channels));
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
-    return image_error(ErrorCode::kBadFile, path, "cannot be decoded: " + oiio_message(in->geterror(), "a read error"));
-  in->close();
+  if (!in->read(data.data(), &message)) return image_error(ErrorCode::kBadFile, path, "cannot be decoded: " + message);
+  in.reset();
 
-  const bool encoded = !spec.format.is_floating_point();
+  const bool encoded = !spec.floating;
   auto decode = [&](float v) {
     if (!encoded || options.encoding == ImageEncoding::kLinear) return v;
     if (options.encoding == ImageEncoding::kSrgb) return srgb_to_linear(v);
