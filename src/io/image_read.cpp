@@ -19,19 +19,31 @@ Error image_error(ErrorCode code, const std::string& path, std::string message) 
   return e;
 }
 
-// The decoding module (io/image_file.h), loaded once per process and never closed. Where it is: the
-// build tree's copy while that exists, else the installed one (cmake/install.cmake).
+// The decoding module (io/image_file.h), loaded once per process and never closed. Where it is
+// looked for: the build tree's copy (while that exists); beside the running executable as
+// installed (bin/pathex with lib/pathex/libpathex_image.so, whatever prefix `cmake --install`
+// was given); the install prefix configured at build time (a program linking the installed
+// library).
 struct ImageModule {
   PathexOpenImageFileFn open = nullptr;
   std::string error;  // why it could not be loaded, when `open` is null
 };
 
+std::vector<std::string> image_module_candidates() {
+  std::vector<std::string> paths{PATHEX_IMAGE_MODULE_BUILD};
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) paths.push_back((exe.parent_path() / PATHEX_IMAGE_MODULE_FROM_BINDIR).lexically_normal().string());
+  paths.push_back(PATHEX_IMAGE_MODULE_INSTALLED);
+  return paths;
+}
+
 const ImageModule& image_module() {
   static const ImageModule module = [] {
     ImageModule m;
     std::string tried;
-    for (const char* path : {PATHEX_IMAGE_MODULE_BUILD, PATHEX_IMAGE_MODULE_INSTALLED}) {
-      void* lib = ::dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    for (const std::string& path : image_module_candidates()) {
+      void* lib = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
       if (lib == nullptr) {
         tried += std::string(tried.empty() ? "" : "; ") + ::dlerror();
         continue;
