@@ -15,6 +15,7 @@
 #include "reach/query.h"
 #include "scene/scene.h"
 #include "scene/universe.h"
+#include "support/load_scene.h"
 #include "support/stat_seed.h"
 
 namespace pathex {
@@ -24,11 +25,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 std::string sample(const std::string& name) { return std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + name; }
 
-Scene load(const std::string& path) {
-  Result<Scene> s = load_scene_file(path, SceneLoadOptions{});
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().render());
-  return std::move(*s);
-}
+using test::load;
 
 Profile profile(const std::string& name) { return resolve_profile(name, Limits{}).expect("a built-in profile"); }
 
@@ -50,7 +47,9 @@ BiasRun bias(const Scene& scene, const std::string& renderer, std::uint64_t spp,
   EXPECT_TRUE(ref.ok()) << (ref.ok() ? "" : ref.error().render());
   Result<BiasRun> run = run_bias(scene, "test", r, *ref, builtin_classes(), o);
   EXPECT_TRUE(run.ok()) << (run.ok() ? "" : run.error().render());
-  if (run.ok()) EXPECT_FALSE(run->report.undersampled);  // no renderer budget: no comparison
+  if (run.ok()) {
+    EXPECT_FALSE(run->report.undersampled);  // no renderer budget: no comparison
+  }
   return std::move(*run);
 }
 

@@ -13,6 +13,7 @@
 
 #include "scene/scene.h"
 #include "support/env_images.h"
+#include "support/load_scene.h"
 #include "support/scratch_files.h"
 #include "trace/environment.h"
 
@@ -23,11 +24,7 @@ using test::relative;
 using test::scratch;
 using test::write;
 
-Scene load(const std::string& path) {
-  Result<Scene> s = load_scene_file(path);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().render());
-  return s.ok() ? *s : Scene{};
-}
+using test::load;
 
 // The texel of the scene's image that world direction `w` (towards the environment) reads.
 glm::vec3 radiance_towards(const Scene& s, const glm::vec3& w) {

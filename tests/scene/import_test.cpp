@@ -15,6 +15,7 @@
 #include "scene/scene.h"
 #include "trace/bsdf_layered.h"
 #include "support/cli_run.h"
+#include "support/load_scene.h"
 #include "support/scratch_files.h"
 #include "support/stat_seed.h"
 #include "trace/render.h"
@@ -29,11 +30,7 @@ using test::relative;
 using test::scratch;
 using test::write;
 
-Scene load(const std::string& path) {
-  Result<Scene> s = load_scene_file(path);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().render());
-  return s.ok() ? *s : Scene{};
-}
+using test::load;
 
 void expect_near(glm::vec3 a, glm::vec3 b, const std::string& what) {
   EXPECT_LT(glm::length(a - b), 1e-5f) << what << ": (" << a.x << ", " << a.y << ", " << a.z << ") vs (" << b.x << ", " << b.y

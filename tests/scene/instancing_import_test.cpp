@@ -7,6 +7,7 @@
 
 #include "scene/scene.h"
 #include "support/cli_run.h"
+#include "support/load_scene.h"
 #include "support/scratch_files.h"
 
 namespace pathex {
@@ -17,11 +18,7 @@ using test::relative;
 using test::scratch;
 using test::write;
 
-Scene load(const std::string& path) {
-  Result<Scene> s = load_scene_file(path);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().render());
-  return s.ok() ? *s : Scene{};
-}
+using test::load;
 
 vec3 moved(const ShapeInstance& i, vec3 p) { return vec3(i.to_world * glm::vec4(p, 1.0f)); }
 

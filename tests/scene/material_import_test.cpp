@@ -13,6 +13,7 @@
 #include "scene/material.h"
 #include "scene/metal_spectra.h"
 #include "scene/scene.h"
+#include "support/load_scene.h"
 #include "support/scratch_files.h"
 
 namespace pathex {
@@ -27,11 +28,7 @@ const std::string kXmlSensor =
     "<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/>"
     "</transform></sensor>\n";
 
-Scene load(const std::string& path) {
-  Result<Scene> s = load_scene_file(path);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().render());
-  return s.ok() ? *s : Scene{};
-}
+using test::load;
 
 const Material& material_of(const Scene& s, std::size_t shape) {
   return s.materials[static_cast<std::size_t>(s.shapes.at(shape).material)];

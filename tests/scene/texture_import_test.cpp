@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "scene/scene.h"
+#include "support/load_scene.h"
 #include "support/scratch_files.h"
 #include "support/test_images.h"
 #include "trace/texture_eval.h"
@@ -25,11 +26,7 @@ using test::write_image;
 const std::string kPbrtHead = "LookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\nLightSource \"point\"\n";
 const std::string kXmlHead = "<scene version=\"3.0.0\">\n<emitter type=\"point\"/>\n";
 
-Scene load(const std::string& path) {
-  Result<Scene> s = load_scene_file(path);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().render());
-  return s.ok() ? *s : Scene{};
-}
+using test::load;
 
 // A 2 x 1 PNG: a black texel and a white one (8-bit codes 0 and 255, the same in every decoding).
 void write_black_white() { write_image<unsigned char>("bw.png", 2, 1, 3, {0, 0, 0, 255, 255, 255}); }

@@ -22,6 +22,7 @@
 #include "support/env_images.h"
 #include "support/stat_seed.h"
 #include "support/test_classes.h"
+#include "support/test_render.h"
 #include "trace/environment.h"
 #include "trace/render.h"
 #include "trace/rng.h"
@@ -110,31 +111,14 @@ TEST(EnvironmentMapping, DirectionDensityIntegratesToOneAndSamplesReportIt) {
 
 // --- renders ---
 
-struct Rendered {
-  HistogramReport report;
-};
+using test::Rendered;
 
 Rendered render_json(const std::string& scene_json, const std::string& renderer, const std::vector<std::string>& classes,
                      std::uint64_t spp, std::uint64_t seed = 7) {
-  Result<Scene> scene = load_scene_json(scene_json, scratch(), "test");
-  EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().render());
-  Result<Profile> profile = resolve_profile(renderer, Limits{});
-  EXPECT_TRUE(profile.ok());
-  static std::vector<std::unique_ptr<test::TestClasses>> keep;  // the reports outlive this call
-  keep.push_back(test::test_classes(classes));
-  const std::vector<ClassInfo>& infos = keep.back()->infos;
-  RenderOptions o;
-  o.spp = spp;
-  o.seed = seed;
-  o.max_bounces = 8;
-  Result<RenderOutput> out = render(*scene, *profile, keep.back()->classifier.get(), o);
-  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
-  RunInfo info;
-  info.spp = spp;
-  Result<HistogramReport> rep = make_report(out->histogram, info, keep.back()->classifier.get(), infos);
-  EXPECT_TRUE(rep.ok());
-  EXPECT_EQ(rep->nonfinite_samples, 0u) << renderer;
-  return Rendered{std::move(*rep)};
+  Rendered r = test::render_scene(load_scene_json(scene_json, scratch(), "test"), renderer, classes, spp, /*threads=*/0, seed,
+                                  test::Sampling{}, /*max_bounces=*/8);
+  EXPECT_EQ(r.report.nonfinite_samples, 0u) << renderer;
+  return r;
 }
 
 using test::expect_close;

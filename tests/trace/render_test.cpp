@@ -16,62 +16,21 @@
 #include "support/scratch_files.h"
 #include "support/stat_seed.h"
 #include "support/test_classes.h"
+#include "support/test_render.h"
 
 namespace pathex {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-struct Rendered {
-  HistogramReport report;
-  RenderOutput out;
-};
-
-// How a test's render samples: the sampler and the Russian-roulette settings (RenderOptions).
-struct Sampling {
-  SamplerKind sampler = RenderOptions{}.sampler;
-  int rr_depth = RenderOptions{}.rr_depth;
-  float rr_threshold = RenderOptions{}.rr_threshold;
-  std::string name() const {
-    return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
-           std::to_string(rr_threshold);
-  }
-};
-
-Rendered render_scene(Result<Scene> scene, const std::string& renderer, const std::vector<std::string>& classes,
-                      std::uint64_t spp, int threads, std::uint64_t seed, const Sampling& sampling,
-                      std::optional<int> max_bounces);
+using test::Rendered;
+using test::Sampling;
+using test::render_scene;
 
 // Renders `scene_json` with `renderer`, classifying by `classes` (full notation).
 Rendered render_json(const std::string& scene_json, const std::string& renderer, const std::vector<std::string>& classes,
                 std::uint64_t spp, int threads = 0, std::uint64_t seed = 7, const Sampling& sampling = {}) {
   return render_scene(load_scene_json(scene_json, ".", "test"), renderer, classes, spp, threads, seed, sampling, 12);
-}
-
-Rendered render_scene(Result<Scene> scene, const std::string& renderer, const std::vector<std::string>& classes,
-                      std::uint64_t spp, int threads, std::uint64_t seed, const Sampling& sampling,
-                      std::optional<int> max_bounces) {
-  EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().render());
-  Result<Profile> profile = resolve_profile(renderer, Limits{});
-  EXPECT_TRUE(profile.ok());
-  static std::vector<std::unique_ptr<test::TestClasses>> keep;  // the reports outlive this call
-  keep.push_back(test::test_classes(classes));
-  const std::vector<ClassInfo>& infos = keep.back()->infos;
-  RenderOptions o;
-  o.spp = spp;
-  o.seed = seed;
-  o.threads = threads;
-  o.max_bounces = max_bounces;
-  o.sampler = sampling.sampler;
-  o.rr_depth = sampling.rr_depth;
-  o.rr_threshold = sampling.rr_threshold;
-  Result<RenderOutput> out = render(*scene, *profile, keep.back()->classifier.get(), o);
-  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
-  RunInfo info;
-  info.spp = spp;
-  Result<HistogramReport> rep = make_report(out->histogram, info, keep.back()->classifier.get(), infos);
-  EXPECT_TRUE(rep.ok());
-  return Rendered{std::move(*rep), std::move(*out)};
 }
 
 using test::expect_close;

@@ -1,0 +1,60 @@
+// One render of a scene for a test, classified by full-notation classes, with its report: the
+// renderer tests' one way to render (render_test, environment_test). A step that fails fails the
+// test with its located message.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "classify/convergence.h"
+#include "io/profile_json.h"
+#include "scene/scene.h"
+#include "support/test_classes.h"
+#include "trace/render.h"
+
+namespace pathex::test {
+
+struct Rendered {
+  HistogramReport report;
+  RenderOutput out;
+};
+
+// How a test's render samples: the sampler and the Russian-roulette settings (RenderOptions).
+struct Sampling {
+  SamplerKind sampler = RenderOptions{}.sampler;
+  int rr_depth = RenderOptions{}.rr_depth;
+  float rr_threshold = RenderOptions{}.rr_threshold;
+  std::string name() const {
+    return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
+           std::to_string(rr_threshold);
+  }
+};
+
+inline Rendered render_scene(Result<Scene> scene, const std::string& renderer, const std::vector<std::string>& classes,
+                             std::uint64_t spp, int threads, std::uint64_t seed, const Sampling& sampling,
+                             std::optional<int> max_bounces) {
+  const Scene s = std::move(scene).expect("a test scene");
+  const Profile profile = resolve_profile(renderer, Limits{}).expect("a built-in renderer");
+  static std::vector<std::unique_ptr<TestClasses>> keep;  // the reports outlive this call
+  keep.push_back(test_classes(classes));
+  RenderOptions o;
+  o.spp = spp;
+  o.seed = seed;
+  o.threads = threads;
+  o.max_bounces = max_bounces;
+  o.sampler = sampling.sampler;
+  o.rr_depth = sampling.rr_depth;
+  o.rr_threshold = sampling.rr_threshold;
+  RenderOutput out = render(s, profile, keep.back()->classifier.get(), o).expect("a render");
+  RunInfo info;
+  info.spp = spp;
+  HistogramReport rep = make_report(out.histogram, info, keep.back()->classifier.get(), keep.back()->infos).expect("a report");
+  return Rendered{std::move(rep), std::move(out)};
+}
+
+}  // namespace pathex::test
