@@ -43,7 +43,9 @@ STATISTICAL_TESTS = [
     ("hard_cases_test", "*"),
     ("only_test", "Only.AgreesWithTheClassOfAFullRender"),
     ("emission_cones_test", "AimedEmission.*"),
+    ("texture_render_test", "*"),
 ]
+# tests/meta/stat_registry_test.cpp checks that every test reaching test::stat_seed is listed here.
 
 
 def upper_bound(failures, runs, confidence=0.95):
