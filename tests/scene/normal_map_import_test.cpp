@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "scene/scene.h"
+#include "support/cli_run.h"
 #include "support/scratch_files.h"
 #include "support/test_images.h"
 #include "trace/texture_eval.h"
@@ -139,6 +140,15 @@ TEST(ImportNormalMapsRefusals, LocatedWithExactMessages) {
     EXPECT_EQ(relative(s.error().where), r.where) << r.file << ": " << s.error().message;
     EXPECT_EQ(relative(s.error().message), r.message) << r.file;
   }
+}
+
+TEST(ImportNormalMapsRefusals, TheCommandLineSaysWhereAndExitsWith2) {
+  const std::string path = write("both-cli.pbrt", kPbrtHead + "Material \"diffuse\" \"float displacement\" 1 \"string normalmap\" \"nm.png\"\n"
+                                                              "Shape \"sphere\"\n");
+  const test::CliRun r = test::run_pathex_args({"trace", path, "--spp", "1", "--out", (test::scratch_dir() / "out").string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(relative(r.err), "pathex: error: both-cli.pbrt:5:43: a material with both displacement and normalmap is not supported: pbrt-v4 "
+                             "applies one of them\n");
 }
 
 }  // namespace
