@@ -118,6 +118,36 @@ TEST(NormalMapRender, TiltedNormalsGiveTheClosedFormOfALambertian) {
   }
 }
 
+TEST(NormalMapRender, MitsubaNormalmapAndBumpmapGiveTheClosedForm) {
+  // The same wall as a Mitsuba rectangle (scaled by 2: dp/du = (4, 0, 0), Mitsuba's uv) under a
+  // directional emitter of irradiance π: a normalmap tilted towards +x by 30° lit from (½, 0, −√3/2),
+  // and a bumpmap of the ramp with scale 2 tan 30° (Mitsuba: dp/du's normal part = scale ∂d/∂u,
+  // ∂d/∂u = 2) tilted towards −x lit from (−½, 0, −√3/2): ¼ each, by lt and bdpt.
+  test::write_image<float>("tilt.exr", 1, 1, 3, {0.75f, 0.5f, 0.9330127f});
+  test::write_image<float>("ramp.exr", 2, 1, 1, {0.0f, 1.0f});
+  const auto scene = [](const std::string& light_x, const std::string& bsdf) {
+    return "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"30\"/><transform name=\"to_world\">"
+           "<lookat origin=\"0, 0, -3\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform><film type=\"hdrfilm\"><integer name=\"width\" "
+           "value=\"8\"/><integer name=\"height\" value=\"8\"/></film></sensor>\n<emitter type=\"directional\"><vector name=\"direction\" "
+           "x=\"" + light_x + "\" y=\"0\" z=\"0.8660254\"/><rgb name=\"irradiance\" value=\"3.14159265\"/></emitter>\n"
+           "<shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"2\"/></transform>" + bsdf + "</shape>\n</scene>\n";
+  };
+  const std::string diffuse = "<bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.5\"/></bsdf>";
+  const std::string normal_map = write("tilt.xml", scene("-0.5", "<bsdf type=\"normalmap\"><texture type=\"bitmap\" name=\"normalmap\">"
+                                                                 "<string name=\"filename\" value=\"tilt.exr\"/></texture>" + diffuse + "</bsdf>"));
+  const std::string bump = write("ramp.xml", scene("0.5", "<bsdf type=\"bumpmap\"><float name=\"scale\" value=\"1.1547005\"/><texture "
+                                                           "type=\"bitmap\"><string name=\"filename\" value=\"ramp.exr\"/><string name=\"wrap_mode\" "
+                                                           "value=\"clamp\"/></texture>" + diffuse + "</bsdf>"));
+  const double z = test::family_sigmas(4);
+  for (const char* renderer : {"lt", "bdpt"}) {
+    for (const std::string& path : {normal_map, bump}) {
+      const Estimate e = render_total(path, renderer, 256);
+      test::stat_log(std::string("mitsuba tilt ") + renderer, std::fabs(e.luminance - 0.25) / std::max(e.std_error, 1e-12), z);
+      EXPECT_LE(std::fabs(e.luminance - 0.25), z * e.std_error + 2e-4) << path << " " << renderer << ": " << e.luminance << " ± " << e.std_error;
+    }
+  }
+}
+
 TEST(NormalMapRender, ATiltedNormalMapEqualsTiltedVertexNormals) {
   // The same tilt by a normal map and by per-vertex normals, under a point light: every estimator
   // (pt-nee included) renders the two within 3σ (nearly the same samples: the normals differ in
