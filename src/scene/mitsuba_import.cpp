@@ -498,6 +498,35 @@ class Importer {
       if (mask_alpha_ >= 0) return located(where(n), "a mask inside a mask is not supported");
       mask_alpha_ = alpha;
       m = x;
+    } else if (type == "normalmap" || type == "bumpmap") {
+      // A bump or normal map over a nested bsdf (docs/textures.md): only the shading normal turns.
+      // normalmap: the RGB <texture name="normalmap">, 2 RGB − 1 in the shading frame; bumpmap: its
+      // one nested float <texture> times `scale` (default 1), differentiated in (u, v).
+      int index = -1;
+      double scale = 1.0;
+      if (type == "normalmap") {
+        if (!p.find("normalmap")) return located(where(n), "normalmap needs a <texture name=\"normalmap\">");
+        MI_TRY(t, operand(p, "normalmap", vec3(0.5f, 0.5f, 1.0f), false));
+        index = t;
+      } else {
+        const std::vector<pugi::xml_node> tex = p.nested("texture");
+        if (tex.size() != 1) return located(where(n), "bumpmap needs one nested <texture>, found " + std::to_string(tex.size()));
+        MI_TRY(t, texture(tex[0], true));
+        MI_TRY(sc, p.number("scale", 1.0));
+        if (!std::isfinite(sc)) return located(where(p.find("scale")), "scale must be finite");
+        index = t;
+        scale = sc;
+      }
+      const std::vector<pugi::xml_node> inner = p.nested("bsdf");
+      if (inner.size() != 1)
+        return located(where(n), type + " with " + std::to_string(inner.size()) + " nested BSDFs is not supported, expected one");
+      MI_TRY(x, bsdf(inner[0], depth + 1));
+      if (material_textures_.perturb != NormalPerturbation::kNone)
+        return located(where(inner[0]), "a bumpmap or normalmap inside a bumpmap or normalmap is not supported");
+      material_textures_.perturb = type == "normalmap" ? NormalPerturbation::kNormalMap : NormalPerturbation::kBumpMitsuba;
+      material_textures_.perturb_texture = index;
+      material_textures_.bump_scale = static_cast<float>(scale);
+      m = x;
     } else if (type == "twosided") {
       // pathex's reflective materials are two-sided already.
       const std::vector<pugi::xml_node> inner = p.nested("bsdf");
@@ -608,6 +637,8 @@ class Importer {
         if (mask_alpha_ >= 0) return located(where(inner[static_cast<std::size_t>(i)]), "a mask inside a blendbsdf is not supported");
         if (material_textures_.amount >= 0)
           return located(where(inner[static_cast<std::size_t>(i)]), "a blendbsdf inside a blendbsdf whose weight is a texture is not supported");
+        if (material_textures_.perturb != NormalPerturbation::kNone)
+          return located(where(inner[static_cast<std::size_t>(i)]), "a bumpmap or normalmap inside a blendbsdf is not supported");
         parts[i] = std::move(material_textures_);
       }
       auto [mixed, textures] = import::blend_textured(a, parts[0], b, parts[1], static_cast<float>(w), weight_texture);
@@ -615,7 +646,7 @@ class Importer {
       material_textures_ = std::move(textures);
     } else {
       return located(where(n), "bsdf \"" + excerpt(type) + "\" is not supported, expected diffuse, conductor, roughconductor, dielectric, "
-                               "roughdielectric, thindielectric, plastic, roughplastic, blendbsdf, mask or twosided");
+                               "roughdielectric, thindielectric, plastic, roughplastic, blendbsdf, mask, twosided, normalmap or bumpmap");
     }
     if (auto e = p.unused()) return *e;
     return m;

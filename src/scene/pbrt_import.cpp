@@ -673,6 +673,8 @@ class Importer {
         return ps.unused("material \"interface\"");
       }
       PBRT_TRY(m, material(mtype, ps, at));
+      if (mtype != "mix")
+        if (auto e = perturbation(ps)) return e;
       if (auto e = ps.unused("material \"" + excerpt(mtype) + "\"")) return e;
       if (auto e = materials_budget_.charge(m, at)) return e;
       named_materials_[type] = m;
@@ -695,6 +697,8 @@ class Importer {
         return ps.unused(what);
       }
       PBRT_TRY(m, material(type, ps, at));
+      if (type != "mix")
+        if (auto e = perturbation(ps)) return e;
       if (auto e = ps.unused(what)) return e;
       if (auto e = materials_budget_.charge(m, at)) return e;
       gs_.material = builder_.add_material(at.str(), m, std::move(material_textures_));
@@ -870,6 +874,35 @@ class Importer {
     PBRT_TRY(index, operand(ps, name, fallback, false));
     material_textures_.bindings.push_back(TextureBinding{-1, param, index, scale});
     return fallback;
+  }
+
+  // A material's bump or normal map (docs/textures.md): pbrt-v4's "texture displacement" (a float
+  // texture or value, applied as BumpMap() does) or "string normalmap" (an image file read with a
+  // linear encoding, looked up at (u, 1 − v) with wrap repeat, as NormalMap() does). Into material_textures_.
+  std::optional<Error> perturbation(Params& ps) {
+    Param* d = ps.find("displacement");
+    Param* nm = ps.find("normalmap");
+    if (d && nm) return located(nm->at, "a material with both displacement and normalmap is not supported: pbrt-v4 applies one of them");
+    if (d) {
+      PBRT_TRY(index, operand(ps, "displacement", vec3(0.0f), true));
+      material_textures_.perturb = NormalPerturbation::kBumpPbrt;
+      material_textures_.perturb_texture = index;
+    } else if (nm) {
+      PBRT_TRY(file, ps.string("normalmap", ""));
+      if (file.empty()) return located(nm->at, "normalmap needs an image file name");
+      ImageReadOptions options;
+      options.max_file_bytes = options_.max_file_bytes;
+      options.max_texels = options_.max_texels;
+      options.encoding = ImageEncoding::kLinear;
+      PBRT_TRY(image, builder_.add_image(files_.resolve(file), options, nm->at));
+      Texture t;
+      t.kind = TextureKind::kImage;
+      t.image = image;
+      t.flip_t = true;
+      material_textures_.perturb = NormalPerturbation::kNormalMap;
+      material_textures_.perturb_texture = builder_.add_texture(t);
+    }
+    return std::nullopt;
   }
 
   // pbrt-v4's textures that pathex reads (docs/textures.md): imagemap, checkerboard (2D), scale,
@@ -1082,6 +1115,8 @@ class Importer {
         if (it == named_materials_.end()) return located(m->at, "unknown named material \"" + excerpt(m->strings[static_cast<std::size_t>(i)]) + "\"");
         parts[i] = it->second;
         if (auto t = named_material_textures_.find(it->first); t != named_material_textures_.end()) part_textures[i] = t->second;
+        if (part_textures[i].perturb != NormalPerturbation::kNone)
+          return located(m->at, "a mix of \"" + excerpt(it->first) + "\", which has a bump or normal map, is not supported");
         if (part_textures[i].amount >= 0)
           return located(m->at, "a mix of \"" + excerpt(it->first) + "\", itself a mix by a texture amount, is not supported");
       }

@@ -85,6 +85,11 @@ std::string scene_content_hash(const Scene& scene) {
       h.add(m.amount);
       h.bytes(m.weight0.data(), m.weight0.size() * sizeof(float));
       h.bytes(m.weight1.data(), m.weight1.size() * sizeof(float));
+      if (m.perturb != NormalPerturbation::kNone) {  // only then: hashes of scenes without bump or normal maps stay as they were
+        h.add(static_cast<std::uint32_t>(m.perturb));
+        h.add(m.perturb_texture);
+        h.add(m.bump_scale);
+      }
     }
   }
   if (!scene.instances.empty()) {

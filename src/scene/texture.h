@@ -78,6 +78,14 @@ struct TextureBinding {
   float scale = 1.0f;  // the value times this, then clamped to [0, 1] (pbrt-v4 diffusetransmission's scale)
 };
 
+// How a material turns its shading normal (docs/textures.md "Bump and normal maps"): a normal map
+// (an RGB texture in the tangent frame (s, t, n) of the shading normal n and the surface's dp/du,
+// RGB in [0, 1] read as 2 RGB − 1, pbrt-v4's NormalMap() and Mitsuba 3's normalmap), or a bump map
+// (a float texture of displacement along n whose finite differences in uv tilt the tangents:
+// pbrt-v4's BumpMap(), Mitsuba 3's bumpmap, which replaces dp/du's normal part by the gradient).
+// Only the shading normal changes: the material's kind and letters stay (a bump is never a letter).
+enum class NormalPerturbation : std::uint32_t { kNone, kNormalMap, kBumpPbrt, kBumpMitsuba };
+
 // The textured parameters of one material. `amount` >= 0: a Mixture whose weights follow a float
 // texture (pbrt-v4's mix with a textured amount): component i weighs
 // (1 − amount) weight0[i] + amount weight1[i]; its stored weights are those at amount ½.
@@ -85,7 +93,10 @@ struct MaterialTextures {
   std::vector<TextureBinding> bindings;
   int amount = -1;
   std::vector<float> weight0, weight1;
-  bool empty() const { return bindings.empty() && amount < 0; }
+  NormalPerturbation perturb = NormalPerturbation::kNone;
+  int perturb_texture = -1;  // index into Scene::textures: the normal map (RGB) or the bump map (float)
+  float bump_scale = 1.0f;   // kBumpMitsuba: the gradient times this (Mitsuba's `scale`)
+  bool empty() const { return bindings.empty() && amount < 0 && perturb == NormalPerturbation::kNone; }
 };
 
 }  // namespace pathex

@@ -496,6 +496,48 @@ void EmbreeScene::instance_hit(unsigned inst_geom, unsigned geom, float u, float
   }
 }
 
+void EmbreeScene::uv_tangents(const Hit& h, vec3* dpdu, vec3* dpdv) const {
+  *dpdu = *dpdv = vec3(0.0f);
+  const Shape& shape = source_->shapes[static_cast<std::size_t>(h.shape)];
+  if (const auto* m = std::get_if<MeshShape>(&shape.geometry)) {
+    const glm::uvec3 t = m->triangles[static_cast<std::size_t>(h.primitive)];
+    vec3 p0 = m->positions[t.x], p1 = m->positions[t.y], p2 = m->positions[t.z];
+    if (h.instance >= 0) {
+      const glm::mat4& w = instances_[static_cast<std::size_t>(h.instance)].to_world;
+      p0 = vec3(w * glm::vec4(p0, 1.0f));
+      p1 = vec3(w * glm::vec4(p1, 1.0f));
+      p2 = vec3(w * glm::vec4(p2, 1.0f));
+    }
+    // pbrt-v4's default uv without per-vertex ones: (0, 0), (1, 0), (1, 1).
+    const glm::vec2 uv0 = m->uvs.empty() ? glm::vec2(0.0f, 0.0f) : m->uvs[t.x];
+    const glm::vec2 uv1 = m->uvs.empty() ? glm::vec2(1.0f, 0.0f) : m->uvs[t.y];
+    const glm::vec2 uv2 = m->uvs.empty() ? glm::vec2(1.0f, 1.0f) : m->uvs[t.z];
+    const glm::vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+    const vec3 dp02 = p0 - p2, dp12 = p1 - p2;
+    const float det = duv02.x * duv12.y - duv02.y * duv12.x;
+    if (!(std::fabs(det) >= 1e-9f)) return;  // degenerate uv: the caller's arbitrary frame
+    *dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
+    *dpdv = (duv02.x * dp12 - duv12.x * dp02) / det;
+  } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
+    *dpdu = q->edge1;
+    *dpdv = q->edge2;
+  } else if (const auto* s = std::get_if<SphereShape>(&shape.geometry)) {
+    // p = c + r (sin θ cos φ, sin θ sin φ, cos θ), φ = 2π u, θ = π v.
+    const vec3 l = h.position - s->center;
+    const float rxy = std::sqrt(l.x * l.x + l.y * l.y);
+    *dpdu = 2.0f * kPi * vec3(-l.y, l.x, 0.0f);
+    if (rxy > 0.0f) *dpdv = kPi * vec3(l.z * l.x / rxy, l.z * l.y / rxy, -rxy);
+  } else {
+    // u = φ / 2π, v = r / radius in the disk's Frame::from_normal.
+    const DiskShape& k = std::get<DiskShape>(shape.geometry);
+    const Frame f = Frame::from_normal(k.normal);
+    const vec3 l = f.to_local(h.position - k.center);
+    const float r = std::sqrt(l.x * l.x + l.y * l.y);
+    *dpdu = 2.0f * kPi * (-l.y * f.s + l.x * f.t);
+    if (r > 0.0f) *dpdv = k.radius * (l.x * f.s + l.y * f.t) / r;
+  }
+}
+
 bool EmbreeScene::occluded(const vec3& o, const vec3& d, float tmin, float tmax) const {
   if (!finite_ray(o, d)) return true;
   RTCRay ray;

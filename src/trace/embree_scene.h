@@ -207,6 +207,11 @@ class EmbreeScene {
   SurfaceSample sample_shape(int shape, glm::vec2 u) const;
   // The unit geometric normal of a shape at a point on it (`primitive`: the triangle of a mesh).
   glm::vec3 normal_at(int shape, int primitive, const glm::vec3& p) const;
+  // dp/du and dp/dv at a hit (HitDetail::kFull), the tangents of Hit::uv in the world, from which
+  // bump and normal maps build their frame (trace/texture_eval.h perturbed_normal): a triangle's
+  // from its corners and their uv (pbrt-v4's Triangle), a quad's edges, a sphere's and a disk's
+  // from their (u, v) maps. Zero (or parallel) where the uv are degenerate, a sphere's poles.
+  void uv_tangents(const Hit& h, glm::vec3* dpdu, glm::vec3* dpdv) const;
   // A shape's geometry as the scene gives it.
   const ShapeGeometry& shape_geometry(int shape) const { return source_->shapes[static_cast<std::size_t>(shape)].geometry; }
   // A hit's position and normal derivatives (trace/differential.h), computed only when asked: the

@@ -313,6 +313,17 @@ class Integrator {
     return *scratch;
   }
 
+  // A hit's shading normal as every strategy sees it (pt, pt-nee, lt, bdpt's joins and the MIS
+  // densities all read the vertex's ns): the geometry's (Hit::shading_normal) turned by its
+  // material's bump or normal map (trace/texture_eval.h perturbed_normal). The letter stays.
+  vec3 shading_normal(const Hit& h) const {
+    const MaterialTextures* tex = rs_.textures_of_shape[static_cast<std::size_t>(h.shape)];
+    if (!tex || tex->perturb == NormalPerturbation::kNone) return h.shading_normal;
+    vec3 dpdu, dpdv;
+    rs_.geometry->uv_tangents(h, &dpdu, &dpdv);
+    return perturbed_normal(*rs_.scene, *tex, h.uv, h.normal, h.shading_normal, dpdu, dpdv);
+  }
+
   // --- densities used by MIS ---
   // Solid-angle density at `v` of sampling the unit direction `wn`, given the unit direction
   // `wp` to v's other neighbour (null when it has none: a surface then has no density).

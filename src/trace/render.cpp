@@ -96,7 +96,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.p = hit->position;
     v.n = hit->normal;
     v.err = hit->error;
-    v.ns = hit->shading_normal;
+    v.ns = shading_normal(*hit);  // a bump or normal map's, if any
     v.shape = hit->shape;
     v.uv = hit->uv;
     v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;

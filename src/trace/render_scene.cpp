@@ -75,8 +75,10 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     rs.emission_of_shape.push_back(s.emission);
     rs.absorption_of_shape.push_back(s.absorption);
     rs.absorbing = rs.absorbing || s.absorption != glm::vec3(0.0f);
-    // Planar mirrors, for the mirror connector: quads of a pure mirror material.
-    const auto* quad = s.group < 0 ? std::get_if<QuadShape>(&s.geometry) : nullptr;
+    // Planar mirrors, for the mirror connector: quads of a pure mirror material (without a bump or
+    // normal map, whose normal the connector's plane does not have).
+    const bool perturbed = tex && tex->perturb != NormalPerturbation::kNone;
+    const auto* quad = s.group < 0 && !perturbed ? std::get_if<QuadShape>(&s.geometry) : nullptr;
     const auto* mirror = std::get_if<Mirror>(rs.material_of_shape.back());
     if (quad && mirror && !s.emissive()) {
       const glm::vec3 n = glm::cross(quad->edge1, quad->edge2);

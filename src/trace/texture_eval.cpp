@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <variant>
 
+#include "trace/frame.h"
 #include "trace/rng.h"
 
 namespace pathex {
@@ -134,6 +135,54 @@ void textured_material(const Scene& scene, const Material& base, const MaterialT
         mix->components[i].weight = (1.0f - a) * textures.weight0[i] + a * textures.weight1[i];
     }
   }
+}
+
+glm::vec3 perturbed_normal(const Scene& scene, const MaterialTextures& textures, glm::vec2 uv, const glm::vec3& ng, const glm::vec3& ns,
+                           glm::vec3 dpdu, glm::vec3 dpdv) {
+  if (textures.perturb == NormalPerturbation::kNone) return ns;
+  const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  const glm::vec3 span = glm::cross(dpdu, dpdv);
+  if (!finite(dpdu) || !finite(dpdv) || !(glm::dot(span, span) > 0.0f)) {  // pbrt-v4's CoordinateSystem(n)
+    const Frame f = Frame::from_normal(ns);
+    dpdu = f.s;
+    dpdv = f.t;
+  }
+  glm::vec3 n = ns;
+  if (textures.perturb == NormalPerturbation::kNormalMap) {
+    // The texel's 2 RGB − 1 in the frame (s, t, ns), s = dp/du made perpendicular to ns, t = ns × s
+    // (pbrt-v4's Frame::FromXZ(dpdu, ns); Mitsuba 3's shading frame, Gram–Schmidt on dp_du).
+    const glm::vec3 c = 2.0f * eval_texture(scene, textures.perturb_texture, uv) - glm::vec3(1.0f);
+    const Frame f = Frame::from_normal_tangent(ns, dpdu);
+    n = c.x * f.s + c.y * f.t + c.z * f.n;
+  } else {
+    const float h = kBumpDelta;
+    const float d = channel0(eval_texture(scene, textures.perturb_texture, uv));
+    const float gu = (channel0(eval_texture(scene, textures.perturb_texture, uv + glm::vec2(h, 0.0f))) - d) / h;
+    const float gv = (channel0(eval_texture(scene, textures.perturb_texture, uv + glm::vec2(0.0f, h))) - d) / h;
+    glm::vec3 su = dpdu, sv = dpdv;
+    if (textures.perturb == NormalPerturbation::kBumpPbrt) {
+      // pbrt-v4's shading tangents where the shading normal is not the geometric one (smooth
+      // meshes): ts = ns × dp/du, ss = ts × ns. dp/du' = ss + gu ns (its BumpMap() without the
+      // displace · dn/du terms, which pathex leaves out: they vanish on flat shading).
+      if (ns != ng) {
+        const glm::vec3 ts = glm::cross(ns, dpdu);
+        if (glm::dot(ts, ts) > 0.0f) {
+          su = glm::cross(ts, ns);
+          sv = ts;
+        }
+      }
+      su += gu * ns;
+      sv += gv * ns;
+    } else {  // Mitsuba 3's bumpmap: dp/du's part along ns replaced by the scaled gradient
+      su += (textures.bump_scale * gu - glm::dot(ns, dpdu)) * ns;
+      sv += (textures.bump_scale * gv - glm::dot(ns, dpdv)) * ns;
+    }
+    n = glm::cross(su, sv);
+  }
+  const float len = glm::length(n);
+  if (!(len > 0.0f) || !std::isfinite(len)) return ns;
+  n /= len;
+  return glm::dot(n, ns) < 0.0f ? -n : n;
 }
 
 float shape_alpha(const Scene& scene, int shape, glm::vec2 uv) {

@@ -23,6 +23,16 @@ glm::vec3 eval_texture(const Scene& scene, int index, glm::vec2 uv);
 // material before (a Mixture's storage is reused).
 void textured_material(const Scene& scene, const Material& base, const MaterialTextures& textures, glm::vec2 uv, Material* out);
 
+// The shading normal `ns` (unit) turned by the normal or bump map of `textures` (NormalPerturbation)
+// at `uv`, with the hit's tangents `dpdu`, `dpdv` (EmbreeScene::uv_tangents) and its unit
+// geometric normal `ng`; `ns` itself without one. Where dp/du and dp/dv span no plane (degenerate
+// uv, a sphere's pole) an arbitrary frame around ns stands in, as pbrt-v4 does. Bump maps take
+// finite differences of step kBumpDelta in u and v: pbrt-v4's step without ray differentials
+// (pathex has none). The result is unit and on ns's side. Only the normal changes: never a letter.
+inline constexpr float kBumpDelta = 0.0005f;
+glm::vec3 perturbed_normal(const Scene& scene, const MaterialTextures& textures, glm::vec2 uv, const glm::vec3& ng, const glm::vec3& ns,
+                           glm::vec3 dpdu, glm::vec3 dpdv);
+
 // The coverage of shape `shape` at `uv` in [0, 1] (Shape::alpha; 1 without one).
 float shape_alpha(const Scene& scene, int shape, glm::vec2 uv);
 

@@ -503,7 +503,7 @@ std::vector<Refusal> refusals() {
       {"coated-aniso.pbrt", "Material \"coateddiffuse\" \"float uroughness\" 0.1 \"float vroughness\" 0.2\n", "coated-aniso.pbrt:4:1",
        "anisotropic roughness (uroughness != vroughness) is not supported"},
       {"coated-displacement.pbrt", "Material \"coateddiffuse\" \"texture displacement\" \"bumps\"\n", "coated-displacement.pbrt:4:26",
-       "parameter \"texture displacement\" of Material \"coateddiffuse\" is not supported"},
+       "unknown texture \"bumps\""},
       {"infinite.pbrt", "LightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "infinite.pbrt:4:24",
        "the image 'sky.exr': cannot read the image: No such file or directory"},
       {"goniometric.pbrt", "LightSource \"goniometric\"\n", "goniometric.pbrt:4:1",

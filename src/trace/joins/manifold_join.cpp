@@ -24,6 +24,8 @@ void Integrator::init_manifold() {
   specular_shapes_.clear();
   for (std::size_t i = 0; i < rs_.material_of_shape.size(); ++i) {
     if (rs_.light_of_shape[i] >= 0 || rs_.in_group[i]) continue;  // instanced members: opaque to the walks (RenderScene::in_group)
+    // A bump or normal map turns the shading normal the walk's constraint does not see: opaque too.
+    if (rs_.textures_of_shape[i] && rs_.textures_of_shape[i]->perturb != NormalPerturbation::kNone) continue;
     const Material& m = *rs_.material_of_shape[i];
     if (const auto* d = std::get_if<Dielectric>(&m); d && d->ior > 0.0f && d->ior != 1.0f) glass_ior_[i] = d->ior;
     // A mirror, or a mixture's mirror components (each weighed by its weight).
