@@ -44,6 +44,7 @@ STATISTICAL_TESTS = [
     ("only_test", "Only.AgreesWithTheClassOfAFullRender"),
     ("emission_cones_test", "AimedEmission.*"),
     ("texture_render_test", "*"),
+    ("normal_map_render_test", "*"),
 ]
 # tests/meta/stat_registry_test.cpp checks that every test reaching test::stat_seed is listed here.
 
