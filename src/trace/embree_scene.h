@@ -207,6 +207,9 @@ class EmbreeScene {
   SurfaceSample sample_shape(int shape, glm::vec2 u) const;
   // The unit geometric normal of a shape at a point on it (`primitive`: the triangle of a mesh).
   glm::vec3 normal_at(int shape, int primitive, const glm::vec3& p) const;
+  // The surface parameters (Hit::uv) of a point p on a shape (`primitive`: the triangle of a mesh),
+  // as a hit there computes them; for points found otherwise than by a ray (the manifold's chains).
+  glm::vec2 uv_at(int shape, int primitive, const glm::vec3& p) const;
   // A shape's geometry as the scene gives it.
   const ShapeGeometry& shape_geometry(int shape) const { return source_->shapes[static_cast<std::size_t>(shape)].geometry; }
   // A hit's position and normal derivatives (trace/differential.h), computed only when asked: the
