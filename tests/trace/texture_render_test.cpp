@@ -115,6 +115,24 @@ TEST(TextureRender, ConstantRoughnessReflectanceAndPlasticTexturesRenderAsTheirV
     }
 }
 
+// The manifold connector evaluates a textured smooth conductor at its solved points (their uv
+// from EmbreeScene::uv_at, tested in embree_test): a 1 x 1 reflectance image renders the plain
+// value's numbers with pt-nee+manifold.
+TEST(TextureRender, TheManifoldConnectorSeesATexturedSmoothConductor) {
+  test::write_image<float>("metal.exr", 1, 1, 3, {0.64f, 0.5f, 0.25f});
+  const std::string scene = kHead + "LightSource \"point\" \"point3 from\" [0 0.5 -0.9] \"rgb I\" [5 5 5]\n"
+                                    "Material \"diffuse\"\nShape \"trianglemesh\" \"point3 P\" [-4 -0.5 -4  4 -0.5 -4  4 -0.5 4  -4 -0.5 4] "
+                                    "\"integer indices\" [0 1 2  0 2 3]\n"
+                                    "Texture \"r\" \"spectrum\" \"imagemap\" \"string filename\" \"metal.exr\"\n";
+  const std::string plain = write("caustic-plain.pbrt", scene + "Material \"conductor\" \"rgb reflectance\" [0.64 0.5 0.25]\n"
+                                                                "Shape \"sphere\" \"float radius\" 0.4\n");
+  const std::string image = write("caustic-image.pbrt", scene + "Material \"conductor\" \"texture reflectance\" \"r\"\n"
+                                                                "Shape \"sphere\" \"float radius\" 0.4\n");
+  const Estimate a = render_total(plain, "pt-nee+manifold", 16), b = render_total(image, "pt-nee+manifold", 16);
+  EXPECT_EQ(a.luminance, b.luminance);
+  EXPECT_EQ(a.std_error, b.std_error);
+}
+
 TEST(TextureRender, ACheckerboardRoughnessRendersTheMeanOfItsTwoRoughnesses) {
   // A conductor wall lit by a small area light whose reflection the camera sees. The scene is
   // symmetric in x and x -> −x swaps the cells' parity, so the image mean of a checkerboard of
