@@ -561,19 +561,20 @@ class Importer {
         c.eta = vec3(metal->eta[0], metal->eta[1], metal->eta[2]);
         c.k = vec3(metal->k[0], metal->k[1], metal->k[2]);
       }
-      MI_TRY(spec, p.color("specular_reflectance", vec3(1.0f)));
+      MI_TRY(spec, spectrum(p, "specular_reflectance", vec3(1.0f), TexturedParam::kSpecularReflectance));
       if (glm::any(glm::lessThan(spec, vec3(0.0f))) || glm::any(glm::greaterThan(spec, vec3(1.0f))))
         return located(where(n), "specular_reflectance must be within [0, 1]");
       c.tint = spec;
       if (type == "roughconductor") {
-        MI_TRY(a, mitsuba_alphas(p, n));
+        MI_TRY(a, mitsuba_alphas(p, n, true));
         c.alpha_u = a.alpha.x;
         c.alpha_v = a.alpha.y;
         c.distribution = a.kind;
       }
       // Smooth with eta 0, k 1 (material none) reflects specular_reflectance at every angle: exactly
-      // a mirror, which the mirror and manifold connectors know.
-      if (c.smooth() && c.eta == vec3(0.0f) && c.k == vec3(1.0f)) m = Mirror{spec};
+      // a mirror, which the mirror and manifold connectors know (untextured: they take one
+      // reflectance per shape; a textured one stays a conductor, evaluated per hit).
+      if (c.smooth() && c.eta == vec3(0.0f) && c.k == vec3(1.0f) && material_textures_.empty()) m = Mirror{spec};
       else m = c;
     } else if (type == "dielectric" || type == "roughdielectric" || type == "thindielectric") {
       // letters: S (dielectric, thindielectric), D (roughdielectric, alpha at least 1e-3)
@@ -584,7 +585,7 @@ class Importer {
       if (type == "thindielectric") {
         m = ThinDielectric{static_cast<float>(eta), refl};
       } else if (type == "roughdielectric") {
-        MI_TRY(a, mitsuba_alphas(p, n));
+        MI_TRY(a, mitsuba_alphas(p, n, true));
         if (std::max(a.alpha.x, a.alpha.y) >= kSmoothAlpha) m = RoughDielectric{static_cast<float>(eta), refl, a.alpha.x, a.alpha.y, a.kind};
         else m = Dielectric{static_cast<float>(eta), refl};
       } else {
@@ -602,7 +603,10 @@ class Importer {
       MI_TRY(eta, relative_ior(p, n, 1.49));
       MI_TRY(spec, p.color("specular_reflectance", vec3(1.0f)));
       if (spec != vec3(1.0f)) return located(where(p.find("specular_reflectance")), "specular_reflectance other than 1 is not supported: pathex's coat reflects by the Fresnel equations alone");
-      MI_TRY(rho, p.color("diffuse_reflectance", vec3(0.5f)));
+      // A textured diffuse_reflectance: the map to the base is not linear in ρ, so it is applied per
+      // hit to the value looked up (TextureMap::kPlastic in texture_eval.cpp's bind), as Mitsuba
+      // applies its own to the value it looks up; mapping the texels would differ between them.
+      MI_TRY(rho, spectrum(p, "diffuse_reflectance", vec3(0.5f), TexturedParam::kReflectance));
       if (glm::any(glm::lessThan(rho, vec3(0.0f))) || glm::any(glm::greaterThan(rho, vec3(1.0f))))
         return located(where(p.find("diffuse_reflectance")), "diffuse_reflectance must be within [0, 1]");
       MI_TRY(nonlinear, p.boolean("nonlinear", false));
@@ -618,6 +622,11 @@ class Importer {
       }
       const float r_bar = bsdf::layered::mean_internal_reflectance(c.eta);
       c.reflectance = nonlinear ? rho : rho / (1.0f - r_bar + rho * r_bar);
+      for (TextureBinding& b : material_textures_.bindings)
+        if (b.param == TexturedParam::kReflectance && !nonlinear) {
+          b.map = TextureMap::kPlastic;
+          b.r_bar = r_bar;
+        }
       m = c;
     } else if (type == "blendbsdf") {
       int weight_texture = -1;
@@ -660,19 +669,42 @@ class Importer {
     glm::vec2 alpha;
     MicrofacetKind kind;
   };
-  Result<MitsubaMicrofacet> mitsuba_alphas(Props& p, pugi::xml_node n) {
+  //
+  // `textures` (roughconductor, roughdielectric: Mitsuba 3 takes their alphas as textures; false
+  // for its roughplastic, whose alpha is a scalar): an alpha that is a texture binds TexturedParam::kAlphaU or kAlphaV
+  // in material_textures_ with the placeholder 1, so the material is rough, letter D; per hit it is
+  // clamped to [1e-3, 1] (texture_eval.cpp's bind).
+  Result<MitsubaMicrofacet> mitsuba_alphas(Props& p, pugi::xml_node n, bool textures = false) {
     MI_TRY(dist, p.string("distribution", "beckmann"));
     if (dist != "ggx" && dist != "beckmann")
       return located(where(p.find("distribution")), "microfacet distribution \"" + excerpt(dist) + "\" is not supported, expected beckmann or ggx");
     p.ignore({"sample_visible"});
-    MI_TRY(alpha, p.number("alpha", 0.1));
-    MI_TRY(u, p.number("alpha_u", alpha));
-    MI_TRY(v, p.number("alpha_v", alpha));
     if (p.find("alpha") && (p.find("alpha_u") || p.find("alpha_v"))) return located(where(p.find("alpha")), "give either alpha or alpha_u and alpha_v");
-    for (double a : {u, v})
+    glm::vec2 alpha;
+    bool textured = false;
+    const char* const names[2] = {"alpha_u", "alpha_v"};
+    for (int i = 0; i < 2; ++i) {
+      const std::string name = p.find(names[i]) ? names[i] : "alpha";
+      pugi::xml_node t = p.find(name);
+      if (t && is_texture_node(t) && !textures)
+        return located(where(t), "a texture for '" + name + "' of roughplastic is not supported: Mitsuba 3's roughplastic takes one <float> " + name);
+      if (t && is_texture_node(t)) {
+        MI_TRY(index, operand(p, name, vec3(0.1f), true));
+        material_textures_.bindings.push_back(TextureBinding{-1, i == 0 ? TexturedParam::kAlphaU : TexturedParam::kAlphaV, index, 1.0f});
+        alpha[i] = 1.0f;
+        textured = true;
+        continue;
+      }
+      MI_TRY(a, p.number(name, 0.1));
       if (!(a >= 0.0) || a > 1.0) return located(where(n), "alpha must be within [0, 1]");
-    return MitsubaMicrofacet{glm::vec2(static_cast<float>(u), static_cast<float>(v)),
-                             dist == "ggx" ? MicrofacetKind::kGgx : MicrofacetKind::kBeckmann};
+      alpha[i] = static_cast<float>(a);
+    }
+    if (textured) alpha = glm::max(alpha, glm::vec2(kSmoothAlpha));  // textured: the rough kind
+    return MitsubaMicrofacet{alpha, dist == "ggx" ? MicrofacetKind::kGgx : MicrofacetKind::kBeckmann};
+  }
+  // A <texture>, or a <ref> to a top-level one.
+  bool is_texture_node(pugi::xml_node t) const {
+    return std::string(t.name()) == "texture" || (std::string(t.name()) == "ref" && is_texture(t.attribute("id").value()));
   }
 
   // A texture operand `name` of a bsdf or texture: a nested <texture>, a <ref> to a top-level one,
@@ -1206,8 +1238,8 @@ Result<vec3> Props::color(const std::string& name, vec3 fallback) {
   if (!n) return fallback;
   const std::string tag = n.name();
   if (tag == "texture" || (tag == "ref" && im_->is_texture(n.attribute("id").value())))
-    return located(im_->where(n), "a texture for '" + name + "' is not supported here (pathex reads textures for reflectances, a blendbsdf's "
-                                  "weight and a mask's opacity), give an <rgb>");
+    return located(im_->where(n), "a texture for '" + name + "' is not supported here (pathex reads textures for reflectances, alphas, a "
+                                  "blendbsdf's weight and a mask's opacity), give an <rgb>");
   if (tag != "rgb" && tag != "float" && tag != "spectrum") return located(im_->where(n), "'" + name + "' must be an <rgb>");
   // An emitter's spectrum is light, every other one a reflectance (Mitsuba's Properties::get_texture).
   const bool emission = what_.rfind("<emitter", 0) == 0;

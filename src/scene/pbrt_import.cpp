@@ -166,7 +166,7 @@ class Params {
     if (!p) return fallback;
     if (p->type == "texture")
       return located(p->at, "a texture for parameter '" + name + "' is not supported (pathex reads textures for reflectance, "
-                            "transmittance, a mix's amount and a shape's alpha), give \"float " + name + "\" value");
+                            "transmittance, roughness, a mix's amount and a shape's alpha), give \"float " + name + "\" value");
     bool ok = false;
     for (const char* t : types) ok = ok || p->type == t;
     if (!ok || p->numbers.size() != 1) return located(p->at, "parameter '" + name + "' expects one " + *types.begin() + " value");
@@ -217,7 +217,7 @@ class Params {
       return located(p->at, "parameter \"" + p->type + " " + name + "\" is not supported: pathex renders in RGB, give \"rgb " + name + "\" [r g b]");
     if (p->type == "texture")
       return located(p->at, "a texture for parameter \"" + name + "\" is not supported here (pathex reads textures for reflectance, "
-                            "transmittance, a mix's amount and a shape's alpha), give \"rgb " + name + "\" [r g b]");
+                            "transmittance, roughness, a mix's amount and a shape's alpha), give \"rgb " + name + "\" [r g b]");
     return located(p->at, "parameter '" + name + "' expects \"rgb " + name + "\" [r g b]");
   }
   // Triples of a point3 (`kind` "point") or normal3 (`kind` "normal") parameter; pbrt-v4 also takes the type without the 3.
@@ -812,16 +812,39 @@ class Importer {
   // TrowbridgeReitzDistribution::RoughnessToAlpha). Below 1e-3 in both, pbrt-v4 renders the
   // surface smooth (EffectivelySmooth), and so does pathex. The anisotropy follows the shading
   // frame's tangents, not pbrt's dpdu.
-  Result<glm::vec2> alphas(Params& ps, const Location& at, const char* what) {
-    PBRT_TRY(r, ps.number("roughness", 0.0));
-    PBRT_TRY(u, ps.number("uroughness", r));
-    PBRT_TRY(v, ps.number("vroughness", r));
+  //
+  // Each of roughness, uroughness, vroughness may be a float texture (pbrt-v4 reads
+  // uroughness, else roughness): it binds TexturedParam::kAlphaU or kAlphaV in material_textures_
+  // (remapped per hit: pbrt-v4 remaps the value it looked up) and its placeholder alpha is 1, so the
+  // material is the rough kind, letter D; per hit its alpha is clamped to [1e-3, 1], never smooth.
+  struct Alphas {
+    glm::vec2 a{0.0f};
+    int texture[2] = {-1, -1};  // the float texture of alpha u and of alpha v, -1: a value
+    bool textured() const { return texture[0] >= 0 || texture[1] >= 0; }
+  };
+  Result<Alphas> alphas(Params& ps, const Location& at, const char* what) {
     PBRT_TRY(remap, ps.boolean("remaproughness", true));
-    if (u < 0 || v < 0) return located(at, "roughness must be non-negative");
-    const glm::vec2 a(static_cast<float>(remap ? std::sqrt(u) : u), static_cast<float>(remap ? std::sqrt(v) : v));
-    if (a.x > 1.0f || a.y > 1.0f)
-      return located(at, std::string(what) + " roughness gives GGX alpha " + fmt_number(std::max(a.x, a.y)) + ", pathex accepts at most 1");
-    return a;
+    Alphas out;
+    const char* const names[2] = {"uroughness", "vroughness"};
+    for (int i = 0; i < 2; ++i) {
+      const std::string name = ps.find(names[i]) ? names[i] : "roughness";
+      if (Param* p = ps.find(name); p && p->type == "texture") {
+        PBRT_TRY(index, operand(ps, name, vec3(0.0f), true));
+        material_textures_.bindings.push_back(TextureBinding{-1, i == 0 ? TexturedParam::kAlphaU : TexturedParam::kAlphaV, index, 1.0f,
+                                                             remap ? TextureMap::kSqrt : TextureMap::kLinear});
+        out.texture[i] = index;
+        out.a[i] = 1.0f;
+        continue;
+      }
+      PBRT_TRY(r, ps.number(name, 0.0));
+      if (r < 0) return located(at, "roughness must be non-negative");
+      out.a[i] = static_cast<float>(remap ? std::sqrt(r) : r);
+    }
+    ps.find("roughness");  // read or overridden by uroughness and vroughness, as in pbrt-v4
+    if (out.a.x > 1.0f || out.a.y > 1.0f)
+      return located(at, std::string(what) + " roughness gives GGX alpha " + fmt_number(std::max(out.a.x, out.a.y)) + ", pathex accepts at most 1");
+    if (out.textured()) out.a = glm::max(out.a, glm::vec2(kSmoothAlpha));  // textured: the rough kind
+    return out;
   }
 
   // A conductor's eta or k: "rgb" (or a float), or one of pbrt-v4's named metal spectra
@@ -1010,9 +1033,9 @@ class Importer {
       Conductor c;  // pbrt-v4's default: metal-Cu-eta, metal-Cu-k
       if (Param* r = ps.find("reflectance")) {
         // pbrt-v4: eta = 1 and k = 2 sqrt(r) / sqrt(1 − r), r clamped to [0, 0.9999], which
-        // reflects r at normal incidence.
+        // reflects r at normal incidence. A texture: that map per hit (texture_eval.cpp's bind).
         if (ps.find("eta") || ps.find("k")) return located(r->at, "conductor takes either reflectance or eta and k, not both");
-        PBRT_TRY(refl, ps.rgb("reflectance", vec3(1.0f), true));
+        PBRT_TRY(refl, spectrum(ps, "reflectance", vec3(1.0f), TexturedParam::kConductorReflectance));
         const vec3 rc = glm::clamp(refl, vec3(0.0f), vec3(0.9999f));
         c.eta = vec3(1.0f);
         c.k = 2.0f * glm::sqrt(rc) / glm::sqrt(vec3(1.0f) - rc);
@@ -1025,8 +1048,8 @@ class Importer {
         c.k = k;
       }
       PBRT_TRY(a, alphas(ps, at, "conductor"));
-      c.alpha_u = a.x;
-      c.alpha_v = a.y;
+      c.alpha_u = a.a.x;
+      c.alpha_v = a.a.y;
       return Material{c};
     }
     if (type == "dielectric" || type == "thindielectric") {  // letters: S when smooth (always for thin), D when rough
@@ -1038,7 +1061,7 @@ class Importer {
       if (!valid_ior(eta)) return located(at, type + " eta must be " + kValidIor + ", found " + fmt_number(eta));
       if (thin) return Material{ThinDielectric{static_cast<float>(eta), vec3(1.0f)}};
       PBRT_TRY(a, alphas(ps, at, "dielectric"));
-      if (std::max(a.x, a.y) >= kSmoothAlpha) return Material{RoughDielectric{static_cast<float>(eta), vec3(1.0f), a.x, a.y}};
+      if (std::max(a.a.x, a.a.y) >= kSmoothAlpha) return Material{RoughDielectric{static_cast<float>(eta), vec3(1.0f), a.a.x, a.a.y}};
       return Material{Dielectric{static_cast<float>(eta), vec3(1.0f)}};
     }
     if (type == "diffusetransmission") {  // letters: D
@@ -1073,8 +1096,8 @@ class Importer {
       PBRT_TRY(eta, ps.number("eta", 1.5));
       if (!valid_ior(eta)) return located(eta_p ? eta_p->at : at, std::string("coateddiffuse eta must be ") + kValidIor + ", found " + fmt_number(eta));
       PBRT_TRY(a2, alphas(ps, at, "coateddiffuse"));
-      if (a2.x != a2.y) return located(at, "anisotropic roughness (uroughness != vroughness) is not supported");
-      const float a = a2.x;
+      if (a2.a.x != a2.a.y || a2.texture[0] != a2.texture[1]) return located(at, "anisotropic roughness (uroughness != vroughness) is not supported");
+      const float a = a2.a.x;
       PBRT_TRY(thickness, ps.number("thickness", 0.01));
       if (!(thickness >= 0.0 && thickness <= 1e6)) return located(ps.find("thickness")->at, "coateddiffuse thickness must be within [0, 1e6]");
       PBRT_TRY(g, ps.number("g", 0.0));

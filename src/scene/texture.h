@@ -69,6 +69,22 @@ inline Texture constant(glm::vec3 value) {
 enum class TexturedParam : std::uint32_t {
   kReflectance,    // Diffuse::albedo, CoatedDiffuse::reflectance, DiffuseTransmission::reflectance
   kTransmittance,  // DiffuseTransmission::transmittance
+  // A microfacet alpha (a float texture), clamped to [kSmoothAlpha, 1]: a textured roughness never
+  // makes a rough lobe a Dirac delta, so the material keeps its letter D (docs/textures.md).
+  kAlphaU,  // Conductor::alpha_u, RoughDielectric::alpha_u, CoatedDiffuse::roughness (isotropic)
+  kAlphaV,  // Conductor::alpha_v, RoughDielectric::alpha_v
+  kSpecularReflectance,   // Conductor::tint (Mitsuba 3's specular_reflectance), in [0, 1]
+  kConductorReflectance,  // pbrt-v4's conductor "reflectance" r: eta 1, k = 2 √r / √(1 − r), r in [0, 0.9999]
+};
+
+// How a binding's texture value becomes the parameter, after the bilinear lookup: each of these
+// maps is non-linear, so it is applied per hit to the filtered value, as the source renderer
+// applies it (pbrt-v4 remaps the roughness it looked up; Mitsuba 3 divides the diffuse
+// reflectance it looked up), never to the texels.
+enum class TextureMap : std::uint32_t {
+  kLinear,
+  kSqrt,     // pbrt-v4's remaproughness: alpha = √roughness
+  kPlastic,  // Mitsuba 3's plastic (nonlinear false): the base ρ / (1 − R̄ + ρ R̄), R̄ = TextureBinding::r_bar
 };
 
 struct TextureBinding {
@@ -76,6 +92,8 @@ struct TextureBinding {
   TexturedParam param = TexturedParam::kReflectance;
   int texture = -1;    // index into Scene::textures
   float scale = 1.0f;  // the value times this, then clamped to [0, 1] (pbrt-v4 diffusetransmission's scale)
+  TextureMap map = TextureMap::kLinear;
+  float r_bar = 0.0f;  // kPlastic: the coat's mean internal reflectance (bsdf::layered::mean_internal_reflectance)
 };
 
 // How a material turns its shading normal (docs/textures.md "Bump and normal maps"): a normal map

@@ -618,6 +618,22 @@ vec3 EmbreeScene::normal_at(int shape_index, int primitive, const vec3& p) const
   return std::get<DiskShape>(shape.geometry).normal;
 }
 
+glm::vec2 EmbreeScene::uv_at(int shape_index, int primitive, const vec3& p) const {
+  const Shape& shape = source_->shapes[static_cast<std::size_t>(shape_index)];
+  float w1 = 0.0f, w2 = 0.0f;  // a mesh point's barycentrics in its triangle (p in its plane)
+  if (const auto* m = std::get_if<MeshShape>(&shape.geometry)) {
+    const glm::uvec3 t = m->triangles[static_cast<std::size_t>(primitive)];
+    const vec3 e1 = m->positions[t.y] - m->positions[t.x], e2 = m->positions[t.z] - m->positions[t.x], w = p - m->positions[t.x];
+    const float e11 = glm::dot(e1, e1), e12 = glm::dot(e1, e2), e22 = glm::dot(e2, e2);
+    const float det = e11 * e22 - e12 * e12;
+    if (det > 0.0f) {
+      w1 = std::clamp((glm::dot(w, e1) * e22 - glm::dot(w, e2) * e12) / det, 0.0f, 1.0f);
+      w2 = std::clamp((glm::dot(w, e2) * e11 - glm::dot(w, e1) * e12) / det, 0.0f, 1.0f - w1);
+    }
+  }
+  return shape_uv(shape, static_cast<unsigned>(primitive), w1, w2, p);
+}
+
 SurfaceSample EmbreeScene::sample_shape(int shape_index, glm::vec2 u) const {
   const Shape& shape = source_->shapes[static_cast<std::size_t>(shape_index)];
   SurfaceSample s;

@@ -212,6 +212,9 @@ class EmbreeScene {
   // from its corners and their uv (pbrt-v4's Triangle), a quad's edges, a sphere's and a disk's
   // from their (u, v) maps. Zero (or parallel) where the uv are degenerate, a sphere's poles.
   void uv_tangents(const Hit& h, glm::vec3* dpdu, glm::vec3* dpdv) const;
+  // The surface parameters (Hit::uv) of a point p on a shape (`primitive`: the triangle of a mesh),
+  // as a hit there computes them; for points found otherwise than by a ray (the manifold's chains).
+  glm::vec2 uv_at(int shape, int primitive, const glm::vec3& p) const;
   // A shape's geometry as the scene gives it.
   const ShapeGeometry& shape_geometry(int shape) const { return source_->shapes[static_cast<std::size_t>(shape)].geometry; }
   // A hit's position and normal derivatives (trace/differential.h), computed only when asked: the

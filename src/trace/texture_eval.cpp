@@ -96,14 +96,43 @@ glm::vec3 eval_texture(const Scene& scene, int index, glm::vec2 uv) {
 
 namespace {
 
+// The one place where a texture's value becomes a material parameter (docs/textures.md). The
+// value is clamped as the source renderers clamp it, then mapped (TextureMap: non-linear maps
+// act on the filtered value at the hit, never on texels).
 void bind(BasicMaterial* m, const TextureBinding& b, glm::vec3 value) {
-  value = glm::clamp(value * b.scale, glm::vec3(0.0f), glm::vec3(1.0f));
+  value *= b.scale;
+  if (b.param == TexturedParam::kAlphaU || b.param == TexturedParam::kAlphaV) {
+    float a = std::max(value.x, 0.0f);
+    if (b.map == TextureMap::kSqrt) a = std::sqrt(a);
+    a = std::isfinite(a) ? std::clamp(a, kSmoothAlpha, 1.0f) : 1.0f;  // never smooth: the letter stays D
+    const bool u = b.param == TexturedParam::kAlphaU;
+    if (auto* c = std::get_if<Conductor>(m)) {
+      (u ? c->alpha_u : c->alpha_v) = a;
+    } else if (auto* d = std::get_if<RoughDielectric>(m)) {
+      (u ? d->alpha_u : d->alpha_v) = a;
+    } else if (auto* coat = std::get_if<CoatedDiffuse>(m); coat && u) {
+      coat->roughness = a;
+    }
+    return;
+  }
+  if (b.param == TexturedParam::kConductorReflectance) {  // pbrt-v4's ConductorMaterial, reflectance mode
+    if (auto* c = std::get_if<Conductor>(m)) {
+      const glm::vec3 r = glm::clamp(value, glm::vec3(0.0f), glm::vec3(0.9999f));
+      c->eta = glm::vec3(1.0f);
+      c->k = 2.0f * glm::sqrt(r) / glm::sqrt(glm::vec3(1.0f) - r);
+    }
+    return;
+  }
+  value = glm::clamp(value, glm::vec3(0.0f), glm::vec3(1.0f));
+  if (b.map == TextureMap::kPlastic) value = value / (1.0f - b.r_bar + value * b.r_bar);
   if (auto* d = std::get_if<Diffuse>(m)) {
     d->albedo = value;
   } else if (auto* c = std::get_if<CoatedDiffuse>(m)) {
     c->reflectance = value;
   } else if (auto* t = std::get_if<DiffuseTransmission>(m)) {
     (b.param == TexturedParam::kTransmittance ? t->transmittance : t->reflectance) = value;
+  } else if (auto* k = std::get_if<Conductor>(m); k && b.param == TexturedParam::kSpecularReflectance) {
+    k->tint = value;
   }
 }
 

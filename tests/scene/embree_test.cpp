@@ -173,6 +173,39 @@ TEST(Embree, SurfaceParametersOfSpheresAndDisks) {
   EXPECT_NEAR(glm::distance((*es)->normal_at(0, 0, vec3(0, 2, 0)), vec3(0, 1, 0)), 0.0f, 1e-7f);
 }
 
+// uv_at (for points found otherwise than by a ray: the manifold's solved chains) gives what a hit
+// at that point gives, on every kind of shape: a sphere, a disk, a quad and a mesh with uv.
+TEST(Embree, UvAtAPointIsTheHitsUv) {
+  Scene s = one_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 2, "material": "m"},
+                        {"type": "disk", "center": [10, 0, 0], "normal": [0, 0, 1], "radius": 2, "material": "m"},
+                        {"type": "quad", "corner": [20, -1, 0], "edge1": [2, 0, 0], "edge2": [0, 3, 0], "material": "m"})");
+  ASSERT_EQ(s.shapes.size(), 3u);
+  Shape mesh = s.shapes[2];
+  MeshShape m;
+  m.positions = {{30, -1, 0}, {32, -1, 0}, {30, 2, 0}};
+  m.triangles = {{0u, 1u, 2u}};
+  m.uvs = {{0.1f, 0.2f}, {0.9f, 0.3f}, {0.4f, 0.8f}};
+  mesh.geometry = m;
+  s.shapes.push_back(mesh);
+  auto es = EmbreeScene::build(s);
+  ASSERT_TRUE(es.ok());
+  Uniform rng;
+  int hits[4] = {0, 0, 0, 0};
+  for (int i = 0; i < 200; ++i) {
+    const glm::vec2 u = rng.next2();
+    const float x0[4] = {0.0f, 10.0f, 20.0f, 30.0f};
+    const int shape = i % 4;
+    const vec3 origin(x0[shape] + 3.0f * u.x - 1.0f, 2.5f * u.y - 1.0f, 5.0f);
+    const auto hit = (*es)->intersect(origin, {0, 0, -1}, 0.0f, INFINITY);
+    if (!hit || hit->shape != shape) continue;
+    ++hits[shape];
+    const glm::vec2 at = (*es)->uv_at(hit->shape, hit->primitive, hit->position);
+    EXPECT_NEAR(at.x, hit->uv.x, 2e-5f) << "shape " << shape;
+    EXPECT_NEAR(at.y, hit->uv.y, 2e-5f) << "shape " << shape;
+  }
+  for (int n : hits) EXPECT_GE(n, 10);
+}
+
 // --- sampling: E[f(X) / pdf] is the integral of f over the shape ---
 TEST(Embree, AreaSamplingIntegratesKnownIntegrals) {
   std::ofstream("/tmp/pathex-two.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 10 0 0\nv 13 0 0\nv 10 1 0\nf 1 2 3\nf 4 5 6\n";

@@ -12,6 +12,7 @@
 #include "support/load_scene.h"
 #include "support/scratch_files.h"
 #include "support/test_images.h"
+#include "trace/bsdf_layered.h"
 #include "trace/texture_eval.h"
 
 namespace pathex {
@@ -146,6 +147,93 @@ TEST(ImportTexturesMitsuba, BitmapCheckerboardBlendWeightAndMask) {
   EXPECT_EQ(textures_of(s, 3).bindings.size(), 1u);
 }
 
+// Issue 35: roughness textures (pbrt-v4 roughness / uroughness / vroughness on conductor,
+// dielectric, coateddiffuse, remapped per hit), pbrt-v4's conductor reflectance texture, Mitsuba
+// 3's alpha textures and specular_reflectance, and plastic's textured diffuse_reflectance. A
+// textured roughness makes the material the rough kind (letter D), placeholder alpha 1.
+TEST(ImportTexturesPbrt, RoughnessAndConductorReflectance) {
+  write_black_white();
+  const Scene s = load(write("rough.pbrt", kPbrtHead +
+                                               "Texture \"r\" \"float\" \"imagemap\" \"string filename\" \"bw.png\"\n"
+                                               "Texture \"c\" \"spectrum\" \"checkerboard\" \"rgb tex1\" [0.64 0.64 0.64] \"rgb tex2\" [0 0 0]\n"
+                                               "Material \"conductor\" \"texture roughness\" \"r\" \"texture reflectance\" \"c\"\nShape \"sphere\"\n"
+                                               "Material \"conductor\" \"texture uroughness\" \"r\" \"float vroughness\" 0.25 \"bool remaproughness\" false\n"
+                                               "Shape \"sphere\"\n"
+                                               "Material \"dielectric\" \"texture roughness\" \"r\"\nShape \"sphere\"\n"
+                                               "Material \"coateddiffuse\" \"texture roughness\" \"r\"\nShape \"sphere\"\n"));
+  ASSERT_EQ(s.shapes.size(), 4u);
+  const auto material = [&](std::size_t shape) { return s.materials.at(static_cast<std::size_t>(s.shapes[shape].material)); };
+  const LetterMask only_d = static_cast<LetterMask>(1u << kD);
+  // The conductor: u and v from "roughness" (√, remapped), k from the reflectance texture.
+  const MaterialTextures& t0 = textures_of(s, 0);
+  ASSERT_EQ(t0.bindings.size(), 3u);
+  EXPECT_EQ(t0.bindings[0].param, TexturedParam::kConductorReflectance);
+  EXPECT_EQ(t0.bindings[1].param, TexturedParam::kAlphaU);
+  EXPECT_EQ(t0.bindings[2].param, TexturedParam::kAlphaV);
+  EXPECT_EQ(t0.bindings[1].map, TextureMap::kSqrt);
+  EXPECT_EQ(t0.bindings[1].texture, t0.bindings[2].texture);
+  EXPECT_EQ(std::get<Conductor>(material(0)).alpha_u, 1.0f);  // the placeholder: rough
+  EXPECT_EQ(letters_of(material(0)), only_d);
+  Material at;
+  textured_material(s, material(0), t0, {0.75f, 0.5f}, &at);  // white texel: roughness 1; even cell: r = 0.64
+  EXPECT_EQ(std::get<Conductor>(at).alpha_u, 1.0f);
+  EXPECT_EQ(std::get<Conductor>(at).eta, vec3(1.0f));
+  EXPECT_NEAR(std::get<Conductor>(at).k.y, 8.0 / 3.0, 1e-5);
+  textured_material(s, material(0), t0, {0.25f, 0.5f}, &at);  // black texel: roughness 0, kept rough at 1e-3
+  EXPECT_EQ(std::get<Conductor>(at).alpha_v, kSmoothAlpha);
+  // uroughness a texture, vroughness 0.25 unmapped.
+  const MaterialTextures& t1 = textures_of(s, 1);
+  ASSERT_EQ(t1.bindings.size(), 1u);
+  EXPECT_EQ(t1.bindings[0].map, TextureMap::kLinear);
+  EXPECT_EQ(std::get<Conductor>(material(1)).alpha_v, 0.25f);
+  // The dielectric is the rough one; the coat rough (D only).
+  EXPECT_TRUE(std::holds_alternative<RoughDielectric>(material(2)));
+  EXPECT_EQ(textures_of(s, 2).bindings.size(), 2u);
+  EXPECT_EQ(std::get<CoatedDiffuse>(material(3)).roughness, 1.0f);
+  EXPECT_EQ(letters_of(material(3)), only_d);
+}
+
+TEST(ImportTexturesMitsuba, AlphaSpecularReflectanceAndPlastic) {
+  write_black_white();
+  const auto tex = [&](const std::string& name) { return "<texture type=\"bitmap\" name=\"" + name + "\"><string name=\"filename\" value=\"bw.png\"/></texture>"; };
+  const std::string xml =
+      kXmlHead +
+      "<sensor type=\"perspective\"><transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>\n"
+      "<shape type=\"sphere\"><bsdf type=\"roughconductor\">" + tex("alpha") + tex("specular_reflectance") + "</bsdf></shape>\n" +
+      "<shape type=\"sphere\"><bsdf type=\"roughdielectric\"><float name=\"alpha_u\" value=\"0.3\"/>" + tex("alpha_v") + "</bsdf></shape>\n" +
+      "<shape type=\"sphere\"><bsdf type=\"conductor\">" + tex("specular_reflectance") + "</bsdf></shape>\n" +
+      "<shape type=\"sphere\"><bsdf type=\"plastic\">" + tex("diffuse_reflectance") + "</bsdf></shape>\n" +
+      "<shape type=\"sphere\"><bsdf type=\"roughplastic\"><boolean name=\"nonlinear\" value=\"true\"/>" + tex("diffuse_reflectance") +
+      "</bsdf></shape>\n</scene>\n";
+  const Scene s = load(write("rough.xml", xml));
+  ASSERT_EQ(s.shapes.size(), 5u);
+  const auto material = [&](std::size_t shape) { return s.materials.at(static_cast<std::size_t>(s.shapes[shape].material)); };
+  // roughconductor: the tint and both alphas (unmapped: Mitsuba's alphas are the distribution's).
+  const MaterialTextures& t0 = textures_of(s, 0);
+  ASSERT_EQ(t0.bindings.size(), 3u);
+  EXPECT_EQ(t0.bindings[0].param, TexturedParam::kSpecularReflectance);
+  EXPECT_EQ(t0.bindings[1].param, TexturedParam::kAlphaU);
+  EXPECT_EQ(t0.bindings[2].param, TexturedParam::kAlphaV);
+  EXPECT_EQ(t0.bindings[1].map, TextureMap::kLinear);
+  EXPECT_EQ(s.textures.at(static_cast<std::size_t>(t0.bindings[1].texture)).channel, FloatChannel::kLuminance);
+  EXPECT_EQ(letters_of(material(0)), static_cast<LetterMask>(1u << kD));
+  // roughdielectric: alpha_u 0.3, alpha_v a texture.
+  ASSERT_TRUE(std::holds_alternative<RoughDielectric>(material(1)));
+  EXPECT_FLOAT_EQ(std::get<RoughDielectric>(material(1)).alpha_u, 0.3f);
+  EXPECT_EQ(textures_of(s, 1).bindings.at(0).param, TexturedParam::kAlphaV);
+  // A smooth conductor of material none with a textured tint stays a conductor (S), not a mirror.
+  ASSERT_TRUE(std::holds_alternative<Conductor>(material(2)));
+  EXPECT_EQ(letters_of(material(2)), static_cast<LetterMask>(1u << kS));
+  // plastic: the base ρ / (1 − R̄ + ρ R̄) per hit (R̄ of eta 1.49 / 1.000277); nonlinear: ρ itself.
+  const TextureBinding& p = textures_of(s, 3).bindings.at(0);
+  EXPECT_EQ(p.map, TextureMap::kPlastic);
+  EXPECT_FLOAT_EQ(p.r_bar, bsdf::layered::mean_internal_reflectance(std::get<CoatedDiffuse>(material(3)).eta));
+  Material at;
+  textured_material(s, material(3), textures_of(s, 3), {0.75f, 0.5f}, &at);  // white: ρ = 1 gives the base 1
+  EXPECT_FLOAT_EQ(std::get<CoatedDiffuse>(at).reflectance.x, 1.0f);
+  EXPECT_EQ(textures_of(s, 4).bindings.at(0).map, TextureMap::kLinear);
+}
+
 TEST(ImportTexturesJson, TextureObjectsForColours) {
   write_black_white();
   const std::string json =
@@ -224,13 +312,15 @@ TEST(ImportTexturesRefusals, LocatedWithExactMessages) {
       {"unknown.pbrt", kPbrtHead + "Material \"diffuse\" \"texture reflectance\" \"nope\"\n", "unknown.pbrt:5:20", "unknown texture \"nope\""},
       {"kind.pbrt", kPbrtHead + "Texture \"f\" \"float\" \"constant\"\nMaterial \"diffuse\" \"texture reflectance\" \"f\"\n", "kind.pbrt:6:20",
        "texture \"f\" is a float texture, parameter 'reflectance' expects a spectrum one"},
-      {"rough.pbrt", kPbrtHead + "Texture \"f\" \"float\" \"constant\"\nMaterial \"conductor\" \"texture roughness\" \"f\"\n", "rough.pbrt:6:22",
-       "a texture for parameter 'roughness' is not supported (pathex reads textures for reflectance, transmittance, a mix's amount and a "
-       "shape's alpha), give \"float roughness\" value"},
-      {"metal.pbrt", kPbrtHead + "Texture \"c\" \"spectrum\" \"constant\"\nMaterial \"conductor\" \"texture reflectance\" \"c\"\n",
+      {"g.pbrt", kPbrtHead + "Texture \"f\" \"float\" \"constant\"\nMaterial \"coateddiffuse\" \"texture g\" \"f\"\n", "g.pbrt:6:26",
+       "a texture for parameter 'g' is not supported (pathex reads textures for reflectance, transmittance, roughness, a mix's amount and "
+       "a shape's alpha), give \"float g\" value"},
+      {"metal.pbrt", kPbrtHead + "Texture \"c\" \"spectrum\" \"constant\"\nMaterial \"conductor\" \"texture eta\" \"c\"\n",
        "metal.pbrt:6:22",
-       "a texture for parameter \"reflectance\" is not supported here (pathex reads textures for reflectance, transmittance, a mix's amount "
-       "and a shape's alpha), give \"rgb reflectance\" [r g b]"},
+       "a texture for parameter \"eta\" is not supported here (pathex reads textures for reflectance, transmittance, roughness, a mix's "
+       "amount and a shape's alpha), give \"rgb eta\" [r g b]"},
+      {"aniso.pbrt", kPbrtHead + "Texture \"f\" \"float\" \"constant\"\nMaterial \"coateddiffuse\" \"texture uroughness\" \"f\"\n",
+       "aniso.pbrt:6:1", "anisotropic roughness (uroughness != vroughness) is not supported"},
       {"lit.pbrt", kPbrtHead + "AreaLightSource \"diffuse\"\nShape \"sphere\" \"float alpha\" 0.5\n", "lit.pbrt:6:16",
        "an alpha cut-out on an area light is not supported"},
       {"alpha2.pbrt", kPbrtHead + "Shape \"sphere\" \"float alpha\" 2\n", "alpha2.pbrt:5:16", "alpha must be within [0, 1]"},
@@ -242,11 +332,16 @@ TEST(ImportTexturesRefusals, LocatedWithExactMessages) {
        kXmlHead + "<shape type=\"sphere\"><bsdf type=\"mask\"><bsdf type=\"diffuse\"/></bsdf><emitter type=\"area\"/></shape>\n</scene>\n",
        "lit.xml:3:1", "a mask (an opacity cut-out) on an area light is not supported"},
       {"eta.xml",
-       kXmlHead + "<bsdf type=\"roughconductor\" id=\"x\"><texture type=\"bitmap\" name=\"specular_reflectance\"><string name=\"filename\" "
+       kXmlHead + "<bsdf type=\"roughdielectric\" id=\"x\"><texture type=\"bitmap\" name=\"specular_reflectance\"><string name=\"filename\" "
                   "value=\"bw.png\"/></texture></bsdf>\n</scene>\n",
-       "eta.xml:3:36",
-       "a texture for 'specular_reflectance' is not supported here (pathex reads textures for reflectances, a blendbsdf's weight and a "
-       "mask's opacity), give an <rgb>"},
+       "eta.xml:3:37",
+       "a texture for 'specular_reflectance' is not supported here (pathex reads textures for reflectances, alphas, a blendbsdf's weight "
+       "and a mask's opacity), give an <rgb>"},
+      {"plastic.xml",
+       kXmlHead + "<bsdf type=\"roughplastic\" id=\"x\"><texture type=\"bitmap\" name=\"alpha\"><string name=\"filename\" "
+                  "value=\"bw.png\"/></texture></bsdf>\n</scene>\n",
+       "plastic.xml:3:34",
+       "a texture for 'alpha' of roughplastic is not supported: Mitsuba 3's roughplastic takes one <float> alpha"},
       {"both.json", json_head + R"({"type": "diffuse", "albedo": {"image": "bw.png", "checkerboard": [[1, 1, 1], [0, 0, 0]]}}}})",
        "both.json:/materials/m/albedo", "expected a texture with either \"image\" or \"checkerboard\""},
       {"wrap.json", json_head + R"({"type": "diffuse", "albedo": {"image": "bw.png", "wrap": "mirror"}}}})", "wrap.json:/materials/m/albedo/wrap",

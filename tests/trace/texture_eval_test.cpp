@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
+#include "trace/fresnel.h"
 #include "trace/rng.h"
 
 namespace pathex {
@@ -68,6 +70,9 @@ TEST(TextureLookup, FloatChannels) {
   im.alpha = {0.125f};
   EXPECT_FLOAT_EQ(image_bilerp(im, {0.5f, 0.5f}, TextureWrap::kRepeat, FloatChannel::kPbrt).z, 0.125f);  // pbrt: the alpha channel
 }
+
+// A conductor's Fresnel reflectance at normal incidence, red channel.
+double fresnel_complex_at_normal(const Conductor& c) { return fresnel_complex(1.0f, c.eta.x, c.k.x); }
 
 Scene scene_with(std::vector<Texture> textures) {
   Scene s;
@@ -151,6 +156,60 @@ TEST(TextureEval, MaterialParametersAndATexturedMixAmount) {
   EXPECT_EQ(std::get<DiffuseTransmission>(m.components[1].material).transmittance, vec3(0.45f));
   EXPECT_EQ(std::get<DiffuseTransmission>(m.components[1].material).reflectance, vec3(0.1f));
   EXPECT_EQ(std::get<Diffuse>(m.components[0].material).albedo, vec3(0.2f));
+}
+
+// Roughness, conductor reflectance and Mitsuba's plastic: each value is mapped at the hit after
+// the lookup (TextureMap), and a textured alpha is clamped to [1e-3, 1], so the material keeps its
+// letter D (issue 35).
+TEST(TextureEval, RoughnessConductorReflectanceAndPlasticMaps) {
+  const Scene s = scene_with({constant(vec3(0.25f)), constant(vec3(0.0f)), constant(vec3(4.0f)), constant(vec3(0.64f)),
+                              constant(vec3(0.5f))});
+  Material out;
+  // pbrt-v4's remaproughness: alpha = √0.25 = ½ along u; unmapped 0.25 along v.
+  MaterialTextures rough;
+  rough.bindings.push_back({-1, TexturedParam::kAlphaU, 0, 1.0f, TextureMap::kSqrt});
+  rough.bindings.push_back({-1, TexturedParam::kAlphaV, 0, 1.0f, TextureMap::kLinear});
+  Conductor metal;
+  metal.alpha_u = metal.alpha_v = 1.0f;
+  textured_material(s, Material{metal}, rough, {0.5f, 0.5f}, &out);
+  EXPECT_EQ(std::get<Conductor>(out).alpha_u, 0.5f);
+  EXPECT_EQ(std::get<Conductor>(out).alpha_v, 0.25f);
+  textured_material(s, Material{RoughDielectric{1.5f, vec3(1.0f), 1.0f, 1.0f}}, rough, {0.5f, 0.5f}, &out);
+  EXPECT_EQ(std::get<RoughDielectric>(out).alpha_u, 0.5f);
+  EXPECT_EQ(std::get<RoughDielectric>(out).alpha_v, 0.25f);
+  CoatedDiffuse coat;
+  coat.roughness = 1.0f;
+  textured_material(s, Material{coat}, rough, {0.5f, 0.5f}, &out);
+  EXPECT_EQ(std::get<CoatedDiffuse>(out).roughness, 0.5f);  // the coat is isotropic: alpha u only
+  // 0 is clamped to 1e-3: still rough, letter D, never a Dirac delta; 4 is clamped to 1.
+  for (auto [texture, expected] : {std::pair{1, kSmoothAlpha}, std::pair{2, 1.0f}}) {
+    MaterialTextures t;
+    t.bindings.push_back({-1, TexturedParam::kAlphaU, texture, 1.0f, TextureMap::kSqrt});
+    t.bindings.push_back({-1, TexturedParam::kAlphaV, texture, 1.0f, TextureMap::kSqrt});
+    textured_material(s, Material{metal}, t, {0.5f, 0.5f}, &out);
+    EXPECT_EQ(std::get<Conductor>(out).alpha_u, expected);
+    EXPECT_FALSE(std::get<Conductor>(out).smooth());
+    EXPECT_EQ(letters_of(out), static_cast<LetterMask>(1u << kD));
+  }
+  // pbrt-v4's conductor reflectance r = 0.64: eta 1, k = 2 √r / √(1 − r) = 8/3, which reflects
+  // exactly r at normal incidence (k² / (4 + k²)).
+  MaterialTextures refl;
+  refl.bindings.push_back({-1, TexturedParam::kConductorReflectance, 3, 1.0f});
+  textured_material(s, Material{Conductor{}}, refl, {0.5f, 0.5f}, &out);
+  const Conductor& c = std::get<Conductor>(out);
+  EXPECT_EQ(c.eta, vec3(1.0f));
+  EXPECT_NEAR(c.k.x, 8.0 / 3.0, 1e-6);
+  EXPECT_NEAR(fresnel_complex_at_normal(c), 0.64, 1e-6);
+  // Mitsuba's specular_reflectance: the conductor's tint.
+  MaterialTextures tint;
+  tint.bindings.push_back({-1, TexturedParam::kSpecularReflectance, 4, 1.0f});
+  textured_material(s, Material{Conductor{}}, tint, {0.5f, 0.5f}, &out);
+  EXPECT_EQ(std::get<Conductor>(out).tint, vec3(0.5f));
+  // Mitsuba's plastic: the base ρ / (1 − R̄ + ρ R̄) of the value looked up, ρ = ½, R̄ = 0.6.
+  MaterialTextures plastic;
+  plastic.bindings.push_back({-1, TexturedParam::kReflectance, 4, 1.0f, TextureMap::kPlastic, 0.6f});
+  textured_material(s, Material{CoatedDiffuse{}}, plastic, {0.5f, 0.5f}, &out);
+  EXPECT_NEAR(std::get<CoatedDiffuse>(out).reflectance.x, 0.5 / 0.7, 1e-6);
 }
 
 // pbrt-v4's stochastic alpha: a fraction 1 − a of rays pass. 200,000 rays of random origins and

@@ -264,11 +264,22 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     v.shape = c.id;
     const glm::dvec3 prev = i == 0 ? glm::dvec3(a->p) : chain[static_cast<std::size_t>(i - 1)].p;
     const float cos_prev = static_cast<float>(glm::dot(glm::normalize(prev - c.p), geometry.ns));
-    if (const auto* glass = std::get_if<Dielectric>(rs_.material_of_shape[static_cast<std::size_t>(c.id)])) {
+    // A textured material's values at the solved point (its uv as a hit there has it), as every
+    // other strategy sees them through material_at().
+    Material textured;
+    const bool has_textures = rs_.textures_of_shape[static_cast<std::size_t>(c.id)] != nullptr;
+    if (has_textures) v.uv = rs_.geometry->uv_at(c.id, c.primitive, v.p);
+    const Material& mat = material_at(v, &textured);
+    if (const auto* glass = std::get_if<Dielectric>(&mat)) {
       const float f = bsdf::fresnel_dielectric(cos_prev, glass->ior);
       transmit *= glass->tint * (c.reflect ? f : 1.0f - f);
-    } else if (const auto* metal = std::get_if<Conductor>(rs_.material_of_shape[static_cast<std::size_t>(c.id)])) {
+    } else if (const auto* metal = std::get_if<Conductor>(&mat)) {
       transmit *= metal->tint * fresnel_complex(cos_prev, metal->eta, metal->k);
+    } else if (const auto* mix = std::get_if<Mixture>(&mat); mix && has_textures) {  // a mix by a texture amount: its weights here
+      vec3 r(0.0f);
+      for (const Mixture::Component& k : mix->components)
+        if (const auto* mirror = std::get_if<Mirror>(&k.material); mirror && std::isfinite(k.weight) && k.weight > 0.0f) r += k.weight * mirror->reflectance;
+      transmit *= r;
     } else {
       transmit *= mirror_reflectance_[static_cast<std::size_t>(c.id)];
     }
