@@ -186,10 +186,14 @@ TEST(Converge, ReferencesSeeWhatTheyJudgeAndNoRendererIsRankedOnWhatItCannotSamp
   std::size_t ranked_classes = 0;
   for (const auto& b : j.at("best")) {
     ++ranked_classes;
-    for (const auto& c : j.at("renderers"))
-      if (c.at("name") == b.at("renderer"))
-        for (const auto& cc : c.at("classes"))
-          if (cc.at("name") == b.at("class")) EXPECT_TRUE(cc.at("cannot_sample").is_null()) << b.dump();
+    for (const auto& c : j.at("renderers")) {
+      if (c.at("name") != b.at("renderer")) continue;
+      for (const auto& cc : c.at("classes")) {
+        if (cc.at("name") == b.at("class")) {
+          EXPECT_TRUE(cc.at("cannot_sample").is_null()) << b.dump();
+        }
+      }
+    }
     EXPECT_NE(b.at("class"), "total") << "pt-nee and bdpt both miss light of the total that the reference samples";
   }
   EXPECT_GE(ranked_classes, 1u);  // bdpt on "local" (L.*DD.*E)
