@@ -10,6 +10,7 @@
 
 #include "scene/scene.h"
 #include "support/cli_run.h"
+#include "support/load_scene.h"
 #include "support/scratch_files.h"
 #include "support/test_images.h"
 #include "trace/texture_eval.h"
@@ -26,11 +27,7 @@ using test::write_image;
 const std::string kPbrtHead = "LookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\nLightSource \"point\"\n";
 const std::string kXmlHead = "<scene version=\"3.0.0\">\n<emitter type=\"point\"/>\n";
 
-Scene load(const std::string& path) {
-  Result<Scene> s = load_scene_file(path);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().render());
-  return s.ok() ? *s : Scene{};
-}
+using test::load;
 
 // A 2 x 1 PNG of 8-bit codes: (255, 128, 0) and (0, 128, 255).
 void write_normals() { write_image<unsigned char>("nm.png", 2, 1, 3, {255, 128, 0, 0, 128, 255}); }

@@ -1,5 +1,6 @@
-// One render of a scene for a test, classified by full-notation classes, with its report: the
-// renderer tests' one way to render (render_test, environment_test). A step that fails fails the
+// One render of a scene for a test, classified by full-notation classes, with its report, or the
+// image's total alone: the renderer tests' one way to render (render_test, environment_test,
+// texture_render_test, normal_map_render_test). A step that fails fails the
 // test with its located message.
 #pragma once
 
@@ -55,6 +56,24 @@ inline Rendered render_scene(Result<Scene> scene, const std::string& renderer, c
   info.spp = spp;
   HistogramReport rep = make_report(out.histogram, info, keep.back()->classifier.get(), keep.back()->infos).expect("a report");
   return Rendered{std::move(rep), std::move(out)};
+}
+
+// The image's total estimate of a scene file rendered with `renderer` (no classes), at `seed`;
+// a non-finite sample fails the test.
+inline Estimate render_total(const std::string& path, const std::string& renderer, std::uint64_t spp, std::uint64_t seed,
+                             int max_bounces = 8) {
+  const Scene s = load_scene_file(path).expect("a test scene");
+  const Profile profile = resolve_profile(renderer, Limits{}).expect("a built-in renderer");
+  RenderOptions o;
+  o.spp = spp;
+  o.seed = seed;
+  o.max_bounces = max_bounces;
+  const RenderOutput out = render(s, profile, nullptr, o).expect("a render");
+  RunInfo info;
+  info.spp = spp;
+  const HistogramReport r = make_report(out.histogram, info, nullptr, {}).expect("a report");
+  EXPECT_EQ(r.nonfinite_samples, 0u) << path << " " << renderer;
+  return r.total;
 }
 
 }  // namespace pathex::test

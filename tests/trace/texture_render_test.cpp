@@ -16,6 +16,7 @@
 #include "support/scratch_files.h"
 #include "support/stat_seed.h"
 #include "support/test_images.h"
+#include "support/test_render.h"
 #include "trace/render.h"
 
 namespace pathex {
@@ -24,22 +25,7 @@ namespace {
 using test::write;
 
 Estimate render_total(const std::string& path, const std::string& renderer, std::uint64_t spp) {
-  Result<Scene> scene = load_scene_file(path);
-  EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().render());
-  if (!scene.ok()) return {};
-  Result<Profile> profile = resolve_profile(renderer, Limits{});
-  EXPECT_TRUE(profile.ok());
-  RenderOptions o;
-  o.spp = spp;
-  o.seed = test::stat_seed(35);
-  o.max_bounces = 8;
-  Result<RenderOutput> out = render(*scene, *profile, nullptr, o);
-  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().render());
-  RunInfo info;
-  info.spp = spp;
-  const HistogramReport r = make_report(out->histogram, info, nullptr, {}).expect("a test input");
-  EXPECT_EQ(r.nonfinite_samples, 0u);
-  return r.total;
+  return test::render_total(path, renderer, spp, test::stat_seed(35));
 }
 
 // A camera at z = −3 looking at the origin (fov 30: it sees [−0.80, 0.80]² of the plane z = 0).
