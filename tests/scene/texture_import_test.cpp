@@ -10,6 +10,7 @@
 
 #include "scene/scene.h"
 #include "support/load_scene.h"
+#include "support/scene_snippets.h"
 #include "support/scratch_files.h"
 #include "support/test_images.h"
 #include "trace/bsdf_layered.h"
@@ -24,8 +25,8 @@ using test::relative;
 using test::write;
 using test::write_image;
 
-const std::string kPbrtHead = "LookAt 0 1 3  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\nLightSource \"point\"\n";
-const std::string kXmlHead = "<scene version=\"3.0.0\">\n<emitter type=\"point\"/>\n";
+using test::kPbrtHead;
+using test::kXmlHead;
 
 using test::load;
 

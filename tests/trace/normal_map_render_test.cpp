@@ -13,6 +13,7 @@
 
 #include "io/profile_json.h"
 #include "scene/scene.h"
+#include "support/scene_snippets.h"
 #include "support/scratch_files.h"
 #include "support/stat_seed.h"
 #include "support/test_images.h"
@@ -33,13 +34,9 @@ Estimate render_total(const std::string& path, const std::string& renderer, std:
 
 // A camera at z = −3 looking at the origin (fov 30: it sees [−0.80, 0.80]² of the plane z = 0,
 // u and v within [0.3, 0.7] on the wall below).
-const std::string kHead =
-    "LookAt 0 0 -3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nFilm \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n"
-    "WorldBegin\n";
 // The square [−2, 2]² of z = 0, uv 0 to 1 across it: dp/du = (4, 0, 0), dp/dv = (0, 4, 0), normal +z.
-const std::string kWall =
-    "Shape \"trianglemesh\" \"point3 P\" [-2 -2 0  2 -2 0  2 2 0  -2 2 0] \"integer indices\" [0 1 2  0 2 3] "
-    "\"point2 uv\" [0 0  1 0  1 1  0 1]";
+using test::kWall;
+const std::string& kHead = test::kRenderHead;
 // A distant light of irradiance π from the unit direction (x, 0, −√3/2) on the camera's side: a
 // diffuse wall of albedo ½ with shading normal n shows ½ |n · l| (pbrt-v4's L is the irradiance).
 std::string distant(float x) {

@@ -13,6 +13,7 @@
 
 #include "io/profile_json.h"
 #include "scene/scene.h"
+#include "support/scene_snippets.h"
 #include "support/scratch_files.h"
 #include "support/stat_seed.h"
 #include "support/test_images.h"
@@ -29,15 +30,11 @@ Estimate render_total(const std::string& path, const std::string& renderer, std:
 }
 
 // A camera at z = −3 looking at the origin (fov 30: it sees [−0.80, 0.80]² of the plane z = 0).
-const std::string kHead =
-    "LookAt 0 0 -3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nFilm \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n"
-    "WorldBegin\n";
 // The square [−2, 2]² of the plane z = 0 with uv from 0 to 1 across it: with uscale = vscale = 8
 // its cells are 0.5 wide and a cell corner is at the origin, so the square the camera sees is
 // exactly half even cells and half odd ones (a mirror in x swaps the parity).
-const std::string kWall =
-    "Shape \"trianglemesh\" \"point3 P\" [-2 -2 0  2 -2 0  2 2 0  -2 2 0] \"integer indices\" [0 1 2  0 2 3] "
-    "\"point2 uv\" [0 0  1 0  1 1  0 1]";
+using test::kWall;
+const std::string& kHead = test::kRenderHead;
 
 TEST(TextureRender, AConstantImageRendersAsItsColour) {
   test::write_image<float>("grey.exr", 1, 1, 3, {0.25f, 0.5f, 0.75f});
