@@ -145,7 +145,7 @@ class LpeParser : detail::ParseCursor {
       return true;
     }
     if (c == 'B') {
-      fail(column, "B (background) is not supported: pathex scenes have no environment emission; L is every light");
+      fail(column, "B (background) is not supported: an infinite light is one of the lights (letters LDD, as an area light); L is every light");
       return true;
     }
     if (c == 's') {
