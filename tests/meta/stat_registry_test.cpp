@@ -40,16 +40,35 @@ std::vector<Block> blocks_of(const std::string& text) {
   std::istringstream in(text);
   std::string line;
   Block* open = nullptr;
+  std::string pending;       // a function's head whose `{` is on a later line (parameters wrapped)
+  std::string pending_name;
   while (std::getline(in, line)) {
     std::smatch m;
+    if (open == nullptr && !pending_name.empty()) {
+      if (line.rfind(' ', 0) != 0 || line.find(';') != std::string::npos) {
+        pending_name.clear();  // not a wrapped head after all (a declaration, or code at column 0)
+      } else if (line.find('{') != std::string::npos) {
+        blocks.push_back({pending_name, false, pending});
+        open = &blocks.back();
+        pending_name.clear();
+      } else {
+        pending += line + "\n";
+        continue;
+      }
+    }
     if (open == nullptr) {
+      const bool head_like = line.rfind("namespace", 0) != 0 && line.rfind("struct", 0) != 0 && line.rfind("class", 0) != 0;
       if (std::regex_search(line, m, test_head)) {
         blocks.push_back({m[1].str() + "." + m[2].str(), true, ""});
         open = &blocks.back();
-      } else if (line.find('{') != std::string::npos && line.rfind("namespace", 0) != 0 && line.rfind("struct", 0) != 0 &&
-                 line.rfind("class", 0) != 0 && std::regex_search(line, m, function_head)) {
+      } else if (head_like && line.find('{') != std::string::npos && std::regex_search(line, m, function_head)) {
         blocks.push_back({m[1].str(), false, ""});
         open = &blocks.back();
+      } else if (head_like && line.find('{') == std::string::npos && std::regex_search(line, m, function_head) &&
+                 line.back() == ',') {
+        pending_name = m[1].str();
+        pending = line + "\n";
+        continue;
       }
     }
     if (open != nullptr) {
@@ -61,6 +80,11 @@ std::vector<Block> blocks_of(const std::string& text) {
   return blocks;
 }
 
+// test::stat_seed or test::stat_seed_from (tests/support/stat_seed.h).
+bool calls_stat_seed(const std::string& body) {
+  return body.find("stat_seed(") != std::string::npos || body.find("stat_seed_from(") != std::string::npos;
+}
+
 // The TESTs of `text` that reach test::stat_seed: directly, or through the file's functions.
 std::set<std::string> seeded_tests(const std::string& text) {
   const std::vector<Block> blocks = blocks_of(text);
@@ -69,7 +93,7 @@ std::set<std::string> seeded_tests(const std::string& text) {
     grew = false;
     for (const Block& b : blocks) {
       if (b.is_test || seeded_functions.count(b.name)) continue;
-      bool seeded = b.body.find("stat_seed(") != std::string::npos;
+      bool seeded = calls_stat_seed(b.body);
       for (const std::string& f : seeded_functions)
         if (std::regex_search(b.body, std::regex("\\b" + f + "\\("))) seeded = true;
       if (seeded) grew = seeded_functions.insert(b.name).second || grew;
@@ -78,7 +102,7 @@ std::set<std::string> seeded_tests(const std::string& text) {
   std::set<std::string> tests;
   for (const Block& b : blocks) {
     if (!b.is_test) continue;
-    bool seeded = b.body.find("stat_seed(") != std::string::npos;
+    bool seeded = calls_stat_seed(b.body);
     for (const std::string& f : seeded_functions)
       if (std::regex_search(b.body, std::regex("\\b" + f + "\\("))) seeded = true;
     if (seeded) tests.insert(b.name);
@@ -100,8 +124,13 @@ TEST(StatRegistry, ParsesTestsAndTheFunctionsTheyCall) {
       "double mean() {\n  return render(options()).mean;\n}\n"
       "TEST(A, ThroughTwoFunctions) {\n  EXPECT_EQ(mean(), 1);\n}\n"
       "TEST(A, Direct) {\n  EXPECT_EQ(test::stat_seed(3), 3u);\n}\n"
-      "TEST(A, NotSeeded) {\n  EXPECT_EQ(seed(), 1u);\n}\n";
-  EXPECT_EQ(seeded_tests(text), (std::set<std::string>{"A.Direct", "A.ThroughTwoFunctions"}));
+      "TEST(A, NotSeeded) {\n  EXPECT_EQ(seed(), 1u);\n}\n"
+      "Rendered wrapped(const std::string& scene,\n                 std::uint64_t seed = 7) {\n"
+      "  return render(scene, test::stat_seed_from(seed));\n}\n"
+      "TEST(A, ThroughAWrappedHead) {\n  EXPECT_EQ(wrapped(\"x\").mean, 1);\n}\n"
+      "double declared(int a,\n                int b);\n"
+      "TEST(A, CallsADeclarationOnly) {\n  EXPECT_EQ(declared(1, 2), 3);\n}\n";
+  EXPECT_EQ(seeded_tests(text), (std::set<std::string>{"A.Direct", "A.ThroughTwoFunctions", "A.ThroughAWrappedHead"}));
   EXPECT_TRUE(glob("Sampling.*", "Sampling.EverySetting"));
   EXPECT_TRUE(glob("*", "Anything.AtAll"));
   EXPECT_FALSE(glob("Sampling.Every", "Sampling.EverySetting"));

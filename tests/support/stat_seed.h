@@ -26,6 +26,14 @@ inline std::uint64_t stat_seed(std::uint64_t fixed) {
   return env != nullptr && *env != '\0' ? std::strtoull(env, nullptr, 10) : fixed;
 }
 
+// `fixed`, or shifted by PATHEX_STAT_SEED when it is set: for a helper that renders at seeds its
+// callers choose (render_test's render_json: 7 by default, 11 and 13 beside it), which must stay
+// distinct from each other at every swept seed.
+inline std::uint64_t stat_seed_from(std::uint64_t fixed) {
+  const char* env = std::getenv("PATHEX_STAT_SEED");
+  return env != nullptr && *env != '\0' ? fixed + 1000003u * std::strtoull(env, nullptr, 10) : fixed;
+}
+
 // One checked value and its tolerance, printed when PATHEX_STAT_LOG is set (nothing otherwise).
 inline void stat_log(const std::string& what, double value, double tolerance) {
   static const bool on = std::getenv("PATHEX_STAT_LOG") != nullptr;

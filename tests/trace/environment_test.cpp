@@ -115,7 +115,8 @@ using test::Rendered;
 
 Rendered render_json(const std::string& scene_json, const std::string& renderer, const std::vector<std::string>& classes,
                      std::uint64_t spp, std::uint64_t seed = 7) {
-  Rendered r = test::render_scene(load_scene_json(scene_json, scratch(), "test"), renderer, classes, spp, /*threads=*/0, seed,
+  Rendered r = test::render_scene(load_scene_json(scene_json, scratch(), "test"), renderer, classes, spp, /*threads=*/0,
+                                  test::stat_seed_from(seed),
                                   test::Sampling{}, /*max_bounces=*/8);
   EXPECT_EQ(r.report.nonfinite_samples, 0u) << renderer;
   return r;

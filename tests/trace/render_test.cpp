@@ -30,7 +30,8 @@ using test::render_scene;
 // Renders `scene_json` with `renderer`, classifying by `classes` (full notation).
 Rendered render_json(const std::string& scene_json, const std::string& renderer, const std::vector<std::string>& classes,
                 std::uint64_t spp, int threads = 0, std::uint64_t seed = 7, const Sampling& sampling = {}) {
-  return render_scene(load_scene_json(scene_json, ".", "test"), renderer, classes, spp, threads, seed, sampling, 12);
+  return render_scene(load_scene_json(scene_json, ".", "test"), renderer, classes, spp, threads, test::stat_seed_from(seed),
+                      sampling, 12);
 }
 
 using test::expect_close;
