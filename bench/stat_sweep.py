@@ -29,6 +29,7 @@ STATISTICAL_TESTS = [
     ("render_test", "Labels.*"),
     ("render_test", "Letters.*"),
     ("render_test", "MirrorConnector.*"),
+    ("render_test", "Estimators.*"),
     ("agreement_test", "Agreement.TracerSamplesExactlyWhatTheCheckerAllows"),
     ("converge_test", "Converge.ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest"),
     ("bias_test", "Bias.UnderSampledLightIsFoundWhereTheStderrCannotSeeIt"),

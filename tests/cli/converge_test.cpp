@@ -68,9 +68,10 @@ double slope_std_error(const std::vector<double>& x, const std::vector<double>& 
 //   has no noise to fall, and is not fitted.
 //
 // converge's own checks of each ladder (the χ² check at false-alarm rate kStderrCheckAlpha = 1e-3,
-// the stability check) must pass: at 100 seeds χ² stayed below 0.73 of its limit and the stability
-// below 0.39 (limit 0.7). Before this calibration (±0.1 on both slopes, rounding-level series
-// fitted) the test failed at 69 of 100 seeds; bench/README.md (2026-12-03) has the command.
+// the stability check) may raise at most one alarm over the run: at 100 seeds (2026-12-05) 4 runs
+// had one (bdpt's two-bounce χ² 20.7 against 18.5 at seed 2), none two. Before this calibration
+// (±0.1 on both slopes, rounding-level series fitted) the test failed at 69 of 100 seeds;
+// bench/README.md (2026-12-03) has the command.
 TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
   constexpr double kStderrSlopeSigmas = 5.0, kRmsSlopeSE = 0.02, kRmsSlopeSigmas = 4.0;
   const std::string dir = out_dir("sphere");
@@ -81,7 +82,11 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("reference").at("kind"), "closed-form");
   EXPECT_EQ(j.at("complete"), true);
-  EXPECT_TRUE(j.at("warnings").empty()) << j.at("warnings").dump();
+  // converge's checks each raise a false alarm at 1e-3 per ladder (χ² in each tail, stability):
+  // over this run's ladders (2 renderers, 5 classes) one alarm is 1-3 % likely, two below 0.05 %.
+  // So at most one may fire; a stderr that lies does on most ladders (NearDeltaScene... below).
+  EXPECT_LE(j.at("warnings").size(), 1u) << j.at("warnings").dump();
+  int alarms = 0;
   const std::vector<double> spp = {16, 64, 256, 1024};
   std::vector<double> log_stderr_se;
   for (double n : spp) log_stderr_se.push_back(1.0 / std::sqrt(2.0 * (std::min(n, double(pathex::kDefaultBatches)) - 1.0)));
@@ -96,10 +101,9 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
       if (check.at("chi2").is_number() && check.at("limit").is_number())
         pathex::test::stat_log(what + " chi2/limit", check.at("chi2").get<double>() / check.at("limit").get<double>(), 1);
       if (check.at("stability").is_number()) pathex::test::stat_log(what + " stability", check.at("stability").get<double>(), 0.7);
-      EXPECT_FALSE(check.at("disagrees")) << what;
-      EXPECT_FALSE(check.at("too_large")) << what;
-      EXPECT_FALSE(check.at("unstable")) << what;
-      EXPECT_TRUE(c.at("warning").is_null()) << what;
+      const bool alarm = check.at("disagrees").get<bool>() || check.at("too_large").get<bool>() || check.at("unstable").get<bool>();
+      EXPECT_EQ(alarm, !c.at("warning").is_null()) << what;
+      alarms += alarm ? 1 : 0;
       ASSERT_EQ(c.at("rungs").size(), 4u) << what;
       const double rounding = pathex::kRoundingFloor * c.at("rungs").back().at("estimate").get<double>();
       const std::vector<double> se = column(c.at("rungs"), "stderr");
@@ -118,6 +122,7 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
       }
     }
   }
+  EXPECT_LE(alarms, 1);
   // pt-nee: total (both), bounce3 (both: with independent replicates its 16-spp rung is no longer
   // exact in every pixel); bdpt: every class (both).
   EXPECT_EQ(fitted, 12);
