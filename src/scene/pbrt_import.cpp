@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -26,6 +27,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "scene/import_common.h"
+#include "scene/loop_subdivision.h"
 #include "scene/metal_spectra.h"
 
 namespace pathex {
@@ -1311,21 +1313,7 @@ class Importer {
       } else {
         PBRT_TRY(p, ps.points("P"));
         const std::size_t corners = type == "trianglemesh" ? 3 : 4;
-        std::vector<long long> idx;
-        if (Param* ip = ps.find("indices")) {
-          if (ip->type != "integer") return located(ip->at, "indices must be integers");
-          for (double x : ip->numbers) {
-            if (x != std::floor(x) || std::fabs(x) > 1e15) return located(ip->at, "indices must be integers");
-            idx.push_back(static_cast<long long>(x));
-          }
-        } else if (p.size() == corners) {
-          for (std::size_t i = 0; i < corners; ++i) idx.push_back(static_cast<long long>(i));
-        }
-        if (p.empty() || idx.empty() || idx.size() % corners != 0)
-          return located(at, type + " needs \"point3 P\" and \"integer indices\" (" + std::to_string(corners) + " per " +
-                                 (corners == 3 ? "triangle" : "patch") + ")");
-        for (long long i : idx)
-          if (i < 0 || i >= static_cast<long long>(p.size())) return located(ps.find("indices")->at, "index " + std::to_string(i) + " is out of range, expected 0.." + std::to_string(p.size() - 1));
+        PBRT_TRY(idx, mesh_indices(ps, type, p.size(), corners, at));
         mesh_elements_ += p.size() + idx.size() / corners * (corners - 2);  // a patch: 4 vertices and 2 triangles at most
         if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
         mesh.positions = p;
@@ -1372,6 +1360,7 @@ class Importer {
       if (auto e = add_mesh(std::move(s), std::move(mesh), m, flip, at)) return e;
       return std::nullopt;
     }
+    if (type == "loopsubdiv") return loop_subdivision(std::move(s), ps, m, flip, at);
     if (type == "cylinder") {  // a tessellated tube (import::tube_mesh)
       if (Param* p = ps.find("phimax"); p && !(p->numbers.size() == 1 && p->numbers[0] >= 360.0))
         return located(p->at, "partial cylinders (phimax) are not supported");
@@ -1384,7 +1373,48 @@ class Importer {
       if (auto e = add_mesh(std::move(s), std::move(mesh), m, flip, at)) return e;
       return std::nullopt;
     }
-    return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder");
+    return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, loopsubdiv, sphere, disk or cylinder");
+  }
+
+  // The "integer indices" of a mesh of `points` points, `corners` per face (without indices, a
+  // mesh of exactly one face's points is that face), each in range.
+  Result<std::vector<long long>> mesh_indices(Params& ps, const std::string& type, std::size_t points, std::size_t corners, const Location& at) {
+    std::vector<long long> idx;
+    if (Param* ip = ps.find("indices")) {
+      if (ip->type != "integer") return located(ip->at, "indices must be integers");
+      for (double x : ip->numbers) {
+        if (x != std::floor(x) || std::fabs(x) > 1e15) return located(ip->at, "indices must be integers");
+        idx.push_back(static_cast<long long>(x));
+      }
+    } else if (points == corners) {
+      for (std::size_t i = 0; i < corners; ++i) idx.push_back(static_cast<long long>(i));
+    }
+    if (points == 0 || idx.empty() || idx.size() % corners != 0)
+      return located(at, type + " needs \"point3 P\" and \"integer indices\" (" + std::to_string(corners) + " per " +
+                             (corners == 3 ? "triangle" : "patch") + ")");
+    for (long long i : idx)
+      if (i < 0 || i >= static_cast<long long>(points)) return located(ps.find("indices")->at, "index " + std::to_string(i) + " is out of range, expected 0.." + std::to_string(points - 1));
+    return idx;
+  }
+
+  // pbrt-v4's "loopsubdiv": the control mesh subdivided at load (scene/loop_subdivision.h), then a
+  // mesh with per-vertex normals like a trianglemesh with "N". pbrt-v4 reads "scheme" and ignores it.
+  std::optional<Error> loop_subdivision(Shape s, Params& ps, const glm::mat4& m, bool flip, const Location& at) {
+    ps.ignore({"scheme"});
+    PBRT_TRY(levels, ps.integer("levels", 3));
+    if (levels < 0) return located(ps.find("levels")->at, "levels must be 0 or more");
+    PBRT_TRY(p, ps.points("P"));
+    PBRT_TRY(idx, mesh_indices(ps, "loopsubdiv", p.size(), 3, at));
+    MeshShape control;
+    control.positions = std::move(p);
+    for (std::size_t i = 0; i < idx.size(); i += 3) control.triangles.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
+    std::size_t edges = 0;
+    if (auto why = import::loop_check(control, &edges)) return located(ps.find("indices") ? ps.find("indices")->at : at, *why);
+    const import::LoopCounts n = import::loop_counts(control.positions.size(), edges, control.triangles.size(), levels);
+    const std::uint64_t most = std::numeric_limits<std::size_t>::max() - mesh_elements_;  // saturating
+    mesh_elements_ += static_cast<std::size_t>(n.vertices >= most || n.triangles >= most - n.vertices ? most : n.vertices + n.triangles);
+    if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
+    return add_mesh(std::move(s), import::loop_subdivide(control, levels), m, flip, at);
   }
 
   // A mesh in object space, placed by `m` with its front side pbrt's: the winding's, reversed by
