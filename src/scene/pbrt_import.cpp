@@ -824,12 +824,13 @@ class Importer {
     int texture[2] = {-1, -1};  // the float texture of alpha u and of alpha v, -1: a value
     bool textured() const { return texture[0] >= 0 || texture[1] >= 0; }
   };
-  Result<Alphas> alphas(Params& ps, const Location& at, const char* what) {
+  // `prefix`: coatedconductor's "interface." and "conductor.".
+  Result<Alphas> alphas(Params& ps, const Location& at, const char* what, const std::string& prefix = "") {
     PBRT_TRY(remap, ps.boolean("remaproughness", true));
     Alphas out;
     const char* const names[2] = {"uroughness", "vroughness"};
     for (int i = 0; i < 2; ++i) {
-      const std::string name = ps.find(names[i]) ? names[i] : "roughness";
+      const std::string name = prefix + (ps.find(prefix + names[i]) ? names[i] : "roughness");
       if (Param* p = ps.find(name); p && p->type == "texture") {
         PBRT_TRY(index, operand(ps, name, vec3(0.0f), true));
         material_textures_.bindings.push_back(TextureBinding{-1, i == 0 ? TexturedParam::kAlphaU : TexturedParam::kAlphaV, index, 1.0f,
@@ -842,7 +843,7 @@ class Importer {
       if (r < 0) return located(at, "roughness must be non-negative");
       out.a[i] = static_cast<float>(remap ? std::sqrt(r) : r);
     }
-    ps.find("roughness");  // read or overridden by uroughness and vroughness, as in pbrt-v4
+    ps.find(prefix + "roughness");  // read or overridden by uroughness and vroughness, as in pbrt-v4
     if (out.a.x > 1.0f || out.a.y > 1.0f)
       return located(at, std::string(what) + " roughness gives GGX alpha " + fmt_number(std::max(out.a.x, out.a.y)) + ", pathex accepts at most 1");
     if (out.textured()) out.a = glm::max(out.a, glm::vec2(kSmoothAlpha));  // textured: the rough kind
@@ -854,9 +855,10 @@ class Importer {
   Result<vec3> metal_rgb(Params& ps, const std::string& name, vec3 fallback) {
     Param* p = ps.find(name);
     if (!p || p->type != "spectrum") return ps.rgb(name, fallback, true);
+    const std::string which = name.substr(name.rfind('.') + 1);  // coatedconductor's "conductor.eta" is an eta
     if (p->strings.size() != 1)
       return located(p->at, "parameter \"spectrum " + name + "\" with sampled values is not supported: give a named metal spectrum "
-                            "(\"metal-Cu-" + name + "\") or \"rgb " + name + "\" [r g b]");
+                            "(\"metal-Cu-" + which + "\") or \"rgb " + name + "\" [r g b]");
     const std::string& s = p->strings[0];
     const bool is_eta = s.size() > 4 && s.compare(s.size() - 4, 4, "-eta") == 0;
     const bool is_k = s.size() > 2 && s.compare(s.size() - 2, 2, "-k") == 0;
@@ -1084,33 +1086,38 @@ class Importer {
     if (type == "hair")
       return located(at, "material \"hair\" is not supported: it needs pbrt-v4's hair BSDF on curve shapes, which pathex "
                          "does not have");
-    if (type == "coateddiffuse") {  // pbrt-v4's layered model (trace/bsdf_layered.h), its defaults
+    if (type == "coateddiffuse" || type == "coatedconductor") {  // pbrt-v4's layered models (trace/bsdf_layered.h), its defaults
+      const bool metal = type == "coatedconductor";
+      const std::string eta_name = metal ? "interface.eta" : "eta";
       CoatedDiffuse c;
-      PBRT_TRY(r, spectrum(ps, "reflectance", vec3(0.5f), TexturedParam::kReflectance));
-      if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
-        return located(ps.find("reflectance")->at, "coateddiffuse reflectance must be within [0, 1]");
+      if (!metal) {
+        PBRT_TRY(r, spectrum(ps, "reflectance", vec3(0.5f), TexturedParam::kReflectance));
+        if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
+          return located(ps.find("reflectance")->at, "coateddiffuse reflectance must be within [0, 1]");
+        c.reflectance = r;
+      }
       PBRT_TRY(albedo, ps.rgb("albedo", vec3(0.0f), true));
       if (glm::any(glm::lessThan(albedo, vec3(0.0f))) || glm::any(glm::greaterThan(albedo, vec3(1.0f))))
-        return located(ps.find("albedo")->at, "coateddiffuse albedo must be within [0, 1]");
-      Param* eta_p = ps.find("eta");
+        return located(ps.find("albedo")->at, type + " albedo must be within [0, 1]");
+      Param* eta_p = ps.find(eta_name);
       if (eta_p && eta_p->type != "float")
-        return located(eta_p->at, "parameter \"" + eta_p->type + " eta\" is not supported: give \"float eta\" (pathex's coat has one index)");
-      PBRT_TRY(eta, ps.number("eta", 1.5));
-      if (!valid_ior(eta)) return located(eta_p ? eta_p->at : at, std::string("coateddiffuse eta must be ") + kValidIor + ", found " + fmt_number(eta));
-      PBRT_TRY(a2, alphas(ps, at, "coateddiffuse"));
+        return located(eta_p->at, "parameter \"" + eta_p->type + " " + eta_name + "\" is not supported: give \"float " + eta_name + "\" (pathex's coat has one index)");
+      PBRT_TRY(eta, ps.number(eta_name, 1.5));
+      if (!valid_ior(eta)) return located(eta_p ? eta_p->at : at, type + " " + eta_name + " must be " + kValidIor + ", found " + fmt_number(eta));
+      PBRT_TRY(a2, alphas(ps, at, type.c_str(), metal ? "interface." : ""));
+      if (metal && a2.textured()) return located(at, "a texture for coatedconductor's interface roughness is not supported");
       if (a2.a.x != a2.a.y || a2.texture[0] != a2.texture[1]) return located(at, "anisotropic roughness (uroughness != vroughness) is not supported");
       const float a = a2.a.x;
       PBRT_TRY(thickness, ps.number("thickness", 0.01));
-      if (!(thickness >= 0.0 && thickness <= 1e6)) return located(ps.find("thickness")->at, "coateddiffuse thickness must be within [0, 1e6]");
+      if (!(thickness >= 0.0 && thickness <= 1e6)) return located(ps.find("thickness")->at, type + " thickness must be within [0, 1e6]");
       PBRT_TRY(g, ps.number("g", 0.0));
-      if (!(g > -1.0 && g < 1.0)) return located(ps.find("g")->at, "coateddiffuse g must be within (-1, 1)");
+      if (!(g > -1.0 && g < 1.0)) return located(ps.find("g")->at, type + " g must be within (-1, 1)");
       PBRT_TRY(depth, ps.integer("maxdepth", 10));
       if (depth < 1 || depth > kMaxCoatDepth)
-        return located(ps.find("maxdepth")->at, "coateddiffuse maxdepth must be within [1, " + std::to_string(kMaxCoatDepth) + "]");
+        return located(ps.find("maxdepth")->at, type + " maxdepth must be within [1, " + std::to_string(kMaxCoatDepth) + "]");
       PBRT_TRY(samples, ps.integer("nsamples", 1));
       if (samples < 1 || samples > kMaxCoatSamples)
-        return located(ps.find("nsamples")->at, "coateddiffuse nsamples must be within [1, " + std::to_string(kMaxCoatSamples) + "]");
-      c.reflectance = r;
+        return located(ps.find("nsamples")->at, type + " nsamples must be within [1, " + std::to_string(kMaxCoatSamples) + "]");
       c.albedo = albedo;
       c.roughness = a < 1e-3f ? 0.0f : a;  // pbrt treats alpha < 1e-3 as smooth
       c.eta = static_cast<float>(eta);
@@ -1118,6 +1125,39 @@ class Importer {
       c.g = static_cast<float>(std::clamp(g, -0.999, 0.999));
       c.max_depth = depth;
       c.samples = samples;
+      if (metal) {
+        // The base: pbrt-v4's conductor.eta and conductor.k (default copper) or reflectance r
+        // (η = 1, k = 2√r/√(1 − r), r clamped to [0, 0.9999]), both divided by the coat's eta.
+        c.base = CoatBase::kConductor;
+        Conductor& k = c.conductor;
+        if (Param* r = ps.find("reflectance")) {
+          if (ps.find("conductor.eta") || ps.find("conductor.k"))
+            return located(r->at, "coatedconductor takes either reflectance or conductor.eta and conductor.k, not both");
+          if (r->type == "texture") return located(r->at, "a texture for coatedconductor's reflectance is not supported");
+          PBRT_TRY(refl, ps.rgb("reflectance", vec3(1.0f), true));
+          const vec3 rc = glm::clamp(refl, vec3(0.0f), vec3(0.9999f));
+          k.eta = vec3(1.0f);
+          k.k = 2.0f * glm::sqrt(rc) / glm::sqrt(vec3(1.0f) - rc);
+        } else {
+          for (const char* name : {"conductor.eta", "conductor.k"})
+            if (Param* p = ps.find(name); p && p->type == "texture") return located(p->at, std::string("a texture for coatedconductor's ") + name + " is not supported");
+          PBRT_TRY(ce, metal_rgb(ps, "conductor.eta", k.eta));
+          PBRT_TRY(ck, metal_rgb(ps, "conductor.k", k.k));
+          if (!(glm::all(glm::greaterThan(ce, vec3(0.0f))))) return located(ps.find("conductor.eta")->at, "coatedconductor conductor.eta must be positive");
+          if (glm::any(glm::lessThan(ck, vec3(0.0f)))) return located(ps.find("conductor.k")->at, "coatedconductor conductor.k must be non-negative");
+          k.eta = ce;
+          k.k = ck;
+        }
+        k.eta /= c.eta;
+        k.k /= c.eta;
+        PBRT_TRY(ca, alphas(ps, at, "coatedconductor", "conductor."));
+        if (ca.textured()) return located(at, "a texture for coatedconductor's conductor roughness is not supported");
+        k.alpha_u = ca.a.x;
+        k.alpha_v = ca.a.y;
+        if (c.smooth() && k.smooth() && albedo != vec3(0.0f))
+          return located(ps.find("albedo")->at, "coatedconductor with a smooth interface over a smooth conductor and a scattering layer (albedo > 0) is "
+                                                "not supported: pathex samples it as one delta reflection, which needs albedo 0");
+      }
       return Material{c};
     }
     if (type == "mix") {
@@ -1149,7 +1189,7 @@ class Importer {
       material_textures_ = std::move(textures);
       return mixed;
     }
-    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, coateddiffuse, conductor, dielectric, "
+    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, coateddiffuse, coatedconductor, conductor, dielectric, "
                        "thindielectric, diffusetransmission, interface or mix");
   }
 
