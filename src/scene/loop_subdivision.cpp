@@ -188,7 +188,7 @@ LoopCounts loop_counts(std::uint64_t vertices, std::uint64_t edges, std::uint64_
   constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
   auto add = [](std::uint64_t a, std::uint64_t b) { return a > kMax - b ? kMax : a + b; };
   auto mul = [](std::uint64_t a, std::uint64_t k) { return a > kMax / k ? kMax : a * k; };
-  for (int l = 0; l < levels; ++l) {
+  for (int l = 0; l < levels && triangles != kMax; ++l) {  // saturated: no need to go on (levels may be 1e9)
     vertices = add(vertices, edges);
     edges = add(mul(edges, 2), mul(triangles, 3));
     triangles = mul(triangles, 4);

@@ -245,6 +245,10 @@ TEST(LoopSubdivision, TheElementLimitHoldsBeforeSubdividing) {
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, ErrorCode::kLimit);
   EXPECT_EQ(relative(s.error().where), "loop-big.pbrt:6:1");
+  // A billion levels: the counts saturate after 32 and the refusal is as quick.
+  const Result<Scene> huge = load_scene_file(write("loop-huge.pbrt", kHead + tetra_shape(" \"integer levels\" [1000000000]")), options);
+  ASSERT_FALSE(huge.ok());
+  EXPECT_EQ(huge.error().code, ErrorCode::kLimit);
 }
 
 }  // namespace
