@@ -40,6 +40,7 @@ STATISTICAL_TESTS = [
     ("import_test", "ImportCornell.ImagesMatchTheJsonSceneWithin3Sigma"),
     ("materials_render_test", "*"),
     ("bsdf_test", "CoatedDiffuse.*"),
+    ("bsdf_test", "CoatedConductor.*"),
     ("only_test", "Only.AgreesWithTheClassOfAFullRender"),
     ("emission_cones_test", "AimedEmission.*"),
     ("texture_render_test", "*"),

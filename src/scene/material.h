@@ -96,10 +96,21 @@ struct DiffuseTransmission {
 };
 
 
-// pbrt-v4's coateddiffuse (trace/bsdf_layered.h): a dielectric coat over a Lambertian base with a
-// homogeneous layer between (σ_t = 1 per unit thickness), evaluated and sampled by pbrt-v4's
-// stochastic random walk between the two interfaces. Letters: a smooth coat (roughness < 1e-3)
-// reflects as a Dirac delta, S, and everything that passes it is D; a rough coat is D only.
+// The base under a layered coat: pbrt-v4's coateddiffuse (Lambertian) or coatedconductor.
+enum class CoatBase : std::uint32_t { kDiffuse, kConductor };
+
+// pbrt-v4's coateddiffuse and coatedconductor (trace/bsdf_layered.h): a dielectric coat over a
+// Lambertian or a conductor base with a homogeneous layer between (σ_t = 1 per unit thickness),
+// evaluated and sampled by pbrt-v4's stochastic random walk between the two interfaces.
+// Letters (per sampled component):
+// - a smooth coat (roughness < 1e-3) reflects as a Dirac delta, S; what passes it reaches a
+//   Lambertian or rough conductor base and leaves with a finite density, D;
+// - a rough coat: its reflection and what passes it are D (also over a smooth conductor: the rough
+//   coat spreads what the mirror returns);
+// - a smooth coat over a smooth conductor with a layer that does not scatter (albedo 0): every
+//   path through it leaves in the mirror direction, so the whole BSDF is one Dirac delta, S, whose
+//   weight is the series of the coat's and the conductor's Fresnel terms
+//   (layered::specular_reflectance). Such a coat with a scattering layer is refused at import.
 struct CoatedDiffuse {
   glm::vec3 reflectance{0.5f};  // the base's Lambertian reflectance in [0, 1]
   glm::vec3 albedo{0.0f};       // the layer medium's single-scattering albedo in [0, 1]
@@ -110,7 +121,15 @@ struct CoatedDiffuse {
   int max_depth = 10;           // scattering events of one walk, at least 1
   int samples = 1;              // walks per eval() and pdf() estimate, at least 1
   MicrofacetKind distribution = MicrofacetKind::kGgx;  // of a rough coat
+  CoatBase base = CoatBase::kDiffuse;
+  // The base of a coatedconductor (`base` kConductor; `reflectance` unused): eta and k relative to
+  // the coat (pbrt-v4 divides the metal's by the coat's eta), GGX alphas, tint 1.
+  Conductor conductor;
   bool smooth() const { return roughness < 1e-3f; }
+  // The whole BSDF is one Dirac delta (see above).
+  bool all_specular() const {
+    return base == CoatBase::kConductor && smooth() && conductor.smooth() && albedo == glm::vec3(0.0f);
+  }
 };
 
 // The largest walk length and walk count a coat may ask for (every format): each eval() and pdf()
@@ -138,10 +157,11 @@ using Material = std::variant<Diffuse, Mirror, Dielectric, Glossy, Mixture, Cond
 // Dirac deltas, both for a smooth coat (its reflection is S, what passes it D). A sampled vertex
 // gets the letter of the sampled event (BsdfSample::letter).
 // Diffuse, Glossy, RoughDielectric, DiffuseTransmission: D. Mirror, Dielectric, ThinDielectric: S.
-// Conductor: S when smooth, else D. CoatedDiffuse: S and D when smooth, else D.
+// Conductor: S when smooth, else D. CoatedDiffuse: S and D when smooth, else D; S alone when all_specular().
 inline LetterMask letters_of(const BasicMaterial& m) {
   constexpr auto kOnlyS = static_cast<LetterMask>(1u << kS), kOnlyD = static_cast<LetterMask>(1u << kD);
-  if (const auto* coat = std::get_if<CoatedDiffuse>(&m)) return coat->smooth() ? static_cast<LetterMask>(kOnlyS | kOnlyD) : kOnlyD;
+  if (const auto* coat = std::get_if<CoatedDiffuse>(&m))
+    return coat->all_specular() ? kOnlyS : coat->smooth() ? static_cast<LetterMask>(kOnlyS | kOnlyD) : kOnlyD;
   if (const auto* c = std::get_if<Conductor>(&m)) return c->smooth() ? kOnlyS : kOnlyD;
   return std::holds_alternative<Mirror>(m) || std::holds_alternative<Dielectric>(m) || std::holds_alternative<ThinDielectric>(m)
              ? kOnlyS

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -26,6 +27,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "scene/import_common.h"
+#include "scene/loop_subdivision.h"
 #include "scene/metal_spectra.h"
 
 namespace pathex {
@@ -822,12 +824,13 @@ class Importer {
     int texture[2] = {-1, -1};  // the float texture of alpha u and of alpha v, -1: a value
     bool textured() const { return texture[0] >= 0 || texture[1] >= 0; }
   };
-  Result<Alphas> alphas(Params& ps, const Location& at, const char* what) {
+  // `prefix`: coatedconductor's "interface." and "conductor.".
+  Result<Alphas> alphas(Params& ps, const Location& at, const char* what, const std::string& prefix = "") {
     PBRT_TRY(remap, ps.boolean("remaproughness", true));
     Alphas out;
     const char* const names[2] = {"uroughness", "vroughness"};
     for (int i = 0; i < 2; ++i) {
-      const std::string name = ps.find(names[i]) ? names[i] : "roughness";
+      const std::string name = prefix + (ps.find(prefix + names[i]) ? names[i] : "roughness");
       if (Param* p = ps.find(name); p && p->type == "texture") {
         PBRT_TRY(index, operand(ps, name, vec3(0.0f), true));
         material_textures_.bindings.push_back(TextureBinding{-1, i == 0 ? TexturedParam::kAlphaU : TexturedParam::kAlphaV, index, 1.0f,
@@ -840,7 +843,7 @@ class Importer {
       if (r < 0) return located(at, "roughness must be non-negative");
       out.a[i] = static_cast<float>(remap ? std::sqrt(r) : r);
     }
-    ps.find("roughness");  // read or overridden by uroughness and vroughness, as in pbrt-v4
+    ps.find(prefix + "roughness");  // read or overridden by uroughness and vroughness, as in pbrt-v4
     if (out.a.x > 1.0f || out.a.y > 1.0f)
       return located(at, std::string(what) + " roughness gives GGX alpha " + fmt_number(std::max(out.a.x, out.a.y)) + ", pathex accepts at most 1");
     if (out.textured()) out.a = glm::max(out.a, glm::vec2(kSmoothAlpha));  // textured: the rough kind
@@ -852,9 +855,10 @@ class Importer {
   Result<vec3> metal_rgb(Params& ps, const std::string& name, vec3 fallback) {
     Param* p = ps.find(name);
     if (!p || p->type != "spectrum") return ps.rgb(name, fallback, true);
+    const std::string which = name.substr(name.rfind('.') + 1);  // coatedconductor's "conductor.eta" is an eta
     if (p->strings.size() != 1)
       return located(p->at, "parameter \"spectrum " + name + "\" with sampled values is not supported: give a named metal spectrum "
-                            "(\"metal-Cu-" + name + "\") or \"rgb " + name + "\" [r g b]");
+                            "(\"metal-Cu-" + which + "\") or \"rgb " + name + "\" [r g b]");
     const std::string& s = p->strings[0];
     const bool is_eta = s.size() > 4 && s.compare(s.size() - 4, 4, "-eta") == 0;
     const bool is_k = s.size() > 2 && s.compare(s.size() - 2, 2, "-k") == 0;
@@ -1082,33 +1086,38 @@ class Importer {
     if (type == "hair")
       return located(at, "material \"hair\" is not supported: it needs pbrt-v4's hair BSDF on curve shapes, which pathex "
                          "does not have");
-    if (type == "coateddiffuse") {  // pbrt-v4's layered model (trace/bsdf_layered.h), its defaults
+    if (type == "coateddiffuse" || type == "coatedconductor") {  // pbrt-v4's layered models (trace/bsdf_layered.h), its defaults
+      const bool metal = type == "coatedconductor";
+      const std::string eta_name = metal ? "interface.eta" : "eta";
       CoatedDiffuse c;
-      PBRT_TRY(r, spectrum(ps, "reflectance", vec3(0.5f), TexturedParam::kReflectance));
-      if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
-        return located(ps.find("reflectance")->at, "coateddiffuse reflectance must be within [0, 1]");
+      if (!metal) {
+        PBRT_TRY(r, spectrum(ps, "reflectance", vec3(0.5f), TexturedParam::kReflectance));
+        if (glm::any(glm::lessThan(r, vec3(0.0f))) || glm::any(glm::greaterThan(r, vec3(1.0f))))
+          return located(ps.find("reflectance")->at, "coateddiffuse reflectance must be within [0, 1]");
+        c.reflectance = r;
+      }
       PBRT_TRY(albedo, ps.rgb("albedo", vec3(0.0f), true));
       if (glm::any(glm::lessThan(albedo, vec3(0.0f))) || glm::any(glm::greaterThan(albedo, vec3(1.0f))))
-        return located(ps.find("albedo")->at, "coateddiffuse albedo must be within [0, 1]");
-      Param* eta_p = ps.find("eta");
+        return located(ps.find("albedo")->at, type + " albedo must be within [0, 1]");
+      Param* eta_p = ps.find(eta_name);
       if (eta_p && eta_p->type != "float")
-        return located(eta_p->at, "parameter \"" + eta_p->type + " eta\" is not supported: give \"float eta\" (pathex's coat has one index)");
-      PBRT_TRY(eta, ps.number("eta", 1.5));
-      if (!valid_ior(eta)) return located(eta_p ? eta_p->at : at, std::string("coateddiffuse eta must be ") + kValidIor + ", found " + fmt_number(eta));
-      PBRT_TRY(a2, alphas(ps, at, "coateddiffuse"));
+        return located(eta_p->at, "parameter \"" + eta_p->type + " " + eta_name + "\" is not supported: give \"float " + eta_name + "\" (pathex's coat has one index)");
+      PBRT_TRY(eta, ps.number(eta_name, 1.5));
+      if (!valid_ior(eta)) return located(eta_p ? eta_p->at : at, type + " " + eta_name + " must be " + kValidIor + ", found " + fmt_number(eta));
+      PBRT_TRY(a2, alphas(ps, at, type.c_str(), metal ? "interface." : ""));
+      if (metal && a2.textured()) return located(at, "a texture for coatedconductor's interface roughness is not supported");
       if (a2.a.x != a2.a.y || a2.texture[0] != a2.texture[1]) return located(at, "anisotropic roughness (uroughness != vroughness) is not supported");
       const float a = a2.a.x;
       PBRT_TRY(thickness, ps.number("thickness", 0.01));
-      if (!(thickness >= 0.0 && thickness <= 1e6)) return located(ps.find("thickness")->at, "coateddiffuse thickness must be within [0, 1e6]");
+      if (!(thickness >= 0.0 && thickness <= 1e6)) return located(ps.find("thickness")->at, type + " thickness must be within [0, 1e6]");
       PBRT_TRY(g, ps.number("g", 0.0));
-      if (!(g > -1.0 && g < 1.0)) return located(ps.find("g")->at, "coateddiffuse g must be within (-1, 1)");
+      if (!(g > -1.0 && g < 1.0)) return located(ps.find("g")->at, type + " g must be within (-1, 1)");
       PBRT_TRY(depth, ps.integer("maxdepth", 10));
       if (depth < 1 || depth > kMaxCoatDepth)
-        return located(ps.find("maxdepth")->at, "coateddiffuse maxdepth must be within [1, " + std::to_string(kMaxCoatDepth) + "]");
+        return located(ps.find("maxdepth")->at, type + " maxdepth must be within [1, " + std::to_string(kMaxCoatDepth) + "]");
       PBRT_TRY(samples, ps.integer("nsamples", 1));
       if (samples < 1 || samples > kMaxCoatSamples)
-        return located(ps.find("nsamples")->at, "coateddiffuse nsamples must be within [1, " + std::to_string(kMaxCoatSamples) + "]");
-      c.reflectance = r;
+        return located(ps.find("nsamples")->at, type + " nsamples must be within [1, " + std::to_string(kMaxCoatSamples) + "]");
       c.albedo = albedo;
       c.roughness = a < 1e-3f ? 0.0f : a;  // pbrt treats alpha < 1e-3 as smooth
       c.eta = static_cast<float>(eta);
@@ -1116,6 +1125,39 @@ class Importer {
       c.g = static_cast<float>(std::clamp(g, -0.999, 0.999));
       c.max_depth = depth;
       c.samples = samples;
+      if (metal) {
+        // The base: pbrt-v4's conductor.eta and conductor.k (default copper) or reflectance r
+        // (η = 1, k = 2√r/√(1 − r), r clamped to [0, 0.9999]), both divided by the coat's eta.
+        c.base = CoatBase::kConductor;
+        Conductor& k = c.conductor;
+        if (Param* r = ps.find("reflectance")) {
+          if (ps.find("conductor.eta") || ps.find("conductor.k"))
+            return located(r->at, "coatedconductor takes either reflectance or conductor.eta and conductor.k, not both");
+          if (r->type == "texture") return located(r->at, "a texture for coatedconductor's reflectance is not supported");
+          PBRT_TRY(refl, ps.rgb("reflectance", vec3(1.0f), true));
+          const vec3 rc = glm::clamp(refl, vec3(0.0f), vec3(0.9999f));
+          k.eta = vec3(1.0f);
+          k.k = 2.0f * glm::sqrt(rc) / glm::sqrt(vec3(1.0f) - rc);
+        } else {
+          for (const char* name : {"conductor.eta", "conductor.k"})
+            if (Param* p = ps.find(name); p && p->type == "texture") return located(p->at, std::string("a texture for coatedconductor's ") + name + " is not supported");
+          PBRT_TRY(ce, metal_rgb(ps, "conductor.eta", k.eta));
+          PBRT_TRY(ck, metal_rgb(ps, "conductor.k", k.k));
+          if (!(glm::all(glm::greaterThan(ce, vec3(0.0f))))) return located(ps.find("conductor.eta")->at, "coatedconductor conductor.eta must be positive");
+          if (glm::any(glm::lessThan(ck, vec3(0.0f)))) return located(ps.find("conductor.k")->at, "coatedconductor conductor.k must be non-negative");
+          k.eta = ce;
+          k.k = ck;
+        }
+        k.eta /= c.eta;
+        k.k /= c.eta;
+        PBRT_TRY(ca, alphas(ps, at, "coatedconductor", "conductor."));
+        if (ca.textured()) return located(at, "a texture for coatedconductor's conductor roughness is not supported");
+        k.alpha_u = ca.a.x;
+        k.alpha_v = ca.a.y;
+        if (c.smooth() && k.smooth() && albedo != vec3(0.0f))
+          return located(ps.find("albedo")->at, "coatedconductor with a smooth interface over a smooth conductor and a scattering layer (albedo > 0) is "
+                                                "not supported: pathex samples it as one delta reflection, which needs albedo 0");
+      }
       return Material{c};
     }
     if (type == "mix") {
@@ -1147,7 +1189,7 @@ class Importer {
       material_textures_ = std::move(textures);
       return mixed;
     }
-    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, coateddiffuse, conductor, dielectric, "
+    return located(at, "material \"" + excerpt(type) + "\" is not supported, expected diffuse, coateddiffuse, coatedconductor, conductor, dielectric, "
                        "thindielectric, diffusetransmission, interface or mix");
   }
 
@@ -1311,21 +1353,7 @@ class Importer {
       } else {
         PBRT_TRY(p, ps.points("P"));
         const std::size_t corners = type == "trianglemesh" ? 3 : 4;
-        std::vector<long long> idx;
-        if (Param* ip = ps.find("indices")) {
-          if (ip->type != "integer") return located(ip->at, "indices must be integers");
-          for (double x : ip->numbers) {
-            if (x != std::floor(x) || std::fabs(x) > 1e15) return located(ip->at, "indices must be integers");
-            idx.push_back(static_cast<long long>(x));
-          }
-        } else if (p.size() == corners) {
-          for (std::size_t i = 0; i < corners; ++i) idx.push_back(static_cast<long long>(i));
-        }
-        if (p.empty() || idx.empty() || idx.size() % corners != 0)
-          return located(at, type + " needs \"point3 P\" and \"integer indices\" (" + std::to_string(corners) + " per " +
-                                 (corners == 3 ? "triangle" : "patch") + ")");
-        for (long long i : idx)
-          if (i < 0 || i >= static_cast<long long>(p.size())) return located(ps.find("indices")->at, "index " + std::to_string(i) + " is out of range, expected 0.." + std::to_string(p.size() - 1));
+        PBRT_TRY(idx, mesh_indices(ps, type, p.size(), corners, at));
         mesh_elements_ += p.size() + idx.size() / corners * (corners - 2);  // a patch: 4 vertices and 2 triangles at most
         if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
         mesh.positions = p;
@@ -1372,6 +1400,7 @@ class Importer {
       if (auto e = add_mesh(std::move(s), std::move(mesh), m, flip, at)) return e;
       return std::nullopt;
     }
+    if (type == "loopsubdiv") return loop_subdivision(std::move(s), ps, m, flip, at);
     if (type == "cylinder") {  // a tessellated tube (import::tube_mesh)
       if (Param* p = ps.find("phimax"); p && !(p->numbers.size() == 1 && p->numbers[0] >= 360.0))
         return located(p->at, "partial cylinders (phimax) are not supported");
@@ -1384,7 +1413,48 @@ class Importer {
       if (auto e = add_mesh(std::move(s), std::move(mesh), m, flip, at)) return e;
       return std::nullopt;
     }
-    return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder");
+    return located(at, "shape \"" + excerpt(type) + "\" is not supported, expected trianglemesh, plymesh, bilinearmesh, loopsubdiv, sphere, disk or cylinder");
+  }
+
+  // The "integer indices" of a mesh of `points` points, `corners` per face (without indices, a
+  // mesh of exactly one face's points is that face), each in range.
+  Result<std::vector<long long>> mesh_indices(Params& ps, const std::string& type, std::size_t points, std::size_t corners, const Location& at) {
+    std::vector<long long> idx;
+    if (Param* ip = ps.find("indices")) {
+      if (ip->type != "integer") return located(ip->at, "indices must be integers");
+      for (double x : ip->numbers) {
+        if (x != std::floor(x) || std::fabs(x) > 1e15) return located(ip->at, "indices must be integers");
+        idx.push_back(static_cast<long long>(x));
+      }
+    } else if (points == corners) {
+      for (std::size_t i = 0; i < corners; ++i) idx.push_back(static_cast<long long>(i));
+    }
+    if (points == 0 || idx.empty() || idx.size() % corners != 0)
+      return located(at, type + " needs \"point3 P\" and \"integer indices\" (" + std::to_string(corners) + " per " +
+                             (corners == 3 ? "triangle" : "patch") + ")");
+    for (long long i : idx)
+      if (i < 0 || i >= static_cast<long long>(points)) return located(ps.find("indices")->at, "index " + std::to_string(i) + " is out of range, expected 0.." + std::to_string(points - 1));
+    return idx;
+  }
+
+  // pbrt-v4's "loopsubdiv": the control mesh subdivided at load (scene/loop_subdivision.h), then a
+  // mesh with per-vertex normals like a trianglemesh with "N". pbrt-v4 reads "scheme" and ignores it.
+  std::optional<Error> loop_subdivision(Shape s, Params& ps, const glm::mat4& m, bool flip, const Location& at) {
+    ps.ignore({"scheme"});
+    PBRT_TRY(levels, ps.integer("levels", 3));
+    if (levels < 0) return located(ps.find("levels")->at, "levels must be 0 or more");
+    PBRT_TRY(p, ps.points("P"));
+    PBRT_TRY(idx, mesh_indices(ps, "loopsubdiv", p.size(), 3, at));
+    MeshShape control;
+    control.positions = std::move(p);
+    for (std::size_t i = 0; i < idx.size(); i += 3) control.triangles.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
+    std::size_t edges = 0;
+    if (auto why = import::loop_check(control, &edges)) return located(ps.find("indices") ? ps.find("indices")->at : at, *why);
+    const import::LoopCounts n = import::loop_counts(control.positions.size(), edges, control.triangles.size(), levels);
+    const std::uint64_t most = std::numeric_limits<std::size_t>::max() - mesh_elements_;  // saturating
+    mesh_elements_ += static_cast<std::size_t>(n.vertices >= most || n.triangles >= most - n.vertices ? most : n.vertices + n.triangles);
+    if (auto e = check_mesh_elements(mesh_elements_, options_, at.str())) return e;
+    return add_mesh(std::move(s), import::loop_subdivide(control, levels), m, flip, at);
   }
 
   // A mesh in object space, placed by `m` with its front side pbrt's: the winding's, reversed by

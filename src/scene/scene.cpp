@@ -273,9 +273,18 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     return BasicMaterial{Glossy{refl, static_cast<float>(rough), dist}};
   }
   if (type == "coateddiffuse") {  // pbrt-v4's layered coateddiffuse (scene/material.h CoatedDiffuse)
-    if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness", "distribution", "eta", "thickness", "albedo", "g", "max_depth", "samples"}); !k)
+    if (auto k = r.keys(j, ptr, {"type", "reflectance", "roughness", "distribution", "eta", "thickness", "albedo", "g", "max_depth", "samples", "base"}); !k)
       return k.error();
     CoatedDiffuse c;
+    if (j.contains("base")) {  // pbrt-v4's coatedconductor: a conductor under the coat, its eta and k divided by the coat's
+      if (j.contains("reflectance")) return r.fail(ptr + "/base", "expected either reflectance (a Lambertian base) or base (a conductor), found both");
+      const json& b = j["base"];
+      if (!b.is_object() || !b.contains("type") || !b["type"].is_string() || b["type"].get<std::string>() != "conductor")
+        return r.fail(ptr + "/base", "expected a conductor material object ({\"type\": \"conductor\", …})");
+      PATHEX_TRY(metal, read_basic(r, b, ptr + "/base", /*component=*/true, nullptr));
+      c.base = CoatBase::kConductor;
+      c.conductor = std::get<Conductor>(metal);
+    }
     PATHEX_TRY(refl, read_colour(r, j, "reflectance", ptr, vec3(0.5f), TexturedParam::kReflectance, tx));
     if (const float hi = max_component(refl); hi > 1.0f) return r.fail(ptr + "/reflectance", "expected values in [0, 1], found " + Reader::fmt(hi));
     PATHEX_TRY(albedo, r.vector3(j, "albedo", ptr, false, vec3(0.0f), true));
@@ -297,6 +306,13 @@ Result<BasicMaterial> read_basic(const Reader& r, const json& j, const std::stri
     c.g = static_cast<float>(g);
     c.max_depth = static_cast<int>(depth);
     c.samples = static_cast<int>(samples);
+    if (c.base == CoatBase::kConductor) {
+      c.conductor.eta /= c.eta;
+      c.conductor.k /= c.eta;
+      if (c.smooth() && c.conductor.smooth() && albedo != vec3(0.0f))
+        return r.fail(ptr + "/albedo", "a smooth coat over a smooth conductor with a scattering layer (albedo > 0) is not supported: pathex "
+                                       "samples it as one delta reflection, which needs albedo 0");
+    }
     return BasicMaterial{c};
   }
   if (component)

@@ -177,6 +177,10 @@ std::optional<DeltaSample> sample_delta(const BasicMaterial& m, const glm::vec3&
     return DeltaSample{reflected, kinds::conductor_reflectance(*c, cos_o), std::abs(cos_o), 1.0f, 1.0f, 1.0f,
                        Lobe::kSpecularReflection};
   }
+  if (const auto* coat = std::get_if<CoatedDiffuse>(&m)) {  // all_specular(): a mirror of the walk's expected reflectance
+    return DeltaSample{reflected, layered::specular_reflectance(*coat, cos_o), std::abs(cos_o), 1.0f, 1.0f, 1.0f,
+                       Lobe::kSpecularReflection};
+  }
   if (const auto* t = std::get_if<ThinDielectric>(&m)) {  // reflect with R', else pass straight through
     const float r = kinds::thin_dielectric_reflectance(*t, cos_o);
     if (uc < r) return DeltaSample{reflected, t->tint, std::abs(cos_o), r, r, 1.0f, Lobe::kSpecularReflection};
@@ -332,7 +336,7 @@ std::optional<BsdfSample> detail::sample_general(const Material& m, const glm::v
   const std::optional<Pick> chosen = pick(m, u_component, &storage);
   if (!chosen) return std::nullopt;
   const BasicMaterial& c = *chosen->material;
-  if (const auto* coat = std::get_if<CoatedDiffuse>(&c))  // its own walk (trace/bsdf_layered.h)
+  if (const auto* coat = std::get_if<CoatedDiffuse>(&c); coat && !coat->all_specular())  // its own walk (trace/bsdf_layered.h)
     return layered::sample_world(m, *coat, chosen->index, chosen->probability, chosen->weight, wo, ns, ng, chosen->u, u);
 
   BsdfSample s;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
 
@@ -162,6 +163,47 @@ vec3 hg_sample(const vec3& wo, float g, vec2 u) {
   return glm::normalize(frame.to_world(vec3(sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t)));
 }
 
+// --- the base: pbrt-v4's DiffuseBxDF (coateddiffuse) or ConductorBxDF (coatedconductor), met
+// from above (wo.z > 0), reflection only ---
+
+bool base_specular(const CoatedDiffuse& m) { return m.base == CoatBase::kConductor && m.conductor.smooth(); }
+
+vec3 base_f(const CoatedDiffuse& m, const vec3& wo, const vec3& wi) {
+  if (m.base == CoatBase::kConductor) return kinds::conductor_eval(m.conductor, wo, wi);
+  return wi.z > 0.0f ? m.reflectance * kInvPi : vec3(0.0f);
+}
+
+float base_pdf(const CoatedDiffuse& m, const vec3& wo, const vec3& wi) {
+  if (m.base == CoatBase::kConductor) return kinds::conductor_pdf(m.conductor, wo, wi);
+  return cosine_hemisphere_pdf(wi.z);
+}
+
+struct BaseSample {
+  vec3 wi;
+  vec3 weight;  // f·cos/pdf (a smooth conductor's: its Fresnel reflectance)
+  float pdf;    // 0 for the smooth conductor's delta
+};
+
+std::optional<BaseSample> base_sample(const CoatedDiffuse& m, const vec3& wo, vec2 u) {
+  if (m.base == CoatBase::kDiffuse) {
+    if (is_black(m.reflectance)) return std::nullopt;
+    const vec3 wi = sample_cosine_hemisphere(u);
+    if (!(wi.z > 0.0f)) return std::nullopt;
+    return BaseSample{wi, m.reflectance, cosine_hemisphere_pdf(wi.z)};
+  }
+  if (m.conductor.smooth()) {
+    const vec3 weight = kinds::conductor_reflectance(m.conductor, wo.z);
+    if (is_black(weight)) return std::nullopt;
+    return BaseSample{vec3(-wo.x, -wo.y, wo.z), weight, 0.0f};
+  }
+  const std::optional<kinds::LocalSample> ls = kinds::conductor_sample(m.conductor, wo, u);
+  if (!ls || !(ls->wi.z > 0.0f)) return std::nullopt;
+  const float pdf = kinds::conductor_pdf(m.conductor, wo, ls->wi);
+  const vec3 weight = kinds::conductor_eval(m.conductor, wo, ls->wi) * (ls->wi.z / pdf);
+  if (!(pdf > 0.0f) || is_black(weight) || !std::isfinite(weight.x + weight.y + weight.z)) return std::nullopt;
+  return BaseSample{ls->wi, weight, pdf};
+}
+
 // --- the walk's state between steps ---
 
 struct Slab {
@@ -212,7 +254,32 @@ float mean_internal_reflectance(float eta) {
 }
 
 float specular_probability(const CoatedDiffuse& m, float cos_o) {
+  if (m.all_specular()) return 1.0f;
   return m.smooth() ? fresnel_dielectric(std::abs(cos_o), m.eta) : 0.0f;
+}
+
+// What sample()'s walk returns in expectation for a smooth coat over a smooth conductor in a
+// layer that does not scatter: the coat reflects R; the rest enters (weight 1/η² in radiance),
+// crosses the layer (τ = e^(−thickness/μt) each way) to the conductor (Fc at the refracted
+// cosine μt), and at the coat from inside leaves with 1 − R (weight η²) or returns with R
+// (no total internal reflection: the angle came from outside). The k-th way out costs 2k steps,
+// so at most K = ⌊max_depth / 2⌋ are taken:
+//   A = R + (1 − R)² τ² Fc Σ_{j<K} (R τ² Fc)^j.
+vec3 specular_reflectance(const CoatedDiffuse& m, float cos_o) {
+  const float mu = std::abs(cos_o);
+  const float r = fresnel_dielectric(mu, m.eta);
+  const float sin2_t = (1.0f - mu * mu) / (m.eta * m.eta);
+  const float mu_t = safe_sqrt(1.0f - sin2_t);
+  const float tau = transmittance(std::max(m.thickness, std::numeric_limits<float>::min()), vec3(0.0f, 0.0f, mu_t));
+  const vec3 trip = tau * tau * kinds::conductor_reflectance(m.conductor, mu_t);
+  const int k = m.max_depth / 2;
+  vec3 sum(0.0f), term(1.0f);
+  for (int j = 0; j < k; ++j) {  // Σ_{j<K} q^j, stopped once the terms no longer change it
+    sum += term;
+    term *= r * trip;
+    if (std::max({term.x, term.y, term.z}) < 1e-9f) break;
+  }
+  return r + (1.0f - r) * (1.0f - r) * trip * sum;
 }
 
 // --- sample(): pbrt's LayeredBxDF::Sample_f, the walk's weight as one product ---
@@ -247,12 +314,11 @@ std::optional<Sample> sample(const CoatedDiffuse& m, const vec3& wo, float uc, v
       continue;
     }
     // --- scatter at the interface reached ---
-    if (z == 0.0f) {  // the Lambertian base, seen from above (w going down)
-      if (is_black(m.reflectance)) return std::nullopt;
-      const vec3 wn = sample_cosine_hemisphere(rng.next2());
-      if (!(wn.z > 0.0f)) return std::nullopt;
-      beta *= m.reflectance;
-      w = wn;
+    if (z == 0.0f) {  // the base, seen from above (w going down)
+      const std::optional<BaseSample> b = base_sample(m, -w, rng.next2());
+      if (!b) return std::nullopt;
+      beta *= b->weight;
+      w = b->wi;
       continue;
     }
     const float uc2 = rng.next();
@@ -271,7 +337,7 @@ std::optional<Sample> sample(const CoatedDiffuse& m, const vec3& wo, float uc, v
 // --- eval(): pbrt's LayeredBxDF::f for a reflection (the exit is the coat) ---
 
 vec3 eval_estimate(const CoatedDiffuse& m, const vec3& wo, const vec3& wi, std::uint64_t key) {
-  if (!(wo.z > 0.0f) || !(wi.z > 0.0f)) return vec3(0.0f);
+  if (!(wo.z > 0.0f) || !(wi.z > 0.0f) || m.all_specular()) return vec3(0.0f);
   const Slab slab(m);
   const Coat& coat = slab.coat;
   const int samples = std::max(m.samples, 1);
@@ -329,20 +395,23 @@ vec3 eval_estimate(const CoatedDiffuse& m, const vec3& wo, const vec3& wi, std::
         w = bs->wi;
         continue;
       }
-      // --- the base: connect to wis (next-event), then sample the Lambertian lobe ---
-      const vec3 to_light = -wis->wi;  // z > 0
-      float wt = 1.0f;
-      if (!coat.smooth) wt = power_heuristic(wis->pdf, cosine_hemisphere_pdf(to_light.z));
-      f += beta * m.reflectance * kInvPi * std::abs(wis->wi.z) * wt * transmittance(slab.thickness, wis->wi) * wis_weight;
-      if (is_black(m.reflectance)) break;
-      const vec3 wn = sample_cosine_hemisphere(rng.next2());
-      if (!(wn.z > 0.0f)) break;
-      beta *= m.reflectance;
-      w = wn;
+      // --- the base: connect to wis (next-event; not to a smooth conductor's delta), then sample it ---
+      if (!base_specular(m)) {
+        const vec3 to_light = -wis->wi;  // z > 0
+        float wt = 1.0f;
+        if (!coat.smooth) wt = power_heuristic(wis->pdf, base_pdf(m, -w, to_light));
+        // (A Lambertian base's value in the order of operations it always had: its renders stay bit for bit.)
+        const vec3 beta_f = m.base == CoatBase::kDiffuse ? beta * m.reflectance * kInvPi : beta * base_f(m, -w, to_light);
+        f += beta_f * std::abs(wis->wi.z) * wt * transmittance(slab.thickness, wis->wi) * wis_weight;
+      }
+      const std::optional<BaseSample> b = base_sample(m, -w, rng.next2());
+      if (!b) break;
+      beta *= b->weight;
+      w = b->wi;
       if (!coat.smooth) {  // the walk's own way out through the rough coat
         const float f_exit = coat_f(coat, -w, wi, TransportMode::kRadiance);
         if (f_exit > 0.0f) {
-          const float wt2 = power_heuristic(cosine_hemisphere_pdf(w.z), coat_pdf(coat, wi, -w, Lobes::kTransmission));
+          const float wt2 = base_specular(m) ? 1.0f : power_heuristic(b->pdf, coat_pdf(coat, wi, -w, Lobes::kTransmission));
           f += beta * transmittance(slab.thickness, w) * f_exit * wt2;
         }
       }
@@ -368,7 +437,7 @@ vec3 eval_estimate(const CoatedDiffuse& m, const vec3& wo, const vec3& wi, std::
 //   the coat's transmittance, times the Jacobian dω_u/dω_wi = |cos θi| / (η² |cos θu|).
 
 float pdf_estimate(const CoatedDiffuse& m, const vec3& wo, const vec3& wi, std::uint64_t key) {
-  if (!(wo.z > 0.0f) || !(wi.z > 0.0f)) return 0.0f;
+  if (!(wo.z > 0.0f) || !(wi.z > 0.0f) || m.all_specular()) return 0.0f;
   const Slab slab(m);
   const Coat& coat = slab.coat;
   const int samples = std::max(m.samples, 1);
@@ -421,12 +490,16 @@ float pdf_estimate(const CoatedDiffuse& m, const vec3& wo, const vec3& wi, std::
         continue;
       }
       if (z == 0.0f) {  // the base
-        if (is_black(m.reflectance)) break;
-        leave_smooth(depth, alive, cosine_hemisphere_pdf(up.z), z, beta * m.reflectance);
-        const vec3 wn = sample_cosine_hemisphere(rng.next2());
-        if (!(wn.z > 0.0f)) break;
-        beta *= m.reflectance;
-        w = wn;
+        if (m.base == CoatBase::kDiffuse && is_black(m.reflectance)) break;
+        if (exit_factor > 0.0f && !base_specular(m)) {  // its density of `up`, and the weight it would carry there
+          const float p_up = base_pdf(m, -w, up);
+          if (p_up > 0.0f)
+            leave_smooth(depth, alive, p_up, z, m.base == CoatBase::kDiffuse ? beta * m.reflectance : beta * base_f(m, -w, up) * (up.z / p_up));
+        }
+        const std::optional<BaseSample> b = base_sample(m, -w, rng.next2());
+        if (!b) break;
+        beta *= b->weight;
+        w = b->wi;
         continue;
       }
       // The coat from inside: leave towards wi (a rough coat), or stay.

@@ -1,6 +1,7 @@
-// pbrt-v4's layered BSDF for `coateddiffuse` (scene/material.h CoatedDiffuse): a dielectric coat
-// (smooth, or rough with GGX or Beckmann microfacets: bsdf_dielectric.cpp's interface) over a
-// Lambertian base, with a homogeneous slab between them (extinction 1 per unit thickness,
+// pbrt-v4's layered BSDF for `coateddiffuse` and `coatedconductor` (scene/material.h
+// CoatedDiffuse): a dielectric coat (smooth, or rough with GGX or Beckmann microfacets:
+// bsdf_dielectric.cpp's interface) over a Lambertian base or a conductor base (bsdf_conductor.cpp's,
+// smooth or rough), with a homogeneous slab between them (extinction 1 per unit thickness,
 // single-scattering `albedo`, Henyey–Greenstein `g`). Light that passes the coat takes a random
 // walk between the two interfaces; pbrt-v4 (Physically Based Rendering, 4th ed., §14.3) samples
 // that walk and estimates the BSDF's value by Monte Carlo, and so do we.
@@ -11,8 +12,12 @@
 //
 // Letters (DESIGN §1). A smooth coat (roughness < 1e-3) reflects as a Dirac delta: that sample is
 // an S event, and pdf() and eval() exclude it (component_probability() gives its probability, the
-// Fresnel reflectance at wo). Everything that passes the coat reaches the Lambertian base at least
-// once, so it leaves with a finite density: D. A rough coat's reflection is D too.
+// Fresnel reflectance at wo). Everything that passes the coat reaches the Lambertian or rough
+// conductor base at least once, so it leaves with a finite density: D. A rough coat's reflection
+// is D too, and so is what passes it (over a smooth conductor too: the coat spreads it on the way
+// out). A smooth coat over a smooth conductor with a layer that does not scatter is one Dirac
+// delta as a whole (CoatedDiffuse::all_specular(), S): bsdf.cpp samples it as a mirror of
+// reflectance specular_reflectance(); eval() and pdf() are 0 for it.
 //
 // Three estimators, each a pure function of the material and the directions:
 // - sample() runs the walk (pbrt's LayeredBxDF::Sample_f) and returns its weight f·|cos θi|/p as
@@ -78,8 +83,12 @@ inline float pdf(const CoatedDiffuse& m, const glm::vec3& wo, const glm::vec3& w
 float mean_internal_reflectance(float eta);
 
 // The probability that sample() returns the coat's delta reflection at wo (the Fresnel
-// reflectance of a smooth coat; 0 for a rough one).
+// reflectance of a smooth coat; 0 for a rough one; 1 for an all_specular() coat).
 float specular_probability(const CoatedDiffuse& m, float cos_o);
+
+// The reflectance of an all_specular() coat at cos θo: the expectation of its walk, a series of the
+// coat's and the conductor's Fresnel terms truncated at max_depth (formula in bsdf_layered.cpp).
+glm::vec3 specular_reflectance(const CoatedDiffuse& m, float cos_o);
 
 struct Sample {
   glm::vec3 wi{0.0f};

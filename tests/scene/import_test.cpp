@@ -482,11 +482,18 @@ std::vector<Refusal> refusals() {
        "a medium bounded by the \"interface\" material (no surface) is not supported: pathex's media fill the inside of a transmissive surface, "
        "such as a dielectric"},
       {"curve.pbrt", "Shape \"curve\"\n", "curve.pbrt:4:1",
-       "shape \"curve\" is not supported, expected trianglemesh, plymesh, bilinearmesh, sphere, disk or cylinder"},
+       "shape \"curve\" is not supported, expected trianglemesh, plymesh, bilinearmesh, loopsubdiv, sphere, disk or cylinder"},
       {"cylinder.pbrt", "Shape \"cylinder\" \"float phimax\" 180\n", "cylinder.pbrt:4:18", "partial cylinders (phimax) are not supported"},
-      {"coated.pbrt", "Material \"coatedconductor\"\n", "coated.pbrt:4:1",
-       "material \"coatedconductor\" is not supported, expected diffuse, coateddiffuse, conductor, dielectric, thindielectric, "
+      {"coated.pbrt", "Material \"coatedplastic\"\n", "coated.pbrt:4:1",
+       "material \"coatedplastic\" is not supported, expected diffuse, coateddiffuse, coatedconductor, conductor, dielectric, thindielectric, "
        "diffusetransmission, interface or mix"},
+      {"coated-metal.pbrt", "Material \"coatedconductor\" \"rgb albedo\" [0.5 0.5 0.5]\n", "coated-metal.pbrt:4:28",
+       "coatedconductor with a smooth interface over a smooth conductor and a scattering layer (albedo > 0) is not supported: pathex samples "
+       "it as one delta reflection, which needs albedo 0"},
+      {"coated-metal-both.pbrt", "Material \"coatedconductor\" \"rgb reflectance\" [0.5 0.5 0.5] \"rgb conductor.k\" [1 1 1]\n",
+       "coated-metal-both.pbrt:4:28", "coatedconductor takes either reflectance or conductor.eta and conductor.k, not both"},
+      {"coated-metal-texture.pbrt", "Texture \"r\" \"float\" \"constant\"\nMaterial \"coatedconductor\" \"texture conductor.roughness\" \"r\"\n",
+       "coated-metal-texture.pbrt:5:1", "a texture for coatedconductor's conductor roughness is not supported"},
       {"coated-thickness.pbrt", "Material \"coateddiffuse\" \"float thickness\" -1\n", "coated-thickness.pbrt:4:26",
        "coateddiffuse thickness must be within [0, 1e6]"},
       {"coated-eta.pbrt", "Material \"coateddiffuse\" \"float eta\" 1\n", "coated-eta.pbrt:4:26",

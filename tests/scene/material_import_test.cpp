@@ -72,6 +72,52 @@ TEST(ImportMaterialsPbrt, ConductorsFromNamedSpectraDefaultCopperAndReflectance)
   EXPECT_EQ(letters_of(material_of(s, 4)), 1u << kS);  // alpha = sqrt(9e-7) < 1e-3: smooth, as pbrt-v4
 }
 
+// pbrt-v4's coatedconductor: its defaults (a smooth coat of eta 1.5 over smooth copper: one delta,
+// S), the metal's eta and k divided by the coat's interface.eta, both roughnesses remapped, and
+// reflectance r as eta 1, k = 2 sqrt(r) / sqrt(1 - r) (then divided too); JSON's coateddiffuse
+// with a conductor "base" is the same material.
+TEST(ImportMaterialsPbrt, CoatedConductorDefaultsRelativeIndexAndRoughness) {
+  const Scene s = load(write("coatedmetal.pbrt", kPbrtHead +
+                                                     "Material \"coatedconductor\"\nShape \"sphere\"\n"
+                                                     "Material \"coatedconductor\" \"float interface.eta\" 1.25 \"spectrum conductor.eta\" \"metal-Au-eta\" "
+                                                     "\"spectrum conductor.k\" \"metal-Au-k\" \"float interface.roughness\" 0.04 "
+                                                     "\"float conductor.uroughness\" 0.01 \"float conductor.vroughness\" 0.09 \"float thickness\" 0.2 "
+                                                     "\"rgb albedo\" [0.5 0.5 0.5] \"float g\" 0.3 \"integer maxdepth\" 20 \"integer nsamples\" 2\nShape \"sphere\"\n"
+                                                     "Material \"coatedconductor\" \"rgb reflectance\" [0.5 0.5 0.5] \"float conductor.roughness\" 0.25\nShape \"sphere\"\n"));
+  ASSERT_EQ(s.shapes.size(), 3u);
+  const auto& def = std::get<CoatedDiffuse>(material_of(s, 0));
+  EXPECT_EQ(def.base, CoatBase::kConductor);
+  EXPECT_EQ(def.eta, 1.5f);
+  EXPECT_EQ(def.conductor.eta, metal("Cu", true) / 1.5f);
+  EXPECT_EQ(def.conductor.k, metal("Cu", false) / 1.5f);
+  EXPECT_EQ(def.thickness, 0.01f);
+  EXPECT_EQ(def.max_depth, 10);
+  EXPECT_TRUE(def.all_specular());
+  EXPECT_EQ(letters_of(material_of(s, 0)), static_cast<LetterMask>(1u << kS));
+  const auto& au = std::get<CoatedDiffuse>(material_of(s, 1));
+  EXPECT_EQ(au.conductor.eta, metal("Au", true) / 1.25f);
+  EXPECT_EQ(au.conductor.k, metal("Au", false) / 1.25f);
+  EXPECT_FLOAT_EQ(au.roughness, 0.2f);
+  EXPECT_FLOAT_EQ(au.conductor.alpha_u, 0.1f);
+  EXPECT_FLOAT_EQ(au.conductor.alpha_v, 0.3f);
+  EXPECT_EQ(au.albedo, glm::vec3(0.5f));
+  EXPECT_FLOAT_EQ(au.g, 0.3f);
+  EXPECT_EQ(au.samples, 2);
+  EXPECT_EQ(letters_of(material_of(s, 1)), static_cast<LetterMask>(1u << kD));
+  const auto& refl = std::get<CoatedDiffuse>(material_of(s, 2));
+  EXPECT_EQ(refl.conductor.eta, glm::vec3(1.0f / 1.5f));
+  EXPECT_FLOAT_EQ(refl.conductor.k.x, 2.0f * std::sqrt(0.5f) / std::sqrt(0.5f) / 1.5f);
+  EXPECT_EQ(letters_of(material_of(s, 2)), static_cast<LetterMask>((1u << kS) | (1u << kD)));  // smooth coat, rough metal
+  const Scene j = load(write("coatedmetal.json", R"({"camera": {"type": "pinhole", "position": [0, 0, 5], "look_at": [0, 0, 0]},
+      "lights": [{"type": "point", "position": [0, 0, 5], "intensity": [1, 1, 1]}],
+      "materials": {"m": {"type": "coateddiffuse", "eta": 1.25, "roughness": 0.2, "base": {"type": "conductor", "metal": "Au", "roughness_u": 0.1, "roughness_v": 0.3}}},
+      "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})"));
+  const auto& ja = std::get<CoatedDiffuse>(j.materials.at(0));
+  EXPECT_EQ(ja.conductor.eta, au.conductor.eta);
+  EXPECT_EQ(ja.conductor.k, au.conductor.k);
+  EXPECT_EQ(ja.conductor.alpha_u, au.conductor.alpha_u);
+}
+
 TEST(ImportMaterialsPbrt, DielectricsDiffuseTransmissionAndInterface) {
   const Scene s = load(write("glass.pbrt", kPbrtHead +
                                                "Material \"dielectric\" \"float roughness\" 0.2\nShape \"sphere\"\n"

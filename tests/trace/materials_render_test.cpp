@@ -106,7 +106,9 @@ TEST(MaterialsFurnace, LossyModelsLoseWhatPbrtV4Loses) {
 // pt-nee, lt and bdpt agree on a sphere of each new finite material over a diffuse floor, lit by
 // a small spherical lamp (so that next-event estimation, light tracing and every BDPT join run
 // through the material's eval() and pdf()). The smooth kinds (S only) cannot be joined at, and lt
-// cannot see them through a pinhole: pt-nee and bdpt are compared there.
+// cannot see them through a pinhole: pt-nee and bdpt are compared there, and for a smooth coat
+// (its S reflection is seen through the pinhole; pbrt-v4's coatedconductor as JSON's coateddiffuse
+// with a conductor "base").
 TEST(MaterialsAgreement, EstimatorsAgreeOnASphereOfEachMaterial) {
   struct Case {
     const char* name;
@@ -125,6 +127,10 @@ TEST(MaterialsAgreement, EstimatorsAgreeOnASphereOfEachMaterial) {
       {"beckmann gold", R"({"type": "conductor", "metal": "Au", "roughness": 0.3, "distribution": "beckmann"})", true},
       {"beckmann glass", R"({"type": "dielectric", "ior": 1.5, "roughness": 0.3, "distribution": "beckmann"})", true},
       {"beckmann coat", R"({"type": "coateddiffuse", "reflectance": [0.6, 0.5, 0.4], "roughness": 0.3, "distribution": "beckmann"})", true},
+      {"rough gold under a rough coat", R"({"type": "coateddiffuse", "roughness": 0.3, "base": {"type": "conductor", "metal": "Au", "roughness": 0.2}})", true},
+      {"smooth copper under a rough coat", R"({"type": "coateddiffuse", "roughness": 0.3, "base": {"type": "conductor"}})", true},
+      {"rough gold under a smooth coat", R"({"type": "coateddiffuse", "base": {"type": "conductor", "metal": "Au", "roughness": 0.3}})", false},
+      {"smooth gold under a smooth coat", R"({"type": "coateddiffuse", "base": {"type": "conductor", "metal": "Au"}})", false},
       {"smooth silver", R"({"type": "conductor", "metal": "Ag"})", false},
       {"thin glass", R"({"type": "thin_dielectric", "ior": 1.5})", false},
   };
