@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -44,8 +45,9 @@ inline int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(p
 
 class Integrator {
  public:
-  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o)
-      : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), table_(strategies.strategies) {
+  // `filter`: the plan's (trace/plan.h), which paths are recorded (default: every path).
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, PathFilter filter = {})
+      : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), filter_(std::move(filter)), table_(strategies.strategies) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
     lens_hits_ = cam_.type == SensorType::kLens;
@@ -79,21 +81,7 @@ class Integrator {
     absorbing_ = rs.absorbing;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
-    // --only: a point or spot light whose requested paths all scatter specularly first emits only
-    // towards the shapes that can (trace/emission_cones.h). With a pinhole or a lens, whose first
-    // letter is D, the test also rules out the light seen directly.
-    aimed_.resize(rs.lights.size());
-    if (o_.only != nullptr && sensor_pair_[0] == 'D' && max_light_ >= 2)
-      for (std::size_t i = 0; i < rs.lights.size(); ++i) {
-        const LightParams& l = rs.lights[i].params;
-        if ((std::holds_alternative<PointLightParams>(l) || std::holds_alternative<SpotLightParams>(l)) &&
-            o_.only->first_vertex_specular(light_pairs_[i][0], light_pairs_[i][1]))
-          aimed_[i] = EmissionCones::make(light_position(l), rs.specular_bounds);
-      }
   }
-
-  // The cones light i emits into under --only (trace/emission_cones.h); none: every direction.
-  const std::optional<EmissionCones>& aimed(std::size_t light) const { return aimed_[light]; }
 
   // A full path x0 … xk in light-to-eye order as a join forms it, without copying a vertex: s light
   // vertices (y0 replaced by a fresh sample light0 when given), the m vertices a connector
@@ -247,8 +235,7 @@ class Integrator {
   }
   // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
   float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    if (const std::optional<EmissionCones>& cones = aimed_[static_cast<std::size_t>(&l - rs_.lights.data())]) return cones->pdf(w);
-    const RayPdf p = pdf_ray(l.params, SurfacePoint{v.p, v.n, l.pdf_pos}, w);
+    const RayPdf p = l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w);
     return finite_part(p.dir, p.delta_dir);
   }
   // A light chosen uniformly by u, and a point on it drawn from u2 (area lights; the others
@@ -466,6 +453,7 @@ class Integrator {
   const RenderSensor& cam_;
   const StrategySet& strategies_;
   const RenderOptions& o_;
+  PathFilter filter_;  // the plan's: which paths are recorded, where subpaths stop
   int max_bounces_ = 16;
   StrategyTable table_;  // which strategy runs each (s, chain, t)
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
@@ -486,7 +474,6 @@ class Integrator {
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
   std::vector<std::string> light_pairs_;  // each light's letters c0 c1
-  std::vector<std::optional<EmissionCones>> aimed_;  // per light: the cones it emits into, or none
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;

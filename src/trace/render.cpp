@@ -62,7 +62,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   float eta2 = 1.0f;  // the product of η² over the refractions so far (radiance walks)
   // `beta` passed in the first vertex already includes the first direction's weight: the caller
   // stores it in path[count - 1].beta and we continue from there.
-  SubpathPrefix live(o_.only, mode == TransportMode::kImportance, path[0].pos_letter, path[0].letter);  // trace/prune.h
+  SubpathPrefix live(filter_, mode == TransportMode::kImportance, path[0].pos_letter, path[0].letter);  // trace/prune.h
   while (count < max_vertices && live.alive()) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
@@ -150,7 +150,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     o = v.p;
     d = bs->wi;
     if (!std::isfinite(beta.x + beta.y + beta.z)) break;
-    live.extend(v.letter);  // --only: a subpath no requested class can complete stops (DESIGN §11)
+    live.extend(v.letter);  // a subpath no recorded path can complete stops (the plan's filter, DESIGN §11)
   }
   return count;
 }
@@ -195,17 +195,9 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   const glm::vec2 u_disk = env ? rng.get2d() : glm::vec2(0.0f);
   const SurfacePoint x = env ? SurfacePoint{} : sample_point(l, rng, &y0.err);
   rng.skip(2);  // u_ray, drawn in advance
-  std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : sample_ray(l.params, x, u_ray);
+  // (An aimed light draws its direction within its cones: RenderLight::sample_ray.)
+  const std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : l.sample_ray(x, u_ray);
   if (env && r) y0.err = box_point_error(r->origin);
-  if (const std::optional<EmissionCones>& cones = aimed_[li]; cones && r) {
-    // --only: the first direction drawn within the cones instead (trace/emission_cones.h).
-    float pdf = 0.0f;
-    r->direction = cones->sample(u_ray, &pdf);
-    r->value = spatial_emission(l.params) * directional_emission(l.params, r->normal, r->direction);
-    r->pdf.dir = pdf;
-    r->weight = r->value / pdf;
-    if (is_black(r->value)) r.reset();
-  }
   y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
     y0.p = x.position;
@@ -276,7 +268,7 @@ Integrator::PathView Integrator::path_of(const Thread& th, const JoinResult& jr)
 
 void Integrator::estimate(Thread& th, int batch) const {
   const JoinResult& jr = th.join;
-  if (o_.only != nullptr && !o_.only->records(jr.letters)) return;  // --only: not requested, no weight, no shadow ray
+  if (!filter_.records(jr.letters)) return;  // not recorded by the plan: no weight, no shadow ray
   // The MIS weight over every strategy of the profile that samples this path (trace/mis_weight.cpp).
   const float weight = mis_weight(th, path_of(th, jr), jr.letters, jr.chain, jr.has_density ? &jr.density : nullptr);
   // The technique, as the histogram names it: a projection's chain starts at c0 (distant: s = 0)
@@ -345,9 +337,9 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   // can be a lens vertex; it forms the t = 0 connection and no other.
   const bool lens_end = ns >= 2 && th.light[static_cast<std::size_t>(ns - 1)].kind == Kind::kLens;
   // --- joins (trace/joins/): each makes th.join from the subpaths; estimate() weighs and records it ---
-  // --only: a plain join whose path has a length no requested path has is not made (its numbers
-  // are its own dimensions, so no other join's change). Connectors count their attempts: they go on.
-  const auto wanted = [&](int s, int t) { return o_.only == nullptr || o_.only->has_length(s + t + 2); };
+  // A plain join whose path has a length no recorded path has is not made (its numbers are its
+  // own dimensions, so no other join's change). Connectors count their attempts: they go on.
+  const auto wanted = [&](int s, int t) { return filter_.has_length(s + t + 2); };
   const auto made = [&](bool joined) {
     if (joined) estimate(th, batch);
   };

@@ -157,4 +157,14 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
   return rs;
 }
 
+void aim_emission(RenderScene& rs, const Scene& scene, const std::vector<int>& lights) {
+  const std::size_t area_lights = rs.lights.size() - scene.lights.size();  // the emissive shapes come first
+  for (const int i : lights) {
+    const Light& light = scene.lights[static_cast<std::size_t>(i)];
+    const glm::vec3 origin = std::holds_alternative<PointLight>(light) ? std::get<PointLight>(light).position
+                                                                       : std::get<SpotLight>(light).position;
+    rs.lights[area_lights + static_cast<std::size_t>(i)].aim = EmissionCones::make(origin, rs.specular_bounds);
+  }
+}
+
 }  // namespace pathex

@@ -36,7 +36,19 @@ struct RenderLight {
   // Area density of the emitting point as the MIS ratios keep it: 1 / area for an area light and
   // for a distant light's aperture, 0 for a Dirac position (point, spot, laser).
   float pdf_pos = 0.0f;
+  // The plan's emission narrowing (trace/plan.h): the cones a point or spot light draws its first
+  // direction in (trace/emission_cones.h); none: the light's own emission sampling.
+  std::optional<EmissionCones> aim;
   bool is_area() const { return shape >= 0; }
+  // The light's first ray from point x (an area light's; the others ignore it) by u, and the
+  // densities of its ray from x towards w: the emitter model's, through the aiming decorator when
+  // the light is aimed. Every strategy samples and weighs a light's emission through these.
+  std::optional<EndpointRay> sample_ray(const SurfacePoint& x, glm::vec2 u) const {
+    return aim ? aimed_ray(*aim, params, x, u) : pathex::sample_ray(params, x, u);
+  }
+  RayPdf pdf_ray(const SurfacePoint& x, const glm::vec3& w) const {
+    return aim ? aimed_pdf(*aim, params, x, w) : pathex::pdf_ray(params, x, w);
+  }
 };
 
 // The sensor: its importance model and the image it measures.
@@ -74,5 +86,10 @@ struct RenderScene {
 };
 
 Result<RenderScene> make_render_scene(const Scene& scene);
+
+// The plan's emission narrowing (trace/plan.h RenderPlan::aimed_lights, indices into scene.lights,
+// each a point or spot light): each aims at the shapes with a specular component
+// (rs.specular_bounds) where that leaves some direction out (EmissionCones::make).
+void aim_emission(RenderScene& rs, const Scene& scene, const std::vector<int>& lights);
 
 }  // namespace pathex

@@ -13,12 +13,12 @@
 #include "classify/pathclass.h"
 #include "classify/histogram.h"
 #include "io/profile_json.h"
-#include "reach/prune.h"
+#include "trace/plan.h"
+#include "trace/prune.h"
 #include "scene/scene.h"
 #include "scene/universe.h"
 #include "support/stat_seed.h"
 #include "trace/emission_cones.h"
-#include "trace/prune.h"
 #include "trace/render.h"
 #include "trace/rng.h"
 
@@ -139,13 +139,9 @@ ClassRender render_class(const Scene& scene, const std::string& renderer, const 
   o.images = false;
   o.threads = 1;
   Profile profile = resolve_profile(renderer, Limits{}).expect("a profile");
-  std::optional<RequestedPaths> requested;
-  if (only) {
-    profile = prune_profile(profile, 10, scene_universe(types), c->dfa, Limits{}).expect("pruning").profile;
-    requested.emplace(RequestedPaths::make(classes, Limits{}).expect("requested paths"));
-    o.only = &*requested;
-  }
-  const RenderOutput out = render(scene, profile, &cl, o).expect("a render");
+  const RenderOutput out =
+      (only ? render(scene, plan_render(scene, profile, 10, classes, Limits{}).expect("a plan"), &cl, o) : render(scene, profile, &cl, o))
+          .expect("a render");
   const HistogramReport rep = make_report(out.histogram, RunInfo{}, &cl, {{expr, expr}}).expect("a report");
   return {rep.classes.at(0).estimate.luminance, rep.classes.at(0).estimate.std_error, out.aimed};
 }
