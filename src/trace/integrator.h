@@ -251,23 +251,17 @@ class Integrator {
   // *error: the point's rounding-error bound (SurfaceSample::error), which offsets rays leaving it.
   SurfacePoint sample_point(const RenderLight& l, Sampler& rng, vec3* error) const {
     const glm::vec2 u2 = rng.get2d_if(l.is_area());
-    *error = aperture_error(l);
+    *error = l.origin_error;
     if (!l.is_area()) return {};
     const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, u2);
     *error = ss.error;
     return {ss.position, ss.normal, l.pdf_pos};
   }
-  // The error bound of a distant light's aperture points (zero for other lights): the aperture is
-  // no shape, but it may coincide with one (a window pane).
-  static vec3 aperture_error(const RenderLight& l) {
-    const auto* d = std::get_if<DistantLightParams>(&l.params);
-    return d ? parallelogram_error(d->corner, d->edge1, d->edge2) : vec3(0.0f);
-  }
   // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
   // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
   // emission_step_density() after it: their product is its emission's joint density.
   const EnvironmentLightParams* environment_of(int light) const {
-    return std::get_if<EnvironmentLightParams>(&rs_.lights[static_cast<std::size_t>(light)].params);
+    return rs_.lights[static_cast<std::size_t>(light)].environment();
   }
   // v is a point of an image infinite light (a light vertex, or an eye vertex that hit its box).
   bool on_environment(const Vertex& v) const {
@@ -276,12 +270,6 @@ class Integrator {
   }
   float env_origin_density(const EnvironmentLightParams& e, const vec3& x0, const vec3& n0, const vec3& x1) const {
     return light_pick_ * connect_area_density(e, x0, n0, x1);
-  }
-  // Where a point or spot light is (the integrator picks an area light's points itself).
-  static vec3 light_position(const LightParams& l) {
-    if (const auto* p = std::get_if<PointLightParams>(&l)) return p->position;
-    if (const auto* p = std::get_if<SpotLightParams>(&l)) return p->position;
-    return vec3(0.0f);
   }
   // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
   void to_pixels(glm::vec2 raster, float* rx, float* ry) const {

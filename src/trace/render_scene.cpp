@@ -125,6 +125,7 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
       const DistantLightParams params{d->direction, d->irradiance, d->aperture_corner, d->aperture_edge1, d->aperture_edge2};
       l.params = params;
       l.pdf_pos = 1.0f / aperture_area(params);
+      l.origin_error = parallelogram_error(params.corner, params.edge1, params.edge2);
     } else {
       const LaserLight& z = std::get<LaserLight>(light);
       l.params = LaserParams{z.position, z.direction, z.power};

@@ -39,7 +39,12 @@ struct RenderLight {
   // The plan's emission narrowing (trace/plan.h): the cones a point or spot light draws its first
   // direction in (trace/emission_cones.h); none: the light's own emission sampling.
   std::optional<EmissionCones> aim;
+  // The rounding-error bound of the points rays leave from when they are not a shape's (a distant
+  // light's aperture may coincide with one, a window pane); zero for the others.
+  glm::vec3 origin_error{0.0f};
   bool is_area() const { return shape >= 0; }
+  // The image infinite light this is (trace/environment.h), or null.
+  const EnvironmentLightParams* environment() const { return std::get_if<EnvironmentLightParams>(&params); }
   // The light's first ray from point x (an area light's; the others ignore it) by u, and the
   // densities of its ray from x towards w: the emitter model's, through the aiming decorator when
   // the light is aimed. Every strategy samples and weighs a light's emission through these.

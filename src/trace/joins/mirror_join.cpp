@@ -99,7 +99,7 @@ const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinB
   if (environment_of(static_cast<int>(li))) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
   vec3 err{0.0f};
   const SurfacePoint x = sample_point(light, rng, &err);
-  Vertex& y0 = fresh_light_vertex(th, li, light.is_area() ? x.position : light_position(light.params),
+  Vertex& y0 = fresh_light_vertex(th, li, light.is_area() ? x.position : fixed_origin(light.params),
                                   light.is_area() ? x.normal : vec3(0.0f), err, 'D');
   y0.beta = spatial_emission(light.params) / (light_pick_ * (light.pdf_pos > 0.0f ? light.pdf_pos : 1.0f));
   return &y0;

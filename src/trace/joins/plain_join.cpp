@@ -133,8 +133,7 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
     // next-event estimation draws it (the light density its x0 has), not the light subpath's y0.
     if (ortho || sensor_pair_[0] != 'D') return false;  // (mis_weight.cpp: no projection of an image light)
     const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(cam_.params));
-    const auto* lens = std::get_if<ThinLensParams>(&cam_.params);
-    const vec3 z = lens ? lens_point(*lens, ul) : std::get<PinholeParams>(cam_.params).position;
+    const vec3 z = sensor_point(cam_.params, ul);
     const std::optional<EndpointConnection> e = pathex::connect(*env, rng.get2d(), z);
     if (!e) return false;
     c = connect_finite(cam_.params, ul, e->position);
@@ -151,12 +150,11 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
     if (!c) return false;
     begin_join(th, kind, s, 1, strategy(s, 1));
   } else {
-    const auto* film = std::get_if<OrthographicParams>(&cam_.params);
-    if (film == nullptr) return false;
+    if (sensor_pair_ != "SD") return false;  // the connector's c(k+1) c(k+2): a Dirac direction from a film
     begin_join(th, kind, s, 1, ortho_of(s));
     ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
     ++stats.attempts;
-    c = pathex::connect(*film, q->p);
+    c = connect_projection(cam_.params, q->p);
     if (!c) {
       ++stats.outside;
       return false;
@@ -199,16 +197,16 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
     if (!c) return false;
     begin_join(th, kind, 1, t, strategy(1, t));
   } else {
-    if (!std::holds_alternative<DistantLightParams>(l.params)) return false;  // the light picked is not distant
+    if (light_pairs_[li] != "DS") return false;  // the connector's c0 c1: a Dirac direction from an aperture
     begin_join(th, kind, 1, t, distant_of(t));
     ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
     ++stats.attempts;
-    c = pathex::connect(l.params, SurfacePoint{}, pt.p);
+    c = connect_projection(l.params, pt.p);
     if (!c) {
       ++stats.outside;
       return false;
     }
-    err = aperture_error(l);
+    err = l.origin_error;
   }
   JoinResult& jr = th.join;
   Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? light_pairs_[li][1] : 'D');
