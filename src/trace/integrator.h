@@ -7,13 +7,11 @@
 #pragma once
 
 #include <algorithm>
-#include <bit>
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
-#include <variant>
 #include <vector>
 
 #include "classify/classifier.h"
@@ -30,7 +28,6 @@
 #include "trace/rng.h"
 #include "trace/scene_features.h"
 #include "trace/strategy_table.h"
-#include "trace/texture_eval.h"
 #include "trace/vertex.h"
 
 namespace pathex::tracer {
@@ -238,25 +235,6 @@ class Integrator {
     const RayPdf p = l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w);
     return finite_part(p.dir, p.delta_dir);
   }
-  // A light chosen uniformly by u, and a point on it drawn from u2 (area lights; the others
-  // ignore the point).
-  // (u n lies in [0, n), far below 2^63: the signed conversion is exact and, unlike the unsigned
-  // one, a single instruction.)
-  // (A lone light's pick and a non-area light's point read no number: Sampler::get1d_if.)
-  std::size_t pick_light(Sampler& rng) const {
-    const float u = rng.get1d_if(rs_.lights.size() > 1);
-    const auto i = static_cast<std::int64_t>(u * static_cast<float>(rs_.lights.size()));
-    return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(i));
-  }
-  // *error: the point's rounding-error bound (SurfaceSample::error), which offsets rays leaving it.
-  SurfacePoint sample_point(const RenderLight& l, Sampler& rng, vec3* error) const {
-    const glm::vec2 u2 = rng.get2d_if(l.is_area());
-    *error = l.origin_error;
-    if (!l.is_area()) return {};
-    const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, u2);
-    *error = ss.error;
-    return {ss.position, ss.normal, l.pdf_pos};
-  }
   // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
   // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
   // emission_step_density() after it: their product is its emission's joint density.
@@ -278,26 +256,8 @@ class Integrator {
     *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
   }
 
-  // The material at surface vertex `v`: its shape's, with its textured parameters evaluated at
-  // v.uv into `*scratch` when it has any (trace/texture_eval.h).
-  const Material& material_at(const Vertex& v, Material* scratch) const {
-    const Material& base = *rs_.material_of_shape[static_cast<std::size_t>(v.shape)];
-    const MaterialTextures* tex = rs_.textures_of_shape[static_cast<std::size_t>(v.shape)];
-    if (!tex) return base;
-    textured_material(*rs_.scene, base, *tex, v.uv, scratch);
-    return *scratch;
-  }
-
-  // A hit's shading normal as every strategy sees it (pt, pt-nee, lt, bdpt's joins and the MIS
-  // densities all read the vertex's ns): the geometry's (Hit::shading_normal) turned by its
-  // material's bump or normal map (trace/texture_eval.h perturbed_normal). The letter stays.
-  vec3 shading_normal(const Hit& h) const {
-    const MaterialTextures* tex = rs_.textures_of_shape[static_cast<std::size_t>(h.shape)];
-    if (!tex || tex->perturb == NormalPerturbation::kNone) return h.shading_normal;
-    vec3 dpdu, dpdv;
-    rs_.geometry->uv_tangents(h, &dpdu, &dpdv);
-    return perturbed_normal(*rs_.scene, *tex, h.uv, h.normal, h.shading_normal, dpdu, dpdv);
-  }
+  // The material at surface vertex `v` (RenderScene::material_at).
+  const Material& material_at(const Vertex& v, Material* scratch) const { return rs_.material_at(v.shape, v.uv, scratch); }
 
   // --- densities used by MIS ---
   // Solid-angle density at `v` of sampling the unit direction `wn`, given the unit direction
@@ -371,10 +331,19 @@ class Integrator {
   // letters a projection adds, the one segment to test (none: from is null). False when black.
   void begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const;
   bool end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const;
-  // The one way a join makes a fresh endpoint: a sensor vertex at connection c (th.join.eye0), a
-  // vertex of light li at p (th.join.light0).
-  Vertex& fresh_sensor_vertex(Thread& th, const EndpointConnection& c, char letter) const;
-  Vertex& fresh_light_vertex(Thread& th, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const;
+  // The one way to make an endpoint vertex, for a subpath (y0, z0) and for a join's fresh end: into
+  // y a vertex of light li at p, into z a sensor vertex at p (normal n, none for a point sensor),
+  // with its letter (c1, c(k+1)) and its forward density. fresh_*: into th.join (light0, eye0).
+  Vertex& light_vertex(Vertex& y, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const;
+  Vertex& sensor_vertex(Vertex& z, const vec3& p, const vec3& n, char letter) const;
+  Vertex& fresh_sensor_vertex(Thread& th, const EndpointConnection& c, char letter) const {
+    th.join.has_eye0 = true;
+    return sensor_vertex(th.join.eye0, c.position, c.normal, letter);
+  }
+  Vertex& fresh_light_vertex(Thread& th, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const {
+    th.join.has_light0 = true;
+    return light_vertex(th.join.light0, li, p, n, err, letter);
+  }
   // Density of the far end of a parallel beam per unit area there, relative to the near end's:
   // points x and y on one line along w, with unit normals (zero: no surface), map areas as
   // dA_x |cos θ_x| = dA_y |cos θ_y|.

@@ -29,7 +29,6 @@
 #include "trace/frame.h"
 #include "trace/integrator.h"
 #include "trace/prune.h"
-#include "trace/render_scene.h"
 #include "trace/rng.h"
 #include "trace/strategy_table.h"
 
@@ -96,7 +95,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.p = hit->position;
     v.n = hit->normal;
     v.err = hit->error;
-    v.ns = shading_normal(*hit);  // a bump or normal map's, if any
+    v.ns = rs_.shading_normal(*hit);  // a bump or normal map's, if any
     v.shape = hit->shape;
     v.uv = hit->uv;
     v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;
@@ -156,22 +155,13 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
 }
 
 int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
-  Vertex& z0 = th.eye[0];
-  z0 = Vertex{};
-  z0.kind = Kind::kCamera;
-  z0.beta = vec3(1.0f);
-  z0.letter = sensor_pair_[0];
-  z0.pos_letter = sensor_pair_[1];
   const glm::vec2 uf = rng.get2d();
   const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(cam_.params));
   const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(cam_.width),
                          (static_cast<float>(py) + uf.y) / static_cast<float>(cam_.height)};
   const std::optional<EndpointRay> r = sample_ray(cam_.params, raster, ul);
-  z0.pdf_fwd = cam_.pdf_pos;
+  const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), sensor_pair_[0]);
   if (!r) return 1;
-  z0.p = r->origin;
-  z0.n = r->pdf.delta_pos ? vec3(0.0f) : r->normal;  // a point sensor has no surface
-  z0.ns = z0.n;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
   const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
                                                       finite_part(r->pdf.dir, r->pdf.delta_dir), max_eye_);
@@ -182,31 +172,22 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
 
 int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
-  const std::size_t li = pick_light(rng);
+  const std::size_t li = rs_.pick_light(rng);
   const RenderLight& l = rs_.lights[li];
-  Vertex& y0 = th.light[0];
-  y0 = Vertex{};
-  y0.kind = Kind::kLight;
-  y0.light = static_cast<int>(li);
-  y0.pos_letter = light_pairs_[li][0];
-  y0.letter = light_pairs_[li][1];
   // An image infinite light draws its disk point from the numbers an area light's point takes.
   const EnvironmentLightParams* env = environment_of(static_cast<int>(li));
   const glm::vec2 u_disk = env ? rng.get2d() : glm::vec2(0.0f);
-  const SurfacePoint x = env ? SurfacePoint{} : sample_point(l, rng, &y0.err);
+  vec3 err{0.0f};
+  const SurfacePoint x = env ? SurfacePoint{} : rs_.sample_point(l, rng, &err);
   rng.skip(2);  // u_ray, drawn in advance
   // (An aimed light draws its direction within its cones: RenderLight::sample_ray.)
   const std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : l.sample_ray(x, u_ray);
-  if (env && r) y0.err = box_point_error(r->origin);
-  y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
+  if (env && r) err = box_point_error(r->origin);
+  Vertex& y0 = light_vertex(th.light[0], li, r ? r->origin : x.position, r ? r->normal : vec3(0.0f), err, light_pairs_[li][1]);
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
-    y0.p = x.position;
     y0.beta = vec3(0.0f);
     return 1;
   }
-  y0.p = r->origin;
-  y0.n = r->normal;
-  y0.ns = y0.n;
   // y0 keeps the spatial part of the emission, L_e⁽⁰⁾ / p (a join at y0 evaluates the directional
   // part); the walk continues with the first ray's whole throughput.
   y0.beta = spatial_emission(l.params) / (light_pick_ * (r->pdf.delta_pos ? 1.0f : r->pdf.pos));

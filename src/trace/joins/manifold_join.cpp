@@ -11,7 +11,6 @@
 #include "trace/fresnel.h"
 #include "trace/integrator.h"
 #include "trace/joins/manifold.h"
-#include "trace/prune.h"
 
 namespace pathex::tracer {
 namespace {
