@@ -30,7 +30,9 @@
 // its delta flag set, and its value is the delta's weight. Hence `weight = value · |cos| /
 // (pdf.pos · pdf.dir)` holds for every kind, where cos is taken between the ray and `normal`
 // (1 when the endpoint has no surface: point, spot, laser, spot meter; a pinhole uses its viewing
-// axis, as pbrt does). MIS code must compare delta flags, never the densities of Dirac parts.
+// axis, as pbrt does). MIS code must compare delta flags, never the densities of Dirac parts: the
+// walks and the MIS weight keep a Dirac's density as 0 (counted as 1 there), and RayPdf::mis_dir()
+// is where a ray's density crosses from one convention to the other.
 //
 // Sensors measure the mean over the image: W_e is normalised so that ∫ W_e cos dσ dA = 1 over the
 // whole film (pbrt's convention, W_e = 1 / (A_img cos⁴θ) for a pinhole with A_img the image area
@@ -63,6 +65,9 @@ struct RayPdf {
   float dir = 0.0f;        // solid-angle density of the direction [1/sr]; 1 if delta_dir
   bool delta_pos = false;
   bool delta_dir = false;
+  // The direction's density as the walks and the MIS weight keep it (trace/mis.h): a Dirac's as 0,
+  // its strategies excluded by letter. The one place the two conventions meet.
+  float mis_dir() const { return delta_dir ? 0.0f : dir; }
 };
 
 // The first ray of a light subpath (from a light) or an eye subpath (from a sensor).
