@@ -5,7 +5,7 @@
 
 For each case (scene, renderer, class), each round runs the full render (every strategy, every
 path, the class measured as one class of the render) and the --only render of that class alone
-(the cheapest cover of its paths, reach/prune.h: other strategies, so another σ), in an order that
+(the cheapest cover of its paths, trace/prune.h: other strategies, so another σ), in an order that
 alternates between rounds, each with the round's seed, one thread, no images. The efficiency of a
 render on the class is 1 / (σ² T): σ the class's standard error (batch means, histogram.json) and
 T the process's CPU seconds (user + system, os.wait4: start-up, checker, rendering, writing).
@@ -36,7 +36,7 @@ CASES = [
     ("caustic of point-glass", "point-glass.json", "bdpt", "$caustic", 64, "128x128"),
     ("$direct on the Cornell box", "cornell.json", "bdpt", "$direct", 16, "128x128"),
     ("L.{8,}E on the Cornell box", "cornell.json", "bdpt", "L.{8,}E", 16, "128x128"),
-    # Classes the cover reduces (reach/prune.h): caustics seen on a diffuse surface (light tracing
+    # Classes the cover reduces (trace/prune.h): caustics seen on a diffuse surface (light tracing
     # alone samples them), long all-diffuse paths (NEE alone).
     ("caustic on a diffuse surface, point-glass", "point-glass.json", "bdpt", "L..S+D.*DDSE", 64, "128x128"),
     ("LD{7,}SE on the Cornell box", "cornell.json", "bdpt", "LD{7,}SE", 16, "128x128"),

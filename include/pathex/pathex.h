@@ -2,7 +2,8 @@
 //
 // Three things a rendering engineer's program or CI does with pathex, and nothing more:
 //   1. compile a path class (a full-path regular expression such as "L.*DD.*E") and test paths;
-//   2. ask whether a renderer profile can sample the class (the checker's verdict and witnesses);
+//   2. ask whether a renderer profile can sample the class (the checker's verdict and witnesses),
+//      and what a render of a scene would run (its Plan);
 //   3. classify full-path strings by a set of named classes in one pass.
 //
 //   #include <pathex/pathex.h>
@@ -109,6 +110,32 @@ struct Answer {
 };
 
 Answer query(const PathClass& path_class, const Renderer& renderer, const QueryOptions& options = {});
+
+// What a render of `renderer` over the scene file `scene` runs: the plan `pathex trace` (and
+// converge, bias) makes before it renders (DESIGN §11). `only` are the requested classes as
+// --only takes them (expressions, or $name of a built-in class); `max_bounces` overrides the
+// profile's bound (else 16).
+class Plan {
+ public:
+  Plan(const Renderer& renderer, const std::string& scene, const std::vector<std::string>& only = {},
+       std::optional<int> max_bounces = std::nullopt);
+
+  bool ok() const;
+  const std::string& error() const;
+  // The strategies that run, in the profile's order, each as its name and what runs of it:
+  // "name (s, chain, t)" (narrowed where pruning narrowed it).
+  const std::vector<std::string>& strategies() const;
+  // The scene's lights (indices into its "lights") whose emission is aimed at the shapes with a
+  // specular component, because every requested path scatters specularly at its first vertex.
+  const std::vector<int>& aimed_lights() const;
+  // Whether the render records `full_path` (every path without `only`; false for a malformed one).
+  bool records(std::string_view full_path) const;
+
+ private:
+  friend struct Access;
+  struct Impl;
+  std::shared_ptr<const Impl> impl_;
+};
 
 // Named classes compiled into one automaton: classifying a path is one pass over its letters.
 class ClassSet {

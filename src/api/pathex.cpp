@@ -6,6 +6,7 @@
 // are the functions the `pathex` command calls.
 #include "pathex/pathex.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "automata/ops.h"
@@ -16,6 +17,8 @@
 #include "reach/query.h"
 #include "scene/scene.h"
 #include "scene/universe.h"
+#include "trace/accel/path_ids.h"
+#include "trace/plan.h"
 
 namespace pathex::api {
 
@@ -38,6 +41,14 @@ struct ClassSet::Impl {
   ClassTable table;  // owns the user's classes the classifier was built from
   std::vector<std::string> names;
   std::optional<Classifier> classifier;
+};
+
+struct Plan::Impl {
+  std::string error;
+  ClassTable table;  // owns the requested classes compiled for the scene
+  std::optional<pathex::RenderPlan> plan;
+  std::vector<std::string> strategies;
+  std::vector<int> aimed_lights;
 };
 
 // The one friend of the public classes: the functions below reach their private halves through it.
@@ -174,6 +185,69 @@ Answer query(const PathClass& path_class, const Renderer& renderer, const QueryO
   for (const Witness& w : q->reachable) a.reachable_witnesses.push_back(w.path);
   for (const Witness& w : q->unreachable) a.unreachable_witnesses.push_back(w.path);
   return a;
+}
+
+// --- Plan ---
+
+Plan::Plan(const Renderer& renderer, const std::string& scene, const std::vector<std::string>& only,
+           std::optional<int> max_bounces) {
+  auto impl = std::make_shared<Impl>();
+  impl_ = impl;
+  if (!renderer.ok()) {
+    impl->error = renderer.error();
+    return;
+  }
+  const Limits limits;
+  Result<Scene> s = load_scene_file(scene);
+  if (!s) {
+    impl->error = s.error().render();
+    return;
+  }
+  // The requested classes as pathex trace compiles them (cli/render_job.cpp): a built-in class by
+  // its $name, any other expression for the scene's ends.
+  const SceneTypes types = scene_types(*s);
+  ClassOptions copts;
+  copts.limits = limits;
+  copts.ends.lights.assign(types.lights.begin(), types.lights.end());
+  copts.ends.sensors = {types.sensor};
+  std::vector<const pathex::PathClass*> requested;
+  for (std::size_t i = 0; i < only.size(); ++i) {
+    const pathex::PathClass* same = nullptr;
+    for (const auto& c : ClassTable::builtins().builtin_classes())
+      if (c->name != "all" && !only[i].empty() && only[i][0] == '$' && c->name == only[i].substr(1)) same = c.get();
+    if (same == nullptr) {
+      Result<const pathex::PathClass*> added = impl->table.add("only-" + std::to_string(i + 1), only[i], copts);
+      if (!added) {
+        impl->error = added.error().render();
+        return;
+      }
+      same = *added;
+    }
+    if (std::find(requested.begin(), requested.end(), same) == requested.end()) requested.push_back(same);
+  }
+  const Profile& profile = *Access::of(renderer).profile;
+  Result<pathex::RenderPlan> p = plan_render(*s, profile, max_bounces.value_or(profile.max_bounces.value_or(16)), requested, limits);
+  if (!p) {
+    impl->error = p.error().render();
+    return;
+  }
+  for (const Strategy& st : p->profile.strategies) impl->strategies.push_back(st.name + " " + st.describe());
+  impl->aimed_lights = p->aimed_lights;
+  impl->plan = std::move(*p);
+}
+
+bool Plan::ok() const { return impl_->error.empty(); }
+const std::string& Plan::error() const { return impl_->error; }
+const std::vector<std::string>& Plan::strategies() const { return impl_->strategies; }
+const std::vector<int>& Plan::aimed_lights() const { return impl_->aimed_lights; }
+
+bool Plan::records(std::string_view full_path) const {
+  // L c0 … c(k+2) E with k >= 1, as many letters as a packed path holds.
+  const std::size_t n = full_path.size();
+  if (!impl_->plan || n < 6 || n - 2 > static_cast<std::size_t>(accel::kMaxPackedLetters) || full_path.front() != 'L' ||
+      full_path.back() != 'E' || full_path.substr(1, n - 2).find_first_not_of("SD") != std::string_view::npos)
+    return false;
+  return impl_->plan->filter.records(accel::pack(std::string(full_path)));
 }
 
 // --- ClassSet ---

@@ -11,6 +11,7 @@
 #include "classify/significance.h"
 #include "io/profile_json.h"
 #include "scene/universe.h"
+#include "trace/plan.h"
 
 namespace pathex {
 
@@ -200,7 +201,11 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
     for (int i = 0; i <= n; ++i) ro.layer_classes.push_back(i);
   ro.progress = o.progress;
   ro.cancel = o.cancel;
-  Result<RenderOutput> out = render(scene, reference, &*classifier, ro);
+  // The reference runs as pathex trace would run it (trace/plan.h): its strategies that can sample
+  // a path of this scene.
+  Result<RenderPlan> ref_plan = plan_render(scene, reference, *bound, {}, o.limits);
+  if (!ref_plan) return ref_plan.error();
+  Result<RenderOutput> out = render(scene, *ref_plan, &*classifier, ro);
   if (!out) return out.error();
   RunInfo info;
   info.scene = scene_name;
@@ -293,7 +298,9 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
       rro.max_bounces = r_bound ? std::min(*r_bound, *bound) : *bound;  // the light the reference measures
       rro.images = false;
       rro.cancel = o.cancel;
-      Result<RenderOutput> r_out = render(scene, renderer, &*r_classifier, rro);
+      Result<RenderPlan> r_plan = plan_render(scene, renderer, *rro.max_bounces, {}, o.limits);
+      if (!r_plan) return r_plan.error();
+      Result<RenderOutput> r_out = render(scene, *r_plan, &*r_classifier, rro);
       if (!r_out) return r_out.error();
       RunInfo r_info = info;
       r_info.renderer = renderer.name;

@@ -48,9 +48,8 @@
 #include "io/input_file.h"
 #include "io/output_set.h"
 #include "io/profile_json.h"
-#include "reach/prune.h"
 #include "scene/universe.h"
-#include "trace/prune.h"
+#include "trace/plan.h"
 #include "trace/render.h"
 
 namespace pathex::cli {
@@ -171,7 +170,6 @@ struct RungSetup {
   const Classifier* classifier = nullptr;
   int threads = 0;
   std::optional<int> max_bounces;  // unset: each profile's own bound, else 16 (as trace)
-  const RequestedPaths* only = nullptr;  // --only: record these paths alone
 };
 
 struct ClassMeasure {
@@ -193,13 +191,13 @@ struct RungResult {
   bool interrupted = false;           // by Ctrl-C: the rung is not kept
 };
 
-// Renders one rung: `profile` at `budget` with `seed`. A time budget stops the render after the
-// chunk in progress when the time is up; Ctrl-C (g_interrupted) stops it and marks it interrupted.
+// Renders one rung: `plan` (trace/plan.h) at `budget` with `seed`. A time budget stops the render
+// after the chunk in progress when the time is up; Ctrl-C (g_interrupted) stops it and marks it interrupted.
 // Under MPI every rank calls it for every rung (it is collective): the ranks deal the rung's
 // passes among themselves (Cluster::deal: whoever is free takes the next chunk), and only rank 0's
 // result holds the rung's measures (the others' `classes` are empty). A rung interrupted on any
 // rank is interrupted on all.
-Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, const Budget& budget, std::uint64_t seed,
+Result<RungResult> run_rung(const RungSetup& setup, const RenderPlan& plan, const Budget& budget, std::uint64_t seed,
                             const std::vector<ClassRow>& rows) {
   Cluster* cluster = current_cluster();
   RenderOptions ro;
@@ -212,7 +210,6 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   ro.seed = seed;
   ro.threads = setup.threads;
   ro.max_bounces = setup.max_bounces;
-  ro.only = setup.only;
   for (int i = 0; i < setup.classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
   ro.cancel = &g_stop;
   g_stop.store(g_interrupted.load());
@@ -227,7 +224,7 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
     });
   const double cpu0 = cpu_seconds();
   const auto wall0 = std::chrono::steady_clock::now();
-  Result<RenderOutput> out = render(*setup.scene, profile, setup.classifier, ro);
+  Result<RenderOutput> out = render(*setup.scene, plan, setup.classifier, ro);
   const double cpu1 = cpu_seconds();
   auto wall1 = std::chrono::steady_clock::now();
   if (timer.joinable()) {
@@ -509,34 +506,33 @@ int run(const ConvergeArgs& a) {
   }
   // --- --only: the requested classes are measured, the others listed as not rendered ---
   std::vector<const PathClass*> not_rendered;
-  std::optional<RequestedPaths> only;
   std::string requested_text;
   if (!a.only.empty()) {
     std::vector<const PathClass*> estimated;
     for (std::size_t i = 0; i < classes.size(); ++i) ((*listed)->estimated[i] ? estimated : not_rendered).push_back(classes[i]);
     classes = std::move(estimated);
     for (const PathClass* c : (*listed)->requested) requested_text += (requested_text.empty() ? "" : " | ") + c->text;
-    Result<RequestedPaths> r = RequestedPaths::make((*listed)->requested, a.limits);
-    if (!r) return report(r.error());
-    only.emplace(std::move(*r));
-    // Each renderer runs the strategies and joins that sample the requested paths (reach/prune.h).
-    const Dfa universe = scene_universe(types);
-    for (Profile* p : [&] {
-           std::vector<Profile*> all;
-           for (Profile& q : profiles) all.push_back(&q);
-           all.push_back(&*ref_profile);
-           return all;
-         }()) {
-      const int bounces = a.max_bounces.value_or(p->max_bounces.value_or(16));
-      Result<ProfilePruning> pruned = prune_profile(*p, bounces, universe, (*listed)->requested_language, a.limits);
-      if (!pruned) return report(pruned.error());
-      if (pruned->samples_nothing()) {
-        std::cout << "nothing to render: no strategy of " << p->name << " samples a path of the requested classes in this scene ("
-                  << describe(types) << ")\n";
-        return kExitNo;
-      }
-      p->strategies = std::move(pruned->profile.strategies);
+  }
+  const bool only = !a.only.empty();
+  // --- the plans (trace/plan.h), as pathex trace makes them: each renderer runs the strategies
+  // and joins that sample the (requested) paths of this scene, and records only those ---
+  const std::vector<const PathClass*> requested = only ? (*listed)->requested : std::vector<const PathClass*>{};
+  std::vector<RenderPlan> plans;  // per renderer of the ladder, then the reference's
+  for (const Profile* p : [&] {
+         std::vector<const Profile*> all;
+         for (const Profile& q : profiles) all.push_back(&q);
+         all.push_back(&*ref_profile);
+         return all;
+       }()) {
+    const int bounces = a.max_bounces.value_or(p->max_bounces.value_or(16));
+    Result<RenderPlan> plan = plan_render(*scene, *p, bounces, requested, a.limits);
+    if (!plan) return report(plan.error());
+    if (plan->samples_nothing()) {
+      std::cout << "nothing to render: no strategy of " << p->name << " samples a path of the requested classes in this scene ("
+                << describe(types) << ")\n";
+      return kExitNo;
     }
+    plans.push_back(std::move(*plan));
   }
   Result<Classifier> classifier = Classifier::build(classes, a.limits);
   if (!classifier) return report(classifier.error());
@@ -544,7 +540,7 @@ int run(const ConvergeArgs& a) {
   std::vector<ClassRow> rows{{only ? "requested" : "total", only ? requested_text : "$all", std::nullopt, 0.0, std::nullopt, ""}};
   for (const PathClass* c : classes) rows.push_back({c->name, c->text, std::nullopt, 0.0, std::nullopt, ""});
 
-  RungSetup setup{&*scene, &*classifier, a.threads, a.max_bounces, only ? &*only : nullptr};
+  RungSetup setup{&*scene, &*classifier, a.threads, a.max_bounces};
   const int width = scene->camera.width, height = scene->camera.height;
   const std::uint64_t base_seed = a.seed;
   std::signal(SIGINT, on_interrupt);
@@ -576,7 +572,7 @@ int run(const ConvergeArgs& a) {
     else rb.seconds *= static_cast<double>(a.reference_factor);
     const std::uint64_t seed = base_seed ^ 0x5eed5eed5eedULL;
     if (progress) std::cerr << "pathex: reference run: " << ref_profile->name << " at " << rb.text() << "\n";
-    Result<RungResult> r = run_rung(setup, *ref_profile, rb, seed, rows);
+    Result<RungResult> r = run_rung(setup, plans.back(), rb, seed, rows);
     if (!r) return report(r.error());
     render_wall += r->wall_s;
     render_cpu += r->cpu_s;
@@ -664,7 +660,7 @@ int run(const ConvergeArgs& a) {
     for (std::size_t i = 0; i < ladder->size(); ++i) {
       const std::uint64_t seed = base_seed + 1000 * k + i;
       if (progress) std::cerr << "\rpathex: " << profiles[k].name << " at " << (*ladder)[i].text() << "        " << std::flush;
-      Result<RungResult> r = run_rung(setup, profiles[k], (*ladder)[i], seed, rows);
+      Result<RungResult> r = run_rung(setup, plans[k], (*ladder)[i], seed, rows);
       if (!r) return report(r.error());
       render_wall += r->wall_s;
       render_cpu += r->cpu_s;

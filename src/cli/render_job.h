@@ -20,7 +20,7 @@
 #include "core/pass_deal.h"
 #include "core/pass_set.h"
 #include "io/shard.h"
-#include "reach/prune.h"
+#include "trace/prune.h"
 #include "trace/render.h"
 
 namespace pathex::cli {
@@ -62,7 +62,7 @@ struct WrittenReport {
 // With requested classes, histogram.json lists them ("only": [{name, expr}]) and marks every class
 // not contained in them "rendered": false; the EXR and PNGs have no layer for a class that was not
 // rendered. run.json's "pruned" lists the strategies the checker did not run or narrowed
-// ([{strategy, profile, runs (null: not run), reason}]; reach/prune.h).
+// ([{strategy, profile, runs (null: not run), reason}]; trace/prune.h).
 Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
                                            const RenderClasses& classes, const std::vector<PrunedStrategy>& not_run = {});
 

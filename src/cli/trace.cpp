@@ -32,8 +32,7 @@
 #include "scene/scene_hash.h"
 #include "scene/universe.h"
 #include "automata/ops.h"
-#include "reach/prune.h"
-#include "trace/prune.h"
+#include "trace/plan.h"
 #include "trace/render.h"
 
 namespace pathex::cli {
@@ -267,30 +266,25 @@ int run(const TraceArgs& a) {
   if (a.missed && !id.only.empty())
     return report(make_error(ErrorCode::kUsage, "--missed measures what the whole render misses: it cannot be given with --only"));
 
-  // --- DESIGN §11: run only the strategies that can sample a requested path of this scene ---
+  // --- DESIGN §11: the plan (trace/plan.h): the strategies that can sample a requested path of
+  // this scene, the lights' emission narrowing, the paths recorded ---
   const Dfa universe = scene_universe(scene_types(*job.scene));
-  Result<ProfilePruning> pruning =
-      prune_profile(*job.profile, id.max_bounces, universe, job.classes->requested_language, a.limits);
-  if (!pruning) return report(pruning.error());
-  if (pruning->samples_nothing() && job.classes->requested.empty()) {
-    // Nothing of the scene can be sampled at all: render as asked (a black image, and the warning
-    // about the lights it cannot reach), running the profile whole as before.
-    pruning->profile = *job.profile;
-    pruning->changes.clear();
-  }
-  if (pruning->samples_nothing()) {
+  Result<RenderPlan> plan = plan_render(*job.scene, *job.profile, id.max_bounces, job.classes->requested, a.limits);
+  if (!plan) return report(plan.error());
+  std::vector<PrunedStrategy>& changes = plan->changes;
+  if (plan->samples_nothing()) {
     std::cout << "nothing to render: no strategy of " << id.renderer << " samples a path of "
               << (id.only.empty() ? "this scene" : "the requested classes in this scene") << " ("
               << describe(scene_types(*job.scene)) << ")\n";
     for (const PathClass* c : job.classes->requested)
       if (is_empty(dfa_intersect(dfa_intersect(c->dfa, universe), bounded_universe(id.max_bounces))))
         std::cout << "  " << c->text << " has no path in this scene\n";
-    for (const PrunedStrategy& p : pruning->changes) std::cout << "  " << p.strategy << " " << p.was << ": " << p.reason << "\n";
+    for (const PrunedStrategy& p : changes) std::cout << "  " << p.strategy << " " << p.was << ": " << p.reason << "\n";
     return kExitNo;
   }
   std::vector<std::string> runs;
   std::vector<ConnectorStrategy> connectors;
-  for (const Strategy& st : pruning->profile.strategies) {
+  for (const Strategy& st : plan->profile.strategies) {
     runs.push_back(st.name);
     if (st.connector != ConnectorKind::kNone) connectors.push_back({st.name, to_string(st.connector)});
   }
@@ -299,12 +293,6 @@ int run(const TraceArgs& a) {
     job.header.identity.connectors = connectors;
   } else if (runs != id.strategies || connectors != id.connectors) {
     return report(make_error(ErrorCode::kUsage, "the strategies " + a.resume + " was rendered with are not the ones this pathex runs for it"));
-  }
-  std::optional<RequestedPaths> only;
-  if (!job.classes->requested.empty()) {
-    Result<RequestedPaths> r = RequestedPaths::make(job.classes->requested, a.limits);
-    if (!r) return report(r.error());
-    only.emplace(std::move(*r));
   }
 
   // The output folder is checked before the render, not after it.
@@ -346,7 +334,6 @@ int run(const TraceArgs& a) {
   ro.rr_threshold = static_cast<float>(id.rr_threshold);
   ro.manifold = id.manifold.value_or(ManifoldOptions{});
   ro.batches = id.batches;
-  ro.only = only ? &*only : nullptr;
   // Without image outputs the render keeps the histogram alone (the same histogram).
   ro.images = id.images;
   if (ro.images)
@@ -369,7 +356,7 @@ int run(const TraceArgs& a) {
     const RenderWatch watch(rank == 0 && !a.quiet, a.time_limit);
     ro.progress = watch.progress();
     ro.cancel = stopped = watch.cancel();
-    return render(*job.scene, pruning->profile, job.classes->classifier.get(), ro);
+    return render(*job.scene, *plan, job.classes->classifier.get(), ro);
   }();
   const double cpu_s = process_cpu_seconds() - cpu_start;
   if (!out) return report(out.error());
@@ -379,7 +366,7 @@ int run(const TraceArgs& a) {
     std::ostringstream now;
     now << "the cones around " << l.shapes << (l.shapes == 1 ? " shape" : " shapes") << " with a specular component ("
         << std::fixed << std::setprecision(1) << 100.0 * l.share << " % of the directions)";
-    pruning->changes.push_back({"light /lights/" + std::to_string(l.light) + " (" + l.kind + ")", "emission (every direction)", now.str(),
+    changes.push_back({"light /lights/" + std::to_string(l.light) + " (" + l.kind + ")", "emission (every direction)", now.str(),
                                 "every requested path scatters specularly at its first vertex"});
   }
   // Non-finite samples are bugs (DESIGN §7): say so, and where the first arose.
@@ -460,7 +447,7 @@ int run(const TraceArgs& a) {
   if (rank == 0) {
     const SignalShield shield;
     Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {
-      Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, pruning->changes);
+      Result<WrittenReport> r = write_render_outputs(dir, header, sums, *job.classes, changes);
       if (!r) return r.error();
       written = std::move(*r);
       if (missed)  // what pathex bias writes to bias.json, without images
@@ -522,7 +509,7 @@ int run(const TraceArgs& a) {
     std::cout << "image mean luminance " << absolute(rep->total) << "\n"
               << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n";
   }
-  for (const PrunedStrategy& p : pruning->changes)
+  for (const PrunedStrategy& p : changes)
     std::cout << (p.now.empty() ? "not run: " : "narrowed: ") << p.strategy << " " << p.was << (p.now.empty() ? "" : " to " + p.now) << ": " << p.reason << "\n";
   if (missed) {
     std::cout << "this renderer " << missed_line(*missed).substr(missed->renderer.size() + 1) << "\n";

@@ -12,9 +12,11 @@
 // nonzero towards every point of every such shape. So each requested path keeps a nonzero density
 // and its estimate its expectation; only its variance changes. The MIS weights of a requested path
 // do not depend on this density: every strategy that samples it traced the light's first ray (the
-// ones that did not, s = 0 and s = 1, would join at its specular first vertex). The integrator
-// still reports it as the light's directional density (Integrator::light_pdf_dir), so that the one
-// emitter model and the walk agree on every path.
+// ones that did not, s = 0 and s = 1, would join at its specular first vertex). It is still the
+// light's directional density wherever the integrator asks for one, so that the emitter model and
+// the walk agree on every path: aimed_ray() and aimed_pdf() below decorate the light's own ray
+// sampling (trace/emitters.h), and a light the plan aims (trace/plan.h) answers through them
+// (RenderLight::sample_ray, RenderLight::pdf_ray in trace/render_scene.h).
 #pragma once
 
 #include <algorithm>
@@ -24,6 +26,7 @@
 
 #include <glm/glm.hpp>
 
+#include "trace/emitters.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
 
@@ -100,5 +103,29 @@ class EmissionCones {
   std::vector<float> cdf_;  // running sums of the cones' solid angles
   float total_ = 0.0f;
 };
+
+// --- aimed emission: a decorator over a light's ray sampling ---
+// The light's own first ray (its origin, normal and spatial emission, drawn from x and u as
+// sample_ray(l, x, u) draws them) with its direction drawn from the cones by u instead: its value
+// is the light's emission that way, its density the cones' (finite: the direction's delta flag
+// stays clear). Nullopt where the light emits nothing that way (outside a spot light's cone).
+inline std::optional<EndpointRay> aimed_ray(const EmissionCones& cones, const LightParams& l, const SurfacePoint& x, glm::vec2 u) {
+  std::optional<EndpointRay> r = sample_ray(l, x, u);
+  if (!r) return r;
+  float pdf = 0.0f;
+  r->direction = cones.sample(u, &pdf);
+  r->value = spatial_emission(l) * directional_emission(l, r->normal, r->direction);
+  r->pdf.dir = pdf;
+  r->weight = r->value / pdf;
+  if (r->value.x == 0.0f && r->value.y == 0.0f && r->value.z == 0.0f) return std::nullopt;
+  return r;
+}
+// The densities of the light's ray from x towards w as aimed_ray() draws it.
+inline RayPdf aimed_pdf(const EmissionCones& cones, const LightParams& l, const SurfacePoint& x, const glm::vec3& w) {
+  RayPdf p = pdf_ray(l, x, w);
+  p.dir = cones.pdf(w);
+  p.delta_dir = false;
+  return p;
+}
 
 }  // namespace pathex

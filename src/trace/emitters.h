@@ -30,7 +30,9 @@
 // its delta flag set, and its value is the delta's weight. Hence `weight = value · |cos| /
 // (pdf.pos · pdf.dir)` holds for every kind, where cos is taken between the ray and `normal`
 // (1 when the endpoint has no surface: point, spot, laser, spot meter; a pinhole uses its viewing
-// axis, as pbrt does). MIS code must compare delta flags, never the densities of Dirac parts.
+// axis, as pbrt does). MIS code must compare delta flags, never the densities of Dirac parts: the
+// walks and the MIS weight keep a Dirac's density as 0 (counted as 1 there), and RayPdf::mis_dir()
+// is where a ray's density crosses from one convention to the other.
 //
 // Sensors measure the mean over the image: W_e is normalised so that ∫ W_e cos dσ dA = 1 over the
 // whole film (pbrt's convention, W_e = 1 / (A_img cos⁴θ) for a pinhole with A_img the image area
@@ -63,6 +65,9 @@ struct RayPdf {
   float dir = 0.0f;        // solid-angle density of the direction [1/sr]; 1 if delta_dir
   bool delta_pos = false;
   bool delta_dir = false;
+  // The direction's density as the walks and the MIS weight keep it (trace/mis.h): a Dirac's as 0,
+  // its strategies excluded by letter. The one place the two conventions meet.
+  float mis_dir() const { return delta_dir ? 0.0f : dir; }
 };
 
 // The first ray of a light subpath (from a light) or an eye subpath (from a sensor).
@@ -336,6 +341,13 @@ std::optional<EndpointConnection> connect(const LightParams& l, const SurfacePoi
 glm::vec3 spatial_emission(const LightParams& l);
 float directional_emission(const LightParams& l, const glm::vec3& n, const glm::vec3& w);
 glm::vec3 emitted(const LightParams& l, const glm::vec3& n, const glm::vec3& w);
+// Where a light with a Dirac position (point, spot, laser) is; zero for the others, whose points
+// are drawn (SurfacePoint).
+glm::vec3 fixed_origin(const LightParams& l);
+// The projection join of a Dirac direction from a finite-area origin, letters D S (the
+// `distant-projection` connector): the aperture point on the line through ref against the light's
+// direction. Nullopt for every other kind.
+std::optional<EndpointConnection> connect_projection(const LightParams& l, const glm::vec3& ref);
 
 // Sensors. `raster` ∈ [0,1)² as above; u_lens is read by the thin lens only.
 inline bool reads_lens_numbers(const SensorParams& s) { return std::holds_alternative<ThinLensParams>(s); }
@@ -349,6 +361,12 @@ std::optional<EndpointConnection> connect_finite(const SensorParams& s, glm::vec
 // 0 for Dirac directions and outside the image.
 glm::vec3 importance(const SensorParams& s, const glm::vec3& origin, const glm::vec3& direction,
                      glm::vec2* raster);
+// The projection join of a sensor with a Dirac direction from a finite film, letters S D (the
+// `ortho-projection` connector): the film point whose ray passes through ref. Nullopt for every
+// other kind.
+std::optional<EndpointConnection> connect_projection(const SensorParams& s, const glm::vec3& ref);
+// The point a sensor's ray leaves from: a thin lens's point drawn from u_lens, else its position.
+glm::vec3 sensor_point(const SensorParams& s, glm::vec2 u_lens);
 // A ray crossing a thin lens (strategy t = 0); nullopt for every other sensor.
 std::optional<EndpointConnection> hit_lens(const SensorParams& s, const glm::vec3& origin,
                                            const glm::vec3& direction);

@@ -640,6 +640,19 @@ inline glm::vec3 emitted(const LightParams& l, const glm::vec3& n, const glm::ve
   return spatial_emission(l) * directional_emission(l, n, w);
 }
 
+inline glm::vec3 fixed_origin(const LightParams& l) {
+  return emitter_detail::visit(emitter_detail::Overloaded{[](const PointLightParams& p) { return p.position; },
+                                                          [](const SpotLightParams& p) { return p.position; },
+                                                          [](const LaserParams& p) { return p.position; },
+                                                          [](const auto&) { return glm::vec3(0.0f); }},
+                               l);
+}
+
+inline std::optional<EndpointConnection> connect_projection(const LightParams& l, const glm::vec3& ref) {
+  if (const auto* d = std::get_if<DistantLightParams>(&l)) return connect(*d, ref);
+  return std::nullopt;
+}
+
 inline std::optional<EndpointRay> sample_ray(const SensorParams& s, glm::vec2 raster, glm::vec2 u_lens) {
   return emitter_detail::visit(emitter_detail::Overloaded{[&](const ThinLensParams& p) { return sample_ray(p, raster, u_lens); },
                                [&](const SpotMeterParams& p) { return sample_ray(p); },
@@ -671,6 +684,16 @@ inline glm::vec3 importance(const SensorParams& s, const glm::vec3& origin, cons
                  [&](const ThinLensParams& p) { return importance(p, origin, direction, raster); },
                  [](const auto&) { return glm::vec3(0.0f); }},
       s);
+}
+
+inline std::optional<EndpointConnection> connect_projection(const SensorParams& s, const glm::vec3& ref) {
+  if (const auto* o = std::get_if<OrthographicParams>(&s)) return connect(*o, ref);
+  return std::nullopt;
+}
+
+inline glm::vec3 sensor_point(const SensorParams& s, glm::vec2 u_lens) {
+  if (const auto* lens = std::get_if<ThinLensParams>(&s)) return lens_point(*lens, u_lens);
+  return emitter_detail::visit([](const auto& p) { return p.position; }, s);
 }
 
 inline std::optional<EndpointConnection> hit_lens(const SensorParams& s, const glm::vec3& origin,

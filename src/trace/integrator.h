@@ -7,12 +7,11 @@
 #pragma once
 
 #include <algorithm>
-#include <bit>
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
-#include <variant>
+#include <utility>
 #include <vector>
 
 #include "classify/classifier.h"
@@ -29,7 +28,6 @@
 #include "trace/rng.h"
 #include "trace/scene_features.h"
 #include "trace/strategy_table.h"
-#include "trace/texture_eval.h"
 #include "trace/vertex.h"
 
 namespace pathex::tracer {
@@ -44,8 +42,9 @@ inline int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(p
 
 class Integrator {
  public:
-  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o)
-      : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), table_(strategies.strategies) {
+  // `filter`: the plan's (trace/plan.h), which paths are recorded (default: every path).
+  Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, PathFilter filter = {})
+      : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), filter_(std::move(filter)), table_(strategies.strategies) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
     lens_hits_ = cam_.type == SensorType::kLens;
@@ -79,21 +78,7 @@ class Integrator {
     absorbing_ = rs.absorbing;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
-    // --only: a point or spot light whose requested paths all scatter specularly first emits only
-    // towards the shapes that can (trace/emission_cones.h). With a pinhole or a lens, whose first
-    // letter is D, the test also rules out the light seen directly.
-    aimed_.resize(rs.lights.size());
-    if (o_.only != nullptr && sensor_pair_[0] == 'D' && max_light_ >= 2)
-      for (std::size_t i = 0; i < rs.lights.size(); ++i) {
-        const LightParams& l = rs.lights[i].params;
-        if ((std::holds_alternative<PointLightParams>(l) || std::holds_alternative<SpotLightParams>(l)) &&
-            o_.only->first_vertex_specular(light_pairs_[i][0], light_pairs_[i][1]))
-          aimed_[i] = EmissionCones::make(light_position(l), rs.specular_bounds);
-      }
   }
-
-  // The cones light i emits into under --only (trace/emission_cones.h); none: every direction.
-  const std::optional<EmissionCones>& aimed(std::size_t light) const { return aimed_[light]; }
 
   // A full path x0 … xk in light-to-eye order as a join forms it, without copying a vertex: s light
   // vertices (y0 replaced by a fresh sample light0 when given), the m vertices a connector
@@ -238,49 +223,20 @@ class Integrator {
   const std::string& sensor_pair() const { return sensor_pair_; }  // c(k+1) c(k+2)
 
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
-  // Densities as the MIS ratios keep them: a Dirac part's is stored as 0.
-  static float finite_part(float pdf, bool delta) { return delta ? 0.0f : pdf; }
+  // Densities as the MIS ratios keep them: a Dirac part's is stored as 0 (RayPdf::mis_dir).
   // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w.
   float sensor_pdf_dir(const Vertex& v, const vec3& w) const {
-    const RayPdf p = pdf_ray(cam_.params, v.p, w);
-    return finite_part(p.dir, p.delta_dir);
+    return pdf_ray(cam_.params, v.p, w).mis_dir();
   }
   // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
   float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    if (const std::optional<EmissionCones>& cones = aimed_[static_cast<std::size_t>(&l - rs_.lights.data())]) return cones->pdf(w);
-    const RayPdf p = pdf_ray(l.params, SurfacePoint{v.p, v.n, l.pdf_pos}, w);
-    return finite_part(p.dir, p.delta_dir);
-  }
-  // A light chosen uniformly by u, and a point on it drawn from u2 (area lights; the others
-  // ignore the point).
-  // (u n lies in [0, n), far below 2^63: the signed conversion is exact and, unlike the unsigned
-  // one, a single instruction.)
-  // (A lone light's pick and a non-area light's point read no number: Sampler::get1d_if.)
-  std::size_t pick_light(Sampler& rng) const {
-    const float u = rng.get1d_if(rs_.lights.size() > 1);
-    const auto i = static_cast<std::int64_t>(u * static_cast<float>(rs_.lights.size()));
-    return std::min(rs_.lights.size() - 1, static_cast<std::size_t>(i));
-  }
-  // *error: the point's rounding-error bound (SurfaceSample::error), which offsets rays leaving it.
-  SurfacePoint sample_point(const RenderLight& l, Sampler& rng, vec3* error) const {
-    const glm::vec2 u2 = rng.get2d_if(l.is_area());
-    *error = aperture_error(l);
-    if (!l.is_area()) return {};
-    const SurfaceSample ss = rs_.geometry->sample_shape(l.shape, u2);
-    *error = ss.error;
-    return {ss.position, ss.normal, l.pdf_pos};
-  }
-  // The error bound of a distant light's aperture points (zero for other lights): the aperture is
-  // no shape, but it may coincide with one (a window pane).
-  static vec3 aperture_error(const RenderLight& l) {
-    const auto* d = std::get_if<DistantLightParams>(&l.params);
-    return d ? parallelogram_error(d->corner, d->edge1, d->edge2) : vec3(0.0f);
+    return l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w).mis_dir();
   }
   // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
   // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
   // emission_step_density() after it: their product is its emission's joint density.
   const EnvironmentLightParams* environment_of(int light) const {
-    return std::get_if<EnvironmentLightParams>(&rs_.lights[static_cast<std::size_t>(light)].params);
+    return rs_.lights[static_cast<std::size_t>(light)].environment();
   }
   // v is a point of an image infinite light (a light vertex, or an eye vertex that hit its box).
   bool on_environment(const Vertex& v) const {
@@ -290,12 +246,6 @@ class Integrator {
   float env_origin_density(const EnvironmentLightParams& e, const vec3& x0, const vec3& n0, const vec3& x1) const {
     return light_pick_ * connect_area_density(e, x0, n0, x1);
   }
-  // Where a point or spot light is (the integrator picks an area light's points itself).
-  static vec3 light_position(const LightParams& l) {
-    if (const auto* p = std::get_if<PointLightParams>(&l)) return p->position;
-    if (const auto* p = std::get_if<SpotLightParams>(&l)) return p->position;
-    return vec3(0.0f);
-  }
   // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
   void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
     const float w = static_cast<float>(cam_.width), h = static_cast<float>(cam_.height);
@@ -303,26 +253,8 @@ class Integrator {
     *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
   }
 
-  // The material at surface vertex `v`: its shape's, with its textured parameters evaluated at
-  // v.uv into `*scratch` when it has any (trace/texture_eval.h).
-  const Material& material_at(const Vertex& v, Material* scratch) const {
-    const Material& base = *rs_.material_of_shape[static_cast<std::size_t>(v.shape)];
-    const MaterialTextures* tex = rs_.textures_of_shape[static_cast<std::size_t>(v.shape)];
-    if (!tex) return base;
-    textured_material(*rs_.scene, base, *tex, v.uv, scratch);
-    return *scratch;
-  }
-
-  // A hit's shading normal as every strategy sees it (pt, pt-nee, lt, bdpt's joins and the MIS
-  // densities all read the vertex's ns): the geometry's (Hit::shading_normal) turned by its
-  // material's bump or normal map (trace/texture_eval.h perturbed_normal). The letter stays.
-  vec3 shading_normal(const Hit& h) const {
-    const MaterialTextures* tex = rs_.textures_of_shape[static_cast<std::size_t>(h.shape)];
-    if (!tex || tex->perturb == NormalPerturbation::kNone) return h.shading_normal;
-    vec3 dpdu, dpdv;
-    rs_.geometry->uv_tangents(h, &dpdu, &dpdv);
-    return perturbed_normal(*rs_.scene, *tex, h.uv, h.normal, h.shading_normal, dpdu, dpdv);
-  }
+  // The material at surface vertex `v` (RenderScene::material_at).
+  const Material& material_at(const Vertex& v, Material* scratch) const { return rs_.material_at(v.shape, v.uv, scratch); }
 
   // --- densities used by MIS ---
   // Solid-angle density at `v` of sampling the unit direction `wn`, given the unit direction
@@ -396,10 +328,19 @@ class Integrator {
   // letters a projection adds, the one segment to test (none: from is null). False when black.
   void begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const;
   bool end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const;
-  // The one way a join makes a fresh endpoint: a sensor vertex at connection c (th.join.eye0), a
-  // vertex of light li at p (th.join.light0).
-  Vertex& fresh_sensor_vertex(Thread& th, const EndpointConnection& c, char letter) const;
-  Vertex& fresh_light_vertex(Thread& th, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const;
+  // The one way to make an endpoint vertex, for a subpath (y0, z0) and for a join's fresh end: into
+  // y a vertex of light li at p, into z a sensor vertex at p (normal n, none for a point sensor),
+  // with its letter (c1, c(k+1)) and its forward density. fresh_*: into th.join (light0, eye0).
+  Vertex& light_vertex(Vertex& y, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const;
+  Vertex& sensor_vertex(Vertex& z, const vec3& p, const vec3& n, char letter) const;
+  Vertex& fresh_sensor_vertex(Thread& th, const EndpointConnection& c, char letter) const {
+    th.join.has_eye0 = true;
+    return sensor_vertex(th.join.eye0, c.position, c.normal, letter);
+  }
+  Vertex& fresh_light_vertex(Thread& th, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const {
+    th.join.has_light0 = true;
+    return light_vertex(th.join.light0, li, p, n, err, letter);
+  }
   // Density of the far end of a parallel beam per unit area there, relative to the near end's:
   // points x and y on one line along w, with unit normals (zero: no surface), map areas as
   // dA_x |cos θ_x| = dA_y |cos θ_y|.
@@ -466,6 +407,7 @@ class Integrator {
   const RenderSensor& cam_;
   const StrategySet& strategies_;
   const RenderOptions& o_;
+  PathFilter filter_;  // the plan's: which paths are recorded, where subpaths stop
   int max_bounces_ = 16;
   StrategyTable table_;  // which strategy runs each (s, chain, t)
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
@@ -486,7 +428,6 @@ class Integrator {
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
   std::vector<std::string> light_pairs_;  // each light's letters c0 c1
-  std::vector<std::optional<EmissionCones>> aimed_;  // per light: the cones it emits into, or none
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;

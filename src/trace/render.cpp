@@ -29,7 +29,6 @@
 #include "trace/frame.h"
 #include "trace/integrator.h"
 #include "trace/prune.h"
-#include "trace/render_scene.h"
 #include "trace/rng.h"
 #include "trace/strategy_table.h"
 
@@ -62,7 +61,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
   float eta2 = 1.0f;  // the product of η² over the refractions so far (radiance walks)
   // `beta` passed in the first vertex already includes the first direction's weight: the caller
   // stores it in path[count - 1].beta and we continue from there.
-  SubpathPrefix live(o_.only, mode == TransportMode::kImportance, path[0].pos_letter, path[0].letter);  // trace/prune.h
+  SubpathPrefix live(filter_, mode == TransportMode::kImportance, path[0].pos_letter, path[0].letter);  // trace/prune.h
   while (count < max_vertices && live.alive()) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
     ++th.rays;
@@ -96,7 +95,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.p = hit->position;
     v.n = hit->normal;
     v.err = hit->error;
-    v.ns = shading_normal(*hit);  // a bump or normal map's, if any
+    v.ns = rs_.shading_normal(*hit);  // a bump or normal map's, if any
     v.shape = hit->shape;
     v.uv = hit->uv;
     v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;
@@ -150,31 +149,22 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     o = v.p;
     d = bs->wi;
     if (!std::isfinite(beta.x + beta.y + beta.z)) break;
-    live.extend(v.letter);  // --only: a subpath no requested class can complete stops (DESIGN §11)
+    live.extend(v.letter);  // a subpath no recorded path can complete stops (the plan's filter, DESIGN §11)
   }
   return count;
 }
 
 int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
-  Vertex& z0 = th.eye[0];
-  z0 = Vertex{};
-  z0.kind = Kind::kCamera;
-  z0.beta = vec3(1.0f);
-  z0.letter = sensor_pair_[0];
-  z0.pos_letter = sensor_pair_[1];
   const glm::vec2 uf = rng.get2d();
   const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(cam_.params));
   const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(cam_.width),
                          (static_cast<float>(py) + uf.y) / static_cast<float>(cam_.height)};
   const std::optional<EndpointRay> r = sample_ray(cam_.params, raster, ul);
-  z0.pdf_fwd = cam_.pdf_pos;
+  const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), sensor_pair_[0]);
   if (!r) return 1;
-  z0.p = r->origin;
-  z0.n = r->pdf.delta_pos ? vec3(0.0f) : r->normal;  // a point sensor has no surface
-  z0.ns = z0.n;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
   const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
-                                                      finite_part(r->pdf.dir, r->pdf.delta_dir), max_eye_);
+                                                      r->pdf.mis_dir(), max_eye_);
   // An orthographic sensor's rays are a parallel beam (see light_subpath()).
   if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.eye[1].pdf_fwd = parallel_jacobian(th.eye[1], z0, r->direction);
   return n;
@@ -182,39 +172,22 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
 
 int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
-  const std::size_t li = pick_light(rng);
+  const std::size_t li = rs_.pick_light(rng);
   const RenderLight& l = rs_.lights[li];
-  Vertex& y0 = th.light[0];
-  y0 = Vertex{};
-  y0.kind = Kind::kLight;
-  y0.light = static_cast<int>(li);
-  y0.pos_letter = light_pairs_[li][0];
-  y0.letter = light_pairs_[li][1];
   // An image infinite light draws its disk point from the numbers an area light's point takes.
   const EnvironmentLightParams* env = environment_of(static_cast<int>(li));
   const glm::vec2 u_disk = env ? rng.get2d() : glm::vec2(0.0f);
-  const SurfacePoint x = env ? SurfacePoint{} : sample_point(l, rng, &y0.err);
+  vec3 err{0.0f};
+  const SurfacePoint x = env ? SurfacePoint{} : rs_.sample_point(l, rng, &err);
   rng.skip(2);  // u_ray, drawn in advance
-  std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : sample_ray(l.params, x, u_ray);
-  if (env && r) y0.err = box_point_error(r->origin);
-  if (const std::optional<EmissionCones>& cones = aimed_[li]; cones && r) {
-    // --only: the first direction drawn within the cones instead (trace/emission_cones.h).
-    float pdf = 0.0f;
-    r->direction = cones->sample(u_ray, &pdf);
-    r->value = spatial_emission(l.params) * directional_emission(l.params, r->normal, r->direction);
-    r->pdf.dir = pdf;
-    r->weight = r->value / pdf;
-    if (is_black(r->value)) r.reset();
-  }
-  y0.pdf_fwd = light_pick_ * l.pdf_pos;  // 0 for Dirac positions
+  // (An aimed light draws its direction within its cones: RenderLight::sample_ray.)
+  const std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : l.sample_ray(x, u_ray);
+  if (env && r) err = box_point_error(r->origin);
+  Vertex& y0 = light_vertex(th.light[0], li, r ? r->origin : x.position, r ? r->normal : vec3(0.0f), err, light_pairs_[li][1]);
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
-    y0.p = x.position;
     y0.beta = vec3(0.0f);
     return 1;
   }
-  y0.p = r->origin;
-  y0.n = r->normal;
-  y0.ns = y0.n;
   // y0 keeps the spatial part of the emission, L_e⁽⁰⁾ / p (a join at y0 evaluates the directional
   // part); the walk continues with the first ray's whole throughput.
   y0.beta = spatial_emission(l.params) / (light_pick_ * (r->pdf.delta_pos ? 1.0f : r->pdf.pos));
@@ -223,7 +196,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   const vec3 saved = y0.beta;
   th.light[0].beta = beta1;
   const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, r->direction,
-                                                        finite_part(r->pdf.dir, r->pdf.delta_dir), max_light_);
+                                                        r->pdf.mis_dir(), max_light_);
   th.light[0].beta = saved;
   // A Dirac direction from a finite-area origin (a distant light's aperture) is a parallel beam:
   // its first vertex has a finite density per area, which the distant-projection connector's
@@ -276,7 +249,7 @@ Integrator::PathView Integrator::path_of(const Thread& th, const JoinResult& jr)
 
 void Integrator::estimate(Thread& th, int batch) const {
   const JoinResult& jr = th.join;
-  if (o_.only != nullptr && !o_.only->records(jr.letters)) return;  // --only: not requested, no weight, no shadow ray
+  if (!filter_.records(jr.letters)) return;  // not recorded by the plan: no weight, no shadow ray
   // The MIS weight over every strategy of the profile that samples this path (trace/mis_weight.cpp).
   const float weight = mis_weight(th, path_of(th, jr), jr.letters, jr.chain, jr.has_density ? &jr.density : nullptr);
   // The technique, as the histogram names it: a projection's chain starts at c0 (distant: s = 0)
@@ -345,9 +318,9 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   // can be a lens vertex; it forms the t = 0 connection and no other.
   const bool lens_end = ns >= 2 && th.light[static_cast<std::size_t>(ns - 1)].kind == Kind::kLens;
   // --- joins (trace/joins/): each makes th.join from the subpaths; estimate() weighs and records it ---
-  // --only: a plain join whose path has a length no requested path has is not made (its numbers
-  // are its own dimensions, so no other join's change). Connectors count their attempts: they go on.
-  const auto wanted = [&](int s, int t) { return o_.only == nullptr || o_.only->has_length(s + t + 2); };
+  // A plain join whose path has a length no recorded path has is not made (its numbers are its
+  // own dimensions, so no other join's change). Connectors count their attempts: they go on.
+  const auto wanted = [&](int s, int t) { return filter_.has_length(s + t + 2); };
   const auto made = [&](bool joined) {
     if (joined) estimate(th, batch);
   };

@@ -48,7 +48,7 @@
 
 namespace pathex {
 
-class RequestedPaths;  // trace/prune.h
+struct RenderPlan;  // trace/plan.h
 
 // Passes a pixel takes back to back (the last chunk may be shorter). Progress is reported, and a
 // cancelled render stops, after whole chunks, so every finished pass covers the whole image.
@@ -86,10 +86,6 @@ struct RenderOptions {
   // histogram, which is the same either way, and RenderOutput::images is empty (0 × 0): no
   // per-pixel sums, no splat buffers, none of the image's memory traffic.
   bool images = true;
-  // pathex trace --only (trace/prune.h): only paths in these classes are recorded, and a subpath
-  // stops once none of them can be completed from it. Null: every path. Hand the tracer the profile
-  // reduced by prune_profile() (reach/prune.h) too, so that no strategy runs for nothing.
-  const RequestedPaths* only = nullptr;
   ManifoldOptions manifold{};          // pathex trace --manifold-*: the manifold connector's limits
   // Called from one thread after each chunk: samples done of the total (with a dealer, the passes
   // it has dealt to every taker).
@@ -145,8 +141,8 @@ struct NonfiniteSample {
   std::tuple<std::uint64_t, int, int> order() const { return {pass, y, x}; }
 };
 
-// A light that emitted only towards the shapes a requested path can reach first (--only;
-// trace/emission_cones.h).
+// A light that emitted only towards the shapes a requested path can reach first (the plan's
+// emission narrowing, trace/plan.h; trace/emission_cones.h).
 struct AimedLight {
   int light = 0;             // index into the scene's "lights"
   std::string kind;          // "point" or "spot"
@@ -165,7 +161,7 @@ struct RenderOutput {
   std::uint64_t rays = 0;      // rays cast (intersections and shadow rays)
   std::vector<ConnectorStats> connectors{};  // one per connector strategy of the profile, in its order
   std::optional<NonfiniteSample> first_nonfinite{};  // when histogram.nonfinite() > 0
-  std::vector<AimedLight> aimed{};                   // --only: the lights whose emission was aimed
+  std::vector<AimedLight> aimed{};                   // the lights whose emission was aimed
 };
 
 // The strategies of a profile the tracer runs: plain joins and the mirror and projection
@@ -178,6 +174,11 @@ struct StrategySet {
 
 Result<StrategySet> runnable_strategies(const Profile& profile);
 
+// A render of `plan` (trace/plan.h, plan_render()): its strategies, its lights' emission
+// narrowing, and only the paths its filter records.
+Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Classifier* classifier,
+                            const RenderOptions& options);
+// A render of `profile` whole, every path recorded (the plan whole_plan(profile)).
 Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
                             const RenderOptions& options);
 

@@ -9,6 +9,7 @@
 #include <chrono>
 
 #include "trace/integrator.h"
+#include "trace/plan.h"
 #include "trace/render.h"
 #include "trace/render_scene.h"
 
@@ -40,10 +41,17 @@ using tracer::Integrator;
 
 Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Classifier* classifier,
                             const RenderOptions& options) {
+  return render(scene, whole_plan(profile), classifier, options);
+}
+
+Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Classifier* classifier,
+                            const RenderOptions& options) {
+  const Profile& profile = plan.profile;
   Result<StrategySet> strategies = runnable_strategies(profile);
   if (!strategies) return strategies.error();
   Result<RenderScene> rs = make_render_scene(scene);
   if (!rs) return rs.error();
+  aim_emission(*rs, scene, plan.aimed_lights);
   RenderOptions o = options;
   // The same rule as the checker's: an explicit bound overrides the profile's own.
   if (!o.max_bounces) o.max_bounces = profile.max_bounces.value_or(16);
@@ -55,11 +63,11 @@ Result<RenderOutput> render(const Scene& scene, const Profile& profile, const Cl
                    o.images ? ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes)
                             : ClassImages(0, 0, nullptr, {}),
                    layout.strategies};
-  Integrator integrator(*rs, *strategies, o);
+  Integrator integrator(*rs, *strategies, o, plan.filter);
   const std::size_t area_lights = rs->lights.size() - scene.lights.size();  // the emissive shapes come first
-  for (std::size_t i = area_lights; i < rs->lights.size(); ++i)
-    if (const std::optional<EmissionCones>& c = integrator.aimed(i))
-      out.aimed.push_back({static_cast<int>(i - area_lights), std::holds_alternative<PointLightParams>(rs->lights[i].params) ? "point" : "spot",
+  for (const int i : plan.aimed_lights)
+    if (const std::optional<EmissionCones>& c = rs->lights[area_lights + static_cast<std::size_t>(i)].aim)
+      out.aimed.push_back({i, std::holds_alternative<PointLight>(scene.lights[static_cast<std::size_t>(i)]) ? "point" : "spot",
                            c->size(), c->share()});
   const int threads = o.threads > 0 ? o.threads : static_cast<int>(tbb::this_task_arena::max_concurrency());
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));

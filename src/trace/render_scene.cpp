@@ -125,6 +125,7 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
       const DistantLightParams params{d->direction, d->irradiance, d->aperture_corner, d->aperture_edge1, d->aperture_edge2};
       l.params = params;
       l.pdf_pos = 1.0f / aperture_area(params);
+      l.origin_error = parallelogram_error(params.corner, params.edge1, params.edge2);
     } else {
       const LaserLight& z = std::get<LaserLight>(light);
       l.params = LaserParams{z.position, z.direction, z.power};
@@ -155,6 +156,16 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     case SensorType::kSpotmeter: cam.params = SpotMeterParams{c.position, forward}; break;
   }
   return rs;
+}
+
+void aim_emission(RenderScene& rs, const Scene& scene, const std::vector<int>& lights) {
+  const std::size_t area_lights = rs.lights.size() - scene.lights.size();  // the emissive shapes come first
+  for (const int i : lights) {
+    const Light& light = scene.lights[static_cast<std::size_t>(i)];
+    const glm::vec3 origin = std::holds_alternative<PointLight>(light) ? std::get<PointLight>(light).position
+                                                                       : std::get<SpotLight>(light).position;
+    rs.lights[area_lights + static_cast<std::size_t>(i)].aim = EmissionCones::make(origin, rs.specular_bounds);
+  }
 }
 
 }  // namespace pathex

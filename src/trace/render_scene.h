@@ -24,7 +24,9 @@
 #include "trace/emission_cones.h"
 #include "trace/emitters.h"
 #include "trace/joins/mirror.h"
+#include "trace/rng.h"
 #include "trace/scene_features.h"
+#include "trace/texture_eval.h"
 
 namespace pathex {
 
@@ -36,7 +38,24 @@ struct RenderLight {
   // Area density of the emitting point as the MIS ratios keep it: 1 / area for an area light and
   // for a distant light's aperture, 0 for a Dirac position (point, spot, laser).
   float pdf_pos = 0.0f;
+  // The plan's emission narrowing (trace/plan.h): the cones a point or spot light draws its first
+  // direction in (trace/emission_cones.h); none: the light's own emission sampling.
+  std::optional<EmissionCones> aim;
+  // The rounding-error bound of the points rays leave from when they are not a shape's (a distant
+  // light's aperture may coincide with one, a window pane); zero for the others.
+  glm::vec3 origin_error{0.0f};
   bool is_area() const { return shape >= 0; }
+  // The image infinite light this is (trace/environment.h), or null.
+  const EnvironmentLightParams* environment() const { return std::get_if<EnvironmentLightParams>(&params); }
+  // The light's first ray from point x (an area light's; the others ignore it) by u, and the
+  // densities of its ray from x towards w: the emitter model's, through the aiming decorator when
+  // the light is aimed. Every strategy samples and weighs a light's emission through these.
+  std::optional<EndpointRay> sample_ray(const SurfacePoint& x, glm::vec2 u) const {
+    return aim ? aimed_ray(*aim, params, x, u) : pathex::sample_ray(params, x, u);
+  }
+  RayPdf pdf_ray(const SurfacePoint& x, const glm::vec3& w) const {
+    return aim ? aimed_pdf(*aim, params, x, w) : pathex::pdf_ray(params, x, w);
+  }
 };
 
 // The sensor: its importance model and the image it measures.
@@ -71,8 +90,51 @@ struct RenderScene {
   // 1 for a shape that is a group member, drawn by instances (scene.h ShapeInstance); the manifold
   // connector's walks know world-space shapes only and treat these as opaque.
   std::vector<std::uint8_t> in_group;
+
+  // --- what every strategy asks of the scene ---
+  // A light chosen uniformly by u. (u n lies in [0, n), far below 2^63: the signed conversion is
+  // exact and, unlike the unsigned one, a single instruction. A lone light's pick reads no number.)
+  std::size_t pick_light(Sampler& rng) const {
+    const float u = rng.get1d_if(lights.size() > 1);
+    const auto i = static_cast<std::int64_t>(u * static_cast<float>(lights.size()));
+    return std::min(lights.size() - 1, static_cast<std::size_t>(i));
+  }
+  // A point on light l drawn from u2 (area lights; the others ignore the point and read no number),
+  // with its rounding-error bound (SurfaceSample::error) in *error, which offsets rays leaving it.
+  SurfacePoint sample_point(const RenderLight& l, Sampler& rng, glm::vec3* error) const {
+    const glm::vec2 u2 = rng.get2d_if(l.is_area());
+    *error = l.origin_error;
+    if (!l.is_area()) return {};
+    const SurfaceSample ss = geometry->sample_shape(l.shape, u2);
+    *error = ss.error;
+    return {ss.position, ss.normal, l.pdf_pos};
+  }
+  // The material of `shape` at `uv`: its own, with its textured parameters evaluated into
+  // `*scratch` when it has any (trace/texture_eval.h).
+  const Material& material_at(int shape, glm::vec2 uv, Material* scratch) const {
+    const Material& base = *material_of_shape[static_cast<std::size_t>(shape)];
+    const MaterialTextures* tex = textures_of_shape[static_cast<std::size_t>(shape)];
+    if (!tex) return base;
+    textured_material(*scene, base, *tex, uv, scratch);
+    return *scratch;
+  }
+  // A hit's shading normal as every strategy sees it (pt, pt-nee, lt, bdpt's joins and the MIS
+  // densities all read the vertex's ns): the geometry's (Hit::shading_normal) turned by its
+  // material's bump or normal map (trace/texture_eval.h perturbed_normal). The letter stays.
+  glm::vec3 shading_normal(const Hit& h) const {
+    const MaterialTextures* tex = textures_of_shape[static_cast<std::size_t>(h.shape)];
+    if (!tex || tex->perturb == NormalPerturbation::kNone) return h.shading_normal;
+    glm::vec3 dpdu, dpdv;
+    geometry->uv_tangents(h, &dpdu, &dpdv);
+    return perturbed_normal(*scene, *tex, h.uv, h.normal, h.shading_normal, dpdu, dpdv);
+  }
 };
 
 Result<RenderScene> make_render_scene(const Scene& scene);
+
+// The plan's emission narrowing (trace/plan.h RenderPlan::aimed_lights, indices into scene.lights,
+// each a point or spot light): each aims at the shapes with a specular component
+// (rs.specular_bounds) where that leaves some direction out (EmissionCones::make).
+void aim_emission(RenderScene& rs, const Scene& scene, const std::vector<int>& lights);
 
 }  // namespace pathex

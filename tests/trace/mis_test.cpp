@@ -139,11 +139,11 @@ struct IntegratorTestAccess {
   static bool nee_join(const Integrator& in, const Thread& th, int t, Sampler& rng, Vertex* y0, JoinDensity* join) {
     const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
     if (pt.kind != Kind::kSurface || !pt.finite || in.scene().lights.empty()) return false;
-    const std::size_t li = in.pick_light(rng);
+    const std::size_t li = in.scene().pick_light(rng);
     const RenderLight& l = in.scene().lights[li];
     if (in.light_pair(static_cast<int>(li))[1] != 'D') return false;
     vec3 err{0.0f};
-    const std::optional<EndpointConnection> c = pathex::connect(l.params, in.sample_point(l, rng, &err), pt.p);
+    const std::optional<EndpointConnection> c = pathex::connect(l.params, in.scene().sample_point(l, rng, &err), pt.p);
     if (!c) return false;
     *y0 = Vertex{};
     y0->kind = Kind::kLight;

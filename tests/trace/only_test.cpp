@@ -17,10 +17,10 @@
 #include "classify/classifier.h"
 #include "classify/pathclass.h"
 #include "io/profile_json.h"
-#include "reach/prune.h"
+#include "trace/plan.h"
+#include "trace/prune.h"
 #include "scene/scene.h"
 #include "scene/universe.h"
-#include "trace/prune.h"
 #include "trace/render.h"
 #include "support/stat_seed.h"
 
@@ -170,13 +170,9 @@ ClassValue render_class(const Scene& scene, const std::string& renderer, const s
   o.max_bounces = max_bounces;
   o.images = false;
   const Profile full = resolve_profile(renderer, Limits{}).expect("a profile");
-  std::optional<RequestedPaths> requested;
-  ProfilePruning p = prune(scene, renderer, classes, max_bounces);
-  if (only) {
-    requested.emplace(RequestedPaths::make(classes, Limits{}).expect("requested paths"));
-    o.only = &*requested;
-  }
-  const RenderOutput out = render(scene, only ? p.profile : full, &cl, o).expect("a render");
+  const RenderOutput out = (only ? render(scene, plan_render(scene, full, max_bounces, classes, Limits{}).expect("a plan"), &cl, o)
+                                 : render(scene, full, &cl, o))
+                               .expect("a render");
   const HistogramReport rep = make_report(out.histogram, RunInfo{}, &cl, {{expr, expr}}).expect("a report");
   return {rep.classes.at(0).estimate.luminance, rep.classes.at(0).estimate.std_error};
 }
@@ -192,7 +188,7 @@ TEST(Only, AgreesWithTheClassOfAFullRender) {
       {"cornell.json", "bdpt", "$direct"},            {"cornell.json", "pt-nee", "$caustic"},
       {"cornell.json", "bdpt", "L.{8,}E"},            {"point-mirror-caustic.json", "bdpt", "$caustic"},
       {"closed-sphere-point.json", "pt-nee", "L.{6}E"}, {"mirror-ortho.json", "bdpt", "$direct"},
-      // The cover selected for --only (reach/prune.h) on every sample scene, several classes.
+      // The cover selected for --only (trace/prune.h) on every sample scene, several classes.
       {"point-glass.json", "bdpt", "L.{8,}E"},        {"point-glass.json", "bdpt", "$direct"},
       {"cornell.json", "bdpt", "$caustic"},           {"cornell.json", "bdpt", "L.*S.*E"},
       {"closed-sphere-point.json", "bdpt", "L.{7,}E"}, {"closed-sphere-emitting.json", "bdpt", "L.{7,}E"},
@@ -220,7 +216,7 @@ Dfa union_of(const std::vector<const PathClass*>& classes) {
   return u;
 }
 
-// The cover --only runs (reach/prune.h) samples every requested path the whole profile samples:
+// The cover --only runs (trace/prune.h) samples every requested path the whole profile samples:
 // checked with the automata (covers()) and, independently of them, against the definition of a
 // strategy (strategy_samples()) on the requested paths up to 11 letters, for every sample scene,
 // two profiles and four classes.
@@ -313,7 +309,7 @@ TEST(DeadState, AStoppedSubpathCouldNotHaveContributed) {
                                          {"L..S.*E & L.*S..E", true, true}}) {
     const std::string& expr = c.expr;
     const std::vector<const PathClass*> classes = classes_for(cornell, {expr});
-    const RequestedPaths only = RequestedPaths::make(classes, Limits{}).expect("requested paths");
+    const PathFilter only = PathFilter::make(classes, Limits{}).expect("requested paths");
     const Classifier& cl = only.classifier();
     std::mt19937_64 rng(5);
     int dead_light = 0, dead_eye = 0, requested = 0;
@@ -326,7 +322,7 @@ TEST(DeadState, AStoppedSubpathCouldNotHaveContributed) {
       const bool in = !cl.members(cl.classify(path)).empty();
       EXPECT_EQ(in, only.records(accel::pack(path))) << path;
       requested += in ? 1 : 0;
-      SubpathPrefix light(&only, true, path[1], path[2]);
+      SubpathPrefix light(only, true, path[1], path[2]);
       bool dead = !light.alive();
       for (std::size_t i = 3; i + 1 < path.size() && !dead; ++i) {
         light.extend(path[i]);
@@ -336,7 +332,7 @@ TEST(DeadState, AStoppedSubpathCouldNotHaveContributed) {
         ++dead_light;
         EXPECT_FALSE(in) << expr << ": the light subpath of " << path << " was stopped";
       }
-      SubpathPrefix eye(&only, false, path[path.size() - 2], path[path.size() - 3]);
+      SubpathPrefix eye(only, false, path[path.size() - 2], path[path.size() - 3]);
       dead = !eye.alive();
       for (std::size_t i = path.size() - 4; i >= 1 && !dead; --i) {
         eye.extend(path[i]);
@@ -352,12 +348,12 @@ TEST(DeadState, AStoppedSubpathCouldNotHaveContributed) {
     EXPECT_EQ(dead_eye > 0, c.eye_dies) << expr << ": " << dead_eye << " eye subpaths stopped";
   }
   // Without requested classes nothing is dead.
-  SubpathPrefix all(nullptr, true, 'S', 'D');
+  SubpathPrefix all(PathFilter(), true, 'S', 'D');
   all.extend('S');
   EXPECT_TRUE(all.alive());
 }
 
-// A join is not made when no requested path has its length (RequestedPaths::has_length), and a light
+// A join is not made when no requested path has its length (PathFilter::has_length), and a light
 // is aimed only when every requested path scatters specularly at its first vertex
 // (first_vertex_specular): both against every string of up to 14 letters between L and E.
 TEST(DeadState, LengthsAndSpecularFirstVerticesAreExact) {
@@ -372,7 +368,7 @@ TEST(DeadState, LengthsAndSpecularFirstVerticesAreExact) {
                                          {"LSDS+D.*E", {4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14}, true},
                                          {"$caustic", {6, 7, 8, 9, 10, 11, 12, 13, 14}, true},
                                          {"$direct", {5}, false}}) {
-    const RequestedPaths only = RequestedPaths::make(classes_for(glass, {c.expr}), Limits{}).expect("requested paths");
+    const PathFilter only = PathFilter::make(classes_for(glass, {c.expr}), Limits{}).expect("requested paths");
     std::vector<int> lengths;
     bool all_specular = true;
     for (int n = 0; n <= 14; ++n) {

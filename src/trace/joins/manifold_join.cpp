@@ -11,7 +11,6 @@
 #include "trace/fresnel.h"
 #include "trace/integrator.h"
 #include "trace/joins/manifold.h"
-#include "trace/prune.h"
 
 namespace pathex::tracer {
 namespace {
@@ -162,9 +161,9 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
       w.failure = ManifoldFailure::kNoSolution;
       return w;
     }
-    // --only: a chain whose path is in no requested class is not solved (its seed still counts
-    // in the batches, so the requested chains' inverse probabilities are unchanged).
-    if (o_.only != nullptr && !o_.only->records(manifold_key(th, *a, s, t, static_cast<int>(chain.size())))) {
+    // A chain whose path the plan's filter does not record is not solved (its seed still counts
+    // in the batches, so the recorded chains' inverse probabilities are unchanged).
+    if (!filter_.records(manifold_key(th, *a, s, t, static_cast<int>(chain.size())))) {
       w.failure = ManifoldFailure::kUnrequested;
       return w;
     }

@@ -93,13 +93,13 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
 const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinBlock block) const {
   if (rs_.lights.empty()) return nullptr;
   join_numbers(rng, block, t);
-  const std::size_t li = pick_light(rng);
+  const std::size_t li = rs_.pick_light(rng);
   const RenderLight& light = rs_.lights[li];
   if (light_pairs_[li][1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
   if (environment_of(static_cast<int>(li))) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
   vec3 err{0.0f};
-  const SurfacePoint x = sample_point(light, rng, &err);
-  Vertex& y0 = fresh_light_vertex(th, li, light.is_area() ? x.position : light_position(light.params),
+  const SurfacePoint x = rs_.sample_point(light, rng, &err);
+  Vertex& y0 = fresh_light_vertex(th, li, light.is_area() ? x.position : fixed_origin(light.params),
                                   light.is_area() ? x.normal : vec3(0.0f), err, 'D');
   y0.beta = spatial_emission(light.params) / (light_pick_ * (light.pdf_pos > 0.0f ? light.pdf_pos : 1.0f));
   return &y0;

@@ -11,7 +11,6 @@
 #include "trace/bsdf.h"
 #include "trace/integrator.h"
 #include "trace/media.h"
-#include "trace/prune.h"
 
 namespace pathex::tracer {
 namespace {
@@ -65,34 +64,30 @@ bool Integrator::end_join(Thread& th, vec3 contrib, PathKey chain_s, const Verte
   return true;
 }
 
-Vertex& Integrator::fresh_sensor_vertex(Thread& th, const EndpointConnection& c, char letter) const {
-  Vertex& z0 = th.join.eye0;
-  z0 = Vertex{};
-  z0.kind = Kind::kCamera;
-  z0.p = c.position;
-  z0.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : c.normal;  // a pinhole is a point
-  z0.ns = z0.n;
-  z0.letter = letter;
-  z0.pos_letter = sensor_pair_[1];
-  z0.pdf_fwd = cam_.pdf_pos;
-  th.join.has_eye0 = true;
-  return z0;
+Vertex& Integrator::sensor_vertex(Vertex& z, const vec3& p, const vec3& n, char letter) const {
+  z = Vertex{};
+  z.kind = Kind::kCamera;
+  z.p = p;
+  z.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : n;  // a pinhole is a point
+  z.ns = z.n;
+  z.letter = letter;
+  z.pos_letter = sensor_pair_[1];
+  z.pdf_fwd = cam_.pdf_pos;
+  return z;
 }
 
-Vertex& Integrator::fresh_light_vertex(Thread& th, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const {
-  Vertex& y0 = th.join.light0;
-  y0 = Vertex{};
-  y0.kind = Kind::kLight;
-  y0.light = static_cast<int>(li);
-  y0.pos_letter = light_pairs_[li][0];
-  y0.letter = letter;
-  y0.p = p;
-  y0.n = n;
-  y0.ns = n;
-  y0.err = err;
-  y0.pdf_fwd = light_pick_ * rs_.lights[li].pdf_pos;
-  th.join.has_light0 = true;
-  return y0;
+Vertex& Integrator::light_vertex(Vertex& y, std::size_t li, const vec3& p, const vec3& n, const vec3& err, char letter) const {
+  y = Vertex{};
+  y.kind = Kind::kLight;
+  y.light = static_cast<int>(li);
+  y.pos_letter = light_pairs_[li][0];
+  y.letter = letter;
+  y.p = p;
+  y.n = n;
+  y.ns = n;
+  y.err = err;
+  y.pdf_fwd = light_pick_ * rs_.lights[li].pdf_pos;  // 0 for Dirac positions
+  return y;
 }
 
 // --- s = 0: the eye subpath's last vertex lies on an area light ---
@@ -133,8 +128,7 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
     // next-event estimation draws it (the light density its x0 has), not the light subpath's y0.
     if (ortho || sensor_pair_[0] != 'D') return false;  // (mis_weight.cpp: no projection of an image light)
     const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(cam_.params));
-    const auto* lens = std::get_if<ThinLensParams>(&cam_.params);
-    const vec3 z = lens ? lens_point(*lens, ul) : std::get<PinholeParams>(cam_.params).position;
+    const vec3 z = sensor_point(cam_.params, ul);
     const std::optional<EndpointConnection> e = pathex::connect(*env, rng.get2d(), z);
     if (!e) return false;
     c = connect_finite(cam_.params, ul, e->position);
@@ -151,12 +145,11 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
     if (!c) return false;
     begin_join(th, kind, s, 1, strategy(s, 1));
   } else {
-    const auto* film = std::get_if<OrthographicParams>(&cam_.params);
-    if (film == nullptr) return false;
+    if (sensor_pair_ != "SD") return false;  // the connector's c(k+1) c(k+2): a Dirac direction from a film
     begin_join(th, kind, s, 1, ortho_of(s));
     ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
     ++stats.attempts;
-    c = pathex::connect(*film, q->p);
+    c = connect_projection(cam_.params, q->p);
     if (!c) {
       ++stats.outside;
       return false;
@@ -183,7 +176,7 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   if (pt.kind != Kind::kSurface || !pt.finite || rs_.lights.empty()) return false;
   const bool distant = kind == ConnectorKind::kDistantProjection;
   join_numbers(rng, distant ? JoinBlock::kDistant : JoinBlock::kNee, t);
-  const std::size_t li = pick_light(rng);
+  const std::size_t li = rs_.pick_light(rng);
   const RenderLight& l = rs_.lights[li];
   std::optional<EndpointConnection> c;
   vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
@@ -195,20 +188,20 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
     begin_join(th, kind, 1, t, strategy(1, t));
   } else if (!distant) {
     if (light_pairs_[li][1] != 'D') return false;  // Dirac directions (distant, laser): no DD join
-    c = pathex::connect(l.params, sample_point(l, rng, &err), pt.p);
+    c = pathex::connect(l.params, rs_.sample_point(l, rng, &err), pt.p);
     if (!c) return false;
     begin_join(th, kind, 1, t, strategy(1, t));
   } else {
-    if (!std::holds_alternative<DistantLightParams>(l.params)) return false;  // the light picked is not distant
+    if (light_pairs_[li] != "DS") return false;  // the connector's c0 c1: a Dirac direction from an aperture
     begin_join(th, kind, 1, t, distant_of(t));
     ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
     ++stats.attempts;
-    c = pathex::connect(l.params, SurfacePoint{}, pt.p);
+    c = connect_projection(l.params, pt.p);
     if (!c) {
       ++stats.outside;
       return false;
     }
-    err = aperture_error(l);
+    err = l.origin_error;
   }
   JoinResult& jr = th.join;
   Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? light_pairs_[li][1] : 'D');
