@@ -13,22 +13,17 @@
 // are added on rank 0 (Cluster::reduce), which measures the rung from the same sums as one process,
 // so every estimate, stderr and error is the same number; its CPU time is the ranks' sum, its wall
 // time rank 0's. Rank 0 alone shows progress, prints and writes.
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <mutex>
 #include <sstream>
-#include <stop_token>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -48,6 +43,7 @@
 #include "io/input_file.h"
 #include "io/output_set.h"
 #include "io/profile_json.h"
+#include "measure/render_watch.h"
 #include "reach/prune.h"
 #include "scene/universe.h"
 #include "trace/prune.h"
@@ -141,13 +137,6 @@ struct Reference {
   nlohmann::ordered_json run;  // for "run": renderer, spp, seed, time
 };
 
-double cpu_seconds() {
-  rusage u{};
-  ::getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
 std::vector<float> luminance_image(const RgbImage& im) {
   std::vector<float> out(static_cast<std::size_t>(im.width) * static_cast<std::size_t>(im.height));
   for (std::size_t i = 0; i < out.size(); ++i)
@@ -155,18 +144,10 @@ std::vector<float> luminance_image(const RgbImage& im) {
   return out;
 }
 
-// --- signals: Ctrl-C keeps the finished rungs ---
-
-std::atomic<bool> g_interrupted{false};
-std::atomic<bool> g_stop{false};  // what render() polls: Ctrl-C or a rung's time running out
-extern "C" void on_interrupt(int) {
-  g_interrupted.store(true);
-  g_stop.store(true);
-}
-
 // --- one rung ---
 
 struct RungSetup {
+  RenderWatch* watch = nullptr;  // Ctrl-C keeps the finished rungs; a time budget stops a rung
   const Scene* scene = nullptr;
   const Classifier* classifier = nullptr;
   int threads = 0;
@@ -194,7 +175,7 @@ struct RungResult {
 };
 
 // Renders one rung: `profile` at `budget` with `seed`. A time budget stops the render after the
-// chunk in progress when the time is up; Ctrl-C (g_interrupted) stops it and marks it interrupted.
+// chunk in progress when the time is up; Ctrl-C (setup.watch) stops it and marks it interrupted.
 // Under MPI every rank calls it for every rung (it is collective): the ranks deal the rung's
 // passes among themselves (Cluster::deal: whoever is free takes the next chunk), and only rank 0's
 // result holds the rung's measures (the others' `classes` are empty). A rung interrupted on any
@@ -214,26 +195,14 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   ro.max_bounces = setup.max_bounces;
   ro.only = setup.only;
   for (int i = 0; i < setup.classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
-  ro.cancel = &g_stop;
-  g_stop.store(g_interrupted.load());
-  std::mutex m;
-  std::condition_variable_any cv;
-  std::jthread timer;
-  if (!budget.spp)
-    timer = std::jthread([&](std::stop_token st) {
-      std::unique_lock lock(m);
-      if (!cv.wait_for(lock, st, std::chrono::duration<double>(budget.seconds), [] { return false; }) && !st.stop_requested())
-        g_stop.store(true);
-    });
-  const double cpu0 = cpu_seconds();
+  setup.watch->restart(budget.spp ? 0.0 : budget.seconds);
+  ro.progress = setup.watch->progress();
+  ro.cancel = setup.watch->cancel();
+  const double cpu0 = process_cpu_seconds();
   const auto wall0 = std::chrono::steady_clock::now();
   Result<RenderOutput> out = render(*setup.scene, profile, setup.classifier, ro);
-  const double cpu1 = cpu_seconds();
+  const double cpu1 = process_cpu_seconds();
   auto wall1 = std::chrono::steady_clock::now();
-  if (timer.joinable()) {
-    timer.request_stop();
-    timer.join();
-  }
   dealer.reset();  // every rank has left the deal: the cluster is free for the reduction
   if (!out) return out.error();
   RungResult r;
@@ -254,7 +223,7 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   const bool root = cluster == nullptr || cluster->rank() == 0;
   r.spp = out->spp_done;
   r.wall_s = std::chrono::duration<double>(wall1 - wall0).count();
-  r.interrupted = g_interrupted.load() || (root && out->spp_done == 0);
+  r.interrupted = setup.watch->interrupted() || (root && out->spp_done == 0);
   if (cluster != nullptr) r.interrupted = cluster->count_failures(!r.interrupted) > 0;
   if (r.interrupted || !root) return r;
   RunInfo info;
@@ -418,7 +387,7 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
 }
 
 int run(const ConvergeArgs& a) {
-  const double cpu_start = cpu_seconds();
+  const double cpu_start = process_cpu_seconds();
   const auto wall_start = std::chrono::steady_clock::now();
   double render_wall = 0.0, render_cpu = 0.0;  // inside render(): the ladder and the reference run
   double own_render_cpu = 0.0;                   // the part of render_cpu this process spent (MPI: rank 0's)
@@ -544,11 +513,13 @@ int run(const ConvergeArgs& a) {
   std::vector<ClassRow> rows{{only ? "requested" : "total", only ? requested_text : "$all", std::nullopt, 0.0, std::nullopt, ""}};
   for (const PathClass* c : classes) rows.push_back({c->name, c->text, std::nullopt, 0.0, std::nullopt, ""});
 
-  RungSetup setup{&*scene, &*classifier, a.threads, a.max_bounces, only ? &*only : nullptr};
+  // Ctrl-C (or SIGTERM) stops the rung in progress and keeps the finished ones; the watch shows no
+  // render progress (the rung's line below is converge's).
+  std::optional<RenderWatch> watch;
+  watch.emplace(/*show=*/false);
+  RungSetup setup{&*watch, &*scene, &*classifier, a.threads, a.max_bounces, only ? &*only : nullptr};
   const int width = scene->camera.width, height = scene->camera.height;
   const std::uint64_t base_seed = a.seed;
-  std::signal(SIGINT, on_interrupt);
-  g_interrupted.store(false);
   const bool progress = root && !a.quiet && ::isatty(STDERR_FILENO);
 
   // --- the reference ---
@@ -582,7 +553,7 @@ int run(const ConvergeArgs& a) {
     render_cpu += r->cpu_s;
     own_render_cpu += r->own_cpu_s;
     if (r->interrupted) {
-      std::signal(SIGINT, SIG_DFL);
+      watch.reset();
       if (root) std::cerr << "pathex: interrupted during the reference run; nothing written\n";
       return kExitNo;
     }
@@ -677,7 +648,7 @@ int run(const ConvergeArgs& a) {
       results[k].push_back(std::move(*r));
     }
   if (progress) std::cerr << "\r" << std::string(60, ' ') << "\r" << std::flush;
-  std::signal(SIGINT, SIG_DFL);
+  watch.reset();
   if (!root) return complete ? kExitOk : kExitNo;  // the other ranks have done their part
 
   // --- statistics ---
@@ -837,7 +808,7 @@ int run(const ConvergeArgs& a) {
   // Overhead: everything but render() — references, statistics, the plot (the writing below is
   // measured by bench/converge_overhead.py from the outside).
   const double wall_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  const double cpu_total = cpu_seconds() - cpu_start;
+  const double cpu_total = process_cpu_seconds() - cpu_start;
   doc["timing"] = {{"render_wall_s", render_wall}, {"render_cpu_s", render_cpu},
                    {"overhead_wall_s", wall_total - render_wall}, {"overhead_cpu_s", cpu_total - own_render_cpu},
                    {"overhead_pct", render_wall > 0 ? 100.0 * (wall_total - render_wall) / render_wall : 0.0}};

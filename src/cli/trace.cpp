@@ -18,7 +18,7 @@
 #include "cli/folder_report.h"
 #include "cli/reach_common.h"
 #include "cli/render_job.h"
-#include "cli/render_watch.h"
+#include "measure/render_watch.h"
 #include "cli/trace_checks.h"
 #include "core/hash.h"
 #include "core/version.h"
@@ -240,13 +240,6 @@ Result<bool> load_resumed(const TraceArgs& a, Job* job) {
 
 std::string rank_shard_path(const std::string& dir, int rank) {
   return ranks_folder(dir) + "/rank-" + std::to_string(rank) + kShardExtension;
-}
-
-// CPU seconds used by this process so far, all threads.
-double process_cpu_seconds() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 int run(const TraceArgs& a) {

@@ -1,4 +1,4 @@
-#include "cli/render_watch.h"
+#include "measure/render_watch.h"
 
 #include <sys/ioctl.h>
 #include <unistd.h>
@@ -6,14 +6,19 @@
 #include <algorithm>
 #include <csignal>
 #include <cstdio>
+#include <ctime>
 
 #include "io/progress.h"
 
-namespace pathex::cli {
+namespace pathex {
 namespace {
 
-std::atomic<bool> g_cancel{false};
-extern "C" void on_stop(int) { g_cancel.store(true); }
+std::atomic<bool> g_cancel{false};     // what render() polls: a signal or the time limit
+std::atomic<bool> g_signalled{false};  // a signal alone
+extern "C" void on_stop(int) {
+  g_signalled.store(true);
+  g_cancel.store(true);
+}
 
 // The terminal's width in columns (stderr's), or 80 when it does not say.
 int terminal_columns() {
@@ -24,9 +29,16 @@ int terminal_columns() {
 
 }  // namespace
 
+double process_cpu_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 RenderWatch::RenderWatch(bool show, double time_limit)
     : show_(show && ::isatty(STDERR_FILENO)), time_limit_(time_limit), start_(std::chrono::steady_clock::now()) {
   g_cancel.store(false);
+  g_signalled.store(false);
   std::signal(SIGINT, on_stop);
   std::signal(SIGTERM, on_stop);
 }
@@ -54,6 +66,14 @@ std::function<void(std::uint64_t, std::uint64_t)> RenderWatch::progress() const 
   };
 }
 
+void RenderWatch::restart(double time_limit) {
+  time_limit_ = time_limit;
+  start_ = std::chrono::steady_clock::now();
+  g_cancel.store(g_signalled.load());
+}
+
 const std::atomic<bool>* RenderWatch::cancel() const { return &g_cancel; }
 
-}  // namespace pathex::cli
+bool RenderWatch::interrupted() const { return g_signalled.load(); }
+
+}  // namespace pathex
