@@ -1,6 +1,6 @@
-// Log-log convergence panels drawn with cairo (see converge_plot.h). The same drawing routine
+// Log-log convergence panels drawn with cairo (see convergence_plot.h). The same drawing routine
 // paints an SVG surface and an image surface; both stream into strings.
-#include "cli/converge_plot.h"
+#include "io/convergence_plot.h"
 
 #include <cairo-svg.h>
 #include <cairo.h>
@@ -15,7 +15,7 @@
 #include <type_traits>
 #include <variant>
 
-namespace pathex::cli {
+namespace pathex {
 namespace {
 
 // libcairo is loaded when a plot is drawn, not linked: its library and the seventeen it pulls in
@@ -342,4 +342,4 @@ Result<PlotFiles> draw_convergence_plot(const std::vector<PlotPanel>& panels) {
   return files;
 }
 
-}  // namespace pathex::cli
+}  // namespace pathex

@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 
-namespace pathex::cli {
+namespace pathex {
 
 struct PlotSeries {
   std::string name;               // the renderer
@@ -31,4 +31,4 @@ struct PlotFiles {
 // Both encodings of the figure (panels in a grid of at most two columns).
 Result<PlotFiles> draw_convergence_plot(const std::vector<PlotPanel>& panels);
 
-}  // namespace pathex::cli
+}  // namespace pathex
