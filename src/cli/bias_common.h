@@ -11,6 +11,7 @@
 #include "cli/render_job.h"
 #include "classify/pathclass.h"
 #include "core/error.h"
+#include "io/bias_json.h"
 #include "scene/scene.h"
 
 namespace pathex::cli {
@@ -26,9 +27,6 @@ Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_f
 Result<BiasRun> measure_missed(const Scene& scene, const std::string& scene_name, const Profile& renderer,
                                const std::string& reference, const std::vector<const PathClass*>& classes,
                                const BiasOptions& options);
-
-// bias.json (keys in README "pathex bias").
-nlohmann::ordered_json to_json(const BiasReport& r);
 
 // "pt-nee cannot sample 6.3 % ± 0.08 % of what bdpt finds (luminance 0.04064 ± 0.00049 of 0.64123)".
 std::string missed_line(const BiasReport& r);
