@@ -201,16 +201,6 @@ std::uint64_t key_of(const vec3& wo, const vec3& wi, std::uint64_t salt) {
   return hash_floats(mix64(salt + 0x3c6ef372fe94f82bULL), {wo.x, wo.y, wo.z, wi.x, wi.y, wi.z});
 }
 
-float mean_internal_reflectance(float eta) {
-  constexpr int kSteps = 4096;
-  double sum = 0.0;
-  for (int i = 0; i < kSteps; ++i) {
-    const double mu = (i + 0.5) / kSteps;
-    sum += 2.0 * mu * fresnel_dielectric(static_cast<float>(-mu), eta);
-  }
-  return static_cast<float>(sum / kSteps);
-}
-
 float specular_probability(const CoatedDiffuse& m, float cos_o) {
   return m.smooth() ? fresnel_dielectric(std::abs(cos_o), m.eta) : 0.0f;
 }
