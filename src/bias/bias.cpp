@@ -343,4 +343,12 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
   return BiasRun{std::move(rep), std::move(*out), std::move(*hist)};
 }
 
+Result<BiasRun> measure_missed(const Scene& scene, const std::string& scene_name, const Profile& renderer,
+                               const std::string& reference, const std::vector<const PathClass*>& classes,
+                               const BiasOptions& options) {
+  Result<Profile> ref = choose_reference(reference, scene, renderer, options);
+  if (!ref) return ref.error();
+  return run_bias(scene, scene_name, renderer, *ref, classes, options);
+}
+
 }  // namespace pathex

@@ -197,4 +197,10 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
                          const Profile& reference, const std::vector<const PathClass*>& classes,
                          const BiasOptions& options);
 
+// The reference for `renderer` (`reference`: a name or file, or empty for the default) and its
+// render with the measurement of what `renderer` misses.
+Result<BiasRun> measure_missed(const Scene& scene, const std::string& scene_name, const Profile& renderer,
+                               const std::string& reference, const std::vector<const PathClass*>& classes,
+                               const BiasOptions& options);
+
 }  // namespace pathex

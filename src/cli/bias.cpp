@@ -11,7 +11,7 @@
 
 #include "cli/bias_common.h"
 #include "cli/common.h"
-#include "cli/estimate_text.h"
+#include "io/estimate_text.h"
 #include "cli/folder_report.h"
 #include "measure/render_watch.h"
 #include "cli/trace_checks.h"

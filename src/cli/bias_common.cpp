@@ -1,6 +1,6 @@
 #include "cli/bias_common.h"
 
-#include "cli/estimate_text.h"
+#include "io/estimate_text.h"
 #include "cli/witness_text.h"
 #include "io/input_file.h"
 #include "io/histogram_json.h"
@@ -32,14 +32,6 @@ Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_f
       return e;
     }
   return classes;
-}
-
-Result<BiasRun> measure_missed(const Scene& scene, const std::string& scene_name, const Profile& renderer,
-                               const std::string& reference, const std::vector<const PathClass*>& classes,
-                               const BiasOptions& options) {
-  Result<Profile> ref = choose_reference(reference, scene, renderer, options);
-  if (!ref) return ref.error();
-  return run_bias(scene, scene_name, renderer, *ref, classes, options);
 }
 
 std::string missed_line(const BiasReport& r) {

@@ -14,7 +14,7 @@
 
 #include "cli/bias_common.h"
 #include "cli/common.h"
-#include "cli/estimate_text.h"
+#include "io/estimate_text.h"
 #include "cli/folder_report.h"
 #include "cli/reach_common.h"
 #include "cli/render_job.h"

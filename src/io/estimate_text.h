@@ -9,7 +9,7 @@
 
 #include "classify/histogram.h"
 
-namespace pathex::cli {
+namespace pathex {
 
 // "12.3 %"
 inline std::string percent(double share, int decimals = 1) {
@@ -51,4 +51,4 @@ inline std::string techniques_text(std::vector<TechniqueEstimate> ts, std::size_
   return out;
 }
 
-}  // namespace pathex::cli
+}  // namespace pathex
