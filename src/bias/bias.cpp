@@ -8,7 +8,7 @@
 
 #include "automata/ops.h"
 #include "classify/classifier.h"
-#include "classify/significance.h"
+#include "stats/significance.h"
 #include "io/profile_json.h"
 #include "scene/universe.h"
 

@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "classify/pathclass.h"
 #include "core/error.h"
 #include "core/limits.h"

@@ -11,7 +11,7 @@
 #include "cli/render_job.h"
 #include "classify/pathclass.h"
 #include "core/error.h"
-#include "io/bias_json.h"
+#include "output/bias_json.h"
 #include "scene/scene.h"
 
 namespace pathex::cli {

@@ -11,7 +11,7 @@
 #include "cli/bias_common.h"
 #include "cli/common.h"
 #include "io/atomic_file.h"
-#include "io/bias_json.h"
+#include "output/bias_json.h"
 #include "io/estimate_text.h"
 #include "io/input_file.h"
 #include "io/junit.h"

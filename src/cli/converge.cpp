@@ -3,7 +3,7 @@
 // an earlier run's histogram.json or EXR, or a long reference run it makes itself), and reports
 // time, estimate, reported and true error, per-pixel RMS error and efficiency 1/(error² × time)
 // per renderer, class and rung; checks that each renderer's reported standard error tells the
-// truth (classify/convergence.h); writes converge.json and a log-log plot (SVG and PNG) as one
+// truth (stats/convergence.h); writes converge.json and a log-log plot (SVG and PNG) as one
 // output set; and ends its table with the most efficient renderer per class.
 //
 // Rendering goes through the tracer's library entry point, render(), one call per rung
@@ -30,7 +30,7 @@
 
 #include "automata/ops.h"
 #include "bias/bias.h"
-#include "classify/convergence.h"
+#include "stats/convergence.h"
 #include "cli/common.h"
 #include "cli/folder_report.h"
 #include "io/convergence_plot.h"

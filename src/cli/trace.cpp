@@ -320,7 +320,7 @@ int run(const TraceArgs& a) {
   }
 
   // --- render the passes still missing: all of them, or under MPI the chunks of them that the
-  // ranks' shared deal hands this rank (whoever is free takes the next, core/pass_deal.h) ---
+  // ranks' shared deal hands this rank (whoever is free takes the next, schedule/pass_deal.h) ---
   const PassSet todo = job.header.share.minus(job.header.passes);
   RenderOptions ro;
   ro.spp = job.header.spp;

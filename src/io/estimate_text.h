@@ -7,7 +7,7 @@
 #include <vector>
 #include <algorithm>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 
 namespace pathex {
 

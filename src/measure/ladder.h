@@ -1,7 +1,7 @@
 // The ladder of `pathex converge` (DESIGN §8, issue 13): its budgets, the classes it measures with
 // their references, each rung's measures, and the statistics of a renderer's rungs against the
 // reference (error, z, efficiency 1/(error² × time), the error's slope against time and the check
-// that the reported standard error tells the truth, stats in classify/convergence.h). The command
+// that the reported standard error tells the truth, stats in stats/convergence.h). The command
 // (cli/converge.cpp) renders the rungs and prints; what is measured and judged is here.
 #pragma once
 
@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "classify/classifier.h"
-#include "classify/convergence.h"
-#include "classify/histogram.h"
-#include "classify/image.h"
+#include "stats/convergence.h"
+#include "stats/histogram.h"
+#include "film/image.h"
 #include "core/error.h"
 #include "trace/render.h"
 

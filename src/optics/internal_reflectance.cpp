@@ -1,6 +1,6 @@
 #include "optics/internal_reflectance.h"
 
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 
 namespace pathex {
 

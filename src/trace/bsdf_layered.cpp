@@ -13,7 +13,7 @@
 #include "trace/bsdf.h"
 #include "trace/bsdf_kinds.h"
 #include "trace/frame.h"
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/microfacet.h"
 #include "trace/rng.h"
 

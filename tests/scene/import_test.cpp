@@ -10,7 +10,7 @@
 #include <fstream>
 #include <map>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "io/profile_json.h"
 #include "optics/internal_reflectance.h"
 #include "scene/scene.h"

@@ -1,7 +1,7 @@
-// The statistics of `pathex converge` (classify/convergence.h): the χ² quantile against tables,
+// The statistics of `pathex converge` (stats/convergence.h): the χ² quantile against tables,
 // the stability of the batch variance for normal and spiky batch means, the stderr check on
 // honest and lying ladders, and the log-log slope.
-#include "classify/convergence.h"
+#include "stats/convergence.h"
 
 #include <gtest/gtest.h>
 

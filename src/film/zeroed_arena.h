@@ -1,5 +1,5 @@
 // Zeroed memory for many small blocks that live as long as their owner (the image tiles of
-// classify/image.h), carved from 2 MiB chunks mapped straight from the kernel and advised as
+// film/image.h), carved from 2 MiB chunks mapped straight from the kernel and advised as
 // transparent huge pages (MADV_HUGEPAGE; this kernel's THP mode is "madvise"). A chunk then
 // costs one page fault instead of 512, and no malloc bookkeeping: a 512 × 512 merge with twenty
 // class layers allocated 145 MB of 3 KiB tiles one `new` at a time, and its heap growth and page

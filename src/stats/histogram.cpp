@@ -1,6 +1,6 @@
 // The accumulator (exact integer sums keyed by path string and batch) and the report built from
 // it: batch means per path, per class (sums of the paths in the class) and for the total.
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 
 #include <algorithm>
 #include <map>

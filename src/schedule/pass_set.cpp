@@ -1,4 +1,4 @@
-#include "core/pass_set.h"
+#include "schedule/pass_set.h"
 
 #include <algorithm>
 

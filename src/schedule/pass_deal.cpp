@@ -1,4 +1,4 @@
-#include "core/pass_deal.h"
+#include "schedule/pass_deal.h"
 
 #include <algorithm>
 #include <numeric>

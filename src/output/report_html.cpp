@@ -1,7 +1,7 @@
 // report.html (see report_html.h): reading a render folder, then writing the page. The reading
 // goes through the one JSON reader (parse_json, JsonReader), the histogram's own parser, the EXR
 // reader and the PNG encoder; the page is plain HTML with a short script for the hover.
-#include "io/report_html.h"
+#include "output/report_html.h"
 
 #include <algorithm>
 #include <cmath>
@@ -23,7 +23,7 @@
 #include "io/junit.h"
 #include "io/output_set.h"
 #include "io/profile_json.h"
-#include "io/shard.h"
+#include "output/shard.h"
 
 namespace pathex {
 namespace fs = std::filesystem;

@@ -4,7 +4,7 @@
 //
 // A render is fully described by what it was made from (the RenderIdentity: scene content,
 // profile, classes, seed, options) and the set of passes it took; its outputs are functions of
-// exact integer sums (classify/histogram.h, classify/image.h), which add. A shard file holds those
+// exact integer sums (stats/histogram.h, film/image.h), which add. A shard file holds those
 // sums, not the floats of the outputs.
 //
 // File layout, version 6 (all integers little-endian; version 1 had the body uncompressed, version
@@ -80,10 +80,10 @@
 #include <string>
 #include <vector>
 
-#include "classify/histogram.h"
-#include "classify/image.h"
+#include "stats/histogram.h"
+#include "film/image.h"
 #include "core/error.h"
-#include "core/pass_set.h"
+#include "schedule/pass_set.h"
 #include "trace/joins/manifold.h"
 #include "trace/render.h"
 

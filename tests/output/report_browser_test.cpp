@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "io/image_io.h"
 #include "support/cli_run.h"
 

@@ -1,4 +1,4 @@
-#include "classify/significance.h"
+#include "stats/significance.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "core/zeroed_arena.h"
+#include "film/zeroed_arena.h"
 
 #include <sys/mman.h>
 

@@ -12,7 +12,7 @@
 #include <optional>
 #include <vector>
 
-#include "core/pass_set.h"
+#include "schedule/pass_set.h"
 
 namespace pathex {
 
@@ -45,14 +45,14 @@ class ChunkDeal final : public PassDealer {
 
 // The chunks of a pass set dealt among several takers (an MPI job's ranks), each keeping to a
 // share of the B batches. A render lays out a batch's cells and row sums (one per path seen so
-// far, classify/histogram.h) the first time it adds to that batch, and passes go to batches
+// far, stats/histogram.h) the first time it adds to that batch, and passes go to batches
 // round-robin (pass mod B): a rank that takes every other chunk of the plain order touches all B
 // batches, as one process does, so two ranks lay out, fault in, write to their rank files and
 // reduce twice the histogram of one process. Here the chunks form lanes by their first pass mod
 // B; taker t of n starts with the lanes of batches [t·B/n, (t+1)·B/n) and takes its lanes' chunks
 // round-robin, each lane in order; once its lanes are done it joins the lane with the most chunks
 // left (shared from then on), so a faster taker still takes more chunks and every chunk is dealt
-// once. Which taker renders a chunk does not change the render's sums (core/pass_deal.h, above).
+// once. Which taker renders a chunk does not change the render's sums (schedule/pass_deal.h, above).
 class LaneDeal {
  public:
   LaneDeal(const PassSet& passes, std::uint64_t chunk, std::uint64_t batches, int takers);  // chunk, batches, takers > 0

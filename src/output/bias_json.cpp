@@ -1,4 +1,4 @@
-#include "io/bias_json.h"
+#include "output/bias_json.h"
 
 #include <cmath>
 

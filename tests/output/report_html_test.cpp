@@ -1,4 +1,4 @@
-// report.html (io/report_html.h, pathex report, trace/bias/converge --report): the page holds every
+// report.html (output/report_html.h, pathex report, trace/bias/converge --report): the page holds every
 // class and the top paths of histogram.json with exactly its numbers, the hover data is the EXR's
 // luminance box-downsampled, the in-memory report of trace --report is the bytes pathex report
 // makes from the files, the file joins the output set, and bad folders get one located message.
@@ -13,9 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "io/image_io.h"
-#include "io/report_html.h"
+#include "output/report_html.h"
 #include "support/cli_run.h"
 
 namespace {

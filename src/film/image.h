@@ -1,5 +1,5 @@
 // Per-class images: one RGB framebuffer for the total and one per requested class, accumulated
-// with the same exact fixed-point sums as the histogram (classify/histogram.h), so that the
+// with the same exact fixed-point sums as the histogram (stats/histogram.h), so that the
 // images, too, are bit-identical whatever the thread count and merge order.
 //
 // Storage is per class set, not per layer: a contribution belongs to exactly one class set (the
@@ -7,7 +7,7 @@
 // whatever the number of class layers; a layer is the sum of the planes of the sets that contain
 // its class (the total: of all planes), formed only when read. Sets with the same layers share a
 // plane (without class layers there is one plane, the total's). Planes are allocated in 8 × 8-pixel
-// tiles (carved from a ZeroedArena, core/zeroed_arena.h), each the first time a contribution lands
+// tiles (carved from a ZeroedArena, film/zeroed_arena.h), each the first time a contribution lands
 // in it, so memory is 48 bytes per pixel per combination of layers, counted only over the tiles
 // where that combination occurs (rare combinations, and there are hundreds with twenty
 // overlapping classes, cost a few tiles).
@@ -36,9 +36,9 @@
 #include <vector>
 
 #include "classify/classifier.h"
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "core/error.h"
-#include "core/zeroed_arena.h"
+#include "film/zeroed_arena.h"
 
 namespace pathex {
 

@@ -3,7 +3,7 @@
 // standard error tells the truth.
 //
 // A ladder is a list of rungs, each an independent render at a larger budget. At rung i the
-// renderer reports an estimate X_i with a standard error s_i (batch means, classify/histogram.h),
+// renderer reports an estimate X_i with a standard error s_i (batch means, stats/histogram.h),
 // and the reference says R ± s_R (s_R = 0 for a closed form). If s_i is honest,
 //
 //     z_i = (X_i − R) / sqrt(s_i² + s_R²)
@@ -37,7 +37,7 @@
 #include <vector>
 
 #include "classify/classifier.h"
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 
 namespace pathex {
 

@@ -1,5 +1,5 @@
-// The image tiles' arena (core/zeroed_arena.h): zeroed, aligned, disjoint blocks, across chunks.
-#include "core/zeroed_arena.h"
+// The image tiles' arena (film/zeroed_arena.h): zeroed, aligned, disjoint blocks, across chunks.
+#include "film/zeroed_arena.h"
 
 #include <gtest/gtest.h>
 

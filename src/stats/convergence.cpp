@@ -1,5 +1,5 @@
 // The statistics of a convergence ladder; the formulas and thresholds are in convergence.h.
-#include "classify/convergence.h"
+#include "stats/convergence.h"
 
 #include <algorithm>
 #include <cmath>

@@ -24,7 +24,7 @@ class PassSet {
   // Part `index` of `count` (index < count): with the set's passes numbered 0 … m−1 in order,
   // those numbered ⌊i·m/n⌋ to ⌊(i+1)·m/n⌋ − 1. The parts are disjoint, cover the set, differ in
   // size by at most one, and may be empty when count > m. Shard i/n of a render is
-  // range(0, spp).part(i, n). (MPI ranks deal their passes as they go, core/pass_deal.h; rank r of
+  // range(0, spp).part(i, n). (MPI ranks deal their passes as they go, schedule/pass_deal.h; rank r of
   // n takes part(r, n) only where MPI cannot serve the deal from a thread.)
   PassSet part(std::uint64_t index, std::uint64_t count) const;
 

@@ -1,7 +1,7 @@
 // Path-class histograms and per-class images: exact fixed-point sums, batch-means statistics
 // against closed forms and the textbook standard error, exact and order-independent merging,
 // non-finite contributions, class shares, and lock-free image accumulation.
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "cli/estimate_text.h"
 
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 #include <numeric>
 #include <thread>
 
-#include "classify/image.h"
+#include "film/image.h"
 #include "io/histogram_json.h"
 
 namespace pathex {

@@ -1,4 +1,4 @@
-// Pass sets, their deal (core/pass_deal.h) and the shard file format (io/shard.h): exact round
+// Pass sets, their deal (schedule/pass_deal.h) and the shard file format (output/shard.h): exact round
 // trips of the sums, and every damaged file refused with its own message.
 #include <gtest/gtest.h>
 #include <zlib.h>
@@ -10,9 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/pass_deal.h"
-#include "core/pass_set.h"
-#include "io/shard.h"
+#include "schedule/pass_deal.h"
+#include "schedule/pass_set.h"
+#include "output/shard.h"
 
 namespace pathex {
 namespace {

@@ -29,10 +29,10 @@
 #include <string>
 #include <vector>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "core/error.h"
 #include "core/limits.h"
-#include "io/shard.h"
+#include "output/shard.h"
 
 namespace pathex {
 

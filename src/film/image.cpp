@@ -1,6 +1,6 @@
 // Exact per-class framebuffers: 128-bit fixed-point channels added with two atomic fetch-adds
 // (see image.h for why the carry is exact), a per-thread PixelSum, and conversion to floats.
-#include "classify/image.h"
+#include "film/image.h"
 
 #include <algorithm>
 #include <atomic>

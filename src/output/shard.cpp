@@ -1,6 +1,6 @@
 // Shard files (format in shard.h): framing and checksum first, then the JSON header, then the
 // varint-encoded exact sums.
-#include "io/shard.h"
+#include "output/shard.h"
 
 #include <zlib.h>
 #include <zstd.h>

@@ -1,4 +1,4 @@
-#include "classify/lpe_emit.h"
+#include "language/lpe_emit.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "classify/notation_hint.h"
+#include "language/notation_hint.h"
 
 #include "automata/ops.h"
 
