@@ -26,8 +26,6 @@
 #include <sstream>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
 #include "automata/ops.h"
 #include "bias/bias.h"
 #include "stats/convergence.h"
@@ -44,6 +42,7 @@
 #include "io/output_set.h"
 #include "io/profile_json.h"
 #include "measure/ladder.h"
+#include "output/converge_json.h"
 #include "measure/render_watch.h"
 #include "reach/prune.h"
 #include "scene/universe.h"
@@ -80,7 +79,7 @@ struct ConvergeArgs {
 struct Reference {
   std::string kind;    // "closed-form", "file", "run"
   std::string source;  // the formula, the file, or the run that made it
-  nlohmann::ordered_json run;  // for "run": renderer, spp, seed, time
+  std::optional<ReferenceRun> run;  // for "run"
 };
 
 // --- one rung ---
@@ -150,10 +149,6 @@ Result<RungResult> run_rung(const RungSetup& setup, const Profile& profile, cons
   r.output = std::move(*out);
   return r;
 }
-
-// --- numbers for the JSON ---
-
-nlohmann::ordered_json number_or_null(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); }
 
 int run(const ConvergeArgs& a) {
   const double cpu_start = process_cpu_seconds();
@@ -337,8 +332,7 @@ int run(const ConvergeArgs& a) {
     ref.kind = "run";
     ref.source = "a reference run of " + ref_profile->name + " at " + std::to_string(r->spp) + " spp, seed " +
                  std::to_string(seed) + ", written to " + a.out + "/reference.json and reference.exr";
-    ref.run = {{"renderer", ref_profile->name}, {"spp", r->spp}, {"seed", seed}, {"cpu_s", r->cpu_s}, {"wall_s", r->wall_s},
-               {"nonfinite_samples", r->nonfinite}};
+    ref.run = ReferenceRun{ref_profile->name, r->spp, seed, r->cpu_s, r->wall_s, r->nonfinite};
     ref_run = std::move(*r);
   }
 
@@ -434,127 +428,10 @@ int run(const ConvergeArgs& a) {
     }
   }
   // The most efficient renderer per class (pooled efficiency 1 / mean(error² × CPU time)).
-  nlohmann::ordered_json best = nlohmann::ordered_json::array();
-  std::vector<std::string> best_lines;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (!rows[i].unmeasurable.empty()) {
-      best_lines.push_back(rows[i].name + ": not measurable with this reference (" + rows[i].unmeasurable + "); nothing ranked");
-      continue;
-    }
-    int top = -1, second = -1;
-    for (std::size_t k = 0; k < profiles.size(); ++k) {
-      const double e = series[k][i].pooled_efficiency;
-      if (!std::isfinite(e) || cannot[k][i]) continue;
-      if (top < 0 || e > series[static_cast<std::size_t>(top)][i].pooled_efficiency) {
-        second = top;
-        top = static_cast<int>(k);
-      } else if (second < 0 || e > series[static_cast<std::size_t>(second)][i].pooled_efficiency) {
-        second = static_cast<int>(k);
-      }
-    }
-    std::string excluded;  // the renderers not ranked on the class: they cannot sample all of it
-    for (std::size_t k = 0; k < profiles.size(); ++k)
-      if (cannot[k][i]) excluded += (excluded.empty() ? "" : ", ") + profiles[k].name + " cannot sample " + *cannot[k][i];
-    if (top < 0) {
-      if (rows[i].reference && !excluded.empty()) best_lines.push_back(rows[i].name + ": none ranked (" + excluded + ")");
-      continue;
-    }
-    const double et = series[static_cast<std::size_t>(top)][i].pooled_efficiency;
-    nlohmann::ordered_json b = {{"class", rows[i].name}, {"renderer", profiles[static_cast<std::size_t>(top)].name}, {"efficiency", et}};
-    std::string line = rows[i].name + ": " + profiles[static_cast<std::size_t>(top)].name + " (efficiency " + fmt(et, "%.3g");
-    if (second >= 0) {
-      const double es = series[static_cast<std::size_t>(second)][i].pooled_efficiency;
-      b["runner_up"] = profiles[static_cast<std::size_t>(second)].name;
-      b["ratio"] = et / es;
-      line += ", " + fmt(et / es, "%.2f") + "x " + profiles[static_cast<std::size_t>(second)].name + "'s";
-    } else {
-      b["runner_up"] = nullptr;
-      b["ratio"] = nullptr;
-    }
-    if (!series[static_cast<std::size_t>(top)][i].warning.empty()) line += "; its stderr is flagged";
-    if (!excluded.empty()) line += "; not ranked: " + excluded;
-    best.push_back(b);
-    best_lines.push_back(line + ")");
-  }
-
-  // --- converge.json ---
-  nlohmann::ordered_json doc;
-  doc["scene"] = a.scene;
-  doc["complete"] = complete;
-  doc["budget"] = by_time ? "time" : "spp";
-  nlohmann::ordered_json lad = nlohmann::ordered_json::array();
-  for (const Budget& b : *ladder) lad.push_back(b.spp ? nlohmann::ordered_json(b.spp) : nlohmann::ordered_json(b.seconds));
-  doc["ladder"] = lad;
-  doc["seed"] = a.seed;
-  doc["threads"] = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
-  doc["ranks"] = cluster != nullptr ? cluster->size() : 1;  // MPI ranks, each with `threads`
-  doc["max_bounces"] = a.max_bounces ? nlohmann::ordered_json(*a.max_bounces) : nlohmann::ordered_json(nullptr);
-  doc["resolution"] = {width, height};
-  if (only) {  // --only: what was estimated, and what was not
-    nlohmann::ordered_json jo = nlohmann::ordered_json::array(), jn = nlohmann::ordered_json::array();
-    for (std::size_t i = 1; i < rows.size(); ++i) jo.push_back({{"name", rows[i].name}, {"expr", rows[i].expr}});
-    for (const PathClass* c : not_rendered)
-      jn.push_back({{"name", c->name}, {"expr", c->text}, {"rendered", false},
-                    {"note", "not rendered: only the requested classes were estimated (--only)"}});
-    doc["only"] = jo;
-    doc["not_rendered"] = jn;
-  }
-  nlohmann::ordered_json jref = {{"kind", ref.kind}, {"source", ref.source}};
-  if (ref.kind == "run") jref["run"] = ref.run;
-  nlohmann::ordered_json jrefc = nlohmann::ordered_json::array();
-  for (const ClassRow& r : rows)
-    jrefc.push_back({{"name", r.name}, {"expr", r.expr}, {"luminance", r.reference ? number_or_null(*r.reference) : nullptr},
-                     {"stderr", r.reference_stderr}, {"per_pixel", r.pixels.has_value()},
-                     {"measurable", r.unmeasurable.empty()},
-                     {"note", r.unmeasurable.empty() ? nlohmann::ordered_json(nullptr)
-                                                     : nlohmann::ordered_json("not measurable with this reference: " + r.unmeasurable)}});
-  jref["classes"] = jrefc;
-  jref["reach_note"] = ref_reach_note.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(ref_reach_note);
-  doc["reference"] = jref;
-  doc["stderr_check"] = {{"alpha", kStderrCheckAlpha}, {"unstable_variance", kUnstableVariance}};
-  nlohmann::ordered_json jren = nlohmann::ordered_json::array();
-  for (std::size_t k = 0; k < profiles.size(); ++k) {
-    std::uint64_t nonfinite = 0;
-    for (const RungResult& r : results[k]) nonfinite += r.nonfinite;
-    nlohmann::ordered_json jc = nlohmann::ordered_json::array();
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      const Series& s = series[k][i];
-      nlohmann::ordered_json jr = nlohmann::ordered_json::array();
-      for (std::size_t j = 0; j < results[k].size(); ++j) {
-        const RungResult& r = results[k][j];
-        const ClassMeasure& m = r.classes[i];
-        jr.push_back({{"budget", r.budget.spp ? nlohmann::ordered_json(r.budget.spp) : nlohmann::ordered_json(r.budget.seconds)},
-                      {"spp", r.spp},
-                      {"seed", r.seed},
-                      {"cpu_s", r.cpu_s},
-                      {"wall_s", r.wall_s},
-                      {"estimate", m.estimate},
-                      {"stderr", number_or_null(m.std_error)},
-                      {"error", j < s.error.size() ? number_or_null(s.error[j]) : nullptr},
-                      {"z", j < s.z.size() ? number_or_null(s.z[j]) : nullptr},
-                      {"rms_pixel_error", m.rms_pixel ? number_or_null(*m.rms_pixel) : nullptr},
-                      {"stderr_stability", number_or_null(m.stability)},
-                      {"efficiency", j < s.efficiency.size() ? number_or_null(s.efficiency[j]) : nullptr}});
-      }
-      jc.push_back({{"name", rows[i].name},
-                    {"expr", rows[i].expr},
-                    {"rungs", jr},
-                    {"slope", number_or_null(s.slope)},
-                    {"efficiency", number_or_null(s.pooled_efficiency)},
-                    {"cannot_sample", cannot[k][i] ? nlohmann::ordered_json(*cannot[k][i]) : nlohmann::ordered_json(nullptr)},
-                    {"stderr_check",
-                     {{"chi2", number_or_null(s.check.chi2)}, {"dof", s.check.dof}, {"limit", s.check.limit},
-                      {"lower_chi2", number_or_null(s.check.lower_chi2)}, {"lower_dof", s.check.lower_dof},
-                      {"lower_limit", s.check.lower_limit},
-                      {"max_abs_z", number_or_null(s.check.max_abs_z)}, {"stability", number_or_null(s.check.stability)},
-                      {"disagrees", s.check.disagrees}, {"too_large", s.check.too_large}, {"unstable", s.check.unstable}}},
-                    {"warning", s.warning.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.warning)}});
-    }
-    jren.push_back({{"name", profiles[k].name}, {"nonfinite_samples", nonfinite}, {"classes", jc}});
-  }
-  doc["renderers"] = jren;
-  doc["best"] = best;
-  doc["warnings"] = warnings;
+  std::vector<std::string> renderer_names;
+  for (const Profile& p : profiles) renderer_names.push_back(p.name);
+  const Rankings rankings = rank_renderers(rows, renderer_names, series, cannot);
+  const std::vector<std::string>& best_lines = rankings.lines;
 
   // --- the plot: one panel per class with a reference ---
   std::vector<PlotPanel> panels;
@@ -576,12 +453,35 @@ int run(const ConvergeArgs& a) {
 
   // Overhead: everything but render() — references, statistics, the plot (the writing below is
   // measured by bench/converge_overhead.py from the outside).
-  const double wall_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  const double cpu_total = process_cpu_seconds() - cpu_start;
-  doc["timing"] = {{"render_wall_s", render_wall}, {"render_cpu_s", render_cpu},
-                   {"overhead_wall_s", wall_total - render_wall}, {"overhead_cpu_s", cpu_total - own_render_cpu},
-                   {"overhead_pct", render_wall > 0 ? 100.0 * (wall_total - render_wall) / render_wall : 0.0}};
-  const std::string json_text = doc.dump(2) + "\n";
+  ConvergeRun doc;
+  doc.scene = a.scene;
+  doc.complete = complete;
+  doc.by_time = by_time;
+  doc.ladder = *ladder;
+  doc.seed = a.seed;
+  doc.threads = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
+  doc.ranks = cluster != nullptr ? cluster->size() : 1;  // MPI ranks, each with `threads`
+  doc.max_bounces = a.max_bounces;
+  doc.width = width;
+  doc.height = height;
+  doc.only = only.has_value();
+  for (const PathClass* c : not_rendered) doc.not_rendered.emplace_back(c->name, c->text);
+  doc.reference_kind = ref.kind;
+  doc.reference_source = ref.source;
+  doc.reference_run = ref.run;
+  doc.reach_note = ref_reach_note;
+  doc.rows = &rows;
+  doc.renderers = renderer_names;
+  doc.results = &results;
+  doc.series = &series;
+  doc.cannot = &cannot;
+  doc.rankings = &rankings;
+  doc.warnings = &warnings;
+  doc.render_wall_s = render_wall;
+  doc.render_cpu_s = render_cpu;
+  doc.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  doc.overhead_cpu_s = process_cpu_seconds() - cpu_start - own_render_cpu;
+  const std::string json_text = converge_json_text(doc);
 
   // --- outputs: one set, whole or not at all ---
   {

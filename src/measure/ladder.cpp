@@ -190,4 +190,50 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
   return s;
 }
 
+Rankings rank_renderers(const std::vector<ClassRow>& rows, const std::vector<std::string>& renderers,
+                        const std::vector<std::vector<Series>>& series,
+                        const std::vector<std::vector<std::optional<std::string>>>& cannot) {
+  Rankings out;
+  std::vector<Ranking>& best = out.best;
+  std::vector<std::string>& best_lines = out.lines;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (!rows[i].unmeasurable.empty()) {
+      best_lines.push_back(rows[i].name + ": not measurable with this reference (" + rows[i].unmeasurable + "); nothing ranked");
+      continue;
+    }
+    int top = -1, second = -1;
+    for (std::size_t k = 0; k < renderers.size(); ++k) {
+      const double e = series[k][i].pooled_efficiency;
+      if (!std::isfinite(e) || cannot[k][i]) continue;
+      if (top < 0 || e > series[static_cast<std::size_t>(top)][i].pooled_efficiency) {
+        second = top;
+        top = static_cast<int>(k);
+      } else if (second < 0 || e > series[static_cast<std::size_t>(second)][i].pooled_efficiency) {
+        second = static_cast<int>(k);
+      }
+    }
+    std::string excluded;  // the renderers not ranked on the class: they cannot sample all of it
+    for (std::size_t k = 0; k < renderers.size(); ++k)
+      if (cannot[k][i]) excluded += (excluded.empty() ? "" : ", ") + renderers[k] + " cannot sample " + *cannot[k][i];
+    if (top < 0) {
+      if (rows[i].reference && !excluded.empty()) best_lines.push_back(rows[i].name + ": none ranked (" + excluded + ")");
+      continue;
+    }
+    const double et = series[static_cast<std::size_t>(top)][i].pooled_efficiency;
+    Ranking b{rows[i].name, renderers[static_cast<std::size_t>(top)], et, "", 0.0};
+    std::string line = rows[i].name + ": " + renderers[static_cast<std::size_t>(top)] + " (efficiency " + fmt(et, "%.3g");
+    if (second >= 0) {
+      const double es = series[static_cast<std::size_t>(second)][i].pooled_efficiency;
+      b.runner_up = renderers[static_cast<std::size_t>(second)];
+      b.ratio = et / es;
+      line += ", " + fmt(et / es, "%.2f") + "x " + renderers[static_cast<std::size_t>(second)] + "'s";
+    }
+    if (!series[static_cast<std::size_t>(top)][i].warning.empty()) line += "; its stderr is flagged";
+    if (!excluded.empty()) line += "; not ranked: " + excluded;
+    best.push_back(b);
+    best_lines.push_back(line + ")");
+  }
+  return out;
+}
+
 }  // namespace pathex

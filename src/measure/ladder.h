@@ -99,4 +99,32 @@ struct Series {
 // without a reference), with the warning the table and converge.json give when the check fails.
 Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const ClassRow& cr);
 
+// The most efficient renderer on a class row (pooled efficiency 1 / mean(error² × CPU time) over
+// the ladder) and its lead over the runner-up. A renderer that cannot sample all of the class is
+// not ranked on it.
+struct Ranking {
+  std::string cls;
+  std::string renderer;
+  double efficiency = 0.0;
+  std::string runner_up;  // empty: none
+  double ratio = 0.0;     // efficiency over the runner-up's
+};
+struct Rankings {
+  std::vector<Ranking> best;
+  std::vector<std::string> lines;  // the table's closing lines, one per class row that has one
+};
+// `series[k][i]` and `cannot[k][i]`: renderer k (named renderers[k]) on class row i.
+Rankings rank_renderers(const std::vector<ClassRow>& rows, const std::vector<std::string>& renderers,
+                        const std::vector<std::vector<Series>>& series,
+                        const std::vector<std::vector<std::optional<std::string>>>& cannot);
+
+// The reference run converge makes when there is no closed form or reference file.
+struct ReferenceRun {
+  std::string renderer;
+  std::uint64_t spp = 0;
+  std::uint64_t seed = 0;
+  double cpu_s = 0.0, wall_s = 0.0;
+  std::uint64_t nonfinite_samples = 0;
+};
+
 }  // namespace pathex
