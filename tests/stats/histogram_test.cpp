@@ -2,7 +2,6 @@
 // against closed forms and the textbook standard error, exact and order-independent merging,
 // non-finite contributions, class shares, and lock-free image accumulation.
 #include "stats/histogram.h"
-#include "cli/estimate_text.h"
 
 #include <gtest/gtest.h>
 
@@ -12,6 +11,7 @@
 #include <thread>
 
 #include "film/image.h"
+#include "io/estimate_text.h"
 #include "io/histogram_json.h"
 
 namespace pathex {
@@ -485,13 +485,13 @@ TEST(HistogramReport, TechniqueSharesVarianceAndOrdering) {
 // correlation said in words only where it matters (|r| ≥ 0.3).
 TEST(HistogramReport, TechniquesTextSaysWhereErrorsCancel) {
   TechniqueEstimate a{"nee (1, DD, 2)", 0.942, 10, 0.9, -0.57}, b{"emitter-hit (0, DD, 3)", 0.058, 3, 0.1, -0.57};
-  EXPECT_EQ(cli::techniques_text({a, b}, 3),
+  EXPECT_EQ(techniques_text({a, b}, 3),
             "nee (1, DD, 2) 94.2 % (90.0 % of the variance; its errors partly cancel the others', r = -0.57), "
             "emitter-hit (0, DD, 3) 5.8 % (10.0 %; its errors partly cancel the others', r = -0.57)");
   a.correlation = b.correlation = 0.1;
-  EXPECT_EQ(cli::techniques_text({a, b}, 1), "nee (1, DD, 2) 94.2 % (90.0 % of the variance), and 1 more");
+  EXPECT_EQ(techniques_text({a, b}, 1), "nee (1, DD, 2) 94.2 % (90.0 % of the variance), and 1 more");
   a.correlation = 0.45;
-  EXPECT_EQ(cli::techniques_text({a}, 1), "nee (1, DD, 2) 94.2 % (90.0 % of the variance; its errors add to the others', r = 0.45)");
+  EXPECT_EQ(techniques_text({a}, 1), "nee (1, DD, 2) 94.2 % (90.0 % of the variance; its errors add to the others', r = 0.45)");
 }
 
 TEST(HistogramReport, ClassTechniquesSumTheirPaths) {
