@@ -13,7 +13,7 @@ packages=(build-essential cmake pkg-config
   libopenimageio-dev
   libgtest-dev libgmock-dev libbenchmark-dev librapidcheck-dev libpugixml-dev
   groff-base
-  chromium)  # the browser test of report.html (tests/io/report_browser_test.cpp)
+  chromium)  # the browser test of report.html (tests/output/report_browser_test.cpp)
 if $fuzz; then packages+=(clang-14 libclang-rt-14-dev python3); fi
 missing=()
 for p in "${packages[@]}"; do

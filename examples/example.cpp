@@ -1,10 +1,12 @@
 // Compiles a path class, asks whether two renderers can sample it, and classifies a few paths,
-// through the installed API only (<pathex/pathex.h>). Exit code 2 on bad input, like `pathex`.
+// through the installed API only (<pathex/pathex.h>); given a scene file, also measures how much
+// of its light pt-nee cannot sample (`pathex bias`). Exit code 2 on bad input, like `pathex`.
+#include <cstdio>
 #include <iostream>
 
 #include <pathex/pathex.h>
 
-int main() {
+int main(int argc, char** argv) {
   namespace px = pathex::api;
   std::cout << "pathex " << px::version() << "\n";
 
@@ -41,5 +43,20 @@ int main() {
   // Errors are values: a bad expression says where and what was expected.
   const px::PathClass bad("L(DD");
   std::cout << "bad expression: " << (bad.ok() ? "accepted" : "refused") << "\n";
+
+  // 4. How much of a scene's light does pt-nee miss? One reference render (bdpt plus the
+  // connectors the scene needs) measures it, with the shortest path it cannot sample.
+  if (argc > 1) {
+    px::BiasOptions o;
+    o.spp = 4;
+    const px::BiasAnswer b = px::bias(argv[1], px::Renderer("pt-nee"), o);
+    if (!b.ok()) {
+      std::cerr << b.error << "\n";
+      return 2;
+    }
+    char share[64];
+    std::snprintf(share, sizeof share, "%.2f %% +- %.2f %%", 100.0 * b.share, 100.0 * b.share_stderr);
+    std::cout << "pt-nee misses " << share << " of what " << b.reference << " finds, e.g. " << b.shortest_missed << "\n";
+  }
   return 0;
 }

@@ -1,10 +1,12 @@
 // pathex: the installed C++ API.
 //
-// Three things a rendering engineer's program or CI does with pathex, and nothing more:
+// What a rendering engineer's program or CI does with pathex, and nothing more:
 //   1. compile a path class (a full-path regular expression such as "L.*DD.*E") and test paths;
 //   2. ask whether a renderer profile can sample the class (the checker's verdict and witnesses),
 //      and what a render of a scene would run (its Plan);
-//   3. classify full-path strings by a set of named classes in one pass.
+//   3. classify full-path strings by a set of named classes in one pass;
+//   4. measure how much of a scene's light a renderer cannot sample (`pathex bias`);
+//   5. run a check file, the CI gate (`pathex check`).
 //
 //   #include <pathex/pathex.h>
 //   pathex::api::PathClass caustic("L..S+D.*..E");
@@ -25,6 +27,7 @@
 //   target_link_libraries(my_tool PRIVATE pathex::pathex)
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -159,5 +162,51 @@ class ClassSet {
   struct Impl;
   std::shared_ptr<const Impl> impl_;
 };
+
+// How much of a scene's light a renderer cannot sample, as `pathex bias SCENE --renderer R`
+// measures it: one render of the scene with a reference profile (by default bdpt plus the
+// connectors the scene needs) whose classifier holds the paths R cannot sample (the checker's
+// language), so the missed light is an estimate from the reference's own samples, with its stderr.
+struct BiasOptions {
+  std::uint64_t spp = 16;  // the reference's samples per pixel
+  std::uint64_t seed = 1;
+  int threads = 0;         // 0: all cores; the numbers do not depend on it
+  std::string reference;   // a profile name or file; empty: the default reference
+};
+
+struct BiasAnswer {
+  std::string reference;        // the reference's name, e.g. "bdpt+mirror+manifold"
+  double total = 0;             // the image's mean luminance, as the reference finds it
+  double missed = 0;            // the part on paths the renderer cannot sample
+  double share = 0;             // missed / total (0 when the total is 0)
+  double share_stderr = 0;      // its standard error
+  // The checker proves that the renderer samples every path of the scene within the reference's
+  // bound: share is then exactly 0, not an estimate.
+  bool exact = false;
+  std::string shortest_missed;  // the shortest path the renderer cannot sample; empty: none
+  std::string error;            // why there is no answer (a bad scene, renderer or reference)
+  bool ok() const { return error.empty(); }
+};
+
+BiasAnswer bias(const std::string& scene_file, const Renderer& renderer, const BiasOptions& options = {});
+
+// A check file (`pathex check FILE`, schema grammar/check.schema.json): every requirement of every
+// case decided exactly, in the file's order.
+struct CheckOutcome {
+  std::string case_name;       // the case's "name"
+  std::string requirement;     // as the command prints it: "LSDSDE is unreachable"
+  bool passed = false;
+  std::string found;           // the verdict or measure found: "reachable", "0.00 % ± 0.00 % of what bdpt finds"
+  std::string counterexample;  // for a failure, the shortest path that shows it (may be empty)
+};
+
+struct CheckAnswer {
+  std::vector<CheckOutcome> outcomes;
+  std::string error;  // the check file could not be run: the command's located message
+  bool ok() const { return error.empty(); }
+  bool passed() const;  // ok() and every outcome passed
+};
+
+CheckAnswer check(const std::string& check_file);
 
 }  // namespace pathex::api

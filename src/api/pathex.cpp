@@ -2,17 +2,20 @@
 //
 // Each public object holds a shared, immutable Impl built once by its constructor; a failed
 // construction keeps the rendered Error (the same text the CLI prints) and nothing else. Nothing
-// here adds behaviour: compile_class, resolve_profile, query, read_class_file and the Classifier
-// are the functions the `pathex` command calls.
+// here adds behaviour: compile_class, resolve_profile, query, read_class_file, the Classifier,
+// measure_missed, parse_check and decide_check are the functions the `pathex` command calls.
 #include "pathex/pathex.h"
 
 #include <algorithm>
 #include <utility>
 
 #include "automata/ops.h"
+#include "bias/bias.h"
+#include "check/check_file.h"
 #include "classify/classifier.h"
 #include "classify/pathclass.h"
 #include "io/class_file.h"
+#include "io/input_file.h"
 #include "io/profile_json.h"
 #include "reach/query.h"
 #include "scene/scene.h"
@@ -299,6 +302,80 @@ std::vector<std::string> ClassSet::classify(std::string_view full_path) const {
   for (int m : impl_->classifier->members(impl_->classifier->classify(full_path)))
     out.push_back(impl_->classifier->name(m));
   return out;
+}
+
+}  // namespace pathex::api
+
+namespace pathex::api {
+
+// --- bias ---
+
+BiasAnswer bias(const std::string& scene_file, const Renderer& renderer, const BiasOptions& options) {
+  BiasAnswer a;
+  if (!renderer.ok()) {
+    a.error = renderer.error();
+    return a;
+  }
+  pathex::BiasOptions bo;
+  bo.spp = options.spp;
+  bo.seed = options.seed;
+  bo.threads = options.threads;
+  bo.images = false;
+  Result<Scene> scene = load_scene_file(scene_file, scene_load_options(bo.limits));
+  if (!scene) {
+    a.error = scene.error().render();
+    return a;
+  }
+  Result<BiasRun> run = measure_missed(*scene, scene_file, *Access::of(renderer).profile, options.reference, {}, bo);
+  if (!run) {
+    a.error = run.error().render();
+    return a;
+  }
+  const BiasReport& r = run->report;
+  a.reference = r.reference;
+  a.total = r.total.luminance;
+  a.missed = r.missed.luminance;
+  a.share = r.share;
+  a.share_stderr = r.share_std_error;
+  a.exact = r.covered;
+  if (r.shortest) a.shortest_missed = r.shortest->path;
+  return a;
+}
+
+}  // namespace pathex::api
+
+namespace pathex::api {
+
+// --- check ---
+
+bool CheckAnswer::passed() const {
+  if (!ok()) return false;
+  for (const CheckOutcome& o : outcomes)
+    if (!o.passed) return false;
+  return true;
+}
+
+CheckAnswer check(const std::string& check_file) {
+  CheckAnswer a;
+  const Limits limits;
+  Result<std::string> text = read_input_file(check_file, limits.max_file_bytes);
+  if (!text) {
+    a.error = text.error().render();
+    return a;
+  }
+  Result<std::vector<Case>> cases = parse_check(*text, check_file);
+  if (!cases) {
+    a.error = cases.error().render();
+    return a;
+  }
+  Result<std::vector<Outcome>> decided = decide_check(check_file, *cases, limits);
+  if (!decided) {
+    a.error = decided.error().render();
+    return a;
+  }
+  for (const Outcome& o : *decided)
+    a.outcomes.push_back({o.c->name, o.r->describe(), o.passed, o.verdict, o.counterexample ? o.counterexample->path : ""});
+  return a;
 }
 
 }  // namespace pathex::api

@@ -10,7 +10,7 @@
 // correct whatever their order, and the tests compile it back and compare minimal DFAs.
 //
 // Printing is separate: to_full_notation() writes pathex syntax (grammar/pathex.ebnf); the LPE
-// emitter (classify/lpe_emit.h) writes the same tree as LPE events.
+// emitter (language/lpe_emit.h) writes the same tree as LPE events.
 #pragma once
 
 #include <cstdint>

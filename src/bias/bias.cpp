@@ -8,7 +8,7 @@
 
 #include "automata/ops.h"
 #include "classify/classifier.h"
-#include "classify/significance.h"
+#include "stats/significance.h"
 #include "io/profile_json.h"
 #include "scene/universe.h"
 #include "trace/plan.h"
@@ -348,6 +348,14 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
   // histogram.json keeps the user's classes and "missed" (the per-class parts are in the report).
   hist->classes.resize(static_cast<std::size_t>(n + 1));
   return BiasRun{std::move(rep), std::move(*out), std::move(*hist)};
+}
+
+Result<BiasRun> measure_missed(const Scene& scene, const std::string& scene_name, const Profile& renderer,
+                               const std::string& reference, const std::vector<const PathClass*>& classes,
+                               const BiasOptions& options) {
+  Result<Profile> ref = choose_reference(reference, scene, renderer, options);
+  if (!ref) return ref.error();
+  return run_bias(scene, scene_name, renderer, *ref, classes, options);
 }
 
 }  // namespace pathex

@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "classify/pathclass.h"
 #include "core/error.h"
 #include "core/limits.h"
@@ -196,5 +196,11 @@ struct BiasRun {
 Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, const Profile& renderer,
                          const Profile& reference, const std::vector<const PathClass*>& classes,
                          const BiasOptions& options);
+
+// The reference for `renderer` (`reference`: a name or file, or empty for the default) and its
+// render with the measurement of what `renderer` misses.
+Result<BiasRun> measure_missed(const Scene& scene, const std::string& scene_name, const Profile& renderer,
+                               const std::string& reference, const std::vector<const PathClass*>& classes,
+                               const BiasOptions& options);
 
 }  // namespace pathex

@@ -11,9 +11,9 @@
 
 #include "cli/bias_common.h"
 #include "cli/common.h"
-#include "cli/estimate_text.h"
+#include "io/estimate_text.h"
 #include "cli/folder_report.h"
-#include "cli/render_watch.h"
+#include "measure/render_watch.h"
 #include "cli/trace_checks.h"
 #include "cli/witness_text.h"
 #include "io/atomic_file.h"

@@ -11,6 +11,7 @@
 #include "cli/render_job.h"
 #include "classify/pathclass.h"
 #include "core/error.h"
+#include "output/bias_json.h"
 #include "scene/scene.h"
 
 namespace pathex::cli {
@@ -20,15 +21,6 @@ namespace pathex::cli {
 // sensor types. A class file entry named "missed" (bias's layer) is refused at its JSON pointer.
 Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_file, const Scene& scene,
                                                     const Limits& limits);
-
-// The reference for `renderer` (`reference`: a name or file, or empty for the default) and its
-// render with the measurement of what `renderer` misses.
-Result<BiasRun> measure_missed(const Scene& scene, const std::string& scene_name, const Profile& renderer,
-                               const std::string& reference, const std::vector<const PathClass*>& classes,
-                               const BiasOptions& options);
-
-// bias.json (keys in README "pathex bias").
-nlohmann::ordered_json to_json(const BiasReport& r);
 
 // "pt-nee cannot sample 6.3 % ± 0.08 % of what bdpt finds (luminance 0.04064 ± 0.00049 of 0.64123)".
 std::string missed_line(const BiasReport& r);

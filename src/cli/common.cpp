@@ -7,7 +7,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "classify/notation_hint.h"
+#include "language/notation_hint.h"
 #include "io/class_file.h"
 
 namespace pathex::cli {

@@ -57,7 +57,7 @@ Result<PathClass> compile_cli_expression(const std::string& expr, const Notation
                                          const std::string& classes_file, ClassTable* table);
 
 // Prints "pathex: hint: …" on stderr when a full-notation expression reads like a Heckbert string
-// (classify/notation_hint.h). compile_cli_expression() calls it.
+// (language/notation_hint.h). compile_cli_expression() calls it.
 void print_notation_hint(const std::string& expr, const PathClass& pc, const ClassOptions& options,
                          const ClassTable* table);
 

@@ -3,7 +3,7 @@
 // an earlier run's histogram.json or EXR, or a long reference run it makes itself), and reports
 // time, estimate, reported and true error, per-pixel RMS error and efficiency 1/(error² × time)
 // per renderer, class and rung; checks that each renderer's reported standard error tells the
-// truth (classify/convergence.h); writes converge.json and a log-log plot (SVG and PNG) as one
+// truth (stats/convergence.h); writes converge.json and a log-log plot (SVG and PNG) as one
 // output set; and ends its table with the most efficient renderer per class.
 //
 // Rendering goes through the tracer's library entry point, render(), one call per rung
@@ -13,32 +13,25 @@
 // are added on rank 0 (Cluster::reduce), which measures the rung from the same sums as one process,
 // so every estimate, stderr and error is the same number; its CPU time is the ranks' sum, its wall
 // time rank 0's. Rank 0 alone shows progress, prints and writes.
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <mutex>
 #include <sstream>
-#include <stop_token>
 #include <thread>
-
-#include <nlohmann/json.hpp>
 
 #include "automata/ops.h"
 #include "bias/bias.h"
-#include "classify/convergence.h"
+#include "stats/convergence.h"
 #include "cli/common.h"
 #include "cli/folder_report.h"
-#include "cli/converge_plot.h"
+#include "io/convergence_plot.h"
 #include "cli/render_job.h"
 #include "cli/trace_checks.h"
 #include "io/atomic_file.h"
@@ -48,6 +41,9 @@
 #include "io/input_file.h"
 #include "io/output_set.h"
 #include "io/profile_json.h"
+#include "measure/ladder.h"
+#include "measure/render_watch.h"
+#include "output/converge_json.h"
 #include "scene/universe.h"
 #include "trace/plan.h"
 #include "trace/render.h"
@@ -77,122 +73,26 @@ struct ConvergeArgs {
   ReportOptions report_options;
 };
 
-// --- budgets ---
-
-// One rung's budget: samples per pixel, or seconds of wall time (the render stops after the chunk
-// in progress when they run out).
-struct Budget {
-  std::uint64_t spp = 0;  // 0 for a time budget
-  double seconds = 0.0;
-  std::string text() const {
-    std::ostringstream s;
-    if (spp) s << spp << " spp";
-    else s << seconds << " s";
-    return s.str();
-  }
-};
-
-// "4,16,64" (positive integers, strictly increasing) or "1,4,16" (positive seconds).
-Result<std::vector<Budget>> parse_ladder(const std::string& text, bool time, const std::string& option) {
-  std::vector<Budget> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    Budget b;
-    try {
-      std::size_t used = 0;
-      if (time) b.seconds = std::stod(item, &used);
-      else b.spp = std::stoull(item, &used);
-      if (used != item.size() || item.empty() || item[0] == '-') throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      return make_error(ErrorCode::kUsage, option + " '" + text + "': '" + item + "' is not a " +
-                                               (time ? "number of seconds" : "whole number of samples per pixel") +
-                                               "; expected a comma-separated list such as " + (time ? "1,4,16" : "4,16,64,256"));
-    }
-    if (time ? !(b.seconds > 0.0 && b.seconds <= 86400.0) : (b.spp < 1 || b.spp > (1u << 24)))
-      return make_error(ErrorCode::kUsage, option + " '" + text + "': " + item + " is out of range, expected " +
-                                               (time ? "0 < seconds <= 86400" : "1 to 16777216 spp"));
-    if (!out.empty() && (time ? b.seconds <= out.back().seconds : b.spp <= out.back().spp))
-      return make_error(ErrorCode::kUsage, option + " '" + text + "': budgets must increase");
-    out.push_back(b);
-  }
-  if (out.empty() || text.back() == ',') return make_error(ErrorCode::kUsage, option + " '" + text + "': expected a list such as 4,16,64");
-  return out;
-}
-
-// --- the classes measured, and the reference ---
-
-// Row 0 is the whole image ("total"); row i > 0 is classifier class i − 1.
-struct ClassRow {
-  std::string name;
-  std::string expr;
-  std::optional<double> reference;         // image mean luminance
-  double reference_stderr = 0.0;           // 0 for a closed form
-  std::optional<std::vector<float>> pixels;  // per-pixel reference luminance, row-major
-  // Non-empty: the reference cannot sample every path of the class (the checker's shortest such
-  // path, and whose), so its value is not the class's and no error is measured against it.
-  std::string unmeasurable;
-};
+// --- the reference (the ladder's budgets, class rows and measures: measure/ladder.h) ---
 
 struct Reference {
   std::string kind;    // "closed-form", "file", "run"
   std::string source;  // the formula, the file, or the run that made it
-  nlohmann::ordered_json run;  // for "run": renderer, spp, seed, time
+  std::optional<ReferenceRun> run;  // for "run"
 };
-
-double cpu_seconds() {
-  rusage u{};
-  ::getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-std::vector<float> luminance_image(const RgbImage& im) {
-  std::vector<float> out(static_cast<std::size_t>(im.width) * static_cast<std::size_t>(im.height));
-  for (std::size_t i = 0; i < out.size(); ++i)
-    out[i] = static_cast<float>(luminance({im.rgb[3 * i], im.rgb[3 * i + 1], im.rgb[3 * i + 2]}));
-  return out;
-}
-
-// --- signals: Ctrl-C keeps the finished rungs ---
-
-std::atomic<bool> g_interrupted{false};
-std::atomic<bool> g_stop{false};  // what render() polls: Ctrl-C or a rung's time running out
-extern "C" void on_interrupt(int) {
-  g_interrupted.store(true);
-  g_stop.store(true);
-}
 
 // --- one rung ---
 
 struct RungSetup {
+  RenderWatch* watch = nullptr;  // Ctrl-C keeps the finished rungs; a time budget stops a rung
   const Scene* scene = nullptr;
   const Classifier* classifier = nullptr;
   int threads = 0;
   std::optional<int> max_bounces;  // unset: each profile's own bound, else 16 (as trace)
 };
 
-struct ClassMeasure {
-  double estimate = 0.0;
-  double std_error = 0.0;
-  double stability = 0.0;
-  std::optional<double> rms_pixel;  // against the per-pixel reference, when there is one
-};
-
-struct RungResult {
-  Budget budget;
-  std::uint64_t seed = 0;
-  std::uint64_t spp = 0;  // done
-  double cpu_s = 0.0, wall_s = 0.0;  // under MPI: every rank's CPU, rank 0's wall time (with the reduction)
-  double own_cpu_s = 0.0;             // this process's rendering CPU (cpu_s for one process)
-  std::uint64_t nonfinite = 0;
-  std::vector<ClassMeasure> classes;  // per ClassRow
-  std::optional<RenderOutput> output;  // kept for the reference run
-  bool interrupted = false;           // by Ctrl-C: the rung is not kept
-};
-
 // Renders one rung: `plan` (trace/plan.h) at `budget` with `seed`. A time budget stops the render
-// after the chunk in progress when the time is up; Ctrl-C (g_interrupted) stops it and marks it interrupted.
+// after the chunk in progress when the time is up; Ctrl-C (setup.watch) stops it and marks it interrupted.
 // Under MPI every rank calls it for every rung (it is collective): the ranks deal the rung's
 // passes among themselves (Cluster::deal: whoever is free takes the next chunk), and only rank 0's
 // result holds the rung's measures (the others' `classes` are empty). A rung interrupted on any
@@ -211,26 +111,14 @@ Result<RungResult> run_rung(const RungSetup& setup, const RenderPlan& plan, cons
   ro.threads = setup.threads;
   ro.max_bounces = setup.max_bounces;
   for (int i = 0; i < setup.classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
-  ro.cancel = &g_stop;
-  g_stop.store(g_interrupted.load());
-  std::mutex m;
-  std::condition_variable_any cv;
-  std::jthread timer;
-  if (!budget.spp)
-    timer = std::jthread([&](std::stop_token st) {
-      std::unique_lock lock(m);
-      if (!cv.wait_for(lock, st, std::chrono::duration<double>(budget.seconds), [] { return false; }) && !st.stop_requested())
-        g_stop.store(true);
-    });
-  const double cpu0 = cpu_seconds();
+  setup.watch->restart(budget.spp ? 0.0 : budget.seconds);
+  ro.progress = setup.watch->progress();
+  ro.cancel = setup.watch->cancel();
+  const double cpu0 = process_cpu_seconds();
   const auto wall0 = std::chrono::steady_clock::now();
   Result<RenderOutput> out = render(*setup.scene, plan, setup.classifier, ro);
-  const double cpu1 = cpu_seconds();
+  const double cpu1 = process_cpu_seconds();
   auto wall1 = std::chrono::steady_clock::now();
-  if (timer.joinable()) {
-    timer.request_stop();
-    timer.join();
-  }
   dealer.reset();  // every rank has left the deal: the cluster is free for the reduction
   if (!out) return out.error();
   RungResult r;
@@ -251,171 +139,16 @@ Result<RungResult> run_rung(const RungSetup& setup, const RenderPlan& plan, cons
   const bool root = cluster == nullptr || cluster->rank() == 0;
   r.spp = out->spp_done;
   r.wall_s = std::chrono::duration<double>(wall1 - wall0).count();
-  r.interrupted = g_interrupted.load() || (root && out->spp_done == 0);
+  r.interrupted = setup.watch->interrupted() || (root && out->spp_done == 0);
   if (cluster != nullptr) r.interrupted = cluster->count_failures(!r.interrupted) > 0;
   if (r.interrupted || !root) return r;
-  RunInfo info;
-  info.spp = out->spp_done;
-  std::vector<ClassInfo> infos;
-  for (std::size_t i = 1; i < rows.size(); ++i) infos.push_back({rows[i].name, rows[i].expr});
-  Result<HistogramReport> rep = make_report(out->histogram, info, setup.classifier, infos, std::uint64_t{0});
-  if (!rep) return rep.error();
-  r.nonfinite = rep->nonfinite_samples;
-  const std::vector<ImageLayer> layers = out->images.layers(1.0 / static_cast<double>(out->spp_done));
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const Estimate& e = i == 0 ? rep->total : rep->classes[i - 1].estimate;
-    ClassMeasure c;
-    c.estimate = e.luminance;
-    c.std_error = e.std_error;
-    c.stability = variance_relative_error(class_batch_means(out->histogram, setup.classifier, static_cast<int>(i) - 1));
-    if (rows[i].pixels) {
-      const std::vector<float> lum = luminance_image(layers[i].image);
-      double sum = 0.0;
-      for (std::size_t p = 0; p < lum.size(); ++p) {
-        const double d = static_cast<double>(lum[p]) - static_cast<double>((*rows[i].pixels)[p]);
-        sum += d * d;
-      }
-      c.rms_pixel = lum.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(lum.size()));
-    }
-    r.classes.push_back(c);
-  }
+  if (Result<bool> m = measure_rung(*out, setup.classifier, rows, &r); !m) return m.error();
   r.output = std::move(*out);
   return r;
 }
 
-// --- reference from a file: an earlier run's histogram.json (with classes.exr beside it, or
-// the EXR of the same name), or an EXR alone ---
-
-// `renderer` gets the histogram's renderer (empty for an EXR alone).
-Result<bool> load_reference_file(const std::string& file, int width, int height, std::vector<ClassRow>* rows,
-                                 std::string* renderer) {
-  namespace fs = std::filesystem;
-  std::string exr;
-  if (file.ends_with(".json")) {
-    Result<std::string> text = read_input_file(file, std::uint64_t{1} << 30);
-    if (!text) return text.error();
-    Result<HistogramFile> h = parse_histogram_json(*text, file);
-    if (!h) return h.error();
-    *renderer = h->report.run.renderer;
-    for (ClassRow& row : *rows) {
-      if (row.name == "total") {
-        if (!h->report.only.empty()) continue;  // an --only render's total is not the image's
-        row.reference = h->report.total.luminance;
-        row.reference_stderr = std::isfinite(h->report.total.std_error) ? h->report.total.std_error : 0.0;
-        continue;
-      }
-      for (const ClassEstimate& c : h->report.classes)
-        if (c.name == row.name && c.rendered) {  // a class that was not rendered has no value
-          row.reference = c.estimate.luminance;
-          row.reference_stderr = std::isfinite(c.estimate.std_error) ? c.estimate.std_error : 0.0;
-        }
-    }
-    const fs::path p(file);
-    for (const fs::path& beside : {fs::path(p).replace_extension(".exr"), p.parent_path() / "classes.exr"}) {
-      std::error_code ec;
-      if (fs::exists(beside, ec)) {
-        exr = beside.string();
-        break;
-      }
-    }
-  } else if (file.ends_with(".exr")) {
-    exr = file;
-  } else {
-    return make_error(ErrorCode::kUsage, "--reference " + file + ": expected a histogram.json or an .exr file of an earlier run");
-  }
-  if (!exr.empty()) {
-    Result<std::vector<ImageLayer>> layers = read_exr_layers(exr);
-    if (!layers) return layers.error();
-    for (ClassRow& row : *rows)
-      for (const ImageLayer& l : *layers)
-        if (l.name == row.name) {
-          if (l.image.width != width || l.image.height != height) {
-            Error e = make_error(ErrorCode::kUsage, "the reference image is " + std::to_string(l.image.width) + " x " +
-                                                        std::to_string(l.image.height) + " pixels, the ladder's " +
-                                                        std::to_string(width) + " x " + std::to_string(height) +
-                                                        "; render both at the same --resolution");
-            e.where = exr;
-            return e;
-          }
-          row.pixels = luminance_image(l.image);
-          if (!file.ends_with(".json")) {  // an EXR alone: the image mean is the reference
-            double s = 0.0;
-            for (float v : *row.pixels) s += v;
-            row.reference = row.pixels->empty() ? 0.0 : s / static_cast<double>(row.pixels->size());
-          }
-        }
-  }
-  for (const ClassRow& row : *rows)
-    if (row.reference) return true;
-  return make_error(ErrorCode::kUsage, "--reference " + file + " has none of the classes measured (by name: total or the class file's)");
-}
-
-// --- numbers for the table and JSON ---
-
-nlohmann::ordered_json number_or_null(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); }
-
-std::string fmt(double v, const char* f = "%.5g") {
-  if (!std::isfinite(v)) return "-";
-  char buf[48];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
-// Per renderer and class: the ladder's statistics.
-struct Series {
-  std::vector<double> error, z, efficiency;
-  double pooled_efficiency = std::numeric_limits<double>::quiet_NaN();
-  double slope = std::numeric_limits<double>::quiet_NaN();
-  StderrCheck check;
-  std::string warning;
-};
-
-Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const ClassRow& cr) {
-  Series s;
-  if (!cr.reference) return s;
-  std::vector<RungError> re;
-  std::vector<double> times;
-  double sum_e2t = 0.0;
-  int n = 0;
-  for (const RungResult& r : rungs) {
-    const ClassMeasure& m = r.classes[row];
-    const double err = std::fabs(m.estimate - *cr.reference);
-    const double rounding = kRoundingFloor * std::fabs(*cr.reference);
-    const double sigma =
-        std::sqrt(m.std_error * m.std_error + cr.reference_stderr * cr.reference_stderr + rounding * rounding);
-    s.error.push_back(err);
-    s.z.push_back(sigma > 0.0 ? (m.estimate - *cr.reference) / sigma : std::numeric_limits<double>::quiet_NaN());
-    s.efficiency.push_back(err > 0.0 && r.cpu_s > 0.0 ? 1.0 / (err * err * r.cpu_s) : std::numeric_limits<double>::quiet_NaN());
-    times.push_back(r.cpu_s);
-    re.push_back({m.estimate, m.std_error, m.stability});
-    if (r.cpu_s > 0.0) {
-      sum_e2t += err * err * r.cpu_s;
-      ++n;
-    }
-  }
-  if (n > 0 && sum_e2t > 0.0) s.pooled_efficiency = static_cast<double>(n) / sum_e2t;
-  s.slope = loglog_slope(times, s.error);
-  s.check = check_stderr(re, *cr.reference, cr.reference_stderr);
-  if (s.check.disagrees) {
-    const RungResult& at = rungs[static_cast<std::size_t>(s.check.max_z_rung)];
-    s.warning = "the reported stderr disagrees with the true error: chi2 " + fmt(s.check.chi2, "%.3g") + " over " +
-                std::to_string(s.check.dof) + " rungs (limit " + fmt(s.check.limit, "%.3g") + " at p = 0.001), " +
-                (at.classes[row].std_error > 0.0 ? fmt(s.check.max_abs_z, "%.1f") + " sigma off"
-                                                  : "a stderr of 0 with an error of " + fmt(s.error[static_cast<std::size_t>(s.check.max_z_rung)], "%.3g")) +
-                " at " + at.budget.text();
-  }
-  if (s.check.too_large)
-    s.warning += std::string(s.warning.empty() ? "" : "; ") + "the reported stderr is larger than the true error: chi2 " +
-                 fmt(s.check.lower_chi2, "%.3g") + " over " + std::to_string(s.check.lower_dof) + " rungs (below " +
-                 fmt(s.check.lower_limit, "%.3g") + ", the lower limit at p = 0.001): the error bars overstate the error";
-  if (s.check.unstable)
-    s.warning += std::string(s.warning.empty() ? "" : "; ") + "the stderr is unstable: its batch variance has a relative error of " +
-                 fmt(s.check.stability, "%.2f") + " (limit " + fmt(kUnstableVariance, "%.2f") + "): a few batches carry the estimate";
-  return s;
-}
-
 int run(const ConvergeArgs& a) {
-  const double cpu_start = cpu_seconds();
+  const double cpu_start = process_cpu_seconds();
   const auto wall_start = std::chrono::steady_clock::now();
   double render_wall = 0.0, render_cpu = 0.0;  // inside render(): the ladder and the reference run
   double own_render_cpu = 0.0;                   // the part of render_cpu this process spent (MPI: rank 0's)
@@ -540,11 +273,13 @@ int run(const ConvergeArgs& a) {
   std::vector<ClassRow> rows{{only ? "requested" : "total", only ? requested_text : "$all", std::nullopt, 0.0, std::nullopt, ""}};
   for (const PathClass* c : classes) rows.push_back({c->name, c->text, std::nullopt, 0.0, std::nullopt, ""});
 
-  RungSetup setup{&*scene, &*classifier, a.threads, a.max_bounces};
+  // Ctrl-C (or SIGTERM) stops the rung in progress and keeps the finished ones; the watch shows no
+  // render progress (the rung's line below is converge's).
+  std::optional<RenderWatch> watch;
+  watch.emplace(/*show=*/false);
+  RungSetup setup{&*watch, &*scene, &*classifier, a.threads, a.max_bounces};
   const int width = scene->camera.width, height = scene->camera.height;
   const std::uint64_t base_seed = a.seed;
-  std::signal(SIGINT, on_interrupt);
-  g_interrupted.store(false);
   const bool progress = root && !a.quiet && ::isatty(STDERR_FILENO);
 
   // --- the reference ---
@@ -578,7 +313,7 @@ int run(const ConvergeArgs& a) {
     render_cpu += r->cpu_s;
     own_render_cpu += r->own_cpu_s;
     if (r->interrupted) {
-      std::signal(SIGINT, SIG_DFL);
+      watch.reset();
       if (root) std::cerr << "pathex: interrupted during the reference run; nothing written\n";
       return kExitNo;
     }
@@ -593,8 +328,7 @@ int run(const ConvergeArgs& a) {
     ref.kind = "run";
     ref.source = "a reference run of " + ref_profile->name + " at " + std::to_string(r->spp) + " spp, seed " +
                  std::to_string(seed) + ", written to " + a.out + "/reference.json and reference.exr";
-    ref.run = {{"renderer", ref_profile->name}, {"spp", r->spp}, {"seed", seed}, {"cpu_s", r->cpu_s}, {"wall_s", r->wall_s},
-               {"nonfinite_samples", r->nonfinite}};
+    ref.run = ReferenceRun{ref_profile->name, r->spp, seed, r->cpu_s, r->wall_s, r->nonfinite};
     ref_run = std::move(*r);
   }
 
@@ -673,7 +407,7 @@ int run(const ConvergeArgs& a) {
       results[k].push_back(std::move(*r));
     }
   if (progress) std::cerr << "\r" << std::string(60, ' ') << "\r" << std::flush;
-  std::signal(SIGINT, SIG_DFL);
+  watch.reset();
   if (!root) return complete ? kExitOk : kExitNo;  // the other ranks have done their part
 
   // --- statistics ---
@@ -690,127 +424,10 @@ int run(const ConvergeArgs& a) {
     }
   }
   // The most efficient renderer per class (pooled efficiency 1 / mean(error² × CPU time)).
-  nlohmann::ordered_json best = nlohmann::ordered_json::array();
-  std::vector<std::string> best_lines;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (!rows[i].unmeasurable.empty()) {
-      best_lines.push_back(rows[i].name + ": not measurable with this reference (" + rows[i].unmeasurable + "); nothing ranked");
-      continue;
-    }
-    int top = -1, second = -1;
-    for (std::size_t k = 0; k < profiles.size(); ++k) {
-      const double e = series[k][i].pooled_efficiency;
-      if (!std::isfinite(e) || cannot[k][i]) continue;
-      if (top < 0 || e > series[static_cast<std::size_t>(top)][i].pooled_efficiency) {
-        second = top;
-        top = static_cast<int>(k);
-      } else if (second < 0 || e > series[static_cast<std::size_t>(second)][i].pooled_efficiency) {
-        second = static_cast<int>(k);
-      }
-    }
-    std::string excluded;  // the renderers not ranked on the class: they cannot sample all of it
-    for (std::size_t k = 0; k < profiles.size(); ++k)
-      if (cannot[k][i]) excluded += (excluded.empty() ? "" : ", ") + profiles[k].name + " cannot sample " + *cannot[k][i];
-    if (top < 0) {
-      if (rows[i].reference && !excluded.empty()) best_lines.push_back(rows[i].name + ": none ranked (" + excluded + ")");
-      continue;
-    }
-    const double et = series[static_cast<std::size_t>(top)][i].pooled_efficiency;
-    nlohmann::ordered_json b = {{"class", rows[i].name}, {"renderer", profiles[static_cast<std::size_t>(top)].name}, {"efficiency", et}};
-    std::string line = rows[i].name + ": " + profiles[static_cast<std::size_t>(top)].name + " (efficiency " + fmt(et, "%.3g");
-    if (second >= 0) {
-      const double es = series[static_cast<std::size_t>(second)][i].pooled_efficiency;
-      b["runner_up"] = profiles[static_cast<std::size_t>(second)].name;
-      b["ratio"] = et / es;
-      line += ", " + fmt(et / es, "%.2f") + "x " + profiles[static_cast<std::size_t>(second)].name + "'s";
-    } else {
-      b["runner_up"] = nullptr;
-      b["ratio"] = nullptr;
-    }
-    if (!series[static_cast<std::size_t>(top)][i].warning.empty()) line += "; its stderr is flagged";
-    if (!excluded.empty()) line += "; not ranked: " + excluded;
-    best.push_back(b);
-    best_lines.push_back(line + ")");
-  }
-
-  // --- converge.json ---
-  nlohmann::ordered_json doc;
-  doc["scene"] = a.scene;
-  doc["complete"] = complete;
-  doc["budget"] = by_time ? "time" : "spp";
-  nlohmann::ordered_json lad = nlohmann::ordered_json::array();
-  for (const Budget& b : *ladder) lad.push_back(b.spp ? nlohmann::ordered_json(b.spp) : nlohmann::ordered_json(b.seconds));
-  doc["ladder"] = lad;
-  doc["seed"] = a.seed;
-  doc["threads"] = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
-  doc["ranks"] = cluster != nullptr ? cluster->size() : 1;  // MPI ranks, each with `threads`
-  doc["max_bounces"] = a.max_bounces ? nlohmann::ordered_json(*a.max_bounces) : nlohmann::ordered_json(nullptr);
-  doc["resolution"] = {width, height};
-  if (only) {  // --only: what was estimated, and what was not
-    nlohmann::ordered_json jo = nlohmann::ordered_json::array(), jn = nlohmann::ordered_json::array();
-    for (std::size_t i = 1; i < rows.size(); ++i) jo.push_back({{"name", rows[i].name}, {"expr", rows[i].expr}});
-    for (const PathClass* c : not_rendered)
-      jn.push_back({{"name", c->name}, {"expr", c->text}, {"rendered", false},
-                    {"note", "not rendered: only the requested classes were estimated (--only)"}});
-    doc["only"] = jo;
-    doc["not_rendered"] = jn;
-  }
-  nlohmann::ordered_json jref = {{"kind", ref.kind}, {"source", ref.source}};
-  if (ref.kind == "run") jref["run"] = ref.run;
-  nlohmann::ordered_json jrefc = nlohmann::ordered_json::array();
-  for (const ClassRow& r : rows)
-    jrefc.push_back({{"name", r.name}, {"expr", r.expr}, {"luminance", r.reference ? number_or_null(*r.reference) : nullptr},
-                     {"stderr", r.reference_stderr}, {"per_pixel", r.pixels.has_value()},
-                     {"measurable", r.unmeasurable.empty()},
-                     {"note", r.unmeasurable.empty() ? nlohmann::ordered_json(nullptr)
-                                                     : nlohmann::ordered_json("not measurable with this reference: " + r.unmeasurable)}});
-  jref["classes"] = jrefc;
-  jref["reach_note"] = ref_reach_note.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(ref_reach_note);
-  doc["reference"] = jref;
-  doc["stderr_check"] = {{"alpha", kStderrCheckAlpha}, {"unstable_variance", kUnstableVariance}};
-  nlohmann::ordered_json jren = nlohmann::ordered_json::array();
-  for (std::size_t k = 0; k < profiles.size(); ++k) {
-    std::uint64_t nonfinite = 0;
-    for (const RungResult& r : results[k]) nonfinite += r.nonfinite;
-    nlohmann::ordered_json jc = nlohmann::ordered_json::array();
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      const Series& s = series[k][i];
-      nlohmann::ordered_json jr = nlohmann::ordered_json::array();
-      for (std::size_t j = 0; j < results[k].size(); ++j) {
-        const RungResult& r = results[k][j];
-        const ClassMeasure& m = r.classes[i];
-        jr.push_back({{"budget", r.budget.spp ? nlohmann::ordered_json(r.budget.spp) : nlohmann::ordered_json(r.budget.seconds)},
-                      {"spp", r.spp},
-                      {"seed", r.seed},
-                      {"cpu_s", r.cpu_s},
-                      {"wall_s", r.wall_s},
-                      {"estimate", m.estimate},
-                      {"stderr", number_or_null(m.std_error)},
-                      {"error", j < s.error.size() ? number_or_null(s.error[j]) : nullptr},
-                      {"z", j < s.z.size() ? number_or_null(s.z[j]) : nullptr},
-                      {"rms_pixel_error", m.rms_pixel ? number_or_null(*m.rms_pixel) : nullptr},
-                      {"stderr_stability", number_or_null(m.stability)},
-                      {"efficiency", j < s.efficiency.size() ? number_or_null(s.efficiency[j]) : nullptr}});
-      }
-      jc.push_back({{"name", rows[i].name},
-                    {"expr", rows[i].expr},
-                    {"rungs", jr},
-                    {"slope", number_or_null(s.slope)},
-                    {"efficiency", number_or_null(s.pooled_efficiency)},
-                    {"cannot_sample", cannot[k][i] ? nlohmann::ordered_json(*cannot[k][i]) : nlohmann::ordered_json(nullptr)},
-                    {"stderr_check",
-                     {{"chi2", number_or_null(s.check.chi2)}, {"dof", s.check.dof}, {"limit", s.check.limit},
-                      {"lower_chi2", number_or_null(s.check.lower_chi2)}, {"lower_dof", s.check.lower_dof},
-                      {"lower_limit", s.check.lower_limit},
-                      {"max_abs_z", number_or_null(s.check.max_abs_z)}, {"stability", number_or_null(s.check.stability)},
-                      {"disagrees", s.check.disagrees}, {"too_large", s.check.too_large}, {"unstable", s.check.unstable}}},
-                    {"warning", s.warning.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.warning)}});
-    }
-    jren.push_back({{"name", profiles[k].name}, {"nonfinite_samples", nonfinite}, {"classes", jc}});
-  }
-  doc["renderers"] = jren;
-  doc["best"] = best;
-  doc["warnings"] = warnings;
+  std::vector<std::string> renderer_names;
+  for (const Profile& p : profiles) renderer_names.push_back(p.name);
+  const Rankings rankings = rank_renderers(rows, renderer_names, series, cannot);
+  const std::vector<std::string>& best_lines = rankings.lines;
 
   // --- the plot: one panel per class with a reference ---
   std::vector<PlotPanel> panels;
@@ -832,12 +449,35 @@ int run(const ConvergeArgs& a) {
 
   // Overhead: everything but render() — references, statistics, the plot (the writing below is
   // measured by bench/converge_overhead.py from the outside).
-  const double wall_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  const double cpu_total = cpu_seconds() - cpu_start;
-  doc["timing"] = {{"render_wall_s", render_wall}, {"render_cpu_s", render_cpu},
-                   {"overhead_wall_s", wall_total - render_wall}, {"overhead_cpu_s", cpu_total - own_render_cpu},
-                   {"overhead_pct", render_wall > 0 ? 100.0 * (wall_total - render_wall) / render_wall : 0.0}};
-  const std::string json_text = doc.dump(2) + "\n";
+  ConvergeRun doc;
+  doc.scene = a.scene;
+  doc.complete = complete;
+  doc.by_time = by_time;
+  doc.ladder = *ladder;
+  doc.seed = a.seed;
+  doc.threads = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
+  doc.ranks = cluster != nullptr ? cluster->size() : 1;  // MPI ranks, each with `threads`
+  doc.max_bounces = a.max_bounces;
+  doc.width = width;
+  doc.height = height;
+  doc.only = only;
+  for (const PathClass* c : not_rendered) doc.not_rendered.emplace_back(c->name, c->text);
+  doc.reference_kind = ref.kind;
+  doc.reference_source = ref.source;
+  doc.reference_run = ref.run;
+  doc.reach_note = ref_reach_note;
+  doc.rows = &rows;
+  doc.renderers = renderer_names;
+  doc.results = &results;
+  doc.series = &series;
+  doc.cannot = &cannot;
+  doc.rankings = &rankings;
+  doc.warnings = &warnings;
+  doc.render_wall_s = render_wall;
+  doc.render_cpu_s = render_cpu;
+  doc.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  doc.overhead_cpu_s = process_cpu_seconds() - cpu_start - own_render_cpu;
+  const std::string json_text = converge_json_text(doc);
 
   // --- outputs: one set, whole or not at all ---
   {

@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "automata/ops.h"
-#include "classify/lpe_emit.h"
+#include "language/lpe_emit.h"
 #include "cli/common.h"
 #include "io/class_file.h"
 #include "io/reach_json.h"

@@ -1,5 +1,5 @@
 // What `pathex report` shares with the commands that write a report after their run (trace, bias
-// and converge --report): reading a folder into report.html (io/report_html.h) with the checker's
+// and converge --report): reading a folder into report.html (output/report_html.h) with the checker's
 // verdicts, and the report's options.
 #pragma once
 
@@ -10,7 +10,7 @@
 #include "cli/common.h"
 #include "core/error.h"
 #include "core/limits.h"
-#include "io/report_html.h"
+#include "output/report_html.h"
 
 namespace pathex::cli {
 

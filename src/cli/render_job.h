@@ -12,14 +12,14 @@
 #include <vector>
 
 #include "classify/classifier.h"
-#include "classify/histogram.h"
-#include "classify/image.h"
+#include "stats/histogram.h"
+#include "film/image.h"
 #include "classify/pathclass.h"
 #include "core/error.h"
 #include "core/limits.h"
-#include "core/pass_deal.h"
-#include "core/pass_set.h"
-#include "io/shard.h"
+#include "output/shard.h"
+#include "schedule/pass_deal.h"
+#include "schedule/pass_set.h"
 #include "trace/prune.h"
 #include "trace/render.h"
 
@@ -44,7 +44,7 @@ struct RenderClasses {
 Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string& text, const std::string& filename,
                                                               const RenderIdentity& identity, const Limits& limits);
 
-// Empty sums (RenderSums, io/shard.h) laid out for `identity` and `classes`: every class gets an
+// Empty sums (RenderSums, output/shard.h) laid out for `identity` and `classes`: every class gets an
 // image layer, every connector strategy of the identity its statistics.
 RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& classes);
 
@@ -101,7 +101,7 @@ class Cluster {
   virtual int rank() const = 0;
   virtual int size() const = 0;
   // This rank's side of the deal of `todo` in chunks of `chunk` passes among the ranks
-  // (core/pass_deal.h) for a render of `batches` batches: every rank makes one and renders the
+  // (schedule/pass_deal.h) for a render of `batches` batches: every rank makes one and renders the
   // chunks it is handed until none is left (or it stops). Not collective; while it lives, this
   // rank makes no other call on the cluster, and destroying it waits until every rank has left
   // the deal.

@@ -1,5 +1,5 @@
 // pathex report: a render folder (of pathex trace, bias or converge) as one self-contained
-// report.html (io/report_html.h builds it). The command reads the folder, asks the checker for each
+// report.html (output/report_html.h builds it). The command reads the folder, asks the checker for each
 // class's verdict when the folder is a trace render (the scene and renderer its render.shard names),
 // writes the page and says where. trace, bias and converge call write_folder_report for --report.
 #include <iostream>
@@ -8,7 +8,7 @@
 #include "cli/folder_report.h"
 #include "cli/reach_common.h"
 #include "cli/render_job.h"
-#include "io/report_html.h"
+#include "output/report_html.h"
 #include "reach/query.h"
 #include "scene/scene.h"
 #include "scene/universe.h"

@@ -14,11 +14,11 @@
 
 #include "cli/bias_common.h"
 #include "cli/common.h"
-#include "cli/estimate_text.h"
+#include "io/estimate_text.h"
 #include "cli/folder_report.h"
 #include "cli/reach_common.h"
 #include "cli/render_job.h"
-#include "cli/render_watch.h"
+#include "measure/render_watch.h"
 #include "cli/trace_checks.h"
 #include "core/hash.h"
 #include "core/version.h"
@@ -241,13 +241,6 @@ std::string rank_shard_path(const std::string& dir, int rank) {
   return ranks_folder(dir) + "/rank-" + std::to_string(rank) + kShardExtension;
 }
 
-// CPU seconds used by this process so far, all threads.
-double process_cpu_seconds() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 int run(const TraceArgs& a) {
   // --threads bounds the whole command, not only the render's loop: Embree's BVH build before it
   // and the concurrent writing after it would otherwise start TBB worker threads (which spin
@@ -315,7 +308,7 @@ int run(const TraceArgs& a) {
   }
 
   // --- render the passes still missing: all of them, or under MPI the chunks of them that the
-  // ranks' shared deal hands this rank (whoever is free takes the next, core/pass_deal.h) ---
+  // ranks' shared deal hands this rank (whoever is free takes the next, schedule/pass_deal.h) ---
   const PassSet todo = job.header.share.minus(job.header.passes);
   RenderOptions ro;
   ro.spp = job.header.spp;

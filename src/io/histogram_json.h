@@ -55,7 +55,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "core/error.h"
 
 namespace pathex {

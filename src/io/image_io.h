@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "classify/image.h"
+#include "film/image.h"
 #include "core/error.h"
 
 namespace pathex {

@@ -5,7 +5,7 @@
 
 #include "io/image_read.h"
 #include "scene/scene.h"
-#include "trace/environment.h"
+#include "optics/sphere_map.h"
 
 namespace pathex {
 

@@ -22,7 +22,7 @@
 #include "scene/import_common.h"
 #include "scene/serialized.h"
 #include "scene/metal_spectra.h"
-#include "trace/bsdf_layered.h"  // the coat's internal reflectance, for plastic
+#include "optics/internal_reflectance.h"
 
 namespace pathex {
 namespace {
@@ -620,7 +620,7 @@ class Importer {
         c.roughness = a.alpha.x < kSmoothAlpha ? 0.0f : a.alpha.x;
         c.distribution = a.kind;
       }
-      const float r_bar = bsdf::layered::mean_internal_reflectance(c.eta);
+      const float r_bar = mean_internal_reflectance(c.eta);
       c.reflectance = nonlinear ? rho : rho / (1.0f - r_bar + rho * r_bar);
       for (TextureBinding& b : material_textures_.bindings)
         if (b.param == TexturedParam::kReflectance && !nonlinear) {

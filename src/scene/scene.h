@@ -241,7 +241,7 @@ inline constexpr std::size_t kMaxFaceCorners = 1024;
 
 // The largest emission, intensity, irradiance or power component a scene may give. The tracer sums
 // contributions exactly in fixed point and counts one of 2^50 (about 1.1e15) or more as non-finite
-// (classify/histogram.h); 1e9 leaves a factor of 1e6 for what geometry and sampling multiply a
+// (stats/histogram.h); 1e9 leaves a factor of 1e6 for what geometry and sampling multiply a
 // light's value by. Physical values stay far below it (the sun's radiance is about 2e7 W/(m^2 sr)).
 inline constexpr float kMaxLightValue = 1e9f;
 // The smallest nonzero one (0 is allowed: a light of zero power). Contributions are summed on a

@@ -93,7 +93,7 @@ struct TextureBinding {
   int texture = -1;    // index into Scene::textures
   float scale = 1.0f;  // the value times this, then clamped to [0, 1] (pbrt-v4 diffusetransmission's scale)
   TextureMap map = TextureMap::kLinear;
-  float r_bar = 0.0f;  // kPlastic: the coat's mean internal reflectance (bsdf::layered::mean_internal_reflectance)
+  float r_bar = 0.0f;  // kPlastic: the coat's mean internal reflectance (optics/internal_reflectance.h)
 };
 
 // How a material turns its shading normal (docs/textures.md "Bump and normal maps"): a normal map

@@ -18,7 +18,7 @@
 //
 // Each kind's sampling and evaluation lives in its own file: bsdf.cpp (diffuse, mirror, smooth
 // dielectric, glossy, mixtures, and the dispatch), bsdf_conductor.cpp, bsdf_dielectric.cpp (rough
-// and thin dielectrics), bsdf_transmission.cpp (diffuse transmission); trace/fresnel.h and
+// and thin dielectrics), bsdf_transmission.cpp (diffuse transmission); optics/fresnel.h and
 // trace/microfacet.h are the Fresnel and GGX they share.
 //
 // Dirac deltas (mirror, smooth dielectric, smooth conductor, thin dielectric; DESIGN §7 "MIS": handled symbolically). For a delta
@@ -68,7 +68,7 @@
 #include "alphabet/alphabet.h"
 #include "scene/material.h"
 #include "trace/frame.h"
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/microfacet.h"
 #include "trace/rng.h"
 
@@ -265,7 +265,7 @@ float component_probability(const Material& m, const glm::vec3& wo, const glm::v
 // a join (shadow ray, connection) at a vertex on it carry energy.
 bool has_finite_component(const Material& m);
 
-// The dielectric Fresnel reflectance (trace/fresnel.h), under its old name.
+// The dielectric Fresnel reflectance (optics/fresnel.h), under its old name.
 using pathex::fresnel_dielectric;
 
 // Veach's correction for shading normals in importance transport (thesis §5.3, pbrt-v3's

@@ -1,5 +1,5 @@
 // The conductor (pbrt-v4's ConductorBxDF): the exact Fresnel reflectance of a complex index
-// eta + i k per RGB channel (trace/fresnel.h), on a smooth surface (a Dirac delta, letter S) or on
+// eta + i k per RGB channel (optics/fresnel.h), on a smooth surface (a Dirac delta, letter S) or on
 // GGX or Beckmann microfacets (letter D, trace/microfacet.h) with alpha_u, alpha_v along the shading frame's tangents. Smooth when
 // both alphas are below 1e-3, as pbrt-v4's EffectivelySmooth(). Two-sided, reflection only.
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "trace/bsdf_kinds.h"
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/microfacet.h"
 
 namespace pathex::bsdf::kinds {

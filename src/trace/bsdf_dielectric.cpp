@@ -19,7 +19,7 @@
 #include <glm/geometric.hpp>
 
 #include "trace/bsdf_kinds.h"
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/microfacet.h"
 
 namespace pathex::bsdf::kinds {

@@ -14,7 +14,7 @@
 #include "trace/bsdf.h"
 #include "trace/bsdf_kinds.h"
 #include "trace/frame.h"
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/microfacet.h"
 #include "trace/rng.h"
 
@@ -241,16 +241,6 @@ bool advance(const Slab& slab, float z, const vec3& w, WalkRng& rng, float* z_ne
 
 std::uint64_t key_of(const vec3& wo, const vec3& wi, std::uint64_t salt) {
   return hash_floats(mix64(salt + 0x3c6ef372fe94f82bULL), {wo.x, wo.y, wo.z, wi.x, wi.y, wi.z});
-}
-
-float mean_internal_reflectance(float eta) {
-  constexpr int kSteps = 4096;
-  double sum = 0.0;
-  for (int i = 0; i < kSteps; ++i) {
-    const double mu = (i + 0.5) / kSteps;
-    sum += 2.0 * mu * fresnel_dielectric(static_cast<float>(-mu), eta);
-  }
-  return static_cast<float>(sum / kSteps);
 }
 
 float specular_probability(const CoatedDiffuse& m, float cos_o) {

@@ -76,12 +76,6 @@ inline float pdf(const CoatedDiffuse& m, const glm::vec3& wo, const glm::vec3& w
   return pdf_estimate(m, wo, wi, key_of(wo, wi, 1));
 }
 
-// R̄ = ∫ 2μ F(−μ) dμ: the share of cosine-distributed light from inside that a smooth coat of
-// index eta reflects back (total internal reflection included), by the midpoint rule on 4,096
-// intervals (error below 1e-6). A thin smooth coat over a base of reflectance ρ has the diffuse
-// albedo T(θo) ρ (1 − R̄) / (1 − ρ R̄) (tests/trace/bsdf_test.cpp).
-float mean_internal_reflectance(float eta);
-
 // The probability that sample() returns the coat's delta reflection at wo (the Fresnel
 // reflectance of a smooth coat; 0 for a rough one; 1 for an all_specular() coat).
 float specular_probability(const CoatedDiffuse& m, float cos_o);

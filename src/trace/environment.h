@@ -30,18 +30,11 @@
 #include <glm/vec3.hpp>
 
 #include "alphabet/alphabet.h"
+#include "optics/sphere_map.h"
 #include "trace/piecewise2d.h"
 
 namespace pathex {
 
-// pbrt-v4's equal-area mapping of the square [0,1]² onto the unit sphere (Clarberg's octahedral
-// construction: the square's centre is +z, its corners −z) and its inverse.
-glm::vec3 equal_area_square_to_sphere(glm::vec2 p);
-glm::vec2 equal_area_sphere_to_square(const glm::vec3& d);
-// Mitsuba 3's latitude-longitude mapping: u = φ / 2π, v = θ / π, with the direction
-// (sin φ sin θ, cos θ, −cos φ sin θ): v = 0 is +Y (the image's top row), u = 0 is −Z.
-glm::vec3 latlong_to_direction(glm::vec2 uv);
-glm::vec2 direction_to_latlong(const glm::vec3& d);
 
 // Everything the light needs, shared (immutable) by the render's handles.
 struct EnvironmentMap {

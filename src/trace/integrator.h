@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "classify/classifier.h"
-#include "classify/histogram.h"
-#include "classify/image.h"
+#include "stats/histogram.h"
+#include "film/image.h"
 #include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/joins/join.h"

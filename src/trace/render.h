@@ -22,7 +22,7 @@
 // a mirror) are found clear.
 //
 // Determinism: every random number is a function of (seed, pixel, pass, dimension), and all
-// sums are exact (classify/histogram.h), so results are bit-identical whatever the thread count.
+// sums are exact (stats/histogram.h), so results are bit-identical whatever the thread count.
 #pragma once
 
 #include <array>
@@ -36,11 +36,11 @@
 #include <vector>
 
 #include "classify/classifier.h"
-#include "classify/histogram.h"
-#include "classify/image.h"
+#include "stats/histogram.h"
+#include "film/image.h"
 #include "core/error.h"
-#include "core/pass_deal.h"
-#include "core/pass_set.h"
+#include "schedule/pass_deal.h"
+#include "schedule/pass_set.h"
 #include "reach/profile.h"
 #include "scene/scene.h"
 #include "trace/joins/manifold.h"
@@ -55,7 +55,7 @@ struct RenderPlan;  // trace/plan.h
 inline constexpr std::uint64_t kPassesPerChunk = 4;
 
 // The batch count of a render with `sampler` when none is given (`pathex trace --batches`): the
-// batch means are the standard error's replicates (classify/histogram.h). Under `sobol` every batch
+// batch means are the standard error's replicates (stats/histogram.h). Under `sobol` every batch
 // is an independently scrambled sequence (trace/rng.h, sobol_stream()), so a batch of m passes
 // gains what m points of one sequence gain: fewer, larger batches keep more of the quasi-Monte
 // Carlo gain, more batches make the standard error itself more precise (its relative error is
@@ -68,7 +68,7 @@ struct RenderOptions {
   // The outputs of renders of disjoint pass sets add up exactly to the render of their union.
   std::optional<PassSet> passes;
   // Where the chunks come from instead (then `passes` is ignored): a deal shared with other
-  // processes (core/pass_deal.h), of which this render takes the chunks it is handed.
+  // processes (schedule/pass_deal.h), of which this render takes the chunks it is handed.
   PassDealer* dealer = nullptr;
   std::uint64_t seed = 1;
   int threads = 0;                     // 0: all cores
@@ -111,7 +111,7 @@ struct ConnectorStats {
   std::uint64_t repeats = 0;     // seeds of a first batch that solved to a chain already found in it
   std::uint64_t truncated = 0;   // chains not found again within max_trials seeds (their weight is low)
 
-  // The counts, in a fixed order (the shard file's, io/shard.h, and the MPI reduction's). Each is
+  // The counts, in a fixed order (the shard file's, output/shard.h, and the MPI reduction's). Each is
   // a sum over samples, and a sample's counts depend on (seed, pixel, pass) alone, so the counts
   // of a render are those of its threads, shards, resumed parts or MPI ranks added.
   static constexpr std::size_t kCounts = 14;

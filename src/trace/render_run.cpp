@@ -1,5 +1,5 @@
 // The tracer's entry point, render() (trace/render.h): which profile strategies the tracer runs,
-// and the run itself: the threads (TBB), the passes dealt in chunks (core/pass_deal.h), each
+// and the run itself: the threads (TBB), the passes dealt in chunks (schedule/pass_deal.h), each
 // thread's integrator state, and the threads' histograms, images and statistics summed into the
 // output. The estimator it drives, sample by sample, is render.cpp's Integrator.
 #include <tbb/enumerable_thread_specific.h>
@@ -94,7 +94,7 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
   // Passes run in chunks: a pixel takes a chunk's passes back to back, so that its camera
   // contributions reach the shared image once per chunk (and its part of the scene stays in
   // cache); cancelling stops on a whole chunk, so every finished pass covers the whole image. The
-  // chunks come from a deal (core/pass_deal.h): this render's passes in order, or an MPI job's.
+  // chunks come from a deal (schedule/pass_deal.h): this render's passes in order, or an MPI job's.
   ChunkDeal own(o.passes.value_or(PassSet::range(0, o.spp)), kPassesPerChunk);
   PassDealer& deal = o.dealer != nullptr ? *o.dealer : own;
   bool dealt_all = false;

@@ -75,7 +75,7 @@ enum class SamplerKind : std::uint8_t { kIndependent, kSobol };
 constexpr const char* to_string(SamplerKind k) { return k == SamplerKind::kSobol ? "sobol" : "independent"; }
 
 // The Sobol stream of pass `pass` of a render of `batches` batches: the renderer deals passes to
-// batches round-robin (batch = pass mod B, classify/histogram.h), and each batch is a replicate of
+// batches round-robin (batch = pass mod B, stats/histogram.h), and each batch is a replicate of
 // its own, an independently scrambled sequence whose point index is pass div B — randomized
 // quasi-Monte Carlo with B independent replicates, so that the batch means the standard error is
 // computed from are independent as it assumes (issue 36: one sequence dealt over the batches made

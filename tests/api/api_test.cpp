@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 #include "support/cli_run.h"
 
 namespace {
@@ -131,3 +133,78 @@ TEST(Api, VersionIsTheProjects) {
 }
 
 }  // namespace
+
+// api::bias is `pathex bias`: the same reference, the same missed share and stderr to the last bit
+// (the same render, seed and classes), and the same located messages.
+TEST(Api, BiasMeasuresWhatTheCommandMeasures) {
+  const std::string scene = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/point-mirror-caustic.json";
+  px::BiasOptions o;
+  o.spp = 4;
+  o.threads = 2;
+  const px::BiasAnswer a = px::bias(scene, px::Renderer("pt-nee"), o);
+  ASSERT_TRUE(a.ok()) << a.error;
+  const std::string out = (pathex::test::scratch_dir() / "api-bias").string();
+  const pathex::test::CliRun cli = pathex::test::run_pathex_args(
+      {"bias", scene, "--renderer", "pt-nee", "--spp", "4", "--threads", "1", "--json", "--no-images", "--out", out});
+  ASSERT_EQ(cli.code, 0) << cli.err;
+  const nlohmann::json j = nlohmann::json::parse(cli.out);
+  EXPECT_EQ(a.reference, j["reference"]["name"]);
+  EXPECT_EQ(a.reference, "bdpt+mirror+manifold");
+  EXPECT_EQ(a.share, j["missed"]["share"].get<double>());
+  EXPECT_EQ(a.share_stderr, j["missed"]["share_stderr"].get<double>());
+  EXPECT_EQ(a.total, j["total"]["luminance"].get<double>());
+  EXPECT_EQ(a.missed, j["missed"]["luminance"].get<double>());
+  EXPECT_FALSE(a.exact);
+  // The mirror's caustic: pt-nee cannot join a point light's path through a specular vertex.
+  EXPECT_EQ(a.shortest_missed, "LSDDSE");
+  EXPECT_GT(a.share, 0.5);  // most of this scene's light comes off the mirror
+
+  const px::BiasAnswer missing = px::bias("no-such-scene.json", px::Renderer("pt-nee"), o);
+  EXPECT_FALSE(missing.ok());
+  const pathex::test::CliRun cli_missing =
+      pathex::test::run_pathex_args({"bias", "no-such-scene.json", "--renderer", "pt-nee", "--out", out});
+  EXPECT_EQ(cli_missing.code, 2);
+  EXPECT_EQ("pathex: error: " + missing.error + "\n", cli_missing.err);
+  o.reference = "no-such-reference";
+  const px::BiasAnswer bad_reference = px::bias(scene, px::Renderer("pt-nee"), o);
+  EXPECT_FALSE(bad_reference.ok());
+  EXPECT_NE(bad_reference.error.find("no-such-reference"), std::string::npos) << bad_reference.error;
+  EXPECT_FALSE(px::bias(scene, px::Renderer("no-such-renderer")).ok());
+}
+
+// api::check is `pathex check`: the same outcomes, in order, as the lines the command prints, and
+// the same located message for a file that cannot be run.
+TEST(Api, CheckDecidesWhatTheCommandDecides) {
+  const std::string file = std::string(PATHEX_SOURCE_DIR) + "/samples/checks/fails-on-purpose.json";
+  const px::CheckAnswer a = px::check(file);
+  ASSERT_TRUE(a.ok()) << a.error;
+  EXPECT_FALSE(a.passed());
+  const pathex::test::CliRun cli = pathex::test::run_pathex_args({"check", file});
+  EXPECT_EQ(cli.code, 1);
+  std::size_t at = 0;  // each outcome's line, in the command's order
+  int failed = 0;
+  for (const px::CheckOutcome& o : a.outcomes) {
+    const std::string line = std::string(o.passed ? "PASS  " : "FAIL  ") + o.case_name + ": " + o.requirement + " (" + o.found + ")\n";
+    at = cli.out.find(line, at);
+    EXPECT_NE(at, std::string::npos) << cli.out << "\n---\n" << line;
+    if (at == std::string::npos) break;
+    failed += o.passed ? 0 : 1;
+  }
+  ASSERT_EQ(a.outcomes.size(), 2u);
+  EXPECT_EQ(failed, 2);
+  EXPECT_EQ(a.outcomes[0].requirement, "LSDSDE is reachable");
+  EXPECT_EQ(a.outcomes[0].found, "unreachable");
+  EXPECT_EQ(a.outcomes[0].counterexample, "LSDSDE");
+
+  const px::CheckAnswer samples = px::check(std::string(PATHEX_SOURCE_DIR) + "/samples/checks/samples.json");
+  ASSERT_TRUE(samples.ok()) << samples.error;
+  EXPECT_TRUE(samples.passed());
+  EXPECT_EQ(samples.outcomes.size(), 23u);
+
+  const px::CheckAnswer missing = px::check("no-such-check.json");
+  EXPECT_FALSE(missing.ok());
+  EXPECT_FALSE(missing.passed());
+  const pathex::test::CliRun cli_missing = pathex::test::run_pathex_args({"check", "no-such-check.json"});
+  EXPECT_EQ(cli_missing.code, 2);
+  EXPECT_EQ("pathex: error: " + missing.error + "\n", cli_missing.err);
+}

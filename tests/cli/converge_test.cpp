@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "classify/convergence.h"
+#include "stats/convergence.h"
 #include "support/cli_run.h"
 #include "support/stat_seed.h"
 

@@ -45,7 +45,7 @@ nlohmann::json manifold_stats(const std::string& args) {
   return {};
 }
 
-// The JSON header of DIR/render.shard (io/shard.h: magic, version, header length, header).
+// The JSON header of DIR/render.shard (output/shard.h: magic, version, header length, header).
 nlohmann::json shard_header(const std::string& dir) {
   std::ifstream in(dir + "/render.shard", std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -201,7 +201,7 @@ struct Header {
   std::string head, body;
 };
 
-// The documented layout (io/shard.h): magic, version, H, header, N, body, CRC-32.
+// The documented layout (output/shard.h): magic, version, H, header, N, body, CRC-32.
 Header read_header(const std::string& path) {
   const std::string b = read_file(path);
   std::uint32_t h = 0;

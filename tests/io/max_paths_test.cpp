@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "io/histogram_json.h"
 
 namespace pathex {

@@ -10,8 +10,9 @@
 #include <fstream>
 #include <map>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "io/profile_json.h"
+#include "optics/internal_reflectance.h"
 #include "scene/scene.h"
 #include "trace/bsdf_layered.h"
 #include "support/cli_run.h"
@@ -882,7 +883,7 @@ TEST(ImportMitsuba, PlasticIsACoatOfThicknessZero) {
   EXPECT_EQ(p.albedo, glm::vec3(0.0f));
   EXPECT_TRUE(p.smooth());
   EXPECT_EQ(p.max_depth, 64);
-  const double r_bar = bsdf::layered::mean_internal_reflectance(p.eta);
+  const double r_bar = mean_internal_reflectance(p.eta);
   EXPECT_NEAR(r_bar, 0.5900, 2e-4);
   expect_near(p.reflectance, glm::vec3(static_cast<float>(0.5 / (1.0 - r_bar + 0.5 * r_bar))), "linear plastic's base");
   expect_near(coat(1).reflectance, glm::vec3(0.2f, 0.4f, 0.6f), "nonlinear plastic's base");

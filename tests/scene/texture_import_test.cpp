@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "optics/internal_reflectance.h"
 #include "scene/scene.h"
 #include "support/load_scene.h"
 #include "support/scene_snippets.h"
@@ -228,7 +229,7 @@ TEST(ImportTexturesMitsuba, AlphaSpecularReflectanceAndPlastic) {
   // plastic: the base ρ / (1 − R̄ + ρ R̄) per hit (R̄ of eta 1.49 / 1.000277); nonlinear: ρ itself.
   const TextureBinding& p = textures_of(s, 3).bindings.at(0);
   EXPECT_EQ(p.map, TextureMap::kPlastic);
-  EXPECT_FLOAT_EQ(p.r_bar, bsdf::layered::mean_internal_reflectance(std::get<CoatedDiffuse>(material(3)).eta));
+  EXPECT_FLOAT_EQ(p.r_bar, mean_internal_reflectance(std::get<CoatedDiffuse>(material(3)).eta));
   Material at;
   textured_material(s, material(3), textures_of(s, 3), {0.75f, 0.5f}, &at);  // white: ρ = 1 gives the base 1
   EXPECT_FLOAT_EQ(std::get<CoatedDiffuse>(at).reflectance.x, 1.0f);

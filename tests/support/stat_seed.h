@@ -16,7 +16,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "classify/significance.h"
+#include "stats/significance.h"
 
 namespace pathex::test {
 
@@ -42,7 +42,7 @@ inline void stat_log(const std::string& what, double value, double tolerance) {
 
 // The tolerance, in standard errors, that makes `checks` independent two-sided checks fail
 // together with probability `family_rate` (Šidák over Student's t with `dof` degrees of freedom,
-// 31 for the default 32 batches: classify/convergence.h's sidak_sigmas, the library's one copy).
+// 31 for the default 32 batches: stats/convergence.h's sidak_sigmas, the library's one copy).
 // One place that states a statistical test's false-failure rate.
 inline double family_sigmas(int checks, double family_rate = 1e-3, int dof = 31) {
   return sidak_sigmas(checks, family_rate, dof);

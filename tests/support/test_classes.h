@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "classify/classifier.h"
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "classify/pathclass.h"
 
 namespace pathex::test {

@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "classify/convergence.h"
+#include "stats/convergence.h"
 #include "io/profile_json.h"
 #include "scene/scene.h"
 #include "support/test_classes.h"

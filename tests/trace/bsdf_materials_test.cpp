@@ -22,7 +22,7 @@
 #include "scene/metal_spectra.h"
 #include "support/bsdf_stats.h"
 #include "trace/bsdf.h"
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/microfacet.h"
 #include "trace/rng.h"
 

@@ -7,6 +7,7 @@
 // Tolerances: Monte Carlo means within kZ = 4 standard errors (estimated from the same samples);
 // chi-square statistics below the critical value at z = 5 (false-alarm probability ~3e-7,
 // Wilson–Hilferty). All random numbers come from fixed seeds, so every run is identical.
+#include "optics/internal_reflectance.h"
 #include "trace/bsdf.h"
 
 #include <gtest/gtest.h>
@@ -1279,7 +1280,7 @@ TEST(CoatedDiffuse, DISABLED_MeasureRoughPlasticAgainstMitsubasFormulas) {
         const double spec = mi_spec_albedo(mu0, a, eta, 200000, 3);
         const double ti = 1 - mi_spec_albedo(mu0, a, eta, 200000, 4);
         const double mitsuba = spec + rho / (1 - rint) * ti * integ;
-        const float rbar = bsdf::layered::mean_internal_reflectance(static_cast<float>(eta));
+        const float rbar = mean_internal_reflectance(static_cast<float>(eta));
         CoatedDiffuse c = coated(static_cast<float>(a), glm::vec3(static_cast<float>(rho / (1 - rbar + rho * rbar))), 0.0f, glm::vec3(0.0f), 0.0f, 64);
         c.eta = static_cast<float>(eta);
         const glm::vec3 wo(static_cast<float>(std::sqrt(1 - mu0 * mu0)), 0.0f, static_cast<float>(mu0));

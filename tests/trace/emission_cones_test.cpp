@@ -11,7 +11,7 @@
 
 #include "classify/classifier.h"
 #include "classify/pathclass.h"
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "io/profile_json.h"
 #include "trace/plan.h"
 #include "trace/prune.h"

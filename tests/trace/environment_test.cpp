@@ -15,7 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "classify/classifier.h"
-#include "classify/convergence.h"
+#include "stats/convergence.h"
 #include "classify/pathclass.h"
 #include "io/profile_json.h"
 #include "scene/scene.h"

@@ -11,7 +11,7 @@
 #include <random>
 #include <set>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "io/histogram_json.h"
 #include "io/profile_json.h"
 #include "scene/scene.h"

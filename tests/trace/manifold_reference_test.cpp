@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 
 namespace {
 

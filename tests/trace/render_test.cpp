@@ -8,11 +8,11 @@
 #include <glm/glm.hpp>
 
 #include "classify/classifier.h"
-#include "classify/convergence.h"
+#include "stats/convergence.h"
 #include "classify/pathclass.h"
 #include "io/profile_json.h"
 #include "scene/scene.h"
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/render.h"
 #include "support/scratch_files.h"
 #include "support/stat_seed.h"

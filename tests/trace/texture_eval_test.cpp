@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/rng.h"
 
 namespace pathex {

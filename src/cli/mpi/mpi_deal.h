@@ -1,4 +1,4 @@
-// The ranks' shared deal of an MPI render's passes (core/pass_deal.h): whoever is free takes the
+// The ranks' shared deal of an MPI render's passes (schedule/pass_deal.h): whoever is free takes the
 // next chunk, so a rank on a faster (or less loaded) core takes more of them than a static share
 // would give it, and no rank waits for another at the end for longer than about a chunk.
 //
@@ -23,7 +23,7 @@
 #include <optional>
 #include <thread>
 
-#include "core/pass_deal.h"
+#include "schedule/pass_deal.h"
 
 namespace pathex::cli {
 

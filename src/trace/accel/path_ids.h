@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "classify/histogram.h"
+#include "stats/histogram.h"
 #include "trace/rng.h"
 
 namespace pathex::accel {

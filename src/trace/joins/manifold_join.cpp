@@ -8,7 +8,7 @@
 
 #include "trace/media.h"
 #include "trace/frame.h"
-#include "trace/fresnel.h"
+#include "optics/fresnel.h"
 #include "trace/integrator.h"
 #include "trace/joins/manifold.h"
 

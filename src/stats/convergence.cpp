@@ -1,0 +1,142 @@
+// The statistics of a convergence ladder; the formulas and thresholds are in convergence.h.
+#include "stats/convergence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pathex {
+
+std::vector<double> class_batch_means(const Histogram& histogram, const Classifier* classifier, int class_index) {
+  const int batches = histogram.num_batches();
+  std::vector<ExactRgb> sums(static_cast<std::size_t>(batches), ExactRgb{});
+  for (Histogram::PathId id = 0; id < histogram.num_paths(); ++id) {
+    if (class_index >= 0) {
+      if (classifier == nullptr) return {};
+      const std::vector<int>& members = classifier->members(histogram.class_set(id));
+      if (std::find(members.begin(), members.end(), class_index) == members.end()) continue;
+    }
+    for (int b = 0; b < batches; ++b) add_to(sums[static_cast<std::size_t>(b)], histogram.cell(id, b).sum);
+  }
+  std::vector<double> means;
+  for (int b = 0; b < batches; ++b) {
+    const std::uint64_t n = histogram.batch_samples(b);
+    if (n == 0) continue;
+    means.push_back(luminance(to_double(sums[static_cast<std::size_t>(b)])) / static_cast<double>(n));
+  }
+  return means;
+}
+
+double variance_relative_error(const std::vector<double>& x) {
+  const std::size_t n = x.size();
+  if (n < 4) return std::numeric_limits<double>::quiet_NaN();
+  double mean = 0.0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(n);
+  double m2 = 0.0, m4 = 0.0;
+  for (double v : x) {
+    const double d2 = (v - mean) * (v - mean);
+    m2 += d2;
+    m4 += d2 * d2;
+  }
+  m2 /= static_cast<double>(n);
+  m4 /= static_cast<double>(n);
+  if (!(m2 > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  const double b = static_cast<double>(n);
+  const double kurtosis = m4 / (m2 * m2);
+  return std::sqrt(std::max(0.0, (kurtosis - (b - 3.0) / (b - 1.0)) / b));
+}
+
+namespace {
+
+// P(χ²_k > x) for an integer k, in closed form: for even k, e^(-x/2) Σ_{i<k/2} (x/2)^i / i!; for
+// odd k, erfc(sqrt(x/2)) + e^(-x/2) Σ_{i=1}^{(k-1)/2} (x/2)^(i-1/2) / Γ(i + 1/2).
+double chi2_survival(double x, int k) {
+  const double h = 0.5 * x;
+  double sum = 0.0;
+  if (k % 2 == 0) {
+    double term = 1.0;
+    for (int i = 0; i < k / 2; ++i) {
+      sum += term;
+      term *= h / (i + 1);
+    }
+    return std::exp(-h) * sum;
+  }
+  for (int i = 1; i <= (k - 1) / 2; ++i) sum += std::exp((i - 0.5) * std::log(h) - h - std::lgamma(i + 0.5));
+  return std::erfc(std::sqrt(h)) + sum;
+}
+
+double median(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+}  // namespace
+
+double chi2_upper_quantile(int dof, double alpha) {
+  // Bisection on the survival function, which falls from 1 at x = 0.
+  double lo = 0.0, hi = 10.0 + 10.0 * dof;
+  while (chi2_survival(hi, dof) > alpha) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (chi2_survival(mid, dof) > alpha ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+StderrCheck check_stderr(const std::vector<RungError>& rungs, double reference, double reference_stderr) {
+  StderrCheck c;
+  std::vector<double> stabilities;
+  for (std::size_t i = 0; i < rungs.size(); ++i) {
+    const RungError& r = rungs[i];
+    stabilities.push_back(r.stability);
+    if (!std::isfinite(r.std_error)) continue;
+    const double rounding = kRoundingFloor * std::fabs(reference);
+    const double sigma =
+        std::sqrt(r.std_error * r.std_error + reference_stderr * reference_stderr + rounding * rounding);
+    const double err = std::fabs(r.estimate - reference);
+    double z = 0.0;
+    if (sigma > 0.0) z = err / sigma;
+    else if (err > 0.0) z = std::numeric_limits<double>::infinity();  // a zero stderr, a zero reference, an error
+    c.chi2 += z * z;
+    ++c.dof;
+    if (r.std_error > rounding) {
+      c.lower_chi2 += z * z;
+      ++c.lower_dof;
+    }
+    if (z > c.max_abs_z || c.max_z_rung < 0) {
+      c.max_abs_z = z;
+      c.max_z_rung = static_cast<int>(i);
+    }
+  }
+  c.limit = c.dof > 0 ? chi2_upper_quantile(c.dof, kStderrCheckAlpha) : 0.0;
+  c.disagrees = c.dof > 0 && c.chi2 > c.limit;
+  c.lower_limit = c.lower_dof > 0 ? chi2_upper_quantile(c.lower_dof, 1.0 - kStderrCheckAlpha) : 0.0;
+  c.too_large = c.lower_dof > 0 && c.lower_chi2 < c.lower_limit;
+  c.stability = median(stabilities);
+  c.unstable = std::isfinite(c.stability) && c.stability >= kUnstableVariance;
+  return c;
+}
+
+double loglog_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < x.size() && i < y.size(); ++i) {
+    if (!(x[i] > 0.0) || !(y[i] > 0.0) || !std::isfinite(x[i]) || !std::isfinite(y[i])) continue;
+    const double lx = std::log(x[i]), ly = std::log(y[i]);
+    sx += lx;
+    sy += ly;
+    sxx += lx * lx;
+    sxy += lx * ly;
+    ++n;
+  }
+  if (n < 2) return std::numeric_limits<double>::quiet_NaN();
+  const double den = n * sxx - sx * sx;
+  if (!(den > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return (n * sxy - sx * sy) / den;
+}
+
+}  // namespace pathex

@@ -1,0 +1,29 @@
+#include "stats/significance.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pathex {
+
+double student_two_sided_tail(double x, int dof) {
+  const double nu = std::max(dof, 1);
+  const double c = std::exp(std::lgamma((nu + 1) / 2) - std::lgamma(nu / 2)) / std::sqrt(nu * 3.14159265358979323846);
+  auto f = [&](double t) { return c * std::pow(1 + t * t / nu, -(nu + 1) / 2); };
+  const int n = 4000;  // even
+  const double h = x / n;
+  double sum = f(0) + f(x);
+  for (int i = 1; i < n; ++i) sum += f(i * h) * (i % 2 ? 4 : 2);
+  return std::max(0.0, 1 - 2 * sum * h / 3);
+}
+
+double sidak_sigmas(int checks, double family_rate, int dof) {
+  const double each = 1 - std::pow(1 - family_rate, 1.0 / std::max(checks, 1));
+  double lo = 0, hi = 60;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (student_two_sided_tail(mid, dof) > each ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+}  // namespace pathex

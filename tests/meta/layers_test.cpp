@@ -1,0 +1,137 @@
+// Issue 38: nothing includes a module above it. The library's folders are layers, bottom to top,
+// in the order src/CMakeLists.txt lists them in PATHEX_LIB_DIRS (the one place the order is
+// written; a subfolder such as trace/joins belongs to its folder), with the command line, cli/, on
+// top. This test reads every source file under src/ and fails on an include of a folder that comes
+// later in that order, naming the file, the line and both folders; and on a folder of src/ that
+// the order does not place.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace pathex {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The layers, bottom first: PATHEX_LIB_DIRS's folders (first path component, once each), then cli.
+std::vector<std::string> layer_order(const std::string& cmake) {
+  const std::regex line(R"(set\(PATHEX_LIB_DIRS ([^)]*)\))");
+  std::smatch m;
+  std::vector<std::string> order;
+  if (!std::regex_search(cmake, m, line)) return order;
+  std::istringstream words(m[1].str());
+  std::string w;
+  while (words >> w) {
+    const std::string top = w.substr(0, w.find('/'));
+    if (std::find(order.begin(), order.end(), top) == order.end()) order.push_back(top);
+  }
+  order.push_back("cli");
+  return order;
+}
+
+struct UpwardInclude {
+  std::string where;  // file:line
+  std::string from, to;
+};
+
+// Every quoted include of a folder of src/ above the including file's folder.
+std::vector<UpwardInclude> upward_includes(const fs::path& src, const std::map<std::string, int>& rank) {
+  std::vector<UpwardInclude> found;
+  const std::regex include(R"(^\s*#\s*include\s*"([a-z_]+)/)");
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(src)) {
+    const std::string ext = e.path().extension().string();
+    if (!e.is_regular_file() || (ext != ".h" && ext != ".cpp")) continue;
+    const std::string rel = fs::relative(e.path(), src).generic_string();
+    const std::string folder = rel.substr(0, rel.find('/'));
+    const auto own = rank.find(folder);
+    if (own == rank.end()) continue;  // reported by the test below
+    std::istringstream lines(read_file(e.path()));
+    std::string l;
+    for (int n = 1; std::getline(lines, l); ++n) {
+      std::smatch m;
+      if (!std::regex_search(l, m, include)) continue;
+      const auto to = rank.find(m[1].str());
+      if (to != rank.end() && to->second > own->second)
+        found.push_back({"src/" + rel + ":" + std::to_string(n), folder, m[1].str()});
+    }
+  }
+  return found;
+}
+
+TEST(Layers, NothingIncludesAFolderAboveIt) {
+  const fs::path src = fs::path(PATHEX_SOURCE_DIR) / "src";
+  const std::vector<std::string> order = layer_order(read_file(src / "CMakeLists.txt"));
+  ASSERT_GT(order.size(), 10u) << "PATHEX_LIB_DIRS not found in src/CMakeLists.txt";
+  std::map<std::string, int> rank;
+  for (std::size_t i = 0; i < order.size(); ++i) rank[order[i]] = static_cast<int>(i);
+  for (const UpwardInclude& u : upward_includes(src, rank))
+    ADD_FAILURE() << u.where << ": " << u.from << "/ includes " << u.to << "/, which is above it (src/CMakeLists.txt's "
+                  << "PATHEX_LIB_DIRS lists the layers bottom to top)";
+}
+
+TEST(Layers, EveryFolderOfSrcHasItsPlace) {
+  const fs::path src = fs::path(PATHEX_SOURCE_DIR) / "src";
+  const std::vector<std::string> order = layer_order(read_file(src / "CMakeLists.txt"));
+  const std::set<std::string> placed(order.begin(), order.end());
+  for (const fs::directory_entry& e : fs::directory_iterator(src))
+    if (e.is_directory()) EXPECT_TRUE(placed.count(e.path().filename().string())) << e.path().filename() << " is not in PATHEX_LIB_DIRS";
+}
+
+// README.md's Layout lists the folders of src/ ("      name/  what it holds"), in the layer order:
+// `ls src/` and the manual say the same thing.
+TEST(Layers, TheReadmesLayoutListsTheFoldersInTheirOrder) {
+  const fs::path root = fs::path(PATHEX_SOURCE_DIR);
+  const std::vector<std::string> order = layer_order(read_file(root / "src" / "CMakeLists.txt"));
+  const std::string readme = read_file(root / "README.md");
+  const std::size_t begin = readme.find("\n## Layout\n");
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t end = readme.find("\n## ", begin + 1);
+  std::istringstream lines(readme.substr(begin, end - begin));
+  const std::regex folder(R"(^      ([a-z_]+)/ )");
+  std::vector<std::string> listed;
+  std::string l;
+  while (std::getline(lines, l)) {
+    std::smatch m;
+    if (std::regex_search(l, m, folder)) listed.push_back(m[1].str());
+  }
+  EXPECT_EQ(listed, order);
+  std::set<std::string> in_src;
+  for (const fs::directory_entry& e : fs::directory_iterator(root / "src"))
+    if (e.is_directory()) in_src.insert(e.path().filename().string());
+  EXPECT_EQ(std::set<std::string>(listed.begin(), listed.end()), in_src);
+}
+
+// The check itself: an include running up the order is found, one running down is not.
+TEST(Layers, AnUpwardIncludeIsFound) {
+  const fs::path dir = fs::temp_directory_path() / "pathex-layers-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "low");
+  fs::create_directories(dir / "high");
+  std::ofstream(dir / "low" / "a.h") << "#pragma once\n#include \"low/b.h\"\n#include <vector>\n#include \"high/c.h\"\n";
+  std::ofstream(dir / "high" / "c.h") << "#pragma once\n#include \"low/a.h\"\n";
+  const std::vector<UpwardInclude> found = upward_includes(dir, {{"low", 0}, {"high", 1}});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].where, "src/low/a.h:4");
+  EXPECT_EQ(found[0].to, "high");
+  EXPECT_EQ(layer_order("set(PATHEX_LIB_DIRS core trace trace/joins io)"),
+            (std::vector<std::string>{"core", "trace", "io", "cli"}));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pathex

@@ -1,0 +1,95 @@
+// The statistics of `pathex converge` (stats/convergence.h): the χ² quantile against tables,
+// the stability of the batch variance for normal and spiky batch means, the stderr check on
+// honest and lying ladders, and the log-log slope.
+#include "stats/convergence.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace pathex {
+namespace {
+
+// Upper points of χ² (Abramowitz & Stegun table 26.8).
+TEST(Convergence, ChiSquareQuantilesMatchTheTable) {
+  EXPECT_NEAR(chi2_upper_quantile(1, 1e-3), 10.828, 1e-3);
+  EXPECT_NEAR(chi2_upper_quantile(4, 1e-3), 18.467, 1e-3);
+  EXPECT_NEAR(chi2_upper_quantile(5, 1e-3), 20.515, 1e-3);
+  EXPECT_NEAR(chi2_upper_quantile(10, 1e-3), 29.588, 1e-3);
+  EXPECT_NEAR(chi2_upper_quantile(4, 0.05), 9.488, 1e-3);
+}
+
+TEST(Convergence, BatchVarianceIsStableForNormalMeansAndNotForASpike) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> normal(1.0, 0.1);
+  double sum = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<double> x(32);
+    for (double& v : x) v = normal(rng);
+    sum += variance_relative_error(x);
+  }
+  EXPECT_NEAR(sum / 200, std::sqrt(2.0 / 31.0), 0.05);  // 0.254 for normal batch means
+  std::vector<double> spike(32, 0.0);
+  spike[7] = 32.0;  // one batch holds the whole estimate
+  EXPECT_GT(variance_relative_error(spike), kUnstableVariance);
+  EXPECT_TRUE(std::isnan(variance_relative_error({1.0, 2.0, 3.0})));  // too few batches
+  EXPECT_TRUE(std::isnan(variance_relative_error(std::vector<double>(8, 2.0))));
+}
+
+TEST(Convergence, StderrCheckPassesHonestLaddersAndFlagsLyingOnes) {
+  // Honest: errors of about one stderr.
+  const StderrCheck honest = check_stderr({{1.01, 0.01, 0.25}, {0.995, 0.005, 0.3}, {1.002, 0.0025, 0.2}}, 1.0, 0.0);
+  EXPECT_FALSE(honest.lies());
+  EXPECT_EQ(honest.dof, 3);
+  EXPECT_NEAR(honest.chi2, 1.0 + 1.0 + 0.64, 1e-6);
+  // 14 sigma off at one rung.
+  const StderrCheck off = check_stderr({{0.86, 0.01, 0.25}, {1.0, 0.005, 0.3}}, 1.0, 0.0);
+  EXPECT_TRUE(off.disagrees);
+  EXPECT_NEAR(off.max_abs_z, 14.0, 1e-6);
+  EXPECT_EQ(off.max_z_rung, 0);
+  // A peak missed entirely: estimate 0 with stderr 0 (off by a million times the rounding floor).
+  const StderrCheck missed = check_stderr({{0.0, 0.0, std::numeric_limits<double>::quiet_NaN()}}, 0.04, 0.0);
+  EXPECT_TRUE(missed.disagrees);
+  EXPECT_NEAR(missed.max_abs_z, 1.0 / kRoundingFloor, 1.0);
+  EXPECT_TRUE(std::isinf(check_stderr({{0.1, 0.0, 0.5}}, 0.0, 0.0).max_abs_z));  // a zero reference
+  // An exact estimator (no variance) is within single-precision rounding of the closed form.
+  EXPECT_FALSE(check_stderr({{0.15915494, 1e-11, 0.25}}, 0.159154943, 0.0).lies());
+  // Unstable: most rungs' batch variance is carried by a few batches.
+  EXPECT_TRUE(check_stderr({{1.0, 0.1, 0.9}, {1.0, 0.1, 0.8}, {1.0, 0.1, 0.2}}, 1.0, 0.0).unstable);
+  // The reference's own stderr widens the band.
+  EXPECT_FALSE(check_stderr({{1.05, 0.01, 0.25}}, 1.0, 0.02).disagrees);
+}
+
+// Issue 36: the lower tail. χ²_2's lower point at p is −2 ln(1 − p) in closed form (its survival
+// function is e^(−x/2)); a ladder whose errors are far inside their error bars — a stderr 30×
+// the true error at every rung — is flagged as too large, and an honest one is not. Rungs with a
+// stderr at the rounding floor (exact estimators) do not count: an error of 0 there is no sign.
+TEST(Convergence, StderrCheckFlagsAStderrThatIsTooLarge) {
+  EXPECT_NEAR(chi2_upper_quantile(2, 1.0 - 1e-3), -2.0 * std::log(1.0 - 1e-3), 1e-9);
+  EXPECT_NEAR(chi2_upper_quantile(4, 1.0 - 1e-3), 0.09080, 1e-4);  // A & S table 26.8
+  const StderrCheck big = check_stderr({{1.0003, 0.01, 0.25}, {0.99985, 0.005, 0.3}, {1.0001, 0.0025, 0.2}, {1.00004, 0.00125, 0.2}}, 1.0, 0.0);
+  EXPECT_TRUE(big.too_large);
+  EXPECT_FALSE(big.disagrees);
+  EXPECT_TRUE(big.lies());
+  EXPECT_EQ(big.lower_dof, 4);
+  EXPECT_NEAR(big.lower_chi2, 0.0009 + 0.0009 + 0.0016 + 0.001024, 1e-9);
+  EXPECT_NEAR(big.lower_limit, 0.09080, 1e-4);
+  EXPECT_FALSE(check_stderr({{1.01, 0.01, 0.25}, {0.995, 0.005, 0.3}, {1.002, 0.0025, 0.2}}, 1.0, 0.0).too_large);
+  // An exact estimator: its stderr (1e-11) is below the rounding floor of 0.159 (1.6e-7), so its
+  // error of 0 is not counted in the lower tail.
+  const StderrCheck exact = check_stderr({{0.159154943, 1e-11, 0.25}, {0.159154943, 1e-12, 0.25}}, 0.159154943, 0.0);
+  EXPECT_EQ(exact.lower_dof, 0);
+  EXPECT_FALSE(exact.lies());
+}
+
+TEST(Convergence, LogLogSlope) {
+  EXPECT_NEAR(loglog_slope({1, 4, 16, 64}, {1, 0.5, 0.25, 0.125}), -0.5, 1e-12);
+  EXPECT_NEAR(loglog_slope({1, 10, 0, 100}, {3, 30, 1, 300}), 1.0, 1e-12);  // x = 0 is left out
+  EXPECT_TRUE(std::isnan(loglog_slope({1}, {1})));
+}
+
+}  // namespace
+}  // namespace pathex
