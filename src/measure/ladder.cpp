@@ -1,5 +1,6 @@
 #include "measure/ladder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -163,7 +164,9 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
     s.z.push_back(sigma > 0.0 ? (m.estimate - *cr.reference) / sigma : std::numeric_limits<double>::quiet_NaN());
     s.efficiency.push_back(err > 0.0 && r.cpu_s > 0.0 ? 1.0 / (err * err * r.cpu_s) : std::numeric_limits<double>::quiet_NaN());
     times.push_back(r.cpu_s);
-    re.push_back({m.estimate, m.std_error, m.stability});
+    // B = min(spp, the batch count) batches, so the stderr has B − 1 degrees of freedom.
+    re.push_back({m.estimate, m.std_error, m.stability,
+                  static_cast<int>(std::min<std::uint64_t>(r.spp, static_cast<std::uint64_t>(kDefaultBatches))) - 1});
     if (r.cpu_s > 0.0) {
       sum_e2t += err * err * r.cpu_s;
       ++n;

@@ -61,10 +61,11 @@ struct RungError {
   double estimate = 0.0;
   double std_error = 0.0;   // reported; NaN when the render had too few batches
   double stability = 0.0;   // variance_relative_error of its batch means (NaN: unknown)
+  int dof = 0;              // the stderr's degrees of freedom (batches − 1); 0: its z is taken as normal
 };
 
 struct StderrCheck {
-  double chi2 = 0.0;        // Σ z_i² over the rungs with a stderr
+  double chi2 = 0.0;        // Σ z_i² over the rungs with a stderr (each z_i as the normal deviate of its t tail)
   int dof = 0;              // how many
   double limit = 0.0;       // chi2_upper_quantile(dof, kStderrCheckAlpha)
   // The lower tail counts only the rungs whose stderr is above the rounding floor (an exact

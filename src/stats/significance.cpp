@@ -16,6 +16,17 @@ double student_two_sided_tail(double x, int dof) {
   return std::max(0.0, 1 - 2 * sum * h / 3);
 }
 
+double normal_equivalent(double x, int dof) {
+  const double p = student_two_sided_tail(std::fabs(x), dof);
+  if (!(p > 1e-12)) return std::fabs(x);  // beyond what the tail's quadrature resolves
+  double lo = 0, hi = std::fabs(x);       // a normal tail is lighter: its point lies below x
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 double sidak_sigmas(int checks, double family_rate, int dof) {
   const double each = 1 - std::pow(1 - family_rate, 1.0 / std::max(checks, 1));
   double lo = 0, hi = 60;

@@ -9,6 +9,11 @@ namespace pathex {
 // from B batches has B − 1), by Simpson's rule over [0, x] of its density.
 double student_two_sided_tail(double x, int dof);
 
+// The |z| of a normal deviate as far into its two-sided tail as `x` is into Student's t's with
+// `dof` degrees of freedom (x itself where that tail is below double precision): a batch-means z
+// made fit for a χ² sum, which assumes normal deviates (stats/convergence.h check_stderr).
+double normal_equivalent(double x, int dof);
+
 // The tolerance, in standard errors, at which `checks` independent two-sided checks of
 // t-distributed deviations (`dof` degrees of freedom) fail together with probability
 // `family_rate` when nothing is wrong (Šidák: each at 1 − (1 − family_rate)^(1/checks)).

@@ -10,6 +10,8 @@
 #include <random>
 #include <vector>
 
+#include "stats/significance.h"
+
 namespace pathex {
 namespace {
 
@@ -61,6 +63,25 @@ TEST(Convergence, StderrCheckPassesHonestLaddersAndFlagsLyingOnes) {
   EXPECT_TRUE(check_stderr({{1.0, 0.1, 0.9}, {1.0, 0.1, 0.8}, {1.0, 0.1, 0.2}}, 1.0, 0.0).unstable);
   // The reference's own stderr widens the band.
   EXPECT_FALSE(check_stderr({{1.05, 0.01, 0.25}}, 1.0, 0.02).disagrees);
+}
+
+// A batch-means z is Student's t with B − 1 degrees of freedom; the χ² check sums it as the normal
+// deviate of the same two-sided tail. With many degrees of freedom that is z itself; with 31 a
+// 3.5σ deviation is a normal 3.19σ (both tails 1.4e-3), and the χ² of four of them falls from 49
+// to 40.8 — an honest ladder of 32 batches no longer alarms at t's heavier tail.
+TEST(Convergence, StderrCheckReadsBatchMeansZAsStudentsT) {
+  EXPECT_NEAR(normal_equivalent(3.0, 100000), 3.0, 1e-3);
+  const double y = normal_equivalent(3.5, 31);
+  EXPECT_LT(y, 3.5);
+  EXPECT_NEAR(std::erfc(y / std::sqrt(2.0)), student_two_sided_tail(3.5, 31), 1e-9);
+  EXPECT_NEAR(y, 3.19, 0.01);
+  EXPECT_EQ(normal_equivalent(-3.5, 31), y);
+  EXPECT_EQ(normal_equivalent(200.0, 31), 200.0);  // beyond the tail's quadrature: z itself
+  std::vector<RungError> rungs(4, RungError{1.035, 0.01, 0.25, 31});
+  const StderrCheck t = check_stderr(rungs, 1.0, 0.0);
+  EXPECT_NEAR(t.chi2, 4 * y * y, 1e-6);
+  for (RungError& r : rungs) r.dof = 0;  // taken as normal: z² as it is
+  EXPECT_NEAR(check_stderr(rungs, 1.0, 0.0).chi2, 4 * 3.5 * 3.5, 1e-6);
 }
 
 // Issue 36: the lower tail. χ²_2's lower point at p is −2 ln(1 − p) in closed form (its survival
