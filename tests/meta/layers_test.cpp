@@ -16,17 +16,14 @@
 #include <string>
 #include <vector>
 
+#include "support/cli_run.h"
+
 namespace pathex {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::read_file;  // tests/support/cli_run.h: the tests' one file reader
 
 // The layers, bottom first: PATHEX_LIB_DIRS's folders (first path component, once each), then cli.
 std::vector<std::string> layer_order(const std::string& cmake) {
@@ -88,8 +85,11 @@ TEST(Layers, EveryFolderOfSrcHasItsPlace) {
   const fs::path src = fs::path(PATHEX_SOURCE_DIR) / "src";
   const std::vector<std::string> order = layer_order(read_file(src / "CMakeLists.txt"));
   const std::set<std::string> placed(order.begin(), order.end());
-  for (const fs::directory_entry& e : fs::directory_iterator(src))
-    if (e.is_directory()) EXPECT_TRUE(placed.count(e.path().filename().string())) << e.path().filename() << " is not in PATHEX_LIB_DIRS";
+  for (const fs::directory_entry& e : fs::directory_iterator(src)) {
+    if (e.is_directory()) {
+      EXPECT_TRUE(placed.count(e.path().filename().string())) << e.path().filename() << " is not in PATHEX_LIB_DIRS";
+    }
+  }
 }
 
 // README.md's Layout lists the folders of src/ ("      name/  what it holds"), in the layer order:

@@ -13,17 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "support/cli_run.h"
+
 namespace pathex {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::read_file;  // tests/support/cli_run.h: the tests' one file reader
 
 // A top-level block of a test file: a function or a TEST, from its first line to the `}` that
 // closes it at column 0 (the project's format puts it there).
