@@ -78,15 +78,19 @@ const std::vector<Case>& cases() {
   return c;
 }
 
+// The library's plan of case `c` over `scene`, as pathex trace makes it (its profile's bound, else 16).
+RenderPlan library_plan(const Scene& scene, const Case& c) {
+  const Profile profile = resolve_profile(c.renderer, Limits{}).expect("a profile");
+  return plan_render(scene, profile, profile.max_bounces.value_or(16), requested_classes(scene, c.only), Limits{}).expect("a plan");
+}
+
 // The library's plan and the API's: the same strategies (name and what runs), the same aimed
 // lights, and the same filter on every path of the scene up to 12 letters.
 TEST(Plan, TheApiGetsTheLibrarysPlan) {
   for (const Case& c : cases()) {
     const std::string what = c.scene + " " + c.renderer;
     const Scene scene = load_scene_file(kScenes + c.scene).expect("a sample scene");
-    const Profile profile = resolve_profile(c.renderer, Limits{}).expect("a profile");
-    const RenderPlan plan =
-        plan_render(scene, profile, profile.max_bounces.value_or(16), requested_classes(scene, c.only), Limits{}).expect("a plan");
+    const RenderPlan plan = library_plan(scene, c);
     const api::Plan ap(api::Renderer(c.renderer), kScenes + c.scene, c.only);
     ASSERT_TRUE(ap.ok()) << what << ": " << ap.error();
     std::vector<std::string> strategies;
@@ -117,9 +121,7 @@ TEST(Plan, TraceRendersTheLibrarysPlan) {
   for (const Case& c : cases()) {
     const std::string what = c.scene + " " + c.renderer;
     const Scene scene = load_scene_file(kScenes + c.scene).expect("a sample scene");
-    const Profile profile = resolve_profile(c.renderer, Limits{}).expect("a profile");
-    const RenderPlan plan =
-        plan_render(scene, profile, profile.max_bounces.value_or(16), requested_classes(scene, c.only), Limits{}).expect("a plan");
+    const RenderPlan plan = library_plan(scene, c);
     const std::string out = (test::scratch_dir() / ("plan-" + c.renderer + "-" + std::to_string(&c - cases().data()))).string();
     std::string args = "trace samples/scenes/" + c.scene + " --renderer " + c.renderer + " --spp 2 --resolution 12x12 --quiet --out " +
                        test::shell_quote(out);
