@@ -1,3 +1,7 @@
+// Textures at a hit (docs/textures.md): an image's bilinear look-up with its wrap mode, the procedural
+// textures (checkerboard, scale, mix, constant) by recursion over the scene's texture list, and a
+// material with its textured parameters evaluated and put in place, so that the BSDFs see plain
+// numbers and stay unaware of textures; and the shading normal a bump or normal map turns.
 #include "trace/texture_eval.h"
 
 #include <algorithm>
