@@ -56,6 +56,9 @@ STATISTICAL_TESTS = [
     ("environment_test", "ImageInfiniteLight.*"),
     ("manifold_test", "ManifoldRender.PointGlassCausticAgreesWithLightTracingAndBdpt"),
     ("manifold_test", "ManifoldRender.PointGlassSeenThroughIsFoundAndEveryAttemptCounted"),
+    ("piecewise2d_test", "Piecewise2D.SamplesFollowTheDensityAndReportIt"),
+    ("emission_cones_test", "EmissionCones.SampledDensityIsThePdfAndTheEstimatorIsUnbiased"),
+    ("convergence_test", "Convergence.BatchVarianceIsStableForNormalMeansAndNotForASpike"),
 ]
 # tests/meta/stat_registry_test.cpp checks that every test reaching test::stat_seed is listed here.
 

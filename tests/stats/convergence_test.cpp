@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "stats/significance.h"
+#include "support/stat_seed.h"
 
 namespace pathex {
 namespace {
@@ -25,7 +26,7 @@ TEST(Convergence, ChiSquareQuantilesMatchTheTable) {
 }
 
 TEST(Convergence, BatchVarianceIsStableForNormalMeansAndNotForASpike) {
-  std::mt19937_64 rng(3);
+  std::mt19937_64 rng(test::stat_seed(3));
   std::normal_distribution<double> normal(1.0, 0.1);
   double sum = 0;
   for (int trial = 0; trial < 200; ++trial) {
