@@ -56,6 +56,7 @@ STATISTICAL_TESTS = [
     ("environment_test", "ImageInfiniteLight.*"),
     ("manifold_test", "ManifoldRender.PointGlassCausticAgreesWithLightTracingAndBdpt"),
     ("manifold_test", "ManifoldRender.PointGlassSeenThroughIsFoundAndEveryAttemptCounted"),
+    ("manifold_test", "ManifoldWalk.SumOverChainsIsTheBruteForceIrradiance"),
     ("piecewise2d_test", "Piecewise2D.SamplesFollowTheDensityAndReportIt"),
     ("emission_cones_test", "EmissionCones.SampledDensityIsThePdfAndTheEstimatorIsUnbiased"),
     ("convergence_test", "Convergence.BatchVarianceIsStableForNormalMeansAndNotForASpike"),

@@ -212,7 +212,7 @@ TEST(ManifoldWalk, SumOverChainsIsTheBruteForceIrradiance) {
     const double b = glm::dot(oc, d), disc = std::max(b * b - (glm::dot(oc, oc) - r * r), 0.0);
     return inside ? -b + std::sqrt(disc) : -b - std::sqrt(disc);
   };
-  std::mt19937_64 rng(1);
+  std::mt19937_64 rng(test::stat_seed(1));
   std::uniform_real_distribution<double> uni(0, 1);
   // A direction uniform in the cone from `from` around the sphere.
   const auto cone = [&](dvec3 from) {
@@ -224,10 +224,13 @@ TEST(ManifoldWalk, SumOverChainsIsTheBruteForceIrradiance) {
     return glm::normalize(s * std::cos(phi) * t1 + s * std::sin(phi) * t2 + z * axis);
   };
   const double radii[] = {0.05, 0.2};
-  const double dr = 0.005;
+  // The annulus' half-width: its average of the irradiance differs from the value at its radius
+  // by a bias ∝ dr² (near the axis, where three chains meet, 2.8σ at dr = 0.005 over 30 seeds:
+  // the fixed seed passed, 16 % of others failed); at 0.0025 with twice the rays, about 0.7σ.
+  const double dr = 0.0025;
   double sums[2] = {0, 0};
   long counts[2] = {0, 0};
-  const long rays = 2000000;
+  const long rays = 4000000;
   const double cos_max = std::sqrt(1 - r * r / glm::dot(c - a, c - a)), omega = 2 * M_PI * (1 - cos_max);
   for (long i = 0; i < rays; ++i) {
     const dvec3 d = cone(a);
@@ -268,8 +271,11 @@ TEST(ManifoldWalk, SumOverChainsIsTheBruteForceIrradiance) {
       walk += w.dw_db * (1 - fresnel(c0, n)) * (1 - fresnel(std::fabs(c1), 1 / n));
     }
     EXPECT_EQ(found.size(), k == 0 ? 3u : 1u) << "radius " << radii[k];
-    // The brute force's error: a count's relative σ is 1 / √count (the weights vary little).
-    EXPECT_NEAR(walk, brute, 4.0 * brute / std::sqrt(static_cast<double>(counts[k])) + 1e-3 * brute) << "radius " << radii[k];
+    // The brute force's error: a count's relative σ is 1 / √count (the weights vary little); two
+    // radii, 0.1 % family-wise, and 0.1 % of the value for what is left of the annulus' bias.
+    const double sigma = brute / std::sqrt(static_cast<double>(counts[k]));
+    test::stat_log("manifold walk against brute force, radius " + std::to_string(radii[k]), (walk - brute) / sigma, test::family_sigmas(2, 1e-3, 1 << 20));
+    EXPECT_NEAR(walk, brute, test::family_sigmas(2, 1e-3, 1 << 20) * sigma + 1e-3 * brute) << "radius " << radii[k];
   }
 }
 
