@@ -14,7 +14,7 @@
 #include "io/estimate_text.h"
 #include "cli/folder_report.h"
 #include "measure/render_watch.h"
-#include "cli/trace_checks.h"
+#include "scene/resolution.h"
 #include "cli/witness_text.h"
 #include "io/atomic_file.h"
 #include "io/histogram_json.h"
