@@ -6,7 +6,8 @@
 //      and what a render of a scene would run (its Plan);
 //   3. classify full-path strings by a set of named classes in one pass;
 //   4. measure how much of a scene's light a renderer cannot sample (`pathex bias`);
-//   5. run a check file, the CI gate (`pathex check`).
+//   5. run a check file, the CI gate (`pathex check`);
+//   6. measure what accuracy costs in time per renderer and class (`pathex converge`).
 //
 //   #include <pathex/pathex.h>
 //   pathex::api::PathClass caustic("L..S+D.*..E");
@@ -208,5 +209,67 @@ struct CheckAnswer {
 };
 
 CheckAnswer check(const std::string& check_file);
+
+// What accuracy costs in time, as `pathex converge SCENE --renderer R1 --renderer R2 …` measures
+// it: every renderer renders the scene at every rung of a ladder of samples per pixel (rung i of
+// renderer k with seed + 1000 k + i), and each rung's estimate per class is compared with a
+// reference: the scene's closed form, an earlier run's histogram.json or EXR, or a reference run
+// made with `reference_renderer` (by default bdpt plus the connectors the scene needs) at
+// `reference_factor` times the last rung. The numbers are the command's, bit for bit (its
+// converge.json); only the times differ between runs. Ctrl-C (SIGINT) and SIGTERM are caught while
+// the call renders: they end the rung in progress and the answer holds the finished rungs.
+struct ConvergeOptions {
+  std::vector<std::uint64_t> spp = {4, 16, 64, 256};  // the ladder, increasing
+  std::uint64_t seed = 1;
+  int threads = 0;                     // 0: all cores; the numbers do not depend on it
+  std::optional<int> max_bounces;      // unset: each profile's own bound, else 16
+  std::string classes_file;            // empty: the scene's closed-form classes, else the built-ins
+  std::vector<std::string> only;       // the requested classes (expressions or $name), as --only
+  std::string reference;               // an earlier run's histogram.json or EXR; empty: see above
+  std::string reference_renderer;      // a profile name or file; empty: the default
+  std::uint64_t reference_factor = 4;
+  // A folder to write converge.json, converge.svg and converge.png into (with reference.json and
+  // reference.exr after a reference run), as one set; empty: nothing is written.
+  std::string out;
+};
+
+struct ConvergeRung {
+  std::uint64_t spp = 0;
+  double cpu_s = 0;                  // rendering CPU seconds, all threads
+  double estimate = 0;               // the class's mean luminance over the image
+  double std_error = 0;              // its reported standard error
+  std::optional<double> error;       // estimate − reference (none without a reference, or not finite)
+  std::optional<double> z;           // error / std_error (none when not finite)
+};
+
+struct ConvergeSeries {
+  std::string renderer;
+  std::vector<ConvergeRung> rungs;
+  double slope = 0;                  // of log |error| against log CPU time (−0.5 for 1/sqrt(t)); NaN: none
+  double efficiency = 0;             // 1 / mean(error² × CPU s) over the ladder; NaN: none
+  std::string cannot_sample;         // a path of the class it cannot sample (then it is not ranked)
+  std::string warning;               // the reported stderr does not tell the truth, when not empty
+};
+
+struct ConvergeClass {
+  std::string name;                  // "total" (or "requested" with `only`), then each class
+  std::string expression;
+  std::optional<double> reference;   // none: no error is measured on this class
+  std::vector<ConvergeSeries> renderers;  // in the order given
+  std::string best;                  // the most efficient renderer; empty: none ranked
+};
+
+struct ConvergeAnswer {
+  std::string reference_kind;        // "closed-form", "file" or "run"
+  std::string reference_source;
+  std::vector<ConvergeClass> classes;
+  std::vector<std::string> warnings;
+  bool complete = true;              // false: interrupted, the finished rungs only
+  std::string error;                 // why there is no answer: the command's located message
+  bool ok() const { return error.empty(); }
+};
+
+ConvergeAnswer converge(const std::string& scene_file, const std::vector<Renderer>& renderers,
+                        const ConvergeOptions& options = {});
 
 }  // namespace pathex::api

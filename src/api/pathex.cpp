@@ -3,10 +3,11 @@
 // Each public object holds a shared, immutable Impl built once by its constructor; a failed
 // construction keeps the rendered Error (the same text the CLI prints) and nothing else. Nothing
 // here adds behaviour: compile_class, resolve_profile, query, read_class_file, the Classifier,
-// measure_missed, parse_check and decide_check are the functions the `pathex` command calls.
+// measure_missed, parse_check, decide_check and converge are the functions the `pathex` command calls.
 #include "pathex/pathex.h"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "automata/ops.h"
@@ -17,6 +18,7 @@
 #include "io/class_file.h"
 #include "io/input_file.h"
 #include "io/profile_json.h"
+#include "measure/converge.h"
 #include "reach/query.h"
 #include "scene/scene.h"
 #include "scene/universe.h"
@@ -206,7 +208,7 @@ Plan::Plan(const Renderer& renderer, const std::string& scene, const std::vector
     impl->error = s.error().render();
     return;
   }
-  // The requested classes as pathex trace compiles them (cli/render_job.cpp): a built-in class by
+  // The requested classes as pathex trace compiles them (output/render_job.cpp): a built-in class by
   // its $name, any other expression for the scene's ends.
   const SceneTypes types = scene_types(*s);
   ClassOptions copts;
@@ -375,6 +377,85 @@ CheckAnswer check(const std::string& check_file) {
   }
   for (const Outcome& o : *decided)
     a.outcomes.push_back({o.c->name, o.r->describe(), o.passed, o.verdict, o.counterexample ? o.counterexample->path : ""});
+  return a;
+}
+
+}  // namespace pathex::api
+
+namespace pathex::api {
+
+// --- converge ---
+
+ConvergeAnswer converge(const std::string& scene_file, const std::vector<Renderer>& renderers, const ConvergeOptions& options) {
+  ConvergeAnswer a;
+  pathex::ConvergeOptions co;
+  co.scene = scene_file;
+  for (const Renderer& r : renderers) {
+    if (!r.ok()) {
+      a.error = r.error();
+      return a;
+    }
+    co.renderers.push_back(Access::of(r).requested);
+  }
+  for (std::uint64_t spp : options.spp) co.spp_list += (co.spp_list.empty() ? "" : ",") + std::to_string(spp);
+  if (options.spp.empty()) co.spp_list = ",";  // refused by the ladder's parser, as an empty --spp
+  co.seed = options.seed;
+  co.threads = options.threads;
+  co.max_bounces = options.max_bounces;
+  co.classes_file = options.classes_file;
+  co.only = options.only;
+  co.reference = options.reference;
+  co.reference_renderer = options.reference_renderer;
+  co.reference_factor = options.reference_factor;
+  co.out = options.out;
+  Result<pathex::ConvergeResult> run = pathex::converge(co);
+  if (!run) {
+    a.error = run.error().render();
+    return a;
+  }
+  const pathex::ConvergeResult& r = *run;
+  if (!r.nothing_to_render.empty()) {
+    a.error = r.nothing_to_render;
+    return a;
+  }
+  if (r.reference_interrupted) {
+    a.error = "interrupted during the reference run";
+    return a;
+  }
+  a.reference_kind = r.reference_kind;
+  a.reference_source = r.reference_source;
+  a.warnings = r.warnings;
+  a.complete = r.complete;
+  for (std::size_t i = 0; i < r.rows.size(); ++i) {
+    ConvergeClass c;
+    c.name = r.rows[i].name;
+    c.expression = r.rows[i].expr;
+    c.reference = r.rows[i].reference;
+    for (const Ranking& b : r.rankings.best)
+      if (b.cls == c.name) c.best = b.renderer;
+    for (std::size_t k = 0; k < r.renderers.size(); ++k) {
+      const Series& s = r.series[k][i];
+      ConvergeSeries cs;
+      cs.renderer = r.renderers[k];
+      for (std::size_t j = 0; j < r.results[k].size(); ++j) {
+        const RungResult& rung = r.results[k][j];
+        ConvergeRung cr;
+        cr.spp = rung.spp;
+        cr.cpu_s = rung.cpu_s;
+        cr.estimate = rung.classes[i].estimate;
+        cr.std_error = rung.classes[i].std_error;
+        if (j < s.error.size() && std::isfinite(s.error[j])) cr.error = s.error[j];
+        if (j < s.z.size() && std::isfinite(s.z[j])) cr.z = s.z[j];
+        cs.rungs.push_back(cr);
+      }
+      cs.slope = s.slope;
+      cs.efficiency = s.pooled_efficiency;
+      if (r.cannot[k][i]) cs.cannot_sample = *r.cannot[k][i];
+      cs.warning = s.warning;
+      c.renderers.push_back(std::move(cs));
+    }
+    a.classes.push_back(std::move(c));
+  }
   return a;
 }
 

@@ -7,14 +7,14 @@
 #include <iostream>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
 #include "cli/bias_common.h"
+#include "output/bias_json.h"
+#include "output/render_job.h"
 #include "cli/common.h"
 #include "io/estimate_text.h"
 #include "cli/folder_report.h"
 #include "measure/render_watch.h"
-#include "cli/trace_checks.h"
+#include "scene/resolution.h"
 #include "cli/witness_text.h"
 #include "io/atomic_file.h"
 #include "io/histogram_json.h"
@@ -126,8 +126,7 @@ int run(BiasArgs a) {
     return measure_missed(*scene, a.scene, *renderer, a.reference, (*classes)->classes, a.options);
   }();
   if (!run) return report(run.error());
-  const nlohmann::ordered_json doc = to_json(run->report);
-  const std::string bias_text = doc.dump(2) + "\n";
+  const std::string bias_text = bias_json_text(run->report);
 
   // --- outputs: one set, whole or not at all ---
   {

@@ -2,37 +2,10 @@
 
 #include "io/estimate_text.h"
 #include "cli/witness_text.h"
-#include "io/input_file.h"
 #include "io/histogram_json.h"
 #include "io/reach_json.h"
 
 namespace pathex::cli {
-
-Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_file, const Scene& scene,
-                                                    const Limits& limits) {
-  RenderIdentity ends;
-  const SceneTypes types = scene_types(scene);
-  for (LightType l : types.lights) ends.lights.push_back(to_string(l));
-  ends.sensor = to_string(types.sensor);
-  std::string text;
-  if (!classes_file.empty()) {
-    Result<std::string> read = read_input_file(classes_file, limits.max_file_bytes);
-    if (!read) return read.error();
-    text = std::move(*read);
-  }
-  Result<std::unique_ptr<RenderClasses>> classes = compile_render_classes(text, classes_file, ends, limits);
-  if (!classes) return classes.error();
-  const auto& user = (*classes)->table.user_classes();
-  for (std::size_t i = 0; i < user.size(); ++i)
-    if (user[i]->name == kMissedClass) {
-      Error e = make_error(ErrorCode::kBadValue, std::string("the class name '") + kMissedClass +
-                                                     "' is reserved for what the renderer misses (missed.exr), "
-                                                     "expected another name");
-      e.where = classes_file + ":/classes/" + std::to_string(i) + "/name";
-      return e;
-    }
-  return classes;
-}
 
 std::string missed_line(const BiasReport& r) {
   if (r.covered)

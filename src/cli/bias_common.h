@@ -1,26 +1,16 @@
-// What `bias`, `trace --missed` and the check file's `missed` requirement share: the classes a
-// render labels, the reference render and its report as JSON and as text.
+// What `bias`, `trace --missed` and the check file's `missed` requirement print: the report as
+// text (the classes bias renders: output/render_job.h's bias_classes).
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "bias/bias.h"
-#include "cli/render_job.h"
 #include "classify/pathclass.h"
 #include "core/error.h"
-#include "output/bias_json.h"
 #include "scene/scene.h"
 
 namespace pathex::cli {
-
-// The classes of a render of `scene`, as trace compiles them (cli/render_job.h): the class file's
-// or, without one, the built-ins but $all; Heckbert and LPE entries get the scene's light and
-// sensor types. A class file entry named "missed" (bias's layer) is refused at its JSON pointer.
-Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_file, const Scene& scene,
-                                                    const Limits& limits);
 
 // "pt-nee cannot sample 6.3 % ± 0.08 % of what bdpt finds (luminance 0.04064 ± 0.00049 of 0.64123)".
 std::string missed_line(const BiasReport& r);

@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "cli/common.h"
-#include "cli/render_job.h"
+#include "output/render_job.h"
 #include "io/output_set.h"
 
 namespace pathex::cli {

@@ -7,7 +7,7 @@
 #include "cli/common.h"
 #include "cli/folder_report.h"
 #include "cli/reach_common.h"
-#include "cli/render_job.h"
+#include "output/render_job.h"
 #include "output/report_html.h"
 #include "reach/query.h"
 #include "scene/scene.h"

@@ -17,7 +17,8 @@
 #include "io/estimate_text.h"
 #include "cli/folder_report.h"
 #include "cli/reach_common.h"
-#include "cli/render_job.h"
+#include "output/bias_json.h"
+#include "output/render_job.h"
 #include "measure/render_watch.h"
 #include "cli/trace_checks.h"
 #include "core/hash.h"
@@ -444,7 +445,7 @@ int run(const TraceArgs& a) {
       if (!r) return r.error();
       written = std::move(*r);
       if (missed)  // what pathex bias writes to bias.json, without images
-        if (Result<bool> m = write_file_atomic(dir + "/missed.json", to_json(*missed).dump(2) + "\n"); !m) return m;
+        if (Result<bool> m = write_file_atomic(dir + "/missed.json", bias_json_text(*missed)); !m) return m;
       if (a.report_html) {  // a file of the set, from the files just staged and what is in memory
         const auto start = std::chrono::steady_clock::now();
         KnownRender known;  // histogram.json and render.shard's header as written, not read back

@@ -2,7 +2,7 @@
 // their references, each rung's measures, and the statistics of a renderer's rungs against the
 // reference (error, z, efficiency 1/(error² × time), the error's slope against time and the check
 // that the reported standard error tells the truth, stats in stats/convergence.h). The command
-// (cli/converge.cpp) renders the rungs and prints; what is measured and judged is here.
+// (cli/converge.cpp) prints; its run (measure/converge.h) renders the rungs; what is measured and judged is here.
 #pragma once
 
 #include <cstdint>

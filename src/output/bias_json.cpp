@@ -93,4 +93,6 @@ nlohmann::ordered_json to_json(const BiasReport& r) {
   return j;
 }
 
+std::string bias_json_text(const BiasReport& r) { return to_json(r).dump(2) + "\n"; }
+
 }  // namespace pathex

@@ -2,6 +2,8 @@
 // `missed` requirement reports and `trace --missed` shares.
 #pragma once
 
+#include <string>
+
 #include <nlohmann/json.hpp>
 
 #include "bias/bias.h"
@@ -9,5 +11,7 @@
 namespace pathex {
 
 nlohmann::ordered_json to_json(const BiasReport& r);
+// bias.json's text: to_json(r), indented by 2, with a final newline.
+std::string bias_json_text(const BiasReport& r);
 
 }  // namespace pathex

@@ -172,6 +172,79 @@ TEST(Api, BiasMeasuresWhatTheCommandMeasures) {
   EXPECT_FALSE(px::bias(scene, px::Renderer("no-such-renderer")).ok());
 }
 
+// api::converge is `pathex converge`: the same references, estimates, stderrs, errors and z per
+// class, renderer and rung as the command's converge.json, bit for bit (only times differ), and
+// the same located message for a scene that cannot be read.
+TEST(Api, ConvergeMeasuresWhatTheCommandMeasures) {
+  const std::string scene = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/closed-sphere-point.json";
+  px::ConvergeOptions o;
+  o.spp = {4, 16};
+  o.threads = 2;
+  const px::ConvergeAnswer a = px::converge(scene, {px::Renderer("pt-nee"), px::Renderer("bdpt")}, o);
+  ASSERT_TRUE(a.ok()) << a.error;
+  const std::string out = (pathex::test::scratch_dir() / "api-converge").string();
+  const pathex::test::CliRun cli = pathex::test::run_pathex_args({"converge", scene, "--renderer", "pt-nee", "--renderer", "bdpt",
+                                                                  "--spp", "4,16", "--threads", "1", "--json", "--quiet", "--out", out});
+  ASSERT_EQ(cli.code, 0) << cli.err;
+  const nlohmann::json j = nlohmann::json::parse(cli.out);
+  EXPECT_EQ(a.reference_kind, "closed-form");
+  EXPECT_EQ(a.reference_kind, j["reference"]["kind"]);
+  EXPECT_EQ(a.reference_source, j["reference"]["source"]);
+  EXPECT_TRUE(a.complete);
+  const nlohmann::json& refs = j["reference"]["classes"];
+  ASSERT_EQ(a.classes.size(), refs.size());
+  EXPECT_EQ(a.classes.front().name, "total");
+  const auto same = [](const std::optional<double>& v, const nlohmann::json& n) {
+    return n.is_null() ? !v.has_value() : v.has_value() && *v == n.get<double>();
+  };
+  int compared = 0;
+  for (std::size_t i = 0; i < a.classes.size(); ++i) {
+    const px::ConvergeClass& c = a.classes[i];
+    EXPECT_EQ(c.name, refs[i]["name"]);
+    EXPECT_EQ(c.expression, refs[i]["expr"]);
+    EXPECT_TRUE(same(c.reference, refs[i]["luminance"])) << c.name;
+    ASSERT_EQ(c.renderers.size(), 2u);
+    for (std::size_t k = 0; k < 2; ++k) {
+      const px::ConvergeSeries& s = c.renderers[k];
+      const nlohmann::json& jc = j["renderers"][k]["classes"][i];
+      EXPECT_EQ(s.renderer, j["renderers"][k]["name"]);
+      EXPECT_EQ(c.name, jc["name"]);
+      ASSERT_EQ(s.rungs.size(), 2u);
+      ASSERT_EQ(jc["rungs"].size(), 2u);
+      for (std::size_t r = 0; r < 2; ++r) {
+        const nlohmann::json& jr = jc["rungs"][r];
+        EXPECT_EQ(s.rungs[r].spp, jr["spp"].get<std::uint64_t>());
+        EXPECT_EQ(s.rungs[r].estimate, jr["estimate"].get<double>()) << c.name << " " << s.renderer << " rung " << r;
+        EXPECT_TRUE(same(s.rungs[r].std_error, jr["stderr"])) << c.name << " " << s.renderer << " rung " << r;
+        EXPECT_TRUE(same(s.rungs[r].error, jr["error"])) << c.name << " " << s.renderer << " rung " << r;
+        EXPECT_TRUE(same(s.rungs[r].z, jr["z"])) << c.name << " " << s.renderer << " rung " << r;
+        ++compared;
+      }
+      EXPECT_EQ(s.cannot_sample, jc["cannot_sample"].is_null() ? "" : jc["cannot_sample"].get<std::string>());
+    }
+  }
+  EXPECT_GE(compared, 8);  // at least the total and one class, two renderers, two rungs
+  // The closed form's total is 1 / pi, and the total has an error on every rung.
+  EXPECT_DOUBLE_EQ(*a.classes.front().reference, 0.31830988618379069);
+  EXPECT_TRUE(a.classes.front().renderers[0].rungs[1].error.has_value());
+  for (const nlohmann::json& b : j["best"])
+    for (const px::ConvergeClass& c : a.classes)
+      if (c.name == b["class"]) {
+        EXPECT_EQ(c.best, b["renderer"]) << c.name;
+      }
+
+  const px::ConvergeAnswer missing = px::converge("no-such-scene.json", {px::Renderer("pt-nee")}, o);
+  EXPECT_FALSE(missing.ok());
+  const pathex::test::CliRun cli_missing =
+      pathex::test::run_pathex_args({"converge", "no-such-scene.json", "--renderer", "pt-nee", "--out", out});
+  EXPECT_EQ(cli_missing.code, 2);
+  EXPECT_EQ("pathex: error: " + missing.error + "\n", cli_missing.err);
+  EXPECT_FALSE(px::converge(scene, {px::Renderer("no-such-renderer")}, o).ok());
+  px::ConvergeOptions decreasing = o;
+  decreasing.spp = {16, 4};
+  EXPECT_FALSE(px::converge(scene, {px::Renderer("pt-nee")}, decreasing).ok());
+}
+
 // api::check is `pathex check`: the same outcomes, in order, as the lines the command prints, and
 // the same located message for a file that cannot be run.
 TEST(Api, CheckDecidesWhatTheCommandDecides) {

@@ -48,9 +48,9 @@ int run_mpi_command_line(int argc, char** argv) {
   int code = 0;
   {
     pathex::cli::MpiCluster cluster;
-    pathex::cli::set_cluster(&cluster);
+    pathex::set_cluster(&cluster);
     code = pathex::cli::run_command_line(argc, argv);
-    pathex::cli::set_cluster(nullptr);
+    pathex::set_cluster(nullptr);
   }
   MPI_Finalize();
   return code;

@@ -1,4 +1,4 @@
-// The ranks of an MPI job as a Cluster (cli/render_job.h); see mpi_cluster.cpp.
+// The ranks of an MPI job as a Cluster (output/render_job.h); see mpi_cluster.cpp.
 #pragma once
 
 #include <mpi.h>
@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "cli/render_job.h"
+#include "output/render_job.h"
 
 namespace pathex::cli {
 

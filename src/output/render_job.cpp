@@ -1,4 +1,4 @@
-#include "cli/render_job.h"
+#include "output/render_job.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,8 +15,9 @@
 #include "io/class_file.h"
 #include "io/histogram_json.h"
 #include "io/image_io.h"
+#include "io/input_file.h"
 
-namespace pathex::cli {
+namespace pathex {
 
 Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string& text, const std::string& filename,
                                                               const RenderIdentity& identity, const Limits& limits) {
@@ -73,6 +74,32 @@ Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string&
   out->classifier = std::make_unique<Classifier>(std::move(*classifier));
   for (const PathClass* c : out->classes) out->infos.push_back({c->name, c->text});
   return out;
+}
+
+Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_file, const Scene& scene,
+                                                    const Limits& limits) {
+  RenderIdentity ends;
+  const SceneTypes types = scene_types(scene);
+  for (LightType l : types.lights) ends.lights.push_back(to_string(l));
+  ends.sensor = to_string(types.sensor);
+  std::string text;
+  if (!classes_file.empty()) {
+    Result<std::string> read = read_input_file(classes_file, limits.max_file_bytes);
+    if (!read) return read.error();
+    text = std::move(*read);
+  }
+  Result<std::unique_ptr<RenderClasses>> classes = compile_render_classes(text, classes_file, ends, limits);
+  if (!classes) return classes.error();
+  const auto& user = (*classes)->table.user_classes();
+  for (std::size_t i = 0; i < user.size(); ++i)
+    if (user[i]->name == kMissedClass) {
+      Error e = make_error(ErrorCode::kBadValue, std::string("the class name '") + kMissedClass +
+                                                     "' is reserved for what the renderer misses (missed.exr), "
+                                                     "expected another name");
+      e.where = classes_file + ":/classes/" + std::to_string(i) + "/name";
+      return e;
+    }
+  return classes;
 }
 
 RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& classes) {
@@ -328,9 +355,9 @@ Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, con
   return std::move(*out);
 }
 
-}  // namespace pathex::cli
+}  // namespace pathex
 
-namespace pathex::cli {
+namespace pathex {
 namespace {
 Cluster* g_cluster = nullptr;
 }  // namespace
@@ -338,4 +365,4 @@ Cluster* g_cluster = nullptr;
 Cluster* current_cluster() { return g_cluster; }
 void set_cluster(Cluster* cluster) { g_cluster = cluster; }
 
-}  // namespace pathex::cli
+}  // namespace pathex

@@ -1,4 +1,4 @@
-#include "output/converge_json.h"
+#include "measure/converge_json.h"
 
 #include <cmath>
 

@@ -17,13 +17,15 @@
 #include "classify/pathclass.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "bias/bias.h"
+#include "scene/scene.h"
 #include "output/shard.h"
 #include "schedule/pass_deal.h"
 #include "schedule/pass_set.h"
 #include "trace/prune.h"
 #include "trace/render.h"
 
-namespace pathex::cli {
+namespace pathex {
 
 // The classes of a render, compiled: the class file's entries (or the built-ins but $all), then
 // each --only expression that is not one of them by name ($name), as class "only-N".
@@ -43,6 +45,12 @@ struct RenderClasses {
 // classes) and identity.only against the end types of `identity` (lights, sensor).
 Result<std::unique_ptr<RenderClasses>> compile_render_classes(const std::string& text, const std::string& filename,
                                                               const RenderIdentity& identity, const Limits& limits);
+
+// The classes of a render of `scene`, as trace compiles them (compile_render_classes): the class file's
+// or, without one, the built-ins but $all; Heckbert and LPE entries get the scene's light and
+// sensor types. A class file entry named "missed" (bias's layer) is refused at its JSON pointer.
+Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_file, const Scene& scene,
+                                                    const Limits& limits);
 
 // Empty sums (RenderSums, output/shard.h) laid out for `identity` and `classes`: every class gets an
 // image layer, every connector strategy of the identity its statistics.
@@ -88,9 +96,9 @@ struct CombinedRender {
 // of different renders (identity_difference) or holding the same pass twice (naming the passes).
 Result<CombinedRender> combine_shards(const std::vector<std::string>& paths, const Limits& limits);
 
-}  // namespace pathex::cli
+}  // namespace pathex
 
-namespace pathex::cli {
+namespace pathex {
 
 // The processes one render is split across: one by default; pathex-mpi installs its MPI ranks
 // (cli/mpi/) before running the command line. Each rank renders the chunks of the run's passes
@@ -118,4 +126,4 @@ class Cluster {
 Cluster* current_cluster();  // null: one process
 void set_cluster(Cluster* cluster);
 
-}  // namespace pathex::cli
+}  // namespace pathex
