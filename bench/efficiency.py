@@ -74,9 +74,11 @@ def reference(args, scene, work):
     return halves
 
 
-def errors(image_error, halves, files, border):
-    """(reference noise whole, off), and {file: (mse, mse_off)} with the noise subtracted."""
-    out = subprocess.run([image_error, halves[0], "--second-ref", halves[1], "--border", str(border)] + files,
+def errors(image_error, halves, files, border, lamp_luminance=None):
+    """(reference noise whole, off), and {file: (mse, mse_off)} with the noise subtracted. With
+    lamp_luminance, "off" leaves out the pixels near a reference luminance above it (image_error)."""
+    lamp = ["--lamp-luminance", str(lamp_luminance)] if lamp_luminance is not None else []
+    out = subprocess.run([image_error, halves[0], "--second-ref", halves[1], "--border", str(border)] + lamp + files,
                          check=True, capture_output=True, text=True).stdout.splitlines()
     noise = json.loads(out[0])
     res = {}

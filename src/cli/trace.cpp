@@ -56,6 +56,7 @@ struct TraceArgs {
   SamplerKind sampler = RenderOptions{}.sampler;  // the defaults of these three: RenderOptions'
   int rr_depth = RenderOptions{}.rr_depth;
   float rr_threshold = RenderOptions{}.rr_threshold;
+  float rr_light_threshold = RenderOptions{}.rr_light_threshold;
   std::optional<int> batches;  // --batches; unset: default_batches(sampler)
   ManifoldOptions manifold = RenderOptions{}.manifold;
   std::string resolution;  // "WxH"; empty: the scene's
@@ -161,6 +162,7 @@ Result<bool> load_fresh(const TraceArgs& a, Job* job) {
   id.sampler = to_string(a.sampler);
   id.rr_depth = a.rr_depth;
   id.rr_threshold = a.rr_threshold;
+  id.rr_light_threshold = a.rr_light_threshold;
   id.batches = a.batches.value_or(default_batches(a.sampler));
   id.images = !a.no_images;
   id.width = scene->camera.width;
@@ -326,6 +328,7 @@ int run(const TraceArgs& a) {
   ro.sampler = id.sampler == "sobol" ? SamplerKind::kSobol : SamplerKind::kIndependent;
   ro.rr_depth = id.rr_depth;
   ro.rr_threshold = static_cast<float>(id.rr_threshold);
+  ro.rr_light_threshold = static_cast<float>(id.rr_light_threshold);
   ro.manifold = id.manifold.value_or(ManifoldOptions{});
   ro.batches = id.batches;
   // Without image outputs the render keeps the histogram alone (the same histogram).
@@ -598,7 +601,10 @@ Command add_trace(CLI::App& app) {
                   "Russian roulette from this vertex of a subpath on (the camera or light point is the first)")
       ->capture_default_str()->check(CLI::Range(1, 1000));
   sub->add_option("--rr-threshold", args->rr_threshold,
-                  "Russian roulette only below this throughput (relative to the subpath's start); 0: no roulette")
+                  "Russian roulette of eye subpaths only below this throughput (relative to the subpath's start); 0: no roulette")
+      ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
+  sub->add_option("--rr-light-threshold", args->rr_light_threshold,
+                  "The same for light subpaths (lt, bdpt)")
       ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
   sub->add_option("--resolution", args->resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
       ->type_name("WxH");
@@ -629,7 +635,8 @@ Command add_trace(CLI::App& app) {
   add_scene_limit_options(sub, &args->limits);
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
-                                  "--resolution", "--max-paths", "--sampler", "--batches", "--rr-depth", "--rr-threshold"})
+                                  "--resolution", "--max-paths", "--sampler", "--batches", "--rr-depth", "--rr-threshold",
+                                  "--rr-light-threshold"})
               if (sub->count(o) > 0) args->settings_given.push_back(o);
             for (const std::string& o : manifold_option_names())
               if (sub->count(o) > 0) args->settings_given.push_back(o);

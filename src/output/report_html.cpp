@@ -351,6 +351,8 @@ std::string trace_command(const RenderIdentity& id, std::uint64_t spp) {
   const RenderIdentity defaults;
   if (id.rr_depth != defaults.rr_depth) cmd += " --rr-depth " + std::to_string(id.rr_depth);
   if (id.rr_threshold != defaults.rr_threshold) cmd += " --rr-threshold " + nlohmann::json(id.rr_threshold).dump();
+  if (id.rr_light_threshold != defaults.rr_light_threshold)
+    cmd += " --rr-light-threshold " + nlohmann::json(id.rr_light_threshold).dump();
   if (id.max_paths != defaults.max_paths) cmd += " --max-paths " + std::to_string(id.max_paths);
   if (!id.images) cmd += " --no-images";
   return cmd;

@@ -327,7 +327,7 @@ json identity_json(const RenderIdentity& id) {
   j["ends"] = {{"lights", id.lights}, {"sensor", id.sensor}};
   j["seed"] = id.seed;
   j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"rr_depth", id.rr_depth},
-                  {"rr_threshold", id.rr_threshold}, {"batches", id.batches},
+                  {"rr_threshold", id.rr_threshold}, {"rr_light_threshold", id.rr_light_threshold}, {"batches", id.batches},
                   {"width", id.width},           {"height", id.height},     {"images", id.images},
                   {"max_paths", id.max_paths}};
   if (const std::optional<ManifoldOptions>& m = id.manifold)
@@ -451,12 +451,14 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   id.seed = rd.uint(j, "", "seed");
   h.spp = rd.uint(j, "", "spp");
   const nlohmann::json& o = j.at("options");
-  if (rd.object(o, "/options", {"max_bounces", "sampler", "rr_depth", "rr_threshold", "batches", "width", "height", "images",
-                                "max_paths", "manifold"})) {
+  if (rd.object(o, "/options", {"max_bounces", "sampler", "rr_depth", "rr_threshold", "rr_light_threshold", "batches", "width",
+                                "height", "images", "max_paths", "manifold"})) {
     id.max_bounces = rd.small(o, "/options", "max_bounces");
     id.sampler = rd.str(o, "/options", "sampler");
     id.rr_depth = rd.small(o, "/options", "rr_depth");
     id.rr_threshold = rd.number(o, "/options", "rr_threshold");
+    // Before issue 39 one threshold served both subpaths.
+    id.rr_light_threshold = o.contains("rr_light_threshold") ? rd.number(o, "/options", "rr_light_threshold") : id.rr_threshold;
     id.batches = rd.small(o, "/options", "batches");
     id.width = rd.small(o, "/options", "width");
     id.height = rd.small(o, "/options", "height");
@@ -543,6 +545,8 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
   if (auto d = option("rr_depth", a.rr_depth, b.rr_depth)) return d;
   if (a.rr_threshold != b.rr_threshold)
     return differ("another rr_threshold", std::to_string(a.rr_threshold), std::to_string(b.rr_threshold));
+  if (a.rr_light_threshold != b.rr_light_threshold)
+    return differ("another rr_light_threshold", std::to_string(a.rr_light_threshold), std::to_string(b.rr_light_threshold));
   if (auto d = option("batch count", a.batches, b.batches)) return d;
   if (a.width != b.width || a.height != b.height)
     return differ("another resolution", std::to_string(a.width) + "x" + std::to_string(a.height),

@@ -30,7 +30,8 @@
 // absolute file), hash}, "classes" {file (absolute, "" for the built-in classes), text (the class
 // file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
-// {max_bounces, sampler, rr_depth, rr_threshold, batches, width, height, images, max_paths, manifold (null, or the
+// {max_bounces, sampler, rr_depth, rr_threshold, rr_light_threshold (absent in files written before
+// issue 39: then rr_threshold's), batches, width, height, images, max_paths, manifold (null, or the
 // manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds})}, "strategies" [names],
 // "connectors" [{strategy, connector}] (the strategies that run a connector, in the profile's order,
 // with the connector's name: "mirror", "distant-projection", "ortho-projection", "manifold"), "share" and
@@ -120,7 +121,8 @@ struct RenderIdentity {
   int max_bounces = 16;
   std::string sampler = "sobol";  // RenderOptions::sampler, by name
   int rr_depth = 3;
-  double rr_threshold = 1.0;  // RenderOptions::rr_threshold (a float, exact as a double)
+  double rr_threshold = RenderOptions{}.rr_threshold;  // RenderOptions::rr_threshold (a float, exact as a double)
+  double rr_light_threshold = RenderOptions{}.rr_light_threshold;  // RenderOptions::rr_light_threshold
   int batches = kDefaultBatches;
   int width = 0, height = 0;  // the camera's resolution (the scene's, or --resolution's)
   bool images = true;

@@ -2,7 +2,7 @@
 //
 // For each pixel and pass: an eye subpath z0 z1 … from the sensor and a light subpath y0 y1 …
 // from a light, each extended by local sampling (BSDF sampling, Russian roulette from
-// RenderOptions::rr_depth vertices on, below rr_threshold; at most max_bounces interior vertices
+// RenderOptions::rr_depth vertices on, below rr_threshold (eye) or rr_light_threshold (light); at most max_bounces interior vertices
 // on the full path).
 // Then every (s, chain, t) the profile runs is joined (trace/joins/: s = 0 an eye vertex on an
 // area light, s = 1 a fresh light sample (next-event estimation), t = 1 a fresh sensor sample (a
@@ -138,8 +138,10 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // radiance scaling 1/η² undone, so that entering glass is no loss) is below rr_threshold
     // survives with probability throughput / threshold, and a survivor carries the threshold.
     if (mode == TransportMode::kRadiance && features_.transmission) eta2 *= bs->eta * bs->eta;  // else η = 1
-    if (count >= o_.rr_depth && o_.rr_threshold > 0.0f) {
-      const float survive = max_component(beta) * eta2 / (beta_start * o_.rr_threshold);
+    constexpr bool kEye = mode == TransportMode::kRadiance;  // eye and light subpaths have thresholds of their own
+    const float threshold = kEye ? o_.rr_threshold : o_.rr_light_threshold;
+    if (count >= o_.rr_depth && threshold > 0.0f) {
+      const float survive = max_component(beta) * eta2 / (beta_start * threshold);
       const float u_rr = rng.get1d_if(survive < 1.0f);  // its dimension taken at every vertex, so the dimensions stay aligned
       if (survive < 1.0f) {
         if (u_rr >= survive) break;

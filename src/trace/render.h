@@ -73,12 +73,16 @@ struct RenderOptions {
   std::uint64_t seed = 1;
   int threads = 0;                     // 0: all cores
   std::optional<int> max_bounces;      // interior vertices, k - 1; unset: the profile's bound, else 16
-  // Russian roulette (pathex trace --rr-depth, --rr-threshold): from the rr_depth-th vertex of a
-  // subpath on (its camera or light point is the first), a walk whose throughput relative to its
-  // start has fallen below rr_threshold survives with probability throughput / rr_threshold;
-  // 0 turns roulette off. Defaults chosen by efficiency (bench/efficiency.py, README).
+  // Russian roulette (pathex trace --rr-depth, --rr-threshold, --rr-light-threshold): from the
+  // rr_depth-th vertex of a subpath on (its camera or light point is the first), a walk whose
+  // throughput relative to its start has fallen below its threshold survives with probability
+  // throughput / threshold; 0 turns roulette off. Eye subpaths use rr_threshold, light subpaths
+  // rr_light_threshold: a light vertex is joined to every eye vertex (bdpt), so it costs more and
+  // its walk is cut sooner. Defaults chosen by efficiency on several scenes (issue 39,
+  // docs/efficiency.md).
   int rr_depth = 3;
-  float rr_threshold = 1.0f;
+  float rr_threshold = 0.3f;
+  float rr_light_threshold = 1.0f;
   SamplerKind sampler = SamplerKind::kSobol;  // --sampler
   int batches = default_batches(SamplerKind::kSobol);  // for batch-means standard errors (`pathex trace --batches`)
   std::vector<int> layer_classes;      // classifier classes that get an image layer

@@ -324,6 +324,27 @@ std::string with_header(const std::string& bytes, const std::string& head) {
 }
 
 // The header goes through the one JSON reader: a wrong value is refused at its JSON pointer.
+// Issue 39: the light subpaths' roulette threshold round-trips, and a shard written before it
+// existed (no rr_light_threshold) reads as one threshold for both subpaths, as it was rendered.
+TEST(ShardFile, LightRouletteThresholdRoundTripsAndDefaultsToTheEyeThreshold) {
+  Fixture f;
+  f.header.identity.rr_threshold = 0.25;
+  f.header.identity.rr_light_threshold = 0.75;
+  const std::string bytes = encode_shard(f.header, f.sums);
+  Result<ShardFile> file = parse_shard(bytes, "x.shard");
+  ASSERT_TRUE(file) << file.error().render();
+  EXPECT_EQ(file->header.identity.rr_threshold, 0.25);
+  EXPECT_EQ(file->header.identity.rr_light_threshold, 0.75);
+  std::uint32_t h = 0;
+  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
+  nlohmann::ordered_json head = nlohmann::ordered_json::parse(bytes.substr(16, h));
+  ASSERT_TRUE(head["options"].contains("rr_light_threshold"));
+  head["options"].erase("rr_light_threshold");
+  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
+  ASSERT_TRUE(old) << old.error().render();
+  EXPECT_EQ(old->header.identity.rr_light_threshold, 0.25);
+}
+
 TEST(ShardFile, HeaderErrorsNameTheFileAndThePointer) {
   Fixture f;
   const std::string bytes = encode_shard(f.header, f.sums);

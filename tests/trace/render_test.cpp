@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <optional>
+#include <tuple>
 
 #include <glm/glm.hpp>
 
@@ -804,14 +805,17 @@ namespace {
 // less than a tenth), roulette from the second vertex, and none.
 std::vector<Sampling> every_sampling() {
   std::vector<Sampling> out;
+  // The default first; then the eye and light thresholds apart (issue 39) and together.
+  const RenderOptions d;
   for (SamplerKind k : {SamplerKind::kIndependent, SamplerKind::kSobol})
-    for (auto [depth, threshold] : std::vector<std::pair<int, float>>{{3, 1.0f}, {3, 0.1f}, {2, 0.5f}, {3, 0.0f}})
-      out.push_back({k, depth, threshold});
+    for (auto [depth, eye, light] : std::vector<std::tuple<int, float, float>>{
+             {d.rr_depth, d.rr_threshold, d.rr_light_threshold}, {3, 0.1f, 0.1f}, {2, 0.5f, 0.5f}, {3, 0.0f, 0.0f}, {3, 1.0f, 0.1f}})
+      out.push_back({k, depth, eye, light});
   return out;
 }
 
 // The closed forms of DESIGN §9 per bounce, for every sampler and roulette setting and the three
-// estimators: 2 samplers x 4 roulette settings x 3 renderers x 9 classes = 216 checks, each render
+// estimators: 2 samplers x 5 roulette settings x 3 renderers x 9 classes = 270 checks, each render
 // with a seed of its own.
 //
 // Each check is |z| <= kSigmas with z = (estimate - closed form) / sigma, sigma^2 = stderr^2 +
@@ -821,7 +825,7 @@ std::vector<Sampling> every_sampling() {
 // Student's t with 31 degrees of freedom: at 100 seeds, 21,600 checks, 2 were beyond 4 (t_31: 7.9)
 // and 1 beyond 5 (0.46), lt's at -5.3: lt on the emitting sphere has the heavier low tail, 12 of its
 // 2,000 below -3 against 5.3. (The Sobol sampler's batches are not independent and overstate its
-// stderr, which only makes its checks safer.) P(|t_31| > 6) = 1.2e-6, so by Šidák's bound the 216
+// stderr, which only makes its checks safer.) P(|t_31| > 6) = 1.2e-6, so by Šidák's bound the 270
 // checks together fail a correct renderer at 0.03 % of seeds, and at well below 0.1 % if lt's low
 // tail is several times t_31's. 0 of 100 seeds failed; 3 sigma plus 1 % per check failed 13 of 100.
 //
@@ -834,6 +838,7 @@ TEST(Sampling, EverySamplerAndRouletteSettingMatchesTheClosedForms) {
   constexpr double kSigmas = 6.0;
   ASSERT_EQ(RenderOptions{}.rr_depth, every_sampling()[0].rr_depth);  // the default is the first setting
   ASSERT_EQ(RenderOptions{}.rr_threshold, every_sampling()[0].rr_threshold);
+  ASSERT_EQ(RenderOptions{}.rr_light_threshold, every_sampling()[0].rr_light_threshold);
   const double rho = 0.5, intensity = 2.0, le = 1.5;
   std::vector<std::string> point_classes, emitting_classes;
   for (int n = 1; n <= 4; ++n) point_classes.push_back("LSDD{" + std::to_string(n) + "}DSE");
@@ -863,7 +868,7 @@ TEST(Sampling, EverySamplerAndRouletteSettingMatchesTheClosedForms) {
 
 // The sample scenes, per class of the built-in set: each sampler and roulette setting agrees with
 // the independent sampler under pbrt-v4's roulette (another seed) within kSigmas standard errors of
-// the difference. The 7 x 8 x 5 checks (216 with an estimate) are many: at 4 each, 30 seeds
+// the difference. The 7 x 10 x 5 checks (270 with an estimate) are many: at 4 each, 30 seeds
 // (PATHEX_STAT_SEED=1001, 1003, …) had tails like Student's t_31 (8 of 6,480 beyond 3.5, 9 expected;
 // largest 3.75), which puts the whole test's false-failure rate near 8 %; at 5.5, by Šidák's bound,
 // about 0.1 % (less: a difference of two estimates has more than 31 degrees of freedom). 0 of the 30
@@ -872,7 +877,7 @@ TEST(Sampling, EverySettingAgreesWithTheIndependentSamplerOnTheSampleScenes) {
   constexpr double kSigmas = 5.5;
   const std::vector<std::string> classes = {"L....E", "L.....E", "L......+E", "L..S+D.*..E", "L.*DD.*E"};
   const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/";
-  const Sampling reference{SamplerKind::kIndependent, 3, 1.0f};
+  const Sampling reference{SamplerKind::kIndependent, 3, 1.0f, 1.0f};
   const std::uint64_t seed = test::stat_seed(11);  // the reference's; every setting renders at seed + 1
   for (const char* file : {"cornell.json", "point-glass.json", "point-mirror-caustic.json", "sun-window.json",
                            "laser.json", "mirror-ortho.json", "spotmeter-caustic.json"}) {
@@ -926,6 +931,28 @@ TEST(Sampling, SobolStandardErrorIsTheSpreadOverSeeds) {
     EXPECT_LE(std::fabs(z), kSigmas) << renderer << ": stderr / spread = " << std::sqrt(var / kSeeds / spread2) << " (z = " << z
                                      << ", 1 is honest)";
   }
+}
+
+// Issue 39: eye subpaths roulette below rr_threshold, light subpaths below rr_light_threshold, and
+// neither threshold touches the other's walks: pt-nee (eye subpaths alone) is bit-identical whatever
+// the light threshold, lt (light subpaths joined to the camera) whatever the eye threshold, and bdpt
+// changes with either.
+TEST(Sampling, EachRouletteThresholdActsOnItsOwnSubpaths) {
+  const auto total = [](const char* renderer, float eye, float light) {
+    const Sampling s{SamplerKind::kSobol, 2, eye, light};
+    return render_json(closed_sphere_emitting(0.8, 1.5), renderer, {"L.*E"}, 8, 1, 5, s).report.total;
+  };
+  const Estimate pt = total("pt-nee", 0.3f, 1.0f), pt_light = total("pt-nee", 0.3f, 0.05f);
+  EXPECT_EQ(pt.rgb, pt_light.rgb);
+  EXPECT_EQ(pt.std_error, pt_light.std_error);
+  const Estimate lt = total("lt", 0.3f, 1.0f), lt_eye = total("lt", 0.05f, 1.0f);
+  EXPECT_EQ(lt.rgb, lt_eye.rgb);
+  EXPECT_EQ(lt.std_error, lt_eye.std_error);
+  EXPECT_FALSE(total("pt-nee", 0.05f, 1.0f).rgb == pt.rgb);
+  EXPECT_FALSE(total("lt", 0.3f, 0.05f).rgb == lt.rgb);
+  const Estimate bd = total("bdpt", 0.3f, 1.0f);
+  EXPECT_FALSE(total("bdpt", 0.05f, 1.0f).rgb == bd.rgb);
+  EXPECT_FALSE(total("bdpt", 0.3f, 0.05f).rgb == bd.rgb);
 }
 
 // Bit-identical for one and two threads with either sampler.

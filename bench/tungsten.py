@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""pathex against Tungsten on Tungsten's Cornell box (issue 39): off-lamp and whole-image
+efficiency 1 / (MSE x CPU s) of pt-nee, and its ratio to Tungsten's fixed figures.
+
+    taskset -c 1 python3 bench/tungsten.py --pathex build/pathex --spp 16,64 --rounds 3 \\
+        [--variant "LABEL:ARGS" ...] [--binary LABEL:PATH ...]
+
+The scene is bench/scenes/tungsten-cornell-box.json (Tungsten's data/example-scenes/cornell-box,
+256 x 256), 64 bounces. The reference is a --ref-spp pt-nee render by --ref (two independent
+halves, cached as bench/efficiency.py caches them). The lamp is the pixels whose reference
+luminance is above 5, dilated by 2 pixels (image_error --lamp-luminance 5 --border 2); "off" is
+the rest. Every run is one process, one thread, the round's seed; CPU time is user + system
+(os.wait4), start-up and writing included (Tungsten's figure is samples per CPU-second of its
+render). Tungsten's figures were measured on this machine kind (issue 39) and are fixed here:
+
+    spp   off-lamp MSE   M samples / CPU s
+    16    7.546e-5       2.33
+    64    1.901e-5       2.40
+
+Printed per spp and variant: median CPU s, M samples per CPU-second, mean MSE (whole, off), the
+efficiency 1 / (mean MSE x median CPU s) whole and off, and off / Tungsten's. Pin the whole run
+to one CPU (taskset -c 1): the variants of a round run back to back, in an order that rotates.
+"""
+import argparse
+import os
+import shlex
+import statistics
+import sys
+import tempfile
+from types import SimpleNamespace
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cli_ab import cpu_run  # noqa: E402
+from efficiency import errors, reference, scene_args  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENE = os.path.join(HERE, "scenes", "tungsten-cornell-box.json")
+PIXELS = 256 * 256
+# spp: (off-lamp MSE, samples per CPU-second), issue 39.
+TUNGSTEN = {16: (7.546e-5, 2.33e6), 64: (1.901e-5, 2.40e6)}
+
+
+def tungsten_efficiency(spp):
+    mse, rate = TUNGSTEN[spp]
+    return 1.0 / (mse * PIXELS * spp / rate)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--pathex", default=os.path.join(HERE, "..", "build", "pathex"))
+    ap.add_argument("--variant", action="append", default=[],
+                    help="LABEL:ARGS, --pathex with extra trace arguments (repeatable); without any, its defaults")
+    ap.add_argument("--binary", action="append", default=[], help="LABEL:PATH, one more pathex with its defaults")
+    ap.add_argument("--renderer", default="pt-nee")
+    ap.add_argument("--spp", default="16,64")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--ref", default=None, help="binary for the reference (default: --pathex)")
+    ap.add_argument("--ref-spp", type=int, default=4096)
+    ap.add_argument("--ref-threads", type=int, default=1)
+    ap.add_argument("--image-error", default=os.path.join(HERE, "..", "build", "bench", "image_error"))
+    ap.add_argument("--cache", default=os.path.expanduser("~/.cache/pathex-efficiency"))
+    args = ap.parse_args()
+    variants = [(label, args.pathex, shlex.split(extra)) for label, _, extra in (v.partition(":") for v in args.variant)]
+    if not variants:
+        variants = [("pathex", args.pathex, [])]
+    variants += [(label, path, []) for label, _, path in (b.partition(":") for b in args.binary)]
+    ref_args = SimpleNamespace(resolution=None, max_bounces=64, ref_renderer="pt-nee", ref_spp=args.ref_spp,
+                               cache=args.cache, ref=args.ref or args.pathex, ref_threads=args.ref_threads)
+    with tempfile.TemporaryDirectory(prefix="pathex-tungsten-") as work:
+        halves = reference(ref_args, SCENE, work)
+        for spp in (int(s) for s in args.spp.split(",")):
+            runs = {label: [] for label, _, _ in variants}  # per round: (cpu, mse, mse_off)
+            for r in range(args.rounds):
+                order = variants[r % len(variants):] + variants[:r % len(variants)]
+                files, cpus = {}, {}
+                for label, binary, extra in order:
+                    out = os.path.join(work, f"{label}-{r}")
+                    cmd = ([binary, "trace"] + scene_args(SCENE, None, 64) +
+                           ["--renderer", args.renderer, "--spp", str(spp), "--seed", str(1 + r), "--threads", "1",
+                            "--quiet", "--out", out] + extra)
+                    cpus[label] = cpu_run(cmd)
+                    files[label] = os.path.join(out, "classes.exr")
+                noise, errs = errors(args.image_error, halves, list(files.values()), 2, lamp_luminance=5)
+                for label in files:
+                    runs[label].append((cpus[label],) + errs[files[label]])
+            t = TUNGSTEN.get(spp)
+            print(f"\nTungsten's Cornell box, {args.renderer}, {spp} spp, {args.rounds} rounds (reference noise "
+                  f"{noise[0]:.3g} whole, {noise[1]:.3g} off)" +
+                  (f"; Tungsten: off MSE {t[0]:.4g}, {t[1] / 1e6:.2f} M samples/CPU s, eff off "
+                   f"{tungsten_efficiency(spp):.4g}" if t else ""))
+            print(f"  {'variant':<16}{'CPU s':>7}{'M smp/s':>9}{'MSE whole':>12}{'MSE off':>12}{'eff whole':>12}"
+                  f"{'eff off':>12}{'off / Tungsten':>16}")
+            for label, _, _ in variants:
+                rs = runs[label]
+                cpu = statistics.median(x[0] for x in rs)
+                mse = statistics.fmean(x[1] for x in rs)
+                mse_off = statistics.fmean(x[2] for x in rs)
+                eff_off = 1.0 / (mse_off * cpu)
+                vs = f"{eff_off / tungsten_efficiency(spp):.2f}x" if t else "-"
+                print(f"  {label:<16}{cpu:>7.3f}{PIXELS * spp / cpu / 1e6:>9.3f}{mse:>12.4g}{mse_off:>12.4g}"
+                      f"{1.0 / (mse * cpu):>12.4g}{eff_off:>12.4g}{vs:>16}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
