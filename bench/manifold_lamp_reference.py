@@ -128,7 +128,7 @@ def lamp_sources(lamp, centre, count, rng):
     return out, distance
 
 
-def quadrature(scene_path, film, lamp_samples, jitters, rows, direct):
+def quadrature(scene_path, film, lamp_samples, jitters, rows, direct, first_jitter=0):
     s, lamp, sphere, quad, ior, albedo = setup(scene_path)
     centre, radius = sphere["center"], sphere["radius"]
     le = lamp["emission"]
@@ -147,7 +147,7 @@ def quadrature(scene_path, film, lamp_samples, jitters, rows, direct):
     nx, ny = film
     means = {THROUGH: [], DIRECT: []}
     for jitter in range(jitters):
-        rng = random.Random(jitter)
+        rng = random.Random(first_jitter + jitter)
         totals = {THROUGH: 0.0, DIRECT: 0.0}
         for iy in range(ny):
             for ix in range(nx):
@@ -194,7 +194,8 @@ def main():
     ap.add_argument("--film", default="96x80", help="film samples, columns x rows (one jittered sample per cell)")
     ap.add_argument("--lamp", type=int, default=16, help="point sources standing for the lamp (a square)")
     ap.add_argument("--jitters", type=int, default=4)
-    ap.add_argument("--table", type=int, default=4000, help="rows of the table over theta")
+    ap.add_argument("--table", type=int, default=2000, help="rows of the table over theta")
+    ap.add_argument("--first-jitter", type=int, default=0, help="the first jitter's seed (runs with disjoint seeds combine)")
     ap.add_argument("--direct", action="store_true", help="also the caustic seen directly (slow: most of the film)")
     ap.add_argument("--json", help="write the figures here")
     a = ap.parse_args()
@@ -205,7 +206,7 @@ def main():
     except ValueError:
         sys.exit(f"--film: expected COLUMNSxROWS, --jitters at least 2, --table at least 100, --lamp at least 1 "
                  f"(got {a.film}, {a.jitters}, {a.table}, {a.lamp})")
-    res = quadrature(a.scene, film, a.lamp, a.jitters, a.table, a.direct)
+    res = quadrature(a.scene, film, a.lamp, a.jitters, a.table, a.direct, a.first_jitter)
     if not a.direct:
         del res[DIRECT]
     command = "python3 bench/manifold_lamp_reference.py " + " ".join(sys.argv[1:])
@@ -216,7 +217,7 @@ def main():
         write_json(a.json, {"scene": os.path.relpath(a.scene, ROOT), "method": "quadrature", "command": command,
                             "classes": {cls: {"luminance": luminance(rgb), "stderr": luminance(se), "rgb": rgb}
                                         for cls, (rgb, se) in res.items()},
-                            "film": list(film), "lamp_points": a.lamp, "jitters": a.jitters, "table_rows": a.table})
+                            "film": list(film), "lamp_points": a.lamp, "jitters": a.jitters, "first_jitter": a.first_jitter, "table_rows": a.table})
 
 
 if __name__ == "__main__":
