@@ -156,11 +156,15 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     w.failure = ManifoldFailure::kNoSolution;
     return w;
   }
-  // Fixed-size scratch on the stack: a walk allocates nothing.
-  std::array<dvec3, kCap> p, y, s, t;
-  std::array<Local, kCap> loc, trial;
-  std::array<double, kDim> c, cy, step;
-  std::array<double, kDim * kDim> j;
+  // Fixed-size scratch, one per thread and reused: a walk allocates and clears nothing.
+  struct Scratch {
+    std::array<dvec3, kCap> p, y, s, t;
+    std::array<Local, kCap> loc, trial;
+    std::array<double, kDim> c, cy, step;
+    std::array<double, kDim * kDim> j;
+  };
+  static thread_local Scratch scratch;
+  auto& [p, y, s, t, loc, trial, c, cy, step, j] = scratch;
   for (std::size_t i = 0; i < m; ++i) p[i] = x[i].p;
   bool solved = false;
   int polish = 0;
