@@ -14,6 +14,16 @@ renderer's median efficiency over the first one's (DESIGN §8: Veach's efficienc
         --renderer pt-nee+mirror --renderer bdpt --renderer lt --spp 64 --rounds 5
 
 The last line says how many times more efficient the first renderer is than the best of the others.
+
+With --reference VALUE (the class's luminance computed another way), the efficiency is
+1 / (MSE T) instead: MSE the mean over the rounds (seeds) of (estimate - VALUE)^2, T the mean CPU
+time, so that a heavy-tailed estimator's understated stderr, or a rare-hit one's stderr of 0 when
+it misses every hit, cannot flatter it (issue 40). A renderer may carry its own sample count as
+NAME:SPP, so that each gets about the same CPU time.
+
+    python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDSSDSE \
+        --reference 1.1e-3 --only --rounds 8 \
+        --renderer pt-nee+manifold:16 --renderer pt:1024 --renderer pt-nee:1024 --renderer bdpt:512
 With --baseline OLD/pathex every renderer also runs with that binary, in the same rounds (labelled
 `@baseline`), and each line compares the renderer with its baseline; --only renders the class
 alone (`--only CLASS`) instead of taking it from a full render (`--classes`).
@@ -22,6 +32,7 @@ alone (`--only CLASS`) instead of taking it from a full render (`--classes`).
         --renderer pt-nee+manifold --baseline /work/old-8eebe78/build/pathex --only --spp 16 --rounds 5
 """
 import argparse
+import math
 import json
 import os
 import statistics
@@ -51,8 +62,10 @@ def main():
     ap.add_argument("--max-bounces", type=int, default=8)
     ap.add_argument("--baseline", help="another pathex binary: every renderer also runs with it")
     ap.add_argument("--only", action="store_true", help="render with --only CLASS (default: the class of a full render)")
+    ap.add_argument("--reference", type=float, help="the class's value: efficiency 1 / (MSE T) over the rounds")
     args = ap.parse_args()
     # (label, binary, renderer) per run
+    spp_of = {r: int(r.split(":")[1]) if ":" in r else args.spp for r in args.renderer}
     runs = [(r, args.pathex, r) for r in args.renderer]
     if args.baseline:
         runs = [x for r in args.renderer for x in ((r, args.pathex, r), (r + " @baseline", args.baseline, r))]
@@ -66,7 +79,7 @@ def main():
             order = runs[rnd % len(runs):] + runs[:rnd % len(runs)]
             for label, binary, r in order:
                 with tempfile.TemporaryDirectory() as out:  # each binary writes its own folder
-                    doc, cpu = run([binary, "trace", args.scene, "--renderer", r, "--spp", str(args.spp), *select,
+                    doc, cpu = run([binary, "trace", args.scene, "--renderer", r.split(":")[0], "--spp", str(spp_of[r]), *select,
                                     "--seed", str(rnd + 1), "--threads", "1", "--max-bounces", str(args.max_bounces),
                                     "--no-images", "--quiet", "--json", "--out", os.path.join(out, "o")])
                 c = [c for c in doc["classes"] if c["expr"] == args.path_class or c.get("name") == "c"][0]
@@ -75,6 +88,13 @@ def main():
     finally:
         os.unlink(classes)
     print(f"class {args.path_class} in {args.scene}, {args.spp} spp, {args.rounds} interleaved rounds, 1 thread")
+    if args.reference is not None:  # 1 / (MSE T) against the reference, the same for every round of a renderer
+        for label in results:
+            mse = statistics.mean((x[0] - args.reference) ** 2 for x in results[label])
+            t = statistics.mean(x[2] for x in results[label])
+            results[label] = [(x[0], x[1], x[2], 1.0 / (mse * t) if mse else float("inf")) for x in results[label]]
+            print(f"  {label:16s} mean {statistics.mean(x[0] for x in results[label]):.6g}  RMSE {math.sqrt(mse):.3g} "
+                  f"({math.sqrt(mse) / args.reference:.1%})  mean CPU {t:.3f} s")
     ref = statistics.median(x[3] for x in results[args.renderer[0]])
     for label, _, r in runs:
         med = lambda i: statistics.median(x[i] for x in results[label])

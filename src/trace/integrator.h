@@ -419,6 +419,7 @@ class Integrator {
   std::vector<vec3> mirror_reflectance_;
   std::vector<int> specular_shapes_;  // the shapes with either (the manifold's seeds aim at points on them)
   std::vector<float> seed_cdf_;       // the seeds' choice among them (cumulative, last 1)
+  std::vector<glm::vec4> specular_bounds_;  // a bounding sphere of each (centre, radius): joins no chain can leave skip
   double scene_size_ = 1.0;       // the scene's bounding-box diagonal (the manifold's shortest segment scales with it)
   std::vector<std::uint8_t> mirror_shape_;  // the shape is a planar mirror
   // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the

@@ -193,7 +193,7 @@ TEST(NewUser, PtOnAPointLightSceneNamesTheUnreachableLight) {
   EXPECT_EQ(r.code, 0);
   EXPECT_EQ(r.err,
             "pathex: warning: pt cannot sample any path from the point light at (0.6, 0.8, 0) (LSD…E), so its light "
-            "is missing from the image; renderers that reach it: pt-nee, lt, bdpt, bdpt+mirror, bdpt+ortho, pt-nee+distant, pt-nee+mirror, "
+            "is missing from the image; renderers that reach it: pt-nee, lt, bdpt, bdpt+mirror, bdpt+ortho, bdpt+manifold, pt-nee+distant, pt-nee+mirror, "
             "pt-nee+manifold, "
             "pbrt-v4-path, pbrt-v4-bdpt, pbrt-v4-lightpath, mitsuba3-path, mitsuba3-ptracer (--renderer NAME)\n");
   EXPECT_EQ(read_json(dir + "/histogram.json")["total"]["luminance"], 0.0);

@@ -236,7 +236,7 @@ TEST(Issue15CheckFiles, UnknownRendererAndMissingSceneNameTheirPointer) {
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "pathex: error: " + scratch("renderer.json").string() +
                        ":/cases/0/renderer: unknown renderer 'pathtracer': not a built-in profile (pt, pt-nee, lt, bdpt, "
-                       "bdpt+mirror, bdpt+ortho, pt-nee+distant, pt-nee+mirror, pt-nee+manifold, pbrt-v4-path, pbrt-v4-bdpt, "
+                       "bdpt+mirror, bdpt+ortho, bdpt+manifold, pt-nee+distant, pt-nee+mirror, pt-nee+manifold, pbrt-v4-path, pbrt-v4-bdpt, "
                        "pbrt-v4-lightpath, mitsuba3-path, mitsuba3-ptracer) nor a profile file\n");
   write(scratch("scene.json"),
         R"({"cases": [{"name": "a", "renderer": "pt", "scene": "nowhere.json", "require": [{"covers-scene": true}]}]})");

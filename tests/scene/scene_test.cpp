@@ -248,6 +248,7 @@ TEST(SampleScenes, TypesAndUniverses) {
       {"sky-image.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // an image sky too (docs/lights.md)
       {"materials.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // issue 35's materials
       {"small-light-caustic.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // issue 36
+      {"lamp-glass.json", {LightType::kArea}, SensorType::kPinhole, sd, "LDD[SD]*DSE"},  // issue 40
       {"laser.json", {LightType::kLaser}, SensorType::kPinhole, sd, "LSS[SD]*DSE"},
       {"closed-sphere-point.json", {LightType::kPoint}, SensorType::kPinhole, d, "LSDD*DSE"},
       {"closed-sphere-emitting.json", {LightType::kArea}, SensorType::kPinhole, d, "LDDD*DSE"},

@@ -46,7 +46,7 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
   std::vector<Profile> profiles;
   for (Profile& p : builtin_profiles(Limits{}).expect("a test input"))
     if (p.name != "bdpt") profiles.push_back(std::move(p));
-  ASSERT_EQ(profiles.size(), 13u);
+  ASSERT_EQ(profiles.size(), 14u);
   struct Comparison {
     std::string what;
     double deviation, sigma;
@@ -68,7 +68,10 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
     // Made to be under-sampled (issue 36): pt meets its lamp of radius 0.03 by chance only, so
     // "every profile finds every path above 1 % at 128 spp" does not hold there by design;
     // tests/bias/bias_test.cpp measures that scene with pathex bias's under-sampling check.
-    if (entry.path().filename() == "small-light-caustic.json") continue;
+    // lamp-glass.json (issue 40) likewise: pt and pt-nee meet its lamp of radius 0.04 through the
+    // glass by chance only; its caustics are checked against bdpt and a quadrature in
+    // tests/trace/manifold_reference_test.cpp.
+    if (entry.path().filename() == "small-light-caustic.json" || entry.path().filename() == "lamp-glass.json") continue;
     Result<Scene> loaded = load_scene_file(entry.path().string());
     ASSERT_TRUE(loaded.ok()) << loaded.error().render();
     Scene scene = *loaded;

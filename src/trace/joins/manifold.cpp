@@ -2,74 +2,66 @@
 #include "trace/joins/manifold.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 
 #include <glm/geometric.hpp>
 
 #include "trace/differential.h"
+#include "trace/joins/join.h"
 
 namespace pathex {
 namespace {
 
 using glm::dvec3;
 
-// The constraint at vertex i of `x` (light end a before x[0], eye end b after x[m-1]): the
-// tangential part of the generalized half vector, on the tangent pair (s, t) given. Empty when a
-// neighbour coincides with the vertex.
-std::optional<glm::dvec2> constraint(const std::vector<ChainVertex>& x, std::size_t i, const dvec3& a, const dvec3& b,
-                                     const dvec3& s, const dvec3& t) {
-  const dvec3& p = x[i].p;
-  const dvec3 prev = i == 0 ? a : x[i - 1].p;
-  const dvec3 next = i + 1 == x.size() ? b : x[i + 1].p;
-  const dvec3 ei = prev - p, eo = next - p;
-  const double li = glm::length(ei), lo = glm::length(eo);
-  if (!(li > 0.0) || !(lo > 0.0)) return std::nullopt;
-  const dvec3 wi = ei / li, wo = eo / lo;
-  const dvec3 n = surface_derivatives(*x[i].shape, x[i].primitive, p).ns;  // the normal the tracer shades with
-  dvec3 h = x[i].eta_light * wi + x[i].eta_eye * wo;
-  const double lh = glm::length(h);
-  if (!(lh > 0.0)) return std::nullopt;
-  h /= lh;
-  h -= glm::dot(h, n) * n;
-  return glm::dvec2(glm::dot(h, s), glm::dot(h, t));
-}
+constexpr std::size_t kCap = static_cast<std::size_t>(tracer::kMaxChain);  // vertices of a chain, at most
+constexpr std::size_t kDim = 2 * kCap;                                    // its unknowns
 
-// Every vertex's tangent pair at its current position.
-struct Frames {
-  std::vector<dvec3> s, t;
+// One vertex's local state at given positions: its surface's derivatives, the unit directions to
+// its neighbours and their lengths, and the normalised generalized half vector.
+struct Local {
+  SurfaceDerivatives g;
+  dvec3 wi{0.0}, wo{0.0}, h{0.0};
+  double li = 0.0, lo = 0.0, lh = 0.0;
 };
-Frames frames_of(const std::vector<ChainVertex>& x) {
-  Frames f;
-  for (const ChainVertex& v : x) {
-    const SurfaceDerivatives d = surface_derivatives(*v.shape, v.primitive, v.p);
-    f.s.push_back(d.dpdu);
-    f.t.push_back(d.dpdv);
+
+// Every vertex's local state and the constraints (2 per vertex, on the tangent pairs `s`, `t`
+// given, or the vertex's own when null): false when one is undefined (a neighbour coincides with
+// the vertex, or the half vector vanishes).
+bool evaluate(const std::vector<ChainVertex>& x, const dvec3* p, const dvec3& a, const dvec3& b, const dvec3* s, const dvec3* t,
+              Local* loc, double* c) {
+  const std::size_t m = x.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    Local& l = loc[i];
+    l.g = surface_derivatives(*x[i].shape, x[i].primitive, p[i]);
+    const dvec3 ei = (i == 0 ? a : p[i - 1]) - p[i], eo = (i + 1 == m ? b : p[i + 1]) - p[i];
+    l.li = glm::length(ei);
+    l.lo = glm::length(eo);
+    if (!(l.li > 0.0) || !(l.lo > 0.0)) return false;
+    l.wi = ei / l.li;
+    l.wo = eo / l.lo;
+    const dvec3 h = x[i].eta_light * l.wi + x[i].eta_eye * l.wo;
+    l.lh = glm::length(h);
+    if (!(l.lh > 0.0)) return false;
+    l.h = h / l.lh;
+    const dvec3 tangential = l.h - glm::dot(l.h, l.g.ns) * l.g.ns;  // the constraint: ĥ's part along the surface
+    c[2 * i] = glm::dot(tangential, s ? s[i] : l.g.dpdu);
+    c[2 * i + 1] = glm::dot(tangential, t ? t[i] : l.g.dpdv);
   }
-  return f;
+  return true;
 }
 
-// All constraints stacked (2 per vertex); empty when one is undefined.
-std::optional<std::vector<double>> constraints(const std::vector<ChainVertex>& x, const dvec3& a, const dvec3& b, const Frames& f) {
-  std::vector<double> c(2 * x.size());
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const std::optional<glm::dvec2> ci = constraint(x, i, a, b, f.s[i], f.t[i]);
-    if (!ci) return std::nullopt;
-    c[2 * i] = ci->x;
-    c[2 * i + 1] = ci->y;
-  }
-  return c;
-}
-
-double largest(const std::vector<double>& c) {
+double largest(const double* c, std::size_t n) {
   double m = 0.0;
-  for (double v : c) m = std::max(m, std::fabs(v));
+  for (std::size_t i = 0; i < n; ++i) m = std::max(m, std::fabs(c[i]));
   return m;
 }
 
 // A dense square system solved in place by Gaussian elimination with partial pivoting: `rhs` has
 // `cols` columns, row-major. Returns min |pivot| / max |pivot| (0: singular).
-double solve_in_place(std::vector<double>& m, std::size_t n, std::vector<double>& rhs, std::size_t cols) {
+double solve_in_place(double* m, std::size_t n, double* rhs, std::size_t cols) {
   double lo = INFINITY, hi = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     std::size_t piv = k;
@@ -99,43 +91,59 @@ double solve_in_place(std::vector<double>& m, std::size_t n, std::vector<double>
   return hi > 0.0 && std::isfinite(lo / hi) ? lo / hi : 0.0;
 }
 
-// The constraint Jacobian ∂C/∂X (2m × 2m, row-major) by central differences along each vertex's
-// tangent pair, step h; and, when `jb` is given, ∂C/∂b (2m × 2) for b moving along (sb, tb).
-bool jacobian(const std::vector<ChainVertex>& x, const dvec3& a, const dvec3& b, const Frames& f, double h, std::vector<double>* j,
-              const dvec3* sb, const dvec3* tb, std::vector<double>* jb) {
+// The change of vertex i's constraint (on its own tangent pair) when the half vector changes by dh
+// and the normal by dn: with ĥ = h / |h| and C = ĥ_tangential · (s, t), dĥ = (dh - ĥ (ĥ·dh)) / |h|
+// and, as n · s = n · t = 0 at the vertex, dC = (dĥ · s - (ĥ·n)(dn · s), the same for t).
+glm::dvec2 d_constraint(const Local& l, const dvec3& dh, const dvec3& dn) {
+  const dvec3 dhat = (dh - l.h * glm::dot(l.h, dh)) / l.lh;
+  const double hn = glm::dot(l.h, l.g.ns);
+  return {glm::dot(dhat, l.g.dpdu) - hn * glm::dot(dn, l.g.dpdu), glm::dot(dhat, l.g.dpdv) - hn * glm::dot(dn, l.g.dpdv)};
+}
+
+// A unit direction w = e / |e| when e's far end moves by d: (d - w (w·d)) / |e|.
+dvec3 d_unit(const dvec3& w, double len, const dvec3& d) { return (d - w * glm::dot(w, d)) / len; }
+
+// The constraint Jacobian ∂C/∂X (2m × 2m, row-major), analytic (Jakob and Marschner 2012): each
+// vertex moves along its tangent pair (dp/du = dpdu, dn/du = dndu, as trace/differential.h), which
+// changes its own constraint and its neighbours'. With `jb`, also ∂C/∂b (2m × 2) for b moving along
+// (sb, tb): only the last vertex sees b. The constraints are on each vertex's own tangent pair.
+void jacobian(const std::vector<ChainVertex>& x, const Local* loc, double* j, const dvec3* sb, const dvec3* tb, double* jb) {
   const std::size_t m = x.size(), n = 2 * m;
-  j->assign(n * n, 0.0);
-  std::vector<ChainVertex> y = x;
+  std::fill(j, j + n * n, 0.0);
   for (std::size_t v = 0; v < m; ++v)
-    for (int axis = 0; axis < 2; ++axis) {
-      const dvec3 dir = axis == 0 ? f.s[v] : f.t[v];
-      const std::optional<dvec3> plus = move_on_surface(*x[v].shape, x[v].primitive, x[v].p, h * dir);
-      const std::optional<dvec3> minus = move_on_surface(*x[v].shape, x[v].primitive, x[v].p, -h * dir);
-      if (!plus || !minus) return false;  // at the shape's edge: no two-sided difference
-      for (std::size_t i = (v > 0 ? v - 1 : 0); i <= std::min(v + 1, m - 1); ++i) {
-        y[v].p = *plus;
-        const std::optional<glm::dvec2> cp = constraint(y, i, a, b, f.s[i], f.t[i]);
-        y[v].p = *minus;
-        const std::optional<glm::dvec2> cm = constraint(y, i, a, b, f.s[i], f.t[i]);
-        if (!cp || !cm) return false;
-        (*j)[(2 * i) * n + 2 * v + static_cast<std::size_t>(axis)] = (cp->x - cm->x) / (2.0 * h);
-        (*j)[(2 * i + 1) * n + 2 * v + static_cast<std::size_t>(axis)] = (cp->y - cm->y) / (2.0 * h);
+    for (std::size_t axis = 0; axis < 2; ++axis) {
+      const dvec3 dp = axis == 0 ? loc[v].g.dpdu : loc[v].g.dpdv;
+      const dvec3 dn = axis == 0 ? loc[v].g.dndu : loc[v].g.dndv;
+      const std::size_t col = 2 * v + axis;
+      // Its own constraint: both directions turn (their near end moves), and so does the normal.
+      const Local& l = loc[v];
+      const dvec3 dh = -x[v].eta_light * d_unit(l.wi, l.li, dp) - x[v].eta_eye * d_unit(l.wo, l.lo, dp);
+      const glm::dvec2 own = d_constraint(l, dh, dn);
+      j[(2 * v) * n + col] = own.x;
+      j[(2 * v + 1) * n + col] = own.y;
+      if (v > 0) {  // the vertex before sees it as its next neighbour
+        const Local& q = loc[v - 1];
+        const glm::dvec2 d = d_constraint(q, x[v - 1].eta_eye * d_unit(q.wo, q.lo, dp), dvec3(0.0));
+        j[(2 * v - 2) * n + col] = d.x;
+        j[(2 * v - 1) * n + col] = d.y;
       }
-      y[v].p = x[v].p;
+      if (v + 1 < m) {  // the vertex after sees it as its previous neighbour
+        const Local& q = loc[v + 1];
+        const glm::dvec2 d = d_constraint(q, x[v + 1].eta_light * d_unit(q.wi, q.li, dp), dvec3(0.0));
+        j[(2 * v + 2) * n + col] = d.x;
+        j[(2 * v + 3) * n + col] = d.y;
+      }
     }
   if (jb) {
-    jb->assign(n * 2, 0.0);
-    const std::size_t i = m - 1;  // only the last vertex sees b
-    for (int axis = 0; axis < 2; ++axis) {
-      const dvec3 dir = axis == 0 ? *sb : *tb;
-      const std::optional<glm::dvec2> cp = constraint(x, i, a, b + h * dir, f.s[i], f.t[i]);
-      const std::optional<glm::dvec2> cm = constraint(x, i, a, b - h * dir, f.s[i], f.t[i]);
-      if (!cp || !cm) return false;
-      (*jb)[(2 * i) * 2 + static_cast<std::size_t>(axis)] = (cp->x - cm->x) / (2.0 * h);
-      (*jb)[(2 * i + 1) * 2 + static_cast<std::size_t>(axis)] = (cp->y - cm->y) / (2.0 * h);
+    std::fill(jb, jb + n * 2, 0.0);
+    const std::size_t i = m - 1;
+    for (std::size_t axis = 0; axis < 2; ++axis) {
+      const Local& q = loc[i];
+      const glm::dvec2 d = d_constraint(q, x[i].eta_eye * d_unit(q.wo, q.lo, axis == 0 ? *sb : *tb), dvec3(0.0));
+      jb[(2 * i) * 2 + axis] = d.x;
+      jb[(2 * i + 1) * 2 + axis] = d.y;
     }
   }
-  return true;
 }
 
 }  // namespace
@@ -144,22 +152,28 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
                          const ManifoldOptions& o) {
   ManifoldWalk w;
   const std::size_t m = x.size(), n = 2 * m;
-  if (m == 0) {
+  if (m == 0 || m > kCap) {
     w.failure = ManifoldFailure::kNoSolution;
     return w;
   }
-  const double h = 1e-7 * std::max(scene_size, 1e-30);  // the difference step
-  std::vector<double> j, jb;
+  // Fixed-size scratch, one per thread and reused: a walk allocates and clears nothing.
+  struct Scratch {
+    std::array<dvec3, kCap> p, y, s, t;
+    std::array<Local, kCap> loc, trial;
+    std::array<double, kDim> c, cy, step;
+    std::array<double, kDim * kDim> j;
+  };
+  static thread_local Scratch scratch;
+  auto& [p, y, s, t, loc, trial, c, cy, step, j] = scratch;
+  for (std::size_t i = 0; i < m; ++i) p[i] = x[i].p;
   bool solved = false;
   int polish = 0;
   for (w.iterations = 0; w.iterations <= o.max_iterations; ++w.iterations) {
-    const Frames f = frames_of(x);
-    const std::optional<std::vector<double>> c = constraints(x, a, b, f);
-    if (!c) {
+    if (!evaluate(x, p.data(), a, b, nullptr, nullptr, loc.data(), c.data())) {
       w.failure = ManifoldFailure::kNoSolution;
       return w;
     }
-    const double err = largest(*c);
+    const double err = largest(c.data(), n);
     // Solved below the threshold; up to three more steps polish it (Newton converges
     // quadratically there), so that the same solution found from two seeds compares equal.
     const bool within = err < o.threshold;
@@ -172,32 +186,28 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
       solved = within;
       break;
     }
-    if (!jacobian(x, a, b, f, h, &j, nullptr, nullptr, nullptr)) {
-      if (within) { solved = true; break; }
-      w.failure = ManifoldFailure::kNoSolution;
-      return w;
-    }
-    std::vector<double> step(c->begin(), c->end());
-    for (double& v : step) v = -v;
-    if (solve_in_place(j, n, step, 1) <= o.singular) {
+    jacobian(x, loc.data(), j.data(), nullptr, nullptr, nullptr);
+    for (std::size_t k = 0; k < n; ++k) step[k] = -c[k];
+    if (solve_in_place(j.data(), n, step.data(), 1) <= o.singular) {
       w.failure = ManifoldFailure::kSingular;
       return w;
     }
-    // Step halving: the largest constraint must fall.
+    for (std::size_t i = 0; i < m; ++i) {
+      s[i] = loc[i].g.dpdu;
+      t[i] = loc[i].g.dpdv;
+    }
+    // Step halving: the largest constraint (on the current tangent pairs) must fall.
     bool moved = false;
     for (double lambda = 1.0; lambda > 1.0 / 1024.0 && !moved; lambda *= 0.5) {
-      std::vector<ChainVertex> y = x;
       bool on = true;
       for (std::size_t v = 0; v < m && on; ++v) {
-        const std::optional<dvec3> p =
-            move_on_surface(*x[v].shape, x[v].primitive, x[v].p, lambda * (step[2 * v] * f.s[v] + step[2 * v + 1] * f.t[v]));
-        if (p) y[v].p = *p;
-        on = p.has_value();
+        const std::optional<dvec3> q = move_on_surface(*x[v].shape, x[v].primitive, p[v], lambda * (step[2 * v] * s[v] + step[2 * v + 1] * t[v]));
+        if (q) y[v] = *q;
+        on = q.has_value();
       }
       if (!on) continue;
-      const std::optional<std::vector<double>> cy = constraints(y, a, b, f);
-      if (cy && largest(*cy) < err) {
-        x = std::move(y);
+      if (evaluate(x, y.data(), a, b, s.data(), t.data(), trial.data(), cy.data()) && largest(cy.data(), n) < err) {
+        std::copy(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(m), p.begin());
         moved = true;
       }
     }
@@ -207,6 +217,7 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
       return w;
     }
   }
+  for (std::size_t i = 0; i < m; ++i) x[i].p = p[i];
   if (!solved) {
     w.failure = ManifoldFailure::kIterationLimit;
     return w;
@@ -232,15 +243,16 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     }
   }
   // --- the generalized geometry term |dω_a / dA_b| ---
-  const Frames f = frames_of(x);
-  dvec3 sb, tb;
-  tangent_frame(glm::normalize(nb), &sb, &tb);
-  if (!jacobian(x, a, b, f, h, &j, &sb, &tb, &jb)) {
+  if (!evaluate(x, p.data(), a, b, nullptr, nullptr, loc.data(), c.data())) {
     w.failure = ManifoldFailure::kNoSolution;
     return w;
   }
-  for (double& v : jb) v = -v;
-  if (solve_in_place(j, n, jb, 2) <= o.singular) {  // jb becomes dX/db (2m × 2)
+  dvec3 sb, tb;
+  tangent_frame(glm::normalize(nb), &sb, &tb);
+  std::array<double, kDim * 2> jb;
+  jacobian(x, loc.data(), j.data(), &sb, &tb, jb.data());
+  for (std::size_t k = 0; k < 2 * n; ++k) jb[k] = -jb[k];
+  if (solve_in_place(j.data(), n, jb.data(), 2) <= o.singular) {  // jb becomes dX/db (2m × 2)
     w.failure = ManifoldFailure::kSingular;
     return w;
   }
@@ -251,7 +263,7 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
   tangent_frame(wa, &e1, &e2);
   double mtx[2][2];
   for (int col = 0; col < 2; ++col) {
-    const dvec3 dx0 = jb[0 * 2 + static_cast<std::size_t>(col)] * f.s[0] + jb[1 * 2 + static_cast<std::size_t>(col)] * f.t[0];
+    const dvec3 dx0 = jb[0 * 2 + static_cast<std::size_t>(col)] * loc[0].g.dpdu + jb[1 * 2 + static_cast<std::size_t>(col)] * loc[0].g.dpdv;
     const dvec3 dw = (dx0 - glm::dot(dx0, wa) * wa) / len;
     mtx[0][col] = glm::dot(dw, e1);
     mtx[1][col] = glm::dot(dw, e2);

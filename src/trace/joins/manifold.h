@@ -8,9 +8,9 @@
 //  - Newton's method on the constraints: at each vertex, the generalized half vector
 //    h = η_i w_i + η_o w_o (w_i, w_o unit towards the neighbours, η the index on each one's side)
 //    must lie along the surface normal; its tangential part is the constraint, two numbers per
-//    vertex. The Jacobian is by central differences in double precision along each vertex's
-//    tangent frame (trace/differential.h); steps that do not reduce the largest constraint are
-//    halved;
+//    vertex. The Jacobian is analytic, in double precision, along each vertex's tangent frame
+//    (the position and normal derivatives of trace/differential.h); steps that do not reduce the
+//    largest constraint are halved;
 //  - the generalized geometry term: with a and the chain's constraints fixed, b moving over its
 //    tangent plane moves the first chain vertex and so the direction leaving a; the irradiance the
 //    chain carries to b per unit intensity at a is |dω_a / dA_b| (implicit function theorem:

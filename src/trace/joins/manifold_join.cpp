@@ -15,6 +15,21 @@
 namespace pathex::tracer {
 namespace {
 bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+
+// A sphere (centre, radius) holding the shape, padded by a relative 1e-4.
+glm::vec4 bounding_sphere(const ShapeGeometry& g) {
+  if (const auto* s = std::get_if<SphereShape>(&g)) return {s->center, s->radius * 1.0001f};
+  if (const auto* d = std::get_if<DiskShape>(&g)) return {d->center, d->radius * 1.0001f};
+  vec3 lo(INFINITY), hi(-INFINITY);
+  const auto add = [&](const vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); };
+  if (const auto* q = std::get_if<QuadShape>(&g)) {
+    for (const vec3& p : {q->corner, q->corner + q->edge1, q->corner + q->edge2, q->corner + q->edge1 + q->edge2}) add(p);
+  } else {
+    for (const vec3& p : std::get<MeshShape>(g).positions) add(p);
+  }
+  const vec3 c = 0.5f * (lo + hi);
+  return {c, 0.5f * glm::length(hi - lo) * 1.0001f + 1e-6f * glm::length(c)};
+}
 }  // namespace
 
 void Integrator::init_manifold() {
@@ -48,6 +63,8 @@ void Integrator::init_manifold() {
     seed_cdf_.push_back(total);
   }
   for (float& c : seed_cdf_) c /= total;
+  specular_bounds_.clear();
+  for (const int shape : specular_shapes_) specular_bounds_.push_back(bounding_sphere(rs_.geometry->shape_geometry(shape)));
   has_manifold_ = !specular_shapes_.empty() && table_.runs(ConnectorKind::kManifold);
   RTCBounds b;
   rtcGetSceneBounds(rs_.geometry->handle(), &b);
@@ -146,13 +163,34 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   if (b->kind != Kind::kSurface || !b->finite) return;
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kManifoldLight);
   if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
+  // A one-sided emitter at a (a fresh light point) whose every specular shape lies behind it sends no
+  // chain any light: the chain's first vertex would leave a at a negative cosine (no transport).
+  if (s == 1 && !is_black(vec3(a->n)) && is_black(end_f(*a, -a->n, TransportMode::kImportance))) {
+    bool behind = true;
+    for (const glm::vec4& bs : specular_bounds_)
+      behind = behind && glm::dot(vec3(bs) - a->p, a->n) < -bs.w;
+    if (behind) return;
+  }
   // The seeds draw from their own counter-based stream (an unbounded count of numbers per join).
   const std::uint64_t stream = stream_key(rng.key(), th.pass, 0x6d616e69666f6c64ULL + static_cast<std::uint64_t>(s) * kMaxRuns +
                                                                static_cast<std::uint64_t>(t));
   std::uint64_t drawn = 0;
   const glm::dvec3 pa(a->p), pb(b->p), nb(b->n);
+  std::vector<ManifoldSolution>& found = th.manifold_found;
+  // A seed keeps its vertices' shapes and types (reflection or refraction) through Newton's
+  // method, so a seed of another signature than every chain still sought cannot find one again:
+  // the batches that seek (`seeking`) skip its solve, and it still counts in its batch.
+  const auto sought = [&](const std::vector<ChainVertex>& x) {
+    for (const ManifoldSolution& f : found) {
+      if (f.batches > 0 || f.chain.size() != x.size()) continue;
+      bool same = true;
+      for (std::size_t i = 0; i < x.size() && same; ++i) same = x[i].id == f.chain[i].id && x[i].reflect == f.chain[i].reflect;
+      if (same) return true;
+    }
+    return false;
+  };
   // One seed, from either end with probability 1/2, solved.
-  const auto trial = [&](std::vector<ChainVertex>& chain) -> ManifoldWalk {
+  const auto trial = [&](std::vector<ChainVertex>& chain, bool seeking) -> ManifoldWalk {
     ManifoldWalk w;
     const bool from_light = bits_to_unit_float(stream_bits(stream, drawn++)) < 0.5f;
     w.failure = seed_chain(from_light ? *a : *b, from_light, stream, &drawn, chain);
@@ -167,12 +205,15 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
       w.failure = ManifoldFailure::kUnrequested;
       return w;
     }
+    if (seeking && !sought(chain)) {
+      w.failure = ManifoldFailure::kUnrequested;
+      return w;
+    }
     ++stats.walks;
     w = solve_chain(chain, pa, pb, nb, scene_size_, o_.manifold);
     stats.iterations += static_cast<std::uint64_t>(w.iterations);
     return w;
   };
-  std::vector<ManifoldSolution>& found = th.manifold_found;
   std::vector<ChainVertex>& seed = th.manifold_seed;
   const double same = 1e-5 * scene_size_;  // solutions are polished (solve_chain), so one found twice compares equal
   const auto index_of = [&](const std::vector<ChainVertex>& x) -> int {
@@ -190,7 +231,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   found.clear();
   for (int j = 0; j < per_batch; ++j) {
     ++stats.attempts;
-    const ManifoldWalk w = trial(seed);
+    const ManifoldWalk w = trial(seed, false);
     switch (w.failure) {
       case ManifoldFailure::kNone: break;
       case ManifoldFailure::kNoSolution: ++stats.no_solution; continue;
@@ -215,7 +256,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   while (left > 0 && (batches + 1) * per_batch <= o_.manifold.max_trials) {
     ++batches;
     for (int j = 0; j < per_batch; ++j) {
-      if (trial(seed).failure != ManifoldFailure::kNone) continue;
+      if (trial(seed, true).failure != ManifoldFailure::kNone) continue;
       const int k = index_of(seed);
       if (k >= 0 && found[static_cast<std::size_t>(k)].batches == 0) {
         found[static_cast<std::size_t>(k)].batches = batches;
