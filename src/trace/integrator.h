@@ -116,6 +116,7 @@ class Integrator {
     // Segments that must all be clear: this lane's and the segments - 1 before it in the batch
     // (the mirror connector tests two). 0 marks a lane whose contribution sits on a later lane.
     int segments = 1;
+    std::uint64_t pass = 0;  // the sample's pass (shadow rays are traced a while after it)
   };
 
   struct Thread {

@@ -22,6 +22,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <utility>
 
 #include "trace/accel/path_ids.h"
 #include "trace/media.h"
@@ -231,9 +232,10 @@ void Integrator::record(Thread& th, const Pending& r) const {
 
 void Integrator::record_nonfinite(Thread& th, const Pending& r) const {
   th.hist.add_nonfinite();
-  if (!th.first_nonfinite)
-    th.first_nonfinite = NonfiniteSample{strategies_.strategies[static_cast<std::size_t>(r.strategy)].name, unpack(r.key),
-                                         th.pass, r.px, th.py};
+  // The earliest by (pass, row, column) of the sample that made it, not the first recorded: the
+  // order a thread meets its rows and flushes its shadow rays depends on the thread count.
+  NonfiniteSample here{strategies_.strategies[static_cast<std::size_t>(r.strategy)].name, unpack(r.key), r.pass, r.px, th.py};
+  if (!th.first_nonfinite || here.order() < th.first_nonfinite->order()) th.first_nonfinite = std::move(here);
 }
 
 Integrator::PathView Integrator::path_of(const Thread& th, const JoinResult& jr) {
@@ -261,7 +263,7 @@ void Integrator::estimate(Thread& th, int batch) const {
                                   jr.chain == ConnectorKind::kOrthoProjection ? 0 : jr.t, connector}
                             .code();
   const Pending r{jr.letters, jr.contribution * weight, jr.strategy, batch, technique, jr.splat, connector,
-                  jr.rx, jr.ry, th.px, jr.num_segments};
+                  jr.rx, jr.ry, th.px, jr.num_segments, th.pass};
   if (jr.num_segments == 0) {
     record(th, r);
     return;

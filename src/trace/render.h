@@ -134,9 +134,7 @@ struct ConnectorStats {
 };
 
 // Where a render's first non-finite contribution arose (they are bugs: DESIGN §7). "First" is by
-// (pass, row, column) of the sample in progress when the contribution was recorded (shadow rays are
-// traced in packets, so that may be a little after the sample that made it), the same for every
-// thread count.
+// (pass, row, column) of the sample that made the contribution, the same for every thread count.
 struct NonfiniteSample {
   std::string strategy;  // the profile's name for the strategy
   std::string path;      // its full-path string

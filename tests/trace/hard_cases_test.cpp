@@ -315,6 +315,21 @@ TEST(Nonfinite, TraceWarnsAndTheCheckFails) {
   EXPECT_NE(c.out.find("PASS  sphere: renders finite (16 spp, seed 1) (no non-finite sample)"), std::string::npos) << c.out;
 }
 
+// The first non-finite sample the warning names is the earliest by (pass, row, column) of the
+// sample that made it, whatever the thread count (it was the first a thread recorded, at the pass in
+// progress when its shadow rays were traced: pass 3 with one thread, pass 0 at (0, 2) with two).
+TEST(Nonfinite, TheFirstNamedIsTheSameForEveryThreadCount) {
+  for (const char* threads : {"1", "2", "3"}) {
+    const std::string dir = (test::scratch_dir() / (std::string("nonfinite-threads-") + threads)).string();
+    const test::CliRun t = test::run_pathex("trace samples/scenes/hard/nonfinite-hot-sphere.json --renderer pt-nee --spp 4 --no-images --threads " +
+                                            std::string(threads) + " --out " + dir);
+    EXPECT_EQ(t.code, 0);
+    EXPECT_NE(t.err.find("240 non-finite samples (dropped; any is a bug); the first from strategy nee on path LSDDDSE (near pixel (0, 0), pass 0)"),
+              std::string::npos)
+        << threads << " threads: " << t.err;
+  }
+}
+
 TEST(Nonfinite, FiniteRequirementNeedsASceneAndOnlyItsKeys) {
   const std::string check = (test::scratch_dir() / "finite-bad.json").string();
   {
