@@ -5,17 +5,14 @@
 #include <filesystem>
 #include <iostream>
 
-#include <nlohmann/json.hpp>
-
 #include "check/check_file.h"
+#include "check/check_json.h"
 #include "cli/bias_common.h"
 #include "cli/common.h"
 #include "io/atomic_file.h"
-#include "output/bias_json.h"
 #include "io/estimate_text.h"
 #include "io/input_file.h"
 #include "io/junit.h"
-#include "io/reach_json.h"
 
 namespace pathex::cli {
 namespace {
@@ -55,7 +52,6 @@ int run(const CheckArgs& a) {
 
   int failed = 0;
   std::vector<JUnitCase> junit;
-  nlohmann::json jcases = nlohmann::json::array();
   for (const Outcome& o : outcomes) {
     failed += o.passed ? 0 : 1;
     std::string message = o.r->describe() + ": found " + o.verdict;
@@ -80,39 +76,14 @@ int run(const CheckArgs& a) {
                  chains_text(p.chains) + "; " + p.reason;
     }
     junit.push_back({o.c->name, o.r->describe(), o.time_s, !o.passed, false, message, details});
-    if (a.json) {
-      nlohmann::json jr = {{"case", o.c->name}, {"renderer", o.c->renderer}, {"requirement", o.r->describe()},
-                           {"passed", o.passed}, {"verdict", o.verdict}};
-      jr["scene"] = o.c->scene.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.c->scene);
-      jr["max_bounces"] = o.c->max_bounces ? nlohmann::json(*o.c->max_bounces) : nlohmann::json(nullptr);
-      if (o.counterexample) {
-        nlohmann::json chains = nlohmann::json::array();
-        for (const ChainEvidence& c : o.counterexample->chains) chains.push_back(to_json(c));
-        jr["counterexample"] = {{"path", o.counterexample->path}, {"chains", chains}};
-        if (o.counterexample->reason.empty()) jr["counterexample"]["strategies"] = o.counterexample->strategies;
-        else jr["counterexample"]["reason"] = o.counterexample->reason;
-      }
-      if (o.missed && o.missed->undersampled) {
-        jr["undersampled"] = nlohmann::json::parse(to_json(*o.missed)["undersampled"].dump());
-      } else if (o.missed) {
-        const BiasReport& b = *o.missed;
-        jr["missed"] = {{"share", b.share}, {"stderr", b.share_std_error}, {"max_share", o.r->missed->max_share},
-                        {"reference", b.reference}, {"spp", b.spp}, {"luminance", b.missed.luminance},
-                        {"total", b.total.luminance}};
-        if (!b.paths.empty())
-          jr["missed"]["largest_path"] = {{"path", b.paths.front().estimate.path}, {"share", b.paths.front().share},
-                                          {"reason", b.paths.front().reason}};
-      }
-      jcases.push_back(jr);
-    } else {
+    if (!a.json) {
       std::cout << (o.passed ? "PASS  " : "FAIL  ") << o.c->name << ": " << o.r->describe() << " (" << o.verdict << ")\n";
       if (!o.passed && !details.empty()) std::cout << "      " << details << "\n";
     }
   }
   const int passed = static_cast<int>(outcomes.size()) - failed;
   if (a.json) {
-    std::cout << nlohmann::json{{"file", a.file}, {"passed", passed}, {"failed", failed}, {"requirements", jcases}}.dump(2)
-              << "\n";
+    std::cout << check_json(a.file, outcomes) << "\n";
   } else {
     std::cout << "check: " << passed << " passed, " << failed << " failed\n";
   }
