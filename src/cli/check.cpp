@@ -9,6 +9,7 @@
 #include "check/check_json.h"
 #include "cli/bias_common.h"
 #include "cli/common.h"
+#include "cli/witness_text.h"
 #include "io/atomic_file.h"
 #include "io/estimate_text.h"
 #include "io/input_file.h"
@@ -23,13 +24,6 @@ struct CheckArgs {
   std::string junit;
   Limits limits;
 };
-
-std::string chains_text(const std::vector<ChainEvidence>& chains) {
-  std::string s;
-  for (const ChainEvidence& c : chains)
-    s += (s.empty() ? "" : " ") + c.chain.letters + "(" + std::to_string(c.chain.from) + ".." + std::to_string(c.chain.to) + ")";
-  return s;
-}
 
 // Reports a check that could not be run; with --junit, the report holds it as an <error>.
 int fail(const CheckArgs& a, const Error& e) {
@@ -58,7 +52,7 @@ int run(const CheckArgs& a) {
     std::string details;
     if (o.counterexample) {
       const Witness& w = *o.counterexample;
-      details = "shortest counterexample " + w.path + ", chains " + chains_text(w.chains) +
+      details = "shortest counterexample " + w.path + ", chains " + chains_text(w.chains, /*connectors=*/false) +
                 (w.reason.empty() ? "; sampled by " + [&] {
                   std::string s;
                   for (const std::string& st : w.strategies) s += (s.empty() ? "" : ", ") + st;
@@ -73,7 +67,7 @@ int run(const CheckArgs& a) {
     } else if (!o.passed && o.missed && !o.missed->paths.empty()) {
       const MissedPath& p = o.missed->paths.front();
       details += "\n      largest missed path " + p.estimate.path + ", " + percent(p.share, 2) + " of the image, chains " +
-                 chains_text(p.chains) + "; " + p.reason;
+                 chains_text(p.chains, /*connectors=*/false) + "; " + p.reason;
     }
     junit.push_back({o.c->name, o.r->describe(), o.time_s, !o.passed, false, message, details});
     if (!a.json) {

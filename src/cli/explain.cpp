@@ -32,7 +32,7 @@ nlohmann::json chains_json(const std::string& path) {
   return arr;
 }
 
-std::string chains_text(const std::string& path) {
+std::string path_chains_text(const std::string& path) {
   Result<FullPath> p = parse_full_path(path, path.size());
   if (!p) return "";
   std::string s;
@@ -138,7 +138,7 @@ int run(const ExplainArgs& a) {
   std::cout << (any ? "" : " none") << "\n";
   std::cout << "shortest members\n";
   if (members.empty()) std::cout << "  none\n";
-  for (const std::string& m : members) std::cout << "  " << m << "   chains " << chains_text(m) << "\n";
+  for (const std::string& m : members) std::cout << "  " << m << "   chains " << path_chains_text(m) << "\n";
   return kExitOk;
 }
 

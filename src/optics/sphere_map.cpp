@@ -9,7 +9,7 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kInvPi = std::numbers::inv_pi_v<float>;
-float safe_sqrt(float x) { return std::sqrt(std::max(x, 0.0f)); }
+float sqrt_nonnegative(float x) { return std::sqrt(std::max(x, 0.0f)); }
 
 }  // namespace
 
@@ -22,13 +22,13 @@ glm::vec3 equal_area_square_to_sphere(glm::vec2 p) {
   const float r = 1.0f - std::abs(signed_distance);
   const float phi = (r == 0.0f ? 1.0f : (vp - up) / r + 1.0f) * kPi / 4.0f;
   const float z = std::copysign(1.0f - r * r, signed_distance);
-  const float s = r * safe_sqrt(2.0f - r * r);
+  const float s = r * sqrt_nonnegative(2.0f - r * r);
   return {std::copysign(std::cos(phi), u) * s, std::copysign(std::sin(phi), v) * s, z};
 }
 
 glm::vec2 equal_area_sphere_to_square(const glm::vec3& d) {
   const float x = std::abs(d.x), y = std::abs(d.y), z = std::abs(d.z);
-  const float r = safe_sqrt(1.0f - z);
+  const float r = sqrt_nonnegative(1.0f - z);
   const float a = std::max(x, y);
   const float b = a == 0.0f ? 0.0f : std::min(x, y) / a;
   float phi = std::atan(b) * (2.0f / kPi);  // in [0, 1]: the angle from the nearer axis

@@ -135,8 +135,8 @@ static nlohmann::ordered_json efficiency_json(const Estimate& total, double cpu_
 namespace {
 
 // histogram.json and run.json (which reads the report's total).
-Result<WrittenReport> write_report(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                   const RenderClasses& classes, const std::vector<PrunedStrategy>& not_run) {
+Result<WrittenReport> write_histogram_and_run_json(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
+                                                   const RenderClasses& classes, const std::vector<PrunedStrategy>& not_run) {
   const RenderIdentity& id = header.identity;
   const std::vector<ConnectorStats>& connectors = sums.connectors;
   RunInfo info;
@@ -251,7 +251,7 @@ Result<WrittenReport> write_render_outputs(const std::string& dir, const ShardHe
   tbb::task_group group;
   group.run([&] { shard.emplace(write_shard(dir + "/" + kRenderShardName, header, sums)); });
   if (header.identity.images) group.run([&] { images.emplace(write_images(dir, header, sums, classes)); });
-  Result<WrittenReport> report = write_report(dir, header, sums, classes, not_run);
+  Result<WrittenReport> report = write_histogram_and_run_json(dir, header, sums, classes, not_run);
   group.wait();
   if (!report) return report.error();
   if (images && !*images) return images->error();

@@ -137,7 +137,7 @@ namespace {
 // A basic material's kind and parameters, as a key: equal keys are the same material. Every kind
 // is a plain struct of floats, so its bytes are its parameters.
 using MaterialKey = std::vector<std::uint32_t>;
-MaterialKey key_of(const BasicMaterial& m) {
+MaterialKey material_key(const BasicMaterial& m) {
   return std::visit(
       [&](const auto& k) -> MaterialKey {
         using T = std::decay_t<decltype(k)>;
@@ -153,7 +153,7 @@ MaterialKey key_of(const BasicMaterial& m) {
 // Adds `m` with weight `w` to `out`, merging components equal to one already there (`index`).
 void flatten(const Material& m, float w, std::vector<Mixture::Component>* out, std::map<MaterialKey, std::size_t>* index) {
   auto add = [&](float weight, const BasicMaterial& basic) {
-    const auto [it, fresh] = index->emplace(key_of(basic), out->size());
+    const auto [it, fresh] = index->emplace(material_key(basic), out->size());
     if (fresh) out->push_back({weight, basic});
     else (*out)[it->second].weight += weight;
   };

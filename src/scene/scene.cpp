@@ -380,8 +380,6 @@ Result<glm::mat4> read_transform(const Reader& r, const json& j, const std::stri
   return m;
 }
 
-vec3 apply_point(const glm::mat4& m, vec3 p) { return vec3(m * glm::vec4(p, 1.0f)); }
-vec3 apply_vector(const glm::mat4& m, vec3 v) { return vec3(m * glm::vec4(v, 0.0f)); }
 
 // OBJ meshes. tinyobjloader does the loading, but it only warns about out-of-range indices and
 // reads a malformed number as 0, so a first pass over the text checks every `v` and `f` line and
@@ -799,7 +797,7 @@ std::vector<std::pair<vec3, vec3>> instance_boxes(const Scene& scene) {
     if (!(g.lo.x <= g.hi.x)) continue;  // an empty group draws nothing
     Box b;
     for (int c = 0; c < 8; ++c)
-      b.add(apply_point(inst.to_world, vec3(c & 1 ? g.hi.x : g.lo.x, c & 2 ? g.hi.y : g.lo.y, c & 4 ? g.hi.z : g.lo.z)));
+      b.add(import::apply_point(inst.to_world, vec3(c & 1 ? g.hi.x : g.lo.x, c & 2 ? g.hi.y : g.lo.y, c & 4 ? g.hi.z : g.lo.z)));
     out.emplace_back(b.lo, b.hi);
   }
   return out;
@@ -965,20 +963,20 @@ Result<Shape> read_shape(const Reader& r, const json& j, const std::string& ptr,
     PATHEX_TRY(c, r.vector3(j, "center", ptr, true));
     PATHEX_TRY(rad, r.number(j, "radius", ptr, 1e-12, 1e12));
     if (!uniform) return r.fail(ptr + "/transform/scale", "a sphere needs a uniform scale");
-    s.geometry = SphereShape{apply_point(m, c), static_cast<float>(rad) * scale};
+    s.geometry = SphereShape{import::apply_point(m, c), static_cast<float>(rad) * scale};
   } else if (type == "quad") {
     PATHEX_TRY(c, r.vector3(j, "corner", ptr, true));
     PATHEX_TRY(e1, r.vector3(j, "edge1", ptr, true, vec3(0.0f), false, true));
     PATHEX_TRY(e2, r.vector3(j, "edge2", ptr, true, vec3(0.0f), false, true));
     if (glm::length(glm::cross(e1, e2)) == 0.0f) return r.fail(ptr, "the quad's edges are parallel: its area is zero");
-    s.geometry = QuadShape{apply_point(m, c), apply_vector(m, e1), apply_vector(m, e2)};
+    s.geometry = QuadShape{import::apply_point(m, c), import::apply_vector(m, e1), import::apply_vector(m, e2)};
   } else if (type == "disk") {
     PATHEX_TRY(c, r.vector3(j, "center", ptr, true));
     PATHEX_TRY(n, r.vector3(j, "normal", ptr, true, vec3(0.0f), false, true));
     PATHEX_TRY(rad, r.number(j, "radius", ptr, 1e-12, 1e12));
     if (!uniform) return r.fail(ptr + "/transform/scale", "a disk needs a uniform scale");
     const vec3 wn = glm::normalize(vec3(glm::transpose(glm::inverse(m)) * glm::vec4(n, 0.0f)));
-    s.geometry = DiskShape{apply_point(m, c), wn, static_cast<float>(rad) * scale};
+    s.geometry = DiskShape{import::apply_point(m, c), wn, static_cast<float>(rad) * scale};
   } else {
     PATHEX_TRY(file, r.string(j, "file", ptr));
     PATHEX_TRY(mesh, load_obj(r, ptr, base_dir, file, options, mesh_elements));

@@ -135,3 +135,112 @@ TEST(Layers, AnUpwardIncludeIsFound) {
 
 }  // namespace
 }  // namespace pathex
+
+namespace pathex {
+namespace {
+
+namespace fs = std::filesystem;
+using test::read_file;
+
+// --- unity builds (src/CMakeLists.txt, PATHEX_UNITY_BUILD): a folder is one translation unit ---
+//
+// In one unit the files' anonymous namespaces are one namespace, so a file-local function hides,
+// in every file after it, a function of the same name declared elsewhere: cli/check.cpp's own
+// chains_text (without connectors) once replaced cli/witness_text.h's in query and bias, in CI's
+// unity build only. A file-local function's name is therefore never a function declared in a
+// header of src/ nor defined outside an anonymous namespace in another file of its unity group.
+// (File-local functions of one name in two files overload each other, as `run(const XArgs&)` in
+// each command does: a call then picks by its argument types, or fails to compile.)
+
+struct FunctionNames {
+  std::set<std::string> file_local;  // defined inside `namespace {`
+  std::set<std::string> other;       // defined or declared elsewhere
+};
+
+// The names of the functions a file defines or declares at column 0 (this code's style: namespace
+// contents are not indented), split by whether they are inside an anonymous namespace.
+FunctionNames function_names(const std::string& text) {
+  static const std::regex function(R"(^(?:[A-Za-z_][\w:<>,*&]*[ *&]+)+([A-Za-z_]\w*)\()");
+  static const std::set<std::string> not_names = {"if", "for", "while", "switch", "return", "operator", "TEST", "main"};
+  FunctionNames names;
+  std::istringstream lines(text);
+  std::string l;
+  bool anonymous = false;
+  while (std::getline(lines, l)) {
+    if (l == "namespace {") anonymous = true;
+    else if (anonymous && l.rfind("}  // namespace", 0) == 0) anonymous = false;
+    std::smatch m;
+    if (l.empty() || l[0] == ' ' || l[0] == '/' || l[0] == '#' || !std::regex_search(l, m, function)) continue;
+    if (not_names.count(m[1].str())) continue;
+    (anonymous ? names.file_local : names.other).insert(m[1].str());
+  }
+  return names;
+}
+
+// Every file-local function of a unity group that shares its name with a function of a header of
+// `src` or of another file of its group: "group/file.cpp: name (also in where)".
+std::vector<std::string> unity_hiding(const fs::path& src, const std::vector<std::string>& groups, const std::set<std::string>& skip) {
+  std::map<std::string, std::set<std::string>> public_names;  // name -> where
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(src))
+    if (e.is_regular_file() && e.path().extension() == ".h")
+      for (const std::string& n : function_names(read_file(e.path())).other)
+        public_names[n].insert(fs::relative(e.path(), src).generic_string());
+  std::vector<std::string> found;
+  for (const std::string& g : groups) {
+    std::map<std::string, FunctionNames> files;
+    for (const fs::directory_entry& e : fs::directory_iterator(src / g)) {
+      const std::string rel = g + "/" + e.path().filename().string();
+      if (e.is_regular_file() && e.path().extension() == ".cpp" && !skip.count(rel)) files[rel] = function_names(read_file(e.path()));
+    }
+    for (const auto& [rel, names] : files)
+      for (const std::string& n : names.file_local) {
+        std::set<std::string> where = public_names.count(n) ? public_names[n] : std::set<std::string>{};
+        for (const auto& [other, other_names] : files)
+          if (other != rel && other_names.other.count(n)) where.insert(other);
+        if (where.empty()) continue;
+        std::string list;
+        for (const std::string& w : where) list += (list.empty() ? "" : ", ") + w;
+        found.push_back(rel + ": " + n + " (also in " + list + ")");
+      }
+  }
+  return found;
+}
+
+// PATHEX_UNITY_DIRS and PATHEX_UNITY_SKIP of src/CMakeLists.txt, and cli (one unit of its own).
+std::vector<std::string> cmake_list(const std::string& cmake, const std::string& name) {
+  const std::regex line("set\\(" + name + " ([^)]*)\\)");
+  std::smatch m;
+  std::vector<std::string> out;
+  if (!std::regex_search(cmake, m, line)) return out;
+  std::istringstream words(m[1].str());
+  for (std::string w; words >> w;) out.push_back(w);
+  return out;
+}
+
+TEST(Layers, NoFileLocalFunctionHidesAnotherInAUnityBuild) {
+  const fs::path src = fs::path(PATHEX_SOURCE_DIR) / "src";
+  const std::string cmake = read_file(src / "CMakeLists.txt");
+  std::vector<std::string> groups = cmake_list(cmake, "PATHEX_UNITY_DIRS");
+  ASSERT_GT(groups.size(), 10u) << "PATHEX_UNITY_DIRS not found in src/CMakeLists.txt";
+  groups.push_back("cli");
+  const std::vector<std::string> skip = cmake_list(cmake, "PATHEX_UNITY_SKIP");
+  for (const std::string& h : unity_hiding(src, groups, std::set<std::string>(skip.begin(), skip.end())))
+    ADD_FAILURE() << "src/" << h << ": in a unity build this file-local function hides the other for the files after it; rename it";
+}
+
+// The check itself finds the hiding that CI's unity build once had.
+TEST(Layers, AFileLocalFunctionThatHidesAHeadersIsFound) {
+  const fs::path dir = fs::temp_directory_path() / "pathex-unity-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "cli");
+  std::ofstream(dir / "cli" / "witness_text.h") << "#pragma once\nnamespace pathex::cli {\n\ninline std::string chains_text(const Chains& c) {\n  return \"\";\n}\n\n}  // namespace pathex::cli\n";
+  std::ofstream(dir / "cli" / "check.cpp") << "namespace pathex::cli {\nnamespace {\n\nstd::string chains_text(const Chains& c) {\n  return \"\";\n}\n\nint run(const CheckArgs& a) {\n  return 0;\n}\n\n}  // namespace\n}  // namespace pathex::cli\n";
+  std::ofstream(dir / "cli" / "query.cpp") << "namespace pathex::cli {\nnamespace {\n\nint run(const QueryArgs& a) {\n  return 0;\n}\n\n}  // namespace\n}  // namespace pathex::cli\n";
+  const std::vector<std::string> found = unity_hiding(dir, {"cli"}, {});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0], "cli/check.cpp: chains_text (also in cli/witness_text.h)");
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pathex
