@@ -17,8 +17,6 @@
 #include "cli/reach_common.h"
 #include "output/render_job.h"
 #include "cli/trace_checks.h"
-#include "io/histogram_json.h"
-#include "io/image_io.h"
 #include "scene/universe.h"
 #include "trace/render.h"
 
