@@ -132,7 +132,7 @@ class Integrator {
     std::vector<ChainVertex> manifold_seed{};       // the manifold connector's chain being solved
     std::vector<ManifoldSolution> manifold_found{};  // and the distinct chains its first batch found
     // The MIS weight's working space (mis_weight()): the strategies that sample the path being
-    // weighed, and its vertices' densities.
+    // weighed, and the densities of its vertices that the weight reads.
     std::array<mis::Technique, 2 * mis::kMaxPath + 2> techniques{};
     std::array<mis::Densities, mis::kMaxPath> densities{};
     // Each subpath vertex's densities as its walk stored them (set by set_masks(), once per sample).
@@ -389,8 +389,8 @@ class Integrator {
   float mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const;
   // The strategies that sample path x, `self` the own one (connectors listed in th.techniques).
   mis::Strategies techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const;
-  // th.densities[lo … hi) of a plain or projection join's path: the subpaths' stored densities with
-  // the four the join changes recomputed.
+  // th.densities[lo … hi) of a plain or projection join's path: the subpaths' stored densities
+  // copied, the four the join changes recomputed in the copy.
   void join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const;
   // th.densities[lo … hi) of a path with constructed vertices: every one computed from the vertices.
   void path_densities(Thread& th, const PathView& x, PathKey key, int lo, int hi) const;
