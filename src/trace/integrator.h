@@ -224,14 +224,14 @@ class Integrator {
   const std::string& sensor_pair() const { return sensor_pair_; }  // c(k+1) c(k+2)
 
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
-  // Densities as the MIS ratios keep them: a Dirac part's is stored as 0 (RayPdf::mis_dir).
+  // Densities as the walks and the MIS ratios keep them: a Dirac part's is 0 (trace/emitters.h).
   // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w.
   float sensor_pdf_dir(const Vertex& v, const vec3& w) const {
-    return pdf_ray(cam_.params, v.p, w).mis_dir();
+    return pdf_ray(cam_.params, v.p, w).dir;
   }
   // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
   float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    return l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w).mis_dir();
+    return l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w).dir;
   }
   // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
   // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
