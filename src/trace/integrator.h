@@ -255,41 +255,16 @@ class Integrator {
   }
 
   // The material at surface vertex `v` (RenderScene::material_at).
-  const Material& material_at(const Vertex& v, Material* scratch) const { return rs_.material_at(v.shape, v.uv, scratch); }
+  const Material& material_at(const Vertex& v, MaterialScratch* scratch) const { return rs_.material_at(v.shape, v.uv, scratch); }
 
-  // --- densities used by MIS ---
+  // --- densities used by MIS (mis_weight.cpp) ---
   // Solid-angle density at `v` of sampling the unit direction `wn`, given the unit direction
   // `wp` to v's other neighbour (null when it has none: a surface then has no density).
-  float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
-    switch (v.kind) {
-      case Kind::kCamera: return sensor_pdf_dir(v, wn);
-      case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
-      case Kind::kSurface: {
-        if (!wp) return 0.0f;
-        Material textured;
-        return bsdf::pdf(material_at(v, &textured), *wp, wn, v.ns, v.n);
-      }
-      case Kind::kLens: return 0.0f;
-    }
-    return 0.0f;
-  }
+  float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const;
   // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
-  float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const {
-    const vec3 d = next.p - v.p;
-    const float d2 = glm::dot(d, d);
-    if (d2 == 0.0f) return 0.0f;
-    const vec3 wn = d / std::sqrt(d2);
-    if (v.kind == Kind::kLight)
-      if (const EnvironmentLightParams* e = environment_of(v.light)) return emission_step_density(*e, abs_cos(next, wn));
-    const vec3 wp = prev ? glm::normalize(prev->p - v.p) : vec3(0.0f);
-    return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
-  }
+  float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const;
   // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
-  float pdf_light_origin(const Vertex& v) const {
-    const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
-    if (const EnvironmentLightParams* e = environment_of(li)) return env_origin_density(*e, v.p, v.n, v.p + v.wo * std::sqrt(v.d2_wo));
-    return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
-  }
+  float pdf_light_origin(const Vertex& v) const;
 
   // --- subpaths ---
   // A template on the direction: the walk's tests of its direction are not branches. What the

@@ -21,6 +21,37 @@
 
 namespace pathex::tracer {
 
+float Integrator::pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
+  switch (v.kind) {
+    case Kind::kCamera: return sensor_pdf_dir(v, wn);
+    case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
+    case Kind::kSurface: {
+      if (!wp) return 0.0f;
+      MaterialScratch textured;
+      return bsdf::pdf(material_at(v, &textured), *wp, wn, v.ns, v.n);
+    }
+    case Kind::kLens: return 0.0f;
+  }
+  return 0.0f;
+}
+
+float Integrator::pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const {
+  const vec3 d = next.p - v.p;
+  const float d2 = glm::dot(d, d);
+  if (d2 == 0.0f) return 0.0f;
+  const vec3 wn = d / std::sqrt(d2);
+  if (v.kind == Kind::kLight)
+    if (const EnvironmentLightParams* e = environment_of(v.light)) return emission_step_density(*e, abs_cos(next, wn));
+  const vec3 wp = prev ? glm::normalize(prev->p - v.p) : vec3(0.0f);
+  return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
+}
+
+float Integrator::pdf_light_origin(const Vertex& v) const {
+  const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
+  if (const EnvironmentLightParams* e = environment_of(li)) return env_origin_density(*e, v.p, v.n, v.p + v.wo * std::sqrt(v.d2_wo));
+  return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
+}
+
 mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
   const int n = x.size(), k = n - 1, s = x.s;
   mis::Strategies st;

@@ -116,7 +116,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     ++count;
     if (count >= max_vertices) break;
     // --- scatter ---
-    Material textured;
+    MaterialScratch textured;
     const Material& m = material_at(v, &textured);
     const vec3 wo = -d;
     const bsdf::NumbersRead reads = bsdf::numbers_read(m);  // the others are not computed

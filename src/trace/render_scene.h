@@ -68,6 +68,10 @@ struct RenderSensor {
   float pdf_pos = 0.0f;
 };
 
+// Room for a material with its textured parameters evaluated (RenderScene::material_at): a
+// Material is made in it only at a textured shape, so that a scene without textures makes none.
+using MaterialScratch = std::optional<Material>;
+
 struct RenderScene {
   std::unique_ptr<EmbreeScene> geometry;
   std::vector<const Material*> material_of_shape;
@@ -109,14 +113,15 @@ struct RenderScene {
     *error = ss.error;
     return {ss.position, ss.normal, l.pdf_pos};
   }
-  // The material of `shape` at `uv`: its own, with its textured parameters evaluated into
-  // `*scratch` when it has any (trace/texture_eval.h).
-  const Material& material_at(int shape, glm::vec2 uv, Material* scratch) const {
+  // The material of `shape` at `uv`: its own, or, when it has textured parameters, the material
+  // with them evaluated, made in `*scratch` (trace/texture_eval.h).
+  const Material& material_at(int shape, glm::vec2 uv, MaterialScratch* scratch) const {
     const Material& base = *material_of_shape[static_cast<std::size_t>(shape)];
     const MaterialTextures* tex = textures_of_shape[static_cast<std::size_t>(shape)];
     if (!tex) return base;
-    textured_material(*scene, base, *tex, uv, scratch);
-    return *scratch;
+    if (!*scratch) scratch->emplace();
+    textured_material(*scene, base, *tex, uv, &**scratch);
+    return **scratch;
   }
   // A hit's shading normal as every strategy sees it (pt, pt-nee, lt, bdpt's joins and the MIS
   // densities all read the vertex's ns): the geometry's (Hit::shading_normal) turned by its

@@ -306,7 +306,7 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     const float cos_prev = static_cast<float>(glm::dot(glm::normalize(prev - c.p), geometry.ns));
     // A textured material's values at the solved point (its uv as a hit there has it), as every
     // other strategy sees them through material_at().
-    Material textured;
+    MaterialScratch textured;
     const bool has_textures = rs_.textures_of_shape[static_cast<std::size_t>(c.id)] != nullptr;
     if (has_textures) v.uv = rs_.geometry->uv_at(c.id, c.primitive, v.p);
     const Material& mat = material_at(v, &textured);

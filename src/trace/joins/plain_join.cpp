@@ -20,7 +20,7 @@ bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f;
 vec3 Integrator::end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs) const {
   // A light vertex's beta already holds its spatial emission; only the directional part is left.
   if (v.kind == Kind::kLight) return vec3(directional_emission(rs_.lights[static_cast<std::size_t>(v.light)].params, v.n, w));
-  Material textured;
+  MaterialScratch textured;
   const Material& m = material_at(v, &textured);
   const vec3 f = pdfs ? bsdf::eval(m, v.wo, w, v.ns, v.n, pdfs, mode) : bsdf::eval(m, v.wo, w, v.ns, v.n, mode);
   // The light end carries importance: shading normals make its transport asymmetric (Veach §5.3).
