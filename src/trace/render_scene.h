@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <new>
 #include <optional>
 #include <vector>
 
@@ -70,7 +71,31 @@ struct RenderSensor {
 
 // Room for a material with its textured parameters evaluated (RenderScene::material_at): a
 // Material is made in it only at a textured shape, so that a scene without textures makes none.
-using MaterialScratch = std::optional<Material>;
+// (Not std::optional<Material>, whose construction zero-fills the storage: 120 bytes at every
+// surface vertex.)
+class MaterialScratch {
+ public:
+  MaterialScratch() {}  // NOLINT: the storage stays unmade
+  MaterialScratch(const MaterialScratch&) = delete;
+  MaterialScratch& operator=(const MaterialScratch&) = delete;
+  ~MaterialScratch() {
+    if (made_) material_.~Material();
+  }
+  // The material in it, default-made the first time.
+  Material& get() {
+    if (!made_) {
+      new (&material_) Material();
+      made_ = true;
+    }
+    return material_;
+  }
+
+ private:
+  union {
+    Material material_;
+  };
+  bool made_ = false;
+};
 
 struct RenderScene {
   std::unique_ptr<EmbreeScene> geometry;
@@ -119,9 +144,9 @@ struct RenderScene {
     const Material& base = *material_of_shape[static_cast<std::size_t>(shape)];
     const MaterialTextures* tex = textures_of_shape[static_cast<std::size_t>(shape)];
     if (!tex) return base;
-    if (!*scratch) scratch->emplace();
-    textured_material(*scene, base, *tex, uv, &**scratch);
-    return **scratch;
+    Material& made = scratch->get();
+    textured_material(*scene, base, *tex, uv, &made);
+    return made;
   }
   // A hit's shading normal as every strategy sees it (pt, pt-nee, lt, bdpt's joins and the MIS
   // densities all read the vertex's ns): the geometry's (Hit::shading_normal) turned by its
