@@ -135,7 +135,7 @@ class Integrator {
     // weighed, and the densities of its vertices that the weight reads.
     std::array<mis::Technique, 2 * mis::kMaxPath + 2> techniques{};
     std::array<mis::Densities, mis::kMaxPath> densities{};
-    // Each subpath vertex's densities as its walk stored them (set by set_masks(), once per sample).
+    // Each subpath vertex's densities as its walk stored them (store_densities(), once per sample).
     std::array<mis::Densities, kMaxVertices> light_densities{}, eye_densities{};
     // The subpaths' letters packed (set by set_masks()): light_mask has c0 c1 of y0, then
     // bit i + 1 for y_i's letter; eye_masks[t] has the eye subpath's last t + 1 letters (z(t-1)
@@ -161,20 +161,11 @@ class Integrator {
 
   // The path of join `jr` over th's subpaths.
   static PathView path_of(const Thread& th, const JoinResult& jr);
-  // A vertex's density as the MIS weight reads it, a Dirac's (stored as 0) counting as 1.
-  static double remap(float f) { return remap_density(f); }
-  // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key().
-  // And each vertex's two densities for the MIS weight.
+  // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key(), and each vertex's
+  // two densities for the MIS weight (store_densities()): once per sample, at its first join.
   void set_masks(Thread& th, int ns, int nt) const {
     th.joins_ready = true;
-    for (int i = 0; i < ns; ++i) {
-      const Vertex& y = th.light[static_cast<std::size_t>(i)];
-      th.light_densities[static_cast<std::size_t>(i)] = {remap(y.pdf_fwd), remap(y.pdf_rev)};
-    }
-    for (int j = 0; j < nt; ++j) {
-      const Vertex& z = th.eye[static_cast<std::size_t>(j)];
-      th.eye_densities[static_cast<std::size_t>(j)] = {remap(z.pdf_rev), remap(z.pdf_fwd)};
-    }
+    store_densities(th, ns, nt);
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
     for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
@@ -225,14 +216,10 @@ class Integrator {
 
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
   // Densities as the walks and the MIS ratios keep them: a Dirac part's is 0 (trace/emitters.h).
-  // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w.
-  float sensor_pdf_dir(const Vertex& v, const vec3& w) const {
-    return pdf_ray(cam_.params, v.p, w).dir;
-  }
-  // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
-  float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    return l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w).dir;
-  }
+  // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w, and of
+  // light l's leaving `v` (a point of the light) (mis_weight.cpp).
+  float sensor_pdf_dir(const Vertex& v, const vec3& w) const;
+  float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const;
   // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
   // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
   // emission_step_density() after it: their product is its emission's joint density.
@@ -240,18 +227,9 @@ class Integrator {
     return rs_.lights[static_cast<std::size_t>(light)].environment();
   }
   // v is a point of an image infinite light (a light vertex, or an eye vertex that hit its box).
-  bool on_environment(const Vertex& v) const {
-    const int li = v.kind == Kind::kLight ? v.light : v.kind == Kind::kSurface ? rs_.light_of_shape[static_cast<std::size_t>(v.shape)] : -1;
-    return li >= 0 && environment_of(li) != nullptr;
-  }
+  bool on_environment(const Vertex& v) const;
   float env_origin_density(const EnvironmentLightParams& e, const vec3& x0, const vec3& n0, const vec3& x1) const {
     return light_pick_ * connect_area_density(e, x0, n0, x1);
-  }
-  // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
-  void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
-    const float w = static_cast<float>(cam_.width), h = static_cast<float>(cam_.height);
-    *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
-    *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
   }
 
   // The material at surface vertex `v` (RenderScene::material_at).
@@ -358,6 +336,8 @@ class Integrator {
   // a reflection or refraction on smooth glass or a reflection on a mirror.
   bool manifold_at(const PathView& x, PathKey key, int s, int m) const;
   // --- the MIS weight (trace/mis_weight.cpp; the routine itself is trace/mis.h) ---
+  // Each subpath vertex's two densities as the weight reads them (th.light_densities, eye_densities).
+  void store_densities(Thread& th, int ns, int nt) const;
   // The power-heuristic weight of path x (letters `key`) as strategy `self` sampled it (at split
   // x.s, its x.m constructed vertices after it), against every strategy of the profile that samples
   // the same path. `join`: the densities the join computed at its two ends (null: recomputed).

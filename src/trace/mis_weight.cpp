@@ -8,8 +8,9 @@
 //
 // The densities come from where they are: a plain join's path is made of the two subpaths, which
 // keep each vertex's densities as their walks sampled them (Vertex::pdf_fwd, pdf_rev); the join
-// changes only the reverse densities of the two vertices nearest each end, and those four are
-// computed here (from the BSDF densities the join's evaluation gave, when it gave them). A
+// changes only the reverse densities of the two vertices nearest each end. The weight reads a copy
+// of the vertices between the two strategies farthest apart, those four computed into it (from the
+// BSDF densities the join's evaluation gave, when it gave them): no subpath density is written. A
 // connector that constructs vertices (the mirror's, the manifold's chain) makes a path no walk
 // sampled: every density is computed from the vertices.
 #include <algorithm>
@@ -20,6 +21,28 @@
 #include "trace/mis.h"
 
 namespace pathex::tracer {
+
+void Integrator::store_densities(Thread& th, int ns, int nt) const {
+  for (int i = 0; i < ns; ++i) {
+    const Vertex& y = th.light[static_cast<std::size_t>(i)];
+    th.light_densities[static_cast<std::size_t>(i)] = {remap_density(y.pdf_fwd), remap_density(y.pdf_rev)};
+  }
+  for (int j = 0; j < nt; ++j) {
+    const Vertex& z = th.eye[static_cast<std::size_t>(j)];
+    th.eye_densities[static_cast<std::size_t>(j)] = {remap_density(z.pdf_rev), remap_density(z.pdf_fwd)};
+  }
+}
+
+float Integrator::sensor_pdf_dir(const Vertex& v, const vec3& w) const { return pdf_ray(cam_.params, v.p, w).dir; }
+
+float Integrator::light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
+  return l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w).dir;
+}
+
+bool Integrator::on_environment(const Vertex& v) const {
+  const int li = v.kind == Kind::kLight ? v.light : v.kind == Kind::kSurface ? rs_.light_of_shape[static_cast<std::size_t>(v.shape)] : -1;
+  return li >= 0 && environment_of(li) != nullptr;
+}
 
 float Integrator::pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
   switch (v.kind) {
@@ -103,18 +126,18 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
 
 void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const {
   const int s = x.s, t = x.t, n = x.size();
-  // The window x[lo … hi) the weight reads, copied from the subpaths' densities as set_masks()
-  // stored them once per sample (the stored ones are never changed: each join's path is its own),
-  // then the ones the join changes recomputed in the copy. A fresh endpoint's: its forward
+  // The window x[lo … hi) the weight reads, copied from the subpaths' densities as
+  // store_densities() kept them once per sample (they are never changed: each join's path is its
+  // own), then the ones the join changes recomputed in the copy. A fresh endpoint's: its forward
   // density, the reverse one set below.
   mis::Densities* d = th.densities.data();
   for (int v = lo; v < std::min(hi, s); ++v) d[v] = th.light_densities[static_cast<std::size_t>(v)];
   for (int v = std::max(lo, s); v < hi; ++v) d[v] = th.eye_densities[static_cast<std::size_t>(n - 1 - v)];
-  if (x.light0) d[0] = {remap(x.light0->pdf_fwd), 1.0};
-  if (x.eye0) d[n - 1] = {1.0, remap(x.eye0->pdf_fwd)};
+  if (x.light0) d[0] = {remap_density(x.light0->pdf_fwd), 1.0};
+  if (x.eye0) d[n - 1] = {1.0, remap_density(x.eye0->pdf_fwd)};
   const auto needed = [&](int v) { return v >= lo && v < hi; };
-  const auto set_light = [&](int v, float f) { d[v].light = remap(f); };  // an eye-side vertex's light density
-  const auto set_eye = [&](int v, float f) { d[v].eye = remap(f); };      // a light-side vertex's eye density
+  const auto set_light = [&](int v, float f) { d[v].light = remap_density(f); };  // an eye-side vertex's light density
+  const auto set_eye = [&](int v, float f) { d[v].eye = remap_density(f); };      // a light-side vertex's eye density
   // --- the four reverse densities the join changes: qs = x(s-1), its predecessor qsm, pt = x_s, ptm ---
   // Every direction is at hand: the join's (w, from qs to pt, at squared distance d2) and each
   // vertex's unit direction to its predecessor (wo, at d2_wo); no normalisation is needed.
@@ -187,7 +210,7 @@ void Integrator::path_densities(Thread& th, const PathView& x, PathKey key, int 
     if (letter_s(v + 2)) return 0.0f;  // x(v+1) is a Dirac
     return pdf(v + 2 <= k ? &x[v + 2] : nullptr, x[v + 1], x[v]);
   };
-  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = mis::Densities{remap(lf(v)), remap(ef(v))};
+  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = mis::Densities{remap_density(lf(v)), remap_density(ef(v))};
 }
 
 float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const {

@@ -9,6 +9,8 @@
 // orthographic "SD", spot meter "SS" (directional letter first, c(k+1), then spatial, c(k+2)).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <new>
@@ -67,6 +69,12 @@ struct RenderSensor {
   // Area density of the ray's origin as the MIS ratios keep it: 1 / lens area, 1 / film area,
   // 0 for a point (pinhole, spot meter).
   float pdf_pos = 0.0f;
+  // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
+  void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
+    const float w = static_cast<float>(width), h = static_cast<float>(height);
+    *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
+    *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
+  }
 };
 
 // Room for a material with its textured parameters evaluated (RenderScene::material_at): a

@@ -109,7 +109,7 @@ bool Integrator::join_lens(Thread& th, int s) const {
   if (is_black(we)) return false;
   begin_join(th, ConnectorKind::kNone, s, 0, strategy(s, 0));
   JoinResult& jr = th.join;
-  to_pixels(raster, &jr.rx, &jr.ry);
+  cam_.to_pixels(raster, &jr.rx, &jr.ry);
   jr.splat = true;
   return end_join(th, qs.beta * we, 0, nullptr, nullptr);
 }
@@ -151,7 +151,7 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   const Vertex& qs = *q;
   const Vertex& z0 = fresh_sensor_vertex(th, *c, ortho ? sensor_pair_[0] : 'D');
   const vec3 w = c->wi;  // from qs to the sensor
-  to_pixels(c->raster, &jr.rx, &jr.ry);
+  cam_.to_pixels(c->raster, &jr.rx, &jr.ry);
   jr.splat = true;
   const vec3 fq = end_f(qs, w, TransportMode::kImportance, &jr.density.at_qs);
   jr.density.w = w;
