@@ -382,7 +382,7 @@ Result<ConvergeResult> converge(const ConvergeOptions& a, const ConvergeHooks& h
     if (nonfinite > 0)
       warnings.push_back(profiles[k].name + ": " + std::to_string(nonfinite) + " non-finite samples (a bug: numbers must stay finite)");
     for (std::size_t i = 0; i < rows.size(); ++i) {
-      series[k].push_back(analyse(results[k], i, rows[i]));
+      series[k].push_back(analyse(results[k], i, rows[i], cannot[k][i].has_value()));
       if (!series[k].back().warning.empty()) warnings.push_back(profiles[k].name + " on " + rows[i].name + ": " + series[k].back().warning);
     }
   }
