@@ -91,4 +91,12 @@ struct ManifoldSolution {
 ManifoldWalk solve_chain(std::vector<ChainVertex>& chain, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& nb,
                          double scene_size, const ManifoldOptions& o);
 
+// |dω_a / dA_b| of a chain whose vertices lie on their surfaces (solved, or a path a walk traced
+// through them): the solid angle at a per unit area at b (unit normal nb) as b moves and the
+// chain's constraints stay fixed. 0 when the constraint Jacobian's smallest pivot over its largest
+// is at or below `singular`, or the chain is undefined (coincident points). The MIS densities of a
+// path through a chain use it too (Integrator::chain_densities()).
+double chain_dw_db(const std::vector<ChainVertex>& chain, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& nb,
+                   double singular);
+
 }  // namespace pathex
