@@ -40,6 +40,10 @@ struct ManifoldOptions {
   double singular = 1e-7;          // smallest |pivot| / largest |pivot| of the constraint Jacobian
   int seeds = 4;                   // seeds per batch: the first batch's distinct chains are the join's contributions
   int max_trials = 2000;           // seeds spent finding them again (their inverse probability), at most
+  // Biased when > 0 (Zeltner et al. 2020's fixed-trials variant): a join draws this many seeds and
+  // counts every distinct chain they find once, with no inverse-probability estimate (a chain a
+  // join finds with probability p < 1 is underweighted by p). 0: the unbiased estimator above.
+  int biased_trials = 0;
   bool operator==(const ManifoldOptions&) const = default;
 };
 

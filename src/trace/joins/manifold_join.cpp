@@ -295,8 +295,10 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
     }
     return -1;
   };
-  // --- the first batch: `seeds` seeds, each an attempt; the distinct chains they solve to ---
-  const int per_batch = std::max(1, o_.manifold.seeds);
+  // --- the first batch: `seeds` seeds, each an attempt; the distinct chains they solve to (the
+  //     biased variant: `biased_trials` seeds, and no batches after it) ---
+  const bool biased = o_.manifold.biased_trials > 0;
+  const int per_batch = biased ? o_.manifold.biased_trials : std::max(1, o_.manifold.seeds);
   found.clear();
   for (int j = 0; j < per_batch; ++j) {
     ++stats.attempts;
@@ -320,6 +322,10 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   // --- each chain's inverse probability of being found by a batch: the number of fresh batches
   //     until one finds it again (geometric, E[K] = 1 / P(a batch finds it)); the batches are
   //     shared, and run until every chain is found again or max_trials seeds are spent ---
+  if (biased) {  // every distinct chain once
+    for (const ManifoldSolution& x : found) emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db);
+    return;
+  }
   std::size_t left = found.size();
   int batches = 0;
   while (left > 0 && (batches + 1) * per_batch <= o_.manifold.max_trials) {
