@@ -441,6 +441,32 @@ TEST(Mis, PathTracerWeightsAreTheTwoStrategyPowerHeuristic) {
   EXPECT_GT(hits_weighed, 300);
 }
 
+// An integrator of `strategies` over `scene` and one thread's state, as the manifold MIS tests
+// below drive them (by IntegratorTestAccess).
+struct ManifoldRig {
+  RenderScene rs;
+  RenderOptions o;
+  HistogramLayout layout;
+  ClassImages images;
+  Integrator in;
+  Integrator::Thread th;
+  ManifoldRig(const Scene& scene, const StrategySet& strategies, std::uint64_t seed)
+      : rs(make_render_scene(scene).expect("a scene the tracer renders")),
+        o(options(seed)),
+        images(1, 1, nullptr, {}),
+        in(rs, strategies, o),
+        th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}} {
+    th.images = &images;
+    th.connectors.resize(strategies.strategies.size());
+  }
+  static RenderOptions options(std::uint64_t seed) {
+    RenderOptions r;
+    r.seed = seed;
+    r.max_bounces = 8;
+    return r;
+  }
+};
+
 // Where bdpt's light tracing (and its other joins) and the manifold connector both sample a path,
 // the whole-path weights of all of them sum to 1: random paths of the glass-sphere scenes formed by
 // every plain join of bdpt+manifold's subpaths, those a manifold chain could build among them. The
@@ -455,16 +481,11 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
   for (const char* name : {"point-glass.json", "lamp-glass.json"}) {
     const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + name).expect("the sample");
-    const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
-    RenderOptions o;
-    o.seed = 5;
-    o.max_bounces = 8;
-    HistogramLayout layout;
-    ClassImages images(1, 1, nullptr, {});
-    const Integrator integrator(rs, strategies, o);
-    Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
-    th.images = &images;
-    th.connectors.resize(strategies.strategies.size());
+    ManifoldRig rig(scene, strategies, 5);
+    const Integrator& integrator = rig.in;
+    const RenderScene& rs = rig.rs;
+    const RenderOptions& o = rig.o;
+    Integrator::Thread& th = rig.th;
     using A = IntegratorTestAccess;
     int checked = 0, shared = 0;
     for (int i = 0; i < 10000; ++i) {
@@ -509,16 +530,10 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
   const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json").expect("the sample");
   const Profile profile = resolve_profile("bdpt+manifold", Limits{}).expect("a built-in profile");
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
-  const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
-  RenderOptions o;
-  o.seed = 3;
-  o.max_bounces = 8;
-  HistogramLayout layout;
-  ClassImages images(1, 1, nullptr, {});
-  const Integrator in(rs, strategies, o);
-  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
-  th.images = &images;
-  th.connectors.resize(strategies.strategies.size());
+  ManifoldRig rig(scene, strategies, 3);
+  const Integrator& in = rig.in;
+  const RenderScene& rs = rig.rs;
+  Integrator::Thread& th = rig.th;
   using A = IntegratorTestAccess;
   const double pi = std::numbers::pi;
   int checked = 0, lt_leads = 0, manifold_leads = 0;
