@@ -204,6 +204,17 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
   static thread_local Scratch scratch;
   auto& [p, y, s, t, loc, trial, c, cy, step, j] = scratch;
   for (std::size_t i = 0; i < m; ++i) p[i] = x[i].p;
+  // The solution's type at positions q: a refraction's neighbours on opposite sides, a reflection's
+  // on one, the light's on the seed's side.
+  const auto right_type = [&](const dvec3* q) {
+    for (std::size_t i = 0; i < m; ++i) {
+      const dvec3 nrm = surface_derivatives(*x[i].shape, x[i].primitive, q[i]).n;
+      const dvec3 prev = i == 0 ? a : q[i - 1], next = i + 1 == m ? b : q[i + 1];
+      const double light = glm::dot(prev - q[i], nrm), sides = light * glm::dot(next - q[i], nrm);
+      if ((x[i].reflect ? !(sides > 0.0) : !(sides < 0.0)) || light * x[i].light_side < 0.0) return false;
+    }
+    return true;
+  };
   bool solved = false;
   int polish = 0;
   for (w.iterations = 0; w.iterations <= o.max_iterations; ++w.iterations) {
@@ -215,6 +226,12 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     // Solved below the threshold; up to three more steps polish it (Newton converges
     // quadratically there), so that the same solution found from two seeds compares equal.
     const bool within = err < o.threshold;
+    // Solved to the wrong type: polishing moves it by about the threshold, which keeps its type
+    // (a neighbour that close to a vertex's tangent plane aside), so it is not polished.
+    if (within && polish == 0 && !right_type(p.data())) {
+      w.failure = ManifoldFailure::kWrongType;
+      return w;
+    }
     if (within && (err < 1e-4 * o.threshold || polish == 3)) {
       solved = true;
       break;
@@ -260,16 +277,10 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     w.failure = ManifoldFailure::kIterationLimit;
     return w;
   }
-  // --- the solution's type: a refraction's neighbours on opposite sides, a reflection's on one,
-  //     the light's on the seed's side ---
-  for (std::size_t i = 0; i < m; ++i) {
-    const dvec3 nrm = surface_derivatives(*x[i].shape, x[i].primitive, x[i].p).n;
-    const dvec3 prev = i == 0 ? a : x[i - 1].p, next = i + 1 == m ? b : x[i + 1].p;
-    const double light = glm::dot(prev - x[i].p, nrm), sides = light * glm::dot(next - x[i].p, nrm);
-    if ((x[i].reflect ? !(sides > 0.0) : !(sides < 0.0)) || light * x[i].light_side < 0.0) {
-      w.failure = ManifoldFailure::kWrongType;
-      return w;
-    }
+  // --- the solution's type, polished ---
+  if (!right_type(p.data())) {
+    w.failure = ManifoldFailure::kWrongType;
+    return w;
   }
   // --- its segments ---
   const double shortest = o.min_segment * scene_size;
