@@ -11,7 +11,10 @@
 // changes only the reverse densities of the two vertices nearest each end, and those four are
 // computed here (from the BSDF densities the join's evaluation gave, when it gave them). A
 // connector that constructs vertices (the mirror's, the manifold's chain) makes a path no walk
-// sampled: every density is computed from the vertices.
+// sampled: every density is computed from the vertices. Across a run of S vertices that the
+// manifold connector could build, every strategy's densities are the chain's (chain_densities(),
+// trace/joins/manifold_join.cpp): a walk that crosses it draws the far end with the generalized
+// geometry term |dω/dA| of the chain, as the manifold's own density leaves the chain out.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -160,6 +163,7 @@ float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, Connect
   const int n = x.size();
   if (x.m > 0 || x.whole != nullptr) {
     path_densities(th, x, key, lo, hi);
+    if (has_manifold_) chain_densities(th, x, key, self, lo, hi);
     return mis::weight({th.densities.data(), nullptr, n, n}, st, lo, hi);
   }
   // A plain join: the subpaths' stored densities with the join's changes made in place and undone
@@ -169,7 +173,13 @@ float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, Connect
   for (int i = 0; i < std::min(s, 2); ++i) light_kept[static_cast<std::size_t>(i)] = th.light_densities[static_cast<std::size_t>(s - 1 - i)];
   for (int i = 0; i < std::min(t, 2); ++i) eye_kept[static_cast<std::size_t>(i)] = th.eye_densities[static_cast<std::size_t>(t - 1 - i)];
   join_densities(th, x, self, join, lo, hi);
-  const float w = mis::weight({th.light_densities.data(), th.eye_densities.data(), s, n}, st, lo, hi);
+  mis::PathDensities d{th.light_densities.data(), th.eye_densities.data(), s, n};
+  if (has_manifold_ && st.count > 0) {  // a chain the manifold could build changes the densities across it
+    for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = d[v];
+    chain_densities(th, x, key, self, lo, hi);
+    d = {th.densities.data(), nullptr, n, n};
+  }
+  const float w = mis::weight(d, st, lo, hi);
   for (int i = 0; i < std::min(s, 2); ++i) th.light_densities[static_cast<std::size_t>(s - 1 - i)] = light_kept[static_cast<std::size_t>(i)];
   for (int i = 0; i < std::min(t, 2); ++i) th.eye_densities[static_cast<std::size_t>(t - 1 - i)] = eye_kept[static_cast<std::size_t>(i)];
   return w;
