@@ -19,7 +19,8 @@ With --reference VALUE (the class's luminance computed another way), the efficie
 1 / (MSE T) instead: MSE the mean over the rounds (seeds) of (estimate - VALUE)^2, T the mean CPU
 time, so that a heavy-tailed estimator's understated stderr, or a rare-hit one's stderr of 0 when
 it misses every hit, cannot flatter it (issue 40). A renderer may carry its own sample count as
-NAME:SPP, so that each gets about the same CPU time.
+NAME:SPP, so that each gets about the same CPU time, and options of its own as NAME:SPP:OPTIONS
+(`bdpt+manifold:16:--manifold-seeds=1`).
 
     python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDSSDSE \
         --reference 1.1e-3 --only --rounds 8 \
@@ -66,6 +67,7 @@ def main():
     args = ap.parse_args()
     # (label, binary, renderer) per run
     spp_of = {r: int(r.split(":")[1]) if ":" in r else args.spp for r in args.renderer}
+    extra_of = {r: r.split(":", 2)[2].split() if r.count(":") >= 2 else [] for r in args.renderer}
     runs = [(r, args.pathex, r) for r in args.renderer]
     if args.baseline:
         runs = [x for r in args.renderer for x in ((r, args.pathex, r), (r + " @baseline", args.baseline, r))]
@@ -79,7 +81,7 @@ def main():
             order = runs[rnd % len(runs):] + runs[:rnd % len(runs)]
             for label, binary, r in order:
                 with tempfile.TemporaryDirectory() as out:  # each binary writes its own folder
-                    doc, cpu = run([binary, "trace", args.scene, "--renderer", r.split(":")[0], "--spp", str(spp_of[r]), *select,
+                    doc, cpu = run([binary, "trace", args.scene, "--renderer", r.split(":")[0], "--spp", str(spp_of[r]), *extra_of[r], *select,
                                     "--seed", str(rnd + 1), "--threads", "1", "--max-bounces", str(args.max_bounces),
                                     "--no-images", "--quiet", "--json", "--out", os.path.join(out, "o")])
                 c = [c for c in doc["classes"] if c["expr"] == args.path_class or c.get("name") == "c"][0]

@@ -41,7 +41,7 @@ import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from manifold_reference import add, cross, dot, luminance, sphere_exit, unit, write_json  # noqa: E402
+from manifold_reference import add, camera_frame, cross, dot, luminance, sphere_exit, unit, write_json  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE = os.path.join(ROOT, "samples", "scenes", "lamp-glass.json")
@@ -133,11 +133,7 @@ def quadrature(scene_path, film, lamp_samples, jitters, rows, direct, first_jitt
     centre, radius = sphere["center"], sphere["radius"]
     le = lamp["emission"]
     cam = s["camera"]
-    forward = unit(add(cam["look_at"], cam["position"], -1.0))
-    right = unit(cross(forward, cam["up"]))
-    up = cross(right, forward)
-    tan_y = math.tan(math.radians(cam.get("fov", 45.0)) * 0.5)
-    tan_x = tan_y * cam["width"] / cam["height"]
+    forward, right, up, tan_x, tan_y = camera_frame(cam)
     e1, e2 = quad["edge1"], quad["edge2"]
     normal = unit(cross(e1, e2))
     lamp_centre = lamp["center"]

@@ -258,16 +258,21 @@ def quadrature_setup(scene_path):
     return s, light, sphere, quad, axis, height, distance, glass.get("ior", 1.5), floor.get("albedo", [0.5] * 3)
 
 
+def camera_frame(cam):
+    """A pinhole camera's frame (forward, right, up) and the tangents of its half field of view (x, y)."""
+    forward = unit(add(cam["look_at"], cam["position"], -1.0))
+    right = unit(cross(forward, cam["up"]))
+    up = cross(right, forward)
+    tan_y = math.tan(math.radians(cam.get("fov", 45.0)) * 0.5)
+    return forward, right, up, tan_y * cam["width"] / cam["height"], tan_y
+
+
 def quadrature(scene_path, film, jitters, table_rows=40000):
     """The image mean of the class per colour channel (albedo / pi E(rho) T_eye over the film), and its standard error."""
     s, light, sphere, quad, axis, height, distance, ior, albedo = quadrature_setup(scene_path)
     branches = caustic_table(distance, sphere["radius"], ior, height, table_rows)
     cam = s["camera"]
-    forward = unit(add(cam["look_at"], cam["position"], -1.0))
-    right = unit(cross(forward, cam["up"]))
-    up = cross(right, forward)
-    tan_y = math.tan(math.radians(cam.get("fov", 45.0)) * 0.5)
-    tan_x = tan_y * cam["width"] / cam["height"]
+    forward, right, up, tan_x, tan_y = camera_frame(cam)
     e1, e2 = quad["edge1"], quad["edge2"]
     normal = unit(cross(e1, e2))
     nx, ny = film

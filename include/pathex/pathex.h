@@ -7,7 +7,8 @@
 //   3. classify full-path strings by a set of named classes in one pass;
 //   4. measure how much of a scene's light a renderer cannot sample (`pathex bias`);
 //   5. run a check file, the CI gate (`pathex check`);
-//   6. measure what accuracy costs in time per renderer and class (`pathex converge`).
+//   6. measure what accuracy costs in time per renderer and class (`pathex converge`);
+//   7. render a scene and say where its light travels, by class and by exact path (`pathex trace`).
 //
 //   #include <pathex/pathex.h>
 //   pathex::api::PathClass caustic("L..S+D.*..E");
@@ -271,5 +272,47 @@ struct ConvergeAnswer {
 
 ConvergeAnswer converge(const std::string& scene_file, const std::vector<Renderer>& renderers,
                         const ConvergeOptions& options = {});
+
+// A render of a scene, as `pathex trace SCENE --renderer R` makes it: every sampled path labelled
+// with its full-path string, and the image's mean luminance split by class and by exact path, each
+// with its standard error. The numbers are those of the command's histogram.json, bit for bit.
+struct TraceOptions {
+  std::uint64_t spp = 16;
+  std::uint64_t seed = 1;
+  int threads = 0;                 // 0: all cores; the numbers do not depend on it
+  std::optional<int> max_bounces;  // unset: the profile's own bound, else 16
+  std::string classes_file;        // empty: the built-in classes
+  std::vector<std::string> only;   // the requested classes (expressions or $name), as --only
+  std::uint64_t max_paths = 1000;  // exact paths listed, largest first (the rest are summed in "other")
+  // A folder to write the render into (histogram.json, run.json, classes.exr, the PNGs and
+  // render.shard) as one set, whole or not at all; empty: nothing is written.
+  std::string out;
+};
+
+struct TraceEstimate {
+  std::string name;         // a class's name, or an exact path ("LDDE"); "other" for the paths past max_paths
+  std::string expression;   // a class's expression (empty for a path)
+  double luminance = 0;     // mean luminance over the image
+  double std_error = 0;     // its standard error (NaN with fewer than two batches)
+  double share = 0;         // of the total (0 when the total is 0)
+  bool rendered = true;     // false: a class `only` left out, whose estimate is unknown (never 0)
+};
+
+struct TraceAnswer {
+  std::string renderer;                 // the profile's name
+  std::uint64_t spp = 0;                // samples per pixel rendered
+  TraceEstimate total;                  // the image (with `only`, the requested classes' paths)
+  std::vector<TraceEstimate> classes;   // in the class set's order
+  std::vector<TraceEstimate> paths;     // largest first, then "other" when paths were left out
+  std::uint64_t distinct_paths = 0;     // every path sampled
+  std::uint64_t nonfinite_samples = 0;  // dropped; any is a bug
+  double cpu_s = 0;                     // rendering CPU seconds, all threads
+  bool complete = true;                 // false: interrupted (Ctrl-C, SIGTERM), the passes rendered only
+  std::string error;                    // why there is no answer: the command's located message
+  bool ok() const { return error.empty(); }
+};
+
+// An empty `scene_file` renders the embedded default scene (the Cornell box of `pathex trace`).
+TraceAnswer trace(const std::string& scene_file, const Renderer& renderer, const TraceOptions& options = {});
 
 }  // namespace pathex::api

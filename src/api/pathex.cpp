@@ -3,7 +3,7 @@
 // Each public object holds a shared, immutable Impl built once by its constructor; a failed
 // construction keeps the rendered Error (the same text the CLI prints) and nothing else. Nothing
 // here adds behaviour: compile_class, resolve_profile, query, read_class_file, the Classifier,
-// measure_missed, parse_check, decide_check and converge are the functions the `pathex` command calls.
+// measure_missed, parse_check, decide_check, converge and run_trace are the functions the `pathex` command calls.
 #include "pathex/pathex.h"
 
 #include <algorithm>
@@ -19,6 +19,7 @@
 #include "io/input_file.h"
 #include "io/profile_json.h"
 #include "measure/converge.h"
+#include "measure/trace_run.h"
 #include "reach/query.h"
 #include "scene/scene.h"
 #include "scene/universe.h"
@@ -456,6 +457,74 @@ ConvergeAnswer converge(const std::string& scene_file, const std::vector<Rendere
     }
     a.classes.push_back(std::move(c));
   }
+  return a;
+}
+
+}  // namespace pathex::api
+
+namespace pathex::api {
+
+// --- trace ---
+
+namespace {
+
+TraceEstimate estimate_of(std::string name, std::string expression, const Estimate& e, double total) {
+  TraceEstimate t;
+  t.name = std::move(name);
+  t.expression = std::move(expression);
+  t.luminance = e.luminance;
+  t.std_error = e.std_error;
+  t.share = total != 0.0 ? e.luminance / total : 0.0;
+  return t;
+}
+
+}  // namespace
+
+TraceAnswer trace(const std::string& scene_file, const Renderer& renderer, const TraceOptions& options) {
+  TraceAnswer a;
+  if (!renderer.ok()) {
+    a.error = renderer.error();
+    return a;
+  }
+  pathex::TraceOptions to;
+  to.job.scene = scene_file;
+  to.job.renderer = Access::of(renderer).requested;
+  to.job.classes_file = options.classes_file;
+  to.job.only = options.only;
+  to.job.spp = options.spp;
+  to.job.seed = options.seed;
+  to.job.max_bounces = options.max_bounces;
+  to.job.max_paths = options.max_paths;
+  to.threads = options.threads;
+  to.progress = false;
+  to.write = !options.out.empty();
+  if (to.write) to.job.out = options.out;
+  to.job.no_images = !to.write;  // without a folder the images would go nowhere
+  Result<pathex::TraceResult> run = run_trace(to);
+  if (!run) {
+    a.error = run.error().render();
+    return a;
+  }
+  if (run->nothing_to_render) {
+    a.error = "no strategy of " + run->job.profile->name + " samples a path of the requested classes in this scene";
+    return a;
+  }
+  const HistogramReport& r = run->written->report;
+  const double total = r.total.luminance;
+  a.renderer = r.run.renderer;
+  a.spp = r.run.spp;
+  a.total = estimate_of("total", "", r.total, total);
+  for (const ClassEstimate& c : r.classes) {
+    a.classes.push_back(estimate_of(c.name, c.expr, c.estimate, total));
+    a.classes.back().share = c.share;
+    a.classes.back().rendered = c.rendered;
+  }
+  for (const PathEstimate& p : r.paths) a.paths.push_back(estimate_of(p.path, "", p.estimate, total));
+  if (r.other) a.paths.push_back(estimate_of("other", "", r.other->estimate, total));
+  a.distinct_paths = r.distinct_paths;
+  a.nonfinite_samples = r.nonfinite_samples;
+  a.cpu_s = run->header.run.cpu_s;
+  a.complete = r.run.complete;
   return a;
 }
 

@@ -1,11 +1,10 @@
 // pathex classify: full paths on stdin, their classes on stdout. One automaton, one pass per path.
 #include <iostream>
 
-#include <nlohmann/json.hpp>
-
 #include "classify/classifier.h"
 #include "cli/common.h"
 #include "io/class_file.h"
+#include "io/class_json.h"
 
 namespace pathex::cli {
 namespace {
@@ -16,12 +15,6 @@ struct ClassifyArgs {
   NotationOptions notation;
   Limits limits;
 };
-
-// One JSON line. A line of input need not be UTF-8 (a stray byte is reported as bad, not a crash):
-// bytes that are not are written as U+FFFD.
-std::string json_line(const nlohmann::json& j) {
-  return j.dump(-1, ' ', /*ensure_ascii=*/false, nlohmann::json::error_handler_t::replace);
-}
 
 int run(const ClassifyArgs& a) {
   Result<ClassOptions> opts = class_options(a.notation, a.limits);
@@ -51,7 +44,7 @@ int run(const ClassifyArgs& a) {
       e.where = "stdin:" + std::to_string(line_no);
       bad = true;
       if (a.json) {
-        std::cout << json_line({{"line", line_no}, {"path", line}, {"error", e.render()}}) << "\n";
+        std::cout << classify_error_json_line(line_no, line, e.render()) << "\n";
       } else {
         report(e);
       }
@@ -59,9 +52,9 @@ int run(const ClassifyArgs& a) {
     }
     const std::vector<int>& members = cl->members(cl->classify(p->text));
     if (a.json) {
-      nlohmann::json names = nlohmann::json::array();
+      std::vector<std::string> names;
       for (int m : members) names.push_back(cl->name(m));
-      std::cout << json_line({{"line", line_no}, {"path", p->text}, {"classes", names}}) << "\n";
+      std::cout << classify_json_line(line_no, p->text, names) << "\n";
     } else {
       std::cout << p->text << "\t";
       if (members.empty()) std::cout << "-";

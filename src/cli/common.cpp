@@ -63,12 +63,16 @@ void add_manifold_options(CLI::App* app, ManifoldOptions* o) {
       ->capture_default_str()->check(non_negative())->check(CLI::Range(1, 100000))->group(group);
   app->add_option(name[5], o->seeds, "Seeds per batch: the first batch's distinct chains are a join's contributions")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(1, 64))->group(group);
+  app->add_option(name[6], o->biased_trials,
+                  "BIASED when > 0: a join draws this many seeds and counts each distinct chain they find once, "
+                  "no inverse-probability estimate (Zeltner et al. 2020's fixed trials); 0: the unbiased estimator")
+      ->capture_default_str()->check(non_negative())->check(CLI::Range(0, 100000))->group(group);
 }
 
 const std::vector<std::string>& manifold_option_names() {
   static const std::vector<std::string> names = {"--manifold-iterations", "--manifold-threshold", "--manifold-min-segment",
                                                  "--manifold-singular", "--manifold-trials",
-                                                 "--manifold-seeds"};
+                                                 "--manifold-seeds", "--manifold-biased-trials"};
   return names;
 }
 

@@ -151,6 +151,7 @@ Command add_converge(CLI::App& app) {
   sub->add_flag("--report", args->report_html, "Also write DIR/report.html, the plot and table as one self-contained web page (pathex report)");
   add_report_options(sub, &args->report_options);
   add_limit_options(sub, &args->options.limits);
+  add_manifold_options(sub, &args->options.manifold);
   add_scene_limit_options(sub, &args->options.limits);
   return {sub, [args] { return run(*args); }};
 }

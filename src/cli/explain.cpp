@@ -1,13 +1,11 @@
 // pathex explain EXPR: everything the engine knows about one path class.
 #include <iostream>
 
-#include <nlohmann/json.hpp>
-
 #include "automata/ops.h"
 #include "language/lpe_emit.h"
 #include "cli/common.h"
 #include "io/class_file.h"
-#include "io/reach_json.h"
+#include "io/class_json.h"
 
 namespace pathex::cli {
 namespace {
@@ -23,14 +21,6 @@ struct ExplainArgs {
   NotationOptions notation;
   Limits limits;
 };
-
-nlohmann::json chains_json(const std::string& path) {
-  nlohmann::json arr = nlohmann::json::array();
-  Result<FullPath> p = parse_full_path(path, path.size());
-  if (!p) return arr;
-  for (const Chain& c : chains(*p)) arr.push_back({{"letters", c.letters}, {"from", c.from}, {"to", c.to}});
-  return arr;
-}
 
 std::string path_chains_text(const std::string& path) {
   Result<FullPath> p = parse_full_path(path, path.size());
@@ -48,18 +38,7 @@ int run_emit_lpe(const ExplainArgs& a, const PathClass& pc) {
   Result<LpeEmission> e = emit_lpe(pc.dfa, a.limits);
   if (!e) return report(e.error());
   if (a.json) {
-    nlohmann::json j;
-    j["expression"] = a.expr;
-    j["notation"] = a.notation.notation;
-    if (e->empty) {
-      j["lpe"] = nullptr;
-    } else {
-      j["lpe"] = e->lpe;
-      j["exact"] = e->exact;
-      j["losses"] = e->losses;
-      j["example"] = e->example ? nlohmann::json(*e->example) : nlohmann::json(nullptr);
-    }
-    std::cout << j.dump(2) << "\n";
+    std::cout << lpe_json_text(a.expr, a.notation.notation, *e);
     return kExitOk;
   }
   if (e->empty) {
@@ -100,24 +79,19 @@ int run(const ExplainArgs& a) {
   }
 
   if (a.json) {
-    nlohmann::json j;
-    j["expression"] = a.expr;
-    j["normal_form"] = normal;
-    j["notation"] = a.notation.notation;
-    j["eye_first"] = pc->eye_first;
-    j["dfa_states"] = d.num_states;
-    j["live_states"] = d.live_count();
-    j["empty"] = empty;
-    j["finite"] = finite;
-    nlohmann::json counts_j = nlohmann::json::array();
-    for (std::size_t n = 0; n < counts.size(); ++n)
-      if (!counts[n].is_zero()) counts_j.push_back({{"length", n}, {"count", count_json(counts[n])}});
-    j["counts_by_length"] = counts_j;
-    j["max_len"] = a.max_len;
-    nlohmann::json ms = nlohmann::json::array();
-    for (const std::string& m : members) ms.push_back({{"path", m}, {"chains", chains_json(m)}});
-    j["shortest_members"] = ms;
-    std::cout << j.dump(2) << "\n";
+    ClassFacts f;
+    f.expression = a.expr;
+    f.normal_form = normal;
+    f.notation = a.notation.notation;
+    f.eye_first = pc->eye_first;
+    f.dfa_states = d.num_states;
+    f.live_states = d.live_count();
+    f.empty = empty;
+    f.finite = finite;
+    f.counts = counts;
+    f.max_len = a.max_len;
+    f.shortest_members = members;
+    std::cout << explain_json_text(f);
     return kExitOk;
   }
   std::cout << "expression    " << a.expr << "\n";

@@ -98,14 +98,7 @@ int run(const QueryArgs& a) {
     results.push_back(std::move(row));
   }
   if (a.json) {
-    nlohmann::json arr = nlohmann::json::array();
-    for (const auto& row : results)
-      for (const QueryResult& q : row) {
-        nlohmann::json j = to_json(q);
-        if (!a.scene.empty()) j["scene"] = a.scene;
-        arr.push_back(j);
-      }
-    std::cout << arr.dump(2) << "\n";
+    std::cout << query_json_text(results, a.scene);
     return kExitOk;
   }
   // Side-by-side table, then the evidence.

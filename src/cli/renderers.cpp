@@ -1,8 +1,6 @@
 // pathex renderers: the built-in profiles, their strategies and what they can reach.
 #include <iostream>
 
-#include <nlohmann/json.hpp>
-
 #include "automata/ops.h"
 #include "cli/common.h"
 #include "io/profile_json.h"
@@ -22,7 +20,7 @@ int run(const RenderersArgs& a) {
   const Dfa& local = ClassTable::builtins().find("local")->dfa;  // L.*DD.*E ∩ U
   Result<std::vector<Profile>> profiles = builtin_profiles(a.limits);
   if (!profiles) return report(profiles.error());
-  nlohmann::json arr = nlohmann::json::array();
+  std::vector<ProfileReach> reach;
   for (const Profile& p : *profiles) {
     Result<CompiledProfile> cp = compile_profile(p, std::nullopt, a.limits);
     if (!cp) return report(cp.error());
@@ -34,14 +32,7 @@ int run(const RenderersArgs& a) {
                                  : within_local ? "a proper subset of the local paths L.*DD.*E"
                                                 : "beyond local sampling (uses connectors)";
     if (a.json) {
-      nlohmann::json j = {{"name", p.name}, {"description", p.description}, {"source", p.source}};
-      j["max_bounces"] = p.max_bounces ? nlohmann::json(*p.max_bounces) : nlohmann::json(nullptr);
-      nlohmann::json st = nlohmann::json::array();
-      for (const Strategy& s : p.strategies) st.push_back(to_json(s));
-      j["strategies"] = st;
-      j["reachable"] = {{"dfa_states", cp->reachable.num_states}, {"relation", relation},
-                        {"equals_local", is_local}, {"shortest_unreachable", misses}};
-      arr.push_back(j);
+      reach.push_back({&p, cp->reachable.num_states, relation, is_local, misses});
       continue;
     }
     std::cout << p.name << (p.max_bounces ? "   (max_bounces " + std::to_string(*p.max_bounces) + ")" : "") << "\n  "
@@ -52,7 +43,7 @@ int run(const RenderersArgs& a) {
     for (const std::string& m : misses) std::cout << " " << m;
     std::cout << (misses.empty() ? " none" : "") << "\n\n";
   }
-  if (a.json) std::cout << arr.dump(2) << "\n";
+  if (a.json) std::cout << renderers_json_text(reach);
   return kExitOk;
 }
 

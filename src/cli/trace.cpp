@@ -186,7 +186,7 @@ Command add_trace(CLI::App& app) {
               "'pathex trace --resume DIR' renders the rest. Split a render: --shard 0/4 … 3/4, then pathex merge.");
   sub->add_option("SCENE", args->options.job.scene, "Scene file (grammar/scene.schema.json); default: the embedded Cornell box");
   sub->add_option("--renderer", args->options.job.renderer, "Renderer profile: built-in name or file")->capture_default_str();
-  sub->add_option("--spp", args->options.job.spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 24));
+  sub->add_option("--spp", args->options.job.spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(std::uint64_t{1}, kMaxTraceSpp));
   sub->add_option("--classes", args->options.job.classes_file, "Class file; default: the built-in classes");
   sub->add_option("--only", args->options.job.only,
                   "Estimate only the paths of this class (an expression; repeatable): other strategies and subpaths are not "
@@ -194,7 +194,7 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--seed", args->options.job.seed, "Random seed (0 to 2^64 - 1)")->capture_default_str()->check(non_negative());
   sub->add_option("--threads", args->options.threads, "Worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
   sub->add_option("--max-bounces", args->options.job.max_bounces, "Largest number of interior vertices (k - 1); default: the profile's bound, else 16")
-      ->check(CLI::Range(0, 1000));
+      ->check(CLI::Range(0, kMaxTraceBounces));
   sub->add_option("--out", args->options.job.out, "Output folder")->capture_default_str();
   sub->add_option("--sampler", args->options.job.sampler,
                   "Random numbers: sobol (Owen-scrambled Sobol points, stratified per pixel) or independent")

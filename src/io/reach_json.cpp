@@ -58,4 +58,31 @@ nlohmann::json to_json(const QueryResult& q) {
   return j;
 }
 
+std::string query_json_text(const std::vector<std::vector<QueryResult>>& rows, const std::string& scene) {
+  nlohmann::json arr = nlohmann::json::array();
+  for (const std::vector<QueryResult>& row : rows)
+    for (const QueryResult& q : row) {
+      nlohmann::json j = to_json(q);
+      if (!scene.empty()) j["scene"] = scene;
+      arr.push_back(std::move(j));
+    }
+  return arr.dump(2) + "\n";
+}
+
+std::string renderers_json_text(const std::vector<ProfileReach>& profiles) {
+  nlohmann::json arr = nlohmann::json::array();
+  for (const ProfileReach& r : profiles) {
+    const Profile& p = *r.profile;
+    nlohmann::json j = {{"name", p.name}, {"description", p.description}, {"source", p.source}};
+    j["max_bounces"] = p.max_bounces ? nlohmann::json(*p.max_bounces) : nlohmann::json(nullptr);
+    nlohmann::json st = nlohmann::json::array();
+    for (const Strategy& s : p.strategies) st.push_back(to_json(s));
+    j["strategies"] = st;
+    j["reachable"] = {{"dfa_states", r.dfa_states}, {"relation", r.relation},
+                      {"equals_local", r.equals_local}, {"shortest_unreachable", r.shortest_unreachable}};
+    arr.push_back(std::move(j));
+  }
+  return arr.dump(2) + "\n";
+}
+
 }  // namespace pathex

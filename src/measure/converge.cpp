@@ -45,6 +45,7 @@ struct RungSetup {
   const Classifier* classifier = nullptr;
   int threads = 0;
   std::optional<int> max_bounces;  // unset: each profile's own bound, else 16 (as trace)
+  ManifoldOptions manifold;        // the manifold connector's limits
 };
 
 // Renders one rung: `plan` (trace/plan.h) at `budget` with `seed`. A time budget stops the render
@@ -66,6 +67,7 @@ Result<RungResult> run_rung(const RungSetup& setup, const RenderPlan& plan, cons
   ro.seed = seed;
   ro.threads = setup.threads;
   ro.max_bounces = setup.max_bounces;
+  ro.manifold = setup.manifold;
   for (int i = 0; i < setup.classifier->num_classes(); ++i) ro.layer_classes.push_back(i);
   setup.watch->restart(budget.spp ? 0.0 : budget.seconds);
   ro.progress = setup.watch->progress();
@@ -347,6 +349,7 @@ Result<ConvergeResult> converge(const ConvergeOptions& a, const ConvergeHooks& h
   for (const Dfa& r : reach) cannot.push_back(unsampled(r, seen));
 
   // --- the ladder: every renderer at every budget, each rung its own render and seed ---
+  setup.manifold = a.manifold;  // (the reference run, above, keeps the defaults)
   std::vector<std::vector<RungResult>> results(profiles.size());
   bool complete = true;
   for (std::size_t k = 0; k < profiles.size() && complete; ++k)
@@ -382,7 +385,7 @@ Result<ConvergeResult> converge(const ConvergeOptions& a, const ConvergeHooks& h
     if (nonfinite > 0)
       warnings.push_back(profiles[k].name + ": " + std::to_string(nonfinite) + " non-finite samples (a bug: numbers must stay finite)");
     for (std::size_t i = 0; i < rows.size(); ++i) {
-      series[k].push_back(analyse(results[k], i, rows[i]));
+      series[k].push_back(analyse(results[k], i, rows[i], cannot[k][i].has_value()));
       if (!series[k].back().warning.empty()) warnings.push_back(profiles[k].name + " on " + rows[i].name + ": " + series[k].back().warning);
     }
   }

@@ -26,6 +26,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "measure/ladder.h"
+#include "trace/joins/manifold.h"
 
 namespace pathex {
 
@@ -45,6 +46,10 @@ struct ConvergeOptions {
   std::vector<std::string> only;       // the requested classes, as trace --only
   std::string out;                     // the output folder; empty: nothing is written
   Limits limits;
+  // The manifold connector's limits for the ladder's renders (pathex converge --manifold-*, as
+  // trace's), so that a variant such as the biased --manifold-biased-trials can be measured against
+  // a reference; a reference run keeps the defaults (the unbiased estimator).
+  ManifoldOptions manifold;
 };
 
 struct ConvergeHooks {

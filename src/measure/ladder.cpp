@@ -147,7 +147,7 @@ std::string fmt(double v, const char* f) {
   return buf;
 }
 
-Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const ClassRow& cr) {
+Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const ClassRow& cr, bool biased) {
   Series s;
   if (!cr.reference) return s;
   std::vector<RungError> re;
@@ -175,7 +175,7 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
   if (n > 0 && sum_e2t > 0.0) s.pooled_efficiency = static_cast<double>(n) / sum_e2t;
   s.slope = loglog_slope(times, s.error);
   s.check = check_stderr(re, *cr.reference, cr.reference_stderr);
-  if (s.check.disagrees) {
+  if (s.check.disagrees && !biased) {
     const RungResult& at = rungs[static_cast<std::size_t>(s.check.max_z_rung)];
     s.warning = "the reported stderr disagrees with the true error: chi2 " + fmt(s.check.chi2, "%.3g") + " over " +
                 std::to_string(s.check.dof) + " rungs (limit " + fmt(s.check.limit, "%.3g") + " at p = 0.001), " +
@@ -183,7 +183,7 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
                                                   : "a stderr of 0 with an error of " + fmt(s.error[static_cast<std::size_t>(s.check.max_z_rung)], "%.3g")) +
                 " at " + at.budget.text();
   }
-  if (s.check.too_large)
+  if (s.check.too_large && !biased)
     s.warning += std::string(s.warning.empty() ? "" : "; ") + "the reported stderr is larger than the true error: chi2 " +
                  fmt(s.check.lower_chi2, "%.3g") + " over " + std::to_string(s.check.lower_dof) + " rungs (below " +
                  fmt(s.check.lower_limit, "%.3g") + ", the lower limit at p = 0.001): the error bars overstate the error";

@@ -97,7 +97,11 @@ struct Series {
 
 // The statistics of one renderer's rungs on class row `row` against its reference `cr` (none
 // without a reference), with the warning the table and converge.json give when the check fails.
-Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const ClassRow& cr);
+// `biased`: the renderer cannot sample a path of the class that the reference holds, so its error
+// is the light it misses, which no stderr covers: the check's numbers are kept, but a stderr that
+// disagrees with that error is no fault of the stderr and gets no warning (the table says instead
+// that the renderer cannot sample the class and is not ranked on it).
+Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const ClassRow& cr, bool biased = false);
 
 // The most efficient renderer on a class row (pooled efficiency 1 / mean(error² × CPU time) over
 // the ladder) and its lead over the runner-up. A renderer that cannot sample all of the class is

@@ -48,6 +48,8 @@ Result<TraceResult> run_trace(const TraceOptions& a, const TraceHooks& hooks) {
   if (a.missed && (!o.shard.empty() || !o.resume.empty() || ranks > 1))
     return make_error(ErrorCode::kUsage, "--missed measures a whole render in one process: it cannot be given with "
                                          "--shard, --resume or MPI");
+  if (!a.write && (!o.shard.empty() || !o.resume.empty() || ranks > 1))
+    return make_error(ErrorCode::kUsage, "a render that writes no files cannot be a shard, a resumed render or an MPI run");
   if (a.missed && !id.only.empty())
     return make_error(ErrorCode::kUsage, "--missed measures what the whole render misses: it cannot be given with --only");
 
@@ -68,13 +70,13 @@ Result<TraceResult> run_trace(const TraceOptions& a, const TraceHooks& hooks) {
 
   // The output folder is checked before the render, not after it.
   std::optional<OutputSet> out_set;
-  if (rank == 0) {
+  if (rank == 0 && a.write) {
     Result<OutputSet> prepared = OutputSet::prepare(job.out);
     if (!prepared) return prepared.error();
     out_set.emplace(std::move(*prepared));
-    if (hooks.before_render)
-      if (Result<bool> r = hooks.before_render(job, res.universe); !r) return r.error();
   }
+  if (rank == 0 && hooks.before_render)
+    if (Result<bool> r = hooks.before_render(job, res.universe); !r) return r.error();
 
   // --- render the passes still missing: all of them, or under MPI the chunks of them that the
   // ranks' shared deal hands this rank (whoever is free takes the next, schedule/pass_deal.h) ---
@@ -209,6 +211,12 @@ Result<TraceResult> run_trace(const TraceOptions& a, const TraceHooks& hooks) {
 
   // --- outputs (rank 0): one set, whole or not at all, shielded from signals (io/output_set.h) ---
   std::optional<Error> failure;
+  if (!a.write) {
+    Result<WrittenReport> r = render_report(header, sums, *job.classes);
+    if (!r) return r.error();
+    res.written = std::move(*r);
+    return res;
+  }
   if (rank == 0) {
     const SignalShield shield;
     Result<bool> w = out_set->write([&](const std::string& dir) -> Result<bool> {

@@ -37,6 +37,10 @@ struct TraceOptions {
   bool missed = false;    // also render the reference and measure what the renderer misses
   std::string reference;  // the reference for `missed`; empty: bias's default
   bool progress = true;   // a progress line on a terminal (rank 0)
+  // False: nothing is written and the output folder is not touched; `written` holds what
+  // histogram.json would (the C++ API's trace without a folder). Refused with --shard, --resume or MPI,
+  // whose work lives in files.
+  bool write = true;
 };
 
 struct TraceResult;
@@ -66,7 +70,7 @@ struct TraceResult {
   std::optional<RenderSums> sums;  // the render's exact sums (the resumed and the other ranks' added)
   double time_s = 0;   // this process's render time
   std::optional<BiasReport> missed;  // with `missed`: what missed.json holds
-  std::optional<WrittenReport> written;  // histogram.json as written
+  std::optional<WrittenReport> written;  // histogram.json as written (or as it would be, without `write`)
 };
 
 // Errors (bad options, scene, profile, classes, resumed folder, output folder, memory, a shard file

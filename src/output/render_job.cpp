@@ -132,11 +132,7 @@ static nlohmann::ordered_json efficiency_json(const Estimate& total, double cpu_
   return e;
 }
 
-namespace {
-
-// histogram.json and run.json (which reads the report's total).
-Result<WrittenReport> write_histogram_and_run_json(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
-                                                   const RenderClasses& classes, const std::vector<PrunedStrategy>& not_run) {
+Result<WrittenReport> render_report(const ShardHeader& header, const RenderSums& sums, const RenderClasses& classes) {
   const RenderIdentity& id = header.identity;
   const std::vector<ConnectorStats>& connectors = sums.connectors;
   RunInfo info;
@@ -185,6 +181,17 @@ Result<WrittenReport> write_histogram_and_run_json(const std::string& dir, const
     doc["connectors"] = std::move(list);
   }
   out.json_text = doc.dump(2) + "\n";
+  return out;
+}
+
+namespace {
+
+// histogram.json and run.json (which reads the report's total).
+Result<WrittenReport> write_histogram_and_run_json(const std::string& dir, const ShardHeader& header, const RenderSums& sums,
+                                                   const RenderClasses& classes, const std::vector<PrunedStrategy>& not_run) {
+  Result<WrittenReport> made = render_report(header, sums, classes);
+  if (!made) return made.error();
+  WrittenReport& out = *made;
   if (Result<bool> w = write_file_atomic(dir + "/histogram.json", out.json_text); !w) return w.error();
   nlohmann::ordered_json run = nlohmann::ordered_json::object();
   run["time_s"] = header.run.time_s;
@@ -204,7 +211,7 @@ Result<WrittenReport> write_histogram_and_run_json(const std::string& dir, const
     run["pruned"] = std::move(list);
   }
   if (Result<bool> w = write_file_atomic(dir + "/run.json", run.dump(2) + "\n"); !w) return w.error();
-  return out;
+  return made;
 }
 
 // The layers of the rendered classes (and the total), a band of rows at a time from the exact sums.

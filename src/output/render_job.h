@@ -64,6 +64,9 @@ struct WrittenReport {
   HistogramReport report;
   std::string json_text;
 };
+// What histogram.json holds for these sums, made but not written (write_render_outputs writes it;
+// the C++ API's trace without a folder reads it).
+Result<WrittenReport> render_report(const ShardHeader& header, const RenderSums& sums, const RenderClasses& classes);
 // histogram.json also lists what each connector did (sums.connectors; "connectors": [{strategy, connector,
 // attempts, successes, failures {outside, occluded, no_transport; the manifold's no_solution, singular, wrong_type, too_short, iteration_limit instead of outside}, and for the manifold repeats, truncated, walks and mean_iterations}] in the profile's order;
 // absent when the profile has none).

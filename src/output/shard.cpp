@@ -330,12 +330,15 @@ json identity_json(const RenderIdentity& id) {
                   {"rr_threshold", id.rr_threshold}, {"rr_light_threshold", id.rr_light_threshold}, {"batches", id.batches},
                   {"width", id.width},           {"height", id.height},     {"images", id.images},
                   {"max_paths", id.max_paths}};
-  if (const std::optional<ManifoldOptions>& m = id.manifold)
+  if (const std::optional<ManifoldOptions>& m = id.manifold) {
     j["options"]["manifold"] = {{"max_iterations", m->max_iterations}, {"threshold", m->threshold},
                                 {"min_segment", m->min_segment},       {"singular", m->singular},
                                 {"max_trials", m->max_trials},             {"seeds", m->seeds}};
-  else
+    // Only when set: an unbiased render's header is as before.
+    if (m->biased_trials > 0) j["options"]["manifold"]["biased_trials"] = m->biased_trials;
+  } else {
     j["options"]["manifold"] = nullptr;
+  }
   j["strategies"] = id.strategies;
   json connectors = json::array();
   for (const ConnectorStrategy& c : id.connectors) connectors.push_back({{"strategy", c.strategy}, {"connector", c.connector}});
@@ -466,7 +469,7 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
     id.max_paths = rd.uint(o, "/options", "max_paths");
     if (!o.contains("manifold")) rd.fail("/options/manifold", "missing manifold (null, or the manifold connector's limits)");
     else if (const nlohmann::json& m = o.at("manifold"); !m.is_null() &&
-        rd.object(m, "/options/manifold", {"max_iterations", "threshold", "min_segment", "singular", "max_trials", "seeds"})) {
+        rd.object(m, "/options/manifold", {"max_iterations", "threshold", "min_segment", "singular", "max_trials", "seeds", "biased_trials"})) {
       const char* mp = "/options/manifold";
       ManifoldOptions limits;
       limits.max_iterations = rd.small(m, mp, "max_iterations");
@@ -475,6 +478,7 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
       limits.singular = rd.number(m, mp, "singular");
       limits.max_trials = rd.small(m, mp, "max_trials");
       limits.seeds = rd.small(m, mp, "seeds");
+      if (m.contains("biased_trials")) limits.biased_trials = rd.small(m, mp, "biased_trials");
       id.manifold = limits;
     }
   }
@@ -566,6 +570,7 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
     if (auto d = real("--manifold-singular", x.singular, y.singular)) return d;
     if (auto d = option("--manifold-trials", x.max_trials, y.max_trials)) return d;
     if (auto d = option("--manifold-seeds", x.seeds, y.seeds)) return d;
+    if (auto d = option("--manifold-biased-trials", x.biased_trials, y.biased_trials)) return d;
   } else if (a.manifold.has_value() != b.manifold.has_value()) {
     return std::optional<std::string>("another manifold setting (one runs the manifold connector, the other does not)");
   }

@@ -32,7 +32,8 @@
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
 // {max_bounces, sampler, rr_depth, rr_threshold, rr_light_threshold (absent in files written before
 // issue 39: then rr_threshold's), batches, width, height, images, max_paths, manifold (null, or the
-// manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds})}, "strategies" [names],
+// manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds,
+// biased_trials when > 0})}, "strategies" [names],
 // "connectors" [{strategy, connector}] (the strategies that run a connector, in the profile's order,
 // with the connector's name: "mirror", "distant-projection", "ortho-projection", "manifold"), "share" and
 // "passes" (each [[first, last), …]: the passes the run was asked for, and those whose sums this

@@ -30,6 +30,13 @@ std::string classes_hash(const std::string& text, const RenderClasses& classes) 
 }
 
 Result<bool> load_fresh(const TraceJobOptions& a, TraceJob* job) {
+  // The command line checks these ranges as it parses (cli/trace.cpp); the library's other callers
+  // (the C++ API) meet them here.
+  if (a.spp < 1 || a.spp > kMaxTraceSpp)
+    return make_error(ErrorCode::kUsage, "spp must be 1 to " + std::to_string(kMaxTraceSpp) + ", not " + std::to_string(a.spp));
+  if (a.max_bounces && (*a.max_bounces < 0 || *a.max_bounces > kMaxTraceBounces))
+    return make_error(ErrorCode::kUsage, "max bounces must be 0 to " + std::to_string(kMaxTraceBounces) + ", not " +
+                                             std::to_string(*a.max_bounces));
   Result<Scene> scene = a.scene.empty() ? load_scene_json(default_scene_json(), ".", "default (embedded cornell)")
                                         : load_scene_file(a.scene, scene_load_options(a.limits));
   if (!scene) return scene.error();

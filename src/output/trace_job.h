@@ -21,6 +21,10 @@
 
 namespace pathex {
 
+// The largest --spp and --max-bounces of a render (the command line's ranges).
+inline constexpr std::uint64_t kMaxTraceSpp = std::uint64_t{1} << 24;
+inline constexpr int kMaxTraceBounces = 1000;
+
 struct TraceJobOptions {
   std::string scene;  // the scene file; empty: the embedded Cornell box
   std::string renderer = "bdpt";  // a built-in profile's name or a profile file

@@ -131,6 +131,7 @@ class Integrator {
     JoinResult join{};  // the join being made (joins build into it; estimate() consumes it)
     std::vector<ChainVertex> manifold_seed{};       // the manifold connector's chain being solved
     std::vector<ManifoldSolution> manifold_found{};  // and the distinct chains its first batch found
+    std::vector<ChainVertex> mis_chain{};            // a path's chain whose MIS densities are computed (chain_densities())
     // The MIS weight's working space (mis_weight()): the strategies that sample the path being
     // weighed, and the densities of its vertices that the weight reads.
     std::array<mis::Technique, 2 * mis::kMaxPath + 2> techniques{};
@@ -349,6 +350,13 @@ class Integrator {
   void join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const;
   // th.densities[lo … hi) of a path with constructed vertices: every one computed from the vertices.
   void path_densities(Thread& th, const PathView& x, PathKey key, int lo, int hi) const;
+  // th.densities[lo … hi) (already filled) changed where the manifold connector could build a run
+  // x_i … x(i+m-1) of S vertices between a = x(i-1) and b = x(i+m) (trace/joins/manifold_join.cpp):
+  // every strategy's density then is over the areas of the path's other vertices, the chain a
+  // function of its ends, as the manifold's own is. A walk that crosses the chain samples b from a
+  // with a's direction density times the generalized geometry term |dω_a/dA_b| (and the Dirac
+  // lobes' choices), a from b likewise; the chain's vertices count 1 for both walks.
+  void chain_densities(Thread& th, const PathView& x, PathKey key, ConnectorKind self, int lo, int hi) const;
   // The estimator's one consumer of joins: weighs th.join by MIS over every strategy of the
   // profile, then records it, or queues its segments and records it once all are found clear.
   void estimate(Thread& th, int batch) const;

@@ -12,7 +12,10 @@
 // of the vertices between the two strategies farthest apart, those four computed into it (from the
 // BSDF densities the join's evaluation gave, when it gave them): no subpath density is written. A
 // connector that constructs vertices (the mirror's, the manifold's chain) makes a path no walk
-// sampled: every density is computed from the vertices.
+// sampled: every density is computed from the vertices. Across a run of S vertices that the
+// manifold connector could build, every strategy's densities are the chain's (chain_densities(),
+// trace/joins/manifold_join.cpp): a walk that crosses it draws the far end with the generalized
+// geometry term |dω/dA| of the chain, as the manifold's own density leaves the chain out.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -219,9 +222,11 @@ float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, Connect
   int lo = 0, hi = 0;
   st.read_range(&lo, &hi);
   // th.densities[lo … hi): a plain join's from the subpaths' stored ones, a constructed path's
-  // from its vertices.
-  if (x.m > 0 || x.whole != nullptr) path_densities(th, x, key, lo, hi);
+  // from its vertices; a chain the manifold could build changes them across it.
+  const bool constructed = x.m > 0 || x.whole != nullptr;
+  if (constructed) path_densities(th, x, key, lo, hi);
   else join_densities(th, x, self, join, lo, hi);
+  if (has_manifold_ && (constructed || st.count > 0)) chain_densities(th, x, key, self, lo, hi);
   return mis::weight(th.densities.data(), st, lo, hi);
 }
 

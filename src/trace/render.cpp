@@ -98,6 +98,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     v.err = hit->error;
     v.ns = rs_.shading_normal(*hit);  // a bump or normal map's, if any
     v.shape = hit->shape;
+    v.primitive = hit->primitive;
     v.uv = hit->uv;
     v.finite = finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0;
     v.wo = -d;

@@ -32,6 +32,7 @@ struct Vertex {
   float pdf_fwd = 0.0f;  // area density of sampling this vertex in its subpath's direction
   float pdf_rev = 0.0f;  // area density of sampling it from the other direction
   int shape = -1;        // surfaces and area-light points
+  int primitive = 0;     // surfaces: the hit's triangle of a mesh (a chain's derivatives need it: chain_densities())
   glm::vec2 uv{0.0f};    // surfaces: the hit's surface parameters when the scene has textures (Hit::uv), else zero
   int light = -1;        // light vertices
   // Without short-circuits: which components are zero follows the scene's orientation, which no

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -243,6 +244,91 @@ TEST(Api, ConvergeMeasuresWhatTheCommandMeasures) {
   px::ConvergeOptions decreasing = o;
   decreasing.spp = {16, 4};
   EXPECT_FALSE(px::converge(scene, {px::Renderer("pt-nee")}, decreasing).ok());
+}
+
+// api::trace is `pathex trace`: the same estimates, bit for bit, as the command's histogram.json
+// for the total, every class and every listed path (and "other"), with or without a folder; the
+// folder it writes is the command's set; `only` narrows as --only does; errors are the command's.
+TEST(Api, TraceMeasuresWhatTheCommandMeasures) {
+  const std::string scene = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/point-glass.json";
+  px::TraceOptions o;
+  o.spp = 4;
+  o.threads = 2;
+  o.max_paths = 5;  // fewer than the scene's paths: "other" is listed
+  const px::TraceAnswer a = px::trace(scene, px::Renderer("bdpt"), o);
+  ASSERT_TRUE(a.ok()) << a.error;
+  const std::string out = (pathex::test::scratch_dir() / "api-trace").string();
+  const pathex::test::CliRun cli = pathex::test::run_pathex_args(
+      {"trace", scene, "--renderer", "bdpt", "--spp", "4", "--threads", "1", "--max-paths", "5", "--json", "--quiet", "--out", out});
+  ASSERT_EQ(cli.code, 0) << cli.err;
+  const nlohmann::json j = nlohmann::json::parse(cli.out);
+  const auto same = [](const px::TraceEstimate& e, const nlohmann::json& n) {
+    return e.luminance == n["luminance"].get<double>() &&
+           (n["stderr"].is_null() ? std::isnan(e.std_error) : e.std_error == n["stderr"].get<double>());
+  };
+  EXPECT_EQ(a.renderer, "bdpt");
+  EXPECT_EQ(a.spp, 4u);
+  EXPECT_TRUE(a.complete);
+  EXPECT_GT(a.total.luminance, 0.0);
+  EXPECT_TRUE(same(a.total, j["total"]));
+  EXPECT_EQ(a.total.share, 1.0);
+  ASSERT_EQ(a.classes.size(), j["classes"].size());
+  for (std::size_t i = 0; i < a.classes.size(); ++i) {
+    EXPECT_EQ(a.classes[i].name, j["classes"][i]["name"]);
+    EXPECT_EQ(a.classes[i].expression, j["classes"][i]["expr"]);
+    EXPECT_TRUE(same(a.classes[i], j["classes"][i])) << a.classes[i].name;
+    EXPECT_EQ(a.classes[i].share, j["classes"][i]["share"].get<double>()) << a.classes[i].name;
+  }
+  ASSERT_EQ(a.paths.size(), j["paths"].size());
+  ASSERT_EQ(a.paths.size(), 6u);  // five listed, then "other"
+  EXPECT_EQ(a.paths.back().name, "other");
+  for (std::size_t i = 0; i < a.paths.size(); ++i) {
+    EXPECT_EQ(a.paths[i].name, j["paths"][i]["path"]);
+    EXPECT_TRUE(same(a.paths[i], j["paths"][i])) << a.paths[i].name;
+  }
+  EXPECT_EQ(a.distinct_paths, j["distinct_paths"].get<std::uint64_t>());
+  EXPECT_EQ(a.nonfinite_samples, 0u);
+  EXPECT_GT(a.cpu_s, 0.0);
+
+  // With a folder: the same answer, and the folder holds the command's histogram.json.
+  px::TraceOptions to_folder = o;
+  to_folder.out = (pathex::test::scratch_dir() / "api-trace-folder").string();
+  const px::TraceAnswer b = px::trace(scene, px::Renderer("bdpt"), to_folder);
+  ASSERT_TRUE(b.ok()) << b.error;
+  EXPECT_EQ(b.total.luminance, a.total.luminance);
+  std::ifstream written(to_folder.out + "/histogram.json");
+  ASSERT_TRUE(written) << "no histogram.json in " << to_folder.out;
+  const nlohmann::json w = nlohmann::json::parse(written);
+  EXPECT_EQ(w["total"], j["total"]);
+  EXPECT_EQ(w["paths"], j["paths"]);
+  EXPECT_TRUE(std::filesystem::exists(to_folder.out + "/classes.exr"));
+  // Without a folder nothing is written (the command's default folder is not made either).
+  EXPECT_FALSE(std::filesystem::exists("pathex-out/histogram.json"));
+
+  // `only`: the caustic alone, the other classes not rendered, as --only reports them.
+  px::TraceOptions caustic = o;
+  caustic.only = {"$caustic"};
+  const px::TraceAnswer c = px::trace(scene, px::Renderer("bdpt"), caustic);
+  ASSERT_TRUE(c.ok()) << c.error;
+  int rendered = 0;
+  for (const px::TraceEstimate& e : c.classes) rendered += e.rendered ? 1 : 0;
+  EXPECT_GE(rendered, 1);
+  EXPECT_LT(rendered, static_cast<int>(c.classes.size()));
+  EXPECT_LT(c.total.luminance, a.total.luminance);
+
+  // Errors are the command's located messages.
+  const px::TraceAnswer missing = px::trace("no-such-scene.json", px::Renderer("bdpt"), o);
+  EXPECT_FALSE(missing.ok());
+  const pathex::test::CliRun cli_missing = pathex::test::run_pathex_args({"trace", "no-such-scene.json", "--out", out});
+  EXPECT_EQ(cli_missing.code, 2);
+  EXPECT_EQ("pathex: error: " + missing.error + "\n", cli_missing.err);
+  EXPECT_FALSE(px::trace(scene, px::Renderer("no-such-renderer"), o).ok());
+  px::TraceOptions no_spp = o;
+  no_spp.spp = 0;
+  EXPECT_EQ(px::trace(scene, px::Renderer("bdpt"), no_spp).error, "spp must be 1 to 16777216, not 0");
+  px::TraceOptions too_deep = o;
+  too_deep.max_bounces = 1001;
+  EXPECT_EQ(px::trace(scene, px::Renderer("bdpt"), too_deep).error, "max bounces must be 0 to 1000, not 1001");
 }
 
 // api::check is `pathex check`: the same outcomes, in order, as the lines the command prints, and

@@ -62,10 +62,11 @@ TEST(ManifoldOptions, HelpStatesTheLibraryDefaults) {
   EXPECT_EQ(d.max_iterations, 64);  // what the README states
   EXPECT_EQ(d.max_trials, 2000);
   EXPECT_EQ(d.seeds, 4);
+  EXPECT_EQ(d.biased_trials, 0);  // unbiased by default
   for (const std::string line : {"--manifold-iterations INT:INT in [1 - 10000]=64", "--manifold-threshold FLOAT:FLOAT in (0, 1)=1e-05",
                                  "--manifold-min-segment FLOAT:FLOAT in [0, 1)=0.001",
                                  "--manifold-singular FLOAT:FLOAT in [0, 1)=1e-07", "--manifold-trials INT:INT in [1 - 100000]=2000",
-                                 "--manifold-seeds INT:INT in [1 - 64]=4"})
+                                 "--manifold-seeds INT:INT in [1 - 64]=4", "--manifold-biased-trials INT:INT in [0 - 100000]=0"})
     EXPECT_NE(r.out.find("  " + line + "\n"), std::string::npos) << line << "\n" << r.out;
 }
 
@@ -81,6 +82,8 @@ TEST(ManifoldOptions, BadValuesAreOneMessageAndExitTwo) {
       {"--manifold-singular inf", "--manifold-singular: expected a number in [0, 1), got 'inf'"},
       {"--manifold-trials 100001", "--manifold-trials: Value 100001 not in range 1 to 100000"},
       {"--manifold-seeds 0", "--manifold-seeds: Value 0 not in range 1 to 64"},
+      {"--manifold-biased-trials 100001", "--manifold-biased-trials: Value 100001 not in range 0 to 100000"},
+      {"--manifold-biased-trials -1", "--manifold-biased-trials: expected a non-negative integer, got '-1'"},
   };
   for (const auto& [args, message] : cases) {
     const CliRun r = run("trace " + kScene + " --renderer pt-nee+manifold --spp 1 --out " + out_dir("bad") + " " + args);
@@ -114,6 +117,13 @@ TEST(ManifoldOptions, TheLimitsReachTheWalk) {
   // One seed per batch: a quarter of the default's first-batch seeds.
   const nlohmann::json seeds = manifold_stats("--manifold-seeds 1");
   EXPECT_EQ(seeds["attempts"].get<long>() * 4, d["attempts"].get<long>());
+
+  // The biased variant: as many seeds per join as asked, no batches after them (every walk is an
+  // attempt's, nothing truncated).
+  const nlohmann::json biased = manifold_stats("--manifold-biased-trials 8");
+  EXPECT_EQ(biased["attempts"].get<long>(), d["attempts"].get<long>() * 2);
+  EXPECT_LE(biased["walks"].get<long>(), biased["attempts"].get<long>());
+  EXPECT_EQ(biased["truncated"].get<long>(), 0);
 }
 
 TEST(ManifoldOptions, MergeRefusesRendersWithOtherLimits) {
@@ -143,14 +153,21 @@ TEST(ManifoldOptions, MergeRefusesRendersWithOtherLimits) {
             nlohmann::json::parse(R"({"max_iterations": 20, "threshold": 1e-05, "min_segment": 0.001, "singular": 1e-07,
                                      "max_trials": 2000, "seeds": 4})"));
   EXPECT_TRUE(shard_header(s1)["options"]["manifold"].is_null());
-  for (const std::string& dir : {a, b, c, s0, s1, m}) std::filesystem::remove_all(dir);
+  // The biased variant is recorded (only when set) and not merged with the unbiased estimator.
+  const std::string e = out_dir("e");
+  ASSERT_EQ(run(common + e + " --manifold-biased-trials 8").code, 0);
+  EXPECT_EQ(shard_header(e)["options"]["manifold"]["biased_trials"], 8);
+  const CliRun u = run("merge " + a + " " + e + " --out " + m);
+  EXPECT_EQ(u.code, 2);
+  EXPECT_NE(u.err.find("are not of one render: another --manifold-biased-trials (8 against 0)\n"), std::string::npos) << u.err;
+  for (const std::string& dir : {a, b, c, e, s0, s1, m}) std::filesystem::remove_all(dir);
 }
 
 TEST(ManifoldOptions, ResumeTakesTheLimitsFromTheFolder) {
   const std::string a = out_dir("resume");
   ASSERT_EQ(run("trace " + kScene + " --renderer bdpt --spp 1 --resolution 8x8 --no-images --quiet --out " + a).code, 0);
   for (const std::string o : {"--manifold-iterations 8", "--manifold-threshold 0.001", "--manifold-min-segment 0",
-                               "--manifold-singular 0", "--manifold-trials 3", "--manifold-seeds 2"}) {
+                               "--manifold-singular 0", "--manifold-trials 3", "--manifold-seeds 2", "--manifold-biased-trials 4"}) {
     const CliRun r = run("trace --resume " + a + " " + o);
     EXPECT_EQ(r.code, 2) << o;
     EXPECT_EQ(r.err, "pathex: error: --resume takes the render's settings from " + a + "; " + o.substr(0, o.find(' ')) +

@@ -81,6 +81,24 @@ TEST(Layers, NothingIncludesAFolderAboveIt) {
                   << "PATHEX_LIB_DIRS lists the layers bottom to top)";
 }
 
+// cli/ keeps options, printing and exit codes (issue 38): every JSON document a command prints or
+// writes is made by the library (io/, output/, check/, measure/), so no file of cli/ includes
+// nlohmann.
+TEST(Layers, TheCommandLineMakesNoJsonOfItsOwn) {
+  const fs::path cli = fs::path(PATHEX_SOURCE_DIR) / "src" / "cli";
+  int files = 0;
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(cli)) {
+    if (!e.is_regular_file()) continue;
+    ++files;
+    std::istringstream in(read_file(e.path()));
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n)
+      EXPECT_EQ(line.find("#include <nlohmann/"), std::string::npos)
+          << e.path().lexically_relative(fs::path(PATHEX_SOURCE_DIR)).string() << ":" << n << ": " << line;
+  }
+  EXPECT_GT(files, 10);
+}
+
 TEST(Layers, EveryFolderOfSrcHasItsPlace) {
   const fs::path src = fs::path(PATHEX_SOURCE_DIR) / "src";
   const std::vector<std::string> order = layer_order(read_file(src / "CMakeLists.txt"));

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <vector>
@@ -27,6 +28,11 @@ namespace pathex {
 namespace {
 
 constexpr int kBounces = 6;
+// The fewest nonzero samples (4 a batch of the 32) for which a path's estimate is compared by its
+// stderr: with fewer, whether a batch holds a contribution at all decides its mean, and the
+// batch-means t is far from Student's (10 % of the comparisons at the fixed seed: the lamp seen
+// in a mirror, met 12 to 16 times, and light tracing's sparse splats).
+constexpr std::uint64_t kMinSamples = 4 * 32;
 
 HistogramReport render_scene(const Scene& scene, const Profile& profile, std::uint64_t spp) {
   RenderOptions o;
@@ -52,6 +58,7 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
     double deviation, sigma;
   };
   std::vector<Comparison> comparisons;
+  int sparse = 0;  // paths found, but with too few samples for their stderr to mean anything
   auto has_mirror_connector = [](const Profile& p) {
     return std::any_of(p.strategies.begin(), p.strategies.end(), [](const Strategy& st) { return st.connector == ConnectorKind::kMirror; });
   };
@@ -109,6 +116,15 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
         if (!(p.estimate.luminance > 0.01 * reference.total.luminance) || !reach.reachable.accepts(p.path)) continue;
         auto it = found.find(p.path);
         ASSERT_NE(it, found.end()) << where << ": bdpt finds " << p.path << " but the profile never samples it";
+        // A batch-means stderr describes an estimate made of enough samples only: light tracing meets
+        // materials.json's LDDDDDDSE (4 % of the image) about 76 times in 128 spp at 16 x 16, and a
+        // few heavy splats carry it — at seed 2 it read 0.0022 ± 0.0003 against bdpt's 0.0054, while
+        // at 2,048 spp it reads 0.0060 ± 0.0010 (issue 36's sweep: 1 of 5 seeds failed). Such a path
+        // is checked for being found, not for its value.
+        if (std::min(p.estimate.samples, it->second->estimate.samples) < kMinSamples) {
+          ++sparse;
+          continue;
+        }
         const double sigma = std::hypot(p.estimate.std_error, it->second->estimate.std_error);
         comparisons.push_back({where + ": " + p.path + " bdpt " + std::to_string(p.estimate.luminance) + " ± " +
                                    std::to_string(p.estimate.std_error) + ", " + name + " " +
@@ -118,6 +134,8 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
     }
   }
   EXPECT_GT(comparisons.size(), 40u);
+  test::stat_log("paths found but too sparse to compare", sparse, static_cast<double>(comparisons.size()) / 4);
+  EXPECT_LT(sparse, static_cast<int>(comparisons.size()) / 4) << "most comparisons must be of well-sampled paths";
   const double tolerance = test::family_sigmas(static_cast<int>(comparisons.size()));
   for (const Comparison& c : comparisons) {
     test::stat_log(c.what, c.deviation / c.sigma, tolerance);

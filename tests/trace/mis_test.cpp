@@ -14,12 +14,15 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <string>
 #include <vector>
 
 #include "io/profile_json.h"
 #include "scene/scene.h"
+#include "optics/fresnel.h"
 #include "trace/integrator.h"
+#include "trace/joins/manifold.h"
 #include "trace/render.h"
 
 namespace pathex::tracer {
@@ -438,45 +441,155 @@ TEST(Mis, PathTracerWeightsAreTheTwoStrategyPowerHeuristic) {
   EXPECT_GT(hits_weighed, 300);
 }
 
+// An integrator of `strategies` over `scene` and one thread's state, as the manifold MIS tests
+// below drive them (by IntegratorTestAccess).
+struct ManifoldRig {
+  RenderScene rs;
+  RenderOptions o;
+  HistogramLayout layout;
+  ClassImages images;
+  Integrator in;
+  Integrator::Thread th;
+  ManifoldRig(const Scene& scene, const StrategySet& strategies, std::uint64_t seed)
+      : rs(make_render_scene(scene).expect("a scene the tracer renders")),
+        o(options(seed)),
+        images(1, 1, nullptr, {}),
+        in(rs, strategies, o),
+        th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}} {
+    th.images = &images;
+    th.connectors.resize(strategies.strategies.size());
+  }
+  static RenderOptions options(std::uint64_t seed) {
+    RenderOptions r;
+    r.seed = seed;
+    r.max_bounces = 8;
+    return r;
+  }
+};
+
 // Where bdpt's light tracing (and its other joins) and the manifold connector both sample a path,
-// the whole-path weights of all of them sum to 1: random paths of the glass-sphere scene formed by
-// every plain join of bdpt+manifold's subpaths, those a manifold chain could build among them.
+// the whole-path weights of all of them sum to 1: random paths of the glass-sphere scenes formed by
+// every plain join of bdpt+manifold's subpaths, those a manifold chain could build among them. The
+// renderer's weight of each plain join (its subpaths' stored densities, changed across a chain the
+// manifold could build: chain_densities()) must equal the whole path's.
 TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
-  const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/point-glass.json").expect("the sample");
   const Profile profile = parse_profile(R"({"name": "bdpt+manifold", "strategies": [
       {"name": "bdpt", "s": "0..", "chain": "DD", "t": "0.."},
       {"name": "manifold", "s": "1..", "chain": "DS+D", "t": "2..", "connector": "manifold"}]})",
                                         "bdpt+manifold.json", Limits{})
                               .expect("a valid profile");
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
-  const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
-  RenderOptions o;
-  o.seed = 5;
-  o.max_bounces = 8;
-  HistogramLayout layout;
-  ClassImages images(1, 1, nullptr, {});
-  const Integrator integrator(rs, strategies, o);
-  Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
-  th.images = &images;
-  th.connectors.resize(strategies.strategies.size());
-  using A = IntegratorTestAccess;
-  int checked = 0, shared = 0;
-  for (int i = 0; i < 10000; ++i) {
-    Sampler rng(5, static_cast<std::uint64_t>(i), 0);
-    int ns = 0;
-    const int nt = A::trace_subpaths(integrator, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
-    for (int t = 0; t <= nt; ++t)
-      for (int s = 0; s <= ns; ++s) {
-        if (s == 1 || t == 1 || s + t < 2 || s + t - 2 > *o.max_bounces || !A::joinable(integrator, th, s, t)) continue;
-        int chains = 0;
-        const double sum = A::whole_path_weight_sum(integrator, th, s, t, &chains);
-        ++checked;
-        if (chains > 0) ++shared;
-        EXPECT_NEAR(sum, 1.0, 1e-4) << A::label(integrator, th, s, t) << " (s=" << s << ", t=" << t << ")";
-      }
+  for (const char* name : {"point-glass.json", "lamp-glass.json"}) {
+    const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + name).expect("the sample");
+    ManifoldRig rig(scene, strategies, 5);
+    const Integrator& integrator = rig.in;
+    const RenderScene& rs = rig.rs;
+    const RenderOptions& o = rig.o;
+    Integrator::Thread& th = rig.th;
+    using A = IntegratorTestAccess;
+    int checked = 0, shared = 0;
+    for (int i = 0; i < 10000; ++i) {
+      Sampler rng(5, static_cast<std::uint64_t>(i), 0);
+      int ns = 0;
+      const int nt = A::trace_subpaths(integrator, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
+      for (int t = 0; t <= nt; ++t)
+        for (int s = 0; s <= ns; ++s) {
+          if (s == 1 || t == 1 || s + t < 2 || s + t - 2 > *o.max_bounces || !A::joinable(integrator, th, s, t)) continue;
+          int chains = 0;
+          const double sum = A::whole_path_weight_sum(integrator, th, s, t, &chains);
+          ++checked;
+          if (chains > 0) ++shared;
+          const std::string where = std::string(name) + " " + A::label(integrator, th, s, t) + " (s=" + std::to_string(s) +
+                                    ", t=" + std::to_string(t) + ")";
+          EXPECT_NEAR(sum, 1.0, 1e-4) << where;
+          // The join's own densities read the cosines at its ends: where the join runs along a
+          // surface (two points of one planar face) they are rounding, and the two sources differ.
+          const std::vector<Vertex> x = A::gather(integrator, th, s, t);
+          const vec3 w = s > 0 && t > 0 ? glm::normalize(x[static_cast<std::size_t>(s)].p - x[static_cast<std::size_t>(s - 1)].p) : vec3(0.0f);
+          if (s > 0 && t > 0 && std::min(abs_cos(x[static_cast<std::size_t>(s - 1)], w), abs_cos(x[static_cast<std::size_t>(s)], w)) < 1e-3f) continue;
+          const float general = A::general_weight(integrator, th, s, t);
+          EXPECT_NEAR(A::own_weight(integrator, th, s, t), general, 1e-4 * std::max(1.0f, general)) << where;
+        }
+    }
+    EXPECT_GT(checked, 1000) << name;
+    EXPECT_GT(shared, 50) << name;  // paths that the manifold and the plain joins both sample
   }
-  EXPECT_GT(checked, 1000);
-  EXPECT_GT(shared, 50);  // paths that the manifold and the plain joins both sample
+}
+
+// Where light tracing, the emitter hit and the manifold connector sample one path through the
+// glass ball of lamp-glass.json (LDDSSDDSE: lamp x0, the ball's two refractions x1 x2, the floor
+// x3, the camera x4), their densities are over the areas of x0, x3 and x4, the chain a function of
+// its ends: the manifold draws x0 from the lamp and x3 from the camera; light tracing draws x3
+// through the chain with the lamp's cosine density times the two refractions' Fresnel choices
+// times |dω_0/dA_3|, the emitter hit draws x0 with the floor's cosine density times the choices
+// times |dω_3/dA_0|. The two generalized geometry terms are computed here by solving the chain
+// from each end (solve_chain), independently of the renderer's one solve and reciprocity; the
+// weights of all three strategies, as the renderer computes them (light tracing's from its
+// subpaths' stored densities too), must be the power heuristic of these densities. Fixed seed.
+TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
+  const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json").expect("the sample");
+  const Profile profile = resolve_profile("bdpt+manifold", Limits{}).expect("a built-in profile");
+  const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
+  ManifoldRig rig(scene, strategies, 3);
+  const Integrator& in = rig.in;
+  const RenderScene& rs = rig.rs;
+  Integrator::Thread& th = rig.th;
+  using A = IntegratorTestAccess;
+  const double pi = std::numbers::pi;
+  int checked = 0, lt_leads = 0, manifold_leads = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Sampler rng(3, static_cast<std::uint64_t>(i), 0);
+    int ns = 0;
+    A::trace_subpaths(in, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
+    if (ns < 4 || !th.light[3].finite || A::label(in, th, 4, 1) != "LDDSSDDSE") continue;
+    const std::vector<Vertex> x = A::gather(in, th, 4, 1);
+    const glm::dvec3 p0(x[0].p), p3(x[3].p), n0(x[0].n), n3(x[3].n);
+    const vec3 w4 = glm::normalize(x[3].p - x[4].p);
+    const double e3 = in.sensor_pdf_dir(x[4], w4) * abs_cos(x[3], w4) / glm::dot(x[3].p - x[4].p, x[3].p - x[4].p);
+    if (!(e3 > 0.0)) continue;  // x3 outside the frame
+    // The chain, light side first, and the same chain from the floor's end.
+    std::vector<ChainVertex> from_light, from_floor;
+    double choices = 1.0;
+    for (int v = 1; v <= 2; ++v) {
+      const float before = glm::dot(x[v - 1].p - x[v].p, x[v].n), after = glm::dot(x[v + 1].p - x[v].p, x[v].n);
+      ASSERT_LT(before * after, 0.0f) << "two refractions";  // (x3 on the floor: not an internal reflection)
+      const double eta_light = before > 0.0f ? 1.0 : 1.5, eta_eye = after > 0.0f ? 1.0 : 1.5;
+      from_light.push_back({&rs.geometry->shape_geometry(x[v].shape), x[v].shape, 0, 1.5, eta_light, eta_eye, false, glm::dvec3(x[v].p), 0});
+      choices *= 1.0 - fresnel_dielectric(glm::dot(glm::normalize(x[v - 1].p - x[v].p), x[v].n), 1.5f);
+    }
+    for (auto it = from_light.rbegin(); it != from_light.rend(); ++it) {
+      from_floor.push_back(*it);
+      std::swap(from_floor.back().eta_light, from_floor.back().eta_eye);
+    }
+    const ManifoldWalk to_floor = solve_chain(from_light, p0, p3, n3, 1.0, ManifoldOptions{});
+    const ManifoldWalk to_lamp = solve_chain(from_floor, p3, p0, n0, 1.0, ManifoldOptions{});
+    if (to_floor.failure != ManifoldFailure::kNone || to_lamp.failure != ManifoldFailure::kNone) continue;
+    const double lamp = in.light_pick() * rs.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;  // x0 drawn on the lamp
+    const double lamp_dir = std::fabs(glm::dot(glm::normalize(x[1].p - x[0].p), x[0].n)) / pi;      // its cosine emission
+    const double floor_dir = std::fabs(glm::dot(glm::normalize(x[2].p - x[3].p), x[3].n)) / pi;     // the floor's cosine density
+    const double manifold = lamp * e3;
+    const double light_tracing = lamp * lamp_dir * choices * to_floor.dw_db;
+    const double emitter_hit = floor_dir * choices * to_lamp.dw_db * e3;
+    const double sum2 = manifold * manifold + light_tracing * light_tracing + emitter_hit * emitter_hit;
+    const PathKey key = in.path_key(th, 4, 1, nullptr);
+    const float w_lt = A::own_weight(in, th, 4, 1);
+    const float w_lt_whole = in.mis_weight(th, A::whole(x, 4, 0), key, ConnectorKind::kNone, nullptr);
+    const float w_manifold = in.mis_weight(th, A::whole(x, 1, 2), key, ConnectorKind::kManifold, nullptr);
+    const float w_hit = in.mis_weight(th, A::whole(x, 0, 0), key, ConnectorKind::kNone, nullptr);
+    const std::string where = "sample " + std::to_string(i) + ", |dω0/dA3| " + std::to_string(to_floor.dw_db);
+    EXPECT_NEAR(w_lt, light_tracing * light_tracing / sum2, 2e-3) << where;
+    EXPECT_NEAR(w_lt_whole, w_lt, 1e-4) << where;
+    EXPECT_NEAR(w_manifold, manifold * manifold / sum2, 2e-3) << where;
+    EXPECT_NEAR(w_hit, emitter_hit * emitter_hit / sum2, 2e-3) << where;
+    EXPECT_NEAR(w_lt + w_manifold + w_hit, 1.0, 1e-4) << where;
+    ++checked;
+    lt_leads += w_lt > 0.5f ? 1 : 0;
+    manifold_leads += w_manifold > 0.5f ? 1 : 0;
+  }
+  EXPECT_GT(checked, 30);
+  // Both light tracing and the manifold take the lead somewhere on the caustic.
+  EXPECT_GT(lt_leads, 3);
+  EXPECT_GT(manifold_leads, 3);
 }
 
 }  // namespace

@@ -632,8 +632,13 @@ TEST(Agreement, SmoothShadedSphereMeshUnderAnAreaLightAgreesAcrossEstimators) {
                {"type": "quad", "corner": [1, 3, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "material": "black", "emission": [20, 20, 20]}]})";
   const std::vector<std::string> classes = {"LDDDDSE", "LDDDDDSE"};
   std::vector<Rendered> runs;
+  // Light tracing reaches this 8 × 8, 10° frame's LDDDDDSE rarely, through the adjoint factor of the
+  // shading normals (unbounded near grazing): at 1,024 spp a few heavy splats carry its estimate,
+  // and 1 seed in 72 read it 2.3× low with a stderr of 24 % (issue 36's sweep). At 8,192 spp its
+  // batch means are near normal again; the other two meet the class at every sample.
   for (const char* renderer : {"pt-nee", "lt", "bdpt"})
-    runs.push_back(render_scene(load_scene_json(scene, test::scratch(), "sphere"), renderer, classes, 1024, 0, test::stat_seed(13), {}, 12));
+    runs.push_back(render_scene(load_scene_json(scene, test::scratch(), "sphere"), renderer, classes,
+                                std::string(renderer) == "lt" ? 8192 : 1024, 0, test::stat_seed(13), {}, 12));
   expect_estimators_agree(runs, classes.size(), 0.005);
 }
 

@@ -148,6 +148,44 @@ void jacobian(const std::vector<ChainVertex>& x, const Local* loc, double* j, co
 
 }  // namespace
 
+double chain_dw_db(const std::vector<ChainVertex>& x, const dvec3& a, const dvec3& b, const dvec3& nb, double singular) {
+  const std::size_t m = x.size(), n = 2 * m;
+  if (m == 0 || m > kCap) return 0.0;
+  struct Scratch {
+    std::array<dvec3, kCap> p;
+    std::array<Local, kCap> loc;
+    std::array<double, kDim> c;
+    std::array<double, kDim * kDim> j;
+    std::array<double, kDim * 2> jb;
+  };
+  static thread_local Scratch scratch;
+  auto& [p, loc, c, j, jb] = scratch;
+  for (std::size_t i = 0; i < m; ++i) p[i] = x[i].p;
+  if (!evaluate(x, p.data(), a, b, nullptr, nullptr, loc.data(), c.data())) return 0.0;
+  // dX/db = -(∂C/∂X)⁻¹ ∂C/∂b for b moving along a tangent pair (sb, tb) of its plane.
+  dvec3 sb, tb;
+  tangent_frame(glm::normalize(nb), &sb, &tb);
+  jacobian(x, loc.data(), j.data(), &sb, &tb, jb.data());
+  for (std::size_t k = 0; k < 2 * n; ++k) jb[k] = -jb[k];
+  if (solve_in_place(j.data(), n, jb.data(), 2) <= singular) return 0.0;  // jb becomes dX/db (2m × 2)
+  // The first vertex's move turns the direction leaving a: the 2 × 2 map from b's tangent plane
+  // to the plane across w_a, whose determinant is the solid angle per area.
+  const dvec3 e = x[0].p - a;
+  const double len = glm::length(e);
+  const dvec3 wa = e / len;
+  dvec3 e1, e2;
+  tangent_frame(wa, &e1, &e2);
+  double mtx[2][2];
+  for (int col = 0; col < 2; ++col) {
+    const dvec3 dx0 = jb[0 * 2 + static_cast<std::size_t>(col)] * loc[0].g.dpdu + jb[1 * 2 + static_cast<std::size_t>(col)] * loc[0].g.dpdv;
+    const dvec3 dw = (dx0 - glm::dot(dx0, wa) * wa) / len;
+    mtx[0][col] = glm::dot(dw, e1);
+    mtx[1][col] = glm::dot(dw, e2);
+  }
+  const double dw_db = std::fabs(mtx[0][0] * mtx[1][1] - mtx[0][1] * mtx[1][0]);
+  return std::isfinite(dw_db) ? dw_db : 0.0;
+}
+
 ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec3& b, const dvec3& nb, double scene_size,
                          const ManifoldOptions& o) {
   ManifoldWalk w;
@@ -166,6 +204,17 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
   static thread_local Scratch scratch;
   auto& [p, y, s, t, loc, trial, c, cy, step, j] = scratch;
   for (std::size_t i = 0; i < m; ++i) p[i] = x[i].p;
+  // The solution's type at positions q: a refraction's neighbours on opposite sides, a reflection's
+  // on one, the light's on the seed's side.
+  const auto right_type = [&](const dvec3* q) {
+    for (std::size_t i = 0; i < m; ++i) {
+      const dvec3 nrm = surface_derivatives(*x[i].shape, x[i].primitive, q[i]).n;
+      const dvec3 prev = i == 0 ? a : q[i - 1], next = i + 1 == m ? b : q[i + 1];
+      const double light = glm::dot(prev - q[i], nrm), sides = light * glm::dot(next - q[i], nrm);
+      if ((x[i].reflect ? !(sides > 0.0) : !(sides < 0.0)) || light * x[i].light_side < 0.0) return false;
+    }
+    return true;
+  };
   bool solved = false;
   int polish = 0;
   for (w.iterations = 0; w.iterations <= o.max_iterations; ++w.iterations) {
@@ -177,6 +226,12 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     // Solved below the threshold; up to three more steps polish it (Newton converges
     // quadratically there), so that the same solution found from two seeds compares equal.
     const bool within = err < o.threshold;
+    // Solved to the wrong type: polishing moves it by about the threshold, which keeps its type
+    // (a neighbour that close to a vertex's tangent plane aside), so it is not polished.
+    if (within && polish == 0 && !right_type(p.data())) {
+      w.failure = ManifoldFailure::kWrongType;
+      return w;
+    }
     if (within && (err < 1e-4 * o.threshold || polish == 3)) {
       solved = true;
       break;
@@ -222,16 +277,10 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     w.failure = ManifoldFailure::kIterationLimit;
     return w;
   }
-  // --- the solution's type: a refraction's neighbours on opposite sides, a reflection's on one,
-  //     the light's on the seed's side ---
-  for (std::size_t i = 0; i < m; ++i) {
-    const dvec3 nrm = surface_derivatives(*x[i].shape, x[i].primitive, x[i].p).n;
-    const dvec3 prev = i == 0 ? a : x[i - 1].p, next = i + 1 == m ? b : x[i + 1].p;
-    const double light = glm::dot(prev - x[i].p, nrm), sides = light * glm::dot(next - x[i].p, nrm);
-    if ((x[i].reflect ? !(sides > 0.0) : !(sides < 0.0)) || light * x[i].light_side < 0.0) {
-      w.failure = ManifoldFailure::kWrongType;
-      return w;
-    }
+  // --- the solution's type, polished ---
+  if (!right_type(p.data())) {
+    w.failure = ManifoldFailure::kWrongType;
+    return w;
   }
   // --- its segments ---
   const double shortest = o.min_segment * scene_size;
@@ -243,36 +292,8 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     }
   }
   // --- the generalized geometry term |dω_a / dA_b| ---
-  if (!evaluate(x, p.data(), a, b, nullptr, nullptr, loc.data(), c.data())) {
-    w.failure = ManifoldFailure::kNoSolution;
-    return w;
-  }
-  dvec3 sb, tb;
-  tangent_frame(glm::normalize(nb), &sb, &tb);
-  std::array<double, kDim * 2> jb;
-  jacobian(x, loc.data(), j.data(), &sb, &tb, jb.data());
-  for (std::size_t k = 0; k < 2 * n; ++k) jb[k] = -jb[k];
-  if (solve_in_place(j.data(), n, jb.data(), 2) <= o.singular) {  // jb becomes dX/db (2m × 2)
-    w.failure = ManifoldFailure::kSingular;
-    return w;
-  }
-  const dvec3 e = x[0].p - a;
-  const double len = glm::length(e);
-  const dvec3 wa = e / len;
-  dvec3 e1, e2;
-  tangent_frame(wa, &e1, &e2);
-  double mtx[2][2];
-  for (int col = 0; col < 2; ++col) {
-    const dvec3 dx0 = jb[0 * 2 + static_cast<std::size_t>(col)] * loc[0].g.dpdu + jb[1 * 2 + static_cast<std::size_t>(col)] * loc[0].g.dpdv;
-    const dvec3 dw = (dx0 - glm::dot(dx0, wa) * wa) / len;
-    mtx[0][col] = glm::dot(dw, e1);
-    mtx[1][col] = glm::dot(dw, e2);
-  }
-  w.dw_db = std::fabs(mtx[0][0] * mtx[1][1] - mtx[0][1] * mtx[1][0]);
-  if (!std::isfinite(w.dw_db)) {
-    w.failure = ManifoldFailure::kSingular;
-    return w;
-  }
+  w.dw_db = chain_dw_db(x, a, b, nb, o.singular);
+  if (!(w.dw_db > 0.0)) w.failure = ManifoldFailure::kSingular;
   return w;
 }
 

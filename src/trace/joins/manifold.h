@@ -40,6 +40,10 @@ struct ManifoldOptions {
   double singular = 1e-7;          // smallest |pivot| / largest |pivot| of the constraint Jacobian
   int seeds = 4;                   // seeds per batch: the first batch's distinct chains are the join's contributions
   int max_trials = 2000;           // seeds spent finding them again (their inverse probability), at most
+  // Biased when > 0 (Zeltner et al. 2020's fixed-trials variant): a join draws this many seeds and
+  // counts every distinct chain they find once, with no inverse-probability estimate (a chain a
+  // join finds with probability p < 1 is underweighted by p). 0: the unbiased estimator above.
+  int biased_trials = 0;
   bool operator==(const ManifoldOptions&) const = default;
 };
 
@@ -90,5 +94,13 @@ struct ManifoldSolution {
 // the shortest segment allowed.
 ManifoldWalk solve_chain(std::vector<ChainVertex>& chain, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& nb,
                          double scene_size, const ManifoldOptions& o);
+
+// |dω_a / dA_b| of a chain whose vertices lie on their surfaces (solved, or a path a walk traced
+// through them): the solid angle at a per unit area at b (unit normal nb) as b moves and the
+// chain's constraints stay fixed. 0 when the constraint Jacobian's smallest pivot over its largest
+// is at or below `singular`, or the chain is undefined (coincident points). The MIS densities of a
+// path through a chain use it too (Integrator::chain_densities()).
+double chain_dw_db(const std::vector<ChainVertex>& chain, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& nb,
+                   double singular);
 
 }  // namespace pathex

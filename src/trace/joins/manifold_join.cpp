@@ -96,6 +96,75 @@ bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const
 }
 
 
+void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, ConnectorKind self, int lo, int hi) const {
+  const int k = x.size() - 1;
+  const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S: x(i-1) is a Dirac vertex
+  const auto read = [&](int v) { return v >= lo && v < hi; };
+  // The probability that a walk leaving towards `wo`'s opposite picks the Dirac lobe the chain took there.
+  const auto picks = [&](const Vertex& c, const vec3& wo, bool reflect) {
+    MaterialScratch textured;
+    const Material& mat = material_at(c, &textured);
+    const Lobe lobe = reflect ? Lobe::kSpecularReflection : Lobe::kSpecularTransmission;
+    const auto* mix = std::get_if<Mixture>(&mat);
+    const int components = mix ? static_cast<int>(mix->components.size()) : 1;
+    double p = 0.0;
+    for (int i = 0; i < components; ++i) p += bsdf::component_probability(mat, wo, c.ns, i, lobe);
+    return p;
+  };
+  // Every maximal run x_i … x(i+m-1) of S vertices that the manifold connector could build, as
+  // techniques() lists them (an image light's x0 joins no chain).
+  for (int i = 1 + (on_environment(x[0]) ? 1 : 0); i <= k - 1; ++i) {
+    if (letter_s(i) || !letter_s(i + 1)) continue;
+    int m = 0;
+    while (i + m <= k - 1 && letter_s(i + m + 1)) ++m;
+    const bool own = self == ConnectorKind::kManifold && i == x.s;
+    if (i + m < lo || i - 1 >= hi) continue;  // none of x(i-1) … x(i+m) is read
+    if (!own && !manifold_at(x, key, i, m)) continue;
+    const Vertex& a = x[i - 1];
+    const Vertex& b = x[i + m];
+    std::vector<ChainVertex>& chain = th.mis_chain;
+    chain.clear();
+    double light_picks = 1.0, eye_picks = 1.0;  // the walks' choices of the chain's lobes, from either end
+    for (int v = i; v < i + m; ++v) {
+      const Vertex& c = x[v];
+      const vec3 to_light = glm::normalize(x[v - 1].p - c.p), to_eye = glm::normalize(x[v + 1].p - c.p);
+      const float before = glm::dot(to_light, c.n), after = glm::dot(to_eye, c.n);
+      const bool reflect = before * after > 0.0f;
+      const double ior = glass_ior_[static_cast<std::size_t>(c.shape)] > 0.0f ? glass_ior_[static_cast<std::size_t>(c.shape)] : 1.0;
+      // The index on each neighbour's side (the normal points out of the glass).
+      chain.push_back({&rs_.geometry->shape_geometry(c.shape), c.shape, c.primitive, ior, before > 0.0f ? 1.0 : ior,
+                       after > 0.0f ? 1.0 : ior, reflect, glm::dvec3(c.p), 0});
+      light_picks *= picks(c, to_light, reflect);
+      eye_picks *= picks(c, to_eye, reflect);
+    }
+    const vec3 wa = glm::normalize(x[i].p - a.p), wb = glm::normalize(x[i + m - 1].p - b.p);
+    const double cos_a = abs_cos(a, wa), cos_b = abs_cos(b, wb);
+    const double ab = chain_dw_db(chain, glm::dvec3(a.p), glm::dvec3(b.p), glm::dvec3(b.n), 0.0);  // |dω_a / dA_b|
+    // |dω_b / dA_a| by reciprocity: the étendue η² cos dA dω is the same at both ends of the chain.
+    const double eta_a = chain.front().eta_light, eta_b = chain.back().eta_eye;
+    const double ba = ab * (eta_a * eta_a * cos_a) / (eta_b * eta_b * cos_b);
+    // The direction densities at either end: a's light (x0's, the light's emission) or BSDF, b's BSDF.
+    float pa = 0.0f;
+    if (i == 1) {
+      const int li = a.kind == Kind::kLight ? a.light : rs_.light_of_shape[static_cast<std::size_t>(a.shape)];
+      pa = light_pdf_dir(rs_.lights[static_cast<std::size_t>(li)], a, wa);
+    } else {
+      const vec3 wp = glm::normalize(x[i - 2].p - a.p);
+      pa = pdf_dir(a, &wp, wa);
+    }
+    const vec3 wn = glm::normalize(x[i + m + 1].p - b.p);
+    const float pb = pdf_dir(b, &wn, wb);
+    const double light_b = pa * light_picks * ab, eye_a = pb * eye_picks * ba;
+    // Where the chain's term is undefined, the walks' densities stay (a function of the path
+    // alone, as every density here: the weights still sum to 1).
+    if (!(ab > 0.0) || !(cos_b > 0.0) || !std::isfinite(light_b) || !std::isfinite(eye_a)) continue;
+    for (int v = i; v < i + m; ++v)
+      if (read(v)) th.densities[static_cast<std::size_t>(v)] = mis::Densities{1.0, 1.0};
+    if (read(i + m)) th.densities[static_cast<std::size_t>(i + m)].light = light_b;
+    if (read(i - 1)) th.densities[static_cast<std::size_t>(i - 1)].eye = eye_a;
+  }
+}
+
 ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
                                        std::vector<ChainVertex>& chain) const {
   const auto u = [&] { return bits_to_unit_float(stream_bits(stream, (*drawn)++)); };
@@ -226,8 +295,10 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
     }
     return -1;
   };
-  // --- the first batch: `seeds` seeds, each an attempt; the distinct chains they solve to ---
-  const int per_batch = std::max(1, o_.manifold.seeds);
+  // --- the first batch: `seeds` seeds, each an attempt; the distinct chains they solve to (the
+  //     biased variant: `biased_trials` seeds, and no batches after it) ---
+  const bool biased = o_.manifold.biased_trials > 0;
+  const int per_batch = biased ? o_.manifold.biased_trials : std::max(1, o_.manifold.seeds);
   found.clear();
   for (int j = 0; j < per_batch; ++j) {
     ++stats.attempts;
@@ -251,6 +322,10 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   // --- each chain's inverse probability of being found by a batch: the number of fresh batches
   //     until one finds it again (geometric, E[K] = 1 / P(a batch finds it)); the batches are
   //     shared, and run until every chain is found again or max_trials seeds are spent ---
+  if (biased) {  // every distinct chain once
+    for (const ManifoldSolution& x : found) emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db);
+    return;
+  }
   std::size_t left = found.size();
   int batches = 0;
   while (left > 0 && (batches + 1) * per_batch <= o_.manifold.max_trials) {
@@ -302,6 +377,7 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     // Rounding of the solved point: its float position and the surface's own test, as a hit's bound.
     v.err = error_gamma(16) * (glm::abs(v.p) + vec3(static_cast<float>(scene_size_)));
     v.shape = c.id;
+    v.primitive = c.primitive;
     const glm::dvec3 prev = i == 0 ? glm::dvec3(a->p) : chain[static_cast<std::size_t>(i - 1)].p;
     const float cos_prev = static_cast<float>(glm::dot(glm::normalize(prev - c.p), geometry.ns));
     // A textured material's values at the solved point (its uv as a hit there has it), as every
