@@ -26,13 +26,14 @@
 //                      of passing through a given point);
 //   and the value: emitted_radiance(), intensity(), importance().
 //
-// Deltas are symbolic (DESIGN §7): a Dirac part reports density 1 (its discrete probability) with
-// its delta flag set, and its value is the delta's weight. Hence `weight = value · |cos| /
-// (pdf.pos · pdf.dir)` holds for every kind, where cos is taken between the ray and `normal`
-// (1 when the endpoint has no surface: point, spot, laser, spot meter; a pinhole uses its viewing
-// axis, as pbrt does). MIS code must compare delta flags, never the densities of Dirac parts: the
-// walks and the MIS weight keep a Dirac's density as 0 (counted as 1 there), and RayPdf::mis_dir()
-// is where a ray's density crosses from one convention to the other.
+// Deltas are symbolic (DESIGN §7), with one convention for the whole tracer: a Dirac part has
+// density 0 and its flag set (RayPdf::delta_pos, delta_dir; EndpointConnection::delta; the letter
+// S), and its value is the delta's weight. The walks store a Dirac's density as 0 too, and the MIS
+// weight alone counts a stored 0 as 1 (tracer::remap_density, pbrt-v4's remap0), its strategies
+// already excluded by letter. Hence `weight = value · |cos| / (the finite parts' densities)` for
+// every kind, where cos is taken between the ray and `normal` (1 when the endpoint has no surface:
+// point, spot, laser, spot meter; a pinhole uses its viewing axis, as pbrt does): a Dirac part is
+// chosen with probability 1. Code must test the flags, never a density, to tell a Dirac part.
 //
 // Sensors measure the mean over the image: W_e is normalised so that ∫ W_e cos dσ dA = 1 over the
 // whole film (pbrt's convention, W_e = 1 / (A_img cos⁴θ) for a pinhole with A_img the image area
@@ -61,13 +62,10 @@ namespace pathex {
 
 // Densities of an emission or importance ray, with the Dirac parts flagged.
 struct RayPdf {
-  float pos = 0.0f;        // area density of the origin [1/area]; 1 if delta_pos
-  float dir = 0.0f;        // solid-angle density of the direction [1/sr]; 1 if delta_dir
+  float pos = 0.0f;        // area density of the origin [1/area]; 0 if delta_pos
+  float dir = 0.0f;        // solid-angle density of the direction [1/sr]; 0 if delta_dir
   bool delta_pos = false;
   bool delta_dir = false;
-  // The direction's density as the walks and the MIS weight keep it (trace/mis.h): a Dirac's as 0,
-  // its strategies excluded by letter. The one place the two conventions meet.
-  float mis_dir() const { return delta_dir ? 0.0f : dir; }
 };
 
 // The first ray of a light subpath (from a light) or an eye subpath (from a sensor).
@@ -77,7 +75,7 @@ struct EndpointRay {
   glm::vec3 normal{0.0f};     // surface normal at the origin; zero when there is no surface
   glm::vec3 value{0.0f};      // Le or We along the ray (for Dirac parts: their weight)
   RayPdf pdf;
-  glm::vec3 weight{0.0f};     // value · |cos| / (pdf.pos · pdf.dir): the starting throughput
+  glm::vec3 weight{0.0f};     // value · |cos| / (pdf.pos · pdf.dir, a Dirac's factor 1): the starting throughput
   Letter pos_letter = kD;     // c0 for a light, c(k+2) for a sensor
   Letter dir_letter = kD;     // c1 for a light, c(k+1) for a sensor
   glm::vec2 raster{0.0f};     // sensors: the film position of the ray, [0,1)^2

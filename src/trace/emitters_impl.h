@@ -152,7 +152,7 @@ inline std::optional<EndpointRay> sample_ray(const PointLightParams& p, glm::vec
   r.origin = p.position;
   r.direction = sample_uniform_sphere(u);
   r.value = p.intensity;
-  r.pdf = {1.0f, kUniformSpherePdf, true, false};
+  r.pdf = {0.0f, kUniformSpherePdf, true, false};
   r.weight = p.intensity * (4.0f * kPi);
   r.pos_letter = PointLightParams::kPosLetter;
   r.dir_letter = PointLightParams::kDirLetter;
@@ -160,7 +160,7 @@ inline std::optional<EndpointRay> sample_ray(const PointLightParams& p, glm::vec
 }
 
 inline RayPdf pdf_ray(const PointLightParams&, const glm::vec3&) {
-  return {1.0f, kUniformSpherePdf, true, false};
+  return {0.0f, kUniformSpherePdf, true, false};
 }
 
 inline std::optional<EndpointConnection> connect(const PointLightParams& p, const glm::vec3& ref) {
@@ -201,7 +201,7 @@ inline std::optional<EndpointRay> sample_ray(const SpotLightParams& p, glm::vec2
   r.value = p.intensity * spot_falloff(p, local.z);
   if (emitter_detail::is_black(r.value)) return std::nullopt;  // the cone's rim, where the falloff is 0
   const float pdf_dir = uniform_cone_pdf(p.cos_total);
-  r.pdf = {1.0f, pdf_dir, true, false};
+  r.pdf = {0.0f, pdf_dir, true, false};
   r.weight = r.value / pdf_dir;
   r.pos_letter = SpotLightParams::kPosLetter;
   r.dir_letter = SpotLightParams::kDirLetter;
@@ -210,7 +210,7 @@ inline std::optional<EndpointRay> sample_ray(const SpotLightParams& p, glm::vec2
 
 inline RayPdf pdf_ray(const SpotLightParams& p, const glm::vec3& direction) {
   const bool inside = glm::dot(direction, p.axis) > p.cos_total;
-  return {1.0f, inside ? uniform_cone_pdf(p.cos_total) : 0.0f, true, false};
+  return {0.0f, inside ? uniform_cone_pdf(p.cos_total) : 0.0f, true, false};
 }
 
 inline std::optional<EndpointConnection> connect(const SpotLightParams& p, const glm::vec3& ref) {
@@ -262,7 +262,7 @@ inline std::optional<EndpointRay> sample_ray(const DistantLightParams& p, glm::v
   r.direction = p.direction;
   r.normal = n;
   r.value = p.irradiance;
-  r.pdf = {1.0f / area, 1.0f, false, true};
+  r.pdf = {1.0f / area, 0.0f, false, true};
   r.weight = p.irradiance * (std::abs(glm::dot(n, p.direction)) * area);
   if (emitter_detail::is_black(r.weight)) return std::nullopt;  // light parallel to the aperture
   r.pos_letter = DistantLightParams::kPosLetter;
@@ -274,7 +274,7 @@ inline RayPdf pdf_ray(const DistantLightParams& p, const glm::vec3& origin) {
   const float area = aperture_area(p);
   const glm::vec2 ab = emitter_detail::aperture_coords(p, origin);
   const bool inside = area > 0.0f && ab.x >= 0.0f && ab.x < 1.0f && ab.y >= 0.0f && ab.y < 1.0f;
-  return {inside ? 1.0f / area : 0.0f, 1.0f, false, true};
+  return {inside ? 1.0f / area : 0.0f, 0.0f, false, true};
 }
 
 inline std::optional<EndpointConnection> connect(const DistantLightParams& p, const glm::vec3& ref) {
@@ -318,7 +318,7 @@ inline std::optional<EndpointRay> sample_ray(const LaserParams& p) {
   return r;
 }
 
-inline RayPdf pdf_ray(const LaserParams&) { return {1.0f, 1.0f, true, true}; }
+inline RayPdf pdf_ray(const LaserParams&) { return {0.0f, 0.0f, true, true}; }
 
 inline std::optional<EndpointConnection> connect(const LaserParams&, const glm::vec3&) {
   return std::nullopt;
@@ -338,7 +338,7 @@ inline std::optional<EndpointRay> sample_ray(const PinholeParams& p, glm::vec2 r
   if (!(cos_theta > 0.0f)) return std::nullopt;
   const float pdf_dir = emitter_detail::perspective_pdf_dir(cam.image_area(), cos_theta);
   r.value = glm::vec3(pdf_dir / cos_theta);  // We = 1 / (A cos⁴θ)
-  r.pdf = {1.0f, pdf_dir, true, false};
+  r.pdf = {0.0f, pdf_dir, true, false};
   r.weight = glm::vec3(1.0f);  // We cos / p_dir = 1 exactly
   r.pos_letter = PinholeParams::kPosLetter;
   r.dir_letter = PinholeParams::kDirLetter;
@@ -359,10 +359,10 @@ inline glm::vec3 importance(const PinholeParams& p, const glm::vec3& direction, 
 inline RayPdf pdf_ray(const PinholeParams& p, const glm::vec3& direction) {
   // importance()'s test of the image, without its value (MIS asks for this density often).
   const float cos_theta = glm::dot(direction, p.forward);
-  if (!(cos_theta > 0.0f)) return {1.0f, 0.0f, true, false};
+  if (!(cos_theta > 0.0f)) return {0.0f, 0.0f, true, false};
   const emitter_detail::Perspective cam = emitter_detail::perspective(p);
-  if (!emitter_detail::in_unit_square(cam.raster(direction, cos_theta))) return {1.0f, 0.0f, true, false};
-  return {1.0f, emitter_detail::perspective_pdf_dir(cam.image_area(), cos_theta), true, false};
+  if (!emitter_detail::in_unit_square(cam.raster(direction, cos_theta))) return {0.0f, 0.0f, true, false};
+  return {0.0f, emitter_detail::perspective_pdf_dir(cam.image_area(), cos_theta), true, false};
 }
 
 inline std::optional<EndpointConnection> connect(const PinholeParams& p, const glm::vec3& ref) {
@@ -495,8 +495,8 @@ inline std::optional<EndpointRay> sample_ray(const OrthographicParams& p, glm::v
   r.direction = p.forward;
   r.normal = p.forward;
   r.value = glm::vec3(1.0f / area);
-  r.pdf = {1.0f / area, 1.0f, false, true};
-  r.weight = glm::vec3(1.0f);  // We · 1 / (1/A · 1) = 1 exactly
+  r.pdf = {1.0f / area, 0.0f, false, true};
+  r.weight = glm::vec3(1.0f);  // We / (1/A): 1 exactly (the Dirac direction has no density)
   r.pos_letter = OrthographicParams::kPosLetter;
   r.dir_letter = OrthographicParams::kDirLetter;
   r.raster = raster;
@@ -509,7 +509,7 @@ inline RayPdf pdf_ray(const OrthographicParams& p, const glm::vec3& origin) {
   const glm::vec2 r =
       emitter_detail::film_to_raster({glm::dot(d, p.right) / p.half_width, glm::dot(d, p.up) / p.half_height});
   const bool inside = area > 0.0f && emitter_detail::in_unit_square(r);
-  return {inside ? 1.0f / area : 0.0f, 1.0f, false, true};
+  return {inside ? 1.0f / area : 0.0f, 0.0f, false, true};
 }
 
 inline std::optional<EndpointConnection> connect(const OrthographicParams& p, const glm::vec3& ref) {
@@ -547,7 +547,7 @@ inline std::optional<EndpointRay> sample_ray(const SpotMeterParams& p) {
   return r;
 }
 
-inline RayPdf pdf_ray(const SpotMeterParams&) { return {1.0f, 1.0f, true, true}; }
+inline RayPdf pdf_ray(const SpotMeterParams&) { return {0.0f, 0.0f, true, true}; }
 
 inline std::optional<EndpointConnection> connect(const SpotMeterParams&, const glm::vec3&) {
   return std::nullopt;

@@ -133,10 +133,10 @@ class Integrator {
     std::vector<ManifoldSolution> manifold_found{};  // and the distinct chains its first batch found
     std::vector<ChainVertex> mis_chain{};            // a path's chain whose MIS densities are computed (chain_densities())
     // The MIS weight's working space (mis_weight()): the strategies that sample the path being
-    // weighed, and its vertices' densities.
+    // weighed, and the densities of its vertices that the weight reads.
     std::array<mis::Technique, 2 * mis::kMaxPath + 2> techniques{};
     std::array<mis::Densities, mis::kMaxPath> densities{};
-    // Each subpath vertex's densities as its walk stored them (set by set_masks(), once per sample).
+    // Each subpath vertex's densities as its walk stored them (store_densities(), once per sample).
     std::array<mis::Densities, kMaxVertices> light_densities{}, eye_densities{};
     // The subpaths' letters packed (set by set_masks()): light_mask has c0 c1 of y0, then
     // bit i + 1 for y_i's letter; eye_masks[t] has the eye subpath's last t + 1 letters (z(t-1)
@@ -162,20 +162,11 @@ class Integrator {
 
   // The path of join `jr` over th's subpaths.
   static PathView path_of(const Thread& th, const JoinResult& jr);
-  // A vertex's density as the MIS weight reads it, a Dirac's (stored as 0) counting as 1.
-  static double remap(float f) { return remap_density(f); }
-  // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key().
-  // And each vertex's two densities for the MIS weight.
+  // The subpaths' letters packed (th.light_mask, th.eye_masks), for path_key(), and each vertex's
+  // two densities for the MIS weight (store_densities()): once per sample, at its first join.
   void set_masks(Thread& th, int ns, int nt) const {
     th.joins_ready = true;
-    for (int i = 0; i < ns; ++i) {
-      const Vertex& y = th.light[static_cast<std::size_t>(i)];
-      th.light_densities[static_cast<std::size_t>(i)] = {remap(y.pdf_fwd), remap(y.pdf_rev)};
-    }
-    for (int j = 0; j < nt; ++j) {
-      const Vertex& z = th.eye[static_cast<std::size_t>(j)];
-      th.eye_densities[static_cast<std::size_t>(j)] = {remap(z.pdf_rev), remap(z.pdf_fwd)};
-    }
+    store_densities(th, ns, nt);
     th.light_mask = 0;
     if (ns > 0) th.light_mask = letter_bit(th.light[0].pos_letter, 0) | letter_bit(th.light[0].letter, 1);
     for (int i = 1; i < ns; ++i) th.light_mask |= letter_bit(th.light[static_cast<std::size_t>(i)].letter, i + 1);
@@ -225,15 +216,11 @@ class Integrator {
   const std::string& sensor_pair() const { return sensor_pair_; }  // c(k+1) c(k+2)
 
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
-  // Densities as the MIS ratios keep them: a Dirac part's is stored as 0 (RayPdf::mis_dir).
-  // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w.
-  float sensor_pdf_dir(const Vertex& v, const vec3& w) const {
-    return pdf_ray(cam_.params, v.p, w).mis_dir();
-  }
-  // Solid-angle density of the light's ray leaving `v` (a point of the light) towards w.
-  float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
-    return l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w).mis_dir();
-  }
+  // Densities as the walks and the MIS ratios keep them: a Dirac part's is 0 (trace/emitters.h).
+  // Solid-angle density of the sensor's ray leaving `v` (a point of the sensor) towards w, and of
+  // light l's leaving `v` (a point of the light) (mis_weight.cpp).
+  float sensor_pdf_dir(const Vertex& v, const vec3& w) const;
+  float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const;
   // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
   // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
   // emission_step_density() after it: their product is its emission's joint density.
@@ -241,56 +228,22 @@ class Integrator {
     return rs_.lights[static_cast<std::size_t>(light)].environment();
   }
   // v is a point of an image infinite light (a light vertex, or an eye vertex that hit its box).
-  bool on_environment(const Vertex& v) const {
-    const int li = v.kind == Kind::kLight ? v.light : v.kind == Kind::kSurface ? rs_.light_of_shape[static_cast<std::size_t>(v.shape)] : -1;
-    return li >= 0 && environment_of(li) != nullptr;
-  }
+  bool on_environment(const Vertex& v) const;
   float env_origin_density(const EnvironmentLightParams& e, const vec3& x0, const vec3& n0, const vec3& x1) const {
     return light_pick_ * connect_area_density(e, x0, n0, x1);
   }
-  // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
-  void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
-    const float w = static_cast<float>(cam_.width), h = static_cast<float>(cam_.height);
-    *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
-    *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
-  }
 
   // The material at surface vertex `v` (RenderScene::material_at).
-  const Material& material_at(const Vertex& v, Material* scratch) const { return rs_.material_at(v.shape, v.uv, scratch); }
+  const Material& material_at(const Vertex& v, MaterialScratch* scratch) const { return rs_.material_at(v.shape, v.uv, scratch); }
 
-  // --- densities used by MIS ---
+  // --- densities used by MIS (mis_weight.cpp) ---
   // Solid-angle density at `v` of sampling the unit direction `wn`, given the unit direction
   // `wp` to v's other neighbour (null when it has none: a surface then has no density).
-  float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
-    switch (v.kind) {
-      case Kind::kCamera: return sensor_pdf_dir(v, wn);
-      case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
-      case Kind::kSurface: {
-        if (!wp) return 0.0f;
-        Material textured;
-        return bsdf::pdf(material_at(v, &textured), *wp, wn, v.ns, v.n);
-      }
-      case Kind::kLens: return 0.0f;
-    }
-    return 0.0f;
-  }
+  float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const;
   // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
-  float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const {
-    const vec3 d = next.p - v.p;
-    const float d2 = glm::dot(d, d);
-    if (d2 == 0.0f) return 0.0f;
-    const vec3 wn = d / std::sqrt(d2);
-    if (v.kind == Kind::kLight)
-      if (const EnvironmentLightParams* e = environment_of(v.light)) return emission_step_density(*e, abs_cos(next, wn));
-    const vec3 wp = prev ? glm::normalize(prev->p - v.p) : vec3(0.0f);
-    return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
-  }
+  float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const;
   // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
-  float pdf_light_origin(const Vertex& v) const {
-    const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
-    if (const EnvironmentLightParams* e = environment_of(li)) return env_origin_density(*e, v.p, v.n, v.p + v.wo * std::sqrt(v.d2_wo));
-    return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
-  }
+  float pdf_light_origin(const Vertex& v) const;
 
   // --- subpaths ---
   // A template on the direction: the walk's tests of its direction are not branches. What the
@@ -384,14 +337,16 @@ class Integrator {
   // a reflection or refraction on smooth glass or a reflection on a mirror.
   bool manifold_at(const PathView& x, PathKey key, int s, int m) const;
   // --- the MIS weight (trace/mis_weight.cpp; the routine itself is trace/mis.h) ---
+  // Each subpath vertex's two densities as the weight reads them (th.light_densities, eye_densities).
+  void store_densities(Thread& th, int ns, int nt) const;
   // The power-heuristic weight of path x (letters `key`) as strategy `self` sampled it (at split
   // x.s, its x.m constructed vertices after it), against every strategy of the profile that samples
   // the same path. `join`: the densities the join computed at its two ends (null: recomputed).
   float mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const;
   // The strategies that sample path x, `self` the own one (connectors listed in th.techniques).
   mis::Strategies techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const;
-  // th.densities[lo … hi) of a plain or projection join's path: the subpaths' stored densities with
-  // the four the join changes recomputed.
+  // th.densities[lo … hi) of a plain or projection join's path: the subpaths' stored densities
+  // copied, the four the join changes recomputed in the copy.
   void join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const;
   // th.densities[lo … hi) of a path with constructed vertices: every one computed from the vertices.
   void path_densities(Thread& th, const PathView& x, PathKey key, int lo, int hi) const;

@@ -68,19 +68,10 @@ struct Strategies {
   }
 };
 
-// A path's vertices' densities as pbrt-v4 keeps them, in two arrays: x_v is light[v] for v < s
-// (the light subpath's vertices) and eye[n - 1 - v] for the others (the eye subpath's, from z0).
-struct PathDensities {
-  const Densities* light = nullptr;
-  const Densities* eye = nullptr;
-  int s = 0, n = 0;
-  const Densities& operator[](int v) const { return v < s ? light[v] : eye[n - 1 - v]; }
-};
-
 // The power-heuristic weight of st.own among the strategies `st`, from the densities x[v] of the
-// path's vertices in [lo, hi) (read_range()). 0 when the sum is not finite (a density overflowed:
-// no weight rather than NaN).
-inline float weight(const PathDensities& x, const Strategies& st, int lo, int hi) {
+// path's vertices x0 … xk, of which only [lo, hi) are read (read_range()). 0 when the sum is not
+// finite (a density overflowed: no weight rather than NaN).
+inline float weight(const Densities* x, const Strategies& st, int lo, int hi) {
   if (st.alone()) return 1.0f;
   // rel(i) = P_i / P_b for the own split b, outwards from b one vertex's ratio at a time; the
   // plain joins' terms are summed on the way, and rel kept for the connectors when there are any.

@@ -8,8 +8,9 @@
 //
 // The densities come from where they are: a plain join's path is made of the two subpaths, which
 // keep each vertex's densities as their walks sampled them (Vertex::pdf_fwd, pdf_rev); the join
-// changes only the reverse densities of the two vertices nearest each end, and those four are
-// computed here (from the BSDF densities the join's evaluation gave, when it gave them). A
+// changes only the reverse densities of the two vertices nearest each end. The weight reads a copy
+// of the vertices between the two strategies farthest apart, those four computed into it (from the
+// BSDF densities the join's evaluation gave, when it gave them): no subpath density is written. A
 // connector that constructs vertices (the mirror's, the manifold's chain) makes a path no walk
 // sampled: every density is computed from the vertices. Across a run of S vertices that the
 // manifold connector could build, every strategy's densities are the chain's (chain_densities(),
@@ -23,6 +24,59 @@
 #include "trace/mis.h"
 
 namespace pathex::tracer {
+
+void Integrator::store_densities(Thread& th, int ns, int nt) const {
+  for (int i = 0; i < ns; ++i) {
+    const Vertex& y = th.light[static_cast<std::size_t>(i)];
+    th.light_densities[static_cast<std::size_t>(i)] = {remap_density(y.pdf_fwd), remap_density(y.pdf_rev)};
+  }
+  for (int j = 0; j < nt; ++j) {
+    const Vertex& z = th.eye[static_cast<std::size_t>(j)];
+    th.eye_densities[static_cast<std::size_t>(j)] = {remap_density(z.pdf_rev), remap_density(z.pdf_fwd)};
+  }
+}
+
+float Integrator::sensor_pdf_dir(const Vertex& v, const vec3& w) const { return pdf_ray(cam_.params, v.p, w).dir; }
+
+float Integrator::light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const {
+  return l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w).dir;
+}
+
+bool Integrator::on_environment(const Vertex& v) const {
+  const int li = v.kind == Kind::kLight ? v.light : v.kind == Kind::kSurface ? rs_.light_of_shape[static_cast<std::size_t>(v.shape)] : -1;
+  return li >= 0 && environment_of(li) != nullptr;
+}
+
+float Integrator::pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
+  switch (v.kind) {
+    case Kind::kCamera: return sensor_pdf_dir(v, wn);
+    case Kind::kLight: return light_pdf_dir(rs_.lights[static_cast<std::size_t>(v.light)], v, wn);
+    case Kind::kSurface: {
+      if (!wp) return 0.0f;
+      MaterialScratch textured;
+      return bsdf::pdf(material_at(v, &textured), *wp, wn, v.ns, v.n);
+    }
+    case Kind::kLens: return 0.0f;
+  }
+  return 0.0f;
+}
+
+float Integrator::pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const {
+  const vec3 d = next.p - v.p;
+  const float d2 = glm::dot(d, d);
+  if (d2 == 0.0f) return 0.0f;
+  const vec3 wn = d / std::sqrt(d2);
+  if (v.kind == Kind::kLight)
+    if (const EnvironmentLightParams* e = environment_of(v.light)) return emission_step_density(*e, abs_cos(next, wn));
+  const vec3 wp = prev ? glm::normalize(prev->p - v.p) : vec3(0.0f);
+  return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
+}
+
+float Integrator::pdf_light_origin(const Vertex& v) const {
+  const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
+  if (const EnvironmentLightParams* e = environment_of(li)) return env_origin_density(*e, v.p, v.n, v.p + v.wo * std::sqrt(v.d2_wo));
+  return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
+}
 
 mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
   const int n = x.size(), k = n - 1, s = x.s;
@@ -75,31 +129,31 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
 
 void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const {
   const int s = x.s, t = x.t, n = x.size();
-  // The subpaths' own densities, as set_masks() stored them once per sample, are overwritten in
-  // place where the join changes them (mis_weight() restores them). A fresh endpoint's: its
-  // forward density, the reverse one set below.
-  const auto at = [&](int v) -> mis::Densities& {
-    return v < s ? th.light_densities[static_cast<std::size_t>(v)] : th.eye_densities[static_cast<std::size_t>(n - 1 - v)];
-  };
-  if (x.light0) at(0) = {remap(x.light0->pdf_fwd), 1.0};
-  if (x.eye0) at(n - 1) = {1.0, remap(x.eye0->pdf_fwd)};
+  // The window x[lo … hi) the weight reads, copied from the subpaths' densities as
+  // store_densities() kept them once per sample (they are never changed: each join's path is its
+  // own), then the ones the join changes recomputed in the copy. A fresh endpoint's: its forward
+  // density, the reverse one set below.
+  mis::Densities* d = th.densities.data();
+  for (int v = lo; v < std::min(hi, s); ++v) d[v] = th.light_densities[static_cast<std::size_t>(v)];
+  for (int v = std::max(lo, s); v < hi; ++v) d[v] = th.eye_densities[static_cast<std::size_t>(n - 1 - v)];
+  if (x.light0) d[0] = {remap_density(x.light0->pdf_fwd), 1.0};
+  if (x.eye0) d[n - 1] = {1.0, remap_density(x.eye0->pdf_fwd)};
   const auto needed = [&](int v) { return v >= lo && v < hi; };
-  const auto set_light = [&](int v, float f) { at(v).light = remap(f); };  // an eye-side vertex's light density
-  const auto set_eye = [&](int v, float f) { at(v).eye = remap(f); };      // a light-side vertex's eye density
+  const auto set_light = [&](int v, float f) { d[v].light = remap_density(f); };  // an eye-side vertex's light density
+  const auto set_eye = [&](int v, float f) { d[v].eye = remap_density(f); };      // a light-side vertex's eye density
   // --- the four reverse densities the join changes: qs = x(s-1), its predecessor qsm, pt = x_s, ptm ---
   // Every direction is at hand: the join's (w, from qs to pt, at squared distance d2) and each
   // vertex's unit direction to its predecessor (wo, at d2_wo); no normalisation is needed.
   const auto area = [](float pdf_w, const Vertex& next, const vec3& w, float dist2) {
     return dist2 > 0.0f ? pdf_w * abs_cos(next, w) / dist2 : 0.0f;
   };
-  const Vertex* qs = s > 0 ? &x[s - 1] : nullptr;
-  const Vertex* pt = t > 0 ? &x[s] : nullptr;
-  const Vertex* qsm = s > 1 ? &x[s - 2] : nullptr;
-  const Vertex* ptm = t > 1 ? &x[s + 1] : nullptr;
-  if (qs && pt) {
+  const bool has_qsm = s > 1, has_ptm = t > 1;
+  if (s > 0 && t > 0) {
+    const Vertex& qs = x[s - 1];
+    const Vertex& pt = x[s];
     JoinDensity own;
     if (join == nullptr) {
-      const vec3 e = pt->p - qs->p;
+      const vec3 e = pt.p - qs.p;
       own.d2 = glm::dot(e, e);
       own.w = own.d2 > 0.0f ? e * (1.0f / std::sqrt(own.d2)) : vec3(0.0f);  // as the join forms it
       join = &own;
@@ -108,26 +162,33 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
     const float d2 = join->d2;
     const bsdf::JoinPdfs& at_qs = join->at_qs;
     const bsdf::JoinPdfs& at_pt = join->at_pt;
-    // A projected endpoint sends a parallel beam: the density at the other end is per area.
-    const EnvironmentLightParams* env = qs->kind == Kind::kLight ? environment_of(qs->light) : nullptr;
-    if (self == ConnectorKind::kDistantProjection) set_light(s, parallel_jacobian(*pt, *qs, w));
-    else if (env && needed(s)) set_light(s, emission_step_density(*env, abs_cos(*pt, w)));
-    else if (needed(s)) set_light(s, area(at_qs.known ? at_qs.to_wi : pdf_dir(*qs, qsm ? &qs->wo : nullptr, w), *pt, w, d2));
-    if (self == ConnectorKind::kOrthoProjection) set_eye(s - 1, parallel_jacobian(*qs, *pt, w));
-    else if (needed(s - 1)) set_eye(s - 1, area(at_pt.known ? at_pt.to_wi : pdf_dir(*pt, ptm ? &pt->wo : nullptr, back), *qs, w, d2));
-    if (ptm && needed(s + 1)) set_light(s + 1, area(at_pt.known ? at_pt.to_wo : pdf_dir(*pt, &back, pt->wo), *ptm, pt->wo, pt->d2_wo));
-    if (qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(*qs, &w, qs->wo), *qsm, qs->wo, qs->d2_wo));
-  } else if (pt) {  // s = 0: pt lies on an area light
-    set_light(0, pdf_light_origin(*pt));
-    if (ptm && needed(1)) {
-      const int li = rs_.light_of_shape[static_cast<std::size_t>(pt->shape)];
-      const RenderLight& l = rs_.lights[static_cast<std::size_t>(li)];
-      if (const EnvironmentLightParams* e = environment_of(li)) set_light(1, emission_step_density(*e, abs_cos(*ptm, pt->wo)));
-      else set_light(1, area(light_pdf_dir(l, *pt, pt->wo), *ptm, pt->wo, pt->d2_wo));
+    // x_s as qs samples it (a projected endpoint sends a parallel beam: its density at the other
+    // end is per area; an image infinite light's step has a density of its own).
+    if (self == ConnectorKind::kDistantProjection) set_light(s, parallel_jacobian(pt, qs, w));
+    else if (needed(s)) {
+      const EnvironmentLightParams* env = qs.kind == Kind::kLight ? environment_of(qs.light) : nullptr;
+      set_light(s, env ? emission_step_density(*env, abs_cos(pt, w))
+                       : area(at_qs.known ? at_qs.to_wi : pdf_dir(qs, has_qsm ? &qs.wo : nullptr, w), pt, w, d2));
     }
-  } else if (qs) {  // t = 0: qs is the lens point
+    // x(s-1) as pt samples it.
+    if (self == ConnectorKind::kOrthoProjection) set_eye(s - 1, parallel_jacobian(qs, pt, w));
+    else if (needed(s - 1)) set_eye(s - 1, area(at_pt.known ? at_pt.to_wi : pdf_dir(pt, has_ptm ? &pt.wo : nullptr, back), qs, w, d2));
+    // x(s+1) as pt samples it, having come from qs; x(s-2) as qs does, having come from pt.
+    if (has_ptm && needed(s + 1)) set_light(s + 1, area(at_pt.known ? at_pt.to_wo : pdf_dir(pt, &back, pt.wo), x[s + 1], pt.wo, pt.d2_wo));
+    if (has_qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(qs, &w, qs.wo), x[s - 2], qs.wo, qs.d2_wo));
+  } else if (t > 0) {  // s = 0: pt lies on an area light
+    const Vertex& pt = x[0];
+    set_light(0, pdf_light_origin(pt));
+    if (has_ptm && needed(1)) {
+      const int li = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];
+      const RenderLight& l = rs_.lights[static_cast<std::size_t>(li)];
+      if (const EnvironmentLightParams* e = environment_of(li)) set_light(1, emission_step_density(*e, abs_cos(x[1], pt.wo)));
+      else set_light(1, area(light_pdf_dir(l, pt, pt.wo), x[1], pt.wo, pt.d2_wo));
+    }
+  } else if (s > 0) {  // t = 0: qs is the lens point
+    const Vertex& qs = x[n - 1];
     set_eye(n - 1, cam_.pdf_pos);
-    if (qsm && needed(n - 2)) set_eye(n - 2, area(sensor_pdf_dir(*qs, qs->wo), *qsm, qs->wo, qs->d2_wo));
+    if (has_qsm && needed(n - 2)) set_eye(n - 2, area(sensor_pdf_dir(qs, qs.wo), x[n - 2], qs.wo, qs.d2_wo));
   }
 }
 
@@ -152,7 +213,7 @@ void Integrator::path_densities(Thread& th, const PathView& x, PathKey key, int 
     if (letter_s(v + 2)) return 0.0f;  // x(v+1) is a Dirac
     return pdf(v + 2 <= k ? &x[v + 2] : nullptr, x[v + 1], x[v]);
   };
-  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = mis::Densities{remap(lf(v)), remap(ef(v))};
+  for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = mis::Densities{remap_density(lf(v)), remap_density(ef(v))};
 }
 
 float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const {
@@ -160,29 +221,13 @@ float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, Connect
   if (st.alone()) return 1.0f;  // no other strategy samples the path: no density is needed
   int lo = 0, hi = 0;
   st.read_range(&lo, &hi);
-  const int n = x.size();
-  if (x.m > 0 || x.whole != nullptr) {
-    path_densities(th, x, key, lo, hi);
-    if (has_manifold_) chain_densities(th, x, key, self, lo, hi);
-    return mis::weight({th.densities.data(), nullptr, n, n}, st, lo, hi);
-  }
-  // A plain join: the subpaths' stored densities with the join's changes made in place and undone
-  // after (pbrt-v4's ScopedAssignment): the two vertices nearest each end.
-  const int s = x.s, t = x.t;
-  std::array<mis::Densities, 2> light_kept{}, eye_kept{};
-  for (int i = 0; i < std::min(s, 2); ++i) light_kept[static_cast<std::size_t>(i)] = th.light_densities[static_cast<std::size_t>(s - 1 - i)];
-  for (int i = 0; i < std::min(t, 2); ++i) eye_kept[static_cast<std::size_t>(i)] = th.eye_densities[static_cast<std::size_t>(t - 1 - i)];
-  join_densities(th, x, self, join, lo, hi);
-  mis::PathDensities d{th.light_densities.data(), th.eye_densities.data(), s, n};
-  if (has_manifold_ && st.count > 0) {  // a chain the manifold could build changes the densities across it
-    for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = d[v];
-    chain_densities(th, x, key, self, lo, hi);
-    d = {th.densities.data(), nullptr, n, n};
-  }
-  const float w = mis::weight(d, st, lo, hi);
-  for (int i = 0; i < std::min(s, 2); ++i) th.light_densities[static_cast<std::size_t>(s - 1 - i)] = light_kept[static_cast<std::size_t>(i)];
-  for (int i = 0; i < std::min(t, 2); ++i) th.eye_densities[static_cast<std::size_t>(t - 1 - i)] = eye_kept[static_cast<std::size_t>(i)];
-  return w;
+  // th.densities[lo … hi): a plain join's from the subpaths' stored ones, a constructed path's
+  // from its vertices; a chain the manifold could build changes them across it.
+  const bool constructed = x.m > 0 || x.whole != nullptr;
+  if (constructed) path_densities(th, x, key, lo, hi);
+  else join_densities(th, x, self, join, lo, hi);
+  if (has_manifold_ && (constructed || st.count > 0)) chain_densities(th, x, key, self, lo, hi);
+  return mis::weight(th.densities.data(), st, lo, hi);
 }
 
 }  // namespace pathex::tracer

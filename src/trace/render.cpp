@@ -117,7 +117,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     ++count;
     if (count >= max_vertices) break;
     // --- scatter ---
-    Material textured;
+    MaterialScratch textured;
     const Material& m = material_at(v, &textured);
     const vec3 wo = -d;
     const bsdf::NumbersRead reads = bsdf::numbers_read(m);  // the others are not computed
@@ -168,7 +168,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   if (!r) return 1;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
   const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
-                                                      r->pdf.mis_dir(), max_eye_);
+                                                      r->pdf.dir, max_eye_);
   // An orthographic sensor's rays are a parallel beam (see light_subpath()).
   if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.eye[1].pdf_fwd = parallel_jacobian(th.eye[1], z0, r->direction);
   return n;
@@ -193,14 +193,15 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
     return 1;
   }
   // y0 keeps the spatial part of the emission, L_e⁽⁰⁾ / p (a join at y0 evaluates the directional
-  // part); the walk continues with the first ray's whole throughput.
+  // part; a Dirac position is chosen with probability 1); the walk continues with the first ray's
+  // whole throughput.
   y0.beta = spatial_emission(l.params) / (light_pick_ * (r->pdf.delta_pos ? 1.0f : r->pdf.pos));
   const vec3 beta1 = r->weight / light_pick_;
   if (is_black(beta1)) return 1;
   const vec3 saved = y0.beta;
   th.light[0].beta = beta1;
   const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, r->direction,
-                                                        r->pdf.mis_dir(), max_light_);
+                                                        r->pdf.dir, max_light_);
   th.light[0].beta = saved;
   // A Dirac direction from a finite-area origin (a distant light's aperture) is a parallel beam:
   // its first vertex has a finite density per area, which the distant-projection connector's

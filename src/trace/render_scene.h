@@ -9,8 +9,11 @@
 // orthographic "SD", spot meter "SS" (directional letter first, c(k+1), then spatial, c(k+2)).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
+#include <new>
 #include <optional>
 #include <vector>
 
@@ -66,6 +69,40 @@ struct RenderSensor {
   // Area density of the ray's origin as the MIS ratios keep it: 1 / lens area, 1 / film area,
   // 0 for a point (pinhole, spot meter).
   float pdf_pos = 0.0f;
+  // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
+  void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
+    const float w = static_cast<float>(width), h = static_cast<float>(height);
+    *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
+    *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
+  }
+};
+
+// Room for a material with its textured parameters evaluated (RenderScene::material_at): a
+// Material is made in it only at a textured shape, so that a scene without textures makes none.
+// (Not std::optional<Material>, whose construction zero-fills the storage: 120 bytes at every
+// surface vertex.)
+class MaterialScratch {
+ public:
+  MaterialScratch() {}  // NOLINT: the storage stays unmade
+  MaterialScratch(const MaterialScratch&) = delete;
+  MaterialScratch& operator=(const MaterialScratch&) = delete;
+  ~MaterialScratch() {
+    if (made_) material_.~Material();
+  }
+  // The material in it, default-made the first time.
+  Material& get() {
+    if (!made_) {
+      new (&material_) Material();
+      made_ = true;
+    }
+    return material_;
+  }
+
+ private:
+  union {
+    Material material_;
+  };
+  bool made_ = false;
 };
 
 struct RenderScene {
@@ -109,14 +146,15 @@ struct RenderScene {
     *error = ss.error;
     return {ss.position, ss.normal, l.pdf_pos};
   }
-  // The material of `shape` at `uv`: its own, with its textured parameters evaluated into
-  // `*scratch` when it has any (trace/texture_eval.h).
-  const Material& material_at(int shape, glm::vec2 uv, Material* scratch) const {
+  // The material of `shape` at `uv`: its own, or, when it has textured parameters, the material
+  // with them evaluated, made in `*scratch` (trace/texture_eval.h).
+  const Material& material_at(int shape, glm::vec2 uv, MaterialScratch* scratch) const {
     const Material& base = *material_of_shape[static_cast<std::size_t>(shape)];
     const MaterialTextures* tex = textures_of_shape[static_cast<std::size_t>(shape)];
     if (!tex) return base;
-    textured_material(*scene, base, *tex, uv, scratch);
-    return *scratch;
+    Material& made = scratch->get();
+    textured_material(*scene, base, *tex, uv, &made);
+    return made;
   }
   // A hit's shading normal as every strategy sees it (pt, pt-nee, lt, bdpt's joins and the MIS
   // densities all read the vertex's ns): the geometry's (Hit::shading_normal) turned by its

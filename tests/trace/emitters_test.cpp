@@ -53,8 +53,10 @@ std::string letters(Letter first, Letter second) {
   return {letter_char(first), letter_char(second)};
 }
 
-// Every sampled ray: letters are the struct's, delta flags say S exactly where the letter is S,
-// the weight is value · |cos| / (pdf.pos · pdf.dir), and pdf_ray() would give the same densities.
+// Every sampled ray: letters are the struct's, delta flags say S exactly where the letter is S, a
+// Dirac part's density is 0 (the tracer's one delta convention, trace/emitters.h), the weight is
+// value · |cos| / (pdf.pos · pdf.dir) with a Dirac part's factor 1, and pdf_ray() would give the
+// same densities.
 template <class P>
 void expect_consistent(const EndpointRay& r, const RayPdf& again) {
   EXPECT_EQ(r.pos_letter, P::kPosLetter);
@@ -62,14 +64,19 @@ void expect_consistent(const EndpointRay& r, const RayPdf& again) {
   EXPECT_EQ(r.pdf.delta_pos, P::kPosLetter == kS);
   EXPECT_EQ(r.pdf.delta_dir, P::kDirLetter == kS);
   if (r.pdf.delta_pos) {
-    EXPECT_EQ(r.pdf.pos, 1.0f);
+    EXPECT_EQ(r.pdf.pos, 0.0f);
+  } else {
+    EXPECT_GT(r.pdf.pos, 0.0f);
   }
   if (r.pdf.delta_dir) {
-    EXPECT_EQ(r.pdf.dir, 1.0f);
+    EXPECT_EQ(r.pdf.dir, 0.0f);
+  } else {
+    EXPECT_GT(r.pdf.dir, 0.0f);
   }
   const bool has_surface = glm::dot(r.normal, r.normal) > 0.0f;
   const float cos_theta = has_surface ? std::abs(glm::dot(r.normal, r.direction)) : 1.0f;
-  const glm::vec3 w = r.value * (cos_theta / (r.pdf.pos * r.pdf.dir));
+  const float pos = r.pdf.delta_pos ? 1.0f : r.pdf.pos, dir = r.pdf.delta_dir ? 1.0f : r.pdf.dir;
+  const glm::vec3 w = r.value * (cos_theta / (pos * dir));
   EXPECT_NEAR(r.weight.x, w.x, 1e-4f * std::abs(w.x));
   EXPECT_NEAR(glm::length(r.direction), 1.0f, 1e-5f);
   EXPECT_NEAR(again.pos, r.pdf.pos, 1e-5f * r.pdf.pos);

@@ -102,7 +102,7 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
   const auto read = [&](int v) { return v >= lo && v < hi; };
   // The probability that a walk leaving towards `wo`'s opposite picks the Dirac lobe the chain took there.
   const auto picks = [&](const Vertex& c, const vec3& wo, bool reflect) {
-    Material textured;
+    MaterialScratch textured;
     const Material& mat = material_at(c, &textured);
     const Lobe lobe = reflect ? Lobe::kSpecularReflection : Lobe::kSpecularTransmission;
     const auto* mix = std::get_if<Mixture>(&mat);
@@ -382,7 +382,7 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     const float cos_prev = static_cast<float>(glm::dot(glm::normalize(prev - c.p), geometry.ns));
     // A textured material's values at the solved point (its uv as a hit there has it), as every
     // other strategy sees them through material_at().
-    Material textured;
+    MaterialScratch textured;
     const bool has_textures = rs_.textures_of_shape[static_cast<std::size_t>(c.id)] != nullptr;
     if (has_textures) v.uv = rs_.geometry->uv_at(c.id, c.primitive, v.p);
     const Material& mat = material_at(v, &textured);

@@ -44,7 +44,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
         continue;
       }
       const Vertex& z0 = fresh_sensor_vertex(th, *c, 'D');
-      to_pixels(c->raster, &rx, &ry);
+      cam_.to_pixels(c->raster, &rx, &ry);
       b = &z0;
     }
     MirrorMiss miss = MirrorMiss::kNone;

@@ -20,7 +20,7 @@ bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f;
 vec3 Integrator::end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs) const {
   // A light vertex's beta already holds its spatial emission; only the directional part is left.
   if (v.kind == Kind::kLight) return vec3(directional_emission(rs_.lights[static_cast<std::size_t>(v.light)].params, v.n, w));
-  Material textured;
+  MaterialScratch textured;
   const Material& m = material_at(v, &textured);
   const vec3 f = pdfs ? bsdf::eval(m, v.wo, w, v.ns, v.n, pdfs, mode) : bsdf::eval(m, v.wo, w, v.ns, v.n, mode);
   // The light end carries importance: shading normals make its transport asymmetric (Veach §5.3).
@@ -109,7 +109,7 @@ bool Integrator::join_lens(Thread& th, int s) const {
   if (is_black(we)) return false;
   begin_join(th, ConnectorKind::kNone, s, 0, strategy(s, 0));
   JoinResult& jr = th.join;
-  to_pixels(raster, &jr.rx, &jr.ry);
+  cam_.to_pixels(raster, &jr.rx, &jr.ry);
   jr.splat = true;
   return end_join(th, qs.beta * we, 0, nullptr, nullptr);
 }
@@ -121,45 +121,37 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   if (q->kind == Kind::kLens || !q->finite) return false;
   const bool ortho = kind == ConnectorKind::kOrthoProjection;
   join_numbers(rng, ortho ? JoinBlock::kOrtho : JoinBlock::kSplat, s);
-  std::optional<EndpointConnection> c;
   const EnvironmentLightParams* env = q->kind == Kind::kLight ? environment_of(q->light) : nullptr;
+  // A Dirac direction (orthographic, spot meter) has no DD join; the connector's c(k+1) c(k+2) are
+  // a Dirac direction from a film. (No projection of an image light: mis_weight.cpp.)
+  if (ortho ? env != nullptr || sensor_pair_ != "SD" : sensor_pair_[0] != 'D') return false;
+  begin_join(th, kind, s, 1, ortho ? ortho_of(s) : strategy(s, 1));
+  if (ortho) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
+  const glm::vec2 ul = ortho ? glm::vec2(0.0f) : rng.get2d_if(reads_lens_numbers(cam_.params));
   if (env) {
     // An image infinite light seen directly: its point is drawn towards the sensor point, as
     // next-event estimation draws it (the light density its x0 has), not the light subpath's y0.
-    if (ortho || sensor_pair_[0] != 'D') return false;  // (mis_weight.cpp: no projection of an image light)
-    const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(cam_.params));
     const vec3 z = sensor_point(cam_.params, ul);
     const std::optional<EndpointConnection> e = pathex::connect(*env, rng.get2d(), z);
     if (!e) return false;
-    c = connect_finite(cam_.params, ul, e->position);
-    if (!c) return false;
-    begin_join(th, kind, s, 1, strategy(s, 1));
     Vertex& y0 = fresh_light_vertex(th, static_cast<std::size_t>(q->light), e->position, e->normal, box_point_error(e->position), 'D');
     y0.pdf_fwd = env_origin_density(*env, y0.p, y0.n, z);
     // L / (pick p |cos θ_x| / d²): the join's |cos θ_x| and We cos / d² complete L We cos / (pick p).
     y0.beta = y0.pdf_fwd > 0.0f ? e->value / y0.pdf_fwd : vec3(0.0f);
     q = &y0;
-  } else if (!ortho) {
-    if (sensor_pair_[0] != 'D') return false;  // a Dirac direction (orthographic, spot meter): no DD join
-    c = connect_finite(cam_.params, rng.get2d_if(reads_lens_numbers(cam_.params)), q->p);
-    if (!c) return false;
-    begin_join(th, kind, s, 1, strategy(s, 1));
-  } else {
-    if (sensor_pair_ != "SD") return false;  // the connector's c(k+1) c(k+2): a Dirac direction from a film
-    begin_join(th, kind, s, 1, ortho_of(s));
-    ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
-    ++stats.attempts;
-    c = connect_projection(cam_.params, q->p);
-    if (!c) {
-      ++stats.outside;
-      return false;
-    }
+  }
+  // The sensor point: a fresh one, or the film point on the line of sight (made in place: an
+  // optional assigned later would be zero-filled first).
+  const std::optional<EndpointConnection> c = ortho ? connect_projection(cam_.params, q->p) : connect_finite(cam_.params, ul, q->p);
+  if (!c) {
+    if (ortho) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].outside;
+    return false;
   }
   JoinResult& jr = th.join;
   const Vertex& qs = *q;
   const Vertex& z0 = fresh_sensor_vertex(th, *c, ortho ? sensor_pair_[0] : 'D');
   const vec3 w = c->wi;  // from qs to the sensor
-  to_pixels(c->raster, &jr.rx, &jr.ry);
+  cam_.to_pixels(c->raster, &jr.rx, &jr.ry);
   jr.splat = true;
   const vec3 fq = end_f(qs, w, TransportMode::kImportance, &jr.density.at_qs);
   jr.density.w = w;
@@ -178,31 +170,25 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   join_numbers(rng, distant ? JoinBlock::kDistant : JoinBlock::kNee, t);
   const std::size_t li = rs_.pick_light(rng);
   const RenderLight& l = rs_.lights[li];
-  std::optional<EndpointConnection> c;
-  vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
   const EnvironmentLightParams* env = environment_of(static_cast<int>(li));
-  if (env && !distant) {  // an image infinite light: a direction drawn from its image
-    c = pathex::connect(*env, rng.get2d(), pt.p);
-    if (!c) return false;
-    err = box_point_error(c->position);
-    begin_join(th, kind, 1, t, strategy(1, t));
-  } else if (!distant) {
-    if (light_pairs_[li][1] != 'D') return false;  // Dirac directions (distant, laser): no DD join
-    c = pathex::connect(l.params, rs_.sample_point(l, rng, &err), pt.p);
-    if (!c) return false;
-    begin_join(th, kind, 1, t, strategy(1, t));
-  } else {
-    if (light_pairs_[li] != "DS") return false;  // the connector's c0 c1: a Dirac direction from an aperture
-    begin_join(th, kind, 1, t, distant_of(t));
-    ConnectorStats& stats = th.connectors[static_cast<std::size_t>(th.join.strategy)];
-    ++stats.attempts;
-    c = connect_projection(l.params, pt.p);
-    if (!c) {
-      ++stats.outside;
-      return false;
-    }
-    err = l.origin_error;
+  // Dirac directions (distant, laser) have no DD join; the connector's c0 c1 are a Dirac direction
+  // from an aperture.
+  if (distant ? light_pairs_[li] != "DS" : !env && light_pairs_[li][1] != 'D') return false;
+  begin_join(th, kind, 1, t, distant ? distant_of(t) : strategy(1, t));
+  if (distant) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
+  vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
+  // The light point: the aperture point on the line (distant), a direction drawn from an image
+  // infinite light's image, or a point of the light. (Made in place: an optional assigned later
+  // would be zero-filled first.)
+  const std::optional<EndpointConnection> c = distant ? connect_projection(l.params, pt.p)
+                                              : env   ? pathex::connect(*env, rng.get2d(), pt.p)
+                                                      : pathex::connect(l.params, rs_.sample_point(l, rng, &err), pt.p);
+  if (!c) {
+    if (distant) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].outside;
+    return false;
   }
+  if (distant) err = l.origin_error;
+  else if (env) err = box_point_error(c->position);
   JoinResult& jr = th.join;
   Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? light_pairs_[li][1] : 'D');
   if (env) y0.pdf_fwd = env_origin_density(*env, y0.p, y0.n, pt.p);
