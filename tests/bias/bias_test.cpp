@@ -306,7 +306,7 @@ TEST(Bias, UnderSampledLightIsFoundWhereTheStderrCannotSeeIt) {
   const UnderSampling& u = *run.report.undersampled;
   EXPECT_EQ(u.spp, 4u);
   EXPECT_EQ(u.seed, test::stat_seed(7) + 1);  // the reference's seed + 1
-  EXPECT_EQ(u.dof, 3);    // 4 passes fill 4 of the 32 batches
+  EXPECT_EQ(u.dof, 16);   // 4 passes fill both replicates of the 16 pixel groups
   // Compared: the image, the five built-in classes, the reference's listed paths pt-nee can sample.
   std::size_t reachable_rows = 0;
   for (const PathEstimate& p : run.histogram.paths) reachable_rows += p.path == "other" ? 0 : 1;
@@ -318,7 +318,7 @@ TEST(Bias, UnderSampledLightIsFoundWhereTheStderrCannotSeeIt) {
     return nullptr;
   };
   // The caustic's main path: where pt-nee found nothing, z is the reference's own estimate over
-  // its stderr, judged with the reference's 31 dof. Now and then (2 seeds in 50) pt-nee does meet
+  // its stderr, judged with the reference's 16 dof. Now and then (2 seeds in 50) pt-nee does meet
   // the path, and that rare, heavy sample gives its estimate a stderr that admits the difference;
   // then the caustic class is flagged instead, or with it. One of the two always is.
   const UnderSampled* path = flagged("LDDSSDDSE");
@@ -328,7 +328,7 @@ TEST(Bias, UnderSampledLightIsFoundWhereTheStderrCannotSeeIt) {
     EXPECT_TRUE(path->path);
     EXPECT_EQ(path->renderer.std_error, 0.0);
     EXPECT_NEAR(path->z, -path->reference.luminance / path->reference.std_error, 1e-6 * std::fabs(path->z));
-    EXPECT_NEAR(path->dof, 31.0, 1e-9);
+    EXPECT_NEAR(path->dof, 16.0, 1e-9);
     EXPECT_GT(path->reference.luminance, 0.05 * run.report.total.luminance);  // a tenth of the image
   }
   if (caustic != nullptr) {

@@ -62,7 +62,7 @@ Rendered render_file(const std::string& file, const std::string& renderer, const
 
 // test::expect_close: |estimate − expected| within `sigmas` standard errors plus `rel` of expected.
 // Each test passes test::family_sigmas(its number of checks): a family-wise false-failure rate of
-// 0.1 % (Šidák over Student's t with 31 dof), and its seed comes from test::stat_seed.
+// 0.1 % (Šidák over Student's t with 16 dof), and its seed comes from test::stat_seed.
 using test::expect_close;
 
 // The mean over a square film of half-width w (tangent units) of f(x, y), with the substitution
