@@ -344,9 +344,12 @@ TEST(Bias, UnderSampledLightIsFoundWhereTheStderrCannotSeeIt) {
 }
 
 TEST(Bias, ACorrectRendererAtItsBudgetIsNotFlagged) {
-  // bdpt samples the caustic from the lamp's side; at 64 spp its estimates agree with the
+  // lt samples the caustic from the lamp's side; at 64 spp its estimates agree with the
   // reference's (a false alarm here has probability 1 % by construction: Šidák over the comparisons).
-  const BiasRun run = undersampling("bdpt", 64);
+  // Not bdpt: at 64 spp its image mean is bimodal here (0.221 ± 0.001 without a caustic firefly,
+  // 0.23–0.25 with one, against 0.25), under-sampled as the check says once the reference's
+  // stderr stops hiding it (issue 39's pixel groups: 3 flags in 60 seeds, bench/README.md).
+  const BiasRun run = undersampling("lt", 64);
   ASSERT_TRUE(run.report.undersampled);
   EXPECT_GT(run.report.undersampled->comparisons, 20);
   EXPECT_TRUE(run.report.undersampled->flagged.empty())
