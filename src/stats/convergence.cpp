@@ -79,9 +79,9 @@ StderrCheck check_stderr(const std::vector<RungError>& rungs, double reference, 
     double z = 0.0;
     if (sigma > 0.0) z = err / sigma;
     else if (err > 0.0) z = std::numeric_limits<double>::infinity();  // a zero stderr, a zero reference, an error
-    // A batch-means z is Student's t with B − 1 degrees of freedom, whose tails are heavier than
-    // the normal's that the χ² quantiles assume: summed as the normal deviate of the same tail, its
-    // false-alarm rate is kStderrCheckAlpha at 16 batches as at 32 (max_abs_z reports z itself).
+    // z is Student's t with the estimate's degrees of freedom (Estimate::dof), whose tails are
+    // heavier than the normal's that the χ² quantiles assume: summed as the normal deviate of the
+    // same tail, its false-alarm rate is kStderrCheckAlpha at 16 dof as at 31 (max_abs_z reports z itself).
     const double zn = r.dof > 0 && std::isfinite(z) ? normal_equivalent(z, r.dof) : z;
     c.chi2 += zn * zn;
     ++c.dof;

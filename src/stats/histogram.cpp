@@ -1,5 +1,6 @@
 // The accumulator (exact integer sums keyed by path string and batch) and the report built from
-// it: batch means per path, per class (sums of the paths in the class) and for the total.
+// it: estimates and their stderrs (VarianceDesign) per path, per class (sums of the paths in the
+// class) and for the total.
 #include "stats/histogram.h"
 
 #include <algorithm>
@@ -411,7 +412,7 @@ class TechniqueTables {
   }
 
   // Each technique's share of the table's whole, its samples and its part of the whole's
-  // batch-means variance (TechniqueEstimate), from luminance sums, in the order of the keys.
+  // variance (TechniqueEstimate, VarianceDesign), from luminance sums, in the order of the keys.
   std::vector<TechniqueEstimate> estimates(std::size_t table, const VarianceDesign& design) const {
     const std::size_t B = static_cast<std::size_t>(h_.num_batches()), E = entry_key_.size();
     std::vector<int> entries = entries_[table];
