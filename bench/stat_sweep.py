@@ -60,6 +60,7 @@ STATISTICAL_TESTS = [
     ("piecewise2d_test", "Piecewise2D.SamplesFollowTheDensityAndReportIt"),
     ("emission_cones_test", "EmissionCones.SampledDensityIsThePdfAndTheEstimatorIsUnbiased"),
     ("convergence_test", "Convergence.BatchVarianceIsStableForNormalMeansAndNotForASpike"),
+    ("histogram_test", "ReplicateGroups.StratifiedReplicatesGetAnHonestStderr"),
 ]
 # tests/meta/stat_registry_test.cpp checks that every test reaching test::stat_seed is listed here.
 

@@ -106,12 +106,12 @@ Witness explained(const std::string& path, const CompiledProfile& why_not) {
   return Witness{path, chain_evidence(path), {}, unreachable_reason(path, why_not)};
 }
 
-int batches_in_use(const Histogram& h) { return static_cast<int>(h.batches_in_use().size()); }
-
 // R's estimates against the reference's, pair by pair (UnderSampled in bias.h). Each difference
-// is a t statistic with the Welch–Satterthwaite degrees of freedom of its two batch-means stderrs
-// (`r_dof`, `ref_dof`): a path R never sampled (0 ± 0) is judged on the reference's stderr alone,
-// with its dof, however few batches R's budget filled.
+// is a t statistic with the Welch–Satterthwaite degrees of freedom of its two stderrs (each
+// estimate's own, Estimate::dof: a rare path's few hits give fewer than the render's `r_dof`,
+// `ref_dof`): a path R never sampled (0 ± 0) is judged on the reference's stderr alone, with its
+// dof, however few passes R's budget took. A reference estimate that is not 0 but has a stderr
+// of 0 (its few hits agreed exactly across the replicates) has an unknown error: no claim.
 UnderSampling compare_estimates(std::vector<UnderSampled> pairs, double rate, double min_difference, int r_dof, int ref_dof) {
   UnderSampling u;
   u.rate = rate;
@@ -120,6 +120,7 @@ UnderSampling compare_estimates(std::vector<UnderSampled> pairs, double rate, do
   std::vector<UnderSampled> compared;
   for (UnderSampled& p : pairs) {
     if (!std::isfinite(p.renderer.std_error) || !std::isfinite(p.reference.std_error)) continue;  // no stderr: no claim
+    if (p.reference.std_error == 0 && p.reference.luminance != 0) continue;                        // nor an unknown one
     compared.push_back(std::move(p));
   }
   u.comparisons = static_cast<int>(compared.size());
@@ -134,8 +135,9 @@ UnderSampling compare_estimates(std::vector<UnderSampled> pairs, double rate, do
     if (sigma == 0 || std::fabs(diff) < min_difference) continue;  // equal, or too little light to matter
     p.z = diff / sigma;
     const double welch = (vr + vref) * (vr + vref);
-    const double denominator = vr * vr / std::max(r_dof, 1) + vref * vref / std::max(ref_dof, 1);
-    p.dof = denominator > 0 ? std::clamp(welch / denominator, 1.0, 1e6) : std::max(ref_dof, 1);
+    const int dr = std::max(std::min(p.renderer.dof, r_dof), 1), dref = std::max(std::min(p.reference.dof, ref_dof), 1);
+    const double denominator = vr * vr / dr + vref * vref / dref;
+    p.dof = denominator > 0 ? std::clamp(welch / denominator, 1.0, 1e6) : dref;
     if (student_two_sided_tail(std::fabs(p.z), static_cast<int>(std::lround(p.dof))) < u.each) u.flagged.push_back(std::move(p));
   }
   std::stable_sort(u.flagged.begin(), u.flagged.end(),
@@ -287,7 +289,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
     std::optional<HistogramReport> r_report;
     std::uint64_t r_spp = 0;
     std::uint64_t r_seed = o.seed;
-    int r_batches = 0;
+    int r_dof = 0;
     if (o.renderer_spp > 0) {
       Result<Classifier> r_classifier = Classifier::build(classes, o.limits);
       if (!r_classifier) return r_classifier.error();
@@ -311,7 +313,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
       Result<HistogramReport> rr = make_report(r_out->histogram, r_info, &*r_classifier, user);
       if (!rr) return rr.error();
       r_report = std::move(*rr);
-      r_batches = batches_in_use(r_out->histogram);
+      r_dof = r_out->histogram.stderr_dof();
       rep.complete = rep.complete && r_out->complete;
     } else {
       RunInfo r_info = info;
@@ -320,7 +322,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
       if (!rr) return rr.error();
       r_report = std::move(*rr);
       r_spp = o.spp;
-      r_batches = batches_in_use(*o.renderer_histogram);
+      r_dof = o.renderer_histogram->stderr_dof();
     }
     std::vector<UnderSampled> pairs;
     pairs.push_back({"total", false, r_report->total, hist->classes[sampled_class].estimate});
@@ -339,7 +341,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
     }
     rep.undersampled = compare_estimates(std::move(pairs), o.undersampled_rate,
                                          o.undersampled_share * hist->classes[sampled_class].estimate.luminance,
-                                         r_batches - 1, batches_in_use(out->histogram) - 1);
+                                         r_dof, out->histogram.stderr_dof());
     rep.undersampled->min_share = o.undersampled_share;
     rep.undersampled->spp = r_spp;
     rep.undersampled->seed = r_seed;

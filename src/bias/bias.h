@@ -142,7 +142,7 @@ struct UnderSampling {
   std::uint64_t spp = 0;         // R's passes
   std::uint64_t seed = 0;        // R's seed
   double rate = 0.01;            // the family-wise false-alarm rate
-  int dof = 0;                   // the smaller of R's and the reference's (batches − 1)
+  int dof = 0;                   // the smaller of R's and the reference's (Histogram::stderr_dof())
   int comparisons = 0;           // the image, each class, each listed path R can sample
   double each = 0;               // the two-sided tail below which one comparison is flagged
   double min_share = 0.01;       // and the smallest difference flagged, as a share of the light R can sample

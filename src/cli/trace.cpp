@@ -203,10 +203,12 @@ Command add_trace(CLI::App& app) {
                      .description("{independent,sobol}"))  // CLI11 would print the enum's bytes
       ->default_str(to_string(RenderOptions{}.sampler));
   sub->add_option("--batches", args->options.job.batches,
-                  "Batches of passes (pass mod B) whose means give the standard error; under sobol each is an independently "
-                  "scrambled sequence. Default: " + std::to_string(default_batches(SamplerKind::kSobol)) + " (sobol), " +
-                      std::to_string(default_batches(SamplerKind::kIndependent)) + " (independent)")
-      ->check(CLI::Range(2, 1024));
+                  "Batches that give the standard error: B / R pixel groups (pixel mod B/R) of R replicates (pass mod R)")
+      ->capture_default_str()->check(CLI::Range(2, 1024));
+  sub->add_option("--replicates", args->options.job.replicates,
+                  "Replicates per pixel, dividing --batches; under sobol each is an independently scrambled sequence of spp/R "
+                  "points, and the standard error comes from their differences (R = B: plain batch means)")
+      ->capture_default_str()->check(CLI::Range(2, 1024));
   sub->add_option("--rr-depth", args->options.job.rr_depth,
                   "Russian roulette from this vertex of a subpath on (the camera or light point is the first)")
       ->capture_default_str()->check(CLI::Range(1, 1000));
@@ -245,7 +247,7 @@ Command add_trace(CLI::App& app) {
   add_scene_limit_options(sub, &args->options.job.limits);
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
-                                  "--resolution", "--max-paths", "--sampler", "--batches", "--rr-depth", "--rr-threshold",
+                                  "--resolution", "--max-paths", "--sampler", "--batches", "--replicates", "--rr-depth", "--rr-threshold",
                                   "--rr-light-threshold"})
               if (sub->count(o) > 0) args->options.job.settings_given.push_back(o);
             for (const std::string& o : manifold_option_names())

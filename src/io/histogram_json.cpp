@@ -258,6 +258,7 @@ json raw_to_json(const Histogram& h) {
   raw["format"] = 2;
   raw["fraction_bits"] = kFractionBits;
   raw["batches"] = h.num_batches();
+  raw["replicates"] = h.layout().replicates();
   raw["strategies"] = h.layout().strategies;
   json batch_samples = json::array();
   for (int b = 0; b < h.num_batches(); ++b) batch_samples.push_back(h.batch_samples(b));
@@ -304,6 +305,11 @@ Result<Histogram> raw_from_json(const json& raw, const std::string& filename, co
   const std::uint64_t batches = rd.failed() ? 0 : rd.uint(raw, ptr, "batches");
   if (!rd.failed() && (batches < 1 || batches > 1000000)) rd.fail(ptr + "/batches", "expected 1 to 1000000 batches");
   layout.num_batches = static_cast<int>(batches);
+  // Absent in files written before issue 39's pixel groups: every batch a replicate (plain batch means).
+  const std::uint64_t replicates = rd.failed() || !raw.contains("replicates") ? batches : rd.uint(raw, ptr, "replicates");
+  if (!rd.failed() && (replicates < 1 || batches % replicates != 0))
+    rd.fail(ptr + "/replicates", "expected a divisor of the batch count " + std::to_string(batches));
+  else if (!rd.failed()) layout.groups = static_cast<int>(batches / replicates);
   if (const json* s = rd.failed() ? nullptr : rd.array(raw, ptr, "strategies")) {
     for (std::size_t i = 0; i < s->size(); ++i) {
       if (!(*s)[i].is_string()) rd.fail(ptr + "/strategies/" + std::to_string(i), "expected a strategy name");

@@ -25,8 +25,8 @@
 //   raw      optional: the exact accumulator state, for merging (below)
 //
 // An estimate is the mean pixel value over the image (RGB, and its Rec. 709 luminance); stderr is
-// the standard error of the luminance by batch means (null when fewer than two batches hold
-// samples); samples counts nonzero contributions; a class's share is its luminance over the
+// the standard error of the luminance from the replicates' differences (stats/histogram.h,
+// "Batches"; null without a degree of freedom: fewer than two replicates hold samples); samples counts nonzero contributions; a class's share is its luminance over the
 // total's. `samples` in `total` is an addition to the keys listed in issue 4.
 //
 // `strategies` (of a path, of "other", of a class) says which sampling technique carries the
@@ -34,7 +34,7 @@
 // technique that contributed — the profile strategy's name and its split: s vertices from the
 // light, the chain (DD for a plain join, DSD for a connector), t vertices from the sensor.
 // share is its luminance over the whole's, samples its nonzero contributions, variance_share its
-// own batch-means variance over the sum of its row's techniques' (≥ 0; the shares of a row sum to
+// own variance over the sum of its row's techniques' (≥ 0; the shares of a row sum to
 // 1, and so do its variance shares; null without a standard error), correlation that of its batch
 // estimates with the rest of the row's (null when unknown) — TechniqueEstimate.
 //
@@ -43,7 +43,7 @@
 // counts, per path and technique its count and per-batch luminance sums, per batch the sample counts — so that the outputs
 // of separate processes can be parsed back and merged exactly (Histogram::merge):
 //
-//   raw {format: 2, fraction_bits: 64, batches: B, strategies: [names], batch_samples: [B ints],
+//   raw {format: 2, fraction_bits: 64, batches: B, replicates: R (absent: B), strategies: [names], batch_samples: [B ints],
 //        nonfinite: n, magnitude: "0x…",
 //        paths: [{path, contributions: [B ints], sums: [B × [r,g,b]],
 //                 techniques: [{strategy, s, t, connector, contributions, sums: [B luminance sums]}]}]}

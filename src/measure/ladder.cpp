@@ -125,7 +125,8 @@ Result<bool> measure_rung(const RenderOutput& out, const Classifier* classifier,
     ClassMeasure c;
     c.estimate = e.luminance;
     c.std_error = e.std_error;
-    c.stability = variance_relative_error(class_batch_means(out.histogram, classifier, static_cast<int>(i) - 1));
+    c.stability = stderr_stability(out.histogram, classifier, static_cast<int>(i) - 1);
+    c.dof = e.dof;
     if (rows[i].pixels) {
       const std::vector<float> lum = luminance_image(layers[i].image);
       double sum = 0.0;
@@ -164,9 +165,7 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
     s.z.push_back(sigma > 0.0 ? (m.estimate - *cr.reference) / sigma : std::numeric_limits<double>::quiet_NaN());
     s.efficiency.push_back(err > 0.0 && r.cpu_s > 0.0 ? 1.0 / (err * err * r.cpu_s) : std::numeric_limits<double>::quiet_NaN());
     times.push_back(r.cpu_s);
-    // B = min(spp, the batch count) batches, so the stderr has B − 1 degrees of freedom.
-    re.push_back({m.estimate, m.std_error, m.stability,
-                  static_cast<int>(std::min<std::uint64_t>(r.spp, static_cast<std::uint64_t>(kDefaultBatches))) - 1});
+    re.push_back({m.estimate, m.std_error, m.stability, m.dof});
     if (r.cpu_s > 0.0) {
       sum_e2t += err * err * r.cpu_s;
       ++n;
@@ -188,7 +187,7 @@ Series analyse(const std::vector<RungResult>& rungs, std::size_t row, const Clas
                  fmt(s.check.lower_chi2, "%.3g") + " over " + std::to_string(s.check.lower_dof) + " rungs (below " +
                  fmt(s.check.lower_limit, "%.3g") + ", the lower limit at p = 0.001): the error bars overstate the error";
   if (s.check.unstable)
-    s.warning += std::string(s.warning.empty() ? "" : "; ") + "the stderr is unstable: its batch variance has a relative error of " +
+    s.warning += std::string(s.warning.empty() ? "" : "; ") + "the stderr is unstable: its variance estimate has a relative error of " +
                  fmt(s.check.stability, "%.2f") + " (limit " + fmt(kUnstableVariance, "%.2f") + "): a few batches carry the estimate";
   return s;
 }

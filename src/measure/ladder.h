@@ -56,6 +56,7 @@ struct ClassMeasure {
   double estimate = 0.0;
   double std_error = 0.0;
   double stability = 0.0;
+  int dof = 0;  // the stderr's degrees of freedom (Estimate::dof)
   std::optional<double> rms_pixel;  // against the per-pixel reference, when there is one
 };
 

@@ -99,6 +99,7 @@ Result<TraceResult> run_trace(const TraceOptions& a, const TraceHooks& hooks) {
   ro.rr_light_threshold = static_cast<float>(id.rr_light_threshold);
   ro.manifold = id.manifold.value_or(ManifoldOptions{});
   ro.batches = id.batches;
+  ro.replicates = id.replicates;
   // Without image outputs the render keeps the histogram alone (the same histogram).
   ro.images = id.images;
   if (ro.images)

@@ -105,6 +105,7 @@ Result<std::unique_ptr<RenderClasses>> bias_classes(const std::string& classes_f
 RenderSums empty_sums(const RenderIdentity& identity, const RenderClasses& classes) {
   HistogramLayout layout;
   layout.num_batches = identity.batches;
+  layout.groups = identity.batches / identity.replicates;
   layout.strategies = identity.strategies;
   std::vector<int> layers;
   if (identity.images)

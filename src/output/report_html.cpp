@@ -347,7 +347,7 @@ std::string trace_command(const RenderIdentity& id, std::uint64_t spp) {
   if (!id.classes_file.empty()) cmd += " --classes " + shell_word(id.classes_file);
   for (const std::string& e : id.only) cmd += " --only " + shell_word(e);
   cmd += " --max-bounces " + std::to_string(id.max_bounces) + " --sampler " + id.sampler + " --batches " +
-         std::to_string(id.batches) + " --resolution " + std::to_string(id.width) + "x" + std::to_string(id.height);
+         std::to_string(id.batches) + " --replicates " + std::to_string(id.replicates) + " --resolution " + std::to_string(id.width) + "x" + std::to_string(id.height);
   const RenderIdentity defaults;
   if (id.rr_depth != defaults.rr_depth) cmd += " --rr-depth " + std::to_string(id.rr_depth);
   if (id.rr_threshold != defaults.rr_threshold) cmd += " --rr-threshold " + nlohmann::json(id.rr_threshold).dump();

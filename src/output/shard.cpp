@@ -328,7 +328,7 @@ json identity_json(const RenderIdentity& id) {
   j["seed"] = id.seed;
   j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"rr_depth", id.rr_depth},
                   {"rr_threshold", id.rr_threshold}, {"rr_light_threshold", id.rr_light_threshold}, {"batches", id.batches},
-                  {"width", id.width},           {"height", id.height},     {"images", id.images},
+                  {"replicates", id.replicates}, {"width", id.width},           {"height", id.height},     {"images", id.images},
                   {"max_paths", id.max_paths}};
   if (const std::optional<ManifoldOptions>& m = id.manifold) {
     j["options"]["manifold"] = {{"max_iterations", m->max_iterations}, {"threshold", m->threshold},
@@ -454,8 +454,8 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   id.seed = rd.uint(j, "", "seed");
   h.spp = rd.uint(j, "", "spp");
   const nlohmann::json& o = j.at("options");
-  if (rd.object(o, "/options", {"max_bounces", "sampler", "rr_depth", "rr_threshold", "rr_light_threshold", "batches", "width",
-                                "height", "images", "max_paths", "manifold"})) {
+  if (rd.object(o, "/options", {"max_bounces", "sampler", "rr_depth", "rr_threshold", "rr_light_threshold", "batches", "replicates",
+                                "width", "height", "images", "max_paths", "manifold"})) {
     id.max_bounces = rd.small(o, "/options", "max_bounces");
     id.sampler = rd.str(o, "/options", "sampler");
     id.rr_depth = rd.small(o, "/options", "rr_depth");
@@ -463,6 +463,8 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
     // Before issue 39 one threshold served both subpaths.
     id.rr_light_threshold = o.contains("rr_light_threshold") ? rd.number(o, "/options", "rr_light_threshold") : id.rr_threshold;
     id.batches = rd.small(o, "/options", "batches");
+    // Before issue 39's pixel groups every batch was a replicate of the whole image.
+    id.replicates = o.contains("replicates") ? rd.small(o, "/options", "replicates") : id.batches;
     id.width = rd.small(o, "/options", "width");
     id.height = rd.small(o, "/options", "height");
     id.images = rd.boolean(o, "/options", "images");
@@ -483,6 +485,8 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
     }
   }
   if (!rd.error && (id.batches < 1 || id.batches > 1000000)) rd.fail("/options/batches", "expected 1 to 1000000 batches");
+  if (!rd.error && (id.replicates < 1 || id.batches % id.replicates != 0))
+    rd.fail("/options/replicates", "expected a divisor of the batch count " + std::to_string(id.batches));
   id.strategies = rd.strings(j, "", "strategies");
   if (const nlohmann::json& c = j.at("connectors"); !c.is_array()) {
     rd.fail("/connectors", "expected an array of {strategy, connector}, found " + JsonReader::kind(c));
@@ -552,6 +556,7 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
   if (a.rr_light_threshold != b.rr_light_threshold)
     return differ("another rr_light_threshold", std::to_string(a.rr_light_threshold), std::to_string(b.rr_light_threshold));
   if (auto d = option("batch count", a.batches, b.batches)) return d;
+  if (auto d = option("replicate count", a.replicates, b.replicates)) return d;
   if (a.width != b.width || a.height != b.height)
     return differ("another resolution", std::to_string(a.width) + "x" + std::to_string(a.height),
                   std::to_string(b.width) + "x" + std::to_string(b.height));
@@ -963,8 +968,8 @@ Result<bool> add_shard_sums(const ShardFile& f, RenderSums* state, std::size_t f
   const RenderIdentity& id = f.header.identity;
   Histogram* h = &state->histogram;
   ClassImages* images = &state->images;
-  if (h->num_batches() != id.batches || h->layout().strategies != id.strategies)
-    return file_error(f.path, "the shard's histogram layout (batches, strategies) is not the merge's");
+  if (h->num_batches() != id.batches || h->layout().replicates() != id.replicates || h->layout().strategies != id.strategies)
+    return file_error(f.path, "the shard's histogram layout (batches, replicates, strategies) is not the merge's");
   const auto same_connectors = [&] {
     if (state->connectors.size() != id.connectors.size()) return false;
     for (std::size_t i = 0; i < id.connectors.size(); ++i)

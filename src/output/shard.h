@@ -31,7 +31,8 @@
 // file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
 // {max_bounces, sampler, rr_depth, rr_threshold, rr_light_threshold (absent in files written before
-// issue 39: then rr_threshold's), batches, width, height, images, max_paths, manifold (null, or the
+// issue 39: then rr_threshold's), batches, replicates (absent in files written before issue 39's
+// pixel groups: then batches, plain batch means), width, height, images, max_paths, manifold (null, or the
 // manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds,
 // biased_trials when > 0})}, "strategies" [names],
 // "connectors" [{strategy, connector}] (the strategies that run a connector, in the profile's order,
@@ -125,6 +126,7 @@ struct RenderIdentity {
   double rr_threshold = RenderOptions{}.rr_threshold;  // RenderOptions::rr_threshold (a float, exact as a double)
   double rr_light_threshold = RenderOptions{}.rr_light_threshold;  // RenderOptions::rr_light_threshold
   int batches = kDefaultBatches;
+  int replicates = kDefaultReplicates;  // per pixel; dividing batches (stats/histogram.h, "Batches")
   int width = 0, height = 0;  // the camera's resolution (the scene's, or --resolution's)
   bool images = true;
   std::uint64_t max_paths = 1000;  // rows of histogram.json's path table (--max-paths)

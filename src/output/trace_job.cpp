@@ -69,7 +69,11 @@ Result<bool> load_fresh(const TraceJobOptions& a, TraceJob* job) {
   id.rr_depth = a.rr_depth;
   id.rr_threshold = a.rr_threshold;
   id.rr_light_threshold = a.rr_light_threshold;
-  id.batches = a.batches.value_or(default_batches(a.sampler));
+  id.batches = a.batches;
+  id.replicates = a.replicates;
+  if (a.replicates < 1 || a.batches % a.replicates != 0)
+    return make_error(ErrorCode::kUsage, "--replicates " + std::to_string(a.replicates) + " must divide --batches " +
+                                             std::to_string(a.batches) + " (the batches are pixel groups of that many replicates)");
   id.images = !a.no_images;
   id.width = scene->camera.width;
   id.height = scene->camera.height;

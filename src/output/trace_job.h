@@ -38,7 +38,8 @@ struct TraceJobOptions {
   int rr_depth = RenderOptions{}.rr_depth;
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
-  std::optional<int> batches;  // unset: default_batches(sampler)
+  int batches = RenderOptions{}.batches;  // the standard error's batches and replicates per pixel
+  int replicates = RenderOptions{}.replicates;
   ManifoldOptions manifold = RenderOptions{}.manifold;
   std::string resolution;  // "WxH"; empty: the scene's
   std::uint64_t max_paths = 1000;  // rows of histogram.json's path table

@@ -9,44 +9,20 @@
 
 namespace pathex {
 
-std::vector<double> class_batch_means(const Histogram& histogram, const Classifier* classifier, int class_index) {
+double stderr_stability(const Histogram& histogram, const Classifier* classifier, int class_index) {
   const int batches = histogram.num_batches();
   std::vector<ExactRgb> sums(static_cast<std::size_t>(batches), ExactRgb{});
   for (Histogram::PathId id = 0; id < histogram.num_paths(); ++id) {
     if (class_index >= 0) {
-      if (classifier == nullptr) return {};
+      if (classifier == nullptr) return std::numeric_limits<double>::quiet_NaN();
       const std::vector<int>& members = classifier->members(histogram.class_set(id));
       if (std::find(members.begin(), members.end(), class_index) == members.end()) continue;
     }
     for (int b = 0; b < batches; ++b) add_to(sums[static_cast<std::size_t>(b)], histogram.cell(id, b).sum);
   }
-  std::vector<double> means;
-  for (int b = 0; b < batches; ++b) {
-    const std::uint64_t n = histogram.batch_samples(b);
-    if (n == 0) continue;
-    means.push_back(luminance(to_double(sums[static_cast<std::size_t>(b)])) / static_cast<double>(n));
-  }
-  return means;
-}
-
-double variance_relative_error(const std::vector<double>& x) {
-  const std::size_t n = x.size();
-  if (n < 4) return std::numeric_limits<double>::quiet_NaN();
-  double mean = 0.0;
-  for (double v : x) mean += v;
-  mean /= static_cast<double>(n);
-  double m2 = 0.0, m4 = 0.0;
-  for (double v : x) {
-    const double d2 = (v - mean) * (v - mean);
-    m2 += d2;
-    m4 += d2 * d2;
-  }
-  m2 /= static_cast<double>(n);
-  m4 /= static_cast<double>(n);
-  if (!(m2 > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  const double b = static_cast<double>(n);
-  const double kurtosis = m4 / (m2 * m2);
-  return std::sqrt(std::max(0.0, (kurtosis - (b - 3.0) / (b - 1.0)) / b));
+  std::vector<double> lum(sums.size());
+  for (std::size_t b = 0; b < sums.size(); ++b) lum[b] = luminance(to_double(sums[b]));
+  return histogram.variance_design().variance_relative_error(lum);
 }
 
 namespace {
@@ -103,9 +79,9 @@ StderrCheck check_stderr(const std::vector<RungError>& rungs, double reference, 
     double z = 0.0;
     if (sigma > 0.0) z = err / sigma;
     else if (err > 0.0) z = std::numeric_limits<double>::infinity();  // a zero stderr, a zero reference, an error
-    // A batch-means z is Student's t with B − 1 degrees of freedom, whose tails are heavier than
-    // the normal's that the χ² quantiles assume: summed as the normal deviate of the same tail, its
-    // false-alarm rate is kStderrCheckAlpha at 16 batches as at 32 (max_abs_z reports z itself).
+    // z is Student's t with the estimate's degrees of freedom (Estimate::dof), whose tails are
+    // heavier than the normal's that the χ² quantiles assume: summed as the normal deviate of the
+    // same tail, its false-alarm rate is kStderrCheckAlpha at 16 dof as at 31 (max_abs_z reports z itself).
     const double zn = r.dof > 0 && std::isfinite(z) ? normal_equivalent(z, r.dof) : z;
     c.chi2 += zn * zn;
     ++c.dof;

@@ -20,13 +20,12 @@
 // variance, such as next-event estimation of one bounce inside a closed sphere, is exact to
 // within that).
 //
-// The second check needs no reference: the stability of the stderr itself. With B batch means
-// of sample kurtosis κ, the variance estimate has relative standard error
-//
-//     ε = sqrt((κ − (B − 3)/(B − 1)) / B),
-//
-// 0.25 for normal batch means at B = 32 and about 0.95 when one batch holds nearly all of the
-// estimate (a rare spike). The ladder is flagged as unstable when the median ε over its rungs is at
+// The second check needs no reference: the stability of the stderr itself, ε, the relative
+// standard error of the variance estimate (VarianceDesign::variance_relative_error(),
+// stats/histogram.h): with G pixel groups of two replicates, from the spread of the groups'
+// terms, sqrt(2/G) = 0.35 for normal ones at G = 16; with B plain batch means of sample kurtosis κ,
+// sqrt((κ − (B − 3)/(B − 1)) / B), 0.25 for normal batch means at B = 32. Either is about 1 when
+// one group or batch holds nearly all of the estimate (a rare spike). The ladder is flagged as unstable when the median ε over its rungs is at
 // least kUnstableVariance: then a few batches carry the estimate and the next render's stderr may
 // differ from this one's by more than itself.
 #pragma once
@@ -45,12 +44,9 @@ inline constexpr double kStderrCheckAlpha = 1e-3;  // false-alarm rate of the χ
 inline constexpr double kUnstableVariance = 0.7;   // median relative error of the batch variance
 inline constexpr double kRoundingFloor = 1e-6;     // relative error of single-precision transport
 
-// The per-batch luminance means S_b / n_b of one class of `classifier` (class_index ≥ 0) or of the
-// whole image (class_index < 0). Batches without samples are left out.
-std::vector<double> class_batch_means(const Histogram& histogram, const Classifier* classifier, int class_index);
-
-// ε above for these batch means; NaN for fewer than 4 batches or when they are all equal.
-double variance_relative_error(const std::vector<double>& batch_means);
+// ε for one class of `classifier` (class_index ≥ 0) or the whole image (class_index < 0): the
+// relative error of its variance estimate (VarianceDesign::variance_relative_error(), stats/histogram.h).
+double stderr_stability(const Histogram& histogram, const Classifier* classifier, int class_index);
 
 // The upper quantile of the χ² distribution with `dof` ≥ 1 degrees of freedom: the x with
 // P(χ²_dof > x) = alpha (the survival function in closed form for integer dof, solved by bisection).
@@ -60,8 +56,8 @@ double chi2_upper_quantile(int dof, double alpha);
 struct RungError {
   double estimate = 0.0;
   double std_error = 0.0;   // reported; NaN when the render had too few batches
-  double stability = 0.0;   // variance_relative_error of its batch means (NaN: unknown)
-  int dof = 0;              // the stderr's degrees of freedom (batches − 1); 0: its z is taken as normal
+  double stability = 0.0;   // the relative error of its variance estimate (NaN: unknown)
+  int dof = 0;              // the stderr's degrees of freedom (Histogram::stderr_dof()); 0: its z is taken as normal
 };
 
 struct StderrCheck {

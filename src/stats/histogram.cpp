@@ -1,5 +1,6 @@
 // The accumulator (exact integer sums keyed by path string and batch) and the report built from
-// it: batch means per path, per class (sums of the paths in the class) and for the total.
+// it: estimates and their stderrs (VarianceDesign) per path, per class (sums of the paths in the
+// class) and for the total.
 #include "stats/histogram.h"
 
 #include <algorithm>
@@ -177,7 +178,7 @@ std::uint64_t Histogram::total_samples() const {
 Result<bool> Histogram::merge(const Histogram& other) {
   if (!(other.layout_ == layout_))
     return make_error(ErrorCode::kUsage,
-                      "cannot merge histograms with different layouts (batch count or strategy list differ)");
+                      "cannot merge histograms with different layouts (batch count, groups or strategy list differ)");
   for (PathId o = 0; o < other.num_paths(); ++o) {
     const PathId id = intern(other.path(o));
     for (int b = 0; b < layout_.num_batches; ++b) {
@@ -199,53 +200,139 @@ Result<bool> Histogram::merge(const Histogram& other) {
 
 // --- statistics ---
 
-Estimate batch_means(const std::vector<ExactRgb>& batch_sums, const std::vector<std::uint64_t>& batch_samples,
-                     std::uint64_t contributions) {
+VarianceDesign::VarianceDesign(std::vector<std::uint64_t> batch_samples, int groups)
+    : n_(std::move(batch_samples)), groups_(std::max(groups, 1)), scale_(static_cast<std::size_t>(groups_), 0.0) {
+  const std::size_t R = n_.size() / static_cast<std::size_t>(groups_);
+  for (std::size_t g = 0; g < static_cast<std::size_t>(groups_); ++g) {
+    double ng = 0, squares = 0;
+    int used = 0;
+    for (std::size_t r = 0; r < R; ++r) {
+      const double n = static_cast<double>(n_[g * R + r]);
+      ng += n;
+      squares += n * n;
+      used += n > 0 ? 1 : 0;
+    }
+    total_ += ng;
+    if (used < 2) continue;
+    dof_ += used - 1;
+    scale_[g] = std::sqrt(ng * ng / (ng * ng - squares));
+  }
+}
+
+std::vector<double> VarianceDesign::deviations(const std::vector<double>& sums) const {
+  const std::size_t R = n_.size() / static_cast<std::size_t>(groups_);
+  std::vector<double> d(n_.size(), 0.0);
+  for (std::size_t g = 0; g < static_cast<std::size_t>(groups_); ++g) {
+    if (scale_[g] == 0) continue;
+    double sum = 0, ng = 0;
+    for (std::size_t r = 0; r < R; ++r) {
+      sum += sums[g * R + r];
+      ng += static_cast<double>(n_[g * R + r]);
+    }
+    const double mean = sum / ng;
+    for (std::size_t r = 0; r < R; ++r)
+      if (n_[g * R + r] != 0) d[g * R + r] = scale_[g] * (sums[g * R + r] - static_cast<double>(n_[g * R + r]) * mean);
+  }
+  return d;
+}
+
+int VarianceDesign::dof(const std::vector<double>& sums) const {
+  const std::size_t R = n_.size() / static_cast<std::size_t>(groups_);
+  int dof = 0;
+  for (std::size_t g = 0; g < static_cast<std::size_t>(groups_); ++g) {
+    if (scale_[g] == 0) continue;
+    int used = 0;
+    bool nonzero = false;
+    for (std::size_t r = 0; r < R; ++r) {
+      used += n_[g * R + r] != 0 ? 1 : 0;
+      nonzero = nonzero || sums[g * R + r] != 0;
+    }
+    if (nonzero) dof += used - 1;
+  }
+  return dof;
+}
+
+double VarianceDesign::variance(const std::vector<double>& sums) const {
+  if (dof_ < 1) return std::numeric_limits<double>::quiet_NaN();
+  double squares = 0;
+  for (double d : deviations(sums)) squares += d * d;
+  return squares / (total_ * total_);
+}
+
+double VarianceDesign::variance_relative_error(const std::vector<double>& sums) const {
+  if (groups_ == 1) {
+    std::vector<double> means;
+    for (std::size_t b = 0; b < n_.size(); ++b)
+      if (n_[b] != 0) means.push_back(sums[b] / static_cast<double>(n_[b]));
+    return pathex::variance_relative_error(means);
+  }
+  // The groups' terms v_g are independent estimates of their groups' parts of the variance: the
+  // relative error of their sum is sqrt(G · var(v)) / Σ v, var(v) from their spread.
+  const std::size_t R = n_.size() / static_cast<std::size_t>(groups_);
+  const std::vector<double> d = deviations(sums);
+  std::vector<double> v;
+  for (std::size_t g = 0; g < static_cast<std::size_t>(groups_); ++g) {
+    if (scale_[g] == 0) continue;
+    double t = 0;
+    for (std::size_t r = 0; r < R; ++r) t += d[g * R + r] * d[g * R + r];
+    v.push_back(t);
+  }
+  const double G = static_cast<double>(v.size());
+  if (v.size() < 4) return std::numeric_limits<double>::quiet_NaN();
+  double mean = 0;
+  for (double t : v) mean += t;
+  mean /= G;
+  if (!(mean > 0)) return std::numeric_limits<double>::quiet_NaN();
+  double spread = 0;
+  for (double t : v) spread += (t - mean) * (t - mean);
+  return std::sqrt(spread / (G - 1) / G) / mean;
+}
+
+double variance_relative_error(const std::vector<double>& x) {
+  const std::size_t n = x.size();
+  if (n < 4) return std::numeric_limits<double>::quiet_NaN();
+  double mean = 0.0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(n);
+  double m2 = 0.0, m4 = 0.0;
+  for (double v : x) {
+    const double d2 = (v - mean) * (v - mean);
+    m2 += d2;
+    m4 += d2 * d2;
+  }
+  m2 /= static_cast<double>(n);
+  m4 /= static_cast<double>(n);
+  if (!(m2 > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  const double b = static_cast<double>(n);
+  const double kurtosis = m4 / (m2 * m2);
+  return std::sqrt(std::max(0.0, (kurtosis - (b - 3.0) / (b - 1.0)) / b));
+}
+
+Estimate estimate_of(const std::vector<ExactRgb>& batch_sums, const VarianceDesign& design, std::uint64_t contributions) {
   Estimate e;
   e.samples = contributions;
   ExactRgb total{};
-  std::uint64_t n_total = 0;
-  for (std::size_t b = 0; b < batch_sums.size(); ++b) {
-    add_to(total, batch_sums[b]);
-    n_total += batch_samples[b];
-  }
-  if (n_total == 0) return e;  // nothing rendered: zero estimate, unknown error
-  const double n = static_cast<double>(n_total);
+  for (const ExactRgb& s : batch_sums) add_to(total, s);
+  if (design.total_samples() == 0) return e;  // nothing rendered: zero estimate, unknown error
+  const double n = design.total_samples();
   const Rgb sum = to_double(total);
   e.rgb = {sum[0] / n, sum[1] / n, sum[2] / n};
   e.luminance = luminance(e.rgb);
-
-  double squares = 0, n2 = 0;
-  int nonempty = 0;
-  for (std::size_t b = 0; b < batch_sums.size(); ++b) {
-    if (batch_samples[b] == 0) continue;
-    ++nonempty;
-    const double nb = static_cast<double>(batch_samples[b]);
-    const double d = luminance(to_double(batch_sums[b])) - nb * e.luminance;
-    squares += d * d;
-    n2 += nb * nb;
-  }
-  if (nonempty >= 2) e.std_error = std::sqrt(squares / (n * n - n2));
+  std::vector<double> lum(batch_sums.size());
+  for (std::size_t b = 0; b < batch_sums.size(); ++b) lum[b] = luminance(to_double(batch_sums[b]));
+  e.std_error = std::sqrt(design.variance(lum));
+  e.dof = design.dof(lum);
   return e;
 }
 
 namespace {
 
-// S_b − n_b X̄ per batch for luminance sums S_b (0 for a batch without samples), X̄ = Σ S_b / N: a
-// function of the sums alone, so that a sum compared with itself gives bit-identical deviations.
-std::vector<double> batch_deviations(const std::vector<ExactSum>& sums, const std::vector<std::uint64_t>& n) {
-  ExactSum total = 0;
-  std::uint64_t n_total = 0;
-  for (std::size_t b = 0; b < sums.size(); ++b) {
-    total += sums[b];
-    n_total += n[b];
-  }
-  std::vector<double> d(sums.size(), 0.0);
-  if (n_total == 0) return d;
-  const double mean = to_double(total) / static_cast<double>(n_total);
-  for (std::size_t b = 0; b < sums.size(); ++b)
-    if (n[b] != 0) d[b] = to_double(sums[b]) - static_cast<double>(n[b]) * mean;
-  return d;
+// The deviations of luminance sums on the grid (VarianceDesign::deviations()): a function of the
+// sums alone, so that a sum compared with itself gives bit-identical deviations.
+std::vector<double> batch_deviations(const std::vector<ExactSum>& sums, const VarianceDesign& design) {
+  std::vector<double> d(sums.size());
+  for (std::size_t b = 0; b < sums.size(); ++b) d[b] = to_double(sums[b]);
+  return design.deviations(d);
 }
 
 // The techniques of a report's tables (each class, each listed path, "other"), keyed by
@@ -325,9 +412,9 @@ class TechniqueTables {
   }
 
   // Each technique's share of the table's whole, its samples and its part of the whole's
-  // batch-means variance (TechniqueEstimate), from luminance sums, in the order of the keys.
-  std::vector<TechniqueEstimate> estimates(std::size_t table, const std::vector<std::uint64_t>& n) const {
-    const std::size_t B = n.size(), E = entry_key_.size();
+  // variance (TechniqueEstimate, VarianceDesign), from luminance sums, in the order of the keys.
+  std::vector<TechniqueEstimate> estimates(std::size_t table, const VarianceDesign& design) const {
+    const std::size_t B = static_cast<std::size_t>(h_.num_batches()), E = entry_key_.size();
     std::vector<int> entries = entries_[table];
     std::sort(entries.begin(), entries.end(), [&](int a, int b) {
       return keys_[static_cast<std::size_t>(entry_key_[static_cast<std::size_t>(a)])] <
@@ -344,21 +431,17 @@ class TechniqueTables {
     ExactSum total = 0;
     for (ExactSum s : whole) total += s;
     const double lum = to_double(total);
-    const std::vector<double> dw = batch_deviations(whole, n);
+    const std::vector<double> dw = batch_deviations(whole, design);
     double variance = 0;
-    int nonempty = 0;
-    for (std::size_t b = 0; b < dw.size(); ++b) {
-      variance += dw[b] * dw[b];
-      nonempty += n[b] != 0 ? 1 : 0;
-    }
+    for (double d : dw) variance += d * d;
     std::vector<TechniqueEstimate> out;
     out.reserve(entries.size());
-    // Each technique's own batch-means variance, and the sum of them all.
+    // Each technique's own variance, and the sum of them all.
     std::vector<std::vector<double>> deviations;
     std::vector<double> own;
     double own_sum = 0;
     for (int e : entries) {
-      deviations.push_back(batch_deviations(batch_sums(e), n));
+      deviations.push_back(batch_deviations(batch_sums(e), design));
       double v = 0;
       for (double d : deviations.back()) v += d * d;
       own.push_back(v);
@@ -374,7 +457,7 @@ class TechniqueTables {
       te.name = Technique::from_code(key.code).name(h_.layout(), key.chain);
       te.share = lum != 0 ? to_double(sum) / lum : 0.0;
       te.samples = contributions_[static_cast<std::size_t>(e)];
-      if (nonempty >= 2 && variance > 0 && own_sum > 0) {
+      if (design.dof() >= 1 && variance > 0 && own_sum > 0) {
         const std::vector<double>& dt = deviations[k];
         te.variance_share = own[k] / own_sum;
         double covariance = 0, rest = 0;  // with the rest of the whole: dw − dt
@@ -430,6 +513,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
                       "than 2^63); the render is numerically broken");
   std::vector<std::uint64_t> n(B);
   for (int b = 0; b < nb; ++b) n[static_cast<std::size_t>(b)] = h.batch_samples(b);
+  const VarianceDesign design = h.variance_design();
 
   HistogramReport report;
   report.run = run;
@@ -469,11 +553,11 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     // The row's techniques are worked out below, for the rows listed only.
     PathEstimate pe;
     pe.path = h.path(p);
-    pe.estimate = batch_means(path_sums, n, count);
+    pe.estimate = estimate_of(path_sums, design, count);
     report.paths.push_back(std::move(pe));
   }
   report.distinct_paths = report.paths.size();
-  report.total = batch_means(total_sums, n, total_count);
+  report.total = estimate_of(total_sums, design, total_count);
   // Rows by luminance, largest first. report.paths[i] is still path id i here, which is what
   // lets the rows past max_paths be summed from the exact cells.
   std::vector<Histogram::PathId> order(report.paths.size());
@@ -506,9 +590,9 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     ClassEstimate ce;
     ce.name = classes[k].name;
     ce.expr = classes[k].expr;
-    ce.estimate = batch_means(class_sums[k], n, class_counts[k]);
+    ce.estimate = estimate_of(class_sums[k], design, class_counts[k]);
     ce.share = report.total.luminance != 0 ? ce.estimate.luminance / report.total.luminance : 0.0;
-    ce.strategies = tables.estimates(k, n);
+    ce.strategies = tables.estimates(k, design);
     report.classes.push_back(std::move(ce));
   }
   if (listed < order.size()) {
@@ -526,8 +610,8 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
     }
     PathEstimate pe;
     pe.path = "other";
-    pe.estimate = batch_means(other_sums, n, other_count);
-    pe.strategies = tables.estimates(other_table, n);
+    pe.estimate = estimate_of(other_sums, design, other_count);
+    pe.strategies = tables.estimates(other_table, design);
     report.other = std::move(pe);
     report.other_paths = order.size() - listed;
   }
@@ -535,7 +619,7 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   rows.reserve(listed);
   for (std::size_t i = 0; i < listed; ++i) {
     rows.push_back(std::move(report.paths[order[i]]));
-    rows.back().strategies = tables.estimates(classes.size() + i, n);
+    rows.back().strategies = tables.estimates(classes.size() + i, design);
   }
   report.paths = std::move(rows);
   return report;

@@ -20,25 +20,35 @@
 // sane radiance) is counted in nonfinite() and never added; the magnitude guard then proves that
 // no sum can leave the representable range (see Histogram::magnitude()).
 //
-// Batch means. Samples are grouped into B batches (default 32) by *pass*, the per-pixel sample
-// index — the renderer deals passes to batches round-robin (pass mod B, trace/render.cpp), so
-// that an interrupted render still spreads what it has over every batch — so that every batch
-// covers the whole image and the batch estimates X_b = S_b / n_b are independent and identically
-// distributed, whatever the strategy (splats from light tracing land anywhere, which rules out a
-// per-pixel variance).
-// With N = Σ n_b and X̄ = Σ S_b / N, the standard error of X̄ is estimated by
+// Batches, and the standard error (issues 36 and 39). Samples are grouped into B batches (default
+// 32): batch b is replicate r = b mod R of pixel group g = b div R, with G = B / R groups
+// (HistogramLayout::groups). The renderer puts the sample of pixel p and pass s in group p mod G
+// and replicate s mod R (trace/integrator.h, batch_of()); under the `sobol` sampler each replicate
+// of a pixel is an independently scrambled sequence whose point index is s div R (trace/rng.h), so
+// a replicate of 16 spp / R points keeps the quasi-Monte Carlo gain of that many points. Pixels are
+// independent of each other, and the R replicates of a group are independent and identically
+// distributed, whatever the strategy (a light-tracing splat counts in the group of the sample
+// that made it, wherever it lands). With S_gr the sum of a group's replicate, n_gr its sample
+// count, n_g = Σ_r n_gr, X̄_g = S_g / n_g and N = Σ n_gr, the variance of the mean X̄ = Σ S / N is
+// estimated by
 //
-//     stderr² = Σ_b (S_b − n_b X̄)² / (N² − Σ_b n_b²),
+//     stderr² = Σ_g c_g Σ_r (S_gr − n_gr X̄_g)² / N²,   c_g = n_g² / (n_g² − Σ_r n_gr²),
 //
-// which is unbiased for independent samples and reduces to the textbook Σ (X_b − X̄)² / (B(B−1))
-// when the batches are equal. It needs at least two batches holding samples; otherwise it is NaN.
+// unbiased for each group's own (unknown) variance: for R = 2 and equal counts it is
+// Σ_g (S_g1 − S_g2)² / N², the per-pixel-set two-replicate estimate, with G(R − 1) degrees of
+// freedom (groups with fewer than two replicates holding samples add none). With one group (G = 1,
+// R = B) it is the textbook batch-means estimate Σ_b (S_b − n_b X̄)² / (N² − Σ_b n_b²), which
+// needs the B batches to be independent: under `sobol` that spends the sequence over B replicates
+// (1 point each per pixel at B = spp), which is what the groups avoid. VarianceDesign below is the
+// one place this is computed: every estimate, technique share, degree of freedom and stability
+// figure reads it. It needs one degree of freedom; otherwise the stderr is NaN.
 //
 // Memory: per distinct path string and per batch that holds a contribution of any path, a cell of
 // 64 bytes, and per technique that sampled it 16 bytes per such batch (about 2 KiB + 0.5 KiB per
 // technique for B = 32 batches in use). A batch's cells and row sums are laid out the first time
-// something is added to it: a render of fewer passes than B fills only as many batches (the
-// default 16 spp half of them, a one-pass shard one), and the others cost nothing, neither memory
-// nor the page faults and copies that first touching it took. A Histogram has one writer; each
+// something is added to it: a render of fewer passes than R fills only that many batches of each
+// group (a one-pass shard G of them), and the others cost nothing, neither memory nor the page
+// faults and copies that first touching it took. A Histogram has one writer; each
 // worker thread owns one (a "shard") and the shards are merged at the end.
 #pragma once
 
@@ -71,8 +81,11 @@ using ExactRgb = std::array<ExactSum, 3>;
 
 inline constexpr int kFractionBits = 64;
 inline constexpr double kMaxContribution = 0x1p50;  // |c| ≥ this counts as non-finite
-inline constexpr int kDefaultBatches = 32;       // the independent sampler's (trace/render.h, default_batches())
-inline constexpr int kDefaultSobolBatches = 32;  // the sobol sampler's
+inline constexpr int kDefaultBatches = 32;    // B, for every sampler (see "Batches" above)
+inline constexpr int kDefaultReplicates = 2;  // R: B / R = 16 pixel groups of two replicates
+// The default stderr's degrees of freedom, G (R − 1) = 16, for a render of at least R passes over
+// at least G pixels (VarianceDesign::dof()).
+inline constexpr int kDefaultDof = kDefaultBatches - kDefaultBatches / kDefaultReplicates;
 
 // Rec. 709 luminance.
 inline double luminance(const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
@@ -151,7 +164,49 @@ std::optional<ExactSum> exact_from_string(std::string_view s);
 struct HistogramLayout {
   int num_batches = kDefaultBatches;    // B ≥ 1; at least 2 for a standard error
   std::vector<std::string> strategies;  // strategy id = index; techniques are named after these
+  // G ≥ 1, dividing B: the pixel groups, each of R = B / G replicates (see "Batches" above). 1:
+  // plain batch means (every batch a replicate of the whole image).
+  int groups = 1;
+  int replicates() const { return num_batches / groups; }
   bool operator==(const HistogramLayout&) const = default;
+};
+
+// The relative standard error of the variance of B batch means x of sample kurtosis κ:
+// sqrt((κ − (B − 3)/(B − 1)) / B); NaN for fewer than 4 or when they are all equal.
+double variance_relative_error(const std::vector<double>& batch_means);
+
+// The standard error's estimate from per-batch sums (see "Batches" above), for a histogram's
+// batch sample counts n_b and pixel groups. deviations() maps a quantity's B batch sums S_b to
+// d_b = sqrt(c_g) (S_b − n_b X̄_g): its variance is Σ_b d_b² / N², and the covariance of two
+// quantities Σ_b d_b d'_b / N² (d is linear in the sums), which the technique shares use.
+class VarianceDesign {
+ public:
+  VarianceDesign(std::vector<std::uint64_t> batch_samples, int groups);
+  int groups() const { return groups_; }
+  int replicates() const { return static_cast<int>(n_.size()) / groups_; }
+  // The degrees of freedom: Σ_g (its replicates holding samples − 1) over groups with two or more.
+  int dof() const { return dof_; }
+  // The same over the groups where a quantity with these sums is not 0 in every replicate: a rare
+  // path's few hits inform only their groups (two hits of one value in a group's two replicates
+  // give a variance of 0 with 1 degree of freedom, not 16). At most dof().
+  int dof(const std::vector<double>& sums) const;
+  double total_samples() const { return total_; }  // N
+  // d_b for sums S_b (0 where a group has fewer than two replicates with samples).
+  std::vector<double> deviations(const std::vector<double>& sums) const;
+  // Σ d_b² / N² (NaN without a degree of freedom).
+  double variance(const std::vector<double>& sums) const;
+  // The variance estimate's own relative standard error (how far the next render's stderr may
+  // stray): with groups, from the spread of the groups' terms Σ_r d_gr² (at least 4 groups with
+  // a degree of freedom); with one group, from the batch means' kurtosis
+  // (variance_relative_error(), stats/convergence.h). NaN when unknown.
+  double variance_relative_error(const std::vector<double>& sums) const;
+
+ private:
+  std::vector<std::uint64_t> n_;
+  int groups_ = 1;
+  int dof_ = 0;
+  double total_ = 0;
+  std::vector<double> scale_;  // per group: sqrt(c_g), 0 without a degree of freedom
 };
 
 // A sampling technique: strategy `strategy` of the layout (a profile strategy) run at one split of
@@ -273,14 +328,17 @@ class Histogram {
   }
   // Whether anything was ever added to the batch's cells or row sums (the others are all zero).
   bool batch_in_use(int batch) const { return !cells_[static_cast<std::size_t>(batch)].empty(); }
-  // The batches in use, ascending: a shard of a few passes, or a render of fewer passes than
-  // batches (the default 16 spp fills 16 of 32), leaves the others empty.
+  // The batches in use, ascending: a shard of fewer passes than replicates (one pass fills one
+  // replicate of every group) leaves the others empty.
   std::vector<int> batches_in_use() const;
   int num_rows() const { return static_cast<int>(rows_.size()); }
   // The path's rows ordered by technique code (the order serialised forms use).
   std::vector<int> sorted_rows(PathId id) const;
   std::uint64_t batch_samples(int batch) const { return batch_samples_[static_cast<std::size_t>(batch)]; }
   std::uint64_t total_samples() const;
+  // The standard error's estimate for this histogram's sample counts, and its degrees of freedom.
+  VarianceDesign variance_design() const { return VarianceDesign(batch_samples_, layout_.groups); }
+  int stderr_dof() const { return variance_design().dof(); }
   std::uint64_t nonfinite() const { return nonfinite_; }
   // Σ |channel| of every accepted contribution on the fixed-point grid, saturating at 2^127. While
   // it stays below 2^127 (a value of 2^63 ≈ 9.2e18) no partial or final sum can overflow.
@@ -355,13 +413,13 @@ class Histogram {
 struct Estimate {
   Rgb rgb{};                   // mean pixel value over the image
   double luminance = 0;        // Rec. 709 luminance of rgb
-  double std_error = std::numeric_limits<double>::quiet_NaN();  // of luminance, by batch means
+  double std_error = std::numeric_limits<double>::quiet_NaN();  // of luminance (VarianceDesign)
+  int dof = 0;                 // std_error's degrees of freedom (VarianceDesign::dof(sums))
   std::uint64_t samples = 0;   // nonzero contributions (a BDPT sample may contribute several)
 };
 
-// The estimate from exact per-batch sums and per-batch sample counts (the formula above).
-Estimate batch_means(const std::vector<ExactRgb>& batch_sums, const std::vector<std::uint64_t>& batch_samples,
-                     std::uint64_t contributions);
+// The estimate from exact per-batch sums, its stderr by `design` (the formula above).
+Estimate estimate_of(const std::vector<ExactRgb>& batch_sums, const VarianceDesign& design, std::uint64_t contributions);
 
 // What the render was; copied into the report as is. Only what the result is a function of: how
 // long it took and on how many threads is not here (pathex trace writes that to run.json), so
@@ -386,12 +444,11 @@ struct TechniqueEstimate {
   std::string name;           // Technique::name()
   double share = 0;           // its luminance / the luminance of the whole (0 when that is 0)
   std::uint64_t samples = 0;  // its nonzero contributions
-  // Its own share of the variance by batch means: v_t = Σ_b (S_tb − n_b X̄_t)², its batch
-  // estimates' own variance, over Σ_t v_t of the whole's techniques: ≥ 0, and the shares of a
+  // Its own share of the variance: v_t = Σ_b d_tb² (VarianceDesign), its own variance, over Σ_t v_t of the whole's techniques: ≥ 0, and the shares of a
   // whole sum to 1, like the luminance shares (issue 36: the covariance share it replaced read as
   // a negative share). NaN when the whole has no standard error.
   double variance_share = std::numeric_limits<double>::quiet_NaN();
-  // Where covariance matters: the correlation, over the batches, of its estimates with the rest
+  // Where covariance matters: the correlation, over the batches' deviations, of its estimates with the rest
   // of the whole's (the sum of the other techniques'): negative when their errors partly cancel
   // (the whole's variance is then below the sum of its techniques'), positive when they add up.
   // NaN when it alone carries the whole or either side has no variance.

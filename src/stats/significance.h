@@ -5,12 +5,12 @@
 
 namespace pathex {
 
-// P(|T| > x) for Student's t with `dof` ≥ 1 degrees of freedom (the batch-means z of an estimate
-// from B batches has B − 1), by Simpson's rule over [0, x] of its density.
+// P(|T| > x) for Student's t with `dof` ≥ 1 degrees of freedom (the z of an estimate has its
+// Estimate::dof, 16 by default), by Simpson's rule over [0, x] of its density.
 double student_two_sided_tail(double x, int dof);
 
 // The |z| of a normal deviate as far into its two-sided tail as `x` is into Student's t's with
-// `dof` degrees of freedom (x itself where that tail is below double precision): a batch-means z
+// `dof` degrees of freedom (x itself where that tail is below double precision): an estimate's z
 // made fit for a χ² sum, which assumes normal deviates (stats/convergence.h check_stderr).
 double normal_equivalent(double x, int dof);
 

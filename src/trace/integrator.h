@@ -35,10 +35,15 @@ namespace pathex::tracer {
 using namespace accel;  // PathKey, PathIds
 static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
 
-// Passes go to batches round-robin: every batch covers the whole image, and an interrupted render
-// still spreads what it has over all batches (so its error is defined). Batches are independent:
-// under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
-inline int batch_of(std::uint64_t pass, int batches) { return static_cast<int>(pass % static_cast<std::uint64_t>(batches)); }
+// The batch of pixel `pixel`'s pass `pass` (stats/histogram.h, "Batches"): replicate pass mod R of
+// pixel group pixel mod G, G = batches / replicates. Passes go to replicates round-robin, so an
+// interrupted render still spreads what it has over all of them (and its error is defined);
+// neighbouring pixels go to different groups, so every group covers the whole image. Replicates
+// are independent: under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
+inline int batch_of(std::uint64_t pixel, std::uint64_t pass, int batches, int replicates) {
+  const auto R = static_cast<std::uint64_t>(replicates), G = static_cast<std::uint64_t>(batches / replicates);
+  return static_cast<int>((pixel % G) * R + pass % R);
+}
 
 class Integrator {
  public:

@@ -300,14 +300,14 @@ void Integrator::trace_shadows(Thread& th) const {
 
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
-  Sampler rng(o_.seed, pixel, pass, o_.sampler, static_cast<std::uint64_t>(o_.batches));
+  Sampler rng(o_.seed, pixel, pass, o_.sampler, static_cast<std::uint64_t>(o_.replicates));
   rng.set_dimension(kEyeDims);
   // The light's first direction, computed before the eye subpath is traced: a Sobol point's chain
   // of dependent multiplies then overlaps the eye subpath's work instead of delaying the light
   // subpath's first ray (Sampler::at2d_now).
   const bool light_walk = !rs_.lights.empty() && max_light_ > 0;  // as light_subpath() tests
   const glm::vec2 u_light_ray = light_walk ? rng.at2d_now(kLightRayDim) : glm::vec2(0.0f);
-  const int batch = batch_of(pass, o_.batches);
+  const int batch = batch_of(pixel, pass, o_.batches, o_.replicates);
   th.px = px;
   th.py = py;
   th.pass = pass;

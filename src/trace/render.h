@@ -54,14 +54,6 @@ struct RenderPlan;  // trace/plan.h
 // cancelled render stops, after whole chunks, so every finished pass covers the whole image.
 inline constexpr std::uint64_t kPassesPerChunk = 4;
 
-// The batch count of a render with `sampler` when none is given (`pathex trace --batches`): the
-// batch means are the standard error's replicates (stats/histogram.h). Under `sobol` every batch
-// is an independently scrambled sequence (trace/rng.h, sobol_stream()), so a batch of m passes
-// gains what m points of one sequence gain: fewer, larger batches keep more of the quasi-Monte
-// Carlo gain, more batches make the standard error itself more precise (its relative error is
-// about 1/sqrt(2(B-1))). The choice, measured: README "Design decisions", bench/README.md.
-constexpr int default_batches(SamplerKind sampler) { return sampler == SamplerKind::kSobol ? kDefaultSobolBatches : kDefaultBatches; }
-
 struct RenderOptions {
   std::uint64_t spp = 16;              // samples (passes) per pixel
   // The passes to take (a shard's share, what a resumed render still lacks); unset: [0, spp).
@@ -84,7 +76,13 @@ struct RenderOptions {
   float rr_threshold = 0.3f;
   float rr_light_threshold = 1.0f;
   SamplerKind sampler = SamplerKind::kSobol;  // --sampler
-  int batches = default_batches(SamplerKind::kSobol);  // for batch-means standard errors (`pathex trace --batches`)
+  // The standard error's batches (`pathex trace --batches`, --replicates; stats/histogram.h,
+  // "Batches"): B batches, R replicates of each pixel (R divides B), B / R pixel groups. Under
+  // `sobol` each replicate is an independently scrambled sequence of spp / R points: fewer
+  // replicates keep more of the quasi-Monte Carlo gain, more groups make the standard error itself
+  // more precise (its relative error is about 1/sqrt(2 · dof), dof = B − B / R). Measured: bench/README.md.
+  int batches = kDefaultBatches;
+  int replicates = kDefaultReplicates;
   std::vector<int> layer_classes;      // classifier classes that get an image layer
   // Accumulate the images at all. Off (`pathex trace --no-images`), the render keeps only the
   // histogram, which is the same either way, and RenderOutput::images is empty (0 × 0): no

@@ -53,10 +53,14 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
   if (!rs) return rs.error();
   aim_emission(*rs, scene, plan.aimed_lights);
   RenderOptions o = options;
+  if (o.batches < 1 || o.replicates < 1 || o.batches % o.replicates != 0)
+    return make_error(ErrorCode::kUsage, "the replicate count (" + std::to_string(o.replicates) +
+                                             ") must divide the batch count (" + std::to_string(o.batches) + ")");
   // The same rule as the checker's: an explicit bound overrides the profile's own.
   if (!o.max_bounces) o.max_bounces = profile.max_bounces.value_or(16);
   HistogramLayout layout;
   layout.num_batches = o.batches;
+  layout.groups = o.batches / o.replicates;
   for (const Strategy& st : strategies->strategies) layout.strategies.push_back(st.name);
 
   RenderOutput out{Histogram(layout, classifier),
@@ -113,7 +117,11 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
         integrator.finish_row(th, out.images, y);
       }
     });
-    for (std::uint64_t p = first; p < end; ++p) out.histogram.add_samples(tracer::batch_of(p, o.batches), pixels);
+    // Each pass adds one sample per pixel: pixels / G to every group, one more to the first pixels mod G.
+    const auto groups = static_cast<std::uint64_t>(layout.groups);
+    for (std::uint64_t p = first; p < end; ++p)
+      for (std::uint64_t g = 0; g < std::min(groups, pixels); ++g)
+        out.histogram.add_samples(tracer::batch_of(g, p, o.batches, o.replicates), pixels / groups + (g < pixels % groups ? 1 : 0));
     out.passes_done.add(first, end);
     if (o.progress) o.progress(deal.dealt() * pixels, deal.total() * pixels);
   }

@@ -68,42 +68,43 @@ inline constexpr float kOneMinusEpsilon = 1.0f - 0x1p-24f;  // the largest float
 // Which numbers a Sampler draws (`pathex trace --sampler`): `independent`, the counter-based
 // stream above (every number independent of every other), or `sobol`, Owen-scrambled Sobol points
 // (trace/sobol.h): each pair of dimensions drawn with get2d() is stratified over a pixel's passes
-// of one batch (the first 2^k points of a batch's sequence put one point in every elementary
+// of one replicate (the first 2^k points of a replicate's sequence put one point in every elementary
 // interval of area 2^-k), each number on its own still uniform and independent across dimension
-// pairs. Both are functions of (seed, pixel, pass, dimension) and the batch count alone.
+// pairs. Both are functions of (seed, pixel, pass, dimension) and the replicate count alone.
 enum class SamplerKind : std::uint8_t { kIndependent, kSobol };
 constexpr const char* to_string(SamplerKind k) { return k == SamplerKind::kSobol ? "sobol" : "independent"; }
 
-// The Sobol stream of pass `pass` of a render of `batches` batches: the renderer deals passes to
-// batches round-robin (batch = pass mod B, stats/histogram.h), and each batch is a replicate of
-// its own, an independently scrambled sequence whose point index is pass div B — randomized
-// quasi-Monte Carlo with B independent replicates, so that the batch means the standard error is
-// computed from are independent as it assumes (issue 36: one sequence dealt over the batches made
-// them correlated and the stderr overstate the error 1.8–7×). Every batch still receives a prefix
-// of its own sequence from any prefix of the passes (an interrupted render, a shard of whole
-// chunks). Returned: the word that keys the scramble (batch and the index's bits past 32: passes
-// past 2^32 of a batch start a new scrambled sequence; with one batch it is pass >> 32, the key of
-// the sampler before batches had sequences of their own) and the point's index.
+// The Sobol stream of pass `pass` of a render of `replicates` replicates per pixel: the renderer
+// deals passes to replicates round-robin (replicate = pass mod R, stats/histogram.h "Batches"), and
+// each replicate is an independently scrambled sequence whose point index is pass div R —
+// randomized quasi-Monte Carlo with R independent replicates per pixel, so that the standard
+// error computed from their differences is honest (issue 36: one sequence dealt over the batches
+// made them correlated and the stderr overstate the error 1.8–7×), while each replicate keeps the
+// gain of spp / R points of one sequence (issue 39). Every replicate still receives a prefix of its
+// own sequence from any prefix of the passes (an interrupted render, a shard of whole chunks).
+// Returned: the word that keys the scramble (the replicate and the index's bits past 32: passes
+// past 2^32 of a replicate start a new scrambled sequence; with one replicate it is pass >> 32, the
+// key of the sampler before replicates had sequences of their own) and the point's index.
 struct SobolStream {
   std::uint64_t key_word;
   std::uint32_t index;
 };
-constexpr SobolStream sobol_stream(std::uint64_t pass, std::uint64_t batches) {
-  const std::uint64_t batch = pass % batches, i = pass / batches;
-  return {(batch << 32) | (i >> 32), static_cast<std::uint32_t>(i)};
+constexpr SobolStream sobol_stream(std::uint64_t pass, std::uint64_t replicates) {
+  const std::uint64_t replicate = pass % replicates, i = pass / replicates;
+  return {(replicate << 32) | (i >> 32), static_cast<std::uint32_t>(i)};
 }
 
 // One sample's random numbers, drawn in order of dimension. Copying a Sampler copies its position;
 // set_dimension() gives a strategy a fixed block of dimensions (e.g. 2 per bounce) so that two
 // strategies never consume each other's numbers. With `sobol`, get2d() draws the pair (d, d + 1)
 // as one stratified 2-D point, so a dimension must always be drawn the same way (as the first of
-// a pair, the second, or alone), which a fixed dimension block gives. `batches` (≥ 1, below 2^32)
-// is the render's batch count, which `sobol` keys its sequences by (sobol_stream()).
+// a pair, the second, or alone), which a fixed dimension block gives. `replicates` (≥ 1, below
+// 2^32) is the render's replicate count per pixel, which `sobol` keys its sequences by (sobol_stream()).
 class Sampler {
  public:
   Sampler(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample, SamplerKind kind = SamplerKind::kIndependent,
-          std::uint64_t batches = 1)
-      : Sampler(seed, pixel, sample, kind, kind == SamplerKind::kSobol ? sobol_stream(sample, batches) : SobolStream{sample, 0}) {}
+          std::uint64_t replicates = 1)
+      : Sampler(seed, pixel, sample, kind, kind == SamplerKind::kSobol ? sobol_stream(sample, replicates) : SobolStream{sample, 0}) {}
 
   // Forced inline: a walk draws a few numbers per vertex, and the call (and the test of kind_ in a
   // function the compiler will not inline) cost as much as the independent stream's hashing.
@@ -158,14 +159,14 @@ class Sampler {
   SamplerKind kind() const { return kind_; }
 
  private:
-  // The scrambling seeds of dimension `dim` of this pixel's batch (of the pair starting there).
+  // The scrambling seeds of dimension `dim` of this pixel's replicate (of the pair starting there).
   sobol::Seeds sobol_seeds(std::uint64_t dim, bool pair) const {
     const std::uint64_t h = stream_bits(key_, dim);
     return {static_cast<std::uint32_t>(h), static_cast<std::uint32_t>(h >> 32),
             pair ? static_cast<std::uint32_t>((h * kGoldenGamma) >> 29) : 0u};  // the y seed: another 32 of h's bits, mixed
   }
 
-  // sobol: the key is the batch's (keyed by stream.key_word; the point's index is stream.index).
+  // sobol: the key is the replicate's (keyed by stream.key_word; the point's index is stream.index).
   Sampler(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample, SamplerKind kind, SobolStream stream)
       : kind_(kind),
         key_(stream_key(seed, pixel, kind == SamplerKind::kSobol ? stream.key_word : sample)),
@@ -173,7 +174,7 @@ class Sampler {
 
   SamplerKind kind_;
   std::uint64_t key_;
-  std::uint32_t reversed_index_;  // sobol: the point's index in its batch's sequence, bit-reversed
+  std::uint32_t reversed_index_;  // sobol: the point's index in its replicate's sequence, bit-reversed
   std::uint64_t dim_ = 0;
 };
 

@@ -7,9 +7,9 @@
 // van der Corput sequence). No table of direction numbers past the second dimension is needed,
 // and a dimension block at 2048 (render.cpp's kJoinDims) is as good as dimension 0. What makes the
 // pairs of one sample independent of each other is randomisation keyed by a hash of (seed,
-// pixel, batch, dimension):
+// pixel, replicate, dimension):
 //
-//   - the index of the point (the pass div the batch count) is shuffled by a nested scramble of
+//   - the index of the point (the pass div the replicate count) is shuffled by a nested scramble of
 //     its bits (each bit flipped by a hash of the bits above it). That maps every aligned block of
 //     2^k indices onto an aligned block of 2^k indices, so the first 2^k points take 2^k consecutive points
 //     of the sequence, which form a (0,k,2)-net; different dimension pairs take different blocks in
@@ -17,14 +17,14 @@
 //   - each coordinate is Owen-scrambled (each bit flipped by a hash of the bits above it), which
 //     keeps the net property and makes every point, on its own, uniform on [0,1)².
 //
-// The sequence is that of one batch of a pixel (trace/rng.h, sobol_stream()): the render's
-// batches are independent replicates, each scrambled with its own seeds, whose point index is the
-// pass div the batch count. So for every pixel, batch and pair of dimensions the first 2^k points
+// The sequence is that of one replicate of a pixel (trace/rng.h, sobol_stream()): the render's
+// replicates are independent, each scrambled with its own seeds, whose point index is the
+// pass div the replicate count. So for every pixel, replicate and pair of dimensions the first 2^k points
 // put exactly one point in each elementary interval of area 2^-k (tests/trace/sampler_test.cpp),
 // while each pass on its own is a
 // uniform point independent across dimension pairs: estimates stay unbiased for any integrand.
 // Nothing depends on the number of passes asked for, on threads or on the order of drawing: the
-// number is a function of (seed, pixel, pass, dimension) and the batch count, as the independent
+// number is a function of (seed, pixel, pass, dimension) and the replicate count, as the independent
 // sampler's is of the first four, so renders stay bit-identical across thread counts and shards.
 //
 // The scramble is the hash-based one of Laine and Karras (2011) with Vegdahl's constants (as

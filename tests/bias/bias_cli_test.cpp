@@ -145,7 +145,7 @@ TEST(BiasCli, UnderSampledLightIsReportedWithItsLevel) {
   const nlohmann::json& u = j["undersampled"];
   EXPECT_EQ(u["spp"], 4);
   EXPECT_EQ(u["seed"], 2);
-  EXPECT_EQ(u["dof"], 3);
+  EXPECT_EQ(u["dof"], 16);
   EXPECT_EQ(u["false_alarm_rate"], 0.01);
   EXPECT_EQ(u["min_share"], 0.01);
   const int n = u["comparisons"];

@@ -306,10 +306,12 @@ TEST(Bias, UnderSampledLightIsFoundWhereTheStderrCannotSeeIt) {
   const UnderSampling& u = *run.report.undersampled;
   EXPECT_EQ(u.spp, 4u);
   EXPECT_EQ(u.seed, test::stat_seed(7) + 1);  // the reference's seed + 1
-  EXPECT_EQ(u.dof, 3);    // 4 passes fill 4 of the 32 batches
+  EXPECT_EQ(u.dof, 16);   // 4 passes fill both replicates of the 16 pixel groups
   // Compared: the image, the five built-in classes, the reference's listed paths pt-nee can sample.
+  // (Not a reference row that is not 0 with a stderr of 0: its few hits agreed exactly, no claim.)
   std::size_t reachable_rows = 0;
-  for (const PathEstimate& p : run.histogram.paths) reachable_rows += p.path == "other" ? 0 : 1;
+  for (const PathEstimate& p : run.histogram.paths)
+    reachable_rows += p.path == "other" || (p.estimate.std_error == 0 && p.estimate.luminance != 0) ? 0 : 1;
   EXPECT_EQ(u.comparisons, static_cast<int>(1 + 5 + reachable_rows));  // pt-nee misses nothing here
   EXPECT_NEAR(u.each, 1 - std::pow(0.99, 1.0 / u.comparisons), 1e-15);
   auto flagged = [&](const std::string& name) -> const UnderSampled* {
@@ -318,7 +320,7 @@ TEST(Bias, UnderSampledLightIsFoundWhereTheStderrCannotSeeIt) {
     return nullptr;
   };
   // The caustic's main path: where pt-nee found nothing, z is the reference's own estimate over
-  // its stderr, judged with the reference's 31 dof. Now and then (2 seeds in 50) pt-nee does meet
+  // its stderr, judged with the reference's 16 dof. Now and then (2 seeds in 50) pt-nee does meet
   // the path, and that rare, heavy sample gives its estimate a stderr that admits the difference;
   // then the caustic class is flagged instead, or with it. One of the two always is.
   const UnderSampled* path = flagged("LDDSSDDSE");
@@ -328,7 +330,7 @@ TEST(Bias, UnderSampledLightIsFoundWhereTheStderrCannotSeeIt) {
     EXPECT_TRUE(path->path);
     EXPECT_EQ(path->renderer.std_error, 0.0);
     EXPECT_NEAR(path->z, -path->reference.luminance / path->reference.std_error, 1e-6 * std::fabs(path->z));
-    EXPECT_NEAR(path->dof, 31.0, 1e-9);
+    EXPECT_NEAR(path->dof, 16.0, 1e-9);
     EXPECT_GT(path->reference.luminance, 0.05 * run.report.total.luminance);  // a tenth of the image
   }
   if (caustic != nullptr) {
@@ -344,9 +346,12 @@ TEST(Bias, UnderSampledLightIsFoundWhereTheStderrCannotSeeIt) {
 }
 
 TEST(Bias, ACorrectRendererAtItsBudgetIsNotFlagged) {
-  // bdpt samples the caustic from the lamp's side; at 64 spp its estimates agree with the
+  // lt samples the caustic from the lamp's side; at 64 spp its estimates agree with the
   // reference's (a false alarm here has probability 1 % by construction: Šidák over the comparisons).
-  const BiasRun run = undersampling("bdpt", 64);
+  // Not bdpt: at 64 spp its image mean is bimodal here (0.221 ± 0.001 without a caustic firefly,
+  // 0.23–0.25 with one, against 0.25), under-sampled as the check says once the reference's
+  // stderr stops hiding it (issue 39's pixel groups: 3 flags in 60 seeds, bench/README.md).
+  const BiasRun run = undersampling("lt", 64);
   ASSERT_TRUE(run.report.undersampled);
   EXPECT_GT(run.report.undersampled->comparisons, 20);
   EXPECT_TRUE(run.report.undersampled->flagged.empty())

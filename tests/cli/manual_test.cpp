@@ -117,7 +117,7 @@ std::string complete(const std::string& words) {
 TEST(BashCompletion, CompletesCommandsOptionsAndChoices) {
   EXPECT_EQ(complete("pathex tr"), "trace\n");
   EXPECT_EQ(complete("pathex c"), "classify\ncheck\nconverge\n");
-  EXPECT_EQ(complete("pathex trace --re"), "--renderer\n--resolution\n--reference\n--report\n--resume\n");
+  EXPECT_EQ(complete("pathex trace --re"), "--renderer\n--replicates\n--resolution\n--reference\n--report\n--resume\n");
   EXPECT_EQ(complete("pathex trace --renderer pt"), "pt\npt-nee\npt-nee+distant\npt-nee+mirror\npt-nee+manifold\n");
   EXPECT_EQ(complete("pathex query --notation ''"), "full\nheckbert\nlpe\n");
   EXPECT_EQ(complete("pathex explain --light p"), "point\n");

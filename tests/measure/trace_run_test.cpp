@@ -47,7 +47,8 @@ TEST(TraceJob, AFreshJobOfTheDefaultSceneAndItsShard) {
   EXPECT_EQ(id.renderer_source, "bdpt");
   EXPECT_EQ(id.max_bounces, 16);
   EXPECT_EQ(id.sampler, "sobol");
-  EXPECT_EQ(id.batches, default_batches(SamplerKind::kSobol));
+  EXPECT_EQ(id.batches, 32);
+  EXPECT_EQ(id.replicates, 2);
   EXPECT_EQ(id.width, 64);
   EXPECT_EQ(id.height, 64);
   EXPECT_EQ(job->header.spp, 16u);

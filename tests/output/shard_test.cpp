@@ -155,6 +155,7 @@ struct Fixture {
     header.identity.strategies = {"a", "b"};
     header.identity.connectors = {{"b", "mirror"}};
     header.identity.batches = 3;
+    header.identity.replicates = 3;  // one group: the histogram below is HistogramLayout{3, …}
     header.spp = 8;
     header.share = PassSet::range(0, 8);
     header.passes = PassSet::range(0, 4);
@@ -343,6 +344,31 @@ TEST(ShardFile, LightRouletteThresholdRoundTripsAndDefaultsToTheEyeThreshold) {
   Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
   ASSERT_TRUE(old) << old.error().render();
   EXPECT_EQ(old->header.identity.rr_light_threshold, 0.25);
+}
+
+// Issue 39: the replicates per pixel round-trip; a shard written before them (no "replicates")
+// reads as one group of `batches` replicates, as it was rendered; a count that does not divide
+// the batches is refused at its pointer.
+TEST(ShardFile, ReplicatesRoundTripAndDefaultToTheBatchCount) {
+  Fixture f;
+  const std::string bytes = encode_shard(f.header, f.sums);
+  std::uint32_t h = 0;
+  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
+  nlohmann::ordered_json head = nlohmann::ordered_json::parse(bytes.substr(16, h));
+  EXPECT_EQ(head["options"]["replicates"], 3);
+  head["options"]["batches"] = 4;
+  head["options"]["replicates"] = 2;
+  Result<ShardFile> grouped = parse_shard(with_header(bytes, head.dump()), "x.shard");
+  ASSERT_TRUE(grouped) << grouped.error().render();
+  EXPECT_EQ(grouped->header.identity.replicates, 2);
+  head["options"]["replicates"] = 3;
+  Result<ShardFile> bad = parse_shard(with_header(bytes, head.dump()), "x.shard");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().render(), "x.shard:/options/replicates: expected a divisor of the batch count 4");
+  head["options"].erase("replicates");
+  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
+  ASSERT_TRUE(old) << old.error().render();
+  EXPECT_EQ(old->header.identity.replicates, 4);
 }
 
 TEST(ShardFile, HeaderErrorsNameTheFileAndThePointer) {

@@ -166,7 +166,7 @@ TEST(ImportCornell, ImagesMatchTheJsonSceneWithin3Sigma) {
     // --- per path string: every string carrying more than 0.5 % of the JSON image (batch-means
     // standard errors; a string the import's run did not sample counts as 0 ± 0) ---
     // The tolerance holds the family of these checks (every string and the total) to a 0.1 %
-    // false-failure rate (test::family_sigmas: Šidák over t with 31 degrees of freedom).
+    // false-failure rate (test::family_sigmas: Šidák over t with 16 degrees of freedom).
     std::map<std::string, const PathEstimate*> by_path;
     for (const PathEstimate& p : report.paths) by_path[p.path] = &p;
     std::vector<std::pair<std::string, double>> z;  // what, standardised deviation

@@ -13,6 +13,7 @@
 #include "film/image.h"
 #include "io/estimate_text.h"
 #include "io/histogram_json.h"
+#include "support/stat_seed.h"
 
 namespace pathex {
 namespace {
@@ -106,7 +107,7 @@ TEST(BatchMeans, EqualBatchesGiveTheTextbookFormula) {
   // stderr² = Σ (X_b − X̄)² / (B (B − 1)) = 5 / 12.
   std::vector<ExactRgb> sums;
   for (double s : {10.0, 20.0, 30.0, 40.0}) sums.push_back(*to_exact(gray(s)));
-  Estimate e = batch_means(sums, {10, 10, 10, 10}, 7);
+  Estimate e = estimate_of(sums, VarianceDesign({10, 10, 10, 10}, 1), 7);
   EXPECT_DOUBLE_EQ(e.luminance, 2.5);
   EXPECT_DOUBLE_EQ(e.rgb[0], 2.5);
   EXPECT_NEAR(e.std_error, std::sqrt(5.0 / 12.0), 1e-15);
@@ -115,16 +116,16 @@ TEST(BatchMeans, EqualBatchesGiveTheTextbookFormula) {
 
 TEST(BatchMeans, UnequalBatchesUseTheUnbiasedWeightedForm) {
   // n = (1, 3), S = (2, 3): N = 4, X̄ = 5/4, Σ (S_b − n_b X̄)² = 9/8, N² − Σ n_b² = 6: stderr² = 3/16.
-  Estimate e = batch_means({*to_exact(gray(2)), *to_exact(gray(3))}, {1, 3}, 4);
+  Estimate e = estimate_of({*to_exact(gray(2)), *to_exact(gray(3))}, VarianceDesign({1, 3}, 1), 4);
   EXPECT_DOUBLE_EQ(e.luminance, 1.25);
   EXPECT_NEAR(e.std_error, std::sqrt(3.0 / 16.0), 1e-15);
 }
 
 TEST(BatchMeans, OneNonEmptyBatchHasNoErrorEstimate) {
-  Estimate e = batch_means({*to_exact(gray(3)), ExactRgb{}}, {3, 0}, 3);
+  Estimate e = estimate_of({*to_exact(gray(3)), ExactRgb{}}, VarianceDesign({3, 0}, 1), 3);
   EXPECT_DOUBLE_EQ(e.luminance, 1.0);
   EXPECT_TRUE(std::isnan(e.std_error));
-  Estimate none = batch_means({ExactRgb{}, ExactRgb{}}, {0, 0}, 0);
+  Estimate none = estimate_of({ExactRgb{}, ExactRgb{}}, VarianceDesign({0, 0}, 1), 0);
   EXPECT_EQ(none.luminance, 0.0);
   EXPECT_TRUE(std::isnan(none.std_error));
 }
@@ -186,6 +187,90 @@ TEST(BatchMeans, IsUnbiasedAndCoversOverManyRuns) {
   EXPECT_NEAR(ratio_sum / runs, 1.0, 4 * std::sqrt(2.0 / (B - 1) / runs));
   // Coverage 0.95, binomial standard error √(0.95·0.05/500) ≈ 0.0097; four of them.
   EXPECT_NEAR(static_cast<double>(covered) / runs, 0.95, 0.04);
+}
+
+// --- pixel groups of replicates (issue 39) ---
+
+TEST(ReplicateGroups, TwoReplicatesGiveThePairedDifferenceFormula) {
+  // Two groups of two replicates: group 0 sums (10, 20) over (10, 10) samples, group 1 (15, 5)
+  // over (5, 5). Σ_g (S_g1 − S_g2)² / N² = (100 + 100) / 30², with one degree of freedom each.
+  const VarianceDesign design({10, 10, 5, 5}, 2);
+  EXPECT_EQ(design.dof(), 2);
+  EXPECT_EQ(design.replicates(), 2);
+  std::vector<ExactRgb> sums;
+  for (double v : {10.0, 20.0, 15.0, 5.0}) sums.push_back(*to_exact(gray(v)));
+  const Estimate e = estimate_of(sums, design, 4);
+  EXPECT_DOUBLE_EQ(e.luminance, 50.0 / 30.0);
+  EXPECT_NEAR(e.std_error, std::sqrt(200.0) / 30.0, 1e-14);
+  // The same batches read as four plain batch means: Σ (S_b − n_b X̄)² = 1000 / 9 over
+  // N² − Σ n_b² = 650, with 3 degrees of freedom.
+  const VarianceDesign plain({10, 10, 5, 5}, 1);
+  EXPECT_EQ(plain.dof(), 3);
+  EXPECT_NEAR(estimate_of(sums, plain, 4).std_error, std::sqrt(1000.0 / 9.0 / 650.0), 1e-14);
+  // A group whose second replicate holds no samples adds none: one degree of freedom, group 0's.
+  const VarianceDesign half({10, 10, 5, 0}, 2);
+  EXPECT_EQ(half.dof(), 1);
+  EXPECT_NEAR(half.variance({10, 20, 15, 0}), 100.0 / (25.0 * 25.0), 1e-15);
+  EXPECT_TRUE(std::isnan(VarianceDesign({3, 0, 4, 0}, 2).variance({1, 0, 1, 0})));
+}
+
+TEST(ReplicateGroups, RendersFillEveryGroupAndTheHistogramReadsItsDesign) {
+  HistogramLayout layout{8, {}, 4};  // four groups of two replicates
+  EXPECT_EQ(layout.replicates(), 2);
+  Histogram h(layout);
+  for (int b = 0; b < 8; ++b) h.add_samples(b, 3);
+  EXPECT_EQ(h.stderr_dof(), 4);
+  Histogram plain(HistogramLayout{8, {}});
+  for (int b = 0; b < 8; ++b) plain.add_samples(b, 3);
+  EXPECT_EQ(plain.stderr_dof(), 7);
+  Histogram other(HistogramLayout{8, {}, 2});
+  EXPECT_FALSE(h.merge(other));  // another grouping is another layout
+}
+
+// Replicates that are stratified within themselves, as a pixel's Sobol points are: each of a
+// group's R = 2 replicates takes n jittered points of f_g(u) = g + u (stratum i: u = (i + ξ) / n),
+// so that a replicate's sum has variance 1 / (12 n), far below n independent points' n / 12, and
+// the groups' means differ (plain batch means over these 32 batches would read that as noise).
+// Over many runs the paired estimate's stderr² is unbiased for var(X̄) = G R / (12 n N²), and
+// X̄ ± t₁₆ · stderr covers the true mean G / 2 95 % of the time.
+TEST(ReplicateGroups, StratifiedReplicatesGetAnHonestStderr) {
+  const int G = 16, R = 2, n = 8, runs = 400;
+  const double N = G * R * n, truth = G * R / (12.0 * n) / (N * N), mean_truth = G / 2.0;
+  Rng rng{test::stat_seed(11)};
+  double ratio_sum = 0;
+  int covered = 0;
+  for (int run = 0; run < runs; ++run) {
+    Histogram h(HistogramLayout{G * R, {}, G});
+    const Histogram::PathId id = h.intern("LDDE");
+    for (int g = 0; g < G; ++g)
+      for (int r = 0; r < R; ++r) {
+        for (int i = 0; i < n; ++i) ASSERT_TRUE(h.add(id, g * R + r, Histogram::kNoStrategy, gray(g + (i + rng.uniform()) / n)));
+        h.add_samples(g * R + r, n);
+      }
+    Result<HistogramReport> rep = make_report(h, RunInfo{}, nullptr, {});
+    ASSERT_TRUE(rep);
+    ratio_sum += rep->total.std_error * rep->total.std_error / truth;
+    if (std::fabs(rep->total.luminance - mean_truth) <= 2.120 * rep->total.std_error) ++covered;  // t(16), 95 %
+  }
+  // stderr² / truth is a χ²₁₆ / 16 variable per run (relative standard deviation √(2/16)); its
+  // mean over the runs is nearly normal.
+  const double k = test::family_sigmas(2, 1e-3, 1000);
+  const double ratio_sd = std::sqrt(2.0 / G / runs);
+  test::stat_log("mean stderr² / truth", ratio_sum / runs - 1.0, k * ratio_sd);
+  EXPECT_NEAR(ratio_sum / runs, 1.0, k * ratio_sd);
+  // The runs not covered are Binomial(400, 0.05), whose upper tail is far heavier than a normal
+  // one at this level: their two-sided tail, exactly, against the same Šidák level per check.
+  const int missed = runs - covered;
+  double below = 0, above = 0;  // P(X ≤ missed), P(X ≥ missed)
+  for (int i = 0; i <= runs; ++i) {
+    const double pmf = std::exp(std::lgamma(runs + 1.0) - std::lgamma(i + 1.0) - std::lgamma(runs - i + 1.0) +
+                                i * std::log(0.05) + (runs - i) * std::log(0.95));
+    if (i <= missed) below += pmf;
+    if (i >= missed) above += pmf;
+  }
+  const double tail = std::min(1.0, 2 * std::min(below, above)), each = 1 - std::sqrt(1 - 1e-3);
+  test::stat_log("coverage: two-sided binomial tail", tail, each);
+  EXPECT_GT(tail, each) << covered << " of " << runs << " covered";
 }
 
 // --- merging ---
@@ -322,7 +407,7 @@ TEST(HistogramMerge, RefusesADifferentLayout) {
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::kUsage);
   EXPECT_EQ(r.error().message,
-            "cannot merge histograms with different layouts (batch count or strategy list differ)");
+            "cannot merge histograms with different layouts (batch count, groups or strategy list differ)");
   EXPECT_FALSE(a.merge(c));
 }
 

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "stats/histogram.h"
 #include "stats/significance.h"
 
 namespace pathex::test {
@@ -42,9 +43,10 @@ inline void stat_log(const std::string& what, double value, double tolerance) {
 
 // The tolerance, in standard errors, that makes `checks` independent two-sided checks fail
 // together with probability `family_rate` (Šidák over Student's t with `dof` degrees of freedom,
-// 31 for the default 32 batches: stats/convergence.h's sidak_sigmas, the library's one copy).
+// kDefaultDof = 16 for a render's default 16 pixel groups of two replicates: stats/histogram.h;
+// stats/significance.h's sidak_sigmas, the library's one copy).
 // One place that states a statistical test's false-failure rate.
-inline double family_sigmas(int checks, double family_rate = 1e-3, int dof = 31) {
+inline double family_sigmas(int checks, double family_rate = 1e-3, int dof = kDefaultDof) {
   return sidak_sigmas(checks, family_rate, dof);
 }
 

@@ -68,7 +68,7 @@ TEST(FarGeometry, LeavesTheCornellBoxUnchanged) {
   };
   for (const auto& v : variants) {
     const Mean m = render_mean(cornell_with(v.shape));
-    // Six comparisons at a family-wise false-failure rate of 0.1 % (Šidák, t with 31 dof).
+    // Six comparisons at a family-wise false-failure rate of 0.1 % (Šidák, t with 16 dof).
     const double tolerance = test::family_sigmas(6) * std::sqrt(box.std_error * box.std_error + m.std_error * m.std_error);
     EXPECT_LE(std::fabs(m.luminance - box.luminance), tolerance)
         << v.what << ": mean " << m.luminance << " ± " << m.std_error << ", the box alone " << box.luminance << " ± "

@@ -62,7 +62,7 @@ Rendered render_file(const std::string& file, const std::string& renderer, const
 
 // test::expect_close: |estimate − expected| within `sigmas` standard errors plus `rel` of expected.
 // Each test passes test::family_sigmas(its number of checks): a family-wise false-failure rate of
-// 0.1 % (Šidák over Student's t with 31 dof), and its seed comes from test::stat_seed.
+// 0.1 % (Šidák over Student's t with 16 dof), and its seed comes from test::stat_seed.
 using test::expect_close;
 
 // The mean over a square film of half-width w (tangent units) of f(x, y), with the substitution
@@ -324,7 +324,7 @@ TEST(Nonfinite, TheFirstNamedIsTheSameForEveryThreadCount) {
     const test::CliRun t = test::run_pathex("trace samples/scenes/hard/nonfinite-hot-sphere.json --renderer pt-nee --spp 4 --no-images --threads " +
                                             std::string(threads) + " --out " + dir);
     EXPECT_EQ(t.code, 0);
-    EXPECT_NE(t.err.find("240 non-finite samples (dropped; any is a bug); the first from strategy nee on path LSDDDSE (near pixel (0, 0), pass 0)"),
+    EXPECT_NE(t.err.find("257 non-finite samples (dropped; any is a bug); the first from strategy nee on path LSDDDSE (near pixel (0, 0), pass 0)"),
               std::string::npos)
         << threads << " threads: " << t.err;
   }
