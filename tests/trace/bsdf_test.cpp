@@ -32,6 +32,7 @@ namespace pathex {
 namespace {
 
 using namespace bsdf_stats;  // NOLINT: the statistics shared with bsdf_materials_test
+using bsdf_stats::Estimate;  // not pathex::Estimate (stats/histogram.h, through support/stat_seed.h)
 
 const glm::vec3 kUp(0.0f, 0.0f, 1.0f);
 
