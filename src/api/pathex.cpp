@@ -468,7 +468,7 @@ namespace pathex::api {
 
 namespace {
 
-TraceEstimate estimate_of(std::string name, std::string expression, const Estimate& e, double total) {
+TraceEstimate trace_estimate(std::string name, std::string expression, const Estimate& e, double total) {
   TraceEstimate t;
   t.name = std::move(name);
   t.expression = std::move(expression);
@@ -513,14 +513,14 @@ TraceAnswer trace(const std::string& scene_file, const Renderer& renderer, const
   const double total = r.total.luminance;
   a.renderer = r.run.renderer;
   a.spp = r.run.spp;
-  a.total = estimate_of("total", "", r.total, total);
+  a.total = trace_estimate("total", "", r.total, total);
   for (const ClassEstimate& c : r.classes) {
-    a.classes.push_back(estimate_of(c.name, c.expr, c.estimate, total));
+    a.classes.push_back(trace_estimate(c.name, c.expr, c.estimate, total));
     a.classes.back().share = c.share;
     a.classes.back().rendered = c.rendered;
   }
-  for (const PathEstimate& p : r.paths) a.paths.push_back(estimate_of(p.path, "", p.estimate, total));
-  if (r.other) a.paths.push_back(estimate_of("other", "", r.other->estimate, total));
+  for (const PathEstimate& p : r.paths) a.paths.push_back(trace_estimate(p.path, "", p.estimate, total));
+  if (r.other) a.paths.push_back(trace_estimate("other", "", r.other->estimate, total));
   a.distinct_paths = r.distinct_paths;
   a.nonfinite_samples = r.nonfinite_samples;
   a.cpu_s = run->header.run.cpu_s;
