@@ -16,6 +16,7 @@
 #include "io/profile_json.h"
 #include "scene/scene.h"
 #include "support/scratch_files.h"
+#include "support/stat_seed.h"
 #include "trace/embree_scene.h"
 #include "trace/render.h"
 
@@ -175,12 +176,15 @@ TEST(Instancing, InPlaceInstancesRenderTheFlattenedBytes) {
 // Moved instances round differently from pre-transformed vertices (Embree tests the triangle in
 // group space, with the ray moved there), so the bytes differ: the same path strings, each path
 // with 50 or more samples within 3 standard errors (with both runs' errors), and the image total
-// within 3 standard errors and within 1e-5 relative (rounding, not sampling: the same seed).
+// within 3 standard errors and within 1e-5 relative (rounding, not sampling: the same seed, so
+// the 3 is no statistical tolerance). Which paths reach 50 samples, and whether rounding sends a
+// rare one elsewhere, depend on the seed: test::stat_seed_from, swept by bench/stat_sweep.py.
 TEST(Instancing, MovedInstancesAgreeWithTheFlattenedTwin) {
   const Scene flat = scene_of(twin_scene(false, true)), inst = scene_of(twin_scene(true, true));
+  const std::uint64_t seed = test::stat_seed_from(21);
   for (const char* renderer : {"pt-nee", "bdpt"}) {
     SCOPED_TRACE(renderer);
-    const HistogramReport a = render_report(inst, renderer, 21, 256), b = render_report(flat, renderer, 21, 256);
+    const HistogramReport a = render_report(inst, renderer, seed, 256), b = render_report(flat, renderer, seed, 256);
     EXPECT_NE(histogram_json_text(a), histogram_json_text(b));  // (as stated above; were they equal, the test above would say more)
     const auto within = [](const Estimate& x, const Estimate& y) {
       const double se = std::sqrt(x.std_error * x.std_error + y.std_error * y.std_error);
