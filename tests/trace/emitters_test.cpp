@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -136,8 +137,15 @@ TEST(AreaLight, CosineEmissionWithDensitiesThatIntegrateToOne) {
     Accumulator cos_mean, below, integral;
     for (int i = 0; i < 100'000; ++i) {
       Sampler s(test::stat_seed_from(1), two_sided, static_cast<std::uint64_t>(i));
-      const auto r = sample_ray(light, x, s.get2d());
-      ASSERT_TRUE(r);
+      const glm::vec2 u = s.get2d();
+      const auto r = sample_ray(light, x, u);
+      // A u with a coordinate exactly 0 (or u.x exactly 1/2 when two-sided: 0 once stretched)
+      // maps onto the hemisphere's rim, where the cosine density is 0: no ray, rightly. Each has
+      // probability 2^-24 a draw: 2 seeds in 100 of bench/stat_sweep.py drew one.
+      if (!r) {
+        ASSERT_TRUE(u.x == 0.0f || u.y == 0.0f || (two_sided && u.x == 0.5f)) << "u " << std::hexfloat << u.x << ", " << u.y;
+        continue;
+      }
       if (i < 2000) expect_consistent<AreaLightParams>(*r, pdf_ray(light, x, r->direction));
       const float c = glm::dot(r->direction, x.normal);
       cos_mean.add(std::abs(c));
@@ -271,7 +279,10 @@ TEST(SpotLight, FalloffPowerAndConeDensity) {
       const auto r = sample_ray(p, s.get2d());
       if (r) {
         if (i < 1000) expect_consistent<SpotLightParams>(*r, pdf_ray(p, r->direction));
-        EXPECT_GT(glm::dot(r->direction, p.axis), p.cos_total);
+        // Inside the cone, but for the rounding of the rotation to world space: a direction
+        // sampled a hair inside the rim can come out on it (seed 36 of bench/stat_sweep.py, both
+        // lights, 0.825336 each), within a few ulps of cos_total (4e-7 at 0.83).
+        EXPECT_GT(glm::dot(r->direction, p.axis), p.cos_total - 4e-7f);
       }
       weight.add(r ? r->weight.x : 0.0);
       integral.add(pdf_ray(p, sample_uniform_sphere(s.get2d())).dir * 4.0 * kPiD);
@@ -319,13 +330,19 @@ TEST(DistantLight, ThroughAWindowIsECosThetaInsideTheProjection) {
   Accumulator integral;
   for (int i = 0; i < 20'000; ++i) {
     Sampler s(test::stat_seed_from(5), 0, static_cast<std::uint64_t>(i));
-    const auto r = sample_ray(sun, s.get2d());
+    const glm::vec2 u_window = s.get2d();
+    const auto r = sample_ray(sun, u_window);
     ASSERT_TRUE(r);
     if (i < 1000) expect_consistent<DistantLightParams>(*r, pdf_ray(sun, r->origin));
     EXPECT_EQ(r->weight, power(sun));
     const glm::vec3 floor = r->origin + (r->origin.z / 0.8f) * r->direction;
     const auto c = connect(sun, floor);
-    ASSERT_TRUE(c) << i;
+    // A window point on the far edge of its half-open [0, 1)² (u of 1 − 2^-24) can round onto
+    // the edge itself on the way to the floor and back, and the join then misses the window
+    // (seed 94 of bench/stat_sweep.py): allowed within 1e-6 of an edge, nowhere else.
+    const auto near_edge = [](float v) { return v < 1e-6f || v > 1.0f - 1e-6f; };
+    if (!c && (near_edge(u_window.x) || near_edge(u_window.y))) continue;
+    ASSERT_TRUE(c) << i << ": u " << std::hexfloat << u_window.x << ", " << u_window.y;
     EXPECT_NEAR(glm::length(c->position - r->origin), 0.0f, 1e-5f);
     const glm::vec2 u = s.get2d();
     integral.add(pdf_ray(sun, glm::vec3(-1.0f + 4.0f * u.x, -1.0f + 3.0f * u.y, 2.0f)).pos * 12.0);

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <set>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -26,6 +27,13 @@ namespace {
 
 // The tolerance, in standard errors, of a mean in a test of `checks` checks: 0.1 % together.
 double sigmas_for(int checks) { return test::family_sigmas(checks, 1e-3, test::kNormalDof); }
+
+// A mean within `k` standard errors `se` of the value it estimates (its deviate logged under
+// PATHEX_STAT_LOG).
+void expect_mean(double mean, double expected, double se, double k, const std::string& what) {
+  test::stat_log(what, (mean - expected) / se, k);
+  EXPECT_NEAR(mean, expected, k * se) << what;
+}
 
 // Chi-square statistic of observed counts against equal expected counts.
 double chi2_uniform(const std::vector<std::uint64_t>& counts, std::uint64_t n) {
@@ -40,6 +48,14 @@ double chi2_uniform(const std::vector<std::uint64_t>& counts, std::uint64_t n) {
 
 std::size_t bin_of(float u, std::size_t bins) {
   return std::min(static_cast<std::size_t>(u * static_cast<float>(bins)), bins - 1);
+}
+
+// A chi-square statistic on `dof` degrees of freedom below the critical value of `checks` such
+// checks at 0.1 % together (its normal deviate logged under PATHEX_STAT_LOG).
+void expect_chi2_below(double statistic, double dof, int checks, const std::string& what) {
+  const double critical = test::family_chi2_critical(dof, checks);
+  test::stat_log(what, test::chi2_deviate(statistic, dof), test::chi2_deviate(critical, dof));
+  EXPECT_LT(statistic, critical) << what << ": chi-square " << statistic << " on " << dof << " degrees of freedom";
 }
 
 // Two-dimensional chi-square of pairs (a_i, b_i) on a bins × bins grid.
@@ -136,12 +152,11 @@ TEST(Sampler, OneDimensionIsUniform) {
     sum2 += static_cast<double>(a) * a;
   }
   // 3 checks (2 chi-square statistics, 1 mean), 0.1 % together.
-  const double crit = test::family_chi2_critical(kBins - 1, 3);
-  EXPECT_LT(chi2_uniform(across_samples, kN), crit);
-  EXPECT_LT(chi2_uniform(across_pixels, kN), crit);
+  expect_chi2_below(chi2_uniform(across_samples, kN), kBins - 1, 3, "across samples");
+  expect_chi2_below(chi2_uniform(across_pixels, kN), kBins - 1, 3, "across pixels");
   const double mean = sum / kN;
   const double var = sum2 / kN - mean * mean;
-  EXPECT_NEAR(mean, 0.5, sigmas_for(3) * std::sqrt(1.0 / 12.0 / kN));
+  expect_mean(mean, 0.5, std::sqrt(1.0 / 12.0 / kN), sigmas_for(3), "mean");
   EXPECT_NEAR(var, 1.0 / 12.0, 1e-3);  // the variance's standard error is ~7.5e-5 here
 }
 
@@ -150,35 +165,30 @@ TEST(Sampler, PairsAreUniformAcrossDimensionsIndicesAndSeeds) {
   // 98 per cell) for neighbouring dimensions, samples, pixels and seeds.
   constexpr std::uint64_t kN = 400'000;
   constexpr std::size_t kBins = 64;
-  const double crit = test::family_chi2_critical(kBins * kBins - 1, 5);  // 5 checks, 0.1 % together
-  const std::uint64_t k = test::stat_seed_from(5);
-  EXPECT_LT(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
-              Sampler s(k, 9, i);
-              const float a = s.get1d();
-              return std::array<float, 2>{a, s.get1d()};
-            }),
-            crit)
-      << "dimension d vs d + 1";
-  EXPECT_LT(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
-              return std::array<float, 2>{Sampler(k, 9, i).at(0), Sampler(k, 9, i + 1).at(0)};
-            }),
-            crit)
-      << "sample s vs s + 1";
-  EXPECT_LT(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
-              return std::array<float, 2>{Sampler(k, i, 0).at(2), Sampler(k, i + 1, 0).at(2)};
-            }),
-            crit)
-      << "pixel p vs p + 1";
-  EXPECT_LT(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
-              return std::array<float, 2>{Sampler(k, i, 0).at(0), Sampler(k + 1, i, 0).at(0)};
-            }),
-            crit)
-      << "seed k vs k + 1";
-  EXPECT_LT(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
-              return std::array<float, 2>{Sampler(k, i, 0).at(0), Sampler(k, 0, i).at(0)};
-            }),
-            crit)
-      << "(p, s) vs (s, p)";
+  constexpr double kDof = kBins * kBins - 1;
+  const std::uint64_t k = test::stat_seed_from(5);  // 5 checks, 0.1 % together
+  expect_chi2_below(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
+                      Sampler s(k, 9, i);
+                      const float a = s.get1d();
+                      return std::array<float, 2>{a, s.get1d()};
+                    }),
+                    kDof, 5, "dimension d vs d + 1");
+  expect_chi2_below(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
+                      return std::array<float, 2>{Sampler(k, 9, i).at(0), Sampler(k, 9, i + 1).at(0)};
+                    }),
+                    kDof, 5, "sample s vs s + 1");
+  expect_chi2_below(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
+                      return std::array<float, 2>{Sampler(k, i, 0).at(2), Sampler(k, i + 1, 0).at(2)};
+                    }),
+                    kDof, 5, "pixel p vs p + 1");
+  expect_chi2_below(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
+                      return std::array<float, 2>{Sampler(k, i, 0).at(0), Sampler(k + 1, i, 0).at(0)};
+                    }),
+                    kDof, 5, "seed k vs k + 1");
+  expect_chi2_below(chi2_pairs(kBins, kN, [k](std::uint64_t i) {
+                      return std::array<float, 2>{Sampler(k, i, 0).at(0), Sampler(k, 0, i).at(0)};
+                    }),
+                    kDof, 5, "(p, s) vs (s, p)");
 }
 
 TEST(Sampler, NeighbouringStreamsAreUncorrelated) {
@@ -219,8 +229,8 @@ TEST(Warps, ConcentricDiskCoversTheDiskUniformly) {
     quadrant += d.x > 0.0f && d.y > 0.0f;
   }
   const double se = std::sqrt(0.25 * 0.75 / kN);
-  EXPECT_NEAR(inner / double(kN), 0.25, sigmas_for(2) * se);  // 2 checks, 0.1 % together
-  EXPECT_NEAR(quadrant / double(kN), 0.25, sigmas_for(2) * se);
+  expect_mean(inner / double(kN), 0.25, se, sigmas_for(2), "disk inner");  // 2 checks, 0.1 % together
+  expect_mean(quadrant / double(kN), 0.25, se, sigmas_for(2), "disk quadrant");
 }
 
 TEST(Warps, SphereConeAndCosineMoments) {
@@ -268,9 +278,9 @@ TEST(Warps, TriangleBarycentricsAreUniform) {
     near_vertex += b.x + b.y < 0.5f;  // the sub-triangle at vertex 2 has 1/4 of the area
   }
   const double k = sigmas_for(3);  // 3 checks, 0.1 % together
-  EXPECT_NEAR(s0 / kN, 1.0 / 3.0, k * std::sqrt(1.0 / 18.0 / kN));
-  EXPECT_NEAR(s1 / kN, 1.0 / 3.0, k * std::sqrt(1.0 / 18.0 / kN));
-  EXPECT_NEAR(near_vertex / double(kN), 0.25, k * std::sqrt(0.25 * 0.75 / kN));
+  expect_mean(s0 / kN, 1.0 / 3.0, std::sqrt(1.0 / 18.0 / kN), k, "triangle b0");
+  expect_mean(s1 / kN, 1.0 / 3.0, std::sqrt(1.0 / 18.0 / kN), k, "triangle b1");
+  expect_mean(near_vertex / double(kN), 0.25, std::sqrt(0.25 * 0.75 / kN), k, "triangle near vertex 2");
 }
 
 }  // namespace
