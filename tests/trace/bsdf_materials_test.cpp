@@ -253,7 +253,12 @@ TEST(RoughDielectric, AtAlphaToZeroIsTheSmoothDielectric) {
         EXPECT_NEAR(glm::length(mean - glm::dvec3(d->wi)), 0.0, 1e-2) << what;
         EXPECT_NEAR(d->weight.x, 1.0f / (ior * ior), 1e-6f) << what;
       } else {
-        EXPECT_EQ(n_t, 0) << what;  // total internal reflection
+        // Total internal reflection, but for GGX's tail: a microfacet tilted past θ − θc = 28°
+        // (probability about 1 / (1 + tan²28° / α²) = 3.5e-6 a sample, up to ~3 times that for
+        // the visible normals at 70°) lets a sample through now and then: ~0.1 expected in
+        // 20,000, 5 or more with probability ~1e-5. (Asserting none failed 5 seeds in 100 of
+        // bench/stat_sweep.py.)
+        EXPECT_LE(n_t, 4) << what;
       }
     }
   }

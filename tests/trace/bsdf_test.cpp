@@ -226,10 +226,12 @@ TEST(Glossy, SampleValuesAreEvalAndPdf) {
 
 TEST(Glossy, NearDeltaRoughnessConvergesToTheMirror) {
   // Roughness 1e-4: every sample is finite, leaves within a few alpha of the mirror direction,
-  // and the albedo is Schlick's F at wo (1 for reflectance 1, the mirror's value).
+  // and its weight is Schlick's F at its half vector (1 for reflectance 1, the mirror's value):
+  // near F at wo, but GGX's tails put a sample's half vector far enough from the normal to move F
+  // by 1e-3 about once in 5,000 (1 seed in 5 of bench/stat_sweep.py compared with F at wo).
   const glm::vec3 wo = polar(60.0, 20.0);
   const glm::vec3 wr = mirror_of(wo, kUp);
-  const float schlick = 0.5f + 0.5f * std::pow(1.0f - 0.5f, 5.0f);  // R0 = 0.5 at cos θ = 1/2
+  const auto schlick = [](float cos_h) { return 0.5f + 0.5f * std::pow(1.0f - cos_h, 5.0f); };  // R0 = 0.5
   for (float alpha : {1e-4f, 0.0f /* clamped to kMinGlossyRoughness */}) {
     const Material white = Glossy{glm::vec3(1.0f), alpha};
     const Material grey = Glossy{glm::vec3(0.5f), alpha};
@@ -250,7 +252,7 @@ TEST(Glossy, NearDeltaRoughnessConvergesToTheMirror) {
       EXPECT_EQ(r->letter, kD) << "still a finite lobe";
       const auto g = bsdf::sample(grey, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
       ASSERT_TRUE(g);
-      EXPECT_NEAR(g->weight.x, schlick, 1e-3f);
+      EXPECT_NEAR(g->weight.x, schlick(glm::dot(wo, glm::normalize(wo + g->wi))), 1e-3f);
     }
     EXPECT_GT(near_mirror, 0.97 * kN) << alpha;
   }
