@@ -248,7 +248,10 @@ TEST(Warps, SphereConeAndCosineMoments) {
     ASSERT_NEAR(glm::length(b), 1.0f, 1e-5f);
     ASSERT_NEAR(glm::length(k), 1.0f, 1e-5f);
     ASSERT_GE(b.z, 0.0f);
-    ASSERT_GT(k.z, c);
+    // In the closed cone: a u.x a few ulps below 1 puts z a fraction of an ulp above c, which
+    // rounds onto c itself (probability ~2^-23 a draw: 7 seeds in 300 of bench/stat_sweep.py
+    // asserted z > c and failed).
+    ASSERT_GE(k.z, c);
     sz += a.z, sz2 += a.z * a.z, cz += b.z, cz2 += b.z * b.z, kz += k.z, kz2 += k.z * k.z;
   }
   // A bound on every standard error here, times the tolerance of 6 checks at 0.1 % together.
