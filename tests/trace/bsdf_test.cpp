@@ -536,7 +536,11 @@ TEST(MixtureBsdf, AbsorptionIsCarriedByTheWeights) {
   for (int i = 0; i < kN; ++i) {
     Sampler s(test::stat_seed_from(14), 0, static_cast<std::uint64_t>(i));
     const float uc = s.get1d();
-    const auto r = bsdf::sample(m, wo, kUp, kUp, uc, s.get2d(), TransportMode::kRadiance);
+    const glm::vec2 u = s.get2d();
+    const auto r = bsdf::sample(m, wo, kUp, kUp, uc, u, TransportMode::kRadiance);
+    // None only where u has a coordinate exactly 0 (probability 2^-24 each): the diffuse lobe's
+    // direction then lies on the horizon, density 0 (seed 68 of bench/stat_sweep.py drew one).
+    if (!r && (u.x == 0.0f || u.y == 0.0f)) continue;
     ASSERT_TRUE(r);
     EXPECT_NEAR(r->weight.x, 0.6f, 1e-5f);
     if (r->is_delta) {
