@@ -61,6 +61,38 @@ STATISTICAL_TESTS = [
     ("emission_cones_test", "EmissionCones.SampledDensityIsThePdfAndTheEstimatorIsUnbiased"),
     ("convergence_test", "Convergence.BatchVarianceIsStableForNormalMeansAndNotForASpike"),
     ("histogram_test", "ReplicateGroups.StratifiedReplicatesGetAnHonestStderr"),
+    # The BSDF, emitter, random-number and histogram unit tests (issue 36, seventh session).
+    ("bsdf_test", "Diffuse.WhiteFurnaceAndSampleWeights"),
+    ("bsdf_test", "Glossy.WhiteFurnaceAgreesWithTheClassicEstimatorAndNeverExceedsOne"),
+    ("bsdf_test", "Glossy.AlphaOneAtNormalIncidenceHasAClosedFormAlbedo"),
+    ("bsdf_test", "Glossy.NearDeltaRoughnessConvergesToTheMirror"),
+    ("bsdf_test", "DielectricBsdf.ReflectsWithFresnelProbabilityAndRefractsBySnell"),
+    ("bsdf_test", "DielectricBsdf.FurnaceInBothTransportModes"),
+    ("bsdf_test", "SampleVersusPdf.*"),
+    ("bsdf_test", "MixtureBsdf.LettersFollowTheWeights"),
+    ("bsdf_test", "MixtureBsdf.AbsorptionIsCarriedByTheWeights"),
+    ("bsdf_materials_test", "RoughDielectric.AtAlphaToZeroIsTheSmoothDielectric"),
+    ("bsdf_materials_test", "Beckmann.ConductorWhiteFurnaceIsItsSingleScatteringAlbedo"),
+    ("bsdf_materials_test", "MaterialsSampleVersusPdf.*"),  # about 70 s a seed
+    ("bsdf_materials_test", "MaterialsAlbedo.*"),  # about 120 s a seed
+    ("emitters_test", "AreaLight.*"),
+    ("emitters_test", "PointLight.*"),
+    ("emitters_test", "SpotLight.*"),
+    ("emitters_test", "DistantLight.ThroughAWindowIsECosThetaInsideTheProjection"),
+    ("emitters_test", "Pinhole.*"),
+    ("emitters_test", "ThinLens.*"),
+    ("emitters_test", "Orthographic.*"),
+    ("rng_test", "Sampler.OneDimensionIsUniform"),
+    ("rng_test", "Sampler.PairsAreUniformAcrossDimensionsIndicesAndSeeds"),
+    ("rng_test", "Sampler.NeighbouringStreamsAreUncorrelated"),
+    ("rng_test", "Warps.*"),
+    ("texture_eval_test", "AlphaTest.*"),
+    ("histogram_test", "BatchMeans.MatchesTheTextbookStandardErrorOnSyntheticData"),
+    ("histogram_test", "BatchMeans.IsUnbiasedAndCoversOverManyRuns"),
+    ("instancing_test", "Instancing.MovedInstancesAgreeWithTheFlattenedTwin"),
+    ("manifold_reference_test", "ManifoldReference.SeenThroughCausticAgreesWithTheQuadrature"),
+    ("manifold_reference_test", "ManifoldReference.LampGlassSeenThroughAgreesWithTheQuadrature"),
+    ("manifold_reference_test", "ManifoldReference.BdptManifoldDirectCausticAgreesWithBdpt"),
 ]
 # tests/meta/stat_registry_test.cpp checks that every test reaching test::stat_seed is listed here.
 

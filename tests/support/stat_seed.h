@@ -50,4 +50,36 @@ inline double family_sigmas(int checks, double family_rate = 1e-3, int dof = kDe
   return sidak_sigmas(checks, family_rate, dof);
 }
 
+// Student's t with this many degrees of freedom is the normal law to the precision of the tails
+// used here: the `dof` to pass family_sigmas for a mean of many independent samples (thousands or
+// more) whose standard error is estimated from the samples themselves, or is known exactly.
+inline constexpr int kNormalDof = 1 << 20;
+
+// The upper critical value of a chi-square statistic with `dof` degrees of freedom (Wilson and
+// Hilferty's cube-root normal approximation) `z` standard normal deviates into its upper tail.
+inline double chi2_upper_critical(double dof, double z) {
+  const double h = 2.0 / (9.0 * dof);
+  return dof * std::pow(1.0 - h + z * std::sqrt(h), 3.0);
+}
+
+// The inverse: how many standard normal deviates into its upper tail a chi-square statistic `x`
+// with `dof` degrees of freedom lies (for stat_log, on the scale of the tolerance's z).
+inline double chi2_deviate(double x, double dof) {
+  const double h = 2.0 / (9.0 * dof);
+  return (std::cbrt(x / dof) - 1.0 + h) / std::sqrt(h);
+}
+
+// The critical value that `checks` one-sided chi-square checks (each with `dof` degrees of
+// freedom) exceed together with probability `family_rate` when nothing is wrong: Šidák's rate a per
+// check, its upper-tail normal deviate (the two-sided one of 2a), through chi2_upper_critical.
+// The same for a one-sided check of a normal deviate (a mean that must stay below a bound).
+inline double family_sigmas_one_sided(int checks, double family_rate = 1e-3, int dof = kNormalDof) {
+  const double each = 1.0 - std::pow(1.0 - family_rate, 1.0 / std::max(checks, 1));
+  return sidak_sigmas(1, 2.0 * each, dof);
+}
+
+inline double family_chi2_critical(double dof, int checks, double family_rate = 1e-3) {
+  return chi2_upper_critical(dof, family_sigmas_one_sided(checks, family_rate));
+}
+
 }  // namespace pathex::test

@@ -6,10 +6,13 @@
 // of refraction between radiance and importance transport), the rough dielectric's limit as
 // alpha → 0 (the smooth one), the exact Fresnel of a complex index, and each kind's letters.
 //
-// Tolerances (support/bsdf_stats.h): means within kZ = 4 standard errors, chi-square below the
-// critical value at z = 5; all at fixed seeds.
+// Tolerances: each statistical test states a family-wise false-failure rate of 0.1 % over the
+// checks it makes (test::family_sigmas for means, test::family_chi2_critical for chi-square
+// statistics), and takes its seeds from test::stat_seed_from: fixed seeds, or others under
+// PATHEX_STAT_SEED (bench/stat_sweep.py sweeps them).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -21,6 +24,7 @@
 #include "scene/material.h"
 #include "scene/metal_spectra.h"
 #include "support/bsdf_stats.h"
+#include "support/stat_seed.h"
 #include "trace/bsdf.h"
 #include "optics/fresnel.h"
 #include "trace/microfacet.h"
@@ -104,14 +108,32 @@ std::vector<glm::vec3> incident_directions() {
   return out;
 }
 
+// The smaller roughness of a microfacet kind (1 for the others).
+float narrowest_alpha(const Material& m) {
+  if (const auto* c = std::get_if<Conductor>(&m)) return std::min(c->alpha_u, c->alpha_v);
+  if (const auto* d = std::get_if<RoughDielectric>(&m)) return std::min(d->alpha_u, d->alpha_v);
+  return 1.0f;
+}
+
 TEST(MaterialsSampleVersusPdf, ChiSquareForEveryNewFiniteKindAngleAndRoughness) {
-  std::uint64_t seed = 1000;
-  for (const Case& c : finite_cases()) {
-    for (const glm::vec3& wo : incident_directions()) {
-      const int sub = c.name.starts_with("beckmann") ? 16 : 6;  // bsdf_stats.h: a narrow Beckmann lobe's bins
+  std::uint64_t seed = test::stat_seed_from(1000);
+  const std::vector<Case> cases = finite_cases();
+  const std::vector<glm::vec3> wos = incident_directions();
+  const int checks = static_cast<int>(cases.size() * wos.size());  // 147, 0.1 % together
+  for (const Case& c : cases) {
+    for (const glm::vec3& wo : wos) {
+      // bsdf_stats.h: the bins of a narrow lobe (Beckmann's, and GGX's of alpha 0.15 or less) on a
+      // 16 x 16 sub-grid. On 6 x 6 midpoints the expected counts of GGX glass at alpha 0.1 were
+      // off enough to put its chi-square 4.3 normal deviates up at the fixed seed (the Šidák
+      // critical value over 147 checks is 4.0).
+      const int sub = c.name.starts_with("beckmann") || narrowest_alpha(c.material) <= 0.15f ? 16 : 6;
       const Chi2 r = chi2_sample_vs_pdf(c.material, wo, kUp, seed++, 200'000, sub);
+      const double critical = test::family_chi2_critical(r.dof, checks);
+      test::stat_log("chi-square " + c.name + " wo.z " + std::to_string(wo.z), test::chi2_deviate(r.statistic, r.dof),
+                     test::chi2_deviate(critical, r.dof));
       EXPECT_FALSE(r.impossible_count) << c.name << " wo.z " << wo.z;
-      EXPECT_LT(r.statistic, r.critical) << c.name << " wo.z " << wo.z << ": chi-square " << r.statistic;
+      EXPECT_LT(r.statistic, critical) << c.name << " wo.z " << wo.z << ": chi-square " << r.statistic << " on " << r.dof
+                                       << " degrees of freedom";
     }
   }
 }
@@ -152,20 +174,24 @@ TEST(MaterialsSample, ValuesAreEvalAndPdfInBothModes) {
 // The directional albedo by sampling equals the integral of eval·|cos| over the sphere with
 // uniform directions (independent of sample() and pdf()), and is at most 1.
 TEST(MaterialsAlbedo, SamplingAgreesWithUniformEvaluationAndNeverExceedsOne) {
-  std::uint64_t seed = 3000;
-  for (const Case& c : finite_cases()) {
-    if (std::holds_alternative<Mixture>(c.material)) continue;  // its delta is not in eval()
-    std::vector<glm::vec3> wos = incident_directions();
-    wos.push_back(kUp);
-    wos.push_back(-kUp);
+  std::uint64_t seed = test::stat_seed_from(3000);
+  std::vector<Case> cases = finite_cases();
+  std::erase_if(cases, [](const Case& c) { return std::holds_alternative<Mixture>(c.material); });  // its delta is not in eval()
+  std::vector<glm::vec3> wos = incident_directions();
+  wos.push_back(kUp);
+  wos.push_back(-kUp);
+  // Two checks per case and direction (a comparison, a one-sided bound): 360, 0.1 % together.
+  const int checks = static_cast<int>(2 * cases.size() * wos.size());
+  const double k = test::family_sigmas(checks, 1e-3, test::kNormalDof), k1 = test::family_sigmas_one_sided(checks);
+  for (const Case& c : cases) {
     for (const glm::vec3& wo : wos) {
       const Estimate by_sampling = albedo_by_sampling(c.material, wo, kUp, seed++, 200'000);
       const Estimate by_eval = albedo_by_uniform_eval(c.material, wo, kUp, seed++, 400'000);
-      expect_agree(by_sampling, by_eval, c.name.c_str());
+      expect_agree(by_sampling, by_eval, (c.name + " wo.z " + std::to_string(wo.z)).c_str(), k);
       // Radiance transport scales refracted radiance by 1/η'², which may exceed 1; importance
       // transport does not, and conserves energy.
       const Estimate importance = albedo_by_sampling(c.material, wo, kUp, seed++, 200'000, TransportMode::kImportance);
-      EXPECT_LE(importance.mean, 1.0 + kZ * importance.se) << c.name;
+      EXPECT_LE(importance.mean, 1.0 + k1 * importance.se) << c.name;
     }
   }
 }
@@ -203,7 +229,7 @@ TEST(RoughDielectric, AtAlphaToZeroIsTheSmoothDielectric) {
       glm::dvec3 dir_t(0.0), dir_smooth(0.0);
       int n_t = 0;
       for (int i = 0; i < 20'000; ++i) {
-        Sampler s(11, 0, static_cast<std::uint64_t>(i));
+        Sampler s(test::stat_seed_from(11), 0, static_cast<std::uint64_t>(i));
         const float uc = s.get1d();
         const glm::vec2 u = s.get2d();
         const auto r = bsdf::sample(rough, wo, kUp, kUp, uc, u, TransportMode::kRadiance);
@@ -217,8 +243,10 @@ TEST(RoughDielectric, AtAlphaToZeroIsTheSmoothDielectric) {
       }
       const float f = fresnel_dielectric(wo.z, ior);
       const std::string what = "ior " + std::to_string(ior) + " theta " + std::to_string(theta);
-      EXPECT_NEAR(refl.estimate().mean, f, kZ * refl.estimate().se + 5e-3) << what;
-      EXPECT_NEAR(trans.estimate().mean, (1.0 - f) / (ior * ior), kZ * trans.estimate().se + 5e-3) << what;
+      // 16 means (2 indices x 4 angles x 2), 0.1 % together; 5e-3 for what alpha 1e-3 is not the mirror.
+      const double k = test::family_sigmas(16, 1e-3, test::kNormalDof);
+      expect_mean(refl.estimate(), f, k, "reflected, " + what, 5e-3);
+      expect_mean(trans.estimate(), (1.0 - f) / (ior * ior), k, "transmitted, " + what, 5e-3);
       if (f < 1.0f) {
         const auto d = bsdf::sample(smooth, wo, kUp, kUp, /*u_component=*/0.9999f, glm::vec2(0.5f), TransportMode::kRadiance);
         ASSERT_TRUE(d && d->wi.z < 0.0f) << what;
@@ -226,7 +254,12 @@ TEST(RoughDielectric, AtAlphaToZeroIsTheSmoothDielectric) {
         EXPECT_NEAR(glm::length(mean - glm::dvec3(d->wi)), 0.0, 1e-2) << what;
         EXPECT_NEAR(d->weight.x, 1.0f / (ior * ior), 1e-6f) << what;
       } else {
-        EXPECT_EQ(n_t, 0) << what;  // total internal reflection
+        // Total internal reflection, but for GGX's tail: a microfacet tilted past θ − θc = 28°
+        // (probability about 1 / (1 + tan²28° / α²) = 3.5e-6 a sample, up to ~3 times that for
+        // the visible normals at 70°) lets a sample through now and then: ~0.1 expected in
+        // 20,000, 5 or more with probability ~1e-5. (Asserting none failed 5 seeds in 100 of
+        // bench/stat_sweep.py.)
+        EXPECT_LE(n_t, 4) << what;
       }
     }
   }
@@ -359,11 +392,11 @@ TEST(Beckmann, DIsWaltersAndNormalisedAndLambdaBelongsToIt) {
 // directional albedo, which single scattering makes the integral over half vectors
 //   A(θo) = ∫ D(m) G2(wo, wi) (wo·m) / cos θo dm,  wi = reflect(wo, m), wi.z > 0,
 // with G2 = 1 / (1 + Λ(wo) + Λ(wi)) (height-correlated). Computed here from Walter's closed
-// forms by the midpoint rule (2,000 × 720), and the sampled mean within 3 standard errors of it.
+// forms by the midpoint rule (2,000 × 720), and the sampled mean within family_sigmas(8) standard errors of it.
 TEST(Beckmann, ConductorWhiteFurnaceIsItsSingleScatteringAlbedo) {
   for (double cos_i : {1.0, 0.7, 0.3, 0.05})
     EXPECT_GT(fresnel_complex(static_cast<float>(cos_i), 0.001f, 1000.0f), 1.0f - 1e-5f);
-  std::uint64_t seed = 4100;
+  std::uint64_t seed = test::stat_seed_from(4100);
   // At alpha 0.1 masking is nil below ~60° (Λ ~ e^−a², a = 1 / (α tan θ)): there the sampled
   // weights are exactly 1; alpha 0.3 loses energy at every angle but normal incidence.
   for (const double alpha : {0.1, 0.3}) {
@@ -393,8 +426,11 @@ TEST(Beckmann, ConductorWhiteFurnaceIsItsSingleScatteringAlbedo) {
       const Estimate furnace = albedo_by_sampling(c, glm::vec3(wo), kUp, seed++, 400'000);
       std::printf("beckmann furnace alpha %g at %g deg: sampled %.6f +- %.6f, integrated %.6f\n", alpha, theta_o,
                   furnace.mean, furnace.se, a);
-      EXPECT_NEAR(furnace.mean, a, 3.0 * furnace.se + 1e-5) << "at " << theta_o << ": sampled " << furnace.mean << " ± "
-                                                            << furnace.se << ", integrated " << a;
+      // 8 checks (2 roughnesses x 4 angles), 0.1 % together (3 standard errors each was 2 % together).
+      const double k = test::family_sigmas(8, 1e-3, test::kNormalDof);
+      if (furnace.se > 0.0) test::stat_log("beckmann furnace " + std::to_string(alpha) + " at " + std::to_string(theta_o), (furnace.mean - a) / furnace.se, k);
+      EXPECT_NEAR(furnace.mean, a, k * furnace.se + 1e-5) << "at " << theta_o << ": sampled " << furnace.mean << " ± "
+                                                          << furnace.se << ", integrated " << a;
       EXPECT_LT(a, 1.0 + 1e-5) << theta_o;  // single scattering loses what masking hides
       if (theta_o == 0.0) {
         EXPECT_GT(a, 0.99);

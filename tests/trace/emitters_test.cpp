@@ -4,12 +4,15 @@
 // form from the eye side and from the light side for every sensor. Also the DESIGN §9 closed
 // forms (point light irradiance, distant light through a window) and grazing configurations.
 //
-// Tolerances: Monte Carlo means within kZ = 4 standard errors (estimated from the same samples);
-// fixed seeds throughout.
+// Tolerances: each test's Monte Carlo means (standard errors estimated from the same samples)
+// within the standard errors that its number of checks gives at a family-wise false-failure rate
+// of 0.1 % (test::family_sigmas); seeds from test::stat_seed_from (fixed, or others under
+// PATHEX_STAT_SEED: bench/stat_sweep.py).
 #include "trace/emitters.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -20,13 +23,13 @@
 
 #include <glm/geometric.hpp>
 
+#include "support/stat_seed.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
 
 namespace pathex {
 namespace {
 
-constexpr double kZ = 4.0;
 constexpr double kPiD = std::numbers::pi;
 
 struct Accumulator {
@@ -44,10 +47,14 @@ struct Accumulator {
   }
 };
 
-// Within kZ standard errors, plus float rounding (some estimators here are exact per sample).
-#define EXPECT_MC_NEAR(acc, expected)                                                  \
-  EXPECT_NEAR((acc).mean(), (expected), kZ * (acc).se() + 1e-5 * std::abs(expected)) \
-      << "standard error " << (acc).se()
+// The tolerance, in standard errors, of a test that makes `checks` such checks: 0.1 % together.
+double sigmas_for(int checks) { return test::family_sigmas(checks, 1e-3, test::kNormalDof); }
+
+// Within k standard errors, plus float rounding (some estimators here are exact per sample).
+#define EXPECT_MC_NEAR(acc, expected, k)                                                                        \
+  test::stat_log(#acc, (acc).se() > 0.0 ? ((acc).mean() - (expected)) / (acc).se() : 0.0, k);                  \
+  EXPECT_NEAR((acc).mean(), (expected), (k) * (acc).se() + 1e-5 * std::abs(expected)) << "standard error " \
+                                                                                      << (acc).se()
 
 std::string letters(Letter first, Letter second) {
   return {letter_char(first), letter_char(second)};
@@ -129,15 +136,23 @@ TEST(EmitterLetters, MatchTheAlphabet) {
 // --- lights ---
 
 TEST(AreaLight, CosineEmissionWithDensitiesThatIntegrateToOne) {
+  const double k = sigmas_for(6);  // 6 Monte Carlo means, 0.1 % together
   for (bool two_sided : {false, true}) {
     const AreaLightParams light{glm::vec3(2.0f, 1.0f, 0.5f), two_sided};
     const SurfacePoint x{glm::vec3(1.0f, 2.0f, 3.0f), glm::normalize(glm::vec3(0.2f, -0.3f, 1.0f)),
                          0.25f};
     Accumulator cos_mean, below, integral;
     for (int i = 0; i < 100'000; ++i) {
-      Sampler s(1, two_sided, static_cast<std::uint64_t>(i));
-      const auto r = sample_ray(light, x, s.get2d());
-      ASSERT_TRUE(r);
+      Sampler s(test::stat_seed_from(1), two_sided, static_cast<std::uint64_t>(i));
+      const glm::vec2 u = s.get2d();
+      const auto r = sample_ray(light, x, u);
+      // A u with a coordinate exactly 0 (or u.x exactly 1/2 when two-sided: 0 once stretched)
+      // maps onto the hemisphere's rim, where the cosine density is 0: no ray, rightly. Each has
+      // probability 2^-24 a draw: 2 seeds in 100 of bench/stat_sweep.py drew one.
+      if (!r) {
+        ASSERT_TRUE(u.x == 0.0f || u.y == 0.0f || (two_sided && u.x == 0.5f)) << "u " << std::hexfloat << u.x << ", " << u.y;
+        continue;
+      }
       if (i < 2000) expect_consistent<AreaLightParams>(*r, pdf_ray(light, x, r->direction));
       const float c = glm::dot(r->direction, x.normal);
       cos_mean.add(std::abs(c));
@@ -148,9 +163,9 @@ TEST(AreaLight, CosineEmissionWithDensitiesThatIntegrateToOne) {
       const glm::vec3 w = sample_uniform_sphere(s.get2d());
       integral.add(pdf_ray(light, x, w).dir * 4.0 * kPiD);
     }
-    EXPECT_MC_NEAR(cos_mean, 2.0 / 3.0);
-    EXPECT_MC_NEAR(below, two_sided ? 0.5 : 0.0);
-    EXPECT_MC_NEAR(integral, 1.0);
+    EXPECT_MC_NEAR(cos_mean, 2.0 / 3.0, k);
+    EXPECT_MC_NEAR(below, two_sided ? 0.5 : 0.0, k);
+    EXPECT_MC_NEAR(integral, 1.0, k);
     EXPECT_EQ(emitted_radiance(light, x.normal, -x.normal),
               two_sided ? light.radiance : glm::vec3(0.0f));
   }
@@ -160,6 +175,7 @@ TEST(AreaLight, CosineEmissionWithDensitiesThatIntegrateToOne) {
 }
 
 TEST(AreaLight, IrradianceFromADiskMatchesTheClosedForm) {
+  const double k = sigmas_for(2);  // 2 Monte Carlo means, 0.1 % together
   // A disk of radius R and radiance Le facing a point on its axis at height h gives the point an
   // irradiance of π Le R² / (h² + R²). Uniform area sampling of the disk, joined by connect().
   const float R = 0.5f, h = 1.5f, Le = 3.0f;
@@ -168,7 +184,7 @@ TEST(AreaLight, IrradianceFromADiskMatchesTheClosedForm) {
   const float kCosCone = std::cos(0.35f);
   Accumulator e, solid_angle_integral;
   for (int i = 0; i < 200'000; ++i) {
-    Sampler s(2, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(2), 0, static_cast<std::uint64_t>(i));
     const glm::vec2 d = sample_concentric_disk(s.get2d()) * R;
     const SurfacePoint x{glm::vec3(d.x, d.y, h), glm::vec3(0.0f, 0.0f, -1.0f),
                          1.0f / (kPi * R * R)};
@@ -188,13 +204,14 @@ TEST(AreaLight, IrradianceFromADiskMatchesTheClosedForm) {
     }
     solid_angle_integral.add(p / uniform_cone_pdf(kCosCone));
   }
-  EXPECT_MC_NEAR(e, kPiD * Le * R * R / (h * h + R * R));
-  EXPECT_MC_NEAR(solid_angle_integral, 1.0);
+  EXPECT_MC_NEAR(e, kPiD * Le * R * R / (h * h + R * R), k);
+  EXPECT_MC_NEAR(solid_angle_integral, 1.0, k);
   // Seen from behind a one-sided light: nothing.
   EXPECT_FALSE(connect(light, SurfacePoint{glm::vec3(0, 0, h), glm::vec3(0, 0, 1), 1.0f}, ref));
 }
 
 TEST(AreaLight, IrradianceIsScaleInvariantFromTinyToHugeScenes) {
+  const double k = sigmas_for(2);  // 2 Monte Carlo means, 0.1 % together
   // DESIGN §10: the disk configuration above scaled by 1e-4 and 1e+4 (the latter also moved 1e+5
   // from the origin) gives the same irradiance, π Le R² / (h² + R²), and finite join densities.
   const float Le = 1.0f;
@@ -204,7 +221,7 @@ TEST(AreaLight, IrradianceIsScaleInvariantFromTinyToHugeScenes) {
     const glm::vec3 ref(offset, -offset, offset);
     Accumulator e;
     for (int i = 0; i < 50'000; ++i) {
-      Sampler s(20, 0, static_cast<std::uint64_t>(i));
+      Sampler s(test::stat_seed_from(20), 0, static_cast<std::uint64_t>(i));
       const glm::vec2 d = sample_concentric_disk(s.get2d()) * R;
       const SurfacePoint x{ref + glm::vec3(d.x, d.y, h), glm::vec3(0.0f, 0.0f, -1.0f),
                            1.0f / (kPi * R * R)};
@@ -213,22 +230,23 @@ TEST(AreaLight, IrradianceIsScaleInvariantFromTinyToHugeScenes) {
       ASSERT_TRUE(std::isfinite(c->pdf_dir) && c->pdf_dir > 0.0f);
       e.add(c->weight.x * std::abs(c->wi.z));
     }
-    EXPECT_MC_NEAR(e, kPiD * 0.25 / (2.25 + 0.25)) << "scale " << scale;
+    EXPECT_MC_NEAR(e, kPiD * 0.25 / (2.25 + 0.25), k) << "scale " << scale;
   }
 }
 
 TEST(PointLight, IsotropicPowerAndInverseSquareIrradiance) {
+  const double k = sigmas_for(1);  // 1 Monte Carlo mean, 0.1 % together
   const PointLightParams light{glm::vec3(0.0f, 0.0f, 2.0f), glm::vec3(5.0f, 4.0f, 3.0f)};
   Accumulator z;
   for (int i = 0; i < 50'000; ++i) {
-    Sampler s(3, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(3), 0, static_cast<std::uint64_t>(i));
     const auto r = sample_ray(light, s.get2d());
     ASSERT_TRUE(r);
     if (i < 1000) expect_consistent<PointLightParams>(*r, pdf_ray(light, r->direction));
     EXPECT_EQ(r->weight, power(light));
     z.add(r->direction.z);
   }
-  EXPECT_MC_NEAR(z, 0.0);
+  EXPECT_MC_NEAR(z, 0.0, k);
   EXPECT_NEAR(power(light).x, 4.0 * kPiD * 5.0, 1e-4);
   // DESIGN §9: a point light at height h over a plane; at horizontal offset x the irradiance is
   // I cos θ / d² with cos θ = h / d.
@@ -244,6 +262,7 @@ TEST(PointLight, IsotropicPowerAndInverseSquareIrradiance) {
 }
 
 TEST(SpotLight, FalloffPowerAndConeDensity) {
+  const double k = sigmas_for(4);  // 4 Monte Carlo means, 0.1 % together
   SpotLightParams spot;
   spot.position = glm::vec3(0.0f, 0.0f, 3.0f);
   spot.axis = glm::normalize(glm::vec3(0.3f, 0.0f, -1.0f));
@@ -263,20 +282,23 @@ TEST(SpotLight, FalloffPowerAndConeDensity) {
   for (const SpotLightParams& p : {spot, hard}) {
     Accumulator weight, integral;
     for (int i = 0; i < 200'000; ++i) {
-      Sampler s(4, 0, static_cast<std::uint64_t>(i));
+      Sampler s(test::stat_seed_from(4), 0, static_cast<std::uint64_t>(i));
       const auto r = sample_ray(p, s.get2d());
       if (r) {
         if (i < 1000) expect_consistent<SpotLightParams>(*r, pdf_ray(p, r->direction));
-        EXPECT_GT(glm::dot(r->direction, p.axis), p.cos_total);
+        // Inside the cone, but for the rounding of the rotation to world space: a direction
+        // sampled a hair inside the rim can come out on it (seed 36 of bench/stat_sweep.py, both
+        // lights, 0.825336 each), within a few ulps of cos_total (4e-7 at 0.83).
+        EXPECT_GT(glm::dot(r->direction, p.axis), p.cos_total - 4e-7f);
       }
       weight.add(r ? r->weight.x : 0.0);
       integral.add(pdf_ray(p, sample_uniform_sphere(s.get2d())).dir * 4.0 * kPiD);
     }
     // Power 2π I (1 − (cos_start + cos_total)/2): the mean starting throughput.
-    EXPECT_MC_NEAR(weight, power(p).x);
+    EXPECT_MC_NEAR(weight, power(p).x, k);
     EXPECT_NEAR(power(p).x,
                 2.0 * kPiD * 10.0 * (1.0 - 0.5 * (p.cos_falloff_start + p.cos_total)), 1e-3);
-    EXPECT_MC_NEAR(integral, 1.0);
+    EXPECT_MC_NEAR(integral, 1.0, k);
   }
   // Joins: inside the cone the inverse-square law with the falloff, outside nothing.
   const glm::vec3 on_axis = spot.position + 2.0f * spot.axis;
@@ -287,6 +309,7 @@ TEST(SpotLight, FalloffPowerAndConeDensity) {
 }
 
 TEST(DistantLight, ThroughAWindowIsECosThetaInsideTheProjection) {
+  const double k = sigmas_for(1);  // 1 Monte Carlo mean, 0.1 % together
   // A 2 × 1 window in the plane z = 2, light travelling down and sideways (DESIGN §9).
   DistantLightParams sun;
   sun.direction = glm::normalize(glm::vec3(0.6f, 0.0f, -0.8f));
@@ -313,19 +336,25 @@ TEST(DistantLight, ThroughAWindowIsECosThetaInsideTheProjection) {
   // same window point. The aperture density integrates to 1 over a box around the window.
   Accumulator integral;
   for (int i = 0; i < 20'000; ++i) {
-    Sampler s(5, 0, static_cast<std::uint64_t>(i));
-    const auto r = sample_ray(sun, s.get2d());
+    Sampler s(test::stat_seed_from(5), 0, static_cast<std::uint64_t>(i));
+    const glm::vec2 u_window = s.get2d();
+    const auto r = sample_ray(sun, u_window);
     ASSERT_TRUE(r);
     if (i < 1000) expect_consistent<DistantLightParams>(*r, pdf_ray(sun, r->origin));
     EXPECT_EQ(r->weight, power(sun));
     const glm::vec3 floor = r->origin + (r->origin.z / 0.8f) * r->direction;
     const auto c = connect(sun, floor);
-    ASSERT_TRUE(c) << i;
+    // A window point on the far edge of its half-open [0, 1)² (u of 1 − 2^-24) can round onto
+    // the edge itself on the way to the floor and back, and the join then misses the window
+    // (seed 94 of bench/stat_sweep.py): allowed within 1e-6 of an edge, nowhere else.
+    const auto near_edge = [](float v) { return v < 1e-6f || v > 1.0f - 1e-6f; };
+    if (!c && (near_edge(u_window.x) || near_edge(u_window.y))) continue;
+    ASSERT_TRUE(c) << i << ": u " << std::hexfloat << u_window.x << ", " << u_window.y;
     EXPECT_NEAR(glm::length(c->position - r->origin), 0.0f, 1e-5f);
     const glm::vec2 u = s.get2d();
     integral.add(pdf_ray(sun, glm::vec3(-1.0f + 4.0f * u.x, -1.0f + 3.0f * u.y, 2.0f)).pos * 12.0);
   }
-  EXPECT_MC_NEAR(integral, 1.0);
+  EXPECT_MC_NEAR(integral, 1.0, k);
 }
 
 TEST(DistantLight, NearlyParallelToTheApertureStaysFinite) {
@@ -369,20 +398,21 @@ SurfacePoint light_point(glm::vec2 u) {
 }
 
 TEST(Pinhole, ImportanceIsNormalisedAndJoinsInvertRays) {
+  const double k = sigmas_for(2);  // 2 Monte Carlo means, 0.1 % together
   PinholeParams cam;  // at the origin looking down −z, 90° × 90°
   Accumulator normalisation, integral;
   for (int i = 0; i < 400'000; ++i) {
-    Sampler s(6, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(6), 0, static_cast<std::uint64_t>(i));
     const glm::vec3 w = sample_uniform_sphere(s.get2d());
     glm::vec2 raster;
     const float we = importance(cam, w, &raster).x;
     normalisation.add(we * std::max(0.0f, glm::dot(w, cam.forward)) * 4.0 * kPiD);
     integral.add(pdf_ray(cam, w).dir * 4.0 * kPiD);
   }
-  EXPECT_MC_NEAR(normalisation, 1.0);
-  EXPECT_MC_NEAR(integral, 1.0);
+  EXPECT_MC_NEAR(normalisation, 1.0, k);
+  EXPECT_MC_NEAR(integral, 1.0, k);
   for (int i = 0; i < 1000; ++i) {
-    Sampler s(7, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(7), 0, static_cast<std::uint64_t>(i));
     const glm::vec2 raster = s.get2d();
     const auto r = sample_ray(cam, raster);
     ASSERT_TRUE(r);
@@ -400,6 +430,7 @@ TEST(Pinhole, ImportanceIsNormalisedAndJoinsInvertRays) {
 }
 
 TEST(Pinhole, MeasurementFromEitherEndIsTheClosedForm) {
+  const double k = sigmas_for(1);  // 1 Monte Carlo mean, 0.1 % together
   PinholeParams cam;
   // Eye side: the fraction of a 512 × 512 raster grid whose rays hit the square, exactly 1/16.
   int hits = 0;
@@ -416,22 +447,23 @@ TEST(Pinhole, MeasurementFromEitherEndIsTheClosedForm) {
   // Light side.
   Accumulator m;
   for (int i = 0; i < 100'000; ++i) {
-    Sampler s(8, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(8), 0, static_cast<std::uint64_t>(i));
     const SurfacePoint x = light_point(s.get2d());
     const auto c = connect(cam, x.position);
     m.add(c ? std::abs(glm::dot(x.normal, c->wi)) * c->weight.x / x.pdf_area : 0.0);
   }
-  EXPECT_MC_NEAR(m, 1.0 / 16.0);
+  EXPECT_MC_NEAR(m, 1.0 / 16.0, k);
 }
 
 TEST(ThinLens, NormalisedFocusedAndMeasuresTheClosedForm) {
+  const double k = sigmas_for(5);  // 5 Monte Carlo means, 0.1 % together
   ThinLensParams cam;
   cam.lens_radius = 0.2f;
   cam.focus_distance = kLightDistance;
   // ∫∫ We cos dσ dA = 1 over lens points and directions; pdf_ray integrates to 1 in both parts.
   Accumulator normalisation, pos_integral, dir_integral;
   for (int i = 0; i < 400'000; ++i) {
-    Sampler s(9, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(9), 0, static_cast<std::uint64_t>(i));
     const glm::vec3 x = lens_point(cam, s.get2d());
     const glm::vec3 w = sample_uniform_sphere(s.get2d());
     glm::vec2 raster;
@@ -443,14 +475,14 @@ TEST(ThinLens, NormalisedFocusedAndMeasuresTheClosedForm) {
     const glm::vec3 y(-0.25f + 0.5f * u.x, -0.25f + 0.5f * u.y, 0.0f);  // 0.5 × 0.5 square
     pos_integral.add(pdf_ray(cam, y, cam.forward).pos * 0.25);
   }
-  EXPECT_MC_NEAR(normalisation, 1.0);
-  EXPECT_MC_NEAR(dir_integral, 1.0);
-  EXPECT_MC_NEAR(pos_integral, 1.0);
+  EXPECT_MC_NEAR(normalisation, 1.0, k);
+  EXPECT_MC_NEAR(dir_integral, 1.0, k);
+  EXPECT_MC_NEAR(pos_integral, 1.0, k);
   // Rays of one raster position meet on the plane of focus; importance() recovers the raster.
   const glm::vec2 raster(0.3f, 0.8f);
   std::optional<glm::vec3> meet;
   for (int i = 0; i < 200; ++i) {
-    Sampler s(10, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(10), 0, static_cast<std::uint64_t>(i));
     const auto r = sample_ray(cam, raster, s.get2d());
     ASSERT_TRUE(r);
     expect_consistent<ThinLensParams>(*r, pdf_ray(cam, r->origin, r->direction));
@@ -473,7 +505,7 @@ TEST(ThinLens, NormalisedFocusedAndMeasuresTheClosedForm) {
   const glm::vec3 axis_point = cam.position + kLightDistance * cam.forward;
   const float kCosCone = std::cos(0.06f);
   for (int i = 0; i < 200'000; ++i) {
-    Sampler s(11, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(11), 0, static_cast<std::uint64_t>(i));
     const SurfacePoint x = light_point(s.get2d());
     const auto c = connect(cam, s.get2d(), x.position);
     m.add(c ? std::abs(glm::dot(x.normal, c->wi)) * c->weight.x / x.pdf_area : 0.0);
@@ -482,17 +514,18 @@ TEST(ThinLens, NormalisedFocusedAndMeasuresTheClosedForm) {
     const auto h = hit_lens(cam, axis_point, w);
     join_integral.add(h ? h->pdf_dir / uniform_cone_pdf(kCosCone) : 0.0);
   }
-  EXPECT_MC_NEAR(m, 1.0 / 16.0);
-  EXPECT_MC_NEAR(join_integral, 1.0);
+  EXPECT_MC_NEAR(m, 1.0 / 16.0, k);
+  EXPECT_MC_NEAR(join_integral, 1.0, k);
 }
 
 TEST(Orthographic, MeasurementProjectionAndDensities) {
+  const double k = sigmas_for(1);  // 1 Monte Carlo mean, 0.1 % together
   OrthographicParams cam;  // 4 × 4 film at the origin looking down −z
   cam.half_width = 2.0f;
   cam.half_height = 2.0f;
   Accumulator pos_integral;
   for (int i = 0; i < 2000; ++i) {
-    Sampler s(12, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(12), 0, static_cast<std::uint64_t>(i));
     const glm::vec2 raster = s.get2d();
     const auto r = sample_ray(cam, raster);
     ASSERT_TRUE(r);
@@ -507,10 +540,10 @@ TEST(Orthographic, MeasurementProjectionAndDensities) {
     const glm::vec2 u = s.get2d();
     pos_integral.add(pdf_ray(cam, glm::vec3(-3.0f + 6.0f * u.x, -3.0f + 6.0f * u.y, 0.0f)).pos * 36.0);
   }
-  EXPECT_MC_NEAR(pos_integral, 1.0);
+  EXPECT_MC_NEAR(pos_integral, 1.0, k);
   // The 2 × 2 unit-radiance square covers 1/4 of the film: every light-side sample says so.
   for (int i = 0; i < 100; ++i) {
-    Sampler s(13, 0, static_cast<std::uint64_t>(i));
+    Sampler s(test::stat_seed_from(13), 0, static_cast<std::uint64_t>(i));
     const SurfacePoint x = light_point(s.get2d());
     const auto c = connect(cam, x.position);
     ASSERT_TRUE(c);

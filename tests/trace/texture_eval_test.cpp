@@ -6,10 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "optics/fresnel.h"
+#include "support/stat_seed.h"
 #include "trace/rng.h"
 
 namespace pathex {
@@ -213,19 +216,23 @@ TEST(TextureEval, RoughnessConductorReflectanceAndPlasticMaps) {
 }
 
 // pbrt-v4's stochastic alpha: a fraction 1 − a of rays pass. 200,000 rays of random origins and
-// directions; binomial tolerance 5 standard errors.
+// directions (a stream of mix64 keyed by test::stat_seed, 0 unless PATHEX_STAT_SEED says
+// otherwise); binomial tolerance for 3 checks at a family-wise false-failure rate of 0.1 %.
 TEST(AlphaTest, PassesAFractionOneMinusAlphaOfTheRays) {
   EXPECT_TRUE(alpha_passes(0.0f, vec3(0.0f), vec3(0, 0, 1)));
   EXPECT_FALSE(alpha_passes(1.0f, vec3(0.0f), vec3(0, 0, 1)));
+  const std::uint64_t stream = test::stat_seed(0) << 32;  // 6 x 200,000 keys per seed, far below 2^32
+  const double k = test::family_sigmas(3, 1e-3, test::kNormalDof);
   for (float a : {0.1f, 0.5f, 0.8f}) {
     const int n = 200000;
     int passed = 0;
     for (int i = 0; i < n; ++i) {
-      const auto u = [&](int k) { return static_cast<float>(mix64(static_cast<std::uint64_t>(6 * i + k) + 1) >> 40) * 0x1p-24f; };
+      const auto u = [&](int c) { return static_cast<float>(mix64((static_cast<std::uint64_t>(6 * i + c) + 1) | stream) >> 40) * 0x1p-24f; };
       passed += alpha_passes(a, vec3(u(0), u(1), u(2)), glm::normalize(vec3(u(3), u(4), u(5)) - 0.5f)) ? 1 : 0;
     }
     const double p = 1.0 - a, se = std::sqrt(p * (1 - p) / n);
-    EXPECT_NEAR(static_cast<double>(passed) / n, p, 5 * se) << "alpha " << a;
+    test::stat_log("alpha " + std::to_string(a), (static_cast<double>(passed) / n - p) / se, k);
+    EXPECT_NEAR(static_cast<double>(passed) / n, p, k * se) << "alpha " << a;
   }
 }
 
