@@ -228,11 +228,23 @@ TEST(Api, ConvergeMeasuresWhatTheCommandMeasures) {
   // The closed form's total is 1 / pi, and the total has an error on every rung.
   EXPECT_DOUBLE_EQ(*a.classes.front().reference, 0.31830988618379069);
   EXPECT_TRUE(a.classes.front().renderers[0].rungs[1].error.has_value());
+  // The ranking weighs CPU time, which differs between two runs: the same best renderer is asserted
+  // only where the call's best is at least twice as efficient as every other (bounce3's two are 2 %
+  // apart, and either may win a run).
+  int ranked = 0;
   for (const nlohmann::json& b : j["best"])
     for (const px::ConvergeClass& c : a.classes)
       if (c.name == b["class"]) {
+        bool clear = !c.best.empty();
+        for (const px::ConvergeSeries& s : c.renderers)
+          if (s.renderer != c.best)
+            for (const px::ConvergeSeries& w : c.renderers)
+              if (w.renderer == c.best && !(w.efficiency > 2.0 * s.efficiency)) clear = false;
+        if (!clear) continue;
         EXPECT_EQ(c.best, b["renderer"]) << c.name;
+        ++ranked;
       }
+  EXPECT_GE(ranked, 1) << "no class has a clear best renderer";
 
   const px::ConvergeAnswer missing = px::converge("no-such-scene.json", {px::Renderer("pt-nee")}, o);
   EXPECT_FALSE(missing.ok());
