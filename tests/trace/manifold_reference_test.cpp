@@ -137,7 +137,7 @@ TEST(ManifoldReference, LampGlassSeenThroughAgreesWithTheQuadrature) {
 // trace/prune.h), agrees with plain bdpt's (light tracing alone) within family_sigmas(1) combined
 // standard errors on one run's 7 degrees of freedom (0.1 %): 8 seeds each. Not Welch–Satterthwaite's
 // (up to 14). Until --only kept light tracing beside the connector, the class was the manifold's
-// alone, whose estimates are heavy-tailed (over 160 seeds a standard deviation of 46 % of the mean,
+// alone, whose estimates are heavy-tailed (over 160 seeds a standard deviation of 67 % of the mean,
 // the largest 7× it): 8 seeds' mean lay low with a small spread, and the test failed at 2 of 100
 // swept seeds. With both strategies: 5.6 % (bench/README.md, issue 36, eighth session).
 TEST(ManifoldReference, BdptManifoldDirectCausticAgreesWithBdpt) {
