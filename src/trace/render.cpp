@@ -20,14 +20,12 @@
 #include "trace/render.h"
 
 #include <array>
-#include <bit>
 #include <cmath>
 #include <utility>
 
 #include "trace/accel/path_ids.h"
 #include "trace/media.h"
 #include "trace/bsdf.h"
-#include "trace/frame.h"
 #include "trace/integrator.h"
 #include "trace/prune.h"
 #include "trace/rng.h"
@@ -48,7 +46,6 @@ constexpr std::uint64_t kLightRayDim = kLightDims + 3;
 static_assert(4 + 4 * 64 <= kLightDims - kEyeDims, "a subpath's numbers fit its block");
 
 float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
-bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
 
 }  // namespace
 
@@ -358,7 +355,6 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
       for (int s = 1; s <= std::min(s_max, max_bounces_ + 1 - t); ++s)
         if (manifold_of(s, t) >= 0) connect_manifold(th, rng, s, t, batch);
 }
-
 
 }  // namespace tracer
 

@@ -105,6 +105,19 @@ class MaterialScratch {
   bool made_ = false;
 };
 
+// The manifold connector's specular surfaces (trace/joins/manifold.h), found once per scene as the
+// planar mirrors are: per shape, the index of a pure smooth dielectric, else 0; the reflectance of
+// a mirror (a smooth conductor's at normal incidence, a mixture's mirror components weighed), else
+// 0. Group members and shapes with a bump or normal map are left out (opaque to the walks).
+struct SpecularSurfaces {
+  std::vector<float> glass_ior;
+  std::vector<glm::vec3> mirror_reflectance;
+  std::vector<int> shapes;             // the shapes with either (the manifold's seeds aim at points on them)
+  std::vector<float> seed_cdf;         // the seeds' choice among them (cumulative, last 1)
+  std::vector<glm::vec4> bounds;       // a bounding sphere of each (centre, radius): joins no chain can leave skip
+  double scene_size = 1.0;             // the scene's bounding-box diagonal (the manifold's shortest segment scales with it)
+};
+
 struct RenderScene {
   std::unique_ptr<EmbreeScene> geometry;
   std::vector<const Material*> material_of_shape;
@@ -127,6 +140,7 @@ struct RenderScene {
   // 1 for a shape that is a group member, drawn by instances (scene.h ShapeInstance); the manifold
   // connector's walks know world-space shapes only and treat these as opaque.
   std::vector<std::uint8_t> in_group;
+  SpecularSurfaces specular;  // the manifold connector's
 
   // --- what every strategy asks of the scene ---
   // A light chosen uniformly by u. (u n lies in [0, n), far below 2^63: the signed conversion is

@@ -13,10 +13,6 @@
 #include "trace/media.h"
 
 namespace pathex::tracer {
-namespace {
-bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
-}  // namespace
-
 vec3 Integrator::end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs) const {
   // A light vertex's beta already holds its spatial emission; only the directional part is left.
   if (v.kind == Kind::kLight) return vec3(directional_emission(rs_.lights[static_cast<std::size_t>(v.light)].params, v.n, w));
@@ -45,11 +41,8 @@ void Integrator::begin_join(Thread& th, ConnectorKind kind, int s, int t, int st
 
 bool Integrator::end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const {
   JoinResult& jr = th.join;
-  if (absorbing_ && from != nullptr) {  // Beer–Lambert along the joining segment (trace/media.h)
-    const vec3 e = to->p - from->p;
-    const float length = std::sqrt(glm::dot(e, e));
-    if (length > 0.0f) contrib *= beer_lambert(segment_absorption(*from, e / length, rs_.absorption_of_shape), length);
-  }
+  // Beer–Lambert along the joining segment (trace/media.h).
+  if (absorbing_ && from != nullptr) contrib *= segment_transmittance(*from, to->p, rs_.absorption_of_shape);
   if (is_black(contrib)) {
     if (jr.chain != ConnectorKind::kNone) ++th.connectors[static_cast<std::size_t>(jr.strategy)].no_transport;
     return false;
