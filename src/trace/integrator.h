@@ -63,8 +63,6 @@ class Integrator {
     mirror_shape_.assign(rs.material_of_shape.size(), 0);
     for (const PlanarMirror& m : rs.mirrors) mirror_shape_[static_cast<std::size_t>(m.shape)] = 1;
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
-    sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
-    for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
     features_ = rs.features;
     absorbing_ = rs.absorbing;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
@@ -358,8 +356,6 @@ class Integrator {
   static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
   std::array<std::uint64_t, 64> runs_mask_{};
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
-  std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
-  std::vector<std::string> light_pairs_;  // each light's letters c0 c1
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;

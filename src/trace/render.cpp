@@ -161,7 +161,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(cam_.width),
                          (static_cast<float>(py) + uf.y) / static_cast<float>(cam_.height)};
   const std::optional<EndpointRay> r = sample_ray(cam_.params, raster, ul);
-  const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), sensor_pair_[0]);
+  const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), cam_.letters[0]);
   if (!r) return 1;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
   const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
@@ -184,7 +184,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   // (An aimed light draws its direction within its cones: RenderLight::sample_ray.)
   const std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : l.sample_ray(x, u_ray);
   if (env && r) err = box_point_error(r->origin);
-  Vertex& y0 = light_vertex(th.light[0], li, r ? r->origin : x.position, r ? r->normal : vec3(0.0f), err, light_pairs_[li][1]);
+  Vertex& y0 = light_vertex(th.light[0], li, r ? r->origin : x.position, r ? r->normal : vec3(0.0f), err, l.letters[1]);
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
     y0.beta = vec3(0.0f);
     return 1;

@@ -191,6 +191,7 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     rs.lights.push_back(l);
   }
   rs.specular = specular_surfaces(rs);
+  for (RenderLight& l : rs.lights) l.letters = {letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))};
   // --- the sensor ---
   const Camera& c = scene.camera;
   RenderSensor& cam = rs.camera;
@@ -214,6 +215,7 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
       break;
     case SensorType::kSpotmeter: cam.params = SpotMeterParams{c.position, forward}; break;
   }
+  cam.letters = {letter_char(dir_letter(cam.params)), letter_char(pos_letter(cam.params))};
   return rs;
 }
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <new>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -47,6 +48,7 @@ struct RenderLight {
   // The rounding-error bound of the points rays leave from when they are not a shape's (a distant
   // light's aperture may coincide with one, a window pane); zero for the others.
   glm::vec3 origin_error{0.0f};
+  std::string letters;  // c0 c1: its position's letter, then its direction's (the header's conventions)
   bool is_area() const { return shape >= 0; }
   // The image infinite light this is (trace/environment.h), or null.
   const EnvironmentLightParams* environment() const { return std::get_if<EnvironmentLightParams>(&params); }
@@ -69,6 +71,7 @@ struct RenderSensor {
   // Area density of the ray's origin as the MIS ratios keep it: 1 / lens area, 1 / film area,
   // 0 for a point (pinhole, spot meter).
   float pdf_pos = 0.0f;
+  std::string letters;  // c(k+1) c(k+2): its direction's letter, then its position's
   // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
   void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
     const float w = static_cast<float>(width), h = static_cast<float>(height);

@@ -31,13 +31,10 @@ namespace pathex::tracer {
 struct IntegratorTestAccess {
   using Thread = Integrator::Thread;
   // What the integrator derives from its scene and profile, derived here from the same: the
-  // probability of picking each light, a light's letters c0 c1 and the sensor's c(k+1) c(k+2).
+  // probability of picking each light, a light's letters c0 c1 and the sensor's c(k+1).
   static float light_pick(const Integrator& in) { return 1.0f / static_cast<float>(in.scene().lights.size()); }
-  static std::string light_pair(const Integrator& in, int li) {
-    const LightParams& l = in.scene().lights[static_cast<std::size_t>(li)].params;
-    return {letter_char(pos_letter(l)), letter_char(dir_letter(l))};
-  }
-  static char sensor_direction_letter(const Integrator& in) { return letter_char(dir_letter(in.scene().camera.params)); }
+  static const std::string& light_pair(const Integrator& in, int li) { return in.scene().lights[static_cast<std::size_t>(li)].letters; }
+  static char sensor_direction_letter(const Integrator& in) { return in.scene().camera.letters[0]; }
   // Whether the plain join (s, DD, t) runs: the profile's strategy, and for t = 0 a thin lens that
   // light subpaths can hit because some (·, DD, 0) runs.
   static bool runs_plain(const Integrator& in, int s, int t) {

@@ -21,7 +21,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
   if (b) {
     if (b->kind != Kind::kSurface || !b->finite) return;
   } else {
-    if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no D end
+    if (cam_.letters[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no D end
     join_numbers(rng, JoinBlock::kMirrorEye, s);
     u_lens = rng.get2d_if(reads_lens_numbers(cam_.params));
   }
@@ -85,7 +85,7 @@ const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinB
   join_numbers(rng, block, t);
   const std::size_t li = rs_.pick_light(rng);
   const RenderLight& light = rs_.lights[li];
-  if (light_pairs_[li][1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
+  if (light.letters[1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
   if (environment_of(static_cast<int>(li))) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
   vec3 err{0.0f};
   const SurfacePoint x = rs_.sample_point(light, rng, &err);
