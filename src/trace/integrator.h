@@ -299,8 +299,8 @@ class Integrator {
                      const std::vector<ChainVertex>& chain, double weight) const;
   int manifold_of(int s, int t) const { return table_.at(s, ConnectorKind::kManifold, t); }
   // A seed chain from end `from` (the light end a when from_light, else the eye end b): the ray
-  // towards a specular shape (drawn by seed_cdf_; a point on its area, or a direction in the cone
-  // of a sphere), followed through every specular surface it meets (a mirror reflects; glass
+  // towards a specular shape (drawn by RenderScene::specular's seed_cdf; a point on its area, or a
+  // direction in the cone of a sphere), followed through every specular surface it meets (a mirror reflects; glass
   // reflects with the Fresnel probability, else refracts) until it leaves them; its hits, light
   // side first. Random numbers from counter-based `stream`.
   ManifoldFailure seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
