@@ -23,7 +23,7 @@
 // Batches, and the standard error (issues 36 and 39). Samples are grouped into B batches (default
 // 32): batch b is replicate r = b mod R of pixel group g = b div R, with G = B / R groups
 // (HistogramLayout::groups). The renderer puts the sample of pixel p and pass s in group p mod G
-// and replicate s mod R (trace/integrator.h, batch_of()); under the `sobol` sampler each replicate
+// and replicate s mod R (batch_of() below); under the `sobol` sampler each replicate
 // of a pixel is an independently scrambled sequence whose point index is s div R (trace/rng.h), so
 // a replicate of 16 spp / R points keeps the quasi-Monte Carlo gain of that many points. Pixels are
 // independent of each other, and the R replicates of a group are independent and identically
@@ -86,6 +86,16 @@ inline constexpr int kDefaultReplicates = 2;  // R: B / R = 16 pixel groups of t
 // The default stderr's degrees of freedom, G (R − 1) = 16, for a render of at least R passes over
 // at least G pixels (VarianceDesign::dof()).
 inline constexpr int kDefaultDof = kDefaultBatches - kDefaultBatches / kDefaultReplicates;
+
+// The batch of pixel `pixel`'s pass `pass` (see "Batches" above): replicate pass mod R of pixel
+// group pixel mod G, G = batches / replicates. Passes go to replicates round-robin, so an
+// interrupted render still spreads what it has over all of them (and its error is defined);
+// neighbouring pixels go to different groups, so every group covers the whole image. Replicates
+// are independent: under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
+inline int batch_of(std::uint64_t pixel, std::uint64_t pass, int batches, int replicates) {
+  const auto R = static_cast<std::uint64_t>(replicates), G = static_cast<std::uint64_t>(batches / replicates);
+  return static_cast<int>((pixel % G) * R + pass % R);
+}
 
 // Rec. 709 luminance.
 inline double luminance(const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }

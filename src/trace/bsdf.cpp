@@ -451,6 +451,22 @@ float component_probability(const Material& m, const glm::vec3& wo, const glm::v
       m);
 }
 
+double lobe_probability(const Material& m, const glm::vec3& wo, const glm::vec3& ns, Lobe lobe) {
+  const auto* mix = std::get_if<Mixture>(&m);
+  const int components = mix ? static_cast<int>(mix->components.size()) : 1;
+  double p = 0.0;
+  for (int i = 0; i < components; ++i) p += component_probability(m, wo, ns, i, lobe);
+  return p;
+}
+
+glm::vec3 mirror_reflectance(const Mixture& mix) {
+  glm::vec3 r(0.0f);
+  for (const Mixture::Component& c : mix.components)
+    if (const auto* mirror = std::get_if<Mirror>(&c.material); mirror && std::isfinite(c.weight) && c.weight > 0.0f)
+      r += c.weight * mirror->reflectance;
+  return r;
+}
+
 bool has_finite_component(const Material& m) {
   if (const auto* mix = std::get_if<Mixture>(&m)) {
     for (const auto& c : mix->components)

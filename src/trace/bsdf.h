@@ -261,6 +261,14 @@ inline glm::vec3 eval(const Material& m, const glm::vec3& wo, const glm::vec3& w
 float component_probability(const Material& m, const glm::vec3& wo, const glm::vec3& ns,
                             int component, Lobe lobe);
 
+// Σ over the components of the lobe `lobe`'s component_probability(): the probability that
+// sample() picks that delta lobe given wo, whichever component holds it.
+double lobe_probability(const Material& m, const glm::vec3& wo, const glm::vec3& ns, Lobe lobe);
+
+// The reflectance of a mixture's mirror components, each weighed by its weight (the share of flux
+// a mirror-like mixture reflects specularly).
+glm::vec3 mirror_reflectance(const Mixture& mix);
+
 // True if the material has at least one finite (D) component with non-zero weight: only then can
 // a join (shadow ray, connection) at a vertex on it carry energy.
 bool has_finite_component(const Material& m);

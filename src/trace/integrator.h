@@ -14,7 +14,6 @@
 #include <utility>
 #include <vector>
 
-#include "classify/classifier.h"
 #include "stats/histogram.h"
 #include "film/image.h"
 #include "trace/accel/path_ids.h"
@@ -35,16 +34,6 @@ namespace pathex::tracer {
 using namespace accel;  // PathKey, PathIds
 static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
 
-// The batch of pixel `pixel`'s pass `pass` (stats/histogram.h, "Batches"): replicate pass mod R of
-// pixel group pixel mod G, G = batches / replicates. Passes go to replicates round-robin, so an
-// interrupted render still spreads what it has over all of them (and its error is defined);
-// neighbouring pixels go to different groups, so every group covers the whole image. Replicates
-// are independent: under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
-inline int batch_of(std::uint64_t pixel, std::uint64_t pass, int batches, int replicates) {
-  const auto R = static_cast<std::uint64_t>(replicates), G = static_cast<std::uint64_t>(batches / replicates);
-  return static_cast<int>((pixel % G) * R + pass % R);
-}
-
 class Integrator {
  public:
   // `filter`: the plan's (trace/plan.h), which paths are recorded (default: every path).
@@ -52,10 +41,7 @@ class Integrator {
       : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), filter_(std::move(filter)), table_(strategies.strategies) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
-    lens_hits_ = cam_.type == SensorType::kLens;
-    bool any_t0 = false;
-    for (int s = 0; s < 2 * kMaxVertices; ++s) any_t0 = any_t0 || table_.plain(s, 0) >= 0;
-    lens_hits_ = lens_hits_ && any_t0;
+    lens_hits_ = cam_.type == SensorType::kLens && table_.runs_at_t(ConnectorKind::kNone, 0);
     // Subpaths are only as long as a strategy can use: s = 1 and t = 1 take fresh samples, so a
     // light subpath is traced only for some s >= 2 (or for its first vertex, for (1, DD, 1)) and an
     // eye subpath beyond z0 for some t >= 2.
@@ -71,14 +57,12 @@ class Integrator {
         if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
           runs_mask_[n] |= std::uint64_t{1} << s2;
     has_mirror_ = table_.runs(ConnectorKind::kMirror) && !rs.mirrors.empty();
-    init_manifold();
+    has_manifold_ = !rs.specular.shapes.empty() && table_.runs(ConnectorKind::kManifold);
     has_connectors_ = table_.runs(ConnectorKind::kDistantProjection) || table_.runs(ConnectorKind::kOrthoProjection) || has_mirror_ ||
                       has_manifold_;
     mirror_shape_.assign(rs.material_of_shape.size(), 0);
     for (const PlanarMirror& m : rs.mirrors) mirror_shape_[static_cast<std::size_t>(m.shape)] = 1;
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
-    sensor_pair_ = {letter_char(dir_letter(cam_.params)), letter_char(pos_letter(cam_.params))};
-    for (const RenderLight& l : rs.lights) light_pairs_.push_back({letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))});
     features_ = rs.features;
     absorbing_ = rs.absorbing;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
@@ -87,19 +71,16 @@ class Integrator {
 
   // A full path x0 … xk in light-to-eye order as a join forms it, without copying a vertex: s light
   // vertices (y0 replaced by a fresh sample light0 when given), the m vertices a connector
-  // constructs, t eye vertices in reverse (z0 replaced by eye0 when given). Or, when `whole` is
-  // set, the vertices whole[0 … s + m + t) (a path assembled elsewhere, as the tests do).
+  // constructs, t eye vertices in reverse (z0 replaced by eye0 when given).
   struct PathView {
     const Vertex* light = nullptr;
     const Vertex* light0 = nullptr;
     const Vertex* chain = nullptr;
     const Vertex* eye = nullptr;
     const Vertex* eye0 = nullptr;
-    const Vertex* whole = nullptr;
     int s = 0, m = 0, t = 0;
     int size() const { return s + m + t; }
     const Vertex& operator[](int i) const {
-      if (whole) return whole[i];
       if (i < s) return i == 0 && light0 ? *light0 : light[i];
       if (i < s + m) return chain[i - s];
       const int j = s + m + t - 1 - i;
@@ -213,12 +194,6 @@ class Integrator {
   // The stages below are public: tests drive them one at a time (tests/trace/mis_test.cpp
   // re-splits paths and checks their MIS weights); only the state is private.
   const RenderScene& scene() const { return rs_; }
-  float light_pick() const { return light_pick_; }  // the probability of picking each light
-  bool lens_hits() const { return lens_hits_; }     // light subpaths may end on the lens (t = 0 runs)
-  // Bit s of runs_mask(n): the profile runs the plain join (s, n - s).
-  std::uint64_t runs_mask(int n) const { return runs_mask_[static_cast<std::size_t>(n)]; }
-  const std::string& light_pair(int light) const { return light_pairs_[static_cast<std::size_t>(light)]; }  // c0 c1
-  const std::string& sensor_pair() const { return sensor_pair_; }  // c(k+1) c(k+2)
 
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
   // Densities as the walks and the MIS ratios keep them: a Dirac part's is 0 (trace/emitters.h).
@@ -301,13 +276,6 @@ class Integrator {
     th.join.has_light0 = true;
     return light_vertex(th.join.light0, li, p, n, err, letter);
   }
-  // Density of the far end of a parallel beam per unit area there, relative to the near end's:
-  // points x and y on one line along w, with unit normals (zero: no surface), map areas as
-  // dA_x |cos θ_x| = dA_y |cos θ_y|.
-  static float parallel_jacobian(const Vertex& far, const Vertex& near, const vec3& w) {
-    const float c = abs_cos(near, w);
-    return c > 0.0f ? abs_cos(far, w) / c : 0.0f;
-  }
   // The profile's strategy running a projection connector with this many eye (distant: its chain
   // is c0 c1 c2, so (0, DSD, t)) or light (ortho: (s, DSD, 0)) vertices, or -1.
   int distant_of(int t) const { return table_.at(0, ConnectorKind::kDistantProjection, t); }
@@ -319,6 +287,9 @@ class Integrator {
   // A connector's light end for s = 1: a fresh light sample in th.join.light0 from random-number
   // block `block` (one per t), or null when the light picked has a Dirac direction (no D end).
   const Vertex* fresh_light_end(Thread& th, Sampler& rng, int t, JoinBlock block) const;
+  // The letters of the path that a connector's chain of m specular vertices (the mirror's one, the
+  // manifold's) makes between a (c(s): y(s-1), or the fresh light end for s = 1) and z(t-1).
+  PathKey chain_key(Thread& th, const Vertex& a, int s, int t, int m) const;
   // The manifold connector (s, DS+D, t), s >= 1, t >= 2 (trace/joins/manifold.h): y(s-1) (a
   // fresh light sample for s = 1) joined to z(t-1) across a chain of smooth glass by specular
   // manifold sampling. Defined in trace/joins/manifold_join.cpp.
@@ -327,19 +298,13 @@ class Integrator {
   void emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a, const Vertex& b,
                      const std::vector<ChainVertex>& chain, double weight) const;
   int manifold_of(int s, int t) const { return table_.at(s, ConnectorKind::kManifold, t); }
-  // The letters of the path a chain of m specular vertices between a (c(s), y(s-1)) and z(t-1) makes.
-  PathKey manifold_key(Thread& th, const Vertex& a, int s, int t, int m) const;
   // A seed chain from end `from` (the light end a when from_light, else the eye end b): the ray
-  // towards a specular shape (drawn by seed_cdf_; a point on its area, or a direction in the cone
-  // of a sphere), followed through every specular surface it meets (a mirror reflects; glass
+  // towards a specular shape (drawn by RenderScene::specular's seed_cdf; a point on its area, or a
+  // direction in the cone of a sphere), followed through every specular surface it meets (a mirror reflects; glass
   // reflects with the Fresnel probability, else refracts) until it leaves them; its hits, light
   // side first. Random numbers from counter-based `stream`.
   ManifoldFailure seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
                              std::vector<ChainVertex>& chain) const;
-  // Whether the ray (o, d) can meet a specular shape: it passes through one's bounding sphere, but
-  // for shape `leaving` when that is a sphere (the ray leaves it outwards).
-  bool meets_specular(const vec3& o, const vec3& d, int leaving) const;
-  void init_manifold();
   // Whether the manifold connector (s, DS^mD, ·) could build the chain x_s … x(s+m-1) of path x
   // (letters `key`): the profile runs it there, its eye end is a surface, and every chain vertex is
   // a reflection or refraction on smooth glass or a reflection on a mirror.
@@ -384,23 +349,13 @@ class Integrator {
   StrategyTable table_;  // which strategy runs each (s, chain, t)
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
   bool has_mirror_ = false;      // a mirror strategy runs and the scene has a planar mirror
-  bool has_manifold_ = false;    // a manifold strategy runs and the scene has smooth glass
-  // The manifold's specular surfaces, per shape: the index of a pure smooth dielectric, else 0; the
-  // reflectance of a mirror (a mixture's mirror components, weighed), else 0.
-  std::vector<float> glass_ior_;
-  std::vector<vec3> mirror_reflectance_;
-  std::vector<int> specular_shapes_;  // the shapes with either (the manifold's seeds aim at points on them)
-  std::vector<float> seed_cdf_;       // the seeds' choice among them (cumulative, last 1)
-  std::vector<glm::vec4> specular_bounds_;  // a bounding sphere of each (centre, radius): joins no chain can leave skip
-  double scene_size_ = 1.0;       // the scene's bounding-box diagonal (the manifold's shortest segment scales with it)
+  bool has_manifold_ = false;    // a manifold strategy runs and the scene has specular surfaces (RenderScene::specular)
   std::vector<std::uint8_t> mirror_shape_;  // the shape is a planar mirror
   // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
   // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
   static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
   std::array<std::uint64_t, 64> runs_mask_{};
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
-  std::string sensor_pair_;               // the sensor's letters c(k+1) c(k+2)
-  std::vector<std::string> light_pairs_;  // each light's letters c0 c1
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;

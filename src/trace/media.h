@@ -40,4 +40,12 @@ inline vec3 beer_lambert(const vec3& sigma, float distance) {
   return {std::exp(-sigma.x * distance), std::exp(-sigma.y * distance), std::exp(-sigma.z * distance)};
 }
 
+// The share of light that the straight segment from v to the point p keeps: exp(-σa d) of the
+// medium it crosses (1 for a segment of no length).
+inline vec3 segment_transmittance(const Vertex& v, const vec3& p, const std::vector<vec3>& absorption_of_shape) {
+  const vec3 e = p - v.p;
+  const float length = std::sqrt(glm::dot(e, e));
+  return length > 0.0f ? beer_lambert(segment_absorption(v, e / length, absorption_of_shape), length) : vec3(1.0f);
+}
+
 }  // namespace pathex::tracer

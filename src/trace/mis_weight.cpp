@@ -223,7 +223,7 @@ float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, Connect
   st.read_range(&lo, &hi);
   // th.densities[lo … hi): a plain join's from the subpaths' stored ones, a constructed path's
   // from its vertices; a chain the manifold could build changes them across it.
-  const bool constructed = x.m > 0 || x.whole != nullptr;
+  const bool constructed = x.m > 0;
   if (constructed) path_densities(th, x, key, lo, hi);
   else join_densities(th, x, self, join, lo, hi);
   if (has_manifold_ && (constructed || st.count > 0)) chain_densities(th, x, key, self, lo, hi);

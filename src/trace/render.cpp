@@ -20,14 +20,12 @@
 #include "trace/render.h"
 
 #include <array>
-#include <bit>
 #include <cmath>
 #include <utility>
 
 #include "trace/accel/path_ids.h"
 #include "trace/media.h"
 #include "trace/bsdf.h"
-#include "trace/frame.h"
 #include "trace/integrator.h"
 #include "trace/prune.h"
 #include "trace/rng.h"
@@ -48,7 +46,6 @@ constexpr std::uint64_t kLightRayDim = kLightDims + 3;
 static_assert(4 + 4 * 64 <= kLightDims - kEyeDims, "a subpath's numbers fit its block");
 
 float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
-bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
 
 }  // namespace
 
@@ -164,7 +161,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(cam_.width),
                          (static_cast<float>(py) + uf.y) / static_cast<float>(cam_.height)};
   const std::optional<EndpointRay> r = sample_ray(cam_.params, raster, ul);
-  const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), sensor_pair_[0]);
+  const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), cam_.letters[0]);
   if (!r) return 1;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
   const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
@@ -187,7 +184,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   // (An aimed light draws its direction within its cones: RenderLight::sample_ray.)
   const std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : l.sample_ray(x, u_ray);
   if (env && r) err = box_point_error(r->origin);
-  Vertex& y0 = light_vertex(th.light[0], li, r ? r->origin : x.position, r ? r->normal : vec3(0.0f), err, light_pairs_[li][1]);
+  Vertex& y0 = light_vertex(th.light[0], li, r ? r->origin : x.position, r ? r->normal : vec3(0.0f), err, l.letters[1]);
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
     y0.beta = vec3(0.0f);
     return 1;
@@ -358,7 +355,6 @@ void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
       for (int s = 1; s <= std::min(s_max, max_bounces_ + 1 - t); ++s)
         if (manifold_of(s, t) >= 0) connect_manifold(th, rng, s, t, batch);
 }
-
 
 }  // namespace tracer
 

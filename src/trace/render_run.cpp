@@ -121,7 +121,7 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
     const auto groups = static_cast<std::uint64_t>(layout.groups);
     for (std::uint64_t p = first; p < end; ++p)
       for (std::uint64_t g = 0; g < std::min(groups, pixels); ++g)
-        out.histogram.add_samples(tracer::batch_of(g, p, o.batches, o.replicates), pixels / groups + (g < pixels % groups ? 1 : 0));
+        out.histogram.add_samples(batch_of(g, p, o.batches, o.replicates), pixels / groups + (g < pixels % groups ? 1 : 0));
     out.passes_done.add(first, end);
     if (o.progress) o.progress(deal.dealt() * pixels, deal.total() * pixels);
   }

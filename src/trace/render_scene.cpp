@@ -3,9 +3,13 @@
 // and the sensor as handles of the one emitter model), with the scene's refusals located.
 #include "trace/render_scene.h"
 
+#include <embree3/rtcore.h>
+
 #include <algorithm>
 #include <cmath>
 
+#include "optics/fresnel.h"
+#include "trace/bsdf.h"
 #include "trace/rng.h"
 
 namespace pathex {
@@ -34,6 +38,60 @@ BoundingSphere bounding_sphere(const ShapeGeometry& g) {
   return {c, std::sqrt(r2)};
 }
 
+// A sphere (centre, radius) holding the shape, padded by a relative 1e-4 (the manifold's: the
+// emission cones' bounding_sphere() above is tighter for quads and meshes).
+glm::vec4 padded_sphere(const ShapeGeometry& g) {
+  if (const auto* s = std::get_if<SphereShape>(&g)) return {s->center, s->radius * 1.0001f};
+  if (const auto* d = std::get_if<DiskShape>(&g)) return {d->center, d->radius * 1.0001f};
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  const auto add = [&](const glm::vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); };
+  if (const auto* q = std::get_if<QuadShape>(&g)) {
+    for (const glm::vec3& p : {q->corner, q->corner + q->edge1, q->corner + q->edge2, q->corner + q->edge1 + q->edge2}) add(p);
+  } else {
+    for (const glm::vec3& p : std::get<MeshShape>(g).positions) add(p);
+  }
+  const glm::vec3 c = 0.5f * (lo + hi);
+  return {c, 0.5f * glm::length(hi - lo) * 1.0001f + 1e-6f * glm::length(c)};
+}
+
+// The specular surfaces of rs (its shapes, lights and geometry made).
+SpecularSurfaces specular_surfaces(const RenderScene& rs) {
+  SpecularSurfaces sp;
+  sp.glass_ior.assign(rs.material_of_shape.size(), 0.0f);
+  sp.mirror_reflectance.assign(rs.material_of_shape.size(), glm::vec3(0.0f));
+  for (std::size_t i = 0; i < rs.material_of_shape.size(); ++i) {
+    if (rs.light_of_shape[i] >= 0 || rs.in_group[i]) continue;  // instanced members: opaque to the walks (RenderScene::in_group)
+    // A bump or normal map turns the shading normal the walk's constraint does not see: opaque too.
+    if (rs.textures_of_shape[i] && rs.textures_of_shape[i]->perturb != NormalPerturbation::kNone) continue;
+    const Material& m = *rs.material_of_shape[i];
+    if (const auto* d = std::get_if<Dielectric>(&m); d && d->ior > 0.0f && d->ior != 1.0f) sp.glass_ior[i] = d->ior;
+    if (const auto* r = std::get_if<Mirror>(&m)) sp.mirror_reflectance[i] = r->reflectance;
+    // A smooth conductor reflects like a mirror, by its Fresnel (here at normal incidence; the
+    // chain's throughput takes it at the chain's angle).
+    if (const auto* c = std::get_if<Conductor>(&m); c && c->smooth()) sp.mirror_reflectance[i] = c->tint * fresnel_complex(1.0f, c->eta, c->k);
+    if (const auto* mix = std::get_if<Mixture>(&m)) sp.mirror_reflectance[i] = bsdf::mirror_reflectance(*mix);
+    const glm::vec3& r = sp.mirror_reflectance[i];
+    if (sp.glass_ior[i] > 0.0f || r.x != 0.0f || r.y != 0.0f || r.z != 0.0f) sp.shapes.push_back(static_cast<int>(i));
+  }
+  // Seeds pick a shape by the share of flux it passes on: 1 for glass (reflected plus
+  // transmitted), a mirror's (or a mixture's mirror parts') mean reflectance, at most 1.
+  float total = 0.0f;
+  for (const int shape : sp.shapes) {
+    const glm::vec3 r = sp.mirror_reflectance[static_cast<std::size_t>(shape)];
+    total += sp.glass_ior[static_cast<std::size_t>(shape)] > 0.0f ? 1.0f : std::clamp((r.x + r.y + r.z) / 3.0f, 1e-3f, 1.0f);
+    sp.seed_cdf.push_back(total);
+  }
+  for (float& c : sp.seed_cdf) c /= total;
+  for (const int shape : sp.shapes) sp.bounds.push_back(padded_sphere(rs.geometry->shape_geometry(shape)));
+  RTCBounds b;
+  rtcGetSceneBounds(rs.geometry->handle(), &b);
+  const double dx = static_cast<double>(b.upper_x) - b.lower_x, dy = static_cast<double>(b.upper_y) - b.lower_y,
+               dz = static_cast<double>(b.upper_z) - b.lower_z;
+  const double size = std::sqrt(dx * dx + dy * dy + dz * dz);
+  sp.scene_size = std::isfinite(size) && size > 0.0 ? size : 1.0;
+  return sp;
+}
+
 // The image infinite light of `image`, whose box is `box` (trace/environment.h).
 EnvironmentLightParams environment_light(const EnvironmentImage& image, const Shape& box) {
   auto m = std::make_shared<EnvironmentMap>();
@@ -55,6 +113,18 @@ EnvironmentLightParams environment_light(const EnvironmentImage& image, const Sh
 }
 
 }  // namespace
+
+bool SpecularSurfaces::meets(const EmbreeScene& geometry, const glm::vec3& o, const glm::vec3& d, int leaving) const {
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    if (shapes[k] == leaving && std::holds_alternative<SphereShape>(geometry.shape_geometry(leaving))) continue;
+    const glm::vec4& bs = bounds[k];
+    const glm::vec3 oc = glm::vec3(bs) - o;
+    const float along = glm::dot(oc, d), r2 = bs.w * bs.w, oc2 = glm::dot(oc, oc);
+    // (in float: the bounds are padded by 1e-4 of the radius, far above this test's rounding)
+    if (oc2 <= r2 || (along > 0.0f && oc2 - along * along <= r2)) return true;
+  }
+  return false;
+}
 
 Result<RenderScene> make_render_scene(const Scene& scene) {
   RenderScene rs;
@@ -132,6 +202,8 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     }
     rs.lights.push_back(l);
   }
+  rs.specular = specular_surfaces(rs);
+  for (RenderLight& l : rs.lights) l.letters = {letter_char(pos_letter(l.params)), letter_char(dir_letter(l.params))};
   // --- the sensor ---
   const Camera& c = scene.camera;
   RenderSensor& cam = rs.camera;
@@ -155,6 +227,7 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
       break;
     case SensorType::kSpotmeter: cam.params = SpotMeterParams{c.position, forward}; break;
   }
+  cam.letters = {letter_char(dir_letter(cam.params)), letter_char(pos_letter(cam.params))};
   return rs;
 }
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <new>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -47,6 +48,7 @@ struct RenderLight {
   // The rounding-error bound of the points rays leave from when they are not a shape's (a distant
   // light's aperture may coincide with one, a window pane); zero for the others.
   glm::vec3 origin_error{0.0f};
+  std::string letters;  // c0 c1: its position's letter, then its direction's (the header's conventions)
   bool is_area() const { return shape >= 0; }
   // The image infinite light this is (trace/environment.h), or null.
   const EnvironmentLightParams* environment() const { return std::get_if<EnvironmentLightParams>(&params); }
@@ -69,6 +71,7 @@ struct RenderSensor {
   // Area density of the ray's origin as the MIS ratios keep it: 1 / lens area, 1 / film area,
   // 0 for a point (pinhole, spot meter).
   float pdf_pos = 0.0f;
+  std::string letters;  // c(k+1) c(k+2): its direction's letter, then its position's
   // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
   void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
     const float w = static_cast<float>(width), h = static_cast<float>(height);
@@ -105,6 +108,22 @@ class MaterialScratch {
   bool made_ = false;
 };
 
+// The manifold connector's specular surfaces (trace/joins/manifold.h), found once per scene as the
+// planar mirrors are: per shape, the index of a pure smooth dielectric, else 0; the reflectance of
+// a mirror (a smooth conductor's at normal incidence, a mixture's mirror components weighed), else
+// 0. Group members and shapes with a bump or normal map are left out (opaque to the walks).
+struct SpecularSurfaces {
+  std::vector<float> glass_ior;
+  std::vector<glm::vec3> mirror_reflectance;
+  std::vector<int> shapes;             // the shapes with either (the manifold's seeds aim at points on them)
+  std::vector<float> seed_cdf;         // the seeds' choice among them (cumulative, last 1)
+  std::vector<glm::vec4> bounds;       // a bounding sphere of each (centre, radius): joins no chain can leave skip
+  double scene_size = 1.0;             // the scene's bounding-box diagonal (the manifold's shortest segment scales with it)
+  // Whether the ray (o, d) can meet one of the shapes: it passes through one's bounding sphere, but
+  // for shape `leaving` when that is a sphere (the ray leaves it outwards).
+  bool meets(const EmbreeScene& geometry, const glm::vec3& o, const glm::vec3& d, int leaving) const;
+};
+
 struct RenderScene {
   std::unique_ptr<EmbreeScene> geometry;
   std::vector<const Material*> material_of_shape;
@@ -127,6 +146,7 @@ struct RenderScene {
   // 1 for a shape that is a group member, drawn by instances (scene.h ShapeInstance); the manifold
   // connector's walks know world-space shapes only and treat these as opaque.
   std::vector<std::uint8_t> in_group;
+  SpecularSurfaces specular;  // the manifold connector's
 
   // --- what every strategy asks of the scene ---
   // A light chosen uniformly by u. (u n lies in [0, n), far below 2^63: the signed conversion is

@@ -45,11 +45,15 @@ class StrategyTable {
   }
   // Shorthand for the plain join (s, DD, t).
   int plain(int s, int t) const { return at(s, ConnectorKind::kNone, t); }
-  // Whether any (s, chain, t) is run.
+  // Whether any (s, chain, t) is run, and any (s, chain, t) for this t.
   bool runs(ConnectorKind chain) const {
+    for (int t = 0; t < kMaxSide; ++t)
+      if (runs_at_t(chain, t)) return true;
+    return false;
+  }
+  bool runs_at_t(ConnectorKind chain, int t) const {
     for (int s = 0; s < kMaxSide; ++s)
-      for (int t = 0; t < kMaxSide; ++t)
-        if (at(s, chain, t) >= 0) return true;
+      if (at(s, chain, t) >= 0) return true;
     return false;
   }
 

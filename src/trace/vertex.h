@@ -47,6 +47,9 @@ inline void link(Vertex& v, const Vertex& pred) {
   v.wo = v.d2_wo > 0.0f ? e / std::sqrt(v.d2_wo) : vec3(0.0f);
 }
 
+// A throughput or contribution that carries nothing.
+inline bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
+
 // A vertex's density as the MIS ratios use it, a Dirac's densities (stored as 0) counting as 1.
 // Branch-free (0 + 1 is exact): Dirac vertices come and go along a path unpredictably.
 inline double remap_density(float f) { return static_cast<double>(f) + static_cast<double>(f == 0.0f); }
@@ -56,6 +59,14 @@ inline float abs_cos(const Vertex& v, const vec3& w) {
   // Arithmetic, not a choice (which compiled to a branch that mispredicted at every point vertex):
   // a point's n is zero, so its |cos| term is 0 and the added 1 is the whole value.
   return std::fabs(glm::dot(v.n, w)) + static_cast<float>(!v.has_normal());
+}
+
+// Density of the far end of a parallel beam per unit area there, relative to the near end's:
+// points x and y on one line along w, with unit normals (zero: no surface), map areas as
+// dA_x |cos θ_x| = dA_y |cos θ_y|.
+inline float parallel_jacobian(const Vertex& far, const Vertex& near, const vec3& w) {
+  const float c = abs_cos(near, w);
+  return c > 0.0f ? abs_cos(far, w) / c : 0.0f;
 }
 
 // |cos| at `v` towards `w` with its shading normal: the BSDF's own cosine, which a join puts at

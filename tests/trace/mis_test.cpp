@@ -30,6 +30,18 @@ namespace pathex::tracer {
 // Drives the integrator's stages by hand (its public interface): subpaths, joins, weights.
 struct IntegratorTestAccess {
   using Thread = Integrator::Thread;
+  // What the integrator derives from its scene and profile, derived here from the same: the
+  // probability of picking each light, a light's letters c0 c1 and the sensor's c(k+1).
+  static float light_pick(const Integrator& in) { return 1.0f / static_cast<float>(in.scene().lights.size()); }
+  static const std::string& light_pair(const Integrator& in, int li) { return in.scene().lights[static_cast<std::size_t>(li)].letters; }
+  static char sensor_direction_letter(const Integrator& in) { return in.scene().camera.letters[0]; }
+  // Whether the plain join (s, DD, t) runs: the profile's strategy, and for t = 0 a thin lens that
+  // light subpaths can hit because some (·, DD, 0) runs.
+  static bool runs_plain(const Integrator& in, int s, int t) {
+    bool lens_hits = false;
+    for (int s2 = 0; s2 < 2 * kMaxVertices; ++s2) lens_hits = lens_hits || in.strategy(s2, 0) >= 0;
+    return in.strategy(s, t) >= 0 && (t > 0 || (lens_hits && in.scene().camera.type == SensorType::kLens));
+  }
   // One sample's eye and light subpaths, as render() traces them.
   static int trace_subpaths(const Integrator& in, Integrator::Thread& th, Sampler& rng, int px, int py, int* ns) {
     const int nt = in.eye_subpath(th, rng, px, py);
@@ -99,39 +111,59 @@ struct IntegratorTestAccess {
     if (t == 0) path.back().kind = Kind::kCamera;
     return path;
   }
-  // Strategy (s, m constructed, t) over the whole path `path`.
-  static Integrator::PathView whole(const std::vector<Vertex>& path, int s, int m) {
-    Integrator::PathView x;
-    x.whole = path.data();
-    x.s = s;
-    x.m = m;
-    x.t = static_cast<int>(path.size()) - s - m;
-    return x;
+  // A path x0 … xk held in one array (as gather() forms it): the view of strategy (s, m
+  // constructed, ·) over it reads x0 … x(s-1) as the light vertices, the m after them as the chain
+  // and the rest, from xk back, as the eye vertices.
+  struct WholePath {
+    std::vector<Vertex> x, reversed;
+    explicit WholePath(std::vector<Vertex> path) : x(std::move(path)), reversed(x.rbegin(), x.rend()) {}
+    Integrator::PathView at(int s, int m) const {
+      Integrator::PathView v;
+      v.light = x.data();
+      v.chain = x.data() + s;
+      v.eye = reversed.data();
+      v.s = s;
+      v.m = m;
+      v.t = static_cast<int>(x.size()) - s - m;
+      return v;
+    }
+  };
+  // The weight of strategy `self` at split s (m constructed vertices) of `path` by the one routine,
+  // with every density recomputed from the vertices (as the renderer weighs a connector's path).
+  static float recomputed_weight(const Integrator& in, Thread& th, const WholePath& path, int s, int m, PathKey key,
+                                 ConnectorKind self) {
+    const Integrator::PathView x = path.at(s, m);
+    const mis::Strategies st = in.techniques(th, x, key, self);
+    if (st.alone()) return 1.0f;
+    int lo = 0, hi = 0;
+    st.read_range(&lo, &hi);
+    in.path_densities(th, x, key, lo, hi);
+    in.chain_densities(th, x, key, self, lo, hi);  // (nothing changes where the manifold does not run)
+    return mis::weight(th.densities.data(), st, lo, hi);
   }
   // The same weight with every density recomputed from the path's vertices.
   static float general_weight(const Integrator& in, Integrator::Thread& th, int s, int t) {
-    const std::vector<Vertex> path = gather(in, th, s, t);
-    return in.mis_weight(th, whole(path, s, 0), in.path_key(th, s, t, nullptr), ConnectorKind::kNone, nullptr);
+    return recomputed_weight(in, th, WholePath(gather(in, th, s, t)), s, 0, in.path_key(th, s, t, nullptr), ConnectorKind::kNone);
   }
   // For the path of plain connection (s, t): the weights that the routine gives it, with every
   // density recomputed, as each strategy that could sample it, the plain joins (s2, DD, ·) whose
   // letters are D and the manifold's chains, each computed as its own strategy. *chains: how many
   // manifold chains could build it. Must sum to 1.
   static double whole_path_weight_sum(const Integrator& in, Integrator::Thread& th, int s, int t, int* chains) {
-    const std::vector<Vertex> path = gather(in, th, s, t);
+    const WholePath path(gather(in, th, s, t));
     const PathKey key = in.path_key(th, s, t, nullptr);
-    const int k = static_cast<int>(path.size()) - 1, n = k + 1;
+    const int k = static_cast<int>(path.x.size()) - 1, n = k + 1;
     double sum = 0.0;
     *chains = 0;
     for (int s2 = 0; s2 <= n; ++s2)
-      if (((in.runs_mask(n) >> s2) & 1) && packed_is_d(key, s2) && packed_is_d(key, s2 + 1))
-        sum += in.mis_weight(th, whole(path, s2, 0), key, ConnectorKind::kNone, nullptr);
+      if (runs_plain(in, s2, n - s2) && packed_is_d(key, s2) && packed_is_d(key, s2 + 1))
+        sum += recomputed_weight(in, th, path, s2, 0, key, ConnectorKind::kNone);
     for (int i = 1; i <= k - 1; ++i) {
       int m = 0;
       while (i + m <= k - 1 && !packed_is_d(key, i + m + 1)) ++m;
-      if (m > 0 && in.manifold_at(whole(path, i, m), key, i, m)) {
+      if (m > 0 && in.manifold_at(path.at(i, m), key, i, m)) {
         ++*chains;
-        sum += in.mis_weight(th, whole(path, i, m), key, ConnectorKind::kManifold, nullptr);
+        sum += recomputed_weight(in, th, path, i, m, key, ConnectorKind::kManifold);
       }
     }
     return sum;
@@ -144,20 +176,20 @@ struct IntegratorTestAccess {
     if (pt.kind != Kind::kSurface || !pt.finite || in.scene().lights.empty()) return false;
     const std::size_t li = in.scene().pick_light(rng);
     const RenderLight& l = in.scene().lights[li];
-    if (in.light_pair(static_cast<int>(li))[1] != 'D') return false;
+    if (light_pair(in, static_cast<int>(li))[1] != 'D') return false;
     vec3 err{0.0f};
     const std::optional<EndpointConnection> c = pathex::connect(l.params, in.scene().sample_point(l, rng, &err), pt.p);
     if (!c) return false;
     *y0 = Vertex{};
     y0->kind = Kind::kLight;
     y0->light = static_cast<int>(li);
-    y0->pos_letter = in.light_pair(static_cast<int>(li))[0];
+    y0->pos_letter = light_pair(in, static_cast<int>(li))[0];
     y0->letter = 'D';
     y0->p = c->position;
     y0->n = c->normal;
     y0->ns = y0->n;
     y0->err = err;
-    y0->pdf_fwd = in.light_pick() * l.pdf_pos;
+    y0->pdf_fwd = light_pick(in) * l.pdf_pos;
     *join = JoinDensity{};
     bsdf::eval(*in.scene().material_of_shape[static_cast<std::size_t>(pt.shape)], pt.wo, c->wi, pt.ns, pt.n, &join->at_pt);
     join->w = -c->wi;
@@ -171,7 +203,7 @@ struct IntegratorTestAccess {
   }
   // The density with which next-event estimation draws the point `on_light` of an area light.
   static float light_point_density(const Integrator& in, const Vertex& on_light) {
-    return in.light_pick() * in.scene().lights[static_cast<std::size_t>(in.scene().light_of_shape[static_cast<std::size_t>(on_light.shape)])].pdf_pos;
+    return light_pick(in) * in.scene().lights[static_cast<std::size_t>(in.scene().light_of_shape[static_cast<std::size_t>(on_light.shape)])].pdf_pos;
   }
   static const Material& material(const Integrator& in, const Vertex& v) { return *in.scene().material_of_shape[static_cast<std::size_t>(v.shape)]; }
   // Whether (s, t) joins two vertices that can be joined (s = 0: an eye vertex on an area light;
@@ -207,8 +239,7 @@ struct IntegratorTestAccess {
     for (int s2 = 0; s2 <= k + 1; ++s2) {
       const int t2 = k + 1 - s2;
       const auto letters_at = [&](int i, int count) { return letters.substr(static_cast<std::size_t>(i) + 1, static_cast<std::size_t>(count)); };
-      bool plain = in.strategy(s2, t2) >= 0 && letters_at(s2, 2) == "DD";
-      if (t2 == 0 && !in.lens_hits()) plain = false;
+      bool plain = runs_plain(in, s2, t2) && letters_at(s2, 2) == "DD";
       if (s2 == 0 && x[0].kind == Kind::kLight && !in.scene().lights[static_cast<std::size_t>(x[0].light)].is_area()) plain = false;
       const bool distant = s2 == 1 && in.distant_of(t2) >= 0 && letters_at(0, 3) == "DSD";
       const bool ortho = t2 == 1 && in.ortho_of(s2) >= 0 && letters_at(k, 3) == "DSD";
@@ -220,7 +251,7 @@ struct IntegratorTestAccess {
       for (int j = 0; j < t2; ++j) th.eye[static_cast<std::size_t>(j)] = x[static_cast<std::size_t>(k - j)];
       if (s2 > 0) {
         th.light[0].kind = Kind::kLight;
-        th.light[0].pdf_fwd = in.light_pick() * in.scene().lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+        th.light[0].pdf_fwd = light_pick(in) * in.scene().lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
         // An image infinite light's x0: the density next-event estimation from x1 draws it with
         // (Integrator::environment_of; x1's own density follows from in.pdf()).
         if (const EnvironmentLightParams* e = in.environment_of(x[0].light); e && k >= 1)
@@ -265,10 +296,10 @@ struct IntegratorTestAccess {
                                         th.eye[static_cast<std::size_t>(j)]);
       // Parallel beams (a distant light's, an orthographic sensor's) give their first vertex a
       // density per area, as light_subpath() and eye_subpath() set it.
-      if (s2 >= 2 && th.light[0].pdf_fwd > 0.0f && in.light_pair(th.light[0].light)[1] == 'S')
-        th.light[1].pdf_fwd = Integrator::parallel_jacobian(th.light[1], th.light[0], glm::normalize(th.light[1].p - th.light[0].p));
-      if (t2 >= 2 && in.scene().camera.pdf_pos > 0.0f && in.sensor_pair()[0] == 'S')
-        th.eye[1].pdf_fwd = Integrator::parallel_jacobian(th.eye[1], th.eye[0], glm::normalize(th.eye[1].p - th.eye[0].p));
+      if (s2 >= 2 && th.light[0].pdf_fwd > 0.0f && light_pair(in, th.light[0].light)[1] == 'S')
+        th.light[1].pdf_fwd = parallel_jacobian(th.light[1], th.light[0], glm::normalize(th.light[1].p - th.light[0].p));
+      if (t2 >= 2 && in.scene().camera.pdf_pos > 0.0f && sensor_direction_letter(in) == 'S')
+        th.eye[1].pdf_fwd = parallel_jacobian(th.eye[1], th.eye[0], glm::normalize(th.eye[1].p - th.eye[0].p));
       in.set_masks(th, s2, t2);
       sum += in.mis_weight(th, plain_path(th, s2, t2), pack(letters), kind, nullptr);
     }
@@ -564,7 +595,7 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
     const ManifoldWalk to_floor = solve_chain(from_light, p0, p3, n3, 1.0, ManifoldOptions{});
     const ManifoldWalk to_lamp = solve_chain(from_floor, p3, p0, n0, 1.0, ManifoldOptions{});
     if (to_floor.failure != ManifoldFailure::kNone || to_lamp.failure != ManifoldFailure::kNone) continue;
-    const double lamp = in.light_pick() * rs.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;  // x0 drawn on the lamp
+    const double lamp = A::light_pick(in) * rs.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;  // x0 drawn on the lamp
     const double lamp_dir = std::fabs(glm::dot(glm::normalize(x[1].p - x[0].p), x[0].n)) / pi;      // its cosine emission
     const double floor_dir = std::fabs(glm::dot(glm::normalize(x[2].p - x[3].p), x[3].n)) / pi;     // the floor's cosine density
     const double manifold = lamp * e3;
@@ -573,9 +604,10 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
     const double sum2 = manifold * manifold + light_tracing * light_tracing + emitter_hit * emitter_hit;
     const PathKey key = in.path_key(th, 4, 1, nullptr);
     const float w_lt = A::own_weight(in, th, 4, 1);
-    const float w_lt_whole = in.mis_weight(th, A::whole(x, 4, 0), key, ConnectorKind::kNone, nullptr);
-    const float w_manifold = in.mis_weight(th, A::whole(x, 1, 2), key, ConnectorKind::kManifold, nullptr);
-    const float w_hit = in.mis_weight(th, A::whole(x, 0, 0), key, ConnectorKind::kNone, nullptr);
+    const A::WholePath whole(x);
+    const float w_lt_whole = A::recomputed_weight(in, th, whole, 4, 0, key, ConnectorKind::kNone);
+    const float w_manifold = A::recomputed_weight(in, th, whole, 1, 2, key, ConnectorKind::kManifold);
+    const float w_hit = A::recomputed_weight(in, th, whole, 0, 0, key, ConnectorKind::kNone);
     const std::string where = "sample " + std::to_string(i) + ", |dω0/dA3| " + std::to_string(to_floor.dw_db);
     EXPECT_NEAR(w_lt, light_tracing * light_tracing / sum2, 2e-3) << where;
     EXPECT_NEAR(w_lt_whole, w_lt, 1e-4) << where;

@@ -1,7 +1,5 @@
 // The manifold connector in the integrator (trace/joins/manifold.h for the walk): the seed, the
 // contribution through the solved chain, and which paths it could build (for MIS).
-#include <embree3/rtcore.h>
-
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -13,66 +11,6 @@
 #include "trace/joins/manifold.h"
 
 namespace pathex::tracer {
-namespace {
-bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
-
-// A sphere (centre, radius) holding the shape, padded by a relative 1e-4.
-glm::vec4 bounding_sphere(const ShapeGeometry& g) {
-  if (const auto* s = std::get_if<SphereShape>(&g)) return {s->center, s->radius * 1.0001f};
-  if (const auto* d = std::get_if<DiskShape>(&g)) return {d->center, d->radius * 1.0001f};
-  vec3 lo(INFINITY), hi(-INFINITY);
-  const auto add = [&](const vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); };
-  if (const auto* q = std::get_if<QuadShape>(&g)) {
-    for (const vec3& p : {q->corner, q->corner + q->edge1, q->corner + q->edge2, q->corner + q->edge1 + q->edge2}) add(p);
-  } else {
-    for (const vec3& p : std::get<MeshShape>(g).positions) add(p);
-  }
-  const vec3 c = 0.5f * (lo + hi);
-  return {c, 0.5f * glm::length(hi - lo) * 1.0001f + 1e-6f * glm::length(c)};
-}
-}  // namespace
-
-void Integrator::init_manifold() {
-  glass_ior_.assign(rs_.material_of_shape.size(), 0.0f);
-  mirror_reflectance_.assign(rs_.material_of_shape.size(), vec3(0.0f));
-  specular_shapes_.clear();
-  for (std::size_t i = 0; i < rs_.material_of_shape.size(); ++i) {
-    if (rs_.light_of_shape[i] >= 0 || rs_.in_group[i]) continue;  // instanced members: opaque to the walks (RenderScene::in_group)
-    // A bump or normal map turns the shading normal the walk's constraint does not see: opaque too.
-    if (rs_.textures_of_shape[i] && rs_.textures_of_shape[i]->perturb != NormalPerturbation::kNone) continue;
-    const Material& m = *rs_.material_of_shape[i];
-    if (const auto* d = std::get_if<Dielectric>(&m); d && d->ior > 0.0f && d->ior != 1.0f) glass_ior_[i] = d->ior;
-    // A mirror, or a mixture's mirror components (each weighed by its weight).
-    if (const auto* r = std::get_if<Mirror>(&m)) mirror_reflectance_[i] = r->reflectance;
-    // A smooth conductor reflects like a mirror, by its Fresnel (here at normal incidence; the
-    // chain's throughput takes it at the chain's angle).
-    if (const auto* c = std::get_if<Conductor>(&m); c && c->smooth()) mirror_reflectance_[i] = c->tint * fresnel_complex(1.0f, c->eta, c->k);
-    if (const auto* mix = std::get_if<Mixture>(&m))
-      for (const Mixture::Component& c : mix->components)
-        if (const auto* r = std::get_if<Mirror>(&c.material); r && std::isfinite(c.weight) && c.weight > 0.0f)
-          mirror_reflectance_[i] += c.weight * r->reflectance;
-    if (glass_ior_[i] > 0.0f || !is_black(mirror_reflectance_[i])) specular_shapes_.push_back(static_cast<int>(i));
-  }
-  // Seeds pick a shape by the share of flux it passes on: 1 for glass (reflected plus
-  // transmitted), a mirror's (or a mixture's mirror parts') mean reflectance, at most 1.
-  seed_cdf_.clear();
-  float total = 0.0f;
-  for (const int shape : specular_shapes_) {
-    const vec3 r = mirror_reflectance_[static_cast<std::size_t>(shape)];
-    total += glass_ior_[static_cast<std::size_t>(shape)] > 0.0f ? 1.0f : std::clamp((r.x + r.y + r.z) / 3.0f, 1e-3f, 1.0f);
-    seed_cdf_.push_back(total);
-  }
-  for (float& c : seed_cdf_) c /= total;
-  specular_bounds_.clear();
-  for (const int shape : specular_shapes_) specular_bounds_.push_back(bounding_sphere(rs_.geometry->shape_geometry(shape)));
-  has_manifold_ = !specular_shapes_.empty() && table_.runs(ConnectorKind::kManifold);
-  RTCBounds b;
-  rtcGetSceneBounds(rs_.geometry->handle(), &b);
-  const double dx = static_cast<double>(b.upper_x) - b.lower_x, dy = static_cast<double>(b.upper_y) - b.lower_y,
-               dz = static_cast<double>(b.upper_z) - b.lower_z;
-  const double size = std::sqrt(dx * dx + dy * dy + dz * dz);
-  scene_size_ = std::isfinite(size) && size > 0.0 ? size : 1.0;
-}
 
 bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const {
   const int k = x.size() - 1;
@@ -90,7 +28,7 @@ bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const
     const float before = glm::dot(x[v - 1].p - c.p, c.n);
     const float after = glm::dot(x[v + 1].p - c.p, c.n);
     // Glass reflects or refracts; a mirror (or a mixture's mirror part) reflects.
-    if (glass_ior_[shape] == 0.0f && (is_black(mirror_reflectance_[shape]) || !(before * after > 0.0f))) return false;
+    if (rs_.specular.glass_ior[shape] == 0.0f && (is_black(rs_.specular.mirror_reflectance[shape]) || !(before * after > 0.0f))) return false;
   }
   return true;
 }
@@ -103,13 +41,7 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
   // The probability that a walk leaving towards `wo`'s opposite picks the Dirac lobe the chain took there.
   const auto picks = [&](const Vertex& c, const vec3& wo, bool reflect) {
     MaterialScratch textured;
-    const Material& mat = material_at(c, &textured);
-    const Lobe lobe = reflect ? Lobe::kSpecularReflection : Lobe::kSpecularTransmission;
-    const auto* mix = std::get_if<Mixture>(&mat);
-    const int components = mix ? static_cast<int>(mix->components.size()) : 1;
-    double p = 0.0;
-    for (int i = 0; i < components; ++i) p += bsdf::component_probability(mat, wo, c.ns, i, lobe);
-    return p;
+    return bsdf::lobe_probability(material_at(c, &textured), wo, c.ns, reflect ? Lobe::kSpecularReflection : Lobe::kSpecularTransmission);
   };
   // Every maximal run x_i … x(i+m-1) of S vertices that the manifold connector could build, as
   // techniques() lists them (an image light's x0 joins no chain).
@@ -130,7 +62,7 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
       const vec3 to_light = glm::normalize(x[v - 1].p - c.p), to_eye = glm::normalize(x[v + 1].p - c.p);
       const float before = glm::dot(to_light, c.n), after = glm::dot(to_eye, c.n);
       const bool reflect = before * after > 0.0f;
-      const double ior = glass_ior_[static_cast<std::size_t>(c.shape)] > 0.0f ? glass_ior_[static_cast<std::size_t>(c.shape)] : 1.0;
+      const double ior = rs_.specular.glass_ior[static_cast<std::size_t>(c.shape)] > 0.0f ? rs_.specular.glass_ior[static_cast<std::size_t>(c.shape)] : 1.0;
       // The index on each neighbour's side (the normal points out of the glass).
       chain.push_back({&rs_.geometry->shape_geometry(c.shape), c.shape, c.primitive, ior, before > 0.0f ? 1.0 : ior,
                        after > 0.0f ? 1.0 : ior, reflect, glm::dvec3(c.p), 0});
@@ -165,26 +97,14 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
   }
 }
 
-bool Integrator::meets_specular(const vec3& o, const vec3& d, int leaving) const {
-  for (std::size_t k = 0; k < specular_shapes_.size(); ++k) {
-    if (specular_shapes_[k] == leaving && std::holds_alternative<SphereShape>(rs_.geometry->shape_geometry(leaving))) continue;
-    const glm::vec4& bs = specular_bounds_[k];
-    const vec3 oc = vec3(bs) - o;
-    const float along = glm::dot(oc, d), r2 = bs.w * bs.w, oc2 = glm::dot(oc, oc);
-    // (in float: the bounds are padded by 1e-4 of the radius, far above this test's rounding)
-    if (oc2 <= r2 || (along > 0.0f && oc2 - along * along <= r2)) return true;
-  }
-  return false;
-}
-
 ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
                                        std::vector<ChainVertex>& chain) const {
   const auto u = [&] { return bits_to_unit_float(stream_bits(stream, (*drawn)++)); };
   chain.clear();
   const float u_shape = u();
   const glm::vec2 u_point(u(), u());
-  const std::size_t pick = static_cast<std::size_t>(std::upper_bound(seed_cdf_.begin(), seed_cdf_.end() - 1, u_shape) - seed_cdf_.begin());
-  const int shape = specular_shapes_[pick];
+  const std::size_t pick = static_cast<std::size_t>(std::upper_bound(rs_.specular.seed_cdf.begin(), rs_.specular.seed_cdf.end() - 1, u_shape) - rs_.specular.seed_cdf.begin());
+  const int shape = rs_.specular.shapes[pick];
   vec3 o = from.p, no = from.n, eo = from.err;
   vec3 d;
   const auto* sphere = std::get_if<SphereShape>(&rs_.geometry->shape_geometry(shape));
@@ -202,8 +122,8 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
   for (;;) {
     const std::optional<Hit> hit = rs_.geometry->intersect(o, d, no, eo, HitDetail::kNoUv);
     if (!hit) break;
-    const float ior = glass_ior_[static_cast<std::size_t>(hit->shape)];
-    const bool mirror = !is_black(mirror_reflectance_[static_cast<std::size_t>(hit->shape)]);
+    const float ior = rs_.specular.glass_ior[static_cast<std::size_t>(hit->shape)];
+    const bool mirror = !is_black(rs_.specular.mirror_reflectance[static_cast<std::size_t>(hit->shape)]);
     if (ior == 0.0f && !mirror) {
       if (chain.empty()) return ManifoldFailure::kOccluded;  // something opaque between the end and the specular surfaces
       break;
@@ -234,7 +154,7 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
     // The chain ends where the ray meets no more specular surfaces: when it passes every specular
     // shape's bounding sphere by (a sphere it leaves outwards it cannot meet again), the ray that
     // would find the opaque surface or nothing beyond is not traced.
-    if (!meets_specular(o, d, glm::dot(d, hit->normal) > 0.0f ? hit->shape : -1)) break;
+    if (!rs_.specular.meets(*rs_.geometry, o, d, glm::dot(d, hit->normal) > 0.0f ? hit->shape : -1)) break;
   }
   if (chain.empty()) return ManifoldFailure::kNoSolution;
   if (!from_light) std::reverse(chain.begin(), chain.end());  // light side first
@@ -252,7 +172,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   // chain any light: the chain's first vertex would leave a at a negative cosine (no transport).
   if (s == 1 && !is_black(vec3(a->n)) && is_black(end_f(*a, -a->n, TransportMode::kImportance))) {
     bool behind = true;
-    for (const glm::vec4& bs : specular_bounds_)
+    for (const glm::vec4& bs : rs_.specular.bounds)
       behind = behind && glm::dot(vec3(bs) - a->p, a->n) < -bs.w;
     if (behind) return;
   }
@@ -298,7 +218,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
     }
     // A chain whose path the plan's filter does not record is not solved (its seed still counts
     // in the batches, so the recorded chains' inverse probabilities are unchanged).
-    if (!filter_.records(manifold_key(th, *a, s, t, static_cast<int>(chain.size())))) {
+    if (!filter_.records(chain_key(th, *a, s, t, static_cast<int>(chain.size())))) {
       w.failure = ManifoldFailure::kUnrequested;
       return w;
     }
@@ -319,7 +239,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
     ++stats.walks;
     // Its generalized geometry term only for a chain that is new to the join (the first batch's),
     // not for one found again: the same chain, the same term.
-    w = solve_chain(chain, pa, pb, nb, scene_size_, o_.manifold, false);
+    w = solve_chain(chain, pa, pb, nb, rs_.specular.scene_size, o_.manifold, false);
     stats.iterations += static_cast<std::uint64_t>(w.iterations);
     if (w.failure == ManifoldFailure::kWrongType) {
       wrong.push_back(static_cast<int>(chain.size()));
@@ -328,7 +248,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
     return w;
   };
   std::vector<ChainVertex>& seed = th.manifold_seed;
-  const double same = 1e-5 * scene_size_;  // solutions are polished (solve_chain), so one found twice compares equal
+  const double same = 1e-5 * rs_.specular.scene_size;  // solutions are polished (solve_chain), so one found twice compares equal
   const auto index_of = [&](const std::vector<ChainVertex>& x) -> int {
     for (std::size_t k = 0; k < found.size(); ++k) {
       const std::vector<ChainVertex>& y = found[k].chain;
@@ -396,16 +316,6 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
     emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)));
 }
 
-PathKey Integrator::manifold_key(Thread& th, const Vertex& a, int s, int t, int m) const {
-  if (!th.joins_ready) set_masks(th, th.ns, th.nt);
-  // The letters: a's c(s) = D, the chain's c(s+1) … c(s+m) = S, b's c(s+m+1) = D.
-  const PathKey light_part = s == 1 ? letter_bit(a.pos_letter, 0) : th.light_mask & (bit(s) - 1);
-  PathKey key = light_part | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + m + 1)) & ~bit(s + m + 1)) |
-                static_cast<PathKey>(s + t + m + 2) << kLengthShift;
-  for (int i = 1; i <= m; ++i) key |= bit(s + i);
-  return key;
-}
-
 void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a_end, const Vertex& b_end,
                                const std::vector<ChainVertex>& chain, double weight) const {
   const Vertex* a = &a_end;
@@ -427,7 +337,7 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     v.ns = vec3(geometry.ns);
     v.finite = false;
     // Rounding of the solved point: its float position and the surface's own test, as a hit's bound.
-    v.err = error_gamma(16) * (glm::abs(v.p) + vec3(static_cast<float>(scene_size_)));
+    v.err = error_gamma(16) * (glm::abs(v.p) + vec3(static_cast<float>(rs_.specular.scene_size)));
     v.shape = c.id;
     v.primitive = c.primitive;
     const glm::dvec3 prev = i == 0 ? glm::dvec3(a->p) : chain[static_cast<std::size_t>(i - 1)].p;
@@ -444,12 +354,9 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     } else if (const auto* metal = std::get_if<Conductor>(&mat)) {
       transmit *= metal->tint * fresnel_complex(cos_prev, metal->eta, metal->k);
     } else if (const auto* mix = std::get_if<Mixture>(&mat); mix && has_textures) {  // a mix by a texture amount: its weights here
-      vec3 r(0.0f);
-      for (const Mixture::Component& k : mix->components)
-        if (const auto* mirror = std::get_if<Mirror>(&k.material); mirror && std::isfinite(k.weight) && k.weight > 0.0f) r += k.weight * mirror->reflectance;
-      transmit *= r;
+      transmit *= bsdf::mirror_reflectance(*mix);
     } else {
-      transmit *= mirror_reflectance_[static_cast<std::size_t>(c.id)];
+      transmit *= rs_.specular.mirror_reflectance[static_cast<std::size_t>(c.id)];
     }
   }
   if (absorbing_) {  // Beer–Lambert along the chain's m + 1 segments, a to b (trace/media.h)
@@ -480,14 +387,8 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
     ++stats.no_transport;
     return;
   }
-  const PathKey key = manifold_key(th, *a, s, t, m);
-  jr.set_connector(ConnectorKind::kManifold, s, t, strategy_index, key, contrib, m);  // b is a surface vertex: t >= 2, no eye0
-  jr.segments[0] = Segment{a, &jr.chain_vertices[0]};
-  for (int i = 1; i < m; ++i) jr.segments[static_cast<std::size_t>(i)] = Segment{&jr.chain_vertices[static_cast<std::size_t>(i - 1)], &jr.chain_vertices[static_cast<std::size_t>(i)]};
-  jr.segments[static_cast<std::size_t>(m)] = Segment{&jr.chain_vertices[static_cast<std::size_t>(m - 1)], b};
-  jr.num_segments = m + 1;  // all must be clear
-  jr.has_density = false;    // MIS over whole paths recomputes every density
-  jr.splat = false;
+  // b is a surface vertex: t >= 2, no eye0.
+  jr.set_connector(ConnectorKind::kManifold, s, t, strategy_index, chain_key(th, *a, s, t, m), contrib, m, a, b);
   estimate(th, batch);
 }
 

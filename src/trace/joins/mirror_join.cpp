@@ -6,9 +6,6 @@
 #include "trace/joins/mirror.h"
 
 namespace pathex::tracer {
-namespace {
-bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
-}  // namespace
 
 void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = mirror_of(s, t);
@@ -24,15 +21,11 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
   if (b) {
     if (b->kind != Kind::kSurface || !b->finite) return;
   } else {
-    if (sensor_pair_[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no D end
+    if (cam_.letters[0] != 'D') return;  // a Dirac direction (orthographic, spot meter): no D end
     join_numbers(rng, JoinBlock::kMirrorEye, s);
     u_lens = rng.get2d_if(reads_lens_numbers(cam_.params));
   }
-  if (!th.joins_ready) set_masks(th, th.ns, th.nt);
-  // The letters: y(s-1)'s c(s) = D, the mirror's c(s+1) = S, z(t-1)'s c(s+2) = D.
-  const PathKey light_part = s == 1 ? letter_bit(a->pos_letter, 0) : th.light_mask & (bit(s) - 1);
-  const PathKey key = light_part | bit(s + 1) | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + 2)) & ~bit(s + 2)) |
-                      static_cast<PathKey>(s + t + 3) << kLengthShift;
+  const PathKey key = chain_key(th, *a, s, t, 1);
   for (const PlanarMirror& mirror : rs_.mirrors) {
     ++stats.attempts;
     float rx = 0.0f, ry = 0.0f;
@@ -79,10 +72,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     m.ns = mirror.normal;
     m.err = mirror.error;
     m.shape = mirror.shape;
-    jr.set_connector(ConnectorKind::kMirror, s, t, strategy_index, key, contrib, 1);
-    jr.segments = {Segment{a, &m}, Segment{&m, b}};  // both must be clear
-    jr.num_segments = 2;
-    jr.has_density = false;  // MIS over whole paths recomputes every density
+    jr.set_connector(ConnectorKind::kMirror, s, t, strategy_index, key, contrib, 1, a, b);
     jr.splat = t == 1;
     jr.rx = rx;
     jr.ry = ry;
@@ -95,7 +85,7 @@ const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinB
   join_numbers(rng, block, t);
   const std::size_t li = rs_.pick_light(rng);
   const RenderLight& light = rs_.lights[li];
-  if (light_pairs_[li][1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
+  if (light.letters[1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
   if (environment_of(static_cast<int>(li))) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
   vec3 err{0.0f};
   const SurfacePoint x = rs_.sample_point(light, rng, &err);
@@ -103,6 +93,16 @@ const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinB
                                   light.is_area() ? x.normal : vec3(0.0f), err, 'D');
   y0.beta = spatial_emission(light.params) / (light_pick_ * (light.pdf_pos > 0.0f ? light.pdf_pos : 1.0f));
   return &y0;
+}
+
+PathKey Integrator::chain_key(Thread& th, const Vertex& a, int s, int t, int m) const {
+  if (!th.joins_ready) set_masks(th, th.ns, th.nt);
+  // The letters: a's c(s) = D, the chain's c(s+1) … c(s+m) = S, b's c(s+m+1) = D.
+  const PathKey light_part = s == 1 ? letter_bit(a.pos_letter, 0) : th.light_mask & (bit(s) - 1);
+  PathKey key = light_part | ((th.eye_masks[static_cast<std::size_t>(t)] << (s + m + 1)) & ~bit(s + m + 1)) |
+                static_cast<PathKey>(s + t + m + 2) << kLengthShift;
+  for (int i = 1; i <= m; ++i) key |= bit(s + i);
+  return key;
 }
 
 }  // namespace pathex::tracer

@@ -13,10 +13,6 @@
 #include "trace/media.h"
 
 namespace pathex::tracer {
-namespace {
-bool is_black(const vec3& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f; }
-}  // namespace
-
 vec3 Integrator::end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs) const {
   // A light vertex's beta already holds its spatial emission; only the directional part is left.
   if (v.kind == Kind::kLight) return vec3(directional_emission(rs_.lights[static_cast<std::size_t>(v.light)].params, v.n, w));
@@ -45,11 +41,8 @@ void Integrator::begin_join(Thread& th, ConnectorKind kind, int s, int t, int st
 
 bool Integrator::end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const {
   JoinResult& jr = th.join;
-  if (absorbing_ && from != nullptr) {  // Beer–Lambert along the joining segment (trace/media.h)
-    const vec3 e = to->p - from->p;
-    const float length = std::sqrt(glm::dot(e, e));
-    if (length > 0.0f) contrib *= beer_lambert(segment_absorption(*from, e / length, rs_.absorption_of_shape), length);
-  }
+  // Beer–Lambert along the joining segment (trace/media.h).
+  if (absorbing_ && from != nullptr) contrib *= segment_transmittance(*from, to->p, rs_.absorption_of_shape);
   if (is_black(contrib)) {
     if (jr.chain != ConnectorKind::kNone) ++th.connectors[static_cast<std::size_t>(jr.strategy)].no_transport;
     return false;
@@ -71,7 +64,7 @@ Vertex& Integrator::sensor_vertex(Vertex& z, const vec3& p, const vec3& n, char 
   z.n = cam_.pdf_pos == 0.0f ? vec3(0.0f) : n;  // a pinhole is a point
   z.ns = z.n;
   z.letter = letter;
-  z.pos_letter = sensor_pair_[1];
+  z.pos_letter = cam_.letters[1];
   z.pdf_fwd = cam_.pdf_pos;
   return z;
 }
@@ -80,7 +73,7 @@ Vertex& Integrator::light_vertex(Vertex& y, std::size_t li, const vec3& p, const
   y = Vertex{};
   y.kind = Kind::kLight;
   y.light = static_cast<int>(li);
-  y.pos_letter = light_pairs_[li][0];
+  y.pos_letter = rs_.lights[li].letters[0];
   y.letter = letter;
   y.p = p;
   y.n = n;
@@ -124,7 +117,7 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   const EnvironmentLightParams* env = q->kind == Kind::kLight ? environment_of(q->light) : nullptr;
   // A Dirac direction (orthographic, spot meter) has no DD join; the connector's c(k+1) c(k+2) are
   // a Dirac direction from a film. (No projection of an image light: mis_weight.cpp.)
-  if (ortho ? env != nullptr || sensor_pair_ != "SD" : sensor_pair_[0] != 'D') return false;
+  if (ortho ? env != nullptr || cam_.letters != "SD" : cam_.letters[0] != 'D') return false;
   begin_join(th, kind, s, 1, ortho ? ortho_of(s) : strategy(s, 1));
   if (ortho) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   const glm::vec2 ul = ortho ? glm::vec2(0.0f) : rng.get2d_if(reads_lens_numbers(cam_.params));
@@ -149,7 +142,7 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   }
   JoinResult& jr = th.join;
   const Vertex& qs = *q;
-  const Vertex& z0 = fresh_sensor_vertex(th, *c, ortho ? sensor_pair_[0] : 'D');
+  const Vertex& z0 = fresh_sensor_vertex(th, *c, ortho ? cam_.letters[0] : 'D');
   const vec3 w = c->wi;  // from qs to the sensor
   cam_.to_pixels(c->raster, &jr.rx, &jr.ry);
   jr.splat = true;
@@ -173,7 +166,7 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   const EnvironmentLightParams* env = environment_of(static_cast<int>(li));
   // Dirac directions (distant, laser) have no DD join; the connector's c0 c1 are a Dirac direction
   // from an aperture.
-  if (distant ? light_pairs_[li] != "DS" : !env && light_pairs_[li][1] != 'D') return false;
+  if (distant ? l.letters != "DS" : !env && l.letters[1] != 'D') return false;
   begin_join(th, kind, 1, t, distant ? distant_of(t) : strategy(1, t));
   if (distant) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
@@ -190,7 +183,7 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   if (distant) err = l.origin_error;
   else if (env) err = box_point_error(c->position);
   JoinResult& jr = th.join;
-  Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? light_pairs_[li][1] : 'D');
+  Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? l.letters[1] : 'D');
   if (env) y0.pdf_fwd = env_origin_density(*env, y0.p, y0.n, pt.p);
   const vec3 w = c->wi;  // from pt to the light
   const vec3 f = end_f(pt, w, TransportMode::kRadiance, &jr.density.at_pt);
