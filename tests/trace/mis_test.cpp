@@ -221,10 +221,10 @@ struct IntegratorTestAccess {
       if (s2 > 0) {
         th.light[0].kind = Kind::kLight;
         th.light[0].pdf_fwd = in.light_pick() * in.scene().lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
-        // An image infinite light's x0: the density next-event estimation from x1 draws it with
-        // (Integrator::environment_of; x1's own density follows from in.pdf()).
-        if (const EnvironmentLightParams* e = in.environment_of(x[0].light); e && k >= 1)
-          th.light[0].pdf_fwd = in.env_origin_density(*e, x[0].p, x[0].n, x[1].p);
+        // An x0 drawn towards x1 (an image infinite light's, a rectangle's sampled by solid angle):
+        // the density next-event estimation from x1 draws it with (Integrator::drawn_towards; x1's
+        // own density follows from in.pdf()).
+        if (k >= 1) th.light[0].pdf_fwd = in.light_origin_density(x[0].light, x[0].p, x[0].n, x[1]);
       }
       if (s2 == 0) {
         th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;
@@ -292,9 +292,11 @@ struct MisCheck {
 
 // Traces `samples` pairs of subpaths and checks every full path that a plain join (s, t) with
 // s != 1 and t != 1 of the profile forms from their vertices.
-std::vector<MisCheck> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed, int samples) {
+std::vector<MisCheck> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed, int samples,
+                                        LightSampling light_sampling = LightSampling::kArea) {
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
-  const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
+  RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
+  if (light_sampling != LightSampling::kArea) sample_lights_by_solid_angle(rs, scene, light_sampling == LightSampling::kSolidAngle);
   RenderOptions o;
   o.seed = seed;
   o.max_bounces = std::min(8, profile.max_bounces.value_or(8));
@@ -354,6 +356,28 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
   }
   EXPECT_GT(checked, 2000u);
   EXPECT_GE(by_length.size(), 5u);  // paths of many lengths
+}
+
+// Issue 39: where next-event estimation draws a rectangular or spherical lamp's points by the solid
+// angle it subtends, x0's light density is that of next-event estimation from x1 and x1's the rest of the
+// emission's joint density (Integrator::drawn_towards): the weights of every strategy still sum to 1
+// on every path, and the subpaths' stored densities give the path's recomputed ones.
+TEST(Mis, WeightsOfEveryStrategySumToOneWithSolidAngleLightSampling) {
+  std::size_t checked = 0;
+  for (const char* file : {"samples/scenes/cornell.json", "bench/scenes/tungsten-cornell-box.json", "samples/scenes/materials.json",
+                           "samples/scenes/lamp-glass.json"}) {
+    const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/" + file).expect("a scene");
+    for (const char* renderer : {"bdpt", "pt-nee", "lt", "pbrt-v4-bdpt", "mitsuba3-ptracer"}) {
+      const Profile profile = resolve_profile(renderer, Limits{}).expect("a built-in profile");
+      for (const MisCheck& c : check_mis_weights(scene, profile, 13, 300, LightSampling::kSolidAngle)) {
+        ++checked;
+        const auto where = [&] { return std::string(file) + " " + renderer + " " + c.path + " (s=" + std::to_string(c.s) + ", t=" + std::to_string(c.t) + ")"; };
+        EXPECT_NEAR(c.weight_sum, 1.0, 1e-4) << where();
+        EXPECT_NEAR(c.weight, c.weight_general, 1e-4 * std::max(1.0, c.weight_general)) << where();
+      }
+    }
+  }
+  EXPECT_GT(checked, 500u);
 }
 
 // Where a profile's plain joins are the emitter hit and next-event estimation alone (pt-nee, pt,
