@@ -474,14 +474,19 @@ struct ManifoldRig {
   ClassImages images;
   Integrator in;
   Integrator::Thread th;
-  ManifoldRig(const Scene& scene, const StrategySet& strategies, std::uint64_t seed)
-      : rs(make_render_scene(scene).expect("a scene the tracer renders")),
+  ManifoldRig(const Scene& scene, const StrategySet& strategies, std::uint64_t seed, LightSampling light_sampling = LightSampling::kArea)
+      : rs(render_scene(scene, light_sampling)),
         o(options(seed)),
         images(1, 1, nullptr, {}),
         in(rs, strategies, o),
         th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}} {
     th.images = &images;
     th.connectors.resize(strategies.strategies.size());
+  }
+  static RenderScene render_scene(const Scene& scene, LightSampling light_sampling) {
+    RenderScene r = make_render_scene(scene).expect("a scene the tracer renders");
+    if (light_sampling != LightSampling::kArea) sample_lights_by_solid_angle(r, scene, light_sampling == LightSampling::kSolidAngle);
+    return r;
   }
   static RenderOptions options(std::uint64_t seed) {
     RenderOptions r;
@@ -495,7 +500,8 @@ struct ManifoldRig {
 // the whole-path weights of all of them sum to 1: random paths of the glass-sphere scenes formed by
 // every plain join of bdpt+manifold's subpaths, those a manifold chain could build among them. The
 // renderer's weight of each plain join (its subpaths' stored densities, changed across a chain the
-// manifold could build: chain_densities()) must equal the whole path's.
+// manifold could build: chain_densities()) must equal the whole path's. With the lamps sampled by
+// area and (issue 39) by the cone they subtend, x0's density then next-event estimation's from x1.
 TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
   const Profile profile = parse_profile(R"({"name": "bdpt+manifold", "strategies": [
       {"name": "bdpt", "s": "0..", "chain": "DD", "t": "0.."},
@@ -503,9 +509,10 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
                                         "bdpt+manifold.json", Limits{})
                               .expect("a valid profile");
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
+  for (const LightSampling light_sampling : {LightSampling::kArea, LightSampling::kSolidAngle})
   for (const char* name : {"point-glass.json", "lamp-glass.json"}) {
     const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + name).expect("the sample");
-    ManifoldRig rig(scene, strategies, 5);
+    ManifoldRig rig(scene, strategies, 5, light_sampling);
     const Integrator& integrator = rig.in;
     const RenderScene& rs = rig.rs;
     const RenderOptions& o = rig.o;
@@ -523,7 +530,7 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
           const double sum = A::whole_path_weight_sum(integrator, th, s, t, &chains);
           ++checked;
           if (chains > 0) ++shared;
-          const std::string where = std::string(name) + " " + A::label(integrator, th, s, t) + " (s=" + std::to_string(s) +
+          const std::string where = std::string(name) + " " + to_string(light_sampling) + " " + A::label(integrator, th, s, t) + " (s=" + std::to_string(s) +
                                     ", t=" + std::to_string(t) + ")";
           EXPECT_NEAR(sum, 1.0, 1e-4) << where;
           // The join's own densities read the cosines at its ends: where the join runs along a
