@@ -12,8 +12,9 @@ spread of the estimates over the seeds:
     ratio = sqrt(mean over seeds of stderr²) / sample standard deviation of the estimates.
 
 An honest stderr gives 1. The spread of --seeds seeds is itself an estimate: with 16 seeds its
-relative standard error is about 1/sqrt(2·15) = 18 %, so even an honest stderr reads outside
-[0.75, 1.25] in roughly one cell in six (the 90 % interval of the ratio for an exactly honest
+relative standard error is about 1/sqrt(2·15) = 18 %, so even an exactly honest stderr reads
+outside [0.75, 1.25] in 18.7 % of cells (honest_outside(); 1.2 % at --seeds 64, the seed count that
+can judge a cell) (the 90 % interval of the ratio for an exactly honest
 stderr is printed as "honest 90 %"). The pooled row per renderer (all scenes and spp) divides
 the summed mean stderr² by the summed spread² (each relative to its cell's own scale, i.e. the
 mean of stderr²/spread² is taken as 1/ratio²'s estimate... pooled as sqrt(Σ stderr² / Σ spread²)
@@ -37,6 +38,18 @@ def chi2_quantile(p, k):
     """Wilson–Hilferty approximation of the chi-square quantile (good to ~1 % at k >= 10)."""
     z = statistics.NormalDist().inv_cdf(p)
     return k * (1 - 2 / (9 * k) + z * math.sqrt(2 / (9 * k))) ** 3
+
+
+def chi2_cdf(x, k):
+    """Wilson–Hilferty approximation of P(chi-square with k degrees of freedom <= x)."""
+    return statistics.NormalDist().cdf(((x / k) ** (1 / 3) - (1 - 2 / (9 * k))) / math.sqrt(2 / (9 * k)))
+
+
+def honest_outside(k, lo=0.75, hi=1.25):
+    """The probability that an exactly honest stderr's cell reads outside [lo, hi]: with k + 1
+    normal seeds the spread² is σ² χ²_k / k, and the ratio σ / spread leaves [lo, hi] when
+    χ²_k / k > 1 / lo² or < 1 / hi² (k = 15: 18.7 %, a cell in five or six; k = 63: 1.2 %)."""
+    return (1 - chi2_cdf(k / lo ** 2, k)) + chi2_cdf(k / hi ** 2, k)
 
 
 def run(pathex, scene, renderer, spp, seed, resolution, extra, work):
@@ -105,6 +118,10 @@ def main():
         rs = [c["ratio"] for c in cells if c["renderer"] == renderer and math.isfinite(c["ratio"])]
         inside = sum(1 for x in rs if 0.75 <= x <= 1.25)
         print(f"| {renderer} | {1 / math.sqrt(statistics.fmean(inv)):.2f} ({len(inv)}) | {inside} of {len(rs)} |")
+    n_cells = sum(1 for c in cells if math.isfinite(c["ratio"]))
+    print(f"\nAn exactly honest stderr reads outside [0.75, 1.25] in a cell with probability "
+          f"{100 * honest_outside(k):.1f} % at {args.seeds} seeds: about {honest_outside(k) * n_cells:.1f} of these "
+          f"{n_cells} cells by chance (bench/README.md, issue 36, eighth session).")
     km = k * max(1, len(cells) // max(1, len(pooled)))
     print(f"\n(pooled over {km // k} cells: honest 90 % [{math.sqrt(km / chi2_quantile(0.95, km)):.2f}, "
           f"{math.sqrt(km / chi2_quantile(0.05, km)):.2f}])")

@@ -365,6 +365,9 @@ class Integrator {
   // side first. Random numbers from counter-based `stream`.
   ManifoldFailure seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
                              std::vector<ChainVertex>& chain) const;
+  // Whether the ray (o, d) can meet a specular shape: it passes through one's bounding sphere, but
+  // for shape `leaving` when that is a sphere (the ray leaves it outwards).
+  bool meets_specular(const vec3& o, const vec3& d, int leaving) const;
   void init_manifold();
   // Whether the manifold connector (s, DS^mD, ·) could build the chain x_s … x(s+m-1) of path x
   // (letters `key`): the profile runs it there, its eye end is a surface, and every chain vertex is

@@ -102,16 +102,12 @@ Result<CoverSelection> select_cover(const Profile& pruned, int max_bounces, cons
   out.profile = pruned;
   out.profile.strategies.clear();
   out.per_strategy.resize(pruned.strategies.size());
-  // Connectors are kept whole; what they sample needs no join.
-  Dfa by_connectors = dfa_empty();
-  for (std::size_t i = 0; i < pruned.strategies.size(); ++i) {
-    const Strategy& st = pruned.strategies[i];
-    if (st.connector == ConnectorKind::kNone) continue;
-    Result<Dfa> l = strategy_language(st, max_bounces, limits);
-    if (!l) return l.error();
-    by_connectors = dfa_union(by_connectors, *l);
-  }
-  const Dfa wanted = dfa_difference(target, by_connectors);
+  // Connectors are kept whole, and a path a connector samples still wants the joins that sample it
+  // too: a connector is an expensive and heavy-tailed sampler that MIS needs beside the joins, not
+  // instead of them (with the connector's paths left to it alone, bdpt+manifold's --only render of
+  // lamp-glass's directly seen caustic lost light tracing and was 50× less efficient than the full
+  // render: bench/README.md, issue 40, eighth session).
+  const Dfa& wanted = target;
   // X: the joins that sample a wanted path, each with the strategy that runs it (the first whose
   // ranges hold it, as in the tracer's table) and the wanted paths it samples.
   const int letters = max_bounces + 4;  // the most letters between L and E: s + t + 2 <= letters

@@ -65,7 +65,8 @@ Result<ProfilePruning> prune_profile(const Profile& p, std::optional<int> max_bo
 // over any set of strategies that samples each path at least once (the weights over the strategies
 // that run sum to 1 on each path they sample), so a render of some classes needs only a cover:
 // a set K of plain joins (s, DD, t) such that every path of universe ∩ requested that the profile
-// samples is sampled by K or by one of the profile's connectors (which are kept whole).
+// samples is sampled by K wherever a join samples it (the profile's connectors are kept whole,
+// beside the joins, not instead of them).
 //
 // The cost model counts expected rays per sample, with a subpath going on past each vertex with
 // probability q = kGoOn: extending the light subpath to the largest s of K and the eye subpath to

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <type_traits>
 
 #include <glm/geometric.hpp>
 
@@ -27,6 +28,13 @@ struct Local {
   double li = 0.0, lo = 0.0, lh = 0.0;
 };
 
+// A vertex's constraint: ĥ's part along the surface, on the tangent pair (s, t).
+void constraint(const Local& l, const dvec3& s, const dvec3& t, double* c) {
+  const dvec3 tangential = l.h - glm::dot(l.h, l.g.ns) * l.g.ns;
+  c[0] = glm::dot(tangential, s);
+  c[1] = glm::dot(tangential, t);
+}
+
 // Every vertex's local state and the constraints (2 per vertex, on the tangent pairs `s`, `t`
 // given, or the vertex's own when null): false when one is undefined (a neighbour coincides with
 // the vertex, or the half vector vanishes).
@@ -46,9 +54,7 @@ bool evaluate(const std::vector<ChainVertex>& x, const dvec3* p, const dvec3& a,
     l.lh = glm::length(h);
     if (!(l.lh > 0.0)) return false;
     l.h = h / l.lh;
-    const dvec3 tangential = l.h - glm::dot(l.h, l.g.ns) * l.g.ns;  // the constraint: ĥ's part along the surface
-    c[2 * i] = glm::dot(tangential, s ? s[i] : l.g.dpdu);
-    c[2 * i + 1] = glm::dot(tangential, t ? t[i] : l.g.dpdv);
+    constraint(l, s ? s[i] : l.g.dpdu, t ? t[i] : l.g.dpdv, c + 2 * i);
   }
   return true;
 }
@@ -60,8 +66,10 @@ double largest(const double* c, std::size_t n) {
 }
 
 // A dense square system solved in place by Gaussian elimination with partial pivoting: `rhs` has
-// `cols` columns, row-major. Returns min |pivot| / max |pivot| (0: singular).
-double solve_in_place(double* m, std::size_t n, double* rhs, std::size_t cols) {
+// `cols` columns, row-major. Returns min |pivot| / max |pivot| (0: singular). N: the size, a
+// std::size_t or, for the common chains, a constant (the loops unrolled: the same operations).
+template <class N>
+double eliminate(double* m, N n, double* rhs, std::size_t cols) {
   double lo = INFINITY, hi = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     std::size_t piv = k;
@@ -89,6 +97,15 @@ double solve_in_place(double* m, std::size_t n, double* rhs, std::size_t cols) {
       rhs[k * cols + c] = v / m[k * n + k];
     }
   return hi > 0.0 && std::isfinite(lo / hi) ? lo / hi : 0.0;
+}
+
+double solve_in_place(double* m, std::size_t n, double* rhs, std::size_t cols) {
+  switch (n) {
+    case 2: return eliminate(m, std::integral_constant<std::size_t, 2>{}, rhs, cols);
+    case 4: return eliminate(m, std::integral_constant<std::size_t, 4>{}, rhs, cols);
+    case 6: return eliminate(m, std::integral_constant<std::size_t, 6>{}, rhs, cols);
+    default: return eliminate(m, n, rhs, cols);
+  }
 }
 
 // The change of vertex i's constraint (on its own tangent pair) when the half vector changes by dh
@@ -187,7 +204,7 @@ double chain_dw_db(const std::vector<ChainVertex>& x, const dvec3& a, const dvec
 }
 
 ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec3& b, const dvec3& nb, double scene_size,
-                         const ManifoldOptions& o) {
+                         const ManifoldOptions& o, bool term) {
   ManifoldWalk w;
   const std::size_t m = x.size(), n = 2 * m;
   if (m == 0 || m > kCap) {
@@ -202,13 +219,16 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     std::array<double, kDim * kDim> j;
   };
   static thread_local Scratch scratch;
-  auto& [p, y, s, t, loc, trial, c, cy, step, j] = scratch;
+  auto& [p, y, s, t, loc_store, trial_store, c, cy, step, j] = scratch;
+  // The local state at p, and at a step's trial point (which becomes p's when the step is taken).
+  Local* loc = loc_store.data();
+  Local* trial = trial_store.data();
   for (std::size_t i = 0; i < m; ++i) p[i] = x[i].p;
   // The solution's type at positions q: a refraction's neighbours on opposite sides, a reflection's
   // on one, the light's on the seed's side.
-  const auto right_type = [&](const dvec3* q) {
+  const auto right_type = [&](const dvec3* q) {  // (loc holds q's local state)
     for (std::size_t i = 0; i < m; ++i) {
-      const dvec3 nrm = surface_derivatives(*x[i].shape, x[i].primitive, q[i]).n;
+      const dvec3& nrm = loc[i].g.n;
       const dvec3 prev = i == 0 ? a : q[i - 1], next = i + 1 == m ? b : q[i + 1];
       const double light = glm::dot(prev - q[i], nrm), sides = light * glm::dot(next - q[i], nrm);
       if ((x[i].reflect ? !(sides > 0.0) : !(sides < 0.0)) || light * x[i].light_side < 0.0) return false;
@@ -217,11 +237,15 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
   };
   bool solved = false;
   int polish = 0;
+  bool evaluated = false;  // loc holds p's state (a step taken: its trial's), c still to be put on p's own tangent pairs
   for (w.iterations = 0; w.iterations <= o.max_iterations; ++w.iterations) {
-    if (!evaluate(x, p.data(), a, b, nullptr, nullptr, loc.data(), c.data())) {
+    if (evaluated) {
+      for (std::size_t i = 0; i < m; ++i) constraint(loc[i], loc[i].g.dpdu, loc[i].g.dpdv, c.data() + 2 * i);
+    } else if (!evaluate(x, p.data(), a, b, nullptr, nullptr, loc, c.data())) {
       w.failure = ManifoldFailure::kNoSolution;
       return w;
     }
+    evaluated = false;
     const double err = largest(c.data(), n);
     // Solved below the threshold; up to three more steps polish it (Newton converges
     // quadratically there), so that the same solution found from two seeds compares equal.
@@ -241,7 +265,7 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
       solved = within;
       break;
     }
-    jacobian(x, loc.data(), j.data(), nullptr, nullptr, nullptr);
+    jacobian(x, loc, j.data(), nullptr, nullptr, nullptr);
     for (std::size_t k = 0; k < n; ++k) step[k] = -c[k];
     if (solve_in_place(j.data(), n, step.data(), 1) <= o.singular) {
       w.failure = ManifoldFailure::kSingular;
@@ -261,9 +285,10 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
         on = q.has_value();
       }
       if (!on) continue;
-      if (evaluate(x, y.data(), a, b, s.data(), t.data(), trial.data(), cy.data()) && largest(cy.data(), n) < err) {
+      if (evaluate(x, y.data(), a, b, s.data(), t.data(), trial, cy.data()) && largest(cy.data(), n) < err) {
         std::copy(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(m), p.begin());
-        moved = true;
+        std::swap(loc, trial);  // the trial's local state is the new p's: not evaluated again
+        moved = evaluated = true;
       }
     }
     if (!moved) {
@@ -292,6 +317,7 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     }
   }
   // --- the generalized geometry term |dω_a / dA_b| ---
+  if (!term) return w;
   w.dw_db = chain_dw_db(x, a, b, nb, o.singular);
   if (!(w.dw_db > 0.0)) w.failure = ManifoldFailure::kSingular;
   return w;

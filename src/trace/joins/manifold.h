@@ -90,10 +90,11 @@ struct ManifoldSolution {
 };
 
 // Solves the chain between a and b (b on a surface of unit normal nb) in place from its seed
-// positions, then checks its type and segments and computes |dω_a / dA_b|. `scene_size` scales
-// the shortest segment allowed.
+// positions, then checks its type and segments and, with `term`, computes |dω_a / dA_b| (a
+// singular term fails the walk). `scene_size` scales the shortest segment allowed. Without
+// `term` (a seed that only has to say which chain it finds) dw_db stays 0.
 ManifoldWalk solve_chain(std::vector<ChainVertex>& chain, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& nb,
-                         double scene_size, const ManifoldOptions& o);
+                         double scene_size, const ManifoldOptions& o, bool term = true);
 
 // |dω_a / dA_b| of a chain whose vertices lie on their surfaces (solved, or a path a walk traced
 // through them): the solid angle at a per unit area at b (unit normal nb) as b moves and the
