@@ -202,6 +202,15 @@ Command add_trace(CLI::App& app) {
                                                                               {"sobol", SamplerKind::kSobol}})
                      .description("{independent,sobol}"))  // CLI11 would print the enum's bytes
       ->default_str(to_string(RenderOptions{}.sampler));
+  sub->add_option("--light-sampling", args->options.job.light_sampling,
+                  "Points of lights for next-event estimation: area (uniform on every light), sphere-cone (spheres uniform "
+                  "in the cone they subtend, seen from outside; others by area) or solid-angle (also rectangles uniform in "
+                  "the solid angle they subtend, where not tiny)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, LightSampling>{{"area", LightSampling::kArea},
+                                                                                {"sphere-cone", LightSampling::kSphereCone},
+                                                                                {"solid-angle", LightSampling::kSolidAngle}})
+                     .description("{area,sphere-cone,solid-angle}"))
+      ->default_str(to_string(RenderOptions{}.light_sampling));
   sub->add_option("--batches", args->options.job.batches,
                   "Batches that give the standard error: B / R pixel groups (pixel mod B/R) of R replicates (pass mod R)")
       ->capture_default_str()->check(CLI::Range(2, 1024));
@@ -247,7 +256,7 @@ Command add_trace(CLI::App& app) {
   add_scene_limit_options(sub, &args->options.job.limits);
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
-                                  "--resolution", "--max-paths", "--sampler", "--batches", "--replicates", "--rr-depth", "--rr-threshold",
+                                  "--resolution", "--max-paths", "--sampler", "--light-sampling", "--batches", "--replicates", "--rr-depth", "--rr-threshold",
                                   "--rr-light-threshold"})
               if (sub->count(o) > 0) args->options.job.settings_given.push_back(o);
             for (const std::string& o : manifold_option_names())

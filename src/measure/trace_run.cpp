@@ -94,6 +94,7 @@ Result<TraceResult> run_trace(const TraceOptions& a, const TraceHooks& hooks) {
   ro.threads = a.threads;
   ro.max_bounces = id.max_bounces;
   ro.sampler = id.sampler == "sobol" ? SamplerKind::kSobol : SamplerKind::kIndependent;
+  ro.light_sampling = light_sampling_named(id.light_sampling);
   ro.rr_depth = id.rr_depth;
   ro.rr_threshold = static_cast<float>(id.rr_threshold);
   ro.rr_light_threshold = static_cast<float>(id.rr_light_threshold);

@@ -349,6 +349,7 @@ std::string trace_command(const RenderIdentity& id, std::uint64_t spp) {
   cmd += " --max-bounces " + std::to_string(id.max_bounces) + " --sampler " + id.sampler + " --batches " +
          std::to_string(id.batches) + " --replicates " + std::to_string(id.replicates) + " --resolution " + std::to_string(id.width) + "x" + std::to_string(id.height);
   const RenderIdentity defaults;
+  if (id.light_sampling != defaults.light_sampling) cmd += " --light-sampling " + id.light_sampling;
   if (id.rr_depth != defaults.rr_depth) cmd += " --rr-depth " + std::to_string(id.rr_depth);
   if (id.rr_threshold != defaults.rr_threshold) cmd += " --rr-threshold " + nlohmann::json(id.rr_threshold).dump();
   if (id.rr_light_threshold != defaults.rr_light_threshold)

@@ -326,7 +326,7 @@ json identity_json(const RenderIdentity& id) {
   if (!id.only.empty()) j["classes"]["only"] = id.only;  // absent when every class is rendered
   j["ends"] = {{"lights", id.lights}, {"sensor", id.sensor}};
   j["seed"] = id.seed;
-  j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"rr_depth", id.rr_depth},
+  j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"light_sampling", id.light_sampling}, {"rr_depth", id.rr_depth},
                   {"rr_threshold", id.rr_threshold}, {"rr_light_threshold", id.rr_light_threshold}, {"batches", id.batches},
                   {"replicates", id.replicates}, {"width", id.width},           {"height", id.height},     {"images", id.images},
                   {"max_paths", id.max_paths}};
@@ -454,10 +454,12 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   id.seed = rd.uint(j, "", "seed");
   h.spp = rd.uint(j, "", "spp");
   const nlohmann::json& o = j.at("options");
-  if (rd.object(o, "/options", {"max_bounces", "sampler", "rr_depth", "rr_threshold", "rr_light_threshold", "batches", "replicates",
+  if (rd.object(o, "/options", {"max_bounces", "sampler", "light_sampling", "rr_depth", "rr_threshold", "rr_light_threshold", "batches", "replicates",
                                 "width", "height", "images", "max_paths", "manifold"})) {
     id.max_bounces = rd.small(o, "/options", "max_bounces");
     id.sampler = rd.str(o, "/options", "sampler");
+    // Before issue 39's solid-angle sampling (eighth session) every light was sampled by area.
+    id.light_sampling = o.contains("light_sampling") ? rd.str(o, "/options", "light_sampling") : "area";
     id.rr_depth = rd.small(o, "/options", "rr_depth");
     id.rr_threshold = rd.number(o, "/options", "rr_threshold");
     // Before issue 39 one threshold served both subpaths.
@@ -550,6 +552,7 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
   };
   if (auto d = option("max_bounces", a.max_bounces, b.max_bounces)) return d;
   if (a.sampler != b.sampler) return differ("another sampler", a.sampler, b.sampler);
+  if (a.light_sampling != b.light_sampling) return differ("another light sampling", a.light_sampling, b.light_sampling);
   if (auto d = option("rr_depth", a.rr_depth, b.rr_depth)) return d;
   if (a.rr_threshold != b.rr_threshold)
     return differ("another rr_threshold", std::to_string(a.rr_threshold), std::to_string(b.rr_threshold));

@@ -30,7 +30,8 @@
 // absolute file), hash}, "classes" {file (absolute, "" for the built-in classes), text (the class
 // file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
-// {max_bounces, sampler, rr_depth, rr_threshold, rr_light_threshold (absent in files written before
+// {max_bounces, sampler, light_sampling (absent in files written before issue 39's solid-angle
+// sampling: then "area"), rr_depth, rr_threshold, rr_light_threshold (absent in files written before
 // issue 39: then rr_threshold's), batches, replicates (absent in files written before issue 39's
 // pixel groups: then batches, plain batch means), width, height, images, max_paths, manifold (null, or the
 // manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds,
@@ -122,6 +123,7 @@ struct RenderIdentity {
   std::uint64_t seed = 1;
   int max_bounces = 16;
   std::string sampler = "sobol";  // RenderOptions::sampler, by name
+  std::string light_sampling = to_string(RenderOptions{}.light_sampling);  // RenderOptions::light_sampling, by name
   int rr_depth = 3;
   double rr_threshold = RenderOptions{}.rr_threshold;  // RenderOptions::rr_threshold (a float, exact as a double)
   double rr_light_threshold = RenderOptions{}.rr_light_threshold;  // RenderOptions::rr_light_threshold

@@ -66,6 +66,7 @@ Result<bool> load_fresh(const TraceJobOptions& a, TraceJob* job) {
   // One bound for the render and for the checker's verdicts: --max-bounces, else the profile's, else 16.
   id.max_bounces = a.max_bounces.value_or(profile->max_bounces.value_or(16));
   id.sampler = to_string(a.sampler);
+  id.light_sampling = to_string(a.light_sampling);
   id.rr_depth = a.rr_depth;
   id.rr_threshold = a.rr_threshold;
   id.rr_light_threshold = a.rr_light_threshold;

@@ -35,6 +35,7 @@ struct TraceJobOptions {
   std::uint64_t seed = 1;
   std::optional<int> max_bounces;  // unset: the profile's bound, else 16
   SamplerKind sampler = RenderOptions{}.sampler;  // the defaults of these: RenderOptions'
+  LightSampling light_sampling = RenderOptions{}.light_sampling;
   int rr_depth = RenderOptions{}.rr_depth;
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;

@@ -47,6 +47,7 @@
 // loader validates them).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -116,6 +117,19 @@ float area_to_solid_angle(float pdf_area, float distance, float abs_cos);
 struct AreaLightParams {
   glm::vec3 radiance{1.0f};  // Le, constant over the surface and the emitting hemisphere
   bool two_sided = false;    // emit on both sides of the normal
+  // Next-event points drawn by the solid angle the light subtends at the point they join, not by
+  // area (`pathex trace --light-sampling solid-angle`): a rectangle corner + a·edge1 + b·edge2,
+  // a, b ∈ [0, 1], edges perpendicular, unit normal edge1 × edge2 normalised, uniformly in its
+  // solid angle (trace/spherical_rect.h), where that is neither tiny nor nearly a hemisphere; a
+  // sphere (center, radius) uniformly in the cone it subtends (pbrt-v4's Sphere::Sample), from
+  // outside it. Elsewhere by area after all, pdf_area = 1 / the light's area. kNone (the
+  // default): the integrator's points, by area.
+  enum class Towards : std::uint8_t { kNone, kRectangle, kSphere };
+  Towards towards = Towards::kNone;
+  glm::vec3 corner{0.0f}, edge1{0.0f}, edge2{0.0f}, normal{0.0f};
+  glm::vec3 center{0.0f};
+  float radius = 0.0f;
+  float pdf_area = 0.0f;
   static constexpr Letter kPosLetter = kD;
   static constexpr Letter kDirLetter = kD;
 };
@@ -129,6 +143,18 @@ std::optional<EndpointConnection> connect(const AreaLightParams& p, const Surfac
                                           const glm::vec3& ref);
 // Power of a light of total surface area `area`: π Le area, doubled when two-sided.
 glm::vec3 power(const AreaLightParams& p, float area);
+// A light sampled by solid angle (p.towards set): next-event estimation from ref, its point drawn
+// by u uniformly in the solid angle Ω the light subtends at ref (pdf_dir 1 / Ω, weight Le Ω), or
+// by area where Ω is not usable.
+std::optional<EndpointConnection> connect(const AreaLightParams& p, glm::vec2 u, const glm::vec3& ref);
+// The area density with which that connect() from ref draws the point x (normal n):
+// |n · w| / (Ω d²), or pdf_area where it samples by area.
+float towards_area_density(const AreaLightParams& p, const glm::vec3& x, const glm::vec3& n, const glm::vec3& ref);
+// The density of x1 that completes the emission's joint density (pdf_area times the cosine
+// emission's) after towards_area_density(x0 from x1): pdf_area |cos θ_1| Ω / (π · sides), or the
+// emission's own pdf_dir |cos θ_1| / d² where Ω is not usable; 0 where x0 does not emit towards x1.
+float towards_step_density(const AreaLightParams& p, const glm::vec3& x0, const glm::vec3& n0, const glm::vec3& x1,
+                           float abs_cos1);
 
 // Isotropic point light, LSD.
 struct PointLightParams {
@@ -346,6 +372,17 @@ glm::vec3 fixed_origin(const LightParams& l);
 // `distant-projection` connector): the aperture point on the line through ref against the light's
 // direction. Nullopt for every other kind.
 std::optional<EndpointConnection> connect_projection(const LightParams& l, const glm::vec3& ref);
+
+// Lights whose next-event points are drawn towards the point x1 they join, not by area: an image
+// infinite light, a rectangle sampled by solid angle. For them x0's light density in every
+// strategy is next-event estimation's from x1 (towards_area_density()), and x1's the rest of the
+// emission's joint density (towards_step_density(), |cos θ_1| the cosine at x1): their product is
+// the emission's, so every strategy keeps its own density (Integrator::drawn_towards says where).
+bool draws_towards(const LightParams& l);
+// Next-event estimation from ref, the point drawn by u (a light that draws_towards()).
+std::optional<EndpointConnection> connect_towards(const LightParams& l, glm::vec2 u, const glm::vec3& ref);
+float towards_area_density(const LightParams& l, const glm::vec3& x, const glm::vec3& n, const glm::vec3& ref);
+float towards_step_density(const LightParams& l, const glm::vec3& x0, const glm::vec3& n0, const glm::vec3& x1, float abs_cos1);
 
 // Sensors. `raster` ∈ [0,1)² as above; u_lens is read by the thin lens only.
 inline bool reads_lens_numbers(const SensorParams& s) { return std::holds_alternative<ThinLensParams>(s); }

@@ -16,6 +16,7 @@
 #include "trace/emitters.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
+#include "trace/spherical_rect.h"
 
 namespace pathex {
 namespace emitter_detail {
@@ -139,6 +140,118 @@ inline std::optional<EndpointConnection> connect(const AreaLightParams& p, const
   c.delta = false;
   if (!emitter_detail::finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
   return c;
+}
+
+namespace emitter_detail {
+// The solid angle a light sampled towards points subtends at ref, and its sample there: the
+// spherical rectangle (trace/spherical_rect.h) or the cone of a sphere seen from outside.
+struct TowardsSolidAngle {
+  const AreaLightParams* p = nullptr;
+  SphericalRect rect;
+  // The sphere's cone: sin²θ_max and 1 − cos θ_max (without cancellation), the axis from ref.
+  double sin2_max = 0.0, one_minus_cos_max = 0.0;
+  glm::dvec3 axis{0.0};
+  double solid_angle = 0.0;
+  bool usable = false;
+
+  TowardsSolidAngle(const AreaLightParams& light, const glm::vec3& ref) : p(&light) {
+    if (light.towards == AreaLightParams::Towards::kRectangle) {
+      rect = SphericalRect::at(light.corner, light.edge1, light.edge2, ref);
+      solid_angle = rect.solid_angle;
+      usable = rect.usable();
+      return;
+    }
+    const glm::dvec3 v = glm::dvec3(light.center) - glm::dvec3(ref);
+    const double d2 = glm::dot(v, v), r2 = static_cast<double>(light.radius) * light.radius;
+    // Inside, on or within a thousandth of the sphere (a point of its own surface): by area.
+    if (!(d2 > r2 * 1.002) || !std::isfinite(d2)) return;
+    sin2_max = r2 / d2;
+    one_minus_cos_max = sin2_max / (1.0 + std::sqrt(1.0 - sin2_max));
+    axis = v / std::sqrt(d2);
+    solid_angle = 2.0 * std::numbers::pi * one_minus_cos_max;
+    usable = solid_angle >= SphericalRect::kMinSolidAngle;
+  }
+  // The light's point in the direction u maps to (usable must hold).
+  glm::vec3 sample(glm::vec2 u) const {
+    if (p->towards == AreaLightParams::Towards::kRectangle) return rect.sample(u);
+    // pbrt-v4's Sphere::Sample: cos θ uniform in [cos θ_max, 1], then the point of the sphere whose
+    // normal makes the angle α with the direction back to ref.
+    const double t = static_cast<double>(u.x) * one_minus_cos_max;  // 1 − cos θ
+    const double cos_t = 1.0 - t, sin2_t = t * (2.0 - t);
+    const double sin_max = std::sqrt(sin2_max);
+    const double cos_a = std::clamp(sin2_t / sin_max + cos_t * std::sqrt(std::max(0.0, 1.0 - sin2_t / sin2_max)), -1.0, 1.0);
+    const double sin_a = std::sqrt(std::max(0.0, 1.0 - cos_a * cos_a));
+    const double phi = 2.0 * std::numbers::pi * static_cast<double>(u.y);
+    const Frame f = Frame::from_normal(glm::vec3(axis));
+    const glm::dvec3 x(f.to_world(glm::vec3(1.0f, 0.0f, 0.0f))), y(f.to_world(glm::vec3(0.0f, 1.0f, 0.0f)));
+    const glm::dvec3 n = -(sin_a * std::cos(phi) * x + sin_a * std::sin(phi) * y + cos_a * axis);
+    return glm::vec3(glm::dvec3(p->center) + static_cast<double>(p->radius) * n);
+  }
+  // A point's area density, at |cos| and squared distance d2 from ref.
+  float density(float abs_cos, float d2) const {
+    if (!usable) return p->pdf_area;
+    return d2 > 0.0f ? abs_cos / (static_cast<float>(solid_angle) * d2) : 0.0f;
+  }
+};
+// The light's unit normal at its point x.
+inline glm::vec3 towards_normal(const AreaLightParams& p, const glm::vec3& x) {
+  return p.towards == AreaLightParams::Towards::kRectangle ? p.normal : glm::normalize(x - p.center);
+}
+}  // namespace emitter_detail
+
+inline std::optional<EndpointConnection> connect(const AreaLightParams& p, glm::vec2 u, const glm::vec3& ref) {
+  const emitter_detail::TowardsSolidAngle r(p, ref);
+  const bool solid = r.usable;
+  EndpointConnection c;
+  if (solid) {
+    c.position = r.sample(u);
+    c.normal = emitter_detail::towards_normal(p, c.position);
+  } else if (p.towards == AreaLightParams::Towards::kRectangle) {
+    c.position = p.corner + u.x * p.edge1 + u.y * p.edge2;
+    c.normal = p.normal;
+  } else {  // as EmbreeScene::sample_shape draws a sphere's point
+    c.normal = sample_uniform_sphere(u);
+    c.position = p.center + p.radius * c.normal;
+  }
+  if (!emitter_detail::unit_and_length(c.position - ref, &c.wi, &c.distance)) return std::nullopt;
+  const float cos_signed = -glm::dot(c.normal, c.wi);  // at the light, towards ref
+  const float cos_l = std::abs(cos_signed);
+  const bool emits = cos_signed > 0.0f || (p.two_sided && cos_signed < 0.0f);  // as emitted_radiance()
+  if (!emits || !(p.pdf_area > 0.0f)) return std::nullopt;
+  c.value = p.radiance;
+  const auto omega = static_cast<float>(r.solid_angle);
+  c.pdf_dir = solid ? 1.0f / omega : area_to_solid_angle(p.pdf_area, c.distance, cos_l);
+  // Le cos / (d² p_A): Le Ω where the density is 1 / Ω per solid angle.
+  c.weight = solid ? c.value * omega : c.value * (cos_l / (c.distance * c.distance * p.pdf_area));
+  c.delta = false;
+  if (!emitter_detail::finite_vec(c.weight) || !std::isfinite(c.pdf_dir)) return std::nullopt;
+  return c;
+}
+
+inline float towards_area_density(const AreaLightParams& p, const glm::vec3& x, const glm::vec3& n, const glm::vec3& ref) {
+  const emitter_detail::TowardsSolidAngle r(p, ref);
+  if (!r.usable) return p.pdf_area;
+  const glm::vec3 e = x - ref;
+  const float d2 = glm::dot(e, e);
+  if (!(d2 > 0.0f)) return 0.0f;
+  const float c = glm::dot(n, e) / std::sqrt(d2);
+  // A sphere's cone reaches only the cap facing ref.
+  if (p.towards == AreaLightParams::Towards::kSphere && !(c < 0.0f)) return 0.0f;
+  return r.density(std::abs(c), d2);
+}
+
+inline float towards_step_density(const AreaLightParams& p, const glm::vec3& x0, const glm::vec3& n0, const glm::vec3& x1,
+                                  float abs_cos1) {
+  const glm::vec3 e = x1 - x0;
+  const float d2 = glm::dot(e, e);
+  if (!(d2 > 0.0f)) return 0.0f;
+  const float c0 = glm::dot(n0, e) / std::sqrt(d2);
+  if (!(c0 > 0.0f || (p.two_sided && c0 < 0.0f))) return 0.0f;
+  const float sides = p.two_sided ? 2.0f : 1.0f;
+  const emitter_detail::TowardsSolidAngle r(p, x1);
+  if (!r.usable) return std::abs(c0) * kInvPi / sides * abs_cos1 / d2;  // the emission's pdf_dir, to area at x1
+  if (p.towards == AreaLightParams::Towards::kSphere && !(c0 > 0.0f)) return 0.0f;  // x0 off the cap: density 0 above
+  return p.pdf_area * abs_cos1 * static_cast<float>(r.solid_angle) * kInvPi / sides;
 }
 
 inline glm::vec3 power(const AreaLightParams& p, float area) {
@@ -613,6 +726,29 @@ inline std::optional<EndpointConnection> connect(const LightParams& l, const Sur
                                [](const EnvironmentLightParams&) { return std::optional<EndpointConnection>(); },
                                [&](const auto& p) { return connect(p, ref); }},
                     l);
+}
+
+inline bool draws_towards(const LightParams& l) {
+  if (const auto* a = std::get_if<AreaLightParams>(&l)) return a->towards != AreaLightParams::Towards::kNone;
+  return std::holds_alternative<EnvironmentLightParams>(l);
+}
+
+inline std::optional<EndpointConnection> connect_towards(const LightParams& l, glm::vec2 u, const glm::vec3& ref) {
+  if (const auto* a = std::get_if<AreaLightParams>(&l)) return connect(*a, u, ref);
+  if (const auto* e = std::get_if<EnvironmentLightParams>(&l)) return connect(*e, u, ref);
+  return std::nullopt;
+}
+
+inline float towards_area_density(const LightParams& l, const glm::vec3& x, const glm::vec3& n, const glm::vec3& ref) {
+  if (const auto* a = std::get_if<AreaLightParams>(&l)) return towards_area_density(*a, x, n, ref);
+  if (const auto* e = std::get_if<EnvironmentLightParams>(&l)) return connect_area_density(*e, x, n, ref);
+  return 0.0f;
+}
+
+inline float towards_step_density(const LightParams& l, const glm::vec3& x0, const glm::vec3& n0, const glm::vec3& x1, float abs_cos1) {
+  if (const auto* a = std::get_if<AreaLightParams>(&l)) return towards_step_density(*a, x0, n0, x1, abs_cos1);
+  if (const auto* e = std::get_if<EnvironmentLightParams>(&l)) return emission_step_density(*e, abs_cos1);
+  return 0.0f;
 }
 
 inline glm::vec3 spatial_emission(const LightParams& l) {

@@ -207,10 +207,38 @@ class Integrator {
   const EnvironmentLightParams* environment_of(int light) const {
     return rs_.lights[static_cast<std::size_t>(light)].environment();
   }
-  // v is a point of an image infinite light (a light vertex, or an eye vertex that hit its box).
-  bool on_environment(const Vertex& v) const;
-  float env_origin_density(const EnvironmentLightParams& e, const vec3& x0, const vec3& n0, const vec3& x1) const {
-    return light_pick_ * connect_area_density(e, x0, n0, x1);
+  // Next-event estimation could join a light point to v: a surface with a finite part (by its
+  // shape: a connector's chain vertex too), a sensor point with a finite direction.
+  bool joinable(const Vertex& v) const {
+    return v.kind == Kind::kSurface ? finite_of_shape_[static_cast<std::size_t>(v.shape)] != 0 : cam_.letters[0] == 'D';
+  }
+  // Light `light`'s x0 has next-event estimation's density from x1 (RenderLight::drawn_towards,
+  // trace/emitters.h draws_towards()): an image infinite light, a rectangle sampled by solid angle.
+  bool drawn_towards(int light, const Vertex& x1) const {
+    return rs_.lights[static_cast<std::size_t>(light)].drawn_towards(joinable(x1));
+  }
+  // v is x0 of a path whose x1 is `x1`, drawn towards x1 (a light vertex, or an eye vertex that hit
+  // the light).
+  bool origin_drawn_towards(const Vertex& v, const Vertex& x1) const;
+  // x0's light density (the pick times the light's): next-event estimation's from x1 where the
+  // light draws towards it, else its area density (0 for a Dirac position).
+  float light_origin_density(int light, const vec3& x0, const vec3& n0, const Vertex& x1) const {
+    const RenderLight& l = rs_.lights[static_cast<std::size_t>(light)];
+    return light_pick_ * (l.drawn_towards(joinable(x1)) ? towards_area_density(l.params, x0, n0, x1.p) : l.pdf_pos);
+  }
+  // x1's light density after such an x0 (drawn_towards() holds): the rest of the emission's joint density.
+  float light_step_density(int light, const Vertex& x0, const Vertex& x1) const {
+    const vec3 w = glm::normalize(x1.p - x0.p);
+    return towards_step_density(rs_.lights[static_cast<std::size_t>(light)].params, x0.p, x0.n, x1.p, abs_cos(x1, w));
+  }
+  // The area density of a join's light point drawn towards its reference point (connect_towards()):
+  // its solid-angle density to area, towards_area_density() without computing the solid angle again.
+  static float towards_join_area_density(const EndpointConnection& c) {
+    return c.distance > 0.0f ? c.pdf_dir * std::fabs(glm::dot(c.normal, c.wi)) / (c.distance * c.distance) : 0.0f;
+  }
+  // The rounding-error bound of a point drawn towards a point (an image light's box, a rectangle).
+  vec3 towards_point_error(int light, const vec3& p) const {
+    return environment_of(light) ? box_point_error(p) : rs_.lights[static_cast<std::size_t>(light)].origin_error;
   }
 
   // The material at surface vertex `v` (RenderScene::material_at).
@@ -222,8 +250,9 @@ class Integrator {
   float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const;
   // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
   float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const;
-  // Density of choosing the point `v` on its area light (for an eye vertex that hit it).
-  float pdf_light_origin(const Vertex& v) const;
+  // Density of choosing the point `v` on its area light (for an eye vertex that hit it, coming
+  // from x1 = `next`).
+  float pdf_light_origin(const Vertex& v, const Vertex& next) const;
 
   // --- subpaths ---
   // A template on the direction: the walk's tests of its direction are not branches. What the

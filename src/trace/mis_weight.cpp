@@ -42,9 +42,9 @@ float Integrator::light_pdf_dir(const RenderLight& l, const Vertex& v, const vec
   return l.pdf_ray(SurfacePoint{v.p, v.n, l.pdf_pos}, w).dir;
 }
 
-bool Integrator::on_environment(const Vertex& v) const {
+bool Integrator::origin_drawn_towards(const Vertex& v, const Vertex& x1) const {
   const int li = v.kind == Kind::kLight ? v.light : v.kind == Kind::kSurface ? rs_.light_of_shape[static_cast<std::size_t>(v.shape)] : -1;
-  return li >= 0 && environment_of(li) != nullptr;
+  return li >= 0 && drawn_towards(li, x1);
 }
 
 float Integrator::pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const {
@@ -66,16 +66,13 @@ float Integrator::pdf(const Vertex* prev, const Vertex& v, const Vertex& next) c
   const float d2 = glm::dot(d, d);
   if (d2 == 0.0f) return 0.0f;
   const vec3 wn = d / std::sqrt(d2);
-  if (v.kind == Kind::kLight)
-    if (const EnvironmentLightParams* e = environment_of(v.light)) return emission_step_density(*e, abs_cos(next, wn));
+  if (v.kind == Kind::kLight && drawn_towards(v.light, next)) return light_step_density(v.light, v, next);
   const vec3 wp = prev ? glm::normalize(prev->p - v.p) : vec3(0.0f);
   return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
 }
 
-float Integrator::pdf_light_origin(const Vertex& v) const {
-  const int li = rs_.light_of_shape[static_cast<std::size_t>(v.shape)];
-  if (const EnvironmentLightParams* e = environment_of(li)) return env_origin_density(*e, v.p, v.n, v.p + v.wo * std::sqrt(v.d2_wo));
-  return light_pick_ * rs_.lights[static_cast<std::size_t>(li)].pdf_pos;
+float Integrator::pdf_light_origin(const Vertex& v, const Vertex& next) const {
+  return light_origin_density(rs_.light_of_shape[static_cast<std::size_t>(v.shape)], v.p, v.n, next);
 }
 
 mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
@@ -109,18 +106,19 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
   st.connectors = out;
   if (self != ConnectorKind::kDistantProjection && n - 1 >= 1 && distant_of(n - 1) >= 0 && dsd_at(0) && light_pos() > 0.0)
     out[count++] = {1, 0, 1.0 / light_pos()};
-  // An image infinite light's x0 is never projected (join_sensor()), nor a connector's fresh light
-  // end, split 1 (fresh_light_end()): its points are drawn towards the point they join.
-  const bool env = on_environment(x[0]);
-  if (self != ConnectorKind::kOrthoProjection && n - 1 >= 1 + env && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f)
+  // An x0 drawn towards x1 (an image infinite light's, a rectangle's sampled by solid angle where x1
+  // could be joined) is never projected (join_sensor()), nor a connector's fresh light end, split 1
+  // (fresh_light_end(), emit_manifold()): those draw light points by area.
+  const bool drawn = origin_drawn_towards(x[0], x[1]);
+  if (self != ConnectorKind::kOrthoProjection && n - 1 >= 1 + drawn && ortho_of(n - 1) >= 0 && dsd_at(n - 1) && cam_.pdf_pos > 0.0f)
     out[count++] = {n - 1, 0, 1.0 / cam_.pdf_pos};
   if (has_mirror_)
-    for (int m = 1 + env; m <= k - 1; ++m)
+    for (int m = 1 + drawn; m <= k - 1; ++m)
       if (!(self == ConnectorKind::kMirror && m == s) && dsd_at(m) && mirror_of(m, k - m) >= 0 && x[m].kind == Kind::kSurface &&
           mirror_shape_[static_cast<std::size_t>(x[m].shape)])
         out[count++] = {m, 1, 1.0};
   if (has_manifold_)
-    for (int i = 1 + env; i <= k - 1; ++i) {
+    for (int i = 1 + drawn; i <= k - 1; ++i) {
       const int m = s_run(i);
       if (m > 0 && !letter_s(i) && !(self == ConnectorKind::kManifold && i == s) && manifold_at(x, key, i, m)) out[count++] = {i, m, 1.0};
     }
@@ -166,9 +164,9 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
     // end is per area; an image infinite light's step has a density of its own).
     if (self == ConnectorKind::kDistantProjection) set_light(s, parallel_jacobian(pt, qs, w));
     else if (needed(s)) {
-      const EnvironmentLightParams* env = qs.kind == Kind::kLight ? environment_of(qs.light) : nullptr;
-      set_light(s, env ? emission_step_density(*env, abs_cos(pt, w))
-                       : area(at_qs.known ? at_qs.to_wi : pdf_dir(qs, has_qsm ? &qs.wo : nullptr, w), pt, w, d2));
+      const bool towards = qs.kind == Kind::kLight && drawn_towards(qs.light, pt);
+      set_light(s, towards ? light_step_density(qs.light, qs, pt)
+                           : area(at_qs.known ? at_qs.to_wi : pdf_dir(qs, has_qsm ? &qs.wo : nullptr, w), pt, w, d2));
     }
     // x(s-1) as pt samples it.
     if (self == ConnectorKind::kOrthoProjection) set_eye(s - 1, parallel_jacobian(qs, pt, w));
@@ -178,11 +176,11 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
     if (has_qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(qs, &w, qs.wo), x[s - 2], qs.wo, qs.d2_wo));
   } else if (t > 0) {  // s = 0: pt lies on an area light
     const Vertex& pt = x[0];
-    set_light(0, pdf_light_origin(pt));
+    set_light(0, pdf_light_origin(pt, x[1]));
     if (has_ptm && needed(1)) {
       const int li = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];
       const RenderLight& l = rs_.lights[static_cast<std::size_t>(li)];
-      if (const EnvironmentLightParams* e = environment_of(li)) set_light(1, emission_step_density(*e, abs_cos(x[1], pt.wo)));
+      if (drawn_towards(li, x[1])) set_light(1, light_step_density(li, pt, x[1]));
       else set_light(1, area(light_pdf_dir(l, pt, pt.wo), x[1], pt.wo, pt.d2_wo));
     }
   } else if (s > 0) {  // t = 0: qs is the lens point
@@ -198,10 +196,7 @@ void Integrator::path_densities(Thread& th, const PathView& x, PathKey key, int 
   const int k = x.size() - 1;
   const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
   const auto lf = [&](int v) -> float {
-    if (v == 0) {
-      if (const EnvironmentLightParams* e = environment_of(x[0].light)) return env_origin_density(*e, x[0].p, x[0].n, x[1].p);
-      return light_pick_ * rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
-    }
+    if (v == 0) return light_origin_density(x[0].light, x[0].p, x[0].n, x[1]);
     if (v == 1 && letter_s(1) && rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos > 0.0f)
       return parallel_jacobian(x[1], x[0], glm::normalize(x[1].p - x[0].p));  // a distant light's parallel beam
     if (letter_s(v)) return 0.0f;  // x(v-1) is a Dirac

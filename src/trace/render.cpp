@@ -204,11 +204,14 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   // its first vertex has a finite density per area, which the distant-projection connector's
   // MIS weight compares with the eye's.
   if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.light[1].pdf_fwd = parallel_jacobian(th.light[1], y0, r->direction);
-  // An image infinite light's two densities (Integrator::environment_of): y0's as next-event
-  // estimation from y1 would draw it, y1's the rest of the emission's joint density.
-  if (env) {
-    y0.pdf_fwd = n >= 2 ? env_origin_density(*env, y0.p, y0.n, th.light[1].p) : 0.0f;
-    if (n >= 2) th.light[1].pdf_fwd = emission_step_density(*env, abs_cos(th.light[1], r->direction));
+  // A light drawn towards y1 (an image infinite light, a rectangle sampled by solid angle:
+  // Integrator::drawn_towards): y0's density as next-event estimation from y1 would draw it, y1's
+  // the rest of the emission's joint density.
+  if (n >= 2 && drawn_towards(static_cast<int>(li), th.light[1])) {
+    y0.pdf_fwd = light_origin_density(static_cast<int>(li), y0.p, y0.n, th.light[1]);
+    th.light[1].pdf_fwd = light_step_density(static_cast<int>(li), y0, th.light[1]);
+  } else if (env) {
+    y0.pdf_fwd = 0.0f;
   }
   return n;
 }

@@ -54,6 +54,22 @@ struct RenderPlan;  // trace/plan.h
 // cancelled render stops, after whole chunks, so every finished pass covers the whole image.
 inline constexpr std::uint64_t kPassesPerChunk = 4;
 
+// How next-event estimation draws the points of spherical and rectangular lights (`pathex trace
+// --light-sampling`): every light by area; spheres by the cone they subtend at the point they join
+// (pbrt-v4's Sphere::Sample), the rest by area; or spheres so and rectangles by the solid angle
+// they subtend (Ureña et al. 2013, trace/spherical_rect.h). Other lights (meshes, disks,
+// parallelograms) are drawn by area always.
+enum class LightSampling : std::uint8_t { kArea, kSphereCone, kSolidAngle };
+constexpr const char* to_string(LightSampling s) {
+  return s == LightSampling::kSolidAngle ? "solid-angle" : s == LightSampling::kSphereCone ? "sphere-cone" : "area";
+}
+// The setting a name gives (a shard's), kArea for any other.
+inline LightSampling light_sampling_named(const std::string& name) {
+  for (LightSampling s : {LightSampling::kSphereCone, LightSampling::kSolidAngle})
+    if (name == to_string(s)) return s;
+  return LightSampling::kArea;
+}
+
 struct RenderOptions {
   std::uint64_t spp = 16;              // samples (passes) per pixel
   // The passes to take (a shard's share, what a resumed render still lacks); unset: [0, spp).
@@ -76,6 +92,8 @@ struct RenderOptions {
   float rr_threshold = 0.3f;
   float rr_light_threshold = 1.0f;
   SamplerKind sampler = SamplerKind::kSobol;  // --sampler
+  // --light-sampling; the default chosen by efficiency on several scenes (issue 39, docs/tracer.md).
+  LightSampling light_sampling = LightSampling::kSphereCone;
   // The standard error's batches (`pathex trace --batches`, --replicates; stats/histogram.h,
   // "Batches"): B batches, R replicates of each pixel (R divides B), B / R pixel groups. Under
   // `sobol` each replicate is an independently scrambled sequence of spp / R points: fewer

@@ -52,6 +52,8 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
   Result<RenderScene> rs = make_render_scene(scene);
   if (!rs) return rs.error();
   aim_emission(*rs, scene, plan.aimed_lights);
+  if (options.light_sampling != LightSampling::kArea)
+    sample_lights_by_solid_angle(*rs, scene, /*rectangles=*/options.light_sampling == LightSampling::kSolidAngle);
   RenderOptions o = options;
   if (o.batches < 1 || o.replicates < 1 || o.batches % o.replicates != 0)
     return make_error(ErrorCode::kUsage, "the replicate count (" + std::to_string(o.replicates) +

@@ -231,6 +231,32 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
   return rs;
 }
 
+void sample_lights_by_solid_angle(RenderScene& rs, const Scene& scene, bool rectangles) {
+  for (RenderLight& l : rs.lights) {
+    auto* area = std::get_if<AreaLightParams>(&l.params);
+    if (!area || !l.is_area()) continue;
+    const Shape& s = scene.shapes[static_cast<std::size_t>(l.shape)];
+    if (s.group >= 0) continue;
+    if (const auto* q = std::get_if<QuadShape>(&s.geometry); rectangles && q && is_rectangle(q->edge1, q->edge2)) {
+      area->towards = AreaLightParams::Towards::kRectangle;
+      area->corner = q->corner;
+      area->edge1 = q->edge1;
+      area->edge2 = q->edge2;
+      area->normal = glm::normalize(glm::cross(q->edge1, q->edge2));  // as the shape's (EmbreeScene::sample_shape)
+      l.origin_error = parallelogram_error(q->corner, q->edge1, q->edge2);
+    } else if (const auto* sp = std::get_if<SphereShape>(&s.geometry)) {
+      area->towards = AreaLightParams::Towards::kSphere;
+      area->center = sp->center;
+      area->radius = sp->radius;
+      // EmbreeScene's bound for a point of the sphere at any normal (its |n| at most 1 a component).
+      l.origin_error = error_gamma(8) * (glm::abs(sp->center) + glm::vec3(sp->radius));
+    } else {
+      continue;
+    }
+    area->pdf_area = l.pdf_pos;
+  }
+}
+
 void aim_emission(RenderScene& rs, const Scene& scene, const std::vector<int>& lights) {
   const std::size_t area_lights = rs.lights.size() - scene.lights.size();  // the emissive shapes come first
   for (const int i : lights) {

@@ -50,6 +50,12 @@ struct RenderLight {
   glm::vec3 origin_error{0.0f};
   std::string letters;  // c0 c1: its position's letter, then its direction's (the header's conventions)
   bool is_area() const { return shape >= 0; }
+  // Whether x0's light density in a path is next-event estimation's from x1 (trace/emitters.h
+  // draws_towards()): always for an image infinite light, which has no other; for a rectangle
+  // sampled by solid angle where next-event estimation could join x0 to x1 (`x1_joinable`: a
+  // surface with a finite part, a sensor with a finite direction), elsewhere (x1 a Dirac vertex,
+  // which the connectors' fresh light ends reach by area) its area density.
+  bool drawn_towards(bool x1_joinable) const { return draws_towards(params) && (x1_joinable || environment() != nullptr); }
   // The image infinite light this is (trace/environment.h), or null.
   const EnvironmentLightParams* environment() const { return std::get_if<EnvironmentLightParams>(&params); }
   // The light's first ray from point x (an area light's; the others ignore it) by u, and the
@@ -189,6 +195,12 @@ struct RenderScene {
 };
 
 Result<RenderScene> make_render_scene(const Scene& scene);
+
+// `pathex trace --light-sampling sphere-cone` (and solid-angle, with `rectangles`): every area
+// light that is one sphere (and one rectangle: a quad with perpendicular edges), not an instance's,
+// draws its next-event points by the solid angle it subtends (AreaLightParams::towards,
+// trace/spherical_rect.h); the others (meshes, disks, parallelograms) keep area sampling.
+void sample_lights_by_solid_angle(RenderScene& rs, const Scene& scene, bool rectangles);
 
 // The plan's emission narrowing (trace/plan.h RenderPlan::aimed_lights, indices into scene.lights,
 // each a point or spot light): each aims at the shapes with a specular component

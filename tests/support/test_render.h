@@ -31,9 +31,11 @@ struct Sampling {
   int rr_depth = RenderOptions{}.rr_depth;
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
+  LightSampling light_sampling = RenderOptions{}.light_sampling;
   std::string name() const {
     return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
-           std::to_string(rr_threshold) + " rr-light-threshold " + std::to_string(rr_light_threshold);
+           std::to_string(rr_threshold) + " rr-light-threshold " + std::to_string(rr_light_threshold) + " light-sampling " +
+           to_string(light_sampling);
   }
 };
 
@@ -53,6 +55,7 @@ inline Rendered render_scene(Result<Scene> scene, const std::string& renderer, c
   o.rr_depth = sampling.rr_depth;
   o.rr_threshold = sampling.rr_threshold;
   o.rr_light_threshold = sampling.rr_light_threshold;
+  o.light_sampling = sampling.light_sampling;
   RenderOutput out = render(s, profile, keep.back()->classifier.get(), o).expect("a render");
   RunInfo info;
   info.spp = spp;

@@ -26,6 +26,7 @@
 #include "support/stat_seed.h"
 #include "trace/frame.h"
 #include "trace/rng.h"
+#include "trace/spherical_rect.h"
 
 namespace pathex {
 namespace {
@@ -609,6 +610,253 @@ TEST(Sensors, LensNumbersAreReadByTheThinLensOnly) {
     }
     EXPECT_EQ(differs > 0, reads_lens_numbers(cam)) << "sensor " << cam.index();
   }
+}
+
+// --- a rectangle sampled by the solid angle it subtends (Ureña et al. 2013; trace/spherical_rect.h) ---
+
+// A rectangle light of sides a × b in a tilted frame, and points placed in that frame: the tests'
+// closed forms are written in its coordinates.
+struct TiltedRect {
+  glm::dvec3 ex, ey, ez;  // orthonormal
+  glm::dvec3 corner;
+  double a, b;
+  TiltedRect(double a_, double b_) : a(a_), b(b_) {
+    ex = glm::normalize(glm::dvec3(0.8, 0.36, -0.48));
+    ez = glm::normalize(glm::cross(ex, glm::dvec3(0.1, 1.0, 0.3)));
+    ey = glm::cross(ez, ex);
+    corner = glm::dvec3(0.3, 1.9, -0.7);
+  }
+  AreaLightParams light(bool two_sided) const {
+    AreaLightParams p{glm::vec3(3.0f, 2.0f, 1.0f), two_sided};
+    p.towards = AreaLightParams::Towards::kRectangle;
+    p.corner = glm::vec3(corner);
+    p.edge1 = glm::vec3(ex * a);
+    p.edge2 = glm::vec3(ey * b);
+    p.normal = glm::normalize(glm::cross(p.edge1, p.edge2));
+    p.pdf_area = 1.0f / glm::length(glm::cross(p.edge1, p.edge2));
+    return p;
+  }
+  // The point at (u, v, h) in the rectangle's coordinates (u along edge1, v along edge2, h along
+  // the normal from the corner).
+  glm::vec3 at(double u, double v, double h) const { return glm::vec3(corner + u * ex + v * ey + h * ez); }
+  // The solid angle at `ref` of the part [u0, u1] × [v0, v1] of the rectangle's plane, in closed form:
+  // Σ ± atan(x y / (h √(x² + y² + h²))) over its corners, x, y, h relative to ref's foot.
+  double solid_angle(const glm::vec3& ref, double u0, double u1, double v0, double v1) const {
+    const glm::dvec3 d = glm::dvec3(ref) - corner;
+    const double pu = glm::dot(d, ex), pv = glm::dot(d, ey), h = std::abs(glm::dot(d, ez));
+    const auto f = [h](double x, double y) { return std::atan(x * y / (h * std::sqrt(x * x + y * y + h * h))); };
+    return f(u1 - pu, v1 - pv) - f(u0 - pu, v1 - pv) - f(u1 - pu, v0 - pv) + f(u0 - pu, v0 - pv);
+  }
+  double solid_angle(const glm::vec3& ref) const { return solid_angle(ref, 0.0, a, 0.0, b); }
+  // A point of the plane back in the rectangle's coordinates (u, v).
+  glm::dvec2 coords(const glm::vec3& x) const {
+    const glm::dvec3 d = glm::dvec3(x) - corner;
+    return {glm::dot(d, ex), glm::dot(d, ey)};
+  }
+};
+
+// Points from which the rectangle (0.6 × 0.4) is seen: in front, off to a side, close above a
+// corner, at a grazing angle, from behind.
+std::vector<glm::vec3> rect_viewpoints(const TiltedRect& r) {
+  return {r.at(0.3, 0.2, 1.5), r.at(1.4, -0.6, 0.7), r.at(0.02, 0.03, 0.05), r.at(2.5, 0.2, 0.12), r.at(0.4, 0.1, -0.9)};
+}
+
+TEST(AreaLight, RectangleSolidAngleIsTheClosedForm) {
+  const TiltedRect r(0.6, 0.4);
+  const AreaLightParams p = r.light(false);
+  for (const glm::vec3& ref : rect_viewpoints(r)) {
+    const SphericalRect s = SphericalRect::at(p.corner, p.edge1, p.edge2, ref);
+    const double expected = r.solid_angle(ref);
+    EXPECT_NEAR(s.solid_angle, expected, 2e-6 * expected) << "at " << ref.x << " " << ref.y << " " << ref.z;
+    EXPECT_TRUE(s.usable());
+  }
+  // A cube's face seen from its centre: a sixth of the sphere.
+  const TiltedRect cube(2.0, 2.0);
+  const AreaLightParams face = cube.light(false);
+  EXPECT_NEAR(SphericalRect::at(face.corner, face.edge1, face.edge2, cube.at(1.0, 1.0, 1.0)).solid_angle, 4.0 * kPiD / 6.0, 1e-6);
+  // In the plane (to float rounding of the tilted point): no solid angle, and none of it sampled;
+  // exactly in it: 0; far away: too small, sampled by area.
+  EXPECT_LT(SphericalRect::at(p.corner, p.edge1, p.edge2, r.at(1.5, 0.2, 0.0)).solid_angle, 1e-7);
+  EXPECT_EQ(SphericalRect::at(glm::vec3(0.0f), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(2, 0.5f, 0)).solid_angle, 0.0);
+  EXPECT_FALSE(SphericalRect::at(p.corner, p.edge1, p.edge2, r.at(1.5, 0.2, 0.0)).usable());
+  const SphericalRect far = SphericalRect::at(p.corner, p.edge1, p.edge2, r.at(0.3, 0.2, 300.0));
+  EXPECT_NEAR(far.solid_angle, 0.24 / (300.0 * 300.0), 1e-3 * 0.24 / (300.0 * 300.0));
+  EXPECT_FALSE(far.usable());
+  EXPECT_TRUE(is_rectangle(p.edge1, p.edge2));
+  EXPECT_FALSE(is_rectangle(p.edge1, p.edge2 + 0.1f * p.edge1)) << "a parallelogram that is not a rectangle";
+  EXPECT_FALSE(is_rectangle(p.edge1, glm::vec3(0.0f)));
+}
+
+// The directions drawn are uniform over the solid angle: a chi-square over an 8 × 8 grid of the
+// rectangle, each cell expected with its own solid angle's share (closed form), at each viewpoint.
+TEST(AreaLight, RectangleSamplesAreUniformInItsSolidAngle) {
+  constexpr int kGrid = 8, kSamples = 200'000;
+  const TiltedRect r(0.6, 0.4);
+  const AreaLightParams p = r.light(true);
+  const std::vector<glm::vec3> refs = rect_viewpoints(r);
+  const double critical = test::family_chi2_critical(kGrid * kGrid - 1, static_cast<int>(refs.size()));
+  for (std::size_t k = 0; k < refs.size(); ++k) {
+    const glm::vec3 ref = refs[k];
+    const SphericalRect s = SphericalRect::at(p.corner, p.edge1, p.edge2, ref);
+    ASSERT_TRUE(s.usable());
+    std::vector<double> count(kGrid * kGrid, 0.0);
+    for (int i = 0; i < kSamples; ++i) {
+      Sampler rng(test::stat_seed_from(31), k, static_cast<std::uint64_t>(i));
+      const glm::vec3 x = s.sample(rng.get2d());
+      ASSERT_TRUE(std::isfinite(x.x + x.y + x.z));
+      const glm::dvec2 uv = r.coords(x);
+      const int cu = std::clamp(static_cast<int>(uv.x / r.a * kGrid), 0, kGrid - 1);
+      const int cv = std::clamp(static_cast<int>(uv.y / r.b * kGrid), 0, kGrid - 1);
+      // On the rectangle, to float rounding.
+      EXPECT_NEAR(glm::dot(glm::dvec3(x) - r.corner, r.ez), 0.0, 1e-5);
+      ASSERT_TRUE(uv.x > -1e-5 && uv.x < r.a + 1e-5 && uv.y > -1e-5 && uv.y < r.b + 1e-5);
+      count[static_cast<std::size_t>(cu * kGrid + cv)] += 1.0;
+    }
+    const double total = r.solid_angle(ref);
+    double chi2 = 0.0;
+    for (int cu = 0; cu < kGrid; ++cu)
+      for (int cv = 0; cv < kGrid; ++cv) {
+        const double share = r.solid_angle(ref, r.a * cu / kGrid, r.a * (cu + 1) / kGrid, r.b * cv / kGrid, r.b * (cv + 1) / kGrid) / total;
+        const double expected = share * kSamples;
+        const double d = count[static_cast<std::size_t>(cu * kGrid + cv)] - expected;
+        chi2 += d * d / expected;
+      }
+    test::stat_log("rectangle solid-angle chi2, viewpoint " + std::to_string(k), chi2, critical);
+    EXPECT_LE(chi2, critical) << "viewpoint " << k;
+  }
+}
+
+// Next-event estimation towards a rectangle by solid angle: the join reports the density 1 / Ω of
+// the closed form and the weight Le Ω; towards_area_density() is that density per area and
+// integrates to 1 over the rectangle; with towards_step_density() it makes up the emission's joint
+// density; and its irradiance agrees with area sampling's.
+TEST(AreaLight, RectangleJoinsBySolidAngleHaveTheDensityTheyReport) {
+  const double k = sigmas_for(2 * 5);  // 2 Monte Carlo checks at 5 viewpoints, 0.1 % together
+  const TiltedRect r(0.6, 0.4);
+  for (bool two_sided : {false, true}) {
+    const AreaLightParams p = r.light(two_sided);
+    const std::vector<glm::vec3> refs = rect_viewpoints(r);
+    for (std::size_t v = 0; v < refs.size(); ++v) {
+      const glm::vec3 ref = refs[v];
+      const double omega = r.solid_angle(ref);
+      const bool behind = glm::dot(glm::dvec3(ref) - r.corner, r.ez) < 0.0;
+      Accumulator integral, difference;
+      for (int i = 0; i < 40'000; ++i) {
+        Sampler s(test::stat_seed_from(32), v + 8 * two_sided, static_cast<std::uint64_t>(i));
+        const std::optional<EndpointConnection> c = connect(p, s.get2d(), ref);
+        // The one-sided light seen from behind: no join (and no emission).
+        if (behind && !two_sided) {
+          ASSERT_FALSE(c);
+          continue;
+        }
+        ASSERT_TRUE(c);
+        EXPECT_NEAR(c->pdf_dir, 1.0 / omega, 2e-5 / omega);
+        EXPECT_NEAR(c->weight.x, 3.0 * omega, 2e-5 * omega);
+        const float d2 = c->distance * c->distance;
+        const float cos_l = std::abs(glm::dot(c->normal, c->wi));
+        const float dens = towards_area_density(p, c->position, c->normal, ref);
+        EXPECT_NEAR(dens * d2 / cos_l, 1.0 / omega, 2e-4 / omega);
+        // The emission's joint density of (x0, x1 = ref) split as x0's from ref and x1's after it.
+        const float cos1 = 0.37f;
+        const float joint = p.pdf_area * cos_l * kInvPi / (two_sided ? 2.0f : 1.0f) * cos1 / d2;
+        EXPECT_NEAR(dens * towards_step_density(p, c->position, c->normal, ref, cos1), joint, 2e-4 * joint);
+        // ∫ density dA = 1 over the rectangle, by uniform points of it.
+        const glm::vec2 ua = s.get2d();
+        const glm::vec3 xa = r.at(ua.x * r.a, ua.y * r.b, 0.0);
+        integral.add(towards_area_density(p, xa, p.normal, ref) / p.pdf_area);
+        // Irradiance at ref (normal towards the rectangle's centre): solid angle against area sampling.
+        const glm::vec3 n_ref = glm::normalize(r.at(0.3, 0.2, 0.0) - ref);
+        const SurfacePoint xp{xa, p.normal, p.pdf_area};
+        const std::optional<EndpointConnection> by_area = connect(p, xp, ref);
+        const double e_sa = c->weight.x * std::max(0.0f, glm::dot(c->wi, n_ref));
+        const double e_area = by_area ? by_area->weight.x * std::max(0.0f, glm::dot(by_area->wi, n_ref)) : 0.0;
+        difference.add(e_sa - e_area);
+      }
+      if (behind && !two_sided) continue;
+      EXPECT_MC_NEAR(integral, 1.0, k);
+      EXPECT_MC_NEAR(difference, 0.0, k);
+    }
+  }
+  // Far away the solid angle is too small to sample: area sampling, its density 1 / area, the
+  // join's as connect() by area gives it.
+  const AreaLightParams p = r.light(false);
+  const glm::vec3 far = r.at(0.3, 0.2, 300.0);
+  const std::optional<EndpointConnection> c = connect(p, glm::vec2(0.25f, 0.75f), far);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(towards_area_density(p, c->position, c->normal, far), p.pdf_area);
+  const std::optional<EndpointConnection> by_area = connect(p, SurfacePoint{c->position, p.normal, p.pdf_area}, far);
+  ASSERT_TRUE(by_area);
+  EXPECT_EQ(c->weight, by_area->weight);
+  EXPECT_EQ(c->pdf_dir, by_area->pdf_dir);
+}
+
+// A sphere sampled by the cone it subtends (pbrt-v4's Sphere::Sample), from near, mid and far
+// (a cone of 0.7°): every point on the sphere and facing ref, the cone's directions uniform (a
+// chi-square over an 8 × 8 grid of (1 − cos θ) / (1 − cos θ_max) and φ), the join's density the
+// closed form 1 / (2π (1 − cos θ_max)) and its weight Le Ω, the area density integrating to 1 over
+// the sphere, its irradiance as area sampling's. From inside the sphere: by area.
+TEST(AreaLight, SphereSamplesAreUniformInItsCone) {
+  constexpr int kGrid = 8, kSamples = 100'000;
+  const glm::vec3 center(0.4f, 1.1f, -0.3f);
+  const float radius = 0.5f;
+  AreaLightParams p{glm::vec3(2.0f, 1.5f, 1.0f), false};
+  p.towards = AreaLightParams::Towards::kSphere;
+  p.center = center;
+  p.radius = radius;
+  p.pdf_area = 1.0f / (4.0f * kPi * radius * radius);
+  const std::vector<glm::vec3> refs = {center + glm::vec3(0.3f, 0.5f, 0.4f), center + glm::vec3(-2.0f, 1.0f, 2.0f),
+                                       center + glm::vec3(10.0f, -35.0f, 20.0f)};
+  const double critical = test::family_chi2_critical(kGrid * kGrid - 1, static_cast<int>(refs.size()));
+  const double k = sigmas_for(2 * static_cast<int>(refs.size()));
+  for (std::size_t v = 0; v < refs.size(); ++v) {
+    const glm::vec3 ref = refs[v];
+    const glm::dvec3 to_c = glm::dvec3(center) - glm::dvec3(ref);
+    const double d = glm::length(to_c);
+    const glm::dvec3 axis = to_c / d;
+    const glm::dvec3 bx = glm::normalize(glm::cross(axis, glm::dvec3(0.3, 0.9, 0.2))), by = glm::cross(axis, bx);
+    const double one_minus_cos_max = 1.0 - std::sqrt(1.0 - static_cast<double>(radius) * radius / (d * d));
+    const double omega = 2.0 * kPiD * one_minus_cos_max;
+    std::vector<double> count(kGrid * kGrid, 0.0);
+    Accumulator integral, difference;
+    for (int i = 0; i < kSamples; ++i) {
+      Sampler s(test::stat_seed_from(33), v, static_cast<std::uint64_t>(i));
+      const std::optional<EndpointConnection> c = connect(p, s.get2d(), ref);
+      ASSERT_TRUE(c);
+      EXPECT_NEAR(glm::length(c->position - center), radius, 2e-6f * (1.0f + glm::length(center)));
+      EXPECT_GT(glm::dot(c->normal, -c->wi), 0.0f) << "a point of the cap facing ref";
+      EXPECT_NEAR(c->pdf_dir, 1.0 / omega, 1e-5 / omega);
+      EXPECT_NEAR(c->weight.x, 2.0 * omega, 1e-5 * omega);
+      const glm::dvec3 w(c->wi);
+      const double t = (1.0 - glm::dot(w, axis)) / one_minus_cos_max;
+      const double phi = std::atan2(glm::dot(w, by), glm::dot(w, bx)) / (2.0 * kPiD) + 0.5;
+      const int ct = std::clamp(static_cast<int>(t * kGrid), 0, kGrid - 1), cp = std::clamp(static_cast<int>(phi * kGrid), 0, kGrid - 1);
+      // Inside the cone, to the float rounding of wi (its cosine to ~2.4e-7, against a 0.7° cone's
+      // 1 − cos θ_max of 7.3e-5).
+      ASSERT_LT(t, 1.0 + 2.4e-7 / one_minus_cos_max) << "inside the cone";
+      count[static_cast<std::size_t>(ct * kGrid + cp)] += 1.0;
+      // ∫ density dA = 1 over the sphere (0 off the cap), by uniform points of it.
+      const glm::vec3 n_a = sample_uniform_sphere(s.get2d());
+      const glm::vec3 xa = center + radius * n_a;
+      integral.add(towards_area_density(p, xa, n_a, ref) / p.pdf_area);
+      // Irradiance at ref facing the sphere: cone against area sampling.
+      const glm::vec3 n_ref = glm::vec3(axis);
+      const std::optional<EndpointConnection> by_area = connect(p, SurfacePoint{xa, n_a, p.pdf_area}, ref);
+      const double e_cone = c->weight.x * std::max(0.0f, glm::dot(c->wi, n_ref));
+      const double e_area = by_area ? by_area->weight.x * std::max(0.0f, glm::dot(by_area->wi, n_ref)) : 0.0;
+      difference.add(e_cone - e_area);
+    }
+    double chi2 = 0.0;
+    for (double n : count) chi2 += (n - kSamples / double(kGrid * kGrid)) * (n - kSamples / double(kGrid * kGrid)) / (kSamples / double(kGrid * kGrid));
+    test::stat_log("sphere cone chi2, viewpoint " + std::to_string(v), chi2, critical);
+    EXPECT_LE(chi2, critical) << "viewpoint " << v;
+    EXPECT_MC_NEAR(integral, 1.0, k);
+    EXPECT_MC_NEAR(difference, 0.0, k);
+  }
+  // From inside (or on) the sphere: by area, density 1 / area.
+  const glm::vec3 inside = center + glm::vec3(0.1f, 0.0f, 0.2f);
+  EXPECT_EQ(towards_area_density(p, center + radius * glm::vec3(0, 1, 0), glm::vec3(0, 1, 0), inside), p.pdf_area);
+  EXPECT_EQ(towards_area_density(p, center + radius * glm::vec3(0, 1, 0), glm::vec3(0, 1, 0), center + radius * glm::vec3(1, 0, 0)),
+            p.pdf_area);
 }
 
 }  // namespace

@@ -252,10 +252,10 @@ struct IntegratorTestAccess {
       if (s2 > 0) {
         th.light[0].kind = Kind::kLight;
         th.light[0].pdf_fwd = light_pick(in) * in.scene().lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
-        // An image infinite light's x0: the density next-event estimation from x1 draws it with
-        // (Integrator::environment_of; x1's own density follows from in.pdf()).
-        if (const EnvironmentLightParams* e = in.environment_of(x[0].light); e && k >= 1)
-          th.light[0].pdf_fwd = in.env_origin_density(*e, x[0].p, x[0].n, x[1].p);
+        // An x0 drawn towards x1 (an image infinite light's, a rectangle's sampled by solid angle):
+        // the density next-event estimation from x1 draws it with (Integrator::drawn_towards; x1's
+        // own density follows from in.pdf()).
+        if (k >= 1) th.light[0].pdf_fwd = in.light_origin_density(x[0].light, x[0].p, x[0].n, x[1]);
       }
       if (s2 == 0) {
         th.eye[static_cast<std::size_t>(t2 - 1)].kind = Kind::kSurface;
@@ -323,9 +323,11 @@ struct MisCheck {
 
 // Traces `samples` pairs of subpaths and checks every full path that a plain join (s, t) with
 // s != 1 and t != 1 of the profile forms from their vertices.
-std::vector<MisCheck> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed, int samples) {
+std::vector<MisCheck> check_mis_weights(const Scene& scene, const Profile& profile, std::uint64_t seed, int samples,
+                                        LightSampling light_sampling = LightSampling::kArea) {
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
-  const RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
+  RenderScene rs = make_render_scene(scene).expect("a scene the tracer renders");
+  if (light_sampling != LightSampling::kArea) sample_lights_by_solid_angle(rs, scene, light_sampling == LightSampling::kSolidAngle);
   RenderOptions o;
   o.seed = seed;
   o.max_bounces = std::min(8, profile.max_bounces.value_or(8));
@@ -385,6 +387,28 @@ TEST(Mis, WeightsOfEveryStrategySumToOne) {
   }
   EXPECT_GT(checked, 2000u);
   EXPECT_GE(by_length.size(), 5u);  // paths of many lengths
+}
+
+// Issue 39: where next-event estimation draws a rectangular or spherical lamp's points by the solid
+// angle it subtends, x0's light density is that of next-event estimation from x1 and x1's the rest of the
+// emission's joint density (Integrator::drawn_towards): the weights of every strategy still sum to 1
+// on every path, and the subpaths' stored densities give the path's recomputed ones.
+TEST(Mis, WeightsOfEveryStrategySumToOneWithSolidAngleLightSampling) {
+  std::size_t checked = 0;
+  for (const char* file : {"samples/scenes/cornell.json", "bench/scenes/tungsten-cornell-box.json", "samples/scenes/materials.json",
+                           "samples/scenes/lamp-glass.json"}) {
+    const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/" + file).expect("a scene");
+    for (const char* renderer : {"bdpt", "pt-nee", "lt", "pbrt-v4-bdpt", "mitsuba3-ptracer"}) {
+      const Profile profile = resolve_profile(renderer, Limits{}).expect("a built-in profile");
+      for (const MisCheck& c : check_mis_weights(scene, profile, 13, 300, LightSampling::kSolidAngle)) {
+        ++checked;
+        const auto where = [&] { return std::string(file) + " " + renderer + " " + c.path + " (s=" + std::to_string(c.s) + ", t=" + std::to_string(c.t) + ")"; };
+        EXPECT_NEAR(c.weight_sum, 1.0, 1e-4) << where();
+        EXPECT_NEAR(c.weight, c.weight_general, 1e-4 * std::max(1.0, c.weight_general)) << where();
+      }
+    }
+  }
+  EXPECT_GT(checked, 500u);
 }
 
 // Where a profile's plain joins are the emitter hit and next-event estimation alone (pt-nee, pt,
@@ -481,14 +505,19 @@ struct ManifoldRig {
   ClassImages images;
   Integrator in;
   Integrator::Thread th;
-  ManifoldRig(const Scene& scene, const StrategySet& strategies, std::uint64_t seed)
-      : rs(make_render_scene(scene).expect("a scene the tracer renders")),
+  ManifoldRig(const Scene& scene, const StrategySet& strategies, std::uint64_t seed, LightSampling light_sampling = LightSampling::kArea)
+      : rs(render_scene(scene, light_sampling)),
         o(options(seed)),
         images(1, 1, nullptr, {}),
         in(rs, strategies, o),
         th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}} {
     th.images = &images;
     th.connectors.resize(strategies.strategies.size());
+  }
+  static RenderScene render_scene(const Scene& scene, LightSampling light_sampling) {
+    RenderScene r = make_render_scene(scene).expect("a scene the tracer renders");
+    if (light_sampling != LightSampling::kArea) sample_lights_by_solid_angle(r, scene, light_sampling == LightSampling::kSolidAngle);
+    return r;
   }
   static RenderOptions options(std::uint64_t seed) {
     RenderOptions r;
@@ -502,7 +531,8 @@ struct ManifoldRig {
 // the whole-path weights of all of them sum to 1: random paths of the glass-sphere scenes formed by
 // every plain join of bdpt+manifold's subpaths, those a manifold chain could build among them. The
 // renderer's weight of each plain join (its subpaths' stored densities, changed across a chain the
-// manifold could build: chain_densities()) must equal the whole path's.
+// manifold could build: chain_densities()) must equal the whole path's. With the lamps sampled by
+// area and (issue 39) by the cone they subtend, x0's density then next-event estimation's from x1.
 TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
   const Profile profile = parse_profile(R"({"name": "bdpt+manifold", "strategies": [
       {"name": "bdpt", "s": "0..", "chain": "DD", "t": "0.."},
@@ -510,9 +540,10 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
                                         "bdpt+manifold.json", Limits{})
                               .expect("a valid profile");
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
+  for (const LightSampling light_sampling : {LightSampling::kArea, LightSampling::kSolidAngle})
   for (const char* name : {"point-glass.json", "lamp-glass.json"}) {
     const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + name).expect("the sample");
-    ManifoldRig rig(scene, strategies, 5);
+    ManifoldRig rig(scene, strategies, 5, light_sampling);
     const Integrator& integrator = rig.in;
     const RenderScene& rs = rig.rs;
     const RenderOptions& o = rig.o;
@@ -530,7 +561,7 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
           const double sum = A::whole_path_weight_sum(integrator, th, s, t, &chains);
           ++checked;
           if (chains > 0) ++shared;
-          const std::string where = std::string(name) + " " + A::label(integrator, th, s, t) + " (s=" + std::to_string(s) +
+          const std::string where = std::string(name) + " " + to_string(light_sampling) + " " + A::label(integrator, th, s, t) + " (s=" + std::to_string(s) +
                                     ", t=" + std::to_string(t) + ")";
           EXPECT_NEAR(sum, 1.0, 1e-4) << where;
           // The join's own densities read the cosines at its ends: where the join runs along a

@@ -44,8 +44,8 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
     return bsdf::lobe_probability(material_at(c, &textured), wo, c.ns, reflect ? Lobe::kSpecularReflection : Lobe::kSpecularTransmission);
   };
   // Every maximal run x_i … x(i+m-1) of S vertices that the manifold connector could build, as
-  // techniques() lists them (an image light's x0 joins no chain).
-  for (int i = 1 + (on_environment(x[0]) ? 1 : 0); i <= k - 1; ++i) {
+  // techniques() lists them (an x0 drawn towards x1 joins no chain).
+  for (int i = 1 + (origin_drawn_towards(x[0], x[1]) ? 1 : 0); i <= k - 1; ++i) {
     if (letter_s(i) || !letter_s(i + 1)) continue;
     int m = 0;
     while (i + m <= k - 1 && letter_s(i + m + 1)) ++m;
@@ -322,6 +322,9 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
   const Vertex* b = &b_end;
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
   const int m = static_cast<int>(chain.size());
+  // A fresh light point where x0's density is drawn towards x1 (a rectangle sampled by solid
+  // angle, x1 on a shape with a finite part): not this connector's to sample (techniques()).
+  if (s == 1 && rs_.lights[static_cast<std::size_t>(a->light)].drawn_towards(finite_of_shape_[static_cast<std::size_t>(chain[0].id)] != 0)) return;
   // --- the chain's vertices and its contribution ---
   JoinResult& jr = th.join;
   vec3 transmit(1.0f);  // the share of flux the chain passes: tint (1 - F) or tint F for glass, R for a mirror

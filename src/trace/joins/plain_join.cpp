@@ -114,21 +114,25 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   if (q->kind == Kind::kLens || !q->finite) return false;
   const bool ortho = kind == ConnectorKind::kOrthoProjection;
   join_numbers(rng, ortho ? JoinBlock::kOrtho : JoinBlock::kSplat, s);
-  const EnvironmentLightParams* env = q->kind == Kind::kLight ? environment_of(q->light) : nullptr;
+  const bool env = q->kind == Kind::kLight && environment_of(q->light) != nullptr;
   // A Dirac direction (orthographic, spot meter) has no DD join; the connector's c(k+1) c(k+2) are
   // a Dirac direction from a film. (No projection of an image light: mis_weight.cpp.)
-  if (ortho ? env != nullptr || cam_.letters != "SD" : cam_.letters[0] != 'D') return false;
+  if (ortho ? env || cam_.letters != "SD" : cam_.letters[0] != 'D') return false;
+  // (The splat's sensor point has a finite direction: a light drawn towards points draws y0 towards it.)
+  const bool towards = !ortho && q->kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(q->light)].drawn_towards(true);
   begin_join(th, kind, s, 1, ortho ? ortho_of(s) : strategy(s, 1));
   if (ortho) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   const glm::vec2 ul = ortho ? glm::vec2(0.0f) : rng.get2d_if(reads_lens_numbers(cam_.params));
-  if (env) {
-    // An image infinite light seen directly: its point is drawn towards the sensor point, as
+  if (towards) {
+    // A light seen directly whose points are drawn towards the point they join (an image infinite
+    // light, a rectangle sampled by solid angle): its point is drawn towards the sensor point, as
     // next-event estimation draws it (the light density its x0 has), not the light subpath's y0.
+    const int li = q->light;
     const vec3 z = sensor_point(cam_.params, ul);
-    const std::optional<EndpointConnection> e = pathex::connect(*env, rng.get2d(), z);
+    const std::optional<EndpointConnection> e = connect_towards(rs_.lights[static_cast<std::size_t>(li)].params, rng.get2d(), z);
     if (!e) return false;
-    Vertex& y0 = fresh_light_vertex(th, static_cast<std::size_t>(q->light), e->position, e->normal, box_point_error(e->position), 'D');
-    y0.pdf_fwd = env_origin_density(*env, y0.p, y0.n, z);
+    Vertex& y0 = fresh_light_vertex(th, static_cast<std::size_t>(li), e->position, e->normal, towards_point_error(li, e->position), 'D');
+    y0.pdf_fwd = light_pick_ * towards_join_area_density(*e);
     // L / (pick p |cos θ_x| / d²): the join's |cos θ_x| and We cos / d² complete L We cos / (pick p).
     y0.beta = y0.pdf_fwd > 0.0f ? e->value / y0.pdf_fwd : vec3(0.0f);
     q = &y0;
@@ -163,28 +167,29 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   join_numbers(rng, distant ? JoinBlock::kDistant : JoinBlock::kNee, t);
   const std::size_t li = rs_.pick_light(rng);
   const RenderLight& l = rs_.lights[li];
-  const EnvironmentLightParams* env = environment_of(static_cast<int>(li));
+  // The eye end pt can be joined: a light drawn towards points draws its point towards pt.
+  const bool towards = !distant && l.drawn_towards(true);
   // Dirac directions (distant, laser) have no DD join; the connector's c0 c1 are a Dirac direction
   // from an aperture.
-  if (distant ? l.letters != "DS" : !env && l.letters[1] != 'D') return false;
+  if (distant ? l.letters != "DS" : !towards && l.letters[1] != 'D') return false;
   begin_join(th, kind, 1, t, distant ? distant_of(t) : strategy(1, t));
   if (distant) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
-  // The light point: the aperture point on the line (distant), a direction drawn from an image
-  // infinite light's image, or a point of the light. (Made in place: an optional assigned later
-  // would be zero-filled first.)
-  const std::optional<EndpointConnection> c = distant ? connect_projection(l.params, pt.p)
-                                              : env   ? pathex::connect(*env, rng.get2d(), pt.p)
-                                                      : pathex::connect(l.params, rs_.sample_point(l, rng, &err), pt.p);
+  // The light point: the aperture point on the line (distant), a point drawn towards pt (a
+  // direction from an image infinite light's image, a rectangle's by solid angle), or a point of
+  // the light. (Made in place: an optional assigned later would be zero-filled first.)
+  const std::optional<EndpointConnection> c = distant   ? connect_projection(l.params, pt.p)
+                                              : towards ? connect_towards(l.params, rng.get2d(), pt.p)
+                                                        : pathex::connect(l.params, rs_.sample_point(l, rng, &err), pt.p);
   if (!c) {
     if (distant) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].outside;
     return false;
   }
   if (distant) err = l.origin_error;
-  else if (env) err = box_point_error(c->position);
+  else if (towards) err = towards_point_error(static_cast<int>(li), c->position);
   JoinResult& jr = th.join;
   Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? l.letters[1] : 'D');
-  if (env) y0.pdf_fwd = env_origin_density(*env, y0.p, y0.n, pt.p);
+  if (towards) y0.pdf_fwd = light_pick_ * towards_join_area_density(*c);
   const vec3 w = c->wi;  // from pt to the light
   const vec3 f = end_f(pt, w, TransportMode::kRadiance, &jr.density.at_pt);
   jr.density.w = -w;  // w runs from pt to the light, the join's from the light to pt
