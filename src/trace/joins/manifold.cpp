@@ -5,7 +5,6 @@
 #include <array>
 #include <cmath>
 #include <optional>
-#include <type_traits>
 
 #include <glm/geometric.hpp>
 
@@ -66,10 +65,8 @@ double largest(const double* c, std::size_t n) {
 }
 
 // A dense square system solved in place by Gaussian elimination with partial pivoting: `rhs` has
-// `cols` columns, row-major. Returns min |pivot| / max |pivot| (0: singular). N: the size, a
-// std::size_t or, for the common chains, a constant (the loops unrolled: the same operations).
-template <class N>
-double eliminate(double* m, N n, double* rhs, std::size_t cols) {
+// `cols` columns, row-major. Returns min |pivot| / max |pivot| (0: singular).
+double solve_in_place(double* m, std::size_t n, double* rhs, std::size_t cols) {
   double lo = INFINITY, hi = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     std::size_t piv = k;
@@ -97,15 +94,6 @@ double eliminate(double* m, N n, double* rhs, std::size_t cols) {
       rhs[k * cols + c] = v / m[k * n + k];
     }
   return hi > 0.0 && std::isfinite(lo / hi) ? lo / hi : 0.0;
-}
-
-double solve_in_place(double* m, std::size_t n, double* rhs, std::size_t cols) {
-  switch (n) {
-    case 2: return eliminate(m, std::integral_constant<std::size_t, 2>{}, rhs, cols);
-    case 4: return eliminate(m, std::integral_constant<std::size_t, 4>{}, rhs, cols);
-    case 6: return eliminate(m, std::integral_constant<std::size_t, 6>{}, rhs, cols);
-    default: return eliminate(m, n, rhs, cols);
-  }
 }
 
 // The change of vertex i's constraint (on its own tangent pair) when the half vector changes by dh
