@@ -238,7 +238,7 @@ Result<ConvergeResult> converge(const ConvergeOptions& a, const ConvergeHooks& h
   // render progress (the rung's line below is converge's).
   std::optional<RenderWatch> watch;
   watch.emplace(/*show=*/false);
-  RungSetup setup{&*watch, &*scene, &*classifier, a.threads, a.max_bounces};
+  RungSetup setup{&*watch, &*scene, &*classifier, a.threads, a.max_bounces, ManifoldOptions{}};  // the reference: the manifold's defaults
   const int width = scene->camera.width, height = scene->camera.height;
   const std::uint64_t base_seed = a.seed;
   const bool progress = root && hooks.progress;
