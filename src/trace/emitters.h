@@ -383,6 +383,11 @@ bool draws_towards(const LightParams& l);
 std::optional<EndpointConnection> connect_towards(const LightParams& l, glm::vec2 u, const glm::vec3& ref);
 float towards_area_density(const LightParams& l, const glm::vec3& x, const glm::vec3& n, const glm::vec3& ref);
 float towards_step_density(const LightParams& l, const glm::vec3& x0, const glm::vec3& n0, const glm::vec3& x1, float abs_cos1);
+// The area density of a connect_towards() point: its solid-angle density to area,
+// towards_area_density() without computing the solid angle again.
+inline float towards_area_density(const EndpointConnection& c) {
+  return c.distance > 0.0f ? c.pdf_dir * std::fabs(glm::dot(c.normal, c.wi)) / (c.distance * c.distance) : 0.0f;
+}
 
 // Sensors. `raster` ∈ [0,1)² as above; u_lens is read by the thin lens only.
 inline bool reads_lens_numbers(const SensorParams& s) { return std::holds_alternative<ThinLensParams>(s); }

@@ -223,22 +223,12 @@ class Integrator {
   // x0's light density (the pick times the light's): next-event estimation's from x1 where the
   // light draws towards it, else its area density (0 for a Dirac position).
   float light_origin_density(int light, const vec3& x0, const vec3& n0, const Vertex& x1) const {
-    const RenderLight& l = rs_.lights[static_cast<std::size_t>(light)];
-    return light_pick_ * (l.drawn_towards(joinable(x1)) ? towards_area_density(l.params, x0, n0, x1.p) : l.pdf_pos);
+    return light_pick_ * rs_.lights[static_cast<std::size_t>(light)].origin_density(x0, n0, x1.p, joinable(x1));
   }
   // x1's light density after such an x0 (drawn_towards() holds): the rest of the emission's joint density.
   float light_step_density(int light, const Vertex& x0, const Vertex& x1) const {
     const vec3 w = glm::normalize(x1.p - x0.p);
     return towards_step_density(rs_.lights[static_cast<std::size_t>(light)].params, x0.p, x0.n, x1.p, abs_cos(x1, w));
-  }
-  // The area density of a join's light point drawn towards its reference point (connect_towards()):
-  // its solid-angle density to area, towards_area_density() without computing the solid angle again.
-  static float towards_join_area_density(const EndpointConnection& c) {
-    return c.distance > 0.0f ? c.pdf_dir * std::fabs(glm::dot(c.normal, c.wi)) / (c.distance * c.distance) : 0.0f;
-  }
-  // The rounding-error bound of a point drawn towards a point (an image light's box, a rectangle).
-  vec3 towards_point_error(int light, const vec3& p) const {
-    return environment_of(light) ? box_point_error(p) : rs_.lights[static_cast<std::size_t>(light)].origin_error;
   }
 
   // The material at surface vertex `v` (RenderScene::material_at).

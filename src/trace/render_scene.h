@@ -58,6 +58,13 @@ struct RenderLight {
   bool drawn_towards(bool x1_joinable) const { return draws_towards(params) && (x1_joinable || environment() != nullptr); }
   // The image infinite light this is (trace/environment.h), or null.
   const EnvironmentLightParams* environment() const { return std::get_if<EnvironmentLightParams>(&params); }
+  // x0's light density in a path whose x1 is at `x1` (without the light's pick): next-event
+  // estimation's from x1 where drawn towards it, else its area density (0 for a Dirac position).
+  float origin_density(const glm::vec3& x0, const glm::vec3& n0, const glm::vec3& x1, bool x1_joinable) const {
+    return drawn_towards(x1_joinable) ? towards_area_density(params, x0, n0, x1) : pdf_pos;
+  }
+  // The rounding-error bound of a point drawn towards a point (an image light's box, a rectangle).
+  glm::vec3 towards_point_error(const glm::vec3& p) const { return environment() ? box_point_error(p) : origin_error; }
   // The light's first ray from point x (an area light's; the others ignore it) by u, and the
   // densities of its ray from x towards w: the emitter model's, through the aiming decorator when
   // the light is aimed. Every strategy samples and weighs a light's emission through these.

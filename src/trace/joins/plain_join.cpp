@@ -127,12 +127,11 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
     // A light seen directly whose points are drawn towards the point they join (an image infinite
     // light, a rectangle sampled by solid angle): its point is drawn towards the sensor point, as
     // next-event estimation draws it (the light density its x0 has), not the light subpath's y0.
-    const int li = q->light;
-    const vec3 z = sensor_point(cam_.params, ul);
-    const std::optional<EndpointConnection> e = connect_towards(rs_.lights[static_cast<std::size_t>(li)].params, rng.get2d(), z);
+    const std::size_t li = static_cast<std::size_t>(q->light);
+    const std::optional<EndpointConnection> e = connect_towards(rs_.lights[li].params, rng.get2d(), sensor_point(cam_.params, ul));
     if (!e) return false;
-    Vertex& y0 = fresh_light_vertex(th, static_cast<std::size_t>(li), e->position, e->normal, towards_point_error(li, e->position), 'D');
-    y0.pdf_fwd = light_pick_ * towards_join_area_density(*e);
+    Vertex& y0 = fresh_light_vertex(th, li, e->position, e->normal, rs_.lights[li].towards_point_error(e->position), 'D');
+    y0.pdf_fwd = light_pick_ * towards_area_density(*e);
     // L / (pick p |cos θ_x| / d²): the join's |cos θ_x| and We cos / d² complete L We cos / (pick p).
     y0.beta = y0.pdf_fwd > 0.0f ? e->value / y0.pdf_fwd : vec3(0.0f);
     q = &y0;
@@ -186,10 +185,10 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
     return false;
   }
   if (distant) err = l.origin_error;
-  else if (towards) err = towards_point_error(static_cast<int>(li), c->position);
+  else if (towards) err = l.towards_point_error(c->position);
   JoinResult& jr = th.join;
   Vertex& y0 = fresh_light_vertex(th, li, c->position, c->normal, err, distant ? l.letters[1] : 'D');
-  if (towards) y0.pdf_fwd = light_pick_ * towards_join_area_density(*c);
+  if (towards) y0.pdf_fwd = light_pick_ * towards_area_density(*c);
   const vec3 w = c->wi;  // from pt to the light
   const vec3 f = end_f(pt, w, TransportMode::kRadiance, &jr.density.at_pt);
   jr.density.w = -w;  // w runs from pt to the light, the join's from the light to pt
