@@ -4,7 +4,10 @@
 //     checker's R under the same bound): the tracer never samples what the checker forbids;
 //   - every string that bdpt finds carrying more than 1 % of the image, and that the profile can
 //     reach, is found by the profile with an estimate within the family-wise tolerance of bdpt's
-//     (the two errors combined; test::family_sigmas over every such comparison, 0.1 %);
+//     (the two errors combined at their Welch–Satterthwaite degrees of freedom; test::family_sigmas
+//     over every such comparison, 0.1 %); a path with too few samples or degrees of freedom for a
+//     stderr, or sampled by the manifold walk alone under a point light (no finite variance), is
+//     checked for being found;
 //     "can reach" is the checker's R, except that the mirror connector joins across planar
 //     mirrors only (quads of a pure mirror material, trace/joins/mirror.h), which the checker,
 //     knowing no geometry, cannot see: in a scene without one, its strategies are left out;
@@ -33,6 +36,14 @@ constexpr int kBounces = 6;
 // batch-means t is far from Student's (10 % of the comparisons at the fixed seed: the lamp seen
 // in a mirror, met 12 to 16 times, and light tracing's sparse splats).
 constexpr std::uint64_t kMinSamples = 4 * 32;
+// The fewest degrees of freedom (Estimate::dof: pixel groups whose replicates hold the path) for
+// which a stderr is compared: cornell.json's lamp, seen directly, covers a few of the 256 pixels at
+// 16 x 16 and its stderr has 4; every sample there adds the lamp's radiance, and under `sobol` both
+// replicates of those pixels can meet the lamp equally often, so its stderr is at times exactly 0
+// while the seed-to-seed spread is 0.4 % of the value (issue 36's sweep: seed 70 of 100). At 5 or
+// more a stderr of 0 needs five such coincidences. (spotmeter-caustic.json's one pixel gives 1.)
+// Each comparison's tolerance is Student's at its Welch–Satterthwaite degrees of freedom.
+constexpr int kMinDof = 5;
 
 HistogramReport render_scene(const Scene& scene, const Profile& profile, std::uint64_t spp) {
   RenderOptions o;
@@ -56,19 +67,21 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
   struct Comparison {
     std::string what;
     double deviation, sigma;
+    int dof;  // Welch–Satterthwaite, rounded down
   };
   std::vector<Comparison> comparisons;
-  int sparse = 0;  // paths found, but with too few samples for their stderr to mean anything
-  auto has_mirror_connector = [](const Profile& p) {
-    return std::any_of(p.strategies.begin(), p.strategies.end(), [](const Strategy& st) { return st.connector == ConnectorKind::kMirror; });
+  int sparse = 0;  // paths found, but with too few samples or degrees of freedom for their stderr to mean anything
+  int heavy = 0;   // paths found, sampled by the manifold walk alone under a point light (no finite variance)
+  auto has_connector = [](const Profile& p, ConnectorKind kind) {
+    return std::any_of(p.strategies.begin(), p.strategies.end(), [&](const Strategy& st) { return st.connector == kind; });
   };
-  std::map<std::string, CompiledProfile> pruned;  // per profile: its checker without the mirror connector
-  auto without_mirror = [&](const Profile& p) -> const CompiledProfile& {
-    auto it = pruned.find(p.name);
+  std::map<std::pair<std::string, ConnectorKind>, CompiledProfile> pruned;  // per profile: its checker without a connector
+  auto without = [&](const Profile& p, ConnectorKind kind) -> const CompiledProfile& {
+    auto it = pruned.find({p.name, kind});
     if (it != pruned.end()) return it->second;
     Profile q = p;
-    std::erase_if(q.strategies, [](const Strategy& st) { return st.connector == ConnectorKind::kMirror; });
-    return pruned.emplace(p.name, compile_profile(q, kBounces, Limits{}).expect("a test input")).first->second;
+    std::erase_if(q.strategies, [&](const Strategy& st) { return st.connector == kind; });
+    return pruned.emplace(std::pair{p.name, kind}, compile_profile(q, kBounces, Limits{}).expect("a test input")).first->second;
   };
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".json") continue;
@@ -82,6 +95,14 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
     Result<Scene> loaded = load_scene_file(entry.path().string());
     ASSERT_TRUE(loaded.ok()) << loaded.error().render();
     Scene scene = *loaded;
+    // Under a point or spot light the manifold walk's estimate of a caustic has a log-divergent
+    // second moment (docs/manifold.md): paths only it samples there have no stderr to compare by
+    // (point-glass.json's LSDSSDDSE read 35-45 % low with a tight stderr at 4 seeds of 100 in issue
+    // 36's sweep; the median seed reads 14 % low). They are checked for being found; their value
+    // against light tracing and bdpt in tests/trace/manifold_test.cpp.
+    const bool delta_light = std::any_of(scene.lights.begin(), scene.lights.end(), [](const Light& l) {
+      return std::holds_alternative<PointLight>(l) || std::holds_alternative<SpotLight>(l);
+    });
     const bool planar_mirror = std::any_of(scene.shapes.begin(), scene.shapes.end(), [&](const Shape& sh) {
       return std::holds_alternative<QuadShape>(sh.geometry) && std::holds_alternative<Mirror>(scene.materials[static_cast<std::size_t>(sh.material)]);
     });
@@ -111,7 +132,8 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
           EXPECT_TRUE(checker.reachable.accepts(p.path)) << where << ": " << p.path;
         }
       }
-      const CompiledProfile& reach = planar_mirror || !has_mirror_connector(profile) ? checker : without_mirror(profile);
+      const CompiledProfile& reach = planar_mirror || !has_connector(profile, ConnectorKind::kMirror) ? checker : without(profile, ConnectorKind::kMirror);
+      const bool manifold_heavy = delta_light && has_connector(profile, ConnectorKind::kManifold);
       for (const PathEstimate& p : reference.paths) {
         if (!(p.estimate.luminance > 0.01 * reference.total.luminance) || !reach.reachable.accepts(p.path)) continue;
         auto it = found.find(p.path);
@@ -121,23 +143,32 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
         // few heavy splats carry it — at seed 2 it read 0.0022 ± 0.0003 against bdpt's 0.0054, while
         // at 2,048 spp it reads 0.0060 ± 0.0010 (issue 36's sweep: 1 of 5 seeds failed). Such a path
         // is checked for being found, not for its value.
-        if (std::min(p.estimate.samples, it->second->estimate.samples) < kMinSamples) {
+        const Estimate& a = p.estimate;
+        const Estimate& b = it->second->estimate;
+        if (std::min(a.samples, b.samples) < kMinSamples || std::min(a.dof, b.dof) < kMinDof) {
           ++sparse;
           continue;
         }
-        const double sigma = std::hypot(p.estimate.std_error, it->second->estimate.std_error);
-        comparisons.push_back({where + ": " + p.path + " bdpt " + std::to_string(p.estimate.luminance) + " ± " +
-                                   std::to_string(p.estimate.std_error) + ", " + name + " " +
-                                   std::to_string(it->second->estimate.luminance) + " ± " + std::to_string(it->second->estimate.std_error),
-                               std::fabs(p.estimate.luminance - it->second->estimate.luminance), sigma});
+        if (manifold_heavy && !without(profile, ConnectorKind::kManifold).reachable.accepts(p.path)) {
+          ++heavy;
+          continue;
+        }
+        const double va = a.std_error * a.std_error, vb = b.std_error * b.std_error;
+        const double welch = (va + vb) * (va + vb) / (va * va / a.dof + vb * vb / b.dof);
+        comparisons.push_back({where + ": " + p.path + " bdpt " + std::to_string(a.luminance) + " ± " + std::to_string(a.std_error) +
+                                   " (" + std::to_string(a.dof) + " dof), " + name + " " + std::to_string(b.luminance) + " ± " +
+                                   std::to_string(b.std_error) + " (" + std::to_string(b.dof) + " dof)",
+                               std::fabs(a.luminance - b.luminance), std::sqrt(va + vb),
+                               std::isfinite(welch) ? static_cast<int>(welch) : std::min(a.dof, b.dof)});
       }
     }
   }
   EXPECT_GT(comparisons.size(), 40u);
   test::stat_log("paths found but too sparse to compare", sparse, static_cast<double>(comparisons.size()) / 4);
   EXPECT_LT(sparse, static_cast<int>(comparisons.size()) / 4) << "most comparisons must be of well-sampled paths";
-  const double tolerance = test::family_sigmas(static_cast<int>(comparisons.size()));
+  test::stat_log("paths found, the manifold walk's alone under a point light", heavy, 0);
   for (const Comparison& c : comparisons) {
+    const double tolerance = test::family_sigmas(static_cast<int>(comparisons.size()), 1e-3, c.dof);
     test::stat_log(c.what, c.deviation / c.sigma, tolerance);
     EXPECT_LE(c.deviation, tolerance * c.sigma + 1e-9) << c.what;
   }
