@@ -111,8 +111,10 @@ SeedMean seed_mean(const std::string& scene, const std::string& renderer, const 
 // seeds' 7 degrees of freedom (5.4; a bias of about 30 % fails). Not Welch–Satterthwaite's, which
 // the reference's larger error makes near normal (3.4): the seeds' estimates are skewed (a rare
 // bright chain), so a mean of 8 lies low with a small spread more often than Student's t says;
-// over 60 swept seeds the deviates averaged −0.6 and one reached −3.6. Every sample of the class
-// is the manifold joining the lamp to the floor through the ball.
+// over 60 swept seeds the deviates averaged −0.6 and one reached −3.6. The class is the manifold
+// joining the lamp to the floor through the ball, and rarely an eye subpath that meets the lamp
+// through the ball (pt-nee's emitter hit (0, DD, 7), MIS-weighted against it: in 2 of the first 8
+// swept seeds' 8 renders).
 TEST(ManifoldReference, LampGlassSeenThroughAgreesWithTheQuadrature) {
   const nlohmann::json ref = read_json(std::string(PATHEX_SOURCE_DIR) + "/tests/trace/scenes/lamp-glass.reference.json");
   ASSERT_EQ(ref["class"], "LDDSSDSSDSE");
@@ -128,7 +130,9 @@ TEST(ManifoldReference, LampGlassSeenThroughAgreesWithTheQuadrature) {
   pathex::test::stat_log("lamp-glass seen through against the quadrature", (m.mean - l0) / combined, k);
   EXPECT_LE(std::abs(m.mean - l0), k * combined)
       << "pt-nee+manifold " << m.mean << " ± " << m.stderr_ << " over 8 seeds, quadrature " << l0 << " ± " << s0;
-  EXPECT_EQ(m.strategies, nlohmann::json({{"manifold-nee (1, DSSD, 4)", true}})) << m.strategies.dump();
+  EXPECT_TRUE(m.strategies.contains("manifold-nee (1, DSSD, 4)")) << m.strategies.dump();
+  for (const auto& [name, sampled] : m.strategies.items())
+    EXPECT_TRUE(name == "manifold-nee (1, DSSD, 4)" || name == "emitter-hit (0, DD, 7)") << m.strategies.dump();
 }
 
 // bdpt+manifold (issue 40) on the same scene: the caustic seen directly (LDDSSDDSE), which the
