@@ -96,57 +96,34 @@ double solve_in_place(double* m, std::size_t n, double* rhs, std::size_t cols) {
   return hi > 0.0 && std::isfinite(lo / hi) ? lo / hi : 0.0;
 }
 
-// The change of vertex i's constraint (on its own tangent pair) when the half vector changes by dh
-// and the normal by dn: with ĥ = h / |h| and C = ĥ_tangential · (s, t), dĥ = (dh - ĥ (ĥ·dh)) / |h|
-// and, as n · s = n · t = 0 at the vertex, dC = (dĥ · s - (ĥ·n)(dn · s), the same for t).
-glm::dvec2 d_constraint(const Local& l, const dvec3& dh, const dvec3& dn) {
-  const dvec3 dhat = (dh - l.h * glm::dot(l.h, dh)) / l.lh;
-  const double hn = glm::dot(l.h, l.g.ns);
-  return {glm::dot(dhat, l.g.dpdu) - hn * glm::dot(dn, l.g.dpdu), glm::dot(dhat, l.g.dpdv) - hn * glm::dot(dn, l.g.dpdv)};
-}
-
-// A unit direction w = e / |e| when e's far end moves by d: (d - w (w·d)) / |e|.
-dvec3 d_unit(const dvec3& w, double len, const dvec3& d) { return (d - w * glm::dot(w, d)) / len; }
-
 // The constraint Jacobian ∂C/∂X (2m × 2m, row-major), analytic (Jakob and Marschner 2012): each
 // vertex moves along its tangent pair (dp/du = dpdu, dn/du = dndu, as trace/differential.h), which
 // changes its own constraint and its neighbours'. With `jb`, also ∂C/∂b (2m × 2) for b moving along
-// (sb, tb): only the last vertex sees b. The constraints are on each vertex's own tangent pair.
+// (sb, tb): only the last vertex sees b. The constraints are on each vertex's own tangent pair r:
+// C_r = ĥ · r (n · r = 0 at the vertex), so with ĥ = h / |h| a change dh of h changes C_r by dh · a_r,
+// a_r = (r - ĥ (ĥ·r)) / |h|; a neighbour at w = e / |e| moving by d turns w by (d - w (w·d)) / |e|,
+// which changes C_r by d · g, g = η (a_r - w (w·a_r)) / |e| (gi: the light side's, go: the eye
+// side's); the vertex's own move by d turns both directions the other way and the normal by dn:
+// -(gi + go) · d - (ĥ·n)(dn · r).
 void jacobian(const std::vector<ChainVertex>& x, const Local* loc, double* j, const dvec3* sb, const dvec3* tb, double* jb) {
   const std::size_t m = x.size(), n = 2 * m;
   std::fill(j, j + n * n, 0.0);
-  for (std::size_t v = 0; v < m; ++v)
-    for (std::size_t axis = 0; axis < 2; ++axis) {
-      const dvec3 dp = axis == 0 ? loc[v].g.dpdu : loc[v].g.dpdv;
-      const dvec3 dn = axis == 0 ? loc[v].g.dndu : loc[v].g.dndv;
-      const std::size_t col = 2 * v + axis;
-      // Its own constraint: both directions turn (their near end moves), and so does the normal.
-      const Local& l = loc[v];
-      const dvec3 dh = -x[v].eta_light * d_unit(l.wi, l.li, dp) - x[v].eta_eye * d_unit(l.wo, l.lo, dp);
-      const glm::dvec2 own = d_constraint(l, dh, dn);
-      j[(2 * v) * n + col] = own.x;
-      j[(2 * v + 1) * n + col] = own.y;
-      if (v > 0) {  // the vertex before sees it as its next neighbour
-        const Local& q = loc[v - 1];
-        const glm::dvec2 d = d_constraint(q, x[v - 1].eta_eye * d_unit(q.wo, q.lo, dp), dvec3(0.0));
-        j[(2 * v - 2) * n + col] = d.x;
-        j[(2 * v - 1) * n + col] = d.y;
+  if (jb) std::fill(jb, jb + n * 2, 0.0);
+  const auto axes = [&](std::size_t v) { return std::array<dvec3, 2>{loc[v].g.dpdu, loc[v].g.dpdv}; };
+  for (std::size_t v = 0; v < m; ++v) {
+    const Local& l = loc[v];
+    const std::array<dvec3, 2> r = axes(v), dn = {l.g.dndu, l.g.dndv};
+    const double hn = glm::dot(l.h, l.g.ns);
+    for (std::size_t k = 0; k < 2; ++k) {
+      const dvec3 a = (r[k] - l.h * glm::dot(l.h, r[k])) / l.lh;
+      const dvec3 gi = (x[v].eta_light / l.li) * (a - l.wi * glm::dot(l.wi, a)), go = (x[v].eta_eye / l.lo) * (a - l.wo * glm::dot(l.wo, a));
+      double* row = j + (2 * v + k) * n;
+      for (std::size_t axis = 0; axis < 2; ++axis) {
+        row[2 * v + axis] = -glm::dot(gi + go, r[axis]) - hn * glm::dot(dn[axis], r[k]);
+        if (v > 0) row[2 * v - 2 + axis] = glm::dot(gi, axes(v - 1)[axis]);
+        if (v + 1 < m) row[2 * v + 2 + axis] = glm::dot(go, axes(v + 1)[axis]);
+        if (jb && v + 1 == m) jb[(2 * v + k) * 2 + axis] = glm::dot(go, axis == 0 ? *sb : *tb);
       }
-      if (v + 1 < m) {  // the vertex after sees it as its previous neighbour
-        const Local& q = loc[v + 1];
-        const glm::dvec2 d = d_constraint(q, x[v + 1].eta_light * d_unit(q.wi, q.li, dp), dvec3(0.0));
-        j[(2 * v + 2) * n + col] = d.x;
-        j[(2 * v + 3) * n + col] = d.y;
-      }
-    }
-  if (jb) {
-    std::fill(jb, jb + n * 2, 0.0);
-    const std::size_t i = m - 1;
-    for (std::size_t axis = 0; axis < 2; ++axis) {
-      const Local& q = loc[i];
-      const glm::dvec2 d = d_constraint(q, x[i].eta_eye * d_unit(q.wo, q.lo, axis == 0 ? *sb : *tb), dvec3(0.0));
-      jb[(2 * i) * 2 + axis] = d.x;
-      jb[(2 * i + 1) * 2 + axis] = d.y;
     }
   }
 }
