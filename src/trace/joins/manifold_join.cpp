@@ -119,8 +119,18 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
     if (!(glm::dot(d, d) > 0.0f)) return ManifoldFailure::kNoSolution;
   }
   d = glm::normalize(d);
+  int within = -1;  // a hollow sphere the ray runs inside (SpecularSurfaces::hollow): it leaves where the sphere alone says
   for (;;) {
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, no, eo, HitDetail::kNoUv);
+    std::optional<Hit> hit;
+    if (within >= 0) {  // o + t d on the sphere again at t = -2 (o - c)·d
+      const SphereShape& ball = std::get<SphereShape>(rs_.geometry->shape_geometry(within));
+      const vec3 f = o - ball.center;
+      hit = Hit{.position = vec3(0.0f), .normal = glm::normalize(f - 2.0f * glm::dot(f, d) * d), .shape = within, .primitive = 0};
+      hit->position = ball.center + ball.radius * hit->normal;
+      hit->error = error_gamma(8) * (glm::abs(ball.center) + ball.radius * glm::abs(hit->normal));  // EmbreeScene's sphere hit's
+    } else {
+      hit = rs_.geometry->intersect(o, d, no, eo, HitDetail::kNoUv);
+    }
     if (!hit) break;
     const float ior = rs_.specular.glass_ior[static_cast<std::size_t>(hit->shape)];
     const bool mirror = !is_black(rs_.specular.mirror_reflectance[static_cast<std::size_t>(hit->shape)]);
@@ -151,6 +161,7 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
     o = hit->position;
     no = hit->normal;
     eo = hit->error;
+    within = rs_.specular.hollow[static_cast<std::size_t>(hit->shape)] && glm::dot(d, hit->normal) < 0.0f ? hit->shape : -1;
     // The chain ends where the ray meets no more specular surfaces: when it passes every specular
     // shape's bounding sphere by (a sphere it leaves outwards it cannot meet again), the ray that
     // would find the opaque surface or nothing beyond is not traced.
