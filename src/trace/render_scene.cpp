@@ -85,11 +85,11 @@ SpecularSurfaces specular_surfaces(const RenderScene& rs) {
   for (const int shape : sp.shapes) sp.bounds.push_back(padded_sphere(rs.geometry->shape_geometry(shape)));
   // A sphere is hollow when every other shape's surface stays outside it (touching allowed): a
   // sphere's nearest point, a flat piece's plane or its box at least the radius from the centre.
-  // Instanced shapes are not looked at: with any, no sphere is hollow.
+  // Instanced shapes are not looked at: with any, no sphere is hollow; nor is one with a cut-out.
   sp.hollow.assign(rs.material_of_shape.size(), 0);
   for (const int shape : sp.shapes) {
     const auto* ball = std::get_if<SphereShape>(&rs.geometry->shape_geometry(shape));
-    bool hollow = ball && rs.scene->instances.empty();
+    bool hollow = ball && rs.scene->instances.empty() && rs.scene->shapes[static_cast<std::size_t>(shape)].alpha < 0;
     const float r = ball ? ball->radius * (1.0f - 1e-4f) : 0.0f;
     const auto outside = [&](const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& on, const glm::vec3& n) {
       const glm::vec3 q = glm::clamp(ball->center, lo, hi);  // the box's point nearest the centre
