@@ -119,14 +119,20 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
     if (!(glm::dot(d, d) > 0.0f)) return ManifoldFailure::kNoSolution;
   }
   d = glm::normalize(d);
-  int within = -1;  // a hollow sphere the ray runs inside (SpecularSurfaces::hollow): it leaves where the sphere alone says
+  // The sphere the ray meets next without a ray traced: the cone's, entered at the near root (what
+  // lies before it the chain's shadow rays see), then a hollow one it runs inside
+  // (SpecularSurfaces::hollow), left at t = -2 (o - c)·d.
+  int within = sphere && d2 > sphere->radius * sphere->radius ? shape : -1;
+  bool entering = within >= 0;
   for (;;) {
     std::optional<Hit> hit;
-    if (within >= 0) {  // o + t d on the sphere again at t = -2 (o - c)·d
+    if (within >= 0) {
       const SphereShape& ball = std::get<SphereShape>(rs_.geometry->shape_geometry(within));
-      const vec3 f = o - ball.center;
-      hit = Hit{.position = vec3(0.0f), .normal = glm::normalize(f - 2.0f * glm::dot(f, d) * d), .shape = within, .primitive = 0};
+      const vec3 f = o - ball.center, across = f - glm::dot(f, d) * d;
+      const float t = entering ? -glm::dot(f, d) - std::sqrt(std::max(0.0f, ball.radius * ball.radius - glm::dot(across, across))) : -2.0f * glm::dot(f, d);
+      hit = Hit{.position = vec3(0.0f), .normal = glm::normalize(f + t * d), .shape = within, .primitive = 0};
       hit->position = ball.center + ball.radius * hit->normal;
+      entering = false;
       hit->error = error_gamma(8) * (glm::abs(ball.center) + ball.radius * glm::abs(hit->normal));  // EmbreeScene's sphere hit's
     } else {
       hit = rs_.geometry->intersect(o, d, no, eo, HitDetail::kNoUv);
