@@ -83,6 +83,40 @@ SpecularSurfaces specular_surfaces(const RenderScene& rs) {
   }
   for (float& c : sp.seed_cdf) c /= total;
   for (const int shape : sp.shapes) sp.bounds.push_back(padded_sphere(rs.geometry->shape_geometry(shape)));
+  // A sphere is hollow when every other shape's surface stays outside it (touching allowed): a
+  // sphere's nearest point, a flat piece's plane or its box at least the radius from the centre.
+  // Instanced shapes are not looked at: with any, no sphere is hollow; nor is one with a cut-out.
+  sp.hollow.assign(rs.material_of_shape.size(), 0);
+  for (const int shape : sp.shapes) {
+    const auto* ball = std::get_if<SphereShape>(&rs.geometry->shape_geometry(shape));
+    bool hollow = ball && rs.scene->instances.empty() && rs.scene->shapes[static_cast<std::size_t>(shape)].alpha < 0;
+    const float r = ball ? ball->radius * (1.0f - 1e-4f) : 0.0f;
+    const auto outside = [&](const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& on, const glm::vec3& n) {
+      const glm::vec3 q = glm::clamp(ball->center, lo, hi);  // the box's point nearest the centre
+      return glm::length(q - ball->center) >= r || std::fabs(glm::dot(ball->center - on, glm::normalize(n))) >= r;
+    };
+    for (std::size_t j = 0; j < rs.scene->shapes.size() && hollow; ++j) {
+      const ShapeGeometry& g = rs.scene->shapes[j].geometry;
+      if (static_cast<int>(j) == shape) continue;
+      if (const auto* o = std::get_if<SphereShape>(&g)) {
+        hollow = std::fabs(glm::length(o->center - ball->center) - o->radius) >= r;
+      } else if (const auto* k = std::get_if<DiskShape>(&g)) {
+        hollow = outside(k->center - k->radius, k->center + k->radius, k->center, k->normal);
+      } else if (const auto* q = std::get_if<QuadShape>(&g)) {
+        const glm::vec3 far = q->corner + q->edge1 + q->edge2;
+        hollow = outside(glm::min(glm::min(q->corner, far), glm::min(q->corner + q->edge1, q->corner + q->edge2)),
+                         glm::max(glm::max(q->corner, far), glm::max(q->corner + q->edge1, q->corner + q->edge2)), q->corner,
+                         glm::cross(q->edge1, q->edge2));
+      } else {
+        const MeshShape& m = std::get<MeshShape>(g);
+        for (const glm::uvec3& t : m.triangles) {
+          const glm::vec3 &a = m.positions[t.x], &b = m.positions[t.y], &c = m.positions[t.z];
+          hollow = hollow && outside(glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c)), a, glm::cross(b - a, c - a));
+        }
+      }
+    }
+    sp.hollow[static_cast<std::size_t>(shape)] = hollow ? 1 : 0;
+  }
   RTCBounds b;
   rtcGetSceneBounds(rs.geometry->handle(), &b);
   const double dx = static_cast<double>(b.upper_x) - b.lower_x, dy = static_cast<double>(b.upper_y) - b.lower_y,

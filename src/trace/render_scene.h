@@ -131,6 +131,7 @@ struct SpecularSurfaces {
   std::vector<int> shapes;             // the shapes with either (the manifold's seeds aim at points on them)
   std::vector<float> seed_cdf;         // the seeds' choice among them (cumulative, last 1)
   std::vector<glm::vec4> bounds;       // a bounding sphere of each (centre, radius): joins no chain can leave skip
+  std::vector<std::uint8_t> hollow;    // of every shape: 1 for a sphere of these that no other surface enters (trace/joins/manifold_join.cpp)
   double scene_size = 1.0;             // the scene's bounding-box diagonal (the manifold's shortest segment scales with it)
   // Whether the ray (o, d) can meet one of the shapes: it passes through one's bounding sphere, but
   // for shape `leaving` when that is a sphere (the ray leaves it outwards).

@@ -14,6 +14,7 @@
 #include "trace/differential.h"
 #include "trace/joins/manifold.h"
 #include "trace/render.h"
+#include "trace/render_scene.h"
 
 namespace pathex {
 namespace {
@@ -168,6 +169,24 @@ TEST(ManifoldWalk, EveryFailureReasonIsReported) {
     EXPECT_EQ(solve_chain(x, dvec3(0, r + u0, 0), dvec3(0, -r - v2, 0), dvec3(0, 1, 0), 10.0, o).failure,
               ManifoldFailure::kSingular);
   }
+}
+
+// The seeds leave a hollow sphere where the sphere alone says, without a ray (SpecularSurfaces::
+// hollow): point-glass.json's sphere is one (the floor, the pyramid and the plate stay outside it),
+// also resting on the floor; not once the floor cuts it or a small sphere sits inside it.
+TEST(ManifoldWalk, ASphereIsHollowUntilAnotherSurfaceEntersIt) {
+  const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/point-glass.json").expect("the sample");
+  const auto hollow = [](const Scene& s) { return make_render_scene(s).expect("a scene the tracer renders").specular.hollow; };
+  const auto moved = [&](float y, float inner) {
+    Scene s = scene;
+    std::get<SphereShape>(s.shapes[1].geometry).center.y = y;
+    if (inner > 0.0f) s.shapes.push_back(s.shapes[1]), std::get<SphereShape>(s.shapes.back().geometry).radius = inner;
+    return hollow(s);
+  };
+  EXPECT_EQ(hollow(scene), (std::vector<std::uint8_t>{0, 1, 0, 0}));
+  EXPECT_EQ(moved(0.5f, 0.0f)[1], 1);  // touching the floor
+  EXPECT_EQ(moved(0.45f, 0.0f)[1], 0);  // cut by it
+  EXPECT_EQ(moved(0.9f, 0.1f)[1], 0);
 }
 
 // Ten glass interfaces: five slabs' worth of parallel disks, alternately entering and leaving.

@@ -7,6 +7,8 @@
 #include <optional>
 
 #include <glm/geometric.hpp>
+#include <glm/mat2x2.hpp>
+#include <glm/matrix.hpp>
 
 #include "trace/differential.h"
 #include "trace/joins/join.h"
@@ -64,89 +66,63 @@ double largest(const double* c, std::size_t n) {
   return m;
 }
 
-// A dense square system solved in place by Gaussian elimination with partial pivoting: `rhs` has
-// `cols` columns, row-major. Returns min |pivot| / max |pivot| (0: singular).
-double solve_in_place(double* m, std::size_t n, double* rhs, std::size_t cols) {
+// The constraint Jacobian ∂C/∂X, block-tridiagonal in 2 × 2 blocks (glm: [column][row]): vertex v's
+// constraint against the moves of vertex v - 1 (l), its own (d) and v + 1 (u); `b` (with sb, tb): ∂C/∂b,
+// which only the last vertex's constraint sees.
+struct Blocks {
+  std::array<glm::dmat2, kCap> l, d, u;
+  glm::dmat2 b{0.0};
+};
+
+// The system Σ J_vw x_w = r_v solved in place of r (a dvec2 or, for two right-hand sides, a dmat2
+// per vertex) by block elimination, each pivot block factored with partial pivoting within it:
+// returns min |pivot| / max |pivot| (0: singular).
+template <class R>
+double solve_blocks(const Blocks& j, std::size_t m, R* r) {
+  std::array<glm::dmat2, kCap> inv;
   double lo = INFINITY, hi = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    std::size_t piv = k;
-    for (std::size_t r = k + 1; r < n; ++r)
-      if (std::fabs(m[r * n + k]) > std::fabs(m[piv * n + k])) piv = r;
-    if (piv != k) {
-      for (std::size_t c = 0; c < n; ++c) std::swap(m[k * n + c], m[piv * n + c]);
-      for (std::size_t c = 0; c < cols; ++c) std::swap(rhs[k * cols + c], rhs[piv * cols + c]);
+  for (std::size_t v = 0; v < m; ++v) {
+    glm::dmat2 s = j.d[v];
+    if (v > 0) {
+      const glm::dmat2 f = j.l[v] * inv[v - 1];
+      s -= f * j.u[v - 1];
+      r[v] -= f * r[v - 1];
     }
-    const double p = m[k * n + k];
-    lo = std::min(lo, std::fabs(p));
-    hi = std::max(hi, std::fabs(p));
-    if (p == 0.0) return 0.0;
-    for (std::size_t r = k + 1; r < n; ++r) {
-      const double f = m[r * n + k] / p;
-      if (f == 0.0) continue;
-      for (std::size_t c = k; c < n; ++c) m[r * n + c] -= f * m[k * n + c];
-      for (std::size_t c = 0; c < cols; ++c) rhs[r * cols + c] -= f * rhs[k * cols + c];
-    }
+    const double p = std::max(std::fabs(s[0][0]), std::fabs(s[0][1])), det = glm::determinant(s);
+    if (!(p > 0.0) || !(det != 0.0)) return 0.0;
+    lo = std::min({lo, p, std::fabs(det) / p});
+    hi = std::max({hi, p, std::fabs(det) / p});
+    inv[v] = glm::inverse(s);
   }
-  for (std::size_t k = n; k-- > 0;)
-    for (std::size_t c = 0; c < cols; ++c) {
-      double v = rhs[k * cols + c];
-      for (std::size_t j = k + 1; j < n; ++j) v -= m[k * n + j] * rhs[j * cols + c];
-      rhs[k * cols + c] = v / m[k * n + k];
-    }
-  return hi > 0.0 && std::isfinite(lo / hi) ? lo / hi : 0.0;
+  for (std::size_t v = m; v-- > 0;) r[v] = inv[v] * (v + 1 < m ? r[v] - j.u[v] * r[v + 1] : r[v]);
+  return std::isfinite(lo / hi) ? lo / hi : 0.0;
 }
 
-// The change of vertex i's constraint (on its own tangent pair) when the half vector changes by dh
-// and the normal by dn: with ĥ = h / |h| and C = ĥ_tangential · (s, t), dĥ = (dh - ĥ (ĥ·dh)) / |h|
-// and, as n · s = n · t = 0 at the vertex, dC = (dĥ · s - (ĥ·n)(dn · s), the same for t).
-glm::dvec2 d_constraint(const Local& l, const dvec3& dh, const dvec3& dn) {
-  const dvec3 dhat = (dh - l.h * glm::dot(l.h, dh)) / l.lh;
-  const double hn = glm::dot(l.h, l.g.ns);
-  return {glm::dot(dhat, l.g.dpdu) - hn * glm::dot(dn, l.g.dpdu), glm::dot(dhat, l.g.dpdv) - hn * glm::dot(dn, l.g.dpdv)};
-}
-
-// A unit direction w = e / |e| when e's far end moves by d: (d - w (w·d)) / |e|.
-dvec3 d_unit(const dvec3& w, double len, const dvec3& d) { return (d - w * glm::dot(w, d)) / len; }
-
-// The constraint Jacobian ∂C/∂X (2m × 2m, row-major), analytic (Jakob and Marschner 2012): each
-// vertex moves along its tangent pair (dp/du = dpdu, dn/du = dndu, as trace/differential.h), which
-// changes its own constraint and its neighbours'. With `jb`, also ∂C/∂b (2m × 2) for b moving along
-// (sb, tb): only the last vertex sees b. The constraints are on each vertex's own tangent pair.
-void jacobian(const std::vector<ChainVertex>& x, const Local* loc, double* j, const dvec3* sb, const dvec3* tb, double* jb) {
-  const std::size_t m = x.size(), n = 2 * m;
-  std::fill(j, j + n * n, 0.0);
-  for (std::size_t v = 0; v < m; ++v)
-    for (std::size_t axis = 0; axis < 2; ++axis) {
-      const dvec3 dp = axis == 0 ? loc[v].g.dpdu : loc[v].g.dpdv;
-      const dvec3 dn = axis == 0 ? loc[v].g.dndu : loc[v].g.dndv;
-      const std::size_t col = 2 * v + axis;
-      // Its own constraint: both directions turn (their near end moves), and so does the normal.
-      const Local& l = loc[v];
-      const dvec3 dh = -x[v].eta_light * d_unit(l.wi, l.li, dp) - x[v].eta_eye * d_unit(l.wo, l.lo, dp);
-      const glm::dvec2 own = d_constraint(l, dh, dn);
-      j[(2 * v) * n + col] = own.x;
-      j[(2 * v + 1) * n + col] = own.y;
-      if (v > 0) {  // the vertex before sees it as its next neighbour
-        const Local& q = loc[v - 1];
-        const glm::dvec2 d = d_constraint(q, x[v - 1].eta_eye * d_unit(q.wo, q.lo, dp), dvec3(0.0));
-        j[(2 * v - 2) * n + col] = d.x;
-        j[(2 * v - 1) * n + col] = d.y;
+// The constraint Jacobian (Jakob and Marschner 2012), analytic: each vertex moves along its tangent
+// pair (dp/du = dpdu, dn/du = dndu, as trace/differential.h), which changes its own constraint and
+// its neighbours'; ∂C/∂b for b moving along (sb, tb) when given. The constraints are on each
+// vertex's own tangent pair r: C_r = ĥ · r (n · r = 0 at the vertex), so with ĥ = h / |h| a change
+// dh of h changes C_r by dh · a_r, a_r = (r - ĥ (ĥ·r)) / |h|; a neighbour at w = e / |e| moving by d
+// turns w by (d - w (w·d)) / |e|, which changes C_r by d · g, g = η (a_r - w (w·a_r)) / |e| (gi: the
+// light side's, go: the eye side's); the vertex's own move by d turns both directions the other way
+// and the normal by dn: -(gi + go) · d - (ĥ·n)(dn · r).
+void jacobian(const std::vector<ChainVertex>& x, const Local* loc, Blocks& j, const dvec3* sb = nullptr, const dvec3* tb = nullptr) {
+  const std::size_t m = x.size();
+  const auto axes = [&](std::size_t v) { return std::array<dvec3, 2>{loc[v].g.dpdu, loc[v].g.dpdv}; };
+  for (std::size_t v = 0; v < m; ++v) {
+    const Local& l = loc[v];
+    const std::array<dvec3, 2> r = axes(v), dn = {l.g.dndu, l.g.dndv};
+    // (l of the first vertex and, without sb, b are not used)
+    const std::array<dvec3, 2> before = v > 0 ? axes(v - 1) : r, after = v + 1 < m ? axes(v + 1) : sb ? std::array<dvec3, 2>{*sb, *tb} : r;
+    const double hn = glm::dot(l.h, l.g.ns);
+    for (int k = 0; k < 2; ++k) {
+      const dvec3 a = (r[k] - l.h * glm::dot(l.h, r[k])) / l.lh;
+      const dvec3 gi = (x[v].eta_light / l.li) * (a - l.wi * glm::dot(l.wi, a)), go = (x[v].eta_eye / l.lo) * (a - l.wo * glm::dot(l.wo, a));
+      for (int axis = 0; axis < 2; ++axis) {
+        j.d[v][axis][k] = -glm::dot(gi + go, r[axis]) - hn * glm::dot(dn[axis], r[k]);
+        j.l[v][axis][k] = glm::dot(gi, before[axis]);
+        (v + 1 < m ? j.u[v] : j.b)[axis][k] = glm::dot(go, after[axis]);
       }
-      if (v + 1 < m) {  // the vertex after sees it as its previous neighbour
-        const Local& q = loc[v + 1];
-        const glm::dvec2 d = d_constraint(q, x[v + 1].eta_light * d_unit(q.wi, q.li, dp), dvec3(0.0));
-        j[(2 * v + 2) * n + col] = d.x;
-        j[(2 * v + 3) * n + col] = d.y;
-      }
-    }
-  if (jb) {
-    std::fill(jb, jb + n * 2, 0.0);
-    const std::size_t i = m - 1;
-    for (std::size_t axis = 0; axis < 2; ++axis) {
-      const Local& q = loc[i];
-      const glm::dvec2 d = d_constraint(q, x[i].eta_eye * d_unit(q.wo, q.lo, axis == 0 ? *sb : *tb), dvec3(0.0));
-      jb[(2 * i) * 2 + axis] = d.x;
-      jb[(2 * i + 1) * 2 + axis] = d.y;
     }
   }
 }
@@ -154,25 +130,26 @@ void jacobian(const std::vector<ChainVertex>& x, const Local* loc, double* j, co
 }  // namespace
 
 double chain_dw_db(const std::vector<ChainVertex>& x, const dvec3& a, const dvec3& b, const dvec3& nb, double singular) {
-  const std::size_t m = x.size(), n = 2 * m;
+  const std::size_t m = x.size();
   if (m == 0 || m > kCap) return 0.0;
   struct Scratch {
     std::array<dvec3, kCap> p;
     std::array<Local, kCap> loc;
     std::array<double, kDim> c;
-    std::array<double, kDim * kDim> j;
-    std::array<double, kDim * 2> jb;
+    Blocks j;
+    std::array<glm::dmat2, kCap> dx;
   };
   static thread_local Scratch scratch;
-  auto& [p, loc, c, j, jb] = scratch;
+  auto& [p, loc, c, j, dx] = scratch;
   for (std::size_t i = 0; i < m; ++i) p[i] = x[i].p;
   if (!evaluate(x, p.data(), a, b, nullptr, nullptr, loc.data(), c.data())) return 0.0;
   // dX/db = -(∂C/∂X)⁻¹ ∂C/∂b for b moving along a tangent pair (sb, tb) of its plane.
   dvec3 sb, tb;
   tangent_frame(glm::normalize(nb), &sb, &tb);
-  jacobian(x, loc.data(), j.data(), &sb, &tb, jb.data());
-  for (std::size_t k = 0; k < 2 * n; ++k) jb[k] = -jb[k];
-  if (solve_in_place(j.data(), n, jb.data(), 2) <= singular) return 0.0;  // jb becomes dX/db (2m × 2)
+  jacobian(x, loc.data(), j, &sb, &tb);
+  std::fill(dx.begin(), dx.begin() + static_cast<std::ptrdiff_t>(m), glm::dmat2(0.0));
+  dx[m - 1] = -j.b;
+  if (solve_blocks(j, m, dx.data()) <= singular) return 0.0;  // dx becomes dX/db
   // The first vertex's move turns the direction leaving a: the 2 × 2 map from b's tangent plane
   // to the plane across w_a, whose determinant is the solid angle per area.
   const dvec3 e = x[0].p - a;
@@ -182,7 +159,7 @@ double chain_dw_db(const std::vector<ChainVertex>& x, const dvec3& a, const dvec
   tangent_frame(wa, &e1, &e2);
   double mtx[2][2];
   for (int col = 0; col < 2; ++col) {
-    const dvec3 dx0 = jb[0 * 2 + static_cast<std::size_t>(col)] * loc[0].g.dpdu + jb[1 * 2 + static_cast<std::size_t>(col)] * loc[0].g.dpdv;
+    const dvec3 dx0 = dx[0][col][0] * loc[0].g.dpdu + dx[0][col][1] * loc[0].g.dpdv;
     const dvec3 dw = (dx0 - glm::dot(dx0, wa) * wa) / len;
     mtx[0][col] = glm::dot(dw, e1);
     mtx[1][col] = glm::dot(dw, e2);
@@ -203,8 +180,9 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
   struct Scratch {
     std::array<dvec3, kCap> p, y, s, t;
     std::array<Local, kCap> loc, trial;
-    std::array<double, kDim> c, cy, step;
-    std::array<double, kDim * kDim> j;
+    std::array<double, kDim> c, cy;
+    std::array<glm::dvec2, kCap> step;
+    Blocks j;
   };
   static thread_local Scratch scratch;
   auto& [p, y, s, t, loc_store, trial_store, c, cy, step, j] = scratch;
@@ -253,9 +231,9 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
       solved = within;
       break;
     }
-    jacobian(x, loc, j.data(), nullptr, nullptr, nullptr);
-    for (std::size_t k = 0; k < n; ++k) step[k] = -c[k];
-    if (solve_in_place(j.data(), n, step.data(), 1) <= o.singular) {
+    jacobian(x, loc, j);
+    for (std::size_t v = 0; v < m; ++v) step[v] = -glm::dvec2(c[2 * v], c[2 * v + 1]);
+    if (solve_blocks(j, m, step.data()) <= o.singular) {
       w.failure = ManifoldFailure::kSingular;
       return w;
     }
@@ -268,7 +246,7 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     for (double lambda = 1.0; lambda > 1.0 / 1024.0 && !moved; lambda *= 0.5) {
       bool on = true;
       for (std::size_t v = 0; v < m && on; ++v) {
-        const std::optional<dvec3> q = move_on_surface(*x[v].shape, x[v].primitive, p[v], lambda * (step[2 * v] * s[v] + step[2 * v + 1] * t[v]));
+        const std::optional<dvec3> q = move_on_surface(*x[v].shape, x[v].primitive, p[v], lambda * (step[v].x * s[v] + step[v].y * t[v]));
         if (q) y[v] = *q;
         on = q.has_value();
       }

@@ -119,8 +119,24 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
     if (!(glm::dot(d, d) > 0.0f)) return ManifoldFailure::kNoSolution;
   }
   d = glm::normalize(d);
+  // The sphere the ray meets next without a ray traced: the cone's, entered at the near root (what
+  // lies before it the chain's shadow rays see), then a hollow one it runs inside
+  // (SpecularSurfaces::hollow), left at t = -2 (o - c)·d.
+  int within = sphere && d2 > sphere->radius * sphere->radius ? shape : -1;
+  bool entering = within >= 0;
   for (;;) {
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, no, eo, HitDetail::kNoUv);
+    std::optional<Hit> hit;
+    if (within >= 0) {
+      const SphereShape& ball = std::get<SphereShape>(rs_.geometry->shape_geometry(within));
+      const vec3 f = o - ball.center, across = f - glm::dot(f, d) * d;
+      const float t = entering ? -glm::dot(f, d) - std::sqrt(std::max(0.0f, ball.radius * ball.radius - glm::dot(across, across))) : -2.0f * glm::dot(f, d);
+      hit = Hit{.position = vec3(0.0f), .normal = glm::normalize(f + t * d), .shape = within, .primitive = 0};
+      hit->position = ball.center + ball.radius * hit->normal;
+      entering = false;
+      hit->error = error_gamma(8) * (glm::abs(ball.center) + ball.radius * glm::abs(hit->normal));  // EmbreeScene's sphere hit's
+    } else {
+      hit = rs_.geometry->intersect(o, d, no, eo, HitDetail::kNoUv);
+    }
     if (!hit) break;
     const float ior = rs_.specular.glass_ior[static_cast<std::size_t>(hit->shape)];
     const bool mirror = !is_black(rs_.specular.mirror_reflectance[static_cast<std::size_t>(hit->shape)]);
@@ -151,6 +167,7 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
     o = hit->position;
     no = hit->normal;
     eo = hit->error;
+    within = rs_.specular.hollow[static_cast<std::size_t>(hit->shape)] && glm::dot(d, hit->normal) < 0.0f ? hit->shape : -1;
     // The chain ends where the ray meets no more specular surfaces: when it passes every specular
     // shape's bounding sphere by (a sphere it leaves outwards it cannot meet again), the ray that
     // would find the opaque surface or nothing beyond is not traced.
