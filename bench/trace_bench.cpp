@@ -237,6 +237,55 @@ void BM_ShadowRays(benchmark::State& state) {
 }
 BENCHMARK(BM_ShadowRays)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Eye subpaths' first rays, interleaved (issue 39): Tungsten's Cornell box (bench/scenes), the
+// camera rays of every pixel's first 4 passes in the order the render makes them (4 pixels of 4
+// passes to a packet), each traced one by one with EmbreeScene::intersect() and in packets of 16
+// with RayPacket (trace/accel/eye_packets.h); `speedup` is the median of the per-iteration ratios
+// of single-ray time over packet time, and every packet hit must equal intersect()'s, field by field.
+void BM_EyeRayPackets(benchmark::State& state) {
+  static const Scene box = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/bench/scenes/tungsten-cornell-box.json").expect("a benchmark input");
+  Result<RenderScene> rs = make_render_scene(box);
+  if (!rs) {
+    state.SkipWithError(rs.error().render().c_str());
+    return;
+  }
+  const EmbreeScene& es = *rs->geometry;
+  std::vector<EndpointRay> rays;
+  for (int y = 0; y < rs->camera.height; ++y)
+    for (int x = 0; x < rs->camera.width; ++x)
+      for (std::uint64_t pass = 0; pass < 4; ++pass) {
+        Sampler rng(1, static_cast<std::uint64_t>(y * rs->camera.width + x), pass, SamplerKind::kSobol, 2);
+        if (const std::optional<EndpointRay> r = rs->camera.primary_ray(rng, x, y)) rays.push_back(*r);
+      }
+  const auto same = [](const std::optional<Hit>& a, const std::optional<Hit>& b) {
+    return a.has_value() == b.has_value() && (!a || (a->t == b->t && a->position == b->position && a->normal == b->normal &&
+                                                     a->error == b->error && a->shape == b->shape && a->primitive == b->primitive));
+  };
+  std::vector<std::optional<Hit>> single(rays.size()), batched(rays.size());
+  std::vector<double> ratios;
+  std::uint64_t differ = 0;
+  RayPacket packet;
+  for (auto _ : state) {
+    const double t0 = cpu_seconds();
+    for (std::size_t i = 0; i < rays.size(); ++i) single[i] = es.intersect(rays[i].origin, rays[i].direction, glm::vec3(0.0f), glm::vec3(0.0f), HitDetail::kNoUv);
+    const double t1 = cpu_seconds();
+    for (std::size_t i = 0; i < rays.size(); i += RayPacket::kCapacity) {
+      const std::size_t n = std::min<std::size_t>(RayPacket::kCapacity, rays.size() - i);
+      for (std::size_t k = 0; k < n; ++k) packet.add(rays[i + k].origin, rays[i + k].direction);
+      packet.trace(es);
+      for (std::size_t k = 0; k < n; ++k) batched[i + k] = packet.hit(es, static_cast<int>(k), HitDetail::kNoUv);
+      packet.clear();
+    }
+    const double t2 = cpu_seconds();
+    ratios.push_back((t1 - t0) / (t2 - t1));
+    for (std::size_t i = 0; i < rays.size(); ++i) differ += !same(batched[i], single[i]);
+  }
+  if (differ != 0) state.SkipWithError("a packet's hit differs from intersect()'s");
+  state.counters["speedup"] = benchmark::Counter(median(ratios));
+  state.SetLabel(std::to_string(rays.size()) + " camera rays of Tungsten's box, one by one against packets of 16");
+}
+BENCHMARK(BM_EyeRayPackets)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // Thread scaling, interleaved: each iteration renders with one thread and then with two (wall
 // time); `speedup` is the summed one-thread time over the summed two-thread time.
 void BM_RenderThreads(benchmark::State& state) {

@@ -416,28 +416,34 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   rtcIntersect1(scene_.get(), &ctx, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return out;
-  Hit& h = out.emplace();
-  h.t = rh.ray.tfar;
-  h.primitive = static_cast<int>(rh.hit.primID);
-  if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
-    instance_hit(rh.hit.instID[0], rh.hit.geomID, rh.hit.u, rh.hit.v, d, detail, &h);
-    return out;
+  if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+    finish_hit(o, d, {rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0]}, detail, out.emplace());
+  return out;
+}
+
+// Inline into both callers (intersect(), RayPacket::hit()): every ray the tracer casts ends here.
+[[gnu::always_inline]] inline void EmbreeScene::finish_hit(const vec3& o, const vec3& d, const RawHit& raw, HitDetail detail,
+                                                            Hit& h) const {
+  h.t = raw.t;
+  h.primitive = static_cast<int>(raw.prim);
+  if (raw.inst != RTC_INVALID_GEOMETRY_ID) {
+    instance_hit(raw.inst, raw.geom, raw.u, raw.v, d, detail, &h);
+    return;
   }
-  h.shape = static_cast<int>(geom_to_shape_[rh.hit.geomID]);
+  h.shape = static_cast<int>(geom_to_shape_[raw.geom]);
   const vec3 p = o + h.t * d;
   // Each branch puts the position back onto the exact surface and computes the normal and uv.
   const Shape& shape = source_->shapes[static_cast<std::size_t>(h.shape)];
   if (const auto* m = std::get_if<MeshShape>(&shape.geometry)) {
-    const glm::uvec3 t = m->triangles[rh.hit.primID];
+    const glm::uvec3 t = m->triangles[raw.prim];
     const vec3 p0 = m->positions[t.x], p1 = m->positions[t.y], p2 = m->positions[t.z];
-    if (detail == HitDetail::kFull) h.uv = shape_uv(shape, rh.hit.primID, rh.hit.u, rh.hit.v, p);
-    h.position = triangle_point(p0, p1, p2, 1.0f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v, &h.error);
+    if (detail == HitDetail::kFull) h.uv = shape_uv(shape, raw.prim, raw.u, raw.v, p);
+    h.position = triangle_point(p0, p1, p2, 1.0f - raw.u - raw.v, raw.u, raw.v, &h.error);
     const vec3 n = glm::cross(p1 - p0, p2 - p0);
     const float len = glm::length(n);
     h.normal = len > 0.0f ? n / len : -glm::normalize(d);  // degenerate triangles face the ray
-    h.shading_normal = m->normals.empty() ? h.normal : mesh_shading_normal(*m, t, rh.hit.u, rh.hit.v, h.normal);
-    return out;
+    h.shading_normal = m->normals.empty() ? h.normal : mesh_shading_normal(*m, t, raw.u, raw.v, h.normal);
+    return;
   } else if (const auto* q = std::get_if<QuadShape>(&shape.geometry)) {
     h.normal = quad_normals_[static_cast<std::size_t>(h.shape)];
     h.error = shape_errors_[static_cast<std::size_t>(h.shape)];  // the projection too: p lies within the quad
@@ -461,7 +467,6 @@ std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, float tm
     if (detail == HitDetail::kFull) h.uv = shape_uv(shape, 0, 0.0f, 0.0f, p);
   }
   h.shading_normal = h.normal;
-  return out;
 }
 
 // A hit on an instance's member (a mesh: make_group_member): computed exactly as the flattened
@@ -587,6 +592,47 @@ void OcclusionBatch::trace(const EmbreeScene& scene) {
     rtcOccluded1(scene.handle(), &ctx, &ray);
     rays_.tfar[lane] = ray.tfar;
   }
+}
+
+int RayPacket::add(const vec3& o, const vec3& d) {
+  const int lane = size_++;
+  rays_.ray.org_x[lane] = o.x;
+  rays_.ray.org_y[lane] = o.y;
+  rays_.ray.org_z[lane] = o.z;
+  rays_.ray.tnear[lane] = 0.0f;
+  rays_.ray.dir_x[lane] = d.x;
+  rays_.ray.dir_y[lane] = d.y;
+  rays_.ray.dir_z[lane] = d.z;
+  rays_.ray.time[lane] = 0.0f;
+  rays_.ray.tfar[lane] = std::numeric_limits<float>::infinity();
+  rays_.ray.mask[lane] = 0xFFFFFFFFu;
+  rays_.ray.id[lane] = 0;
+  rays_.ray.flags[lane] = 0;
+  rays_.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+  rays_.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
+  // A non-finite ray never reaches Embree and hits nothing, as in intersect().
+  valid_[lane] = finite_ray(o, d) ? -1 : 0;
+  return lane;
+}
+
+void RayPacket::trace(const EmbreeScene& scene) {
+  for (int lane = size_; lane < kCapacity; ++lane) valid_[lane] = 0;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcIntersect16(valid_, scene.handle(), &ctx, &rays_);
+}
+
+std::optional<Hit> RayPacket::hit(const EmbreeScene& scene, int lane, HitDetail detail) const {
+  std::optional<Hit> out;
+  if (valid_[lane] == 0 || rays_.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID) return out;
+  const vec3 o(rays_.ray.org_x[lane], rays_.ray.org_y[lane], rays_.ray.org_z[lane]);
+  const vec3 d(rays_.ray.dir_x[lane], rays_.ray.dir_y[lane], rays_.ray.dir_z[lane]);
+  scene.finish_hit(o, d,
+                   {rays_.ray.tfar[lane], rays_.hit.u[lane], rays_.hit.v[lane], rays_.hit.geomID[lane], rays_.hit.primID[lane],
+                    rays_.hit.instID[0][lane]},
+                   detail, out.emplace());
+  return out;
 }
 
 std::optional<Hit> EmbreeScene::intersect(const vec3& o, const vec3& d, const vec3& origin_normal, const vec3& origin_error,

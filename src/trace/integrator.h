@@ -16,6 +16,7 @@
 
 #include "stats/histogram.h"
 #include "film/image.h"
+#include "trace/accel/eye_ahead.h"
 #include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/joins/join.h"
@@ -144,6 +145,7 @@ class Integrator {
     std::uint64_t pass = 0;
     int py = 0;
     std::optional<NonfiniteSample> first_nonfinite{};
+    EyeAhead ahead{};  // the eye subpath's first ray and hit, made in a packet before the sample (trace/accel/eye_packets.h)
   };
 
   // The path of join `jr` over th's subpaths.
@@ -178,6 +180,7 @@ class Integrator {
   // The profile's strategy that runs the plain join (s, DD, t), or -1.
   int strategy(int s, int t) const { return table_.plain(s, t); }
 
+  bool traces_eye_rays() const { return max_eye_ >= 2; }  // an eye subpath goes past z0
   // One sample: pixel (px, py), pass `pass`. Its camera contributions collect in th.row (the
   // caller flushes them with finish_row()); light-tracing splats go through th.splats.
   void sample(Thread& th, int px, int py, std::uint64_t pass) const;

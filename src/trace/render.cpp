@@ -67,7 +67,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // before the ray is traced: they do not depend on the hit, and so their computation overlaps
     // the intersection instead of delaying the scattering (Sampler::at2d_now).
     const glm::vec2 u_dir = rng.at2d_now(rng.dimension() + 1);
-    const std::optional<Hit> hit = rs_.geometry->intersect(o, d, prev.n, prev.err, rs_.textured ? HitDetail::kFull : HitDetail::kNoUv);  // zero for points: no offset
+    const std::optional<Hit> hit = th.ahead.intersect(*rs_.geometry, o, d, prev.n, prev.err, rs_.textured ? HitDetail::kFull : HitDetail::kNoUv);  // zero for points: no offset
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
       const std::optional<EndpointConnection> lens = hit_lens(cam_.params, o, d);
@@ -156,11 +156,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
 }
 
 int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
-  const glm::vec2 uf = rng.get2d();
-  const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(cam_.params));
-  const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(cam_.width),
-                         (static_cast<float>(py) + uf.y) / static_cast<float>(cam_.height)};
-  const std::optional<EndpointRay> r = sample_ray(cam_.params, raster, ul);
+  const std::optional<EndpointRay> r = th.ahead.primary_ray(cam_, rng, px, py);
   const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), cam_.letters[0]);
   if (!r) return 1;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.

@@ -8,6 +8,7 @@
 
 #include <chrono>
 
+#include "trace/accel/eye_packets.h"
 #include "trace/integrator.h"
 #include "trace/plan.h"
 #include "trace/render.h"
@@ -95,6 +96,8 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
         return th;
       });
   const int w = rs->camera.width, h = rs->camera.height;
+  // The eye subpaths' first rays in packets (outputs identical): wherever an eye subpath goes past z0.
+  const bool eye_packets = integrator.traces_eye_rays();
   const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
   const auto start = std::chrono::steady_clock::now();
   // Passes run in chunks: a pixel takes a chunk's passes back to back, so that its camera
@@ -114,8 +117,12 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
     tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& rows) {
       Integrator::Thread& th = locals.local();
       for (int y = rows.begin(); y < rows.end(); ++y) {
-        for (int x = 0; x < w; ++x)
-          for (std::uint64_t p = first; p < end; ++p) integrator.sample(th, x, y, p);
+        if (eye_packets) {
+          tracer::sample_row_in_packets(integrator, th, *rs, o, y, first, end);  // trace/accel/eye_packets.h
+        } else {
+          for (int x = 0; x < w; ++x)
+            for (std::uint64_t p = first; p < end; ++p) integrator.sample(th, x, y, p);
+        }
         integrator.finish_row(th, out.images, y);
       }
     });

@@ -91,6 +91,17 @@ struct RenderSensor {
     *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
     *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
   }
+  // The eye subpath's first ray through pixel (px, py), from the sample's numbers at rng's
+  // dimension (film, then lens), and its origin's normal as the sensor vertex keeps it (none for
+  // a point).
+  std::optional<EndpointRay> primary_ray(Sampler& rng, int px, int py) const {
+    const glm::vec2 uf = rng.get2d();
+    const glm::vec2 ul = rng.get2d_if(reads_lens_numbers(params));
+    const glm::vec2 raster{(static_cast<float>(px) + uf.x) / static_cast<float>(width),
+                           (static_cast<float>(py) + uf.y) / static_cast<float>(height)};
+    return sample_ray(params, raster, ul);
+  }
+  glm::vec3 origin_normal(const EndpointRay& r) const { return pdf_pos == 0.0f ? glm::vec3(0.0f) : r.normal; }
 };
 
 // Room for a material with its textured parameters evaluated (RenderScene::material_at): a

@@ -153,6 +153,8 @@ class Sampler {
     return {sobol::to_unit_float(p[0]), sobol::to_unit_float(p[1])};
   }
 
+  // The same numbers from here on (the same stream at the same dimension).
+  friend bool operator==(const Sampler&, const Sampler&) = default;
   std::uint64_t dimension() const { return dim_; }
   void set_dimension(std::uint64_t dim) { dim_ = dim; }
   std::uint64_t key() const { return key_; }

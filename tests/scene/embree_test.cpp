@@ -12,7 +12,10 @@
 #include <thread>
 
 #include "scene/scene.h"
+#include "trace/accel/eye_ahead.h"
 #include "trace/embree_scene.h"
+#include "trace/render_scene.h"
+#include "trace/rng.h"
 
 namespace pathex {
 namespace {
@@ -506,6 +509,109 @@ TEST(Embree, OcclusionBatchAgreesWithVisibleAtEveryBatchSize) {
   EXPECT_EQ(agree, open + blocked);
   EXPECT_GT(blocked, 500) << "the test needs segments that something blocks";
   EXPECT_GT(open, 500) << "and segments that nothing blocks";
+}
+
+// A packet's closest hits (RayPacket, which traces the render's first eye rays: issue 39) are the
+// ones intersect() finds, field by field: camera-like rays from one point into the box and past
+// it (hits and misses), rays from random points inside it in every direction, and non-finite
+// rays; for every packet size.
+TEST(Embree, RayPacketHitsAreIntersectsHits) {
+  Result<Scene> scene = load_scene_json(default_scene_json(), ".", "default");
+  ASSERT_TRUE(scene.ok());
+  auto es = EmbreeScene::build(*scene);
+  ASSERT_TRUE(es.ok());
+  std::vector<std::pair<vec3, vec3>> rays;
+  Uniform u;
+  const vec3 eye(0.0f, 1.0f, 3.0f);  // before the box's open side, as its camera
+  for (int i = 0; i < 600; ++i) rays.push_back({eye, glm::normalize(vec3(u.next(), u.next(), u.next()) * 2.6f - vec3(1.3f, 0.3f, 1.3f) - eye)});
+  for (int i = 0; i < 600; ++i) rays.push_back({vec3(u.next() * 1.8f - 0.9f, u.next() * 1.8f + 0.1f, u.next() * 1.8f - 0.9f), sample_uniform_sphere(u.next2())});
+  rays.push_back({vec3(std::nanf(""), 0, 0), vec3(0, 0, -1)});
+  rays.push_back({vec3(0, 1, 3), vec3(0, INFINITY, -1)});
+  int hits = 0, misses = 0, packets = 0;
+  RayPacket packet;
+  for (std::size_t i = 0; i < rays.size();) {
+    const int size = 1 + packets++ % RayPacket::kCapacity;
+    const std::size_t n = std::min<std::size_t>(static_cast<std::size_t>(size), rays.size() - i);
+    for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(packet.add(rays[i + k].first, rays[i + k].second), static_cast<int>(k));
+    EXPECT_EQ(packet.full(), n == RayPacket::kCapacity);
+    packet.trace(**es);
+    for (std::size_t k = 0; k < n; ++k)
+      for (const HitDetail detail : {HitDetail::kFull, HitDetail::kNoUv}) {
+        const auto& [o, d] = rays[i + k];
+        const std::optional<Hit> alone = (*es)->intersect(o, d, 0.0f, std::numeric_limits<float>::infinity(), detail);
+        const std::optional<Hit> batched = packet.hit(**es, static_cast<int>(k), detail);
+        ASSERT_EQ(batched.has_value(), alone.has_value()) << "ray " << i + k;
+        if (!alone) {
+          misses += detail == HitDetail::kFull;
+          continue;
+        }
+        hits += detail == HitDetail::kFull;
+        EXPECT_EQ(std::memcmp(&*batched, &*alone, sizeof(Hit)), 0) << "ray " << i + k;
+      }
+    packet.clear();
+    EXPECT_EQ(packet.size(), 0);
+    i += n;
+  }
+  EXPECT_GT(hits, 600);
+  EXPECT_GT(misses, 100);
+}
+
+// The eye's starts made ahead (trace/accel/eye_ahead.h) give exactly what the sample would have
+// computed: the selected start's ray and hit to its own sample and query, and to any other one
+// (another pixel, other numbers, another ray, an origin with an error bound) what computing gives.
+TEST(EyeAhead, GivesAStartOnlyToItsOwnSampleAndQuery) {
+  Result<Scene> scene = load_scene_json(default_scene_json(), ".", "default");
+  ASSERT_TRUE(scene.ok());
+  Result<RenderScene> rs = make_render_scene(*scene);
+  ASSERT_TRUE(rs.ok());
+  const RenderSensor& cam = rs->camera;
+  const EmbreeScene& es = *rs->geometry;
+  const auto sampler = [](int pixel) { return Sampler(1, static_cast<std::uint64_t>(pixel), 3, SamplerKind::kSobol, 2); };
+  const auto same_ray = [](const std::optional<EndpointRay>& a, const std::optional<EndpointRay>& b) {
+    return a.has_value() == b.has_value() && (!a || (a->origin == b->origin && a->direction == b->direction && a->weight == b->weight));
+  };
+  const auto same_hit = [](const std::optional<Hit>& a, const std::optional<Hit>& b) {
+    return a.has_value() == b.has_value() && (!a || std::memcmp(&*a, &*b, sizeof(Hit)) == 0);
+  };
+  tracer::EyeAhead ahead;
+  for (int x = 0; x < 16; ++x) ahead.add(cam, sampler(x), x, 0, 3);
+  EXPECT_TRUE(ahead.full());
+  ahead.trace(es, HitDetail::kNoUv);
+  for (int x = 0; x < 16; ++x) {
+    Sampler fresh = sampler(x);
+    const std::optional<EndpointRay> want = cam.primary_ray(fresh, x, 0);
+    ASSERT_TRUE(want.has_value());
+    const std::optional<Hit> want_hit = es.intersect(want->origin, want->direction, vec3(0.0f), vec3(0.0f), HitDetail::kNoUv);
+    // Its own sample and query: the prepared ones, the sampler moved on as drawing moves it.
+    ahead.select(x);
+    Sampler mine = sampler(x);
+    EXPECT_TRUE(same_ray(ahead.primary_ray(cam, mine, x, 0), want));
+    EXPECT_TRUE(mine == fresh);
+    EXPECT_TRUE(same_hit(ahead.intersect(es, want->origin, want->direction, vec3(0.0f), vec3(0.0f), HitDetail::kNoUv), want_hit));
+    // Another pixel, other numbers, another query: computed.
+    const int other = (x + 1) % 16;
+    for (const auto& [px, pixel] : {std::pair{other, x}, std::pair{x, other}}) {
+      ahead.select(x);
+      Sampler rng = sampler(pixel), ref = sampler(pixel);
+      EXPECT_TRUE(same_ray(ahead.primary_ray(cam, rng, px, 0), cam.primary_ray(ref, px, 0)));
+      EXPECT_TRUE(rng == ref);
+    }
+    ahead.select(x);
+    const vec3 d = glm::normalize(want->direction + vec3(0.01f, 0.0f, 0.0f)), e(1e-7f);
+    EXPECT_TRUE(same_hit(ahead.intersect(es, want->origin, d, vec3(0.0f), vec3(0.0f), HitDetail::kNoUv),
+                         es.intersect(want->origin, d, vec3(0.0f), vec3(0.0f), HitDetail::kNoUv)));
+    ahead.select(x);
+    EXPECT_TRUE(same_hit(ahead.intersect(es, want->origin, want->direction, vec3(0, 0, -1), e, HitDetail::kNoUv),
+                         es.intersect(want->origin, want->direction, vec3(0, 0, -1), e, HitDetail::kNoUv)));
+    // Given once: a second ask computes (the same answers).
+    ahead.select(x);
+    Sampler twice = sampler(x);
+    (void)ahead.primary_ray(cam, twice, x, 0);
+    twice = sampler(x);
+    EXPECT_TRUE(same_ray(ahead.primary_ray(cam, twice, x, 0), want));
+  }
+  ahead.clear();
+  EXPECT_EQ(ahead.size(), 0);
 }
 
 }  // namespace
