@@ -25,7 +25,6 @@
 #include "trace/render.h"
 #include "trace/render_scene.h"
 #include "trace/rng.h"
-#include "trace/scene_features.h"
 #include "trace/strategy_table.h"
 #include "trace/vertex.h"
 
@@ -60,10 +59,7 @@ class Integrator {
     has_manifold_ = !rs.specular.shapes.empty() && table_.runs(ConnectorKind::kManifold);
     has_connectors_ = table_.runs(ConnectorKind::kDistantProjection) || table_.runs(ConnectorKind::kOrthoProjection) || has_mirror_ ||
                       has_manifold_;
-    mirror_shape_.assign(rs.material_of_shape.size(), 0);
-    for (const PlanarMirror& m : rs.mirrors) mirror_shape_[static_cast<std::size_t>(m.shape)] = 1;
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
-    features_ = rs.features;
     absorbing_ = rs.absorbing;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
@@ -201,12 +197,6 @@ class Integrator {
   // light l's leaving `v` (a point of the light) (mis_weight.cpp).
   float sensor_pdf_dir(const Vertex& v, const vec3& w) const;
   float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const;
-  // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
-  // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
-  // emission_step_density() after it: their product is its emission's joint density.
-  const EnvironmentLightParams* environment_of(int light) const {
-    return rs_.lights[static_cast<std::size_t>(light)].environment();
-  }
   // Next-event estimation could join a light point to v: a surface with a finite part (by its
   // shape: a connector's chain vertex too), a sensor point with a finite direction.
   bool joinable(const Vertex& v) const {
@@ -240,15 +230,13 @@ class Integrator {
   float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const;
   // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
   float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const;
-  // Density of choosing the point `v` on its area light (for an eye vertex that hit it, coming
-  // from x1 = `next`).
-  float pdf_light_origin(const Vertex& v, const Vertex& next) const;
 
   // --- subpaths ---
   // A template on the direction: the walk's tests of its direction are not branches. What the
-  // scene cannot have (features_, trace/scene_features.h) it skips.
+  // scene cannot have (RenderScene::features, trace/scene_features.h) it skips.
   template <TransportMode mode>
-  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d, float pdf_dir,
+  // From path[0] along (o, d), drawn with density pdf_dir, with throughput beta.
+  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, vec3 o, vec3 d, float pdf_dir, vec3 beta,
                   int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
   // u_ray: the numbers of the light's first direction (Sampler::at2d_now at kLightRayDim).
@@ -369,7 +357,6 @@ class Integrator {
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
   bool has_mirror_ = false;      // a mirror strategy runs and the scene has a planar mirror
   bool has_manifold_ = false;    // a manifold strategy runs and the scene has specular surfaces (RenderScene::specular)
-  std::vector<std::uint8_t> mirror_shape_;  // the shape is a planar mirror
   // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
   // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
   static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
@@ -379,7 +366,6 @@ class Integrator {
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;
   bool lens_hits_ = false;
-  SceneFeatures features_;  // what the scene's materials can do: the walk skips the rest
   bool absorbing_ = false;  // some shape has an absorbing interior (trace/media.h)
 };
 

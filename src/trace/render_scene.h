@@ -151,6 +151,7 @@ struct RenderScene {
   bool absorbing = false;                    // some shape has an absorbing interior
   std::vector<RenderLight> lights;
   std::vector<PlanarMirror> mirrors;         // quads of a pure mirror material (the mirror connector's)
+  std::vector<std::uint8_t> planar_mirror;   // per shape: 1 for one of `mirrors`
   RenderSensor camera;
   SceneFeatures features;                    // what the shapes' materials can do (trace/scene_features.h)
   // A sphere around each shape whose material has a specular (Dirac) component: where a path whose

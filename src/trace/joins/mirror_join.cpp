@@ -40,8 +40,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
       cam_.to_pixels(c->raster, &rx, &ry);
       b = &z0;
     }
-    MirrorMiss miss = MirrorMiss::kNone;
-    const std::optional<MirrorJoin> j = mirror_join(mirror, a->p, b->p, &miss);
+    const std::optional<MirrorJoin> j = mirror_join(mirror, a->p, b->p);
     if (!j) {
       ++stats.outside;  // off the mirror, or the ends on different sides of its plane
       continue;
@@ -86,7 +85,7 @@ const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinB
   const std::size_t li = rs_.pick_light(rng);
   const RenderLight& light = rs_.lights[li];
   if (light.letters[1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
-  if (environment_of(static_cast<int>(li))) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
+  if (light.environment()) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
   vec3 err{0.0f};
   const SurfacePoint x = rs_.sample_point(light, rng, &err);
   Vertex& y0 = fresh_light_vertex(th, li, light.is_area() ? x.position : fixed_origin(light.params),

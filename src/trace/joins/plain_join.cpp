@@ -83,7 +83,6 @@ Vertex& Integrator::light_vertex(Vertex& y, std::size_t li, const vec3& p, const
   return y;
 }
 
-// --- s = 0: the eye subpath's last vertex lies on an area light ---
 bool Integrator::join_emitter(Thread& th, int t) const {
   const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
   if (pt.kind != Kind::kSurface) return false;
@@ -93,7 +92,6 @@ bool Integrator::join_emitter(Thread& th, int t) const {
   return end_join(th, pt.beta * emitted(rs_.lights[static_cast<std::size_t>(hit_light)].params, pt.n, pt.wo), 0, nullptr, nullptr);
 }
 
-// --- t = 0: the light subpath's last vertex lies on the lens ---
 bool Integrator::join_lens(Thread& th, int s) const {
   const Vertex& qs = th.light[static_cast<std::size_t>(s - 1)];
   if (qs.kind != Kind::kLens) return false;
@@ -107,14 +105,12 @@ bool Integrator::join_lens(Thread& th, int s) const {
   return end_join(th, qs.beta * we, 0, nullptr, nullptr);
 }
 
-// --- a light vertex joined to a sensor point: a fresh one (the splat, t = 1) or, for
-//     ortho-projection, the film point on the line of sight through y(s-1) ---
 bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind) const {
   const Vertex* q = &th.light[static_cast<std::size_t>(s - 1)];
   if (q->kind == Kind::kLens || !q->finite) return false;
   const bool ortho = kind == ConnectorKind::kOrthoProjection;
   join_numbers(rng, ortho ? JoinBlock::kOrtho : JoinBlock::kSplat, s);
-  const bool env = q->kind == Kind::kLight && environment_of(q->light) != nullptr;
+  const bool env = q->kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(q->light)].environment() != nullptr;
   // A Dirac direction (orthographic, spot meter) has no DD join; the connector's c(k+1) c(k+2) are
   // a Dirac direction from a film. (No projection of an image light: mis_weight.cpp.)
   if (ortho ? env || cam_.letters != "SD" : cam_.letters[0] != 'D') return false;
@@ -157,8 +153,6 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   return end_join(th, qs.beta * fq * (shading_cos(qs, w) * c->weight), ortho ? bit(s + 1) : 0, &qs, &z0);
 }
 
-// --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
-//     for distant-projection, the aperture point on the line through z(t-1) against the light ---
 bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind) const {
   const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
   if (pt.kind != Kind::kSurface || !pt.finite || rs_.lights.empty()) return false;
@@ -198,7 +192,6 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   return end_join(th, pt.beta * f * (shading_cos(pt, w) / light_pick_) * c->weight, distant ? bit(1) : 0, &pt, &y0);
 }
 
-// --- s, t >= 2: a shadow ray between y(s-1) and z(t-1) ---
 bool Integrator::join_shadow(Thread& th, int s, int t) const {
   const Vertex& qs = th.light[static_cast<std::size_t>(s - 1)];
   const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
