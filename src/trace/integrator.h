@@ -50,11 +50,6 @@ class Integrator {
     }
     // (A light splat from y0, the join (1, DD, 1), uses the light subpath's first vertex.)
     if (max_light_ < 2 && table_.plain(1, 1) < 0) max_light_ = 0;
-    // runs_mask_[n] bit s2: the profile runs (s2, n - s2); t2 = 0 only when light paths can hit the lens.
-    for (std::size_t n = 0; n < runs_mask_.size(); ++n)
-      for (int s2 = 0; s2 <= static_cast<int>(n); ++s2)
-        if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
-          runs_mask_[n] |= std::uint64_t{1} << s2;
     has_mirror_ = table_.runs(ConnectorKind::kMirror) && !rs.mirrors.empty();
     has_manifold_ = !rs.specular.shapes.empty() && table_.runs(ConnectorKind::kManifold);
     has_connectors_ = table_.runs(ConnectorKind::kDistantProjection) || table_.runs(ConnectorKind::kOrthoProjection) || has_mirror_ ||
@@ -266,7 +261,7 @@ class Integrator {
   // shading-normal correction at the light end (mode kImportance); the BSDF's densities for free
   // into *pdfs when given. Every join evaluates its ends here.
   vec3 end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs = nullptr) const;
-  // A join's start (th.join reset for strategy (s, kind, t)) and end: its contribution, the S
+  // A join's start (th.join reset for strategy (s, kind, t), a connector's attempt counted) and end: its contribution, the S
   // letters a projection adds, the one segment to test (none: from is null). False when black.
   void begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const;
   bool end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const;
@@ -357,10 +352,8 @@ class Integrator {
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
   bool has_mirror_ = false;      // a mirror strategy runs and the scene has a planar mirror
   bool has_manifold_ = false;    // a manifold strategy runs and the scene has specular surfaces (RenderScene::specular)
-  // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
-  // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
-  static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
-  std::array<std::uint64_t, 64> runs_mask_{};
+  // A full path has s + t = k + 1 <= max_bounces + 2 vertices (kMaxVertices bounds max_bounces).
+  static_assert(kMaxVertices <= StrategyTable::kMaxSplits, "plain_splits() covers every path");
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses

@@ -93,7 +93,8 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
   }
   // --- the plain joins whose two join letters are D ---
   const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
-  st.plain = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
+  // (The split s = n, t = 0, only when light paths can hit the lens.)
+  st.plain = table_.plain_splits(n) & d_pairs & ~(lens_hits_ ? 0 : std::uint64_t{1} << n);
   if (self == ConnectorKind::kNone) st.plain &= ~(std::uint64_t{1} << s);
   if (!has_connectors_) return st;
   // --- the connectors: one term each, the plain density with their constructed vertices left out ---

@@ -13,10 +13,7 @@
 // Labels: each vertex keeps the letter of the scattering event sampled there (the component a
 // BSDF chose; a light's and a sensor's two letters). The full-path string of a connection is
 // those letters in light-to-eye order with the two join letters set to D (a join evaluates only
-// finite parts). A strategy (s', t') has nonzero density for that string exactly when the
-// profile runs it and the string's letters c(s') and c(s'+1) are both D; the power heuristic
-// sums over those strategies only (trace/mis.h), with Dirac densities kept symbolic (stored as
-// 0, counted as 1, and their strategies excluded by letter).
+// finite parts): which strategies sample the path follows from them (mis_weight.cpp).
 #include "trace/render.h"
 
 #include <array>
@@ -166,15 +163,9 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
   const std::size_t li = rs_.pick_light(rng);
   const RenderLight& l = rs_.lights[li];
-  // An image infinite light draws its disk point from the numbers an area light's point takes.
-  const EnvironmentLightParams* env = l.environment();
-  const glm::vec2 u_disk = env ? rng.get2d() : glm::vec2(0.0f);
   vec3 err{0.0f};
-  const SurfacePoint x = env ? SurfacePoint{} : rs_.sample_point(l, rng, &err);
-  rng.skip(2);  // u_ray, drawn in advance
-  // (An aimed light draws its direction within its cones: RenderLight::sample_ray.)
-  const std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : l.sample_ray(x, u_ray);
-  if (env && r) err = box_point_error(r->origin);
+  SurfacePoint x;
+  const std::optional<EndpointRay> r = rs_.emit(l, rng, u_ray, &x, &err);
   Vertex& y0 = light_vertex(th.light[0], li, r ? r->origin : x.position, r ? r->normal : vec3(0.0f), err, l.letters[1]);
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
     y0.beta = vec3(0.0f);
@@ -197,7 +188,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   if (n >= 2 && drawn_towards(static_cast<int>(li), th.light[1])) {
     y0.pdf_fwd = light_origin_density(static_cast<int>(li), y0.p, y0.n, th.light[1]);
     th.light[1].pdf_fwd = light_step_density(static_cast<int>(li), y0, th.light[1]);
-  } else if (env) {
+  } else if (l.environment()) {
     y0.pdf_fwd = 0.0f;
   }
   return n;

@@ -37,6 +37,7 @@ void Integrator::begin_join(Thread& th, ConnectorKind kind, int s, int t, int st
   jr.splat = false;
   jr.rx = jr.ry = 0.0f;
   jr.num_segments = 0;
+  if (kind != ConnectorKind::kNone) ++th.connectors[static_cast<std::size_t>(strategy_index)].attempts;
 }
 
 bool Integrator::end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const {
@@ -117,7 +118,6 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   // (The splat's sensor point has a finite direction: a light drawn towards points draws y0 towards it.)
   const bool towards = !ortho && q->kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(q->light)].drawn_towards(true);
   begin_join(th, kind, s, 1, ortho ? ortho_of(s) : strategy(s, 1));
-  if (ortho) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   const glm::vec2 ul = ortho ? glm::vec2(0.0f) : rng.get2d_if(reads_lens_numbers(cam_.params));
   if (towards) {
     // A light seen directly whose points are drawn towards the point they join (an image infinite
@@ -166,7 +166,6 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   // from an aperture.
   if (distant ? l.letters != "DS" : !towards && l.letters[1] != 'D') return false;
   begin_join(th, kind, 1, t, distant ? distant_of(t) : strategy(1, t));
-  if (distant) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
   // The light point: the aperture point on the line (distant), a point drawn towards pt (a
   // direction from an image infinite light's image, a rectangle's by solid angle), or a point of
