@@ -261,9 +261,8 @@ class Integrator {
   // shading-normal correction at the light end (mode kImportance); the BSDF's densities for free
   // into *pdfs when given. Every join evaluates its ends here.
   vec3 end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs = nullptr) const;
-  // A join's start (th.join reset for strategy (s, kind, t), a connector's attempt counted) and end: its contribution, the S
+  // A plain or projection join's end (its start: JoinResult::begin): its contribution, the S
   // letters a projection adds, the one segment to test (none: from is null). False when black.
-  void begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const;
   bool end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const;
   // The one way to make an endpoint vertex, for a subpath (y0, z0) and for a join's fresh end: into
   // y a vertex of light li at p, into z a sensor vertex at p (normal n, none for a point sensor),

@@ -28,7 +28,6 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
   const PathKey key = chain_key(th, *a, s, t, 1);
   for (const PlanarMirror& mirror : rs_.mirrors) {
     ++stats.attempts;
-    float rx = 0.0f, ry = 0.0f;
     std::optional<EndpointConnection> c;  // t = 1: the sensor's join to a's image
     if (t == 1) {
       c = connect_finite(cam_.params, u_lens, mirror_image(mirror, a->p));
@@ -36,9 +35,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
         ++stats.outside;
         continue;
       }
-      const Vertex& z0 = fresh_sensor_vertex(th, *c, 'D');
-      cam_.to_pixels(c->raster, &rx, &ry);
-      b = &z0;
+      b = &fresh_sensor_vertex(th, *c, 'D');
     }
     const std::optional<MirrorJoin> j = mirror_join(mirror, a->p, b->p);
     if (!j) {
@@ -73,8 +70,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     m.shape = mirror.shape;
     jr.set_connector(ConnectorKind::kMirror, s, t, strategy_index, key, contrib, 1, a, b);
     jr.splat = t == 1;
-    jr.rx = rx;
-    jr.ry = ry;
+    if (jr.splat) cam_.to_pixels(c->raster, &jr.rx, &jr.ry);
     estimate(th, batch);
   }
 }

@@ -24,22 +24,6 @@ vec3 Integrator::end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf:
   return mode == TransportMode::kImportance && v.ns != v.n ? f * bsdf::shading_normal_correction(v.wo, w, v.ns, v.n, mode) : f;
 }
 
-void Integrator::begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const {
-  JoinResult& jr = th.join;
-  jr.chain = kind;
-  jr.s = s;
-  jr.t = t;
-  jr.strategy = strategy_index;
-  jr.density = JoinDensity{};
-  jr.has_density = false;
-  jr.has_light0 = jr.has_eye0 = false;
-  jr.chain_length = 0;
-  jr.splat = false;
-  jr.rx = jr.ry = 0.0f;
-  jr.num_segments = 0;
-  if (kind != ConnectorKind::kNone) ++th.connectors[static_cast<std::size_t>(strategy_index)].attempts;
-}
-
 bool Integrator::end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const {
   JoinResult& jr = th.join;
   // Beer–Lambert along the joining segment (trace/media.h).
@@ -89,7 +73,7 @@ bool Integrator::join_emitter(Thread& th, int t) const {
   if (pt.kind != Kind::kSurface) return false;
   const int hit_light = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];
   if (hit_light < 0) return false;
-  begin_join(th, ConnectorKind::kNone, 0, t, strategy(0, t));
+  th.join.begin(ConnectorKind::kNone, 0, t, strategy(0, t));
   return end_join(th, pt.beta * emitted(rs_.lights[static_cast<std::size_t>(hit_light)].params, pt.n, pt.wo), 0, nullptr, nullptr);
 }
 
@@ -99,7 +83,7 @@ bool Integrator::join_lens(Thread& th, int s) const {
   glm::vec2 raster;
   const vec3 we = importance(cam_.params, qs.p, qs.wo, &raster);
   if (is_black(we)) return false;
-  begin_join(th, ConnectorKind::kNone, s, 0, strategy(s, 0));
+  th.join.begin(ConnectorKind::kNone, s, 0, strategy(s, 0));
   JoinResult& jr = th.join;
   cam_.to_pixels(raster, &jr.rx, &jr.ry);
   jr.splat = true;
@@ -117,7 +101,8 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   if (ortho ? env || cam_.letters != "SD" : cam_.letters[0] != 'D') return false;
   // (The splat's sensor point has a finite direction: a light drawn towards points draws y0 towards it.)
   const bool towards = !ortho && q->kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(q->light)].drawn_towards(true);
-  begin_join(th, kind, s, 1, ortho ? ortho_of(s) : strategy(s, 1));
+  th.join.begin(kind, s, 1, ortho ? ortho_of(s) : strategy(s, 1));
+  if (ortho) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   const glm::vec2 ul = ortho ? glm::vec2(0.0f) : rng.get2d_if(reads_lens_numbers(cam_.params));
   if (towards) {
     // A light seen directly whose points are drawn towards the point they join (an image infinite
@@ -165,7 +150,8 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   // Dirac directions (distant, laser) have no DD join; the connector's c0 c1 are a Dirac direction
   // from an aperture.
   if (distant ? l.letters != "DS" : !towards && l.letters[1] != 'D') return false;
-  begin_join(th, kind, 1, t, distant ? distant_of(t) : strategy(1, t));
+  th.join.begin(kind, 1, t, distant ? distant_of(t) : strategy(1, t));
+  if (distant) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
   // The light point: the aperture point on the line (distant), a point drawn towards pt (a
   // direction from an image infinite light's image, a rectangle's by solid angle), or a point of
@@ -198,7 +184,7 @@ bool Integrator::join_shadow(Thread& th, int s, int t) const {
   const vec3 d = pt.p - qs.p;
   const float d2 = glm::dot(d, d);
   if (d2 <= 0.0f) return false;
-  begin_join(th, ConnectorKind::kNone, s, t, strategy(s, t));
+  th.join.begin(ConnectorKind::kNone, s, t, strategy(s, t));
   JoinResult& jr = th.join;
   const vec3 w = d * (1.0f / std::sqrt(d2));  // one division, not three
   const vec3 fq = end_f(qs, w, TransportMode::kImportance, &jr.density.at_qs);
