@@ -182,8 +182,6 @@ class Integrator {
     for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].flush(images, static_cast<int>(x), y);
   }
 
-  // The stages below are public: tests drive them one at a time (tests/trace/mis_test.cpp
-  // re-splits paths and checks their MIS weights); only the state is private.
   const RenderScene& scene() const { return rs_; }
 
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
@@ -239,8 +237,7 @@ class Integrator {
 
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;  // the most joins of one kind per sample
   // --- joins (trace/joins/): each makes th.join from the two subpaths, or returns false ---
-  // Random numbers: each join draws from a block of its own, per kind and subpath length, so that
-  // adding a strategy leaves every other strategy's numbers unchanged (trace/rng.h).
+  // Random numbers: each join draws from a block of its own, per kind and subpath length (render.cpp).
   enum class JoinBlock : std::uint64_t { kEmitter, kLens, kSplat, kNee, kShadow, kDistant, kOrtho, kMirrorLight, kMirrorEye, kManifoldLight };
   static constexpr std::uint64_t kJoinDims = 2048;  // after the eye's and the light subpath's blocks
   static constexpr std::uint64_t kDimsPerJoin = 4;
@@ -281,8 +278,7 @@ class Integrator {
   // is c0 c1 c2, so (0, DSD, t)) or light (ortho: (s, DSD, 0)) vertices, or -1.
   int distant_of(int t) const { return table_.at(0, ConnectorKind::kDistantProjection, t); }
   int ortho_of(int s) const { return table_.at(s, ConnectorKind::kOrthoProjection, 0); }
-  // The mirror connector (s, DSD, t), s, t >= 1: y(s-1) (a fresh light sample for s = 1) joined to
-  // z(t-1) (a fresh sensor sample for t = 1) across each planar mirror by the image method.
+  // The mirror connector (s, DSD, t), s, t >= 1 (trace/joins/mirror_join.cpp).
   void connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const;
   int mirror_of(int s, int t) const { return table_.at(s, ConnectorKind::kMirror, t); }
   // A connector's light end for s = 1: a fresh light sample in th.join.light0 from random-number

@@ -234,7 +234,6 @@ Integrator::PathView Integrator::path_of(const Thread& th, const JoinResult& jr)
 void Integrator::estimate(Thread& th, int batch) const {
   const JoinResult& jr = th.join;
   if (!filter_.records(jr.letters)) return;  // not recorded by the plan: no weight, no shadow ray
-  // The MIS weight over every strategy of the profile that samples this path (trace/mis_weight.cpp).
   const float weight = mis_weight(th, path_of(th, jr), jr.letters, jr.chain, jr.has_density ? &jr.density : nullptr);
   // The technique, as the histogram names it: a projection's chain starts at c0 (distant: s = 0)
   // or ends at c(k+2) (ortho: t = 0).

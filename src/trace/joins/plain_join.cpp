@@ -1,11 +1,6 @@
 // The plain joins (s, DD, t) of DESIGN §4 and the two projection connectors (distant (0, DSD, t),
 // orthographic (s, DSD, 0)), each a function from the two subpaths to the JoinResult in th.join
-// (true when it made one): its vertices, letters, contribution before weighting, the segments that
-// must be clear and the densities MIS needs of it. The estimator (render.cpp) weighs and records it.
-//
-// Each join draws its random numbers from a block of its own (join_numbers()), so that adding a
-// strategy leaves every other strategy's numbers unchanged. At a join's two end vertices the
-// scattering functions are evaluated by one helper, end_f().
+// (trace/joins/join.h; true when it made one), which the estimator (render.cpp) weighs and records.
 #include <cmath>
 
 #include "trace/bsdf.h"
