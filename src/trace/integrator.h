@@ -26,7 +26,6 @@
 #include "trace/render.h"
 #include "trace/render_scene.h"
 #include "trace/rng.h"
-#include "trace/scene_features.h"
 #include "trace/strategy_table.h"
 #include "trace/vertex.h"
 
@@ -52,19 +51,11 @@ class Integrator {
     }
     // (A light splat from y0, the join (1, DD, 1), uses the light subpath's first vertex.)
     if (max_light_ < 2 && table_.plain(1, 1) < 0) max_light_ = 0;
-    // runs_mask_[n] bit s2: the profile runs (s2, n - s2); t2 = 0 only when light paths can hit the lens.
-    for (std::size_t n = 0; n < runs_mask_.size(); ++n)
-      for (int s2 = 0; s2 <= static_cast<int>(n); ++s2)
-        if (strategy(s2, static_cast<int>(n) - s2) >= 0 && (s2 < static_cast<int>(n) || lens_hits_))
-          runs_mask_[n] |= std::uint64_t{1} << s2;
     has_mirror_ = table_.runs(ConnectorKind::kMirror) && !rs.mirrors.empty();
     has_manifold_ = !rs.specular.shapes.empty() && table_.runs(ConnectorKind::kManifold);
     has_connectors_ = table_.runs(ConnectorKind::kDistantProjection) || table_.runs(ConnectorKind::kOrthoProjection) || has_mirror_ ||
                       has_manifold_;
-    mirror_shape_.assign(rs.material_of_shape.size(), 0);
-    for (const PlanarMirror& m : rs.mirrors) mirror_shape_[static_cast<std::size_t>(m.shape)] = 1;
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
-    features_ = rs.features;
     absorbing_ = rs.absorbing;
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
@@ -194,8 +185,6 @@ class Integrator {
     for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].flush(images, static_cast<int>(x), y);
   }
 
-  // The stages below are public: tests drive them one at a time (tests/trace/mis_test.cpp
-  // re-splits paths and checks their MIS weights); only the state is private.
   const RenderScene& scene() const { return rs_; }
 
   // --- the sensor and the lights: the one emitter model (trace/emitters.h) ---
@@ -204,12 +193,6 @@ class Integrator {
   // light l's leaving `v` (a point of the light) (mis_weight.cpp).
   float sensor_pdf_dir(const Vertex& v, const vec3& w) const;
   float light_pdf_dir(const RenderLight& l, const Vertex& v, const vec3& w) const;
-  // The image infinite light `light` is, or null (trace/environment.h). Its x0 has the light density
-  // of next-event estimation from x1 (env_origin_density, times the pick), and x1 the density
-  // emission_step_density() after it: their product is its emission's joint density.
-  const EnvironmentLightParams* environment_of(int light) const {
-    return rs_.lights[static_cast<std::size_t>(light)].environment();
-  }
   // Next-event estimation could join a light point to v: a surface with a finite part (by its
   // shape: a connector's chain vertex too), a sensor point with a finite direction.
   bool joinable(const Vertex& v) const {
@@ -243,15 +226,13 @@ class Integrator {
   float pdf_dir(const Vertex& v, const vec3* wp, const vec3& wn) const;
   // Area density at `next` of sampling it from `v` whose other neighbour is `prev`.
   float pdf(const Vertex* prev, const Vertex& v, const Vertex& next) const;
-  // Density of choosing the point `v` on its area light (for an eye vertex that hit it, coming
-  // from x1 = `next`).
-  float pdf_light_origin(const Vertex& v, const Vertex& next) const;
 
   // --- subpaths ---
   // A template on the direction: the walk's tests of its direction are not branches. What the
-  // scene cannot have (features_, trace/scene_features.h) it skips.
+  // scene cannot have (RenderScene::features, trace/scene_features.h) it skips.
   template <TransportMode mode>
-  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d, float pdf_dir,
+  // From path[0] along (o, d), drawn with density pdf_dir, with throughput beta.
+  int random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, vec3 o, vec3 d, float pdf_dir, vec3 beta,
                   int max_vertices) const;
   int eye_subpath(Thread& th, Sampler& rng, int px, int py) const;
   // u_ray: the numbers of the light's first direction (Sampler::at2d_now at kLightRayDim).
@@ -259,8 +240,7 @@ class Integrator {
 
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;  // the most joins of one kind per sample
   // --- joins (trace/joins/): each makes th.join from the two subpaths, or returns false ---
-  // Random numbers: each join draws from a block of its own, per kind and subpath length, so that
-  // adding a strategy leaves every other strategy's numbers unchanged (trace/rng.h).
+  // Random numbers: each join draws from a block of its own, per kind and subpath length (render.cpp).
   enum class JoinBlock : std::uint64_t { kEmitter, kLens, kSplat, kNee, kShadow, kDistant, kOrtho, kMirrorLight, kMirrorEye, kManifoldLight };
   static constexpr std::uint64_t kJoinDims = 2048;  // after the eye's and the light subpath's blocks
   static constexpr std::uint64_t kDimsPerJoin = 4;
@@ -281,9 +261,8 @@ class Integrator {
   // shading-normal correction at the light end (mode kImportance); the BSDF's densities for free
   // into *pdfs when given. Every join evaluates its ends here.
   vec3 end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf::JoinPdfs* pdfs = nullptr) const;
-  // A join's start (th.join reset for strategy (s, kind, t)) and end: its contribution, the S
+  // A plain or projection join's end (its start: JoinResult::begin): its contribution, the S
   // letters a projection adds, the one segment to test (none: from is null). False when black.
-  void begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const;
   bool end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const;
   // The one way to make an endpoint vertex, for a subpath (y0, z0) and for a join's fresh end: into
   // y a vertex of light li at p, into z a sensor vertex at p (normal n, none for a point sensor),
@@ -302,8 +281,7 @@ class Integrator {
   // is c0 c1 c2, so (0, DSD, t)) or light (ortho: (s, DSD, 0)) vertices, or -1.
   int distant_of(int t) const { return table_.at(0, ConnectorKind::kDistantProjection, t); }
   int ortho_of(int s) const { return table_.at(s, ConnectorKind::kOrthoProjection, 0); }
-  // The mirror connector (s, DSD, t), s, t >= 1: y(s-1) (a fresh light sample for s = 1) joined to
-  // z(t-1) (a fresh sensor sample for t = 1) across each planar mirror by the image method.
+  // The mirror connector (s, DSD, t), s, t >= 1 (trace/joins/mirror_join.cpp).
   void connect_mirror(Thread& th, Sampler& rng, int s, int t, int batch) const;
   int mirror_of(int s, int t) const { return table_.at(s, ConnectorKind::kMirror, t); }
   // A connector's light end for s = 1: a fresh light sample in th.join.light0 from random-number
@@ -372,17 +350,13 @@ class Integrator {
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
   bool has_mirror_ = false;      // a mirror strategy runs and the scene has a planar mirror
   bool has_manifold_ = false;    // a manifold strategy runs and the scene has specular surfaces (RenderScene::specular)
-  std::vector<std::uint8_t> mirror_shape_;  // the shape is a planar mirror
-  // [n]: bit s2 set when the profile runs (s2, n - s2) and, for n - s2 = 0, light paths can hit the
-  // lens. A full path has s + t = k + 1 <= max_bounces + 2 < 64 (kMaxVertices bounds max_bounces).
-  static_assert(kMaxVertices <= 64, "runs_mask_ holds s + t <= kMaxVertices - 1");
-  std::array<std::uint64_t, 64> runs_mask_{};
+  // A full path has s + t = k + 1 <= max_bounces + 2 vertices (kMaxVertices bounds max_bounces).
+  static_assert(kMaxVertices <= StrategyTable::kMaxSplits, "plain_splits() covers every path");
   std::vector<std::uint8_t> finite_of_shape_;  // the shape's material has a finite BSDF part
   int max_light_ = 0;  // longest light subpath any strategy uses (0: none)
   int max_eye_ = 1;    // longest eye subpath any strategy uses
   float light_pick_ = 0.0f;
   bool lens_hits_ = false;
-  SceneFeatures features_;  // what the scene's materials can do: the walk skips the rest
   bool absorbing_ = false;  // some shape has an absorbing interior (trace/media.h)
 };
 

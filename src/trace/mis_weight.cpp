@@ -71,10 +71,6 @@ float Integrator::pdf(const Vertex* prev, const Vertex& v, const Vertex& next) c
   return pdf_dir(v, prev ? &wp : nullptr, wn) * abs_cos(next, wn) / d2;  // solid angle at v to area at next
 }
 
-float Integrator::pdf_light_origin(const Vertex& v, const Vertex& next) const {
-  return light_origin_density(rs_.light_of_shape[static_cast<std::size_t>(v.shape)], v.p, v.n, next);
-}
-
 mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
   const int n = x.size(), k = n - 1, s = x.s;
   mis::Strategies st;
@@ -97,7 +93,8 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
   }
   // --- the plain joins whose two join letters are D ---
   const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
-  st.plain = runs_mask_[static_cast<std::size_t>(n)] & d_pairs;
+  // (The split s = n, t = 0, only when light paths can hit the lens.)
+  st.plain = table_.plain_splits(n) & d_pairs & ~(lens_hits_ ? 0 : std::uint64_t{1} << n);
   if (self == ConnectorKind::kNone) st.plain &= ~(std::uint64_t{1} << s);
   if (!has_connectors_) return st;
   // --- the connectors: one term each, the plain density with their constructed vertices left out ---
@@ -115,7 +112,7 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
   if (has_mirror_)
     for (int m = 1 + drawn; m <= k - 1; ++m)
       if (!(self == ConnectorKind::kMirror && m == s) && dsd_at(m) && mirror_of(m, k - m) >= 0 && x[m].kind == Kind::kSurface &&
-          mirror_shape_[static_cast<std::size_t>(x[m].shape)])
+          rs_.planar_mirror[static_cast<std::size_t>(x[m].shape)])
         out[count++] = {m, 1, 1.0};
   if (has_manifold_)
     for (int i = 1 + drawn; i <= k - 1; ++i) {
@@ -176,12 +173,11 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
     if (has_qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(qs, &w, qs.wo), x[s - 2], qs.wo, qs.d2_wo));
   } else if (t > 0) {  // s = 0: pt lies on an area light
     const Vertex& pt = x[0];
-    set_light(0, pdf_light_origin(pt, x[1]));
+    const int li = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];
+    set_light(0, light_origin_density(li, pt.p, pt.n, x[1]));
     if (has_ptm && needed(1)) {
-      const int li = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];
-      const RenderLight& l = rs_.lights[static_cast<std::size_t>(li)];
       if (drawn_towards(li, x[1])) set_light(1, light_step_density(li, pt, x[1]));
-      else set_light(1, area(light_pdf_dir(l, pt, pt.wo), x[1], pt.wo, pt.d2_wo));
+      else set_light(1, area(light_pdf_dir(rs_.lights[static_cast<std::size_t>(li)], pt, pt.wo), x[1], pt.wo, pt.d2_wo));
     }
   } else if (s > 0) {  // t = 0: qs is the lens point
     const Vertex& qs = x[n - 1];

@@ -13,10 +13,7 @@
 // Labels: each vertex keeps the letter of the scattering event sampled there (the component a
 // BSDF chose; a light's and a sensor's two letters). The full-path string of a connection is
 // those letters in light-to-eye order with the two join letters set to D (a join evaluates only
-// finite parts). A strategy (s', t') has nonzero density for that string exactly when the
-// profile runs it and the string's letters c(s') and c(s'+1) are both D; the power heuristic
-// sums over those strategies only (trace/mis.h), with Dirac densities kept symbolic (stored as
-// 0, counted as 1, and their strategies excluded by letter).
+// finite parts): which strategies sample the path follows from them (mis_weight.cpp).
 #include "trace/render.h"
 
 #include <array>
@@ -50,15 +47,13 @@ float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 }  // namespace
 
 template <TransportMode mode>
-int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, int count, vec3 o, vec3 d,
-                            float pdf_dir, int max_vertices) const {
-  vec3 beta = path[static_cast<std::size_t>(count - 1)].beta;
+int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVertices>& path, vec3 o, vec3 d, float pdf_dir,
+                            vec3 beta, int max_vertices) const {
+  int count = 1;
   // Russian roulette compares the throughput with the subpath's start, so that a light subpath
   // (whose throughput starts at the light's power) is treated like an eye subpath.
   const float beta_start = std::max(max_component(beta), 1e-30f);
   float eta2 = 1.0f;  // the product of η² over the refractions so far (radiance walks)
-  // `beta` passed in the first vertex already includes the first direction's weight: the caller
-  // stores it in path[count - 1].beta and we continue from there.
   SubpathPrefix live(filter_, mode == TransportMode::kImportance, path[0].pos_letter, path[0].letter);  // trace/prune.h
   while (count < max_vertices && live.alive()) {
     Vertex& prev = path[static_cast<std::size_t>(count - 1)];
@@ -72,17 +67,11 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     if (mode == TransportMode::kImportance && lens_hits_) {
       const std::optional<EndpointConnection> lens = hit_lens(cam_.params, o, d);
       if (lens && (!hit || lens->distance < hit->t)) {
-        Vertex& v = path[static_cast<std::size_t>(count)];
-        v = Vertex{};
+        Vertex& v = sensor_vertex(path[static_cast<std::size_t>(count)], lens->position, lens->normal, 'D');  // a lens's letters are DD
         v.kind = Kind::kLens;
-        v.p = lens->position;
-        v.n = lens->normal;
-        v.ns = lens->normal;
         v.beta = beta;
         link(v, prev);
         v.pdf_fwd = v.d2_wo > 0.0f ? pdf_dir * std::fabs(glm::dot(v.n, d)) / v.d2_wo : 0.0f;
-        v.letter = 'D';
-        v.pos_letter = 'D';
         return count + 1;
       }
     }
@@ -128,7 +117,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // A Dirac's densities stay symbolic: 0 here, remapped to 1 in the MIS ratios, and every
     // strategy that would join at this vertex is excluded by its letter S.
     // (Without a specular material no lobe is a Dirac: the test is skipped.)
-    const bool delta = features_.specular && bs->is_delta;
+    const bool delta = rs_.features.specular && bs->is_delta;
     pdf_dir = delta ? 0.0f : bs->pdf;
     const float pdf_rev_dir = delta ? 0.0f : bs->pdf_rev;
     prev.pdf_rev = pdf_rev_dir * abs_cos(prev, d) * inv_d2;
@@ -136,7 +125,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // From vertex rr_depth on, a walk whose throughput relative to its start (a refraction's
     // radiance scaling 1/η² undone, so that entering glass is no loss) is below rr_threshold
     // survives with probability throughput / threshold, and a survivor carries the threshold.
-    if (mode == TransportMode::kRadiance && features_.transmission) eta2 *= bs->eta * bs->eta;  // else η = 1
+    if (mode == TransportMode::kRadiance && rs_.features.transmission) eta2 *= bs->eta * bs->eta;  // else η = 1
     constexpr bool kEye = mode == TransportMode::kRadiance;  // eye and light subpaths have thresholds of their own
     const float threshold = kEye ? o_.rr_threshold : o_.rr_light_threshold;
     if (count >= o_.rr_depth && threshold > 0.0f) {
@@ -160,8 +149,7 @@ int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
   const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), cam_.letters[0]);
   if (!r) return 1;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
-  const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, 1, r->origin, r->direction,
-                                                      r->pdf.dir, max_eye_);
+  const int n = random_walk<TransportMode::kRadiance>(th, rng, th.eye, r->origin, r->direction, r->pdf.dir, vec3(1.0f), max_eye_);
   // An orthographic sensor's rays are a parallel beam (see light_subpath()).
   if (n >= 2 && r->pdf.delta_dir && !r->pdf.delta_pos) th.eye[1].pdf_fwd = parallel_jacobian(th.eye[1], z0, r->direction);
   return n;
@@ -171,31 +159,21 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   if (rs_.lights.empty() || max_light_ == 0) return 0;
   const std::size_t li = rs_.pick_light(rng);
   const RenderLight& l = rs_.lights[li];
-  // An image infinite light draws its disk point from the numbers an area light's point takes.
-  const EnvironmentLightParams* env = environment_of(static_cast<int>(li));
-  const glm::vec2 u_disk = env ? rng.get2d() : glm::vec2(0.0f);
   vec3 err{0.0f};
-  const SurfacePoint x = env ? SurfacePoint{} : rs_.sample_point(l, rng, &err);
-  rng.skip(2);  // u_ray, drawn in advance
-  // (An aimed light draws its direction within its cones: RenderLight::sample_ray.)
-  const std::optional<EndpointRay> r = env ? sample_ray(*env, u_ray, u_disk) : l.sample_ray(x, u_ray);
-  if (env && r) err = box_point_error(r->origin);
+  SurfacePoint x;
+  const std::optional<EndpointRay> r = rs_.emit(l, rng, u_ray, &x, &err);
   Vertex& y0 = light_vertex(th.light[0], li, r ? r->origin : x.position, r ? r->normal : vec3(0.0f), err, l.letters[1]);
   if (!r) {  // no emission from this sample: y0 alone, carrying nothing
     y0.beta = vec3(0.0f);
     return 1;
   }
   // y0 keeps the spatial part of the emission, L_e⁽⁰⁾ / p (a join at y0 evaluates the directional
-  // part; a Dirac position is chosen with probability 1); the walk continues with the first ray's
+  // part; a Dirac position is chosen with probability 1); the walk starts with the first ray's
   // whole throughput.
   y0.beta = spatial_emission(l.params) / (light_pick_ * (r->pdf.delta_pos ? 1.0f : r->pdf.pos));
   const vec3 beta1 = r->weight / light_pick_;
   if (is_black(beta1)) return 1;
-  const vec3 saved = y0.beta;
-  th.light[0].beta = beta1;
-  const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, 1, y0.p, r->direction,
-                                                        r->pdf.dir, max_light_);
-  th.light[0].beta = saved;
+  const int n = random_walk<TransportMode::kImportance>(th, rng, th.light, y0.p, r->direction, r->pdf.dir, beta1, max_light_);
   // A Dirac direction from a finite-area origin (a distant light's aperture) is a parallel beam:
   // its first vertex has a finite density per area, which the distant-projection connector's
   // MIS weight compares with the eye's.
@@ -206,7 +184,7 @@ int Integrator::light_subpath(Thread& th, Sampler& rng, glm::vec2 u_ray) const {
   if (n >= 2 && drawn_towards(static_cast<int>(li), th.light[1])) {
     y0.pdf_fwd = light_origin_density(static_cast<int>(li), y0.p, y0.n, th.light[1]);
     th.light[1].pdf_fwd = light_step_density(static_cast<int>(li), y0, th.light[1]);
-  } else if (env) {
+  } else if (l.environment()) {
     y0.pdf_fwd = 0.0f;
   }
   return n;
@@ -252,7 +230,6 @@ Integrator::PathView Integrator::path_of(const Thread& th, const JoinResult& jr)
 void Integrator::estimate(Thread& th, int batch) const {
   const JoinResult& jr = th.join;
   if (!filter_.records(jr.letters)) return;  // not recorded by the plan: no weight, no shadow ray
-  // The MIS weight over every strategy of the profile that samples this path (trace/mis_weight.cpp).
   const float weight = mis_weight(th, path_of(th, jr), jr.letters, jr.chain, jr.has_density ? &jr.density : nullptr);
   // The technique, as the histogram names it: a projection's chain starts at c0 (distant: s = 0)
   // or ends at c(k+2) (ortho: t = 0).

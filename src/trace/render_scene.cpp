@@ -184,12 +184,11 @@ Result<RenderScene> make_render_scene(const Scene& scene) {
     const bool perturbed = tex && tex->perturb != NormalPerturbation::kNone;
     const auto* quad = s.group < 0 && !perturbed ? std::get_if<QuadShape>(&s.geometry) : nullptr;
     const auto* mirror = std::get_if<Mirror>(rs.material_of_shape.back());
-    if (quad && mirror && !s.emissive()) {
-      const glm::vec3 n = glm::cross(quad->edge1, quad->edge2);
-      if (glm::length(n) > 0.0f)
-        rs.mirrors.push_back({static_cast<int>(i), quad->corner, quad->edge1, quad->edge2, glm::normalize(n),
-                              mirror->reflectance, parallelogram_error(quad->corner, quad->edge1, quad->edge2)});
-    }
+    const glm::vec3 n = quad ? glm::cross(quad->edge1, quad->edge2) : glm::vec3(0.0f);
+    rs.planar_mirror.push_back(quad && mirror && !s.emissive() && glm::length(n) > 0.0f ? 1 : 0);
+    if (rs.planar_mirror.back())
+      rs.mirrors.push_back({static_cast<int>(i), quad->corner, quad->edge1, quad->edge2, glm::normalize(n),
+                            mirror->reflectance, parallelogram_error(quad->corner, quad->edge1, quad->edge2)});
     // A zero-area emitter emits nothing; it is not a light (and would have an infinite density).
     if (!s.emissive() || !(rs.geometry->shape_area(static_cast<int>(i)) > 0.0f)) continue;
     RenderLight l;

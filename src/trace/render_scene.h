@@ -163,6 +163,7 @@ struct RenderScene {
   bool absorbing = false;                    // some shape has an absorbing interior
   std::vector<RenderLight> lights;
   std::vector<PlanarMirror> mirrors;         // quads of a pure mirror material (the mirror connector's)
+  std::vector<std::uint8_t> planar_mirror;   // per shape: 1 for one of `mirrors`
   RenderSensor camera;
   SceneFeatures features;                    // what the shapes' materials can do (trace/scene_features.h)
   // A sphere around each shape whose material has a specular (Dirac) component: where a path whose
@@ -190,6 +191,20 @@ struct RenderScene {
     const SurfaceSample ss = geometry->sample_shape(l.shape, u2);
     *error = ss.error;
     return {ss.position, ss.normal, l.pdf_pos};
+  }
+  // Light l's first ray, its direction from u_ray (drawn in advance, its dimensions skipped) and its
+  // point from the next numbers: an area light's point (*x, with its rounding-error bound in
+  // *error), or an image infinite light's disk point, drawn from the numbers an area light's point
+  // takes. (An aimed light draws its direction within its cones: RenderLight::sample_ray.)
+  std::optional<EndpointRay> emit(const RenderLight& l, Sampler& rng, glm::vec2 u_ray, SurfacePoint* x, glm::vec3* error) const {
+    const EnvironmentLightParams* env = l.environment();
+    const glm::vec2 u_disk = env ? rng.get2d() : glm::vec2(0.0f);
+    if (!env) *x = sample_point(l, rng, error);
+    rng.skip(2);
+    if (!env) return l.sample_ray(*x, u_ray);
+    const std::optional<EndpointRay> r = sample_ray(*env, u_ray, u_disk);
+    if (r) *error = box_point_error(r->origin);
+    return r;
   }
   // The material of `shape` at `uv`: its own, or, when it has textured parameters, the material
   // with them evaluated, made in `*scratch` (trace/texture_eval.h).

@@ -8,6 +8,7 @@
 // only those strategies: nothing else in the tracer knows which strategies exist.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -34,6 +35,9 @@ class StrategyTable {
             slots_[index(s, chain, t)] = static_cast<std::int16_t>(i);
             break;
           }
+    for (int n = 0; n < kMaxSplits; ++n)
+      for (int s = 0; s <= n; ++s)
+        if (plain(s, n - s) >= 0) splits_[static_cast<std::size_t>(n)] |= std::uint64_t{1} << s;
   }
 
   // The strategy running `chain` with s letters before it and t after it, or -1 (also for s or t
@@ -45,6 +49,9 @@ class StrategyTable {
   }
   // Shorthand for the plain join (s, DD, t).
   int plain(int s, int t) const { return at(s, ConnectorKind::kNone, t); }
+  // The plain joins of a path of n < kMaxSplits vertices: bit s set when (s, DD, n - s) is run.
+  static constexpr int kMaxSplits = 64;
+  std::uint64_t plain_splits(int n) const { return splits_[static_cast<std::size_t>(n)]; }
   // Whether any (s, chain, t) is run, and any (s, chain, t) for this t.
   bool runs(ConnectorKind chain) const {
     for (int t = 0; t < kMaxSide; ++t)
@@ -64,6 +71,7 @@ class StrategyTable {
   }
   static_assert(static_cast<std::size_t>(ConnectorKind::kManifold) + 1 == kChains, "one slot block per keyed chain");
   std::vector<std::int16_t> slots_;  // [chain][s][t]
+  std::array<std::uint64_t, kMaxSplits> splits_{};
 };
 
 }  // namespace pathex

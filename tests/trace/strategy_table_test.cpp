@@ -30,6 +30,19 @@ TEST(StrategyTable, KeysPlainJoinsAndConnectorsApart) {
   EXPECT_EQ(table.at(1, ConnectorKind::kManifold, 1), -1);
 }
 
+TEST(StrategyTable, PlainSplitsAreThePlainJoinsOfAPathsLength) {
+  // pt-nee joins a path of n vertices at s = 0 (its last vertex on a light) and s = 1 (next-event
+  // estimation); bdpt at every split, t = 0 (a light path on the lens) included.
+  EXPECT_EQ(StrategyTable(profile("pt-nee").strategies).plain_splits(4), 0b11u);
+  EXPECT_EQ(StrategyTable(profile("bdpt").strategies).plain_splits(3), 0b1111u);
+  for (const char* name : {"pt-nee", "bdpt", "lt", "bdpt+mirror"}) {
+    const StrategyTable table(profile(name).strategies);
+    for (int n = 0; n < StrategyTable::kMaxSplits; ++n)
+      for (int s = 0; s < StrategyTable::kMaxSplits; ++s)
+        EXPECT_EQ((table.plain_splits(n) >> s) & 1, s <= n && table.plain(s, n - s) >= 0 ? 1u : 0u) << name << " n " << n << " s " << s;
+  }
+}
+
 TEST(StrategyTable, ManifoldChainsAreKeyedByTheirEnds) {
   const Profile p = profile("pt-nee+manifold");  // emitter-hit, nee, manifold-nee (1, DS+D, 2..)
   const StrategyTable table(p.strategies);

@@ -67,16 +67,28 @@ struct JoinResult {
   bool splat = false;
   float rx = 0.0f, ry = 0.0f;
 
+  // A join's start: strategy (s, chain, t), nothing built yet. (The end densities' values are read
+  // only where `known`.)
+  void begin(ConnectorKind kind, int light_s, int eye_t, int strategy_index) {
+    chain = kind;
+    s = light_s;
+    t = eye_t;
+    strategy = strategy_index;
+    density.at_qs.known = density.at_pt.known = false;
+    has_density = false;
+    has_light0 = has_eye0 = false;
+    chain_length = 0;
+    splat = false;
+    rx = ry = 0.0f;
+    num_segments = 0;
+  }
   // What a connector that builds chain_vertices (mirror, manifold) records once it has a
   // contribution: its strategy (s, chain, t), the path's letters, and the length + 1 segments from
   // a across the chain to b, all of which must be clear. At s = 1 (t = 1) the connector stands on a
   // fresh light (sensor) sample, light0 (eye0). MIS recomputes every density of such a path.
   void set_connector(ConnectorKind kind, int light_s, int eye_t, int strategy_index, accel::PathKey key, vec3 c, int length,
                      const Vertex* a, const Vertex* b) {
-    chain = kind;
-    s = light_s;
-    t = eye_t;
-    strategy = strategy_index;
+    begin(kind, light_s, eye_t, strategy_index);
     letters = key;
     contribution = c;
     has_light0 = light_s == 1;
@@ -86,8 +98,6 @@ struct JoinResult {
       segments[static_cast<std::size_t>(i)] = {i == 0 ? a : &chain_vertices[static_cast<std::size_t>(i - 1)],
                                                 i == length ? b : &chain_vertices[static_cast<std::size_t>(i)]};
     num_segments = length + 1;
-    has_density = false;
-    splat = false;
   }
 
   // The fresh endpoint standing in for y0 or z0 (z0 first), as the plain-join MIS routine takes it.

@@ -25,9 +25,6 @@ struct PlanarMirror {
   glm::vec3 error{0.0f};          // rounding-error bound of points on it (as a quad hit's)
 };
 
-// Why a mirror join failed.
-enum class MirrorMiss { kNone, kSide, kOff };
-
 struct MirrorJoin {
   glm::vec3 point{0.0f};  // m, on the mirror
   glm::vec3 w_a{0.0f};    // unit, from a towards m
@@ -40,12 +37,10 @@ inline glm::vec3 mirror_image(const PlanarMirror& m, const glm::vec3& p) {
   return p - 2.0f * glm::dot(p - m.corner, m.normal) * m.normal;
 }
 
-// The join of a and b across mirror `m`, or the reason there is none (`*miss`): kSide when a and b
-// are not strictly on one side of the plane, kOff when the crossing misses the parallelogram.
-inline std::optional<MirrorJoin> mirror_join(const PlanarMirror& m, const glm::vec3& a, const glm::vec3& b,
-                                             MirrorMiss* miss) {
+// The join of a and b across mirror `m`, or none: a and b are not strictly on one side of the
+// plane, or the crossing misses the parallelogram.
+inline std::optional<MirrorJoin> mirror_join(const PlanarMirror& m, const glm::vec3& a, const glm::vec3& b) {
   const float da = glm::dot(a - m.corner, m.normal), db = glm::dot(b - m.corner, m.normal);
-  *miss = MirrorMiss::kSide;
   if (!(da * db > 0.0f)) return std::nullopt;
   // Along a → b' the signed distance to the plane falls linearly from da to −db.
   const float frac = da / (da + db);
@@ -58,7 +53,6 @@ inline std::optional<MirrorJoin> mirror_join(const PlanarMirror& m, const glm::v
   const float d1 = glm::dot(d, m.edge1), d2 = glm::dot(d, m.edge2);
   const float det = e11 * e22 - e12 * e12;
   const float u = (d1 * e22 - d2 * e12) / det, v = (d2 * e11 - d1 * e12) / det;
-  *miss = MirrorMiss::kOff;
   if (!(u >= 0.0f && u < 1.0f && v >= 0.0f && v < 1.0f)) return std::nullopt;
   MirrorJoin j;
   j.point = p;
@@ -68,7 +62,6 @@ inline std::optional<MirrorJoin> mirror_join(const PlanarMirror& m, const glm::v
   j.w_a = ea / la;
   j.w_b = eb / lb;
   j.unfolded = la + lb;
-  *miss = MirrorMiss::kNone;
   return j;
 }
 

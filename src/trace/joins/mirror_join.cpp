@@ -28,7 +28,6 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
   const PathKey key = chain_key(th, *a, s, t, 1);
   for (const PlanarMirror& mirror : rs_.mirrors) {
     ++stats.attempts;
-    float rx = 0.0f, ry = 0.0f;
     std::optional<EndpointConnection> c;  // t = 1: the sensor's join to a's image
     if (t == 1) {
       c = connect_finite(cam_.params, u_lens, mirror_image(mirror, a->p));
@@ -36,12 +35,9 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
         ++stats.outside;
         continue;
       }
-      const Vertex& z0 = fresh_sensor_vertex(th, *c, 'D');
-      cam_.to_pixels(c->raster, &rx, &ry);
-      b = &z0;
+      b = &fresh_sensor_vertex(th, *c, 'D');
     }
-    MirrorMiss miss = MirrorMiss::kNone;
-    const std::optional<MirrorJoin> j = mirror_join(mirror, a->p, b->p, &miss);
+    const std::optional<MirrorJoin> j = mirror_join(mirror, a->p, b->p);
     if (!j) {
       ++stats.outside;  // off the mirror, or the ends on different sides of its plane
       continue;
@@ -74,8 +70,7 @@ void Integrator::connect_mirror(Thread& th, Sampler& rng, int s, int t, int batc
     m.shape = mirror.shape;
     jr.set_connector(ConnectorKind::kMirror, s, t, strategy_index, key, contrib, 1, a, b);
     jr.splat = t == 1;
-    jr.rx = rx;
-    jr.ry = ry;
+    if (jr.splat) cam_.to_pixels(c->raster, &jr.rx, &jr.ry);
     estimate(th, batch);
   }
 }
@@ -86,7 +81,7 @@ const Vertex* Integrator::fresh_light_end(Thread& th, Sampler& rng, int t, JoinB
   const std::size_t li = rs_.pick_light(rng);
   const RenderLight& light = rs_.lights[li];
   if (light.letters[1] != 'D') return nullptr;  // a Dirac direction (distant, laser): no D end
-  if (environment_of(static_cast<int>(li))) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
+  if (light.environment()) return nullptr;  // an image light's points are drawn towards a point (mis_weight.cpp skips these)
   vec3 err{0.0f};
   const SurfacePoint x = rs_.sample_point(light, rng, &err);
   Vertex& y0 = fresh_light_vertex(th, li, light.is_area() ? x.position : fixed_origin(light.params),

@@ -1,11 +1,6 @@
 // The plain joins (s, DD, t) of DESIGN §4 and the two projection connectors (distant (0, DSD, t),
 // orthographic (s, DSD, 0)), each a function from the two subpaths to the JoinResult in th.join
-// (true when it made one): its vertices, letters, contribution before weighting, the segments that
-// must be clear and the densities MIS needs of it. The estimator (render.cpp) weighs and records it.
-//
-// Each join draws its random numbers from a block of its own (join_numbers()), so that adding a
-// strategy leaves every other strategy's numbers unchanged. At a join's two end vertices the
-// scattering functions are evaluated by one helper, end_f().
+// (trace/joins/join.h; true when it made one), which the estimator (render.cpp) weighs and records.
 #include <cmath>
 
 #include "trace/bsdf.h"
@@ -22,21 +17,6 @@ vec3 Integrator::end_f(const Vertex& v, const vec3& w, TransportMode mode, bsdf:
   // The light end carries importance: shading normals make its transport asymmetric (Veach §5.3).
   // (1 where the shading normal is the geometric one; the test saves the call.)
   return mode == TransportMode::kImportance && v.ns != v.n ? f * bsdf::shading_normal_correction(v.wo, w, v.ns, v.n, mode) : f;
-}
-
-void Integrator::begin_join(Thread& th, ConnectorKind kind, int s, int t, int strategy_index) const {
-  JoinResult& jr = th.join;
-  jr.chain = kind;
-  jr.s = s;
-  jr.t = t;
-  jr.strategy = strategy_index;
-  jr.density = JoinDensity{};
-  jr.has_density = false;
-  jr.has_light0 = jr.has_eye0 = false;
-  jr.chain_length = 0;
-  jr.splat = false;
-  jr.rx = jr.ry = 0.0f;
-  jr.num_segments = 0;
 }
 
 bool Integrator::end_join(Thread& th, vec3 contrib, PathKey chain_s, const Vertex* from, const Vertex* to) const {
@@ -83,44 +63,40 @@ Vertex& Integrator::light_vertex(Vertex& y, std::size_t li, const vec3& p, const
   return y;
 }
 
-// --- s = 0: the eye subpath's last vertex lies on an area light ---
 bool Integrator::join_emitter(Thread& th, int t) const {
   const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
   if (pt.kind != Kind::kSurface) return false;
   const int hit_light = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];
   if (hit_light < 0) return false;
-  begin_join(th, ConnectorKind::kNone, 0, t, strategy(0, t));
+  th.join.begin(ConnectorKind::kNone, 0, t, strategy(0, t));
   return end_join(th, pt.beta * emitted(rs_.lights[static_cast<std::size_t>(hit_light)].params, pt.n, pt.wo), 0, nullptr, nullptr);
 }
 
-// --- t = 0: the light subpath's last vertex lies on the lens ---
 bool Integrator::join_lens(Thread& th, int s) const {
   const Vertex& qs = th.light[static_cast<std::size_t>(s - 1)];
   if (qs.kind != Kind::kLens) return false;
   glm::vec2 raster;
   const vec3 we = importance(cam_.params, qs.p, qs.wo, &raster);
   if (is_black(we)) return false;
-  begin_join(th, ConnectorKind::kNone, s, 0, strategy(s, 0));
+  th.join.begin(ConnectorKind::kNone, s, 0, strategy(s, 0));
   JoinResult& jr = th.join;
   cam_.to_pixels(raster, &jr.rx, &jr.ry);
   jr.splat = true;
   return end_join(th, qs.beta * we, 0, nullptr, nullptr);
 }
 
-// --- a light vertex joined to a sensor point: a fresh one (the splat, t = 1) or, for
-//     ortho-projection, the film point on the line of sight through y(s-1) ---
 bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind) const {
   const Vertex* q = &th.light[static_cast<std::size_t>(s - 1)];
   if (q->kind == Kind::kLens || !q->finite) return false;
   const bool ortho = kind == ConnectorKind::kOrthoProjection;
   join_numbers(rng, ortho ? JoinBlock::kOrtho : JoinBlock::kSplat, s);
-  const bool env = q->kind == Kind::kLight && environment_of(q->light) != nullptr;
+  const bool env = q->kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(q->light)].environment() != nullptr;
   // A Dirac direction (orthographic, spot meter) has no DD join; the connector's c(k+1) c(k+2) are
   // a Dirac direction from a film. (No projection of an image light: mis_weight.cpp.)
   if (ortho ? env || cam_.letters != "SD" : cam_.letters[0] != 'D') return false;
   // (The splat's sensor point has a finite direction: a light drawn towards points draws y0 towards it.)
   const bool towards = !ortho && q->kind == Kind::kLight && rs_.lights[static_cast<std::size_t>(q->light)].drawn_towards(true);
-  begin_join(th, kind, s, 1, ortho ? ortho_of(s) : strategy(s, 1));
+  th.join.begin(kind, s, 1, ortho ? ortho_of(s) : strategy(s, 1));
   if (ortho) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   const glm::vec2 ul = ortho ? glm::vec2(0.0f) : rng.get2d_if(reads_lens_numbers(cam_.params));
   if (towards) {
@@ -157,8 +133,6 @@ bool Integrator::join_sensor(Thread& th, Sampler& rng, int s, ConnectorKind kind
   return end_join(th, qs.beta * fq * (shading_cos(qs, w) * c->weight), ortho ? bit(s + 1) : 0, &qs, &z0);
 }
 
-// --- an eye vertex joined to a light point: a fresh light sample (next-event estimation) or,
-//     for distant-projection, the aperture point on the line through z(t-1) against the light ---
 bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind) const {
   const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
   if (pt.kind != Kind::kSurface || !pt.finite || rs_.lights.empty()) return false;
@@ -171,7 +145,7 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   // Dirac directions (distant, laser) have no DD join; the connector's c0 c1 are a Dirac direction
   // from an aperture.
   if (distant ? l.letters != "DS" : !towards && l.letters[1] != 'D') return false;
-  begin_join(th, kind, 1, t, distant ? distant_of(t) : strategy(1, t));
+  th.join.begin(kind, 1, t, distant ? distant_of(t) : strategy(1, t));
   if (distant) ++th.connectors[static_cast<std::size_t>(th.join.strategy)].attempts;
   vec3 err{0.0f};  // the light point's rounding-error bound, which offsets the shadow ray
   // The light point: the aperture point on the line (distant), a point drawn towards pt (a
@@ -198,7 +172,6 @@ bool Integrator::join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind)
   return end_join(th, pt.beta * f * (shading_cos(pt, w) / light_pick_) * c->weight, distant ? bit(1) : 0, &pt, &y0);
 }
 
-// --- s, t >= 2: a shadow ray between y(s-1) and z(t-1) ---
 bool Integrator::join_shadow(Thread& th, int s, int t) const {
   const Vertex& qs = th.light[static_cast<std::size_t>(s - 1)];
   const Vertex& pt = th.eye[static_cast<std::size_t>(t - 1)];
@@ -206,7 +179,7 @@ bool Integrator::join_shadow(Thread& th, int s, int t) const {
   const vec3 d = pt.p - qs.p;
   const float d2 = glm::dot(d, d);
   if (d2 <= 0.0f) return false;
-  begin_join(th, ConnectorKind::kNone, s, t, strategy(s, t));
+  th.join.begin(ConnectorKind::kNone, s, t, strategy(s, t));
   JoinResult& jr = th.join;
   const vec3 w = d * (1.0f / std::sqrt(d2));  // one division, not three
   const vec3 fq = end_f(qs, w, TransportMode::kImportance, &jr.density.at_qs);
