@@ -24,7 +24,7 @@ void atomic_add(std::uint64_t* words, ExactSum v) {
 }
 
 // Asks for the cache lines of a pixel's six words (48 bytes may straddle two lines) ahead of the
-// atomic adds to them.
+// atomic adds to them (the splat buffer's spill queue).
 void request(const std::uint64_t* words) {
   __builtin_prefetch(words, 1);
   __builtin_prefetch(words + 5, 1);
@@ -267,11 +267,6 @@ void ClassImages::PixelSum::add(std::uint32_t set, const ExactRgb& c) {
   }
   slots_.push_back(slot);
   sums_.push_back(c);
-}
-
-void ClassImages::PixelSum::prefetch(ClassImages& images, int x, int y) const {
-  if (!images.inside(x, y)) return;
-  for (std::uint32_t slot : slots_) request(images.words(slot, x, y));
 }
 
 bool ClassImages::PixelSum::flush(ClassImages& images, int x, int y) {

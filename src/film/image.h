@@ -125,8 +125,6 @@ class ClassImages {
     // Adds the collected sums to pixel (x, y) of `images` and clears them. Returns false (and
     // still clears) for a pixel outside the image.
     bool flush(ClassImages& images, int x, int y);
-    // Starts loading the pixel's words in the planes that flush() will add to.
-    void prefetch(ClassImages& images, int x, int y) const;
 
    private:
     const std::vector<std::size_t>* slot_of_set_;  // the image's, read only

@@ -179,9 +179,6 @@ class Integrator {
   // and adds the row's camera contributions to row y of the image.
   void finish_row(Thread& th, ClassImages& images, int y) const {
     trace_shadows(th);
-    // All the row's words are requested before the first is added to: the adds are atomic, and an
-    // atomic add to a line not in cache waits for it, one line after another.
-    for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].prefetch(images, static_cast<int>(x), y);
     for (std::size_t x = 0; x < th.row.size(); ++x) th.row[x].flush(images, static_cast<int>(x), y);
   }
 
