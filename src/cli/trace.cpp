@@ -216,8 +216,9 @@ Command add_trace(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(2, 1024));
   sub->add_option("--replicates", args->options.job.replicates,
                   "Replicates per pixel, dividing --batches; under sobol each is an independently scrambled sequence of spp/R "
-                  "points, and the standard error comes from their differences (R = B: plain batch means)")
-      ->capture_default_str()->check(CLI::Range(2, 1024));
+                  "points, and the standard error comes from their differences (R = B: plain batch means). Default: 2, "
+                  "or on a sensor of fewer pixels than B/2 groups B over the largest divisor of B not above its pixel count")
+      ->default_str("2")->check(CLI::Range(2, 1024));
   sub->add_option("--rr-depth", args->options.job.rr_depth,
                   "Russian roulette from this vertex of a subpath on (the camera or light point is the first)")
       ->capture_default_str()->check(CLI::Range(1, 1000));

@@ -71,9 +71,12 @@ Result<bool> load_fresh(const TraceJobOptions& a, TraceJob* job) {
   id.rr_threshold = a.rr_threshold;
   id.rr_light_threshold = a.rr_light_threshold;
   id.batches = a.batches;
-  id.replicates = a.replicates;
-  if (a.replicates < 1 || a.batches % a.replicates != 0)
-    return make_error(ErrorCode::kUsage, "--replicates " + std::to_string(a.replicates) + " must divide --batches " +
+  // Resolved here, from the resolution the render will have, so that every shard records the same R.
+  id.replicates = a.replicates != 0 ? a.replicates
+                                    : default_replicates(a.batches, static_cast<std::uint64_t>(scene->camera.width) *
+                                                                        static_cast<std::uint64_t>(scene->camera.height));
+  if (id.replicates < 1 || a.batches % id.replicates != 0)
+    return make_error(ErrorCode::kUsage, "--replicates " + std::to_string(id.replicates) + " must divide --batches " +
                                              std::to_string(a.batches) + " (the batches are pixel groups of that many replicates)");
   id.images = !a.no_images;
   id.width = scene->camera.width;

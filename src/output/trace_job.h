@@ -40,7 +40,7 @@ struct TraceJobOptions {
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
   int batches = RenderOptions{}.batches;  // the standard error's batches and replicates per pixel
-  int replicates = RenderOptions{}.replicates;
+  int replicates = RenderOptions{}.replicates;  // 0: default_replicates(batches, the sensor's pixels)
   ManifoldOptions manifold = RenderOptions{}.manifold;
   std::string resolution;  // "WxH"; empty: the scene's
   std::uint64_t max_paths = 1000;  // rows of histogram.json's path table

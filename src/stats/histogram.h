@@ -52,6 +52,7 @@
 // worker thread owns one (a "shard") and the shards are merged at the end.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -86,6 +87,20 @@ inline constexpr int kDefaultReplicates = 2;  // R: B / R = 16 pixel groups of t
 // The default stderr's degrees of freedom, G (R − 1) = 16, for a render of at least R passes over
 // at least G pixels (VarianceDesign::dof()).
 inline constexpr int kDefaultDof = kDefaultBatches - kDefaultBatches / kDefaultReplicates;
+
+// The replicates per pixel when none are asked for: kDefaultReplicates (B / 2 groups), unless the
+// sensor has fewer pixels than that many groups. Then the groups beyond the pixel count would stay
+// empty and the stderr would have as few degrees of freedom as the sensor has pixels — a spot
+// meter's one, a stderr that is honest in expectation but useless for a z. So G is the largest
+// divisor of B not above the pixel count and R = B / G: a spot meter gets one group of B
+// replicates (B − 1 degrees of freedom, the textbook batch means). Under `sobol` the price is
+// fewer points in each replicate's sequence (spp / R), the quasi-Monte Carlo gain of a shorter
+// sequence (issue 36; measured in bench/README.md).
+inline int default_replicates(int batches, std::uint64_t pixels) {
+  int groups = batches / kDefaultReplicates;
+  while (groups > 1 && (batches % groups != 0 || static_cast<std::uint64_t>(groups) > pixels)) --groups;
+  return batches / std::max(groups, 1);
+}
 
 // The batch of pixel `pixel`'s pass `pass` (see "Batches" above): replicate pass mod R of pixel
 // group pixel mod G, G = batches / replicates. Passes go to replicates round-robin, so an

@@ -99,8 +99,10 @@ struct RenderOptions {
   // `sobol` each replicate is an independently scrambled sequence of spp / R points: fewer
   // replicates keep more of the quasi-Monte Carlo gain, more groups make the standard error itself
   // more precise (its relative error is about 1/sqrt(2 · dof), dof = B − B / R). Measured: bench/README.md.
+  // replicates 0: default_replicates(batches, the sensor's pixels) — 2, or more on a sensor of fewer
+  // pixels than B / 2 (a spot meter: one group of B), resolved by render().
   int batches = kDefaultBatches;
-  int replicates = kDefaultReplicates;
+  int replicates = 0;
   std::vector<int> layer_classes;      // classifier classes that get an image layer
   // Accumulate the images at all. Off (`pathex trace --no-images`), the render keeps only the
   // histogram, which is the same either way, and RenderOutput::images is empty (0 × 0): no

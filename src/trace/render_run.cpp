@@ -56,6 +56,8 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
   if (options.light_sampling != LightSampling::kArea)
     sample_lights_by_solid_angle(*rs, scene, /*rectangles=*/options.light_sampling == LightSampling::kSolidAngle);
   RenderOptions o = options;
+  const std::uint64_t pixels = static_cast<std::uint64_t>(rs->camera.width) * static_cast<std::uint64_t>(rs->camera.height);
+  if (o.replicates == 0 && o.batches >= 1) o.replicates = default_replicates(o.batches, pixels);
   if (o.batches < 1 || o.replicates < 1 || o.batches % o.replicates != 0)
     return make_error(ErrorCode::kUsage, "the replicate count (" + std::to_string(o.replicates) +
                                              ") must divide the batch count (" + std::to_string(o.batches) + ")");
@@ -98,7 +100,6 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
   const int w = rs->camera.width, h = rs->camera.height;
   // The eye subpaths' first rays in packets (outputs identical): wherever an eye subpath goes past z0.
   const bool eye_packets = integrator.traces_eye_rays();
-  const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
   const auto start = std::chrono::steady_clock::now();
   // Passes run in chunks: a pixel takes a chunk's passes back to back, so that its camera
   // contributions reach the shared image once per chunk (and its part of the scene stays in

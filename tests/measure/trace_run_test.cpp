@@ -58,6 +58,30 @@ TEST(TraceJob, AFreshJobOfTheDefaultSceneAndItsShard) {
   EXPECT_EQ(job->out, "pathex-out");
 }
 
+// Without --replicates the job resolves R from the resolution the render will have (issue 36), so
+// every shard records the same design: 2 on the 64 × 64 box, 32 on a spot meter (one group, 31
+// degrees of freedom instead of the one that 16 groups of two gave its single pixel), 16 at 3 × 1;
+// an explicit R is kept, and one that does not divide B is refused.
+TEST(TraceJob, TheReplicatesFollowTheSensorsPixelCount) {
+  const auto replicates = [](const std::string& scene, const std::string& resolution, int r) -> Result<int> {
+    TraceJobOptions o;
+    o.scene = scene.empty() ? "" : std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + scene;
+    o.resolution = resolution;
+    o.replicates = r;
+    Result<TraceJob> job = load_trace_job(o);
+    if (!job) return job.error();
+    return job->header.identity.replicates;
+  };
+  EXPECT_EQ(replicates("", "", 0).expect("the box"), 2);
+  EXPECT_EQ(replicates("spotmeter-caustic.json", "", 0).expect("a spot meter"), 32);
+  EXPECT_EQ(replicates("", "3x1", 0).expect("three pixels"), 16);
+  EXPECT_EQ(replicates("", "4x4", 0).expect("sixteen pixels"), 2);
+  EXPECT_EQ(replicates("spotmeter-caustic.json", "", 4).expect("explicit"), 4);
+  const Result<int> bad = replicates("", "", 3);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message, "--replicates 3 must divide --batches 32 (the batches are pixel groups of that many replicates)");
+}
+
 TEST(TraceRun, MissedIsRefusedWithAShardAndTheImagesBeyondTheMemoryLimit) {
   TraceOptions o;
   o.job.shard = "0/2";

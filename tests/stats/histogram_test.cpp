@@ -227,6 +227,29 @@ TEST(ReplicateGroups, TwoReplicatesGiveThePairedDifferenceFormula) {
   EXPECT_TRUE(std::isnan(VarianceDesign({3, 0, 4, 0}, 2).variance({1, 0, 1, 0})));
 }
 
+// Without --replicates the groups follow the sensor's pixel count (issue 36): B / 2 groups of two
+// replicates on any sensor of at least B / 2 pixels, else the largest divisor of B not above the
+// pixel count, so no group stays empty and the stderr keeps B − G ≥ B / 2 degrees of freedom.
+TEST(ReplicateGroups, TheDefaultGroupsFollowThePixelCount) {
+  EXPECT_EQ(default_replicates(32, 256 * 256), 2);
+  EXPECT_EQ(default_replicates(32, 16), 2);
+  EXPECT_EQ(default_replicates(32, 15), 4);  // 8 groups
+  EXPECT_EQ(default_replicates(32, 4), 8);
+  EXPECT_EQ(default_replicates(32, 3), 16);  // 2 groups: 3 does not divide 32
+  EXPECT_EQ(default_replicates(32, 1), 32);  // a spot meter: plain batch means, 31 dof
+  EXPECT_EQ(default_replicates(64, 1000), 2);
+  EXPECT_EQ(default_replicates(12, 5), 3);   // 4 groups of 3
+  EXPECT_EQ(default_replicates(5, 100), 5);  // no divisor of 5 in 2..2: one group
+  EXPECT_EQ(default_replicates(2, 1), 2);
+  for (int b = 2; b <= 64; ++b)
+    for (std::uint64_t pixels : {1u, 2u, 3u, 7u, 16u, 1000u}) {
+      const int r = default_replicates(b, pixels);
+      ASSERT_EQ(b % r, 0) << b << " " << pixels;
+      EXPECT_GE(r, 2) << b << " " << pixels;
+      EXPECT_LE(static_cast<std::uint64_t>(b / r), std::max<std::uint64_t>(pixels, 1)) << b << " " << pixels;
+    }
+}
+
 TEST(ReplicateGroups, RendersFillEveryGroupAndTheHistogramReadsItsDesign) {
   HistogramLayout layout{8, {}, 4};  // four groups of two replicates
   EXPECT_EQ(layout.replicates(), 2);

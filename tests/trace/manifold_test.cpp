@@ -366,9 +366,9 @@ TEST(ManifoldWalk, MirrorSphereReflectionIsCoddingtonsRayTube) {
 // pt-nee cannot sample it (no DD join); pt-nee+manifold finds the one reflection point, and the
 // walk's unbiased trial-count weight makes each sample's estimate a whole multiple of the closed
 // form (0, 1, 2 … times it), so its estimate is within 4σ (Student's, 31 degrees of freedom).
-// The spot meter has one pixel, so the default design (16 pixel groups of two replicates) would
-// give its stderr one degree of freedom: at 16 spp issue 36's sweep read 12/16 and 14/16 of the
-// closed form with a stderr of 0 (seeds 2 and 4). One group of 32 independent batches instead.
+// The spot meter has one pixel: 16 pixel groups of two replicates gave its stderr one degree of
+// freedom, and at 16 spp issue 36's sweep read 12/16 and 14/16 of the closed form with a stderr of
+// 0 (seeds 2 and 4). The default design now follows the pixel count: one group of 32 replicates.
 TEST(ManifoldRender, MirrorSphereImageOnTheFloorIsTheClosedForm) {
   const double rho = 0.7, intensity = 3.0, refl = 0.9;
   const dvec3 centre(0.0, 0.8, 0.0), light(-1.2, 1.5, 0.4), b(-0.2, 0.0, 1.1);
@@ -381,7 +381,6 @@ TEST(ManifoldRender, MirrorSphereImageOnTheFloorIsTheClosedForm) {
   const double expected = rho / M_PI * intensity * refl * mirror_sphere_image(light, centre, 0.5, b, dvec3(0, 1, 0)).dw_db;
   RenderOptions o;
   o.spp = 256;
-  o.replicates = o.batches;
   o.seed = test::stat_seed(5);
   o.max_bounces = 4;
   o.images = false;
