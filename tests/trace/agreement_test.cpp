@@ -41,7 +41,8 @@ constexpr std::uint64_t kMinSamples = 4 * 32;
 // 16 x 16 and its stderr has 4; every sample there adds the lamp's radiance, and under `sobol` both
 // replicates of those pixels can meet the lamp equally often, so its stderr is at times exactly 0
 // while the seed-to-seed spread is 0.4 % of the value (issue 36's sweep: seed 70 of 100). At 5 or
-// more a stderr of 0 needs five such coincidences. (spotmeter-caustic.json's one pixel gives 1.)
+// more a stderr of 0 needs five such coincidences. (spotmeter-caustic.json's one pixel gave 1 until the
+// default groups followed the pixel count: one group of 32 replicates, 31.)
 // Each comparison's tolerance is Student's at its Welch–Satterthwaite degrees of freedom.
 constexpr int kMinDof = 5;
 
