@@ -63,7 +63,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // the intersection instead of delaying the scattering (Sampler::at2d_now).
     const glm::vec2 u_dir = rng.at2d_now(rng.dimension() + 1);
     const HitDetail detail = rs_.textured ? HitDetail::kFull : HitDetail::kNoUv;  // err: zero for points, no offset
-    const std::optional<Hit> hit = mode == TransportMode::kRadiance && count == 1
+    const std::optional<Hit> hit = mode == TransportMode::kRadiance && count == 1 && th.split.splitting()
                                        ? th.split.first_hit(th.ahead, *rs_.geometry, o, d, prev.n, prev.err, detail)  // the camera ray's
                                        : th.ahead.intersect(*rs_.geometry, o, d, prev.n, prev.err, detail);
     // --- a light subpath may end on the lens (strategy t = 0) ---
@@ -148,7 +148,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
 }
 
 int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
-  const std::optional<EndpointRay> r = th.split.primary_ray(th.ahead, cam_, rng, px, py);
+  const std::optional<EndpointRay> r = th.split.splitting() ? th.split.primary_ray(th.ahead, cam_, rng, px, py) : th.ahead.primary_ray(cam_, rng, px, py);
   const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), cam_.letters[0]);
   if (!r) return 1;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
@@ -276,6 +276,7 @@ void Integrator::trace_shadows(Thread& th) const {
 
 // --splits N: the sample's runs after one camera ray (trace/accel/first_vertex_split.h).
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
+  if (o_.splits == 1) return sample_run(th, px, py, pass);
   for (int run = 0; run < o_.splits; ++run) {
     th.split.begin(o_.splits, run, sobol_stream(pass, static_cast<std::uint64_t>(o_.replicates)).index);
     sample_run(th, px, py, pass);

@@ -43,8 +43,8 @@ class FirstVertexSplit {
   // The weight of every contribution of this run: 1 / N (exactly 1 without splitting).
   float weight() const { return weight_; }
 
-  // The camera ray (EyeAhead::primary_ray(), made by run 0 and kept), with rng moved past the
-  // camera's numbers and on to this run's point.
+  // While splitting(): the camera ray (EyeAhead::primary_ray(), made by run 0 and kept), with rng
+  // moved past the camera's numbers and on to this run's point.
   std::optional<EndpointRay> primary_ray(EyeAhead& ahead, const RenderSensor& sensor, Sampler& rng, int px, int py) {
     if (run_ == 0) {
       ray_ = ahead.primary_ray(sensor, rng, px, py);
@@ -52,16 +52,15 @@ class FirstVertexSplit {
     } else {
       rng.set_dimension(after_camera_);
     }
-    if (splitting()) rng.reindex(point_, static_cast<std::uint64_t>(run_));
+    rng.reindex(point_, static_cast<std::uint64_t>(run_));
     return ray_;
   }
-  // The camera ray's hit (EyeAhead::intersect()), traced by run 0 and kept.
+  // While splitting(): the camera ray's hit (EyeAhead::intersect()), traced by run 0 and kept.
   std::optional<Hit> first_hit(EyeAhead& ahead, const EmbreeScene& scene, const glm::vec3& o, const glm::vec3& d,
                                const glm::vec3& n, const glm::vec3& e, HitDetail detail) {
     if (run_ > 0) return hit_;
-    std::optional<Hit> h = ahead.intersect(scene, o, d, n, e, detail);
-    if (splitting()) hit_ = h;
-    return h;
+    hit_ = ahead.intersect(scene, o, d, n, e, detail);
+    return hit_;
   }
 
  private:
