@@ -346,6 +346,25 @@ TEST(ShardFile, LightRouletteThresholdRoundTripsAndDefaultsToTheEyeThreshold) {
   EXPECT_EQ(old->header.identity.rr_light_threshold, 0.25);
 }
 
+// Issue 39: the runs per camera ray (--splits) round-trip, and a shard written before them (no
+// "splits") reads as unsplit, as it was rendered.
+TEST(ShardFile, SplitsRoundTripAndDefaultToOne) {
+  Fixture f;
+  f.header.identity.splits = 8;
+  const std::string bytes = encode_shard(f.header, f.sums);
+  Result<ShardFile> file = parse_shard(bytes, "x.shard");
+  ASSERT_TRUE(file) << file.error().render();
+  EXPECT_EQ(file->header.identity.splits, 8);
+  std::uint32_t h = 0;
+  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
+  nlohmann::ordered_json head = nlohmann::ordered_json::parse(bytes.substr(16, h));
+  ASSERT_TRUE(head["options"].contains("splits"));
+  head["options"].erase("splits");
+  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
+  ASSERT_TRUE(old) << old.error().render();
+  EXPECT_EQ(old->header.identity.splits, 1);
+}
+
 // Issue 39: the replicates per pixel round-trip; a shard written before them (no "replicates")
 // reads as one group of `batches` replicates, as it was rendered; a count that does not divide
 // the batches is refused at its pointer.
