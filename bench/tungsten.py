@@ -10,18 +10,24 @@ The scene is bench/scenes/tungsten-cornell-box.json (Tungsten's data/example-sce
 halves, cached as bench/efficiency.py caches them). The lamp is the pixels whose reference
 luminance is above 5, dilated by 2 pixels (image_error --lamp-luminance 5 --border 2); "off" is
 the rest. Every run is one process, one thread, the round's seed; CPU time is user + system
-(os.wait4), start-up and writing included (Tungsten's figure is samples per CPU-second of its
-render). Tungsten's figures were measured on this machine kind (issue 39) and are fixed here:
+(os.wait4), start-up and writing included; "render" is the render's own CPU seconds as pathex
+reports them in run.json's "cpu_s" (the scene's Embree build, the render, not reading the scene,
+planning or writing the outputs). Tungsten's figure is samples per CPU-second of its render, so
+the render-to-render ratio is the like-for-like one; both are printed. A variant may set its own
+--max-bounces (else 64). Tungsten's figures were measured on this machine kind (issue 39) and are
+fixed here:
 
     spp   off-lamp MSE   M samples / CPU s
     16    7.546e-5       2.33
     64    1.901e-5       2.40
 
-Printed per spp and variant: median CPU s, M samples per CPU-second, mean MSE (whole, off), the
-efficiency 1 / (mean MSE x median CPU s) whole and off, and off / Tungsten's. Pin the whole run
+Printed per spp and variant: median CPU s (process, render), M samples per CPU-second (process),
+mean MSE (whole, off), the efficiency 1 / (mean MSE x median CPU s) whole and off, and off /
+Tungsten's with the process's CPU and with the render's. Pin the whole run
 to one CPU (taskset -c 1): the variants of a round run back to back, in an order that rotates.
 """
 import argparse
+import json
 import os
 import shlex
 import statistics
@@ -69,36 +75,41 @@ def main():
     with tempfile.TemporaryDirectory(prefix="pathex-tungsten-") as work:
         halves = reference(ref_args, SCENE, work)
         for spp in (int(s) for s in args.spp.split(",")):
-            runs = {label: [] for label, _, _ in variants}  # per round: (cpu, mse, mse_off)
+            runs = {label: [] for label, _, _ in variants}  # per round: (cpu, render cpu, mse, mse_off)
             for r in range(args.rounds):
                 order = variants[r % len(variants):] + variants[:r % len(variants)]
                 files, cpus = {}, {}
                 for label, binary, extra in order:
                     out = os.path.join(work, f"{label}-{r}")
-                    cmd = ([binary, "trace"] + scene_args(SCENE, None, 64) +
+                    bounces = None if "--max-bounces" in extra else 64
+                    cmd = ([binary, "trace"] + scene_args(SCENE, None, bounces) +
                            ["--renderer", args.renderer, "--spp", str(spp), "--seed", str(1 + r), "--threads", "1",
                             "--quiet", "--out", out] + extra)
                     cpus[label] = cpu_run(cmd)
+                    with open(os.path.join(out, "run.json")) as f:
+                        cpus[label] = (cpus[label], json.load(f)["cpu_s"])
                     files[label] = os.path.join(out, "classes.exr")
                 noise, errs = errors(args.image_error, halves, list(files.values()), 2, lamp_luminance=5)
                 for label in files:
-                    runs[label].append((cpus[label],) + errs[files[label]])
+                    runs[label].append(cpus[label] + errs[files[label]])
             t = TUNGSTEN.get(spp)
             print(f"\nTungsten's Cornell box, {args.renderer}, {spp} spp, {args.rounds} rounds (reference noise "
                   f"{noise[0]:.3g} whole, {noise[1]:.3g} off)" +
                   (f"; Tungsten: off MSE {t[0]:.4g}, {t[1] / 1e6:.2f} M samples/CPU s, eff off "
                    f"{tungsten_efficiency(spp):.4g}" if t else ""))
-            print(f"  {'variant':<16}{'CPU s':>7}{'M smp/s':>9}{'MSE whole':>12}{'MSE off':>12}{'eff whole':>12}"
-                  f"{'eff off':>12}{'off / Tungsten':>16}")
+            print(f"  {'variant':<16}{'CPU s':>7}{'render':>8}{'M smp/s':>9}{'MSE whole':>12}{'MSE off':>12}"
+                  f"{'eff whole':>12}{'eff off':>12}{'off / Tungsten':>16}{'render / T.':>13}")
             for label, _, _ in variants:
                 rs = runs[label]
                 cpu = statistics.median(x[0] for x in rs)
-                mse = statistics.fmean(x[1] for x in rs)
-                mse_off = statistics.fmean(x[2] for x in rs)
+                render = statistics.median(x[1] for x in rs)
+                mse = statistics.fmean(x[2] for x in rs)
+                mse_off = statistics.fmean(x[3] for x in rs)
                 eff_off = 1.0 / (mse_off * cpu)
                 vs = f"{eff_off / tungsten_efficiency(spp):.2f}x" if t else "-"
-                print(f"  {label:<16}{cpu:>7.3f}{PIXELS * spp / cpu / 1e6:>9.3f}{mse:>12.4g}{mse_off:>12.4g}"
-                      f"{1.0 / (mse * cpu):>12.4g}{eff_off:>12.4g}{vs:>16}", flush=True)
+                vs_render = f"{1.0 / (mse_off * render) / tungsten_efficiency(spp):.2f}x" if t else "-"
+                print(f"  {label:<16}{cpu:>7.3f}{render:>8.3f}{PIXELS * spp / cpu / 1e6:>9.3f}{mse:>12.4g}"
+                      f"{mse_off:>12.4g}{1.0 / (mse * cpu):>12.4g}{eff_off:>12.4g}{vs:>16}{vs_render:>13}", flush=True)
 
 
 if __name__ == "__main__":

@@ -228,6 +228,10 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--rr-light-threshold", args->options.job.rr_light_threshold,
                   "The same for light subpaths (lt, bdpt)")
       ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
+  sub->add_option("--splits", args->options.job.splits,
+                  "Runs of each sample after its camera ray and first hit, each weighted 1/N: more paths of indirect light "
+                  "per camera ray (issue 39, docs/efficiency.md)")
+      ->capture_default_str()->check(CLI::Range(1, 1024));
   sub->add_option("--resolution", args->options.job.resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
       ->type_name("WxH");
   sub->add_option("--max-paths", args->options.job.max_paths,
@@ -258,7 +262,7 @@ Command add_trace(CLI::App& app) {
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
                                   "--resolution", "--max-paths", "--sampler", "--light-sampling", "--batches", "--replicates", "--rr-depth", "--rr-threshold",
-                                  "--rr-light-threshold"})
+                                  "--rr-light-threshold", "--splits"})
               if (sub->count(o) > 0) args->options.job.settings_given.push_back(o);
             for (const std::string& o : manifold_option_names())
               if (sub->count(o) > 0) args->options.job.settings_given.push_back(o);

@@ -17,6 +17,7 @@
 #include "stats/histogram.h"
 #include "film/image.h"
 #include "trace/accel/eye_ahead.h"
+#include "trace/accel/first_vertex_split.h"
 #include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/joins/join.h"
@@ -136,6 +137,7 @@ class Integrator {
     std::uint64_t pass = 0;
     int py = 0;
     std::optional<NonfiniteSample> first_nonfinite{};
+    FirstVertexSplit split{};  // --splits: the run of the sample in progress, its camera ray and hit
     EyeAhead ahead{};  // the eye subpath's first ray and hit, made in a packet before the sample (trace/accel/eye_packets.h)
   };
 
@@ -175,6 +177,7 @@ class Integrator {
   // One sample: pixel (px, py), pass `pass`. Its camera contributions collect in th.row (the
   // caller flushes them with finish_row()); light-tracing splats go through th.splats.
   void sample(Thread& th, int px, int py, std::uint64_t pass) const;
+  void sample_run(Thread& th, int px, int py, std::uint64_t pass) const;  // one of its --splits runs
   // After a row's samples: traces the shadow rays still queued, records what they let through,
   // and adds the row's camera contributions to row y of the image.
   void finish_row(Thread& th, ClassImages& images, int y) const {

@@ -62,7 +62,10 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // before the ray is traced: they do not depend on the hit, and so their computation overlaps
     // the intersection instead of delaying the scattering (Sampler::at2d_now).
     const glm::vec2 u_dir = rng.at2d_now(rng.dimension() + 1);
-    const std::optional<Hit> hit = th.ahead.intersect(*rs_.geometry, o, d, prev.n, prev.err, rs_.textured ? HitDetail::kFull : HitDetail::kNoUv);  // zero for points: no offset
+    const HitDetail detail = rs_.textured ? HitDetail::kFull : HitDetail::kNoUv;  // err: zero for points, no offset
+    const std::optional<Hit> hit = mode == TransportMode::kRadiance && count == 1 && th.split.splitting()
+                                       ? th.split.first_hit(th.ahead, *rs_.geometry, o, d, prev.n, prev.err, detail)  // the camera ray's
+                                       : th.ahead.intersect(*rs_.geometry, o, d, prev.n, prev.err, detail);
     // --- a light subpath may end on the lens (strategy t = 0) ---
     if (mode == TransportMode::kImportance && lens_hits_) {
       const std::optional<EndpointConnection> lens = hit_lens(cam_.params, o, d);
@@ -145,7 +148,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
 }
 
 int Integrator::eye_subpath(Thread& th, Sampler& rng, int px, int py) const {
-  const std::optional<EndpointRay> r = th.ahead.primary_ray(cam_, rng, px, py);
+  const std::optional<EndpointRay> r = th.split.splitting() ? th.split.primary_ray(th.ahead, cam_, rng, px, py) : th.ahead.primary_ray(cam_, rng, px, py);
   const Vertex& z0 = sensor_vertex(th.eye[0], r ? r->origin : vec3(0.0f), r ? r->normal : vec3(0.0f), cam_.letters[0]);
   if (!r) return 1;
   // Importance over the sampling density is 1 for every sensor: pixel values are radiance.
@@ -237,7 +240,7 @@ void Integrator::estimate(Thread& th, int batch) const {
   const int technique = Technique{jr.strategy, jr.chain == ConnectorKind::kDistantProjection ? 0 : jr.s,
                                   jr.chain == ConnectorKind::kOrthoProjection ? 0 : jr.t, connector}
                             .code();
-  const Pending r{jr.letters, jr.contribution * weight, jr.strategy, batch, technique, jr.splat, connector,
+  const Pending r{jr.letters, jr.contribution * (weight * th.split.weight()), jr.strategy, batch, technique, jr.splat, connector,
                   jr.rx, jr.ry, th.px, jr.num_segments, th.pass};
   if (jr.num_segments == 0) {
     record(th, r);
@@ -271,20 +274,31 @@ void Integrator::trace_shadows(Thread& th) const {
   th.shadow.clear();
 }
 
+// --splits N: the sample's runs after one camera ray (trace/accel/first_vertex_split.h).
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
+  if (o_.splits == 1) return sample_run(th, px, py, pass);
+  for (int run = 0; run < o_.splits; ++run) {
+    th.split.begin(o_.splits, run, sobol_stream(pass, static_cast<std::uint64_t>(o_.replicates)).index);
+    sample_run(th, px, py, pass);
+  }
+}
+
+void Integrator::sample_run(Thread& th, int px, int py, std::uint64_t pass) const {
   const std::uint64_t pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(cam_.width) + static_cast<std::uint64_t>(px);
   Sampler rng(o_.seed, pixel, pass, o_.sampler, static_cast<std::uint64_t>(o_.replicates));
   rng.set_dimension(kEyeDims);
   // The light's first direction, computed before the eye subpath is traced: a Sobol point's chain
   // of dependent multiplies then overlaps the eye subpath's work instead of delaying the light
-  // subpath's first ray (Sampler::at2d_now).
+  // subpath's first ray (Sampler::at2d_now). A split sample's runs take it after the camera's
+  // numbers, from their own point.
   const bool light_walk = !rs_.lights.empty() && max_light_ > 0;  // as light_subpath() tests
-  const glm::vec2 u_light_ray = light_walk ? rng.at2d_now(kLightRayDim) : glm::vec2(0.0f);
+  const glm::vec2 u_light_ray_ahead = light_walk && !th.split.splitting() ? rng.at2d_now(kLightRayDim) : glm::vec2(0.0f);
   const int batch = batch_of(pixel, pass, o_.batches, o_.replicates);
   th.px = px;
   th.py = py;
   th.pass = pass;
   const int nt = eye_subpath(th, rng, px, py);
+  const glm::vec2 u_light_ray = light_walk && th.split.splitting() ? rng.at2d(kLightRayDim) : u_light_ray_ahead;
   rng.set_dimension(kLightDims);
   const int ns = light_subpath(th, rng, u_light_ray);
   th.ns = ns;

@@ -91,6 +91,9 @@ struct RenderOptions {
   int rr_depth = 3;
   float rr_threshold = 0.3f;
   float rr_light_threshold = 1.0f;
+  // --splits: runs of each sample after its camera ray and first hit, each weighted 1 / splits
+  // (trace/accel/first_vertex_split.h; issue 39, docs/efficiency.md).
+  int splits = 1;
   SamplerKind sampler = SamplerKind::kSobol;  // --sampler
   // --light-sampling; the default chosen by efficiency on several scenes (issue 39, docs/tracer.md).
   LightSampling light_sampling = LightSampling::kSphereCone;

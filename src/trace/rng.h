@@ -141,6 +141,13 @@ class Sampler {
     return u;
   }
   void skip(std::uint64_t n) { dim_ += n; }
+  // The numbers from here on are those of point `index` of the same scrambled sequences (sobol),
+  // or of a stream of their own keyed by `salt` (independent): a split sample's run takes its
+  // numbers past the camera's so (trace/accel/first_vertex_split.h).
+  void reindex(std::uint32_t index, std::uint64_t salt) {
+    if (kind_ == SamplerKind::kSobol) reversed_index_ = sobol::reverse_bits(index);
+    else key_ = mix64(key_ ^ (salt + 0x452821e638d01377ULL));
+  }
   // The number get1d() would draw at an absolute dimension, without moving the cursor.
   [[gnu::always_inline]] float at(std::uint64_t dim) const {
     if (kind_ == SamplerKind::kIndependent) return bits_to_unit_float(stream_bits(key_, dim));

@@ -311,6 +311,13 @@ TEST(ShardFile, EveryTruncationAndEveryFlippedByteIsRefused) {
   EXPECT_EQ(message(bytes + "x"), "corrupted shard file: 1 bytes after its checksum");
 }
 
+// The file's JSON header.
+nlohmann::ordered_json header_of(const std::string& bytes) {
+  std::uint32_t h = 0;
+  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
+  return nlohmann::ordered_json::parse(bytes.substr(16, h));
+}
+
 // The file with its JSON header replaced by `head` (lengths and checksum made right again), as a
 // newer or hand-edited writer would make it.
 std::string with_header(const std::string& bytes, const std::string& head) {
@@ -336,14 +343,29 @@ TEST(ShardFile, LightRouletteThresholdRoundTripsAndDefaultsToTheEyeThreshold) {
   ASSERT_TRUE(file) << file.error().render();
   EXPECT_EQ(file->header.identity.rr_threshold, 0.25);
   EXPECT_EQ(file->header.identity.rr_light_threshold, 0.75);
-  std::uint32_t h = 0;
-  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
-  nlohmann::ordered_json head = nlohmann::ordered_json::parse(bytes.substr(16, h));
+  nlohmann::ordered_json head = header_of(bytes);
   ASSERT_TRUE(head["options"].contains("rr_light_threshold"));
   head["options"].erase("rr_light_threshold");
   Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
   ASSERT_TRUE(old) << old.error().render();
   EXPECT_EQ(old->header.identity.rr_light_threshold, 0.25);
+}
+
+// Issue 39: the runs per camera ray (--splits) round-trip, and a shard written before them (no
+// "splits") reads as unsplit, as it was rendered.
+TEST(ShardFile, SplitsRoundTripAndDefaultToOne) {
+  Fixture f;
+  f.header.identity.splits = 8;
+  const std::string bytes = encode_shard(f.header, f.sums);
+  Result<ShardFile> file = parse_shard(bytes, "x.shard");
+  ASSERT_TRUE(file) << file.error().render();
+  EXPECT_EQ(file->header.identity.splits, 8);
+  nlohmann::ordered_json head = header_of(bytes);
+  ASSERT_TRUE(head["options"].contains("splits"));
+  head["options"].erase("splits");
+  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
+  ASSERT_TRUE(old) << old.error().render();
+  EXPECT_EQ(old->header.identity.splits, 1);
 }
 
 // Issue 39: the replicates per pixel round-trip; a shard written before them (no "replicates")
@@ -352,9 +374,7 @@ TEST(ShardFile, LightRouletteThresholdRoundTripsAndDefaultsToTheEyeThreshold) {
 TEST(ShardFile, ReplicatesRoundTripAndDefaultToTheBatchCount) {
   Fixture f;
   const std::string bytes = encode_shard(f.header, f.sums);
-  std::uint32_t h = 0;
-  for (std::size_t i = 0; i < 4; ++i) h |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[12 + i])) << (8 * i);
-  nlohmann::ordered_json head = nlohmann::ordered_json::parse(bytes.substr(16, h));
+  nlohmann::ordered_json head = header_of(bytes);
   EXPECT_EQ(head["options"]["replicates"], 3);
   head["options"]["batches"] = 4;
   head["options"]["replicates"] = 2;

@@ -32,10 +32,11 @@ struct Sampling {
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
   LightSampling light_sampling = RenderOptions{}.light_sampling;
+  int splits = RenderOptions{}.splits;
   std::string name() const {
     return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
            std::to_string(rr_threshold) + " rr-light-threshold " + std::to_string(rr_light_threshold) + " light-sampling " +
-           to_string(light_sampling);
+           to_string(light_sampling) + " splits " + std::to_string(splits);
   }
 };
 
@@ -56,6 +57,7 @@ inline Rendered render_scene(Result<Scene> scene, const std::string& renderer, c
   o.rr_threshold = sampling.rr_threshold;
   o.rr_light_threshold = sampling.rr_light_threshold;
   o.light_sampling = sampling.light_sampling;
+  o.splits = sampling.splits;
   RenderOutput out = render(s, profile, keep.back()->classifier.get(), o).expect("a render");
   RunInfo info;
   info.spp = spp;
