@@ -157,16 +157,27 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
-// The nearest point in (tmin, tmax) of a sphere or disk that a ray meets (past the points its
-// cut-out lets the ray through: a sphere has two).
-bool analytic_t(const Analytic* a, const vec3& o, const vec3& d, float tmin, float tmax, float* t) {
+// The nearest point in (tmin, tmax) of a sphere or disk that a ray meets. (`inline`: without the
+// hint GCC calls it out of line from analytic_t(), 20 instructions more a ray.)
+inline bool shape_t(const Analytic* a, const vec3& o, const vec3& d, float tmin, float tmax, float* t) {
+  return a->sphere ? sphere_t(std::get<SphereShape>(a->shape->geometry), o, d, tmin, tmax, t)
+                   : disk_t(std::get<DiskShape>(a->shape->geometry), o, d, tmin, tmax, t);
+}
+
+// shape_t() past the points a cut-out lets the ray through (a sphere has two).
+bool cut_out_t(const Analytic* a, const vec3& o, const vec3& d, float tmin, float tmax, float* t) {
   for (int tries = 0; tries < 3; ++tries) {
-    const bool hit = a->sphere ? sphere_t(std::get<SphereShape>(a->shape->geometry), o, d, tmin, tmax, t)
-                               : disk_t(std::get<DiskShape>(a->shape->geometry), o, d, tmin, tmax, t);
+    const bool hit = shape_t(a, o, d, tmin, tmax, t);
     if (!hit || !passes(a, 0, 0.0f, 0.0f, o, d, o + *t * d)) return hit;
     tmin = std::nextafter(*t, std::numeric_limits<float>::infinity());
   }
   return false;
+}
+
+// The ray's nearest point on a sphere or disk. Without a cut-out the test is as small as before
+// cut-outs were added: it runs for every ray of a packet that meets the shape's bounds.
+bool analytic_t(const Analytic* a, const vec3& o, const vec3& d, float tmin, float tmax, float* t) {
+  return a->index < 0 ? shape_t(a, o, d, tmin, tmax, t) : cut_out_t(a, o, d, tmin, tmax, t);
 }
 
 void analytic_intersect(const RTCIntersectFunctionNArguments* args) {

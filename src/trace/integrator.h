@@ -18,6 +18,7 @@
 #include "film/image.h"
 #include "trace/accel/eye_ahead.h"
 #include "trace/accel/first_vertex_split.h"
+#include "trace/accel/nee_mis.h"
 #include "trace/accel/path_ids.h"
 #include "trace/bsdf.h"
 #include "trace/joins/join.h"
@@ -58,6 +59,7 @@ class Integrator {
                       has_manifold_;
     for (const Material* m : rs.material_of_shape) finite_of_shape_.push_back(bsdf::has_finite_component(*m) ? 1 : 0);
     absorbing_ = rs.absorbing;
+    nee_pair_ = accel::nee_pair_only(table_, has_connectors_);
     max_light_ = std::min(max_light_, max_bounces_ + 1);
     max_eye_ = std::min(std::max(max_eye_, 1), max_bounces_ + 2);
   }
@@ -316,6 +318,10 @@ class Integrator {
   // x.s, its x.m constructed vertices after it), against every strategy of the profile that samples
   // the same path. `join`: the densities the join computed at its two ends (null: recomputed).
   float mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const;
+  // mis_weight() of a plain join (x.t >= 2) of pt-nee's pair of strategies (nee_pair()) by the fast
+  // path (trace/accel/nee_mis.h): equal bit for bit (tests/trace/mis_test.cpp).
+  float nee_pair_weight(const PathView& x, PathKey key, const JoinDensity* join) const;
+  bool nee_pair() const { return nee_pair_; }
   // The strategies that sample path x, `self` the own one (connectors listed in th.techniques).
   mis::Strategies techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const;
   // th.densities[lo … hi) of a plain or projection join's path: the subpaths' stored densities
@@ -358,6 +364,7 @@ class Integrator {
   float light_pick_ = 0.0f;
   bool lens_hits_ = false;
   bool absorbing_ = false;  // some shape has an absorbing interior (trace/media.h)
+  bool nee_pair_ = false;   // the plain joins are at most (0, n) and (1, n - 1), no connector (accel::nee_pair_only)
 };
 
 }  // namespace pathex::tracer

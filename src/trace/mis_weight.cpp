@@ -207,6 +207,23 @@ void Integrator::path_densities(Thread& th, const PathView& x, PathKey key, int 
   for (int v = lo; v < hi; ++v) th.densities[static_cast<std::size_t>(v)] = mis::Densities{remap_density(lf(v)), remap_density(ef(v))};
 }
 
+float Integrator::nee_pair_weight(const PathView& x, PathKey key, const JoinDensity* join) const {
+  // The other strategy, (0, t + 1) for next-event estimation, (1, t - 1) for the emitter hit, as
+  // techniques() finds it: the profile runs it and its join letters are D.
+  const int s = x.s;
+  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));
+  if (((table_.plain_splits(x.size()) & d_pairs) >> (1 - s) & 1) == 0) return 1.0f;
+  const Vertex& pt = x[s];
+  if (s == 0) return accel::two_strategy_weight(pt.pdf_fwd, light_origin_density(rs_.light_of_shape[static_cast<std::size_t>(pt.shape)], pt.p, pt.n, x[1]));
+  // y0 as the emitter hit would draw it: pt's BSDF density towards it, to area at y0 (as join_densities() sets it).
+  const Vertex& y0 = x[0];
+  const vec3 e = pt.p - y0.p;
+  const float d2 = join ? join->d2 : glm::dot(e, e);
+  const vec3 w = join ? join->w : d2 > 0.0f ? e * (1.0f / std::sqrt(d2)) : vec3(0.0f);
+  const float dir = join && join->at_pt.known ? join->at_pt.to_wi : pdf_dir(pt, &pt.wo, -w);
+  return accel::two_strategy_weight(y0.pdf_fwd, d2 > 0.0f ? dir * abs_cos(y0, w) / d2 : 0.0f);
+}
+
 float Integrator::mis_weight(Thread& th, const PathView& x, PathKey key, ConnectorKind self, const JoinDensity* join) const {
   const mis::Strategies st = techniques(th, x, key, self);
   if (st.alone()) return 1.0f;  // no other strategy samples the path: no density is needed

@@ -233,7 +233,9 @@ Integrator::PathView Integrator::path_of(const Thread& th, const JoinResult& jr)
 void Integrator::estimate(Thread& th, int batch) const {
   const JoinResult& jr = th.join;
   if (!filter_.records(jr.letters)) return;  // not recorded by the plan: no weight, no shadow ray
-  const float weight = mis_weight(th, path_of(th, jr), jr.letters, jr.chain, jr.has_density ? &jr.density : nullptr);
+  const JoinDensity* density = jr.has_density ? &jr.density : nullptr;
+  const float weight = nee_pair_ && jr.chain == ConnectorKind::kNone && jr.t >= 2 ? nee_pair_weight(path_of(th, jr), jr.letters, density)
+                                                                                : mis_weight(th, path_of(th, jr), jr.letters, jr.chain, density);
   // The technique, as the histogram names it: a projection's chain starts at c0 (distant: s = 0)
   // or ends at c(k+2) (ortho: t = 0).
   const bool connector = jr.chain != ConnectorKind::kNone;

@@ -201,6 +201,11 @@ struct IntegratorTestAccess {
   static float weight_of(const Integrator& in, Thread& th, int s, int t, const Vertex* y0, const JoinDensity* join) {
     return in.mis_weight(th, plain_path(th, s, t, y0), in.path_key(th, s, t, y0), ConnectorKind::kNone, join);
   }
+  // The same weight by pt-nee's fast path (trace/accel/nee_mis.h), as the estimator takes it when
+  // in.nee_pair() and t >= 2.
+  static float fast_weight_of(const Integrator& in, const Thread& th, int s, int t, const Vertex* y0, const JoinDensity* join) {
+    return in.nee_pair_weight(plain_path(th, s, t, y0), in.path_key(th, s, t, y0), join);
+  }
   // The density with which next-event estimation draws the point `on_light` of an area light.
   static float light_point_density(const Integrator& in, const Vertex& on_light) {
     return light_pick(in) * in.scene().lights[static_cast<std::size_t>(in.scene().light_of_shape[static_cast<std::size_t>(on_light.shape)])].pdf_pos;
@@ -446,6 +451,11 @@ TEST(Mis, PathTracerWeightsAreTheTwoStrategyPowerHeuristic) {
       HistogramLayout layout;
       ClassImages images(1, 1, nullptr, {});
       const Integrator in(rs, strategies, o);
+      // pt-nee's and pt's joins the estimator weighs by the fast path, which must equal the general
+      // routine bit for bit (below). (pbrt-v4-path and mitsuba3-path run a distant connector: never.)
+      const bool fast = in.nee_pair();
+      EXPECT_EQ(fast, std::string(renderer) == "pt-nee" || std::string(renderer) == "pt") << renderer;
+      const auto same_bits = [&](float a, float b) { return !fast || std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); };
       Integrator::Thread th{Histogram(layout, nullptr), {ClassImages::PixelSum(images)}, {}, {}, 0, {}, {}, {}};
       th.images = &images;
       th.connectors.resize(strategies.strategies.size());
@@ -467,6 +477,7 @@ TEST(Mis, PathTracerWeightsAreTheTwoStrategyPowerHeuristic) {
             const double expected = other ? heuristic(pt.pdf_fwd, A::light_point_density(in, pt)) : 1.0;
             const float w = A::weight_of(in, th, 0, t, nullptr, nullptr);
             EXPECT_NEAR(w, expected, 1e-6) << where(0);
+            EXPECT_PRED2(same_bits, A::fast_weight_of(in, th, 0, t, nullptr, nullptr), w) << where(0) << ", the fast path";
             if (w < 1.0f) ++hits_weighed;
           }
           Vertex y0;
@@ -484,6 +495,9 @@ TEST(Mis, PathTracerWeightsAreTheTwoStrategyPowerHeuristic) {
             const float w = A::weight_of(in, th, 1, t, &y0, &join);
             EXPECT_NEAR(w, expected, 1e-5 * expected) << where(1);
             EXPECT_NEAR(w, A::weight_of(in, th, 1, t, &y0, nullptr), 1e-6) << where(1) << ", the join's density recomputed";
+            EXPECT_PRED2(same_bits, A::fast_weight_of(in, th, 1, t, &y0, &join), w) << where(1) << ", the fast path";
+            EXPECT_PRED2(same_bits, A::fast_weight_of(in, th, 1, t, &y0, nullptr), A::weight_of(in, th, 1, t, &y0, nullptr))
+                << where(1) << ", the fast path, the join's density recomputed";
             if (w < 1.0f) ++nee_weighed;
           }
         }
