@@ -67,12 +67,16 @@ void add_manifold_options(CLI::App* app, ManifoldOptions* o) {
                   "BIASED when > 0: a join draws this many seeds and counts each distinct chain they find once, "
                   "no inverse-probability estimate (Zeltner et al. 2020's fixed trials); 0: the unbiased estimator")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(0, 100000))->group(group);
+  app->add_option(name[7], o->rate,
+                  "Share of the eye subpaths whose joins run the connector (a coin per sample; unbiased: the contribution "
+                  "is divided by it and MIS weighs the connector by it)")
+      ->capture_default_str()->check(real_in(0, true, 1, false))->group(group);
 }
 
 const std::vector<std::string>& manifold_option_names() {
   static const std::vector<std::string> names = {"--manifold-iterations", "--manifold-threshold", "--manifold-min-segment",
                                                  "--manifold-singular", "--manifold-trials",
-                                                 "--manifold-seeds", "--manifold-biased-trials"};
+                                                 "--manifold-seeds", "--manifold-biased-trials", "--manifold-rate"};
   return names;
 }
 

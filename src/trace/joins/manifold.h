@@ -44,6 +44,10 @@ struct ManifoldOptions {
   // counts every distinct chain they find once, with no inverse-probability estimate (a chain a
   // join finds with probability p < 1 is underweighted by p). 0: the unbiased estimator above.
   int biased_trials = 0;
+  // The share of eye subpaths whose joins run the connector (a coin per sample, its own stream);
+  // a contribution is divided by it and MIS counts it in the connector's density (the sample count
+  // of the balance heuristic's n_i p_i), so any rate in (0, 1] is unbiased. 1: every sample.
+  double rate = 1.0;
   bool operator==(const ManifoldOptions&) const = default;
 };
 

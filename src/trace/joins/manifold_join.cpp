@@ -34,6 +34,13 @@ bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const
 }
 
 
+double Integrator::manifold_rate(PathKey key, int b, int k) const {
+  if (o_.manifold.rate >= 1.0 || b + 1 > k - 1) return o_.manifold.rate;
+  for (int v = b + 1; v <= k - 1; ++v)
+    if (packed_is_d(key, v + 1)) return o_.manifold.rate;  // x_v's letter c(v+1) is D
+  return 1.0;
+}
+
 void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, ConnectorKind self, int lo, int hi) const {
   const int k = x.size() - 1;
   const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S: x(i-1) is a Dirac vertex
@@ -181,6 +188,13 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
 void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = manifold_of(s, t);
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
+  // Where light tracing cannot join (manifold_rate()) every sample runs the connector; elsewhere
+  // the share --manifold-rate of them, by one coin per sample from a stream of its own.
+  bool through = t >= 3;
+  for (int j = 1; j <= t - 2 && through; ++j) through = th.eye[static_cast<std::size_t>(j)].letter == 'S';
+  const double rate = through ? 1.0 : o_.manifold.rate;
+  if (rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate)
+    return;
   const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
   if (b->kind != Kind::kSurface || !b->finite) return;
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kManifoldLight);
@@ -310,7 +324,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   //     until one finds it again (geometric, E[K] = 1 / P(a batch finds it)); the batches are
   //     shared, and run until every chain is found again or max_trials seeds are spent ---
   if (biased) {  // every distinct chain once
-    for (const ManifoldSolution& x : found) emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db);
+    for (const ManifoldSolution& x : found) emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db / rate);
     return;
   }
   std::size_t left = found.size();
@@ -330,7 +344,8 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   }
   stats.truncated += left;  // weighed by the batches run, an underestimate of their inverse probability
   for (const ManifoldSolution& x : found)
-    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)));
+    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain,
+                  x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)) / rate);
 }
 
 void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a_end, const Vertex& b_end,
