@@ -33,12 +33,10 @@ bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const
   return true;
 }
 
-
 double Integrator::manifold_rate(PathKey key, int b, int k) const {
-  if (o_.manifold.rate >= 1.0 || b + 1 > k - 1) return o_.manifold.rate;
-  for (int v = b + 1; v <= k - 1; ++v)
-    if (packed_is_d(key, v + 1)) return o_.manifold.rate;  // x_v's letter c(v+1) is D
-  return 1.0;
+  bool through = b + 1 <= k - 1;  // the camera sees x_b through S vertices only (x_v's letter is c(v+1))
+  for (int v = b + 1; v <= k - 1 && through; ++v) through = !packed_is_d(key, v + 1);
+  return through ? 1.0 : o_.manifold.rate;
 }
 
 void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, ConnectorKind self, int lo, int hi) const {
@@ -188,13 +186,11 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
 void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = manifold_of(s, t);
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
-  // Where light tracing cannot join (manifold_rate()) every sample runs the connector; elsewhere
-  // the share --manifold-rate of them, by one coin per sample from a stream of its own.
+  // manifold_rate() from the eye subpath; below 1, one coin per sample (from a stream of its own).
   bool through = t >= 3;
   for (int j = 1; j <= t - 2 && through; ++j) through = th.eye[static_cast<std::size_t>(j)].letter == 'S';
   const double rate = through ? 1.0 : o_.manifold.rate;
-  if (rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate)
-    return;
+  if (rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate) return;
   const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
   if (b->kind != Kind::kSurface || !b->finite) return;
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kManifoldLight);
@@ -344,8 +340,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   }
   stats.truncated += left;  // weighed by the batches run, an underestimate of their inverse probability
   for (const ManifoldSolution& x : found)
-    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain,
-                  x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)) / rate);
+    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)) / rate);
 }
 
 void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a_end, const Vertex& b_end,
