@@ -61,14 +61,14 @@ TEST(ManifoldOptions, HelpStatesTheLibraryDefaults) {
   const pathex::ManifoldOptions d;
   EXPECT_EQ(d.max_iterations, 64);  // what the README states
   EXPECT_EQ(d.max_trials, 2000);
-  EXPECT_EQ(d.seeds, 4);
+  EXPECT_FALSE(d.seeds);  // resolved from the profile: 1 in bdpt+manifold, 4 in pt-nee+manifold (below)
   EXPECT_EQ(d.biased_trials, 0);  // unbiased by default
-  EXPECT_EQ(d.rate, 1.0);         // every sample runs the connector
+  EXPECT_FALSE(d.rate);            // resolved from the profile: 0.125 in bdpt+manifold, 1 in pt-nee+manifold
   for (const std::string line : {"--manifold-iterations INT:INT in [1 - 10000]=64", "--manifold-threshold FLOAT:FLOAT in (0, 1)=1e-05",
                                  "--manifold-min-segment FLOAT:FLOAT in [0, 1)=0.001",
                                  "--manifold-singular FLOAT:FLOAT in [0, 1)=1e-07", "--manifold-trials INT:INT in [1 - 100000]=2000",
-                                 "--manifold-seeds INT:INT in [1 - 64]=4", "--manifold-biased-trials INT:INT in [0 - 100000]=0",
-                                 "--manifold-rate FLOAT:FLOAT in (0, 1]=1"})
+                                 "--manifold-seeds INT:INT in [1 - 64]", "--manifold-biased-trials INT:INT in [0 - 100000]=0",
+                                 "--manifold-rate FLOAT:FLOAT in (0, 1]"})
     EXPECT_NE(r.out.find("  " + line + "\n"), std::string::npos) << line << "\n" << r.out;
 }
 
@@ -173,7 +173,13 @@ TEST(ManifoldOptions, MergeRefusesRendersWithOtherLimits) {
   const CliRun v = run("merge " + a + " " + q + " --out " + m);
   EXPECT_EQ(v.code, 2);
   EXPECT_NE(v.err.find("are not of one render: another --manifold-rate (0.25 against 1)\n"), std::string::npos) << v.err;
-  for (const std::string& dir : {a, b, c, e, q, s0, s1, m}) std::filesystem::remove_all(dir);
+  // bdpt+manifold's defaults (its light tracing and joins also sample the paths the camera sees directly):
+  // recorded resolved, so its shards and a merge agree on them.
+  const std::string bm = out_dir("bm");
+  ASSERT_EQ(run("trace " + kScene + " --renderer bdpt+manifold --spp 1 --resolution 8x8 --no-images --quiet --out " + bm).code, 0);
+  EXPECT_EQ(shard_header(bm)["options"]["manifold"]["rate"], 0.125);
+  EXPECT_EQ(shard_header(bm)["options"]["manifold"]["seeds"], 1);
+  for (const std::string& dir : {a, b, c, e, q, s0, s1, m, bm}) std::filesystem::remove_all(dir);
 }
 
 TEST(ManifoldOptions, ResumeTakesTheLimitsFromTheFolder) {

@@ -144,15 +144,15 @@ TEST(ManifoldReference, LampGlassSeenThroughAgreesWithTheQuadrature) {
 // alone, whose estimates are heavy-tailed (over 160 seeds a standard deviation of 67 % of the mean,
 // the largest 7× it): 8 seeds' mean lay low with a small spread, and the test failed at 2 of 100
 // swept seeds. With both strategies: 5.6 % (bench/README.md, issue 36, eighth session).
-// The same with the connector run for an eighth of the samples (--manifold-rate 0.125: its
-// contributions times 8, its MIS density times 1/8 where light tracing can join; issue 40), 32 spp:
-// a family of the two comparisons.
+// The same with the connector run for an eighth of the samples with one seed a batch (bdpt+manifold's
+// defaults since issue 40: its contributions times 8, its MIS density times 1/8 where light tracing can
+// join), 32 spp, and at every sample with 4 seeds (the defaults before), 16 spp: a family of the two.
 TEST(ManifoldReference, BdptManifoldDirectCausticAgreesWithBdpt) {
   const std::string scene = "samples/scenes/lamp-glass.json";
   const SeedMean plain = seed_mean(scene, "bdpt", "LDDSSDDSE", 64, 8);
   ASSERT_GT(plain.mean, 0.0);
   const double k = pathex::test::family_sigmas(2, 1e-3, 7);
-  for (const auto& [renderer, spp] : {std::pair<std::string, int>{"bdpt+manifold", 16}, {"bdpt+manifold --manifold-rate 0.125", 32}}) {
+  for (const auto& [renderer, spp] : {std::pair<std::string, int>{"bdpt+manifold --manifold-rate 1 --manifold-seeds 4", 16}, {"bdpt+manifold", 32}}) {
     const SeedMean both = seed_mean(scene, renderer, "LDDSSDDSE", spp, 8);
     ASSERT_GT(both.mean, 0.0) << renderer;
     const double v1 = both.stderr_ * both.stderr_, v2 = plain.stderr_ * plain.stderr_;

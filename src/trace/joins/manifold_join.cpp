@@ -36,7 +36,7 @@ bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const
 double Integrator::manifold_rate(PathKey key, int b, int k) const {
   bool through = b + 1 <= k - 1;  // the camera sees x_b through S vertices only (x_v's letter is c(v+1))
   for (int v = b + 1; v <= k - 1 && through; ++v) through = !packed_is_d(key, v + 1);
-  return through ? 1.0 : o_.manifold.rate;
+  return through ? 1.0 : o_.manifold.rate.value_or(1.0);
 }
 
 void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, ConnectorKind self, int lo, int hi) const {
@@ -189,7 +189,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   // manifold_rate() from the eye subpath; below 1, one coin per sample (from a stream of its own).
   bool through = t >= 3;
   for (int j = 1; j <= t - 2 && through; ++j) through = th.eye[static_cast<std::size_t>(j)].letter == 'S';
-  const double rate = through ? 1.0 : o_.manifold.rate;
+  const double rate = through ? 1.0 : o_.manifold.rate.value_or(1.0);
   if (rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate) return;
   const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
   if (b->kind != Kind::kSurface || !b->finite) return;
@@ -289,7 +289,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   // --- the first batch: `seeds` seeds, each an attempt; the distinct chains they solve to (the
   //     biased variant: `biased_trials` seeds, and no batches after it) ---
   const bool biased = o_.manifold.biased_trials > 0;
-  const int per_batch = biased ? o_.manifold.biased_trials : std::max(1, o_.manifold.seeds);
+  const int per_batch = biased ? o_.manifold.biased_trials : std::max(1, o_.manifold.seeds.value_or(kManifoldSeeds));
   found.clear();
   wrong.clear();
   for (int j = 0; j < per_batch; ++j) {
