@@ -40,7 +40,8 @@ const CLI::Validator& non_negative();
 void add_notation_options(CLI::App* app, NotationOptions* n);
 // The manifold connector's limits (trace/joins/manifold.h), group "Manifold connector", each with
 // its default and its range: --manifold-iterations, --manifold-threshold, --manifold-min-segment,
-// --manifold-singular, --manifold-trials, --manifold-seeds, --manifold-biased-trials.
+// --manifold-singular, --manifold-trials, --manifold-seeds, --manifold-biased-trials,
+// --manifold-rate.
 void add_manifold_options(CLI::App* app, ManifoldOptions* o);
 // The names of those options, in that order (for commands that refuse them in some modes).
 const std::vector<std::string>& manifold_option_names();

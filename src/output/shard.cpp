@@ -333,9 +333,10 @@ json identity_json(const RenderIdentity& id) {
   if (const std::optional<ManifoldOptions>& m = id.manifold) {
     j["options"]["manifold"] = {{"max_iterations", m->max_iterations}, {"threshold", m->threshold},
                                 {"min_segment", m->min_segment},       {"singular", m->singular},
-                                {"max_trials", m->max_trials},             {"seeds", m->seeds}};
+                                {"max_trials", m->max_trials},             {"seeds", m->seeds.value_or(kManifoldSeeds)}};
     // Only when set: an unbiased render's header is as before.
     if (m->biased_trials > 0) j["options"]["manifold"]["biased_trials"] = m->biased_trials;
+    if (m->rate.value_or(1.0) != 1.0) j["options"]["manifold"]["rate"] = *m->rate;
   } else {
     j["options"]["manifold"] = nullptr;
   }
@@ -475,7 +476,7 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
     id.max_paths = rd.uint(o, "/options", "max_paths");
     if (!o.contains("manifold")) rd.fail("/options/manifold", "missing manifold (null, or the manifold connector's limits)");
     else if (const nlohmann::json& m = o.at("manifold"); !m.is_null() &&
-        rd.object(m, "/options/manifold", {"max_iterations", "threshold", "min_segment", "singular", "max_trials", "seeds", "biased_trials"})) {
+        rd.object(m, "/options/manifold", {"max_iterations", "threshold", "min_segment", "singular", "max_trials", "seeds", "biased_trials", "rate"})) {
       const char* mp = "/options/manifold";
       ManifoldOptions limits;
       limits.max_iterations = rd.small(m, mp, "max_iterations");
@@ -485,6 +486,7 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
       limits.max_trials = rd.small(m, mp, "max_trials");
       limits.seeds = rd.small(m, mp, "seeds");
       if (m.contains("biased_trials")) limits.biased_trials = rd.small(m, mp, "biased_trials");
+      limits.rate = m.contains("rate") ? rd.number(m, mp, "rate") : 1.0;  // absent: every sample (as before issue 40)
       id.manifold = limits;
     }
   }
@@ -580,8 +582,9 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
     if (auto d = real("--manifold-min-segment", x.min_segment, y.min_segment)) return d;
     if (auto d = real("--manifold-singular", x.singular, y.singular)) return d;
     if (auto d = option("--manifold-trials", x.max_trials, y.max_trials)) return d;
-    if (auto d = option("--manifold-seeds", x.seeds, y.seeds)) return d;
+    if (auto d = option("--manifold-seeds", x.seeds.value_or(kManifoldSeeds), y.seeds.value_or(kManifoldSeeds))) return d;
     if (auto d = option("--manifold-biased-trials", x.biased_trials, y.biased_trials)) return d;
+    if (auto d = real("--manifold-rate", x.rate.value_or(1.0), y.rate.value_or(1.0))) return d;
   } else if (a.manifold.has_value() != b.manifold.has_value()) {
     return std::optional<std::string>("another manifold setting (one runs the manifold connector, the other does not)");
   }

@@ -36,7 +36,7 @@
 // splitting: then 1), batches, replicates (absent in files written before issue 39's
 // pixel groups: then batches, plain batch means), width, height, images, max_paths, manifold (null, or the
 // manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds,
-// biased_trials when > 0})}, "strategies" [names],
+// biased_trials when > 0, rate when not 1: the resolved --manifold-rate; absent, 1})}, "strategies" [names],
 // "connectors" [{strategy, connector}] (the strategies that run a connector, in the profile's order,
 // with the connector's name: "mirror", "distant-projection", "ortho-projection", "manifold"), "share" and
 // "passes" (each [[first, last), …]: the passes the run was asked for, and those whose sums this

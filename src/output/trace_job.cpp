@@ -86,7 +86,7 @@ Result<bool> load_fresh(const TraceJobOptions& a, TraceJob* job) {
   // The manifold's limits are part of the render only where its connector runs.
   if (std::any_of(profile->strategies.begin(), profile->strategies.end(),
                   [](const Strategy& st) { return st.connector == ConnectorKind::kManifold; }))
-    id.manifold = a.manifold;
+    id.manifold = resolved_manifold(*profile, a.manifold);  // recorded resolved: shards and merge agree
   for (const Strategy& st : runnable->strategies) id.strategies.push_back(st.name);
 
   std::string class_text;

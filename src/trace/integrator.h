@@ -335,6 +335,8 @@ class Integrator {
   // function of its ends, as the manifold's own is. A walk that crosses the chain samples b from a
   // with a's direction density times the generalized geometry term |dω_a/dA_b| (and the Dirac
   // lobes' choices), a from b likewise; the chain's vertices count 1 for both walks.
+  // The share of samples running the manifold join with eye end x_b of x0 … xk (its MIS factor).
+  double manifold_rate(PathKey key, int b, int k) const;
   void chain_densities(Thread& th, const PathView& x, PathKey key, ConnectorKind self, int lo, int hi) const;
   // The estimator's one consumer of joins: weighs th.join by MIS over every strategy of the
   // profile, then records it, or queues its segments and records it once all are found clear.

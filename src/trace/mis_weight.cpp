@@ -88,8 +88,8 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
     case ConnectorKind::kNone: st.own = {s, 0, 1.0}; break;
     case ConnectorKind::kDistantProjection: st.own = {1, 0, 1.0 / light_pos()}; break;
     case ConnectorKind::kOrthoProjection: st.own = {n - 1, 0, 1.0 / cam_.pdf_pos}; break;
-    case ConnectorKind::kMirror:
-    case ConnectorKind::kManifold: st.own = {s, x.m, 1.0}; break;
+    case ConnectorKind::kMirror: st.own = {s, x.m, 1.0}; break;
+    case ConnectorKind::kManifold: st.own = {s, x.m, manifold_rate(key, s + x.m, k)}; break;  // run for that share of the samples
   }
   // --- the plain joins whose two join letters are D ---
   const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
@@ -117,7 +117,7 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
   if (has_manifold_)
     for (int i = 1 + drawn; i <= k - 1; ++i) {
       const int m = s_run(i);
-      if (m > 0 && !letter_s(i) && !(self == ConnectorKind::kManifold && i == s) && manifold_at(x, key, i, m)) out[count++] = {i, m, 1.0};
+      if (m > 0 && !letter_s(i) && !(self == ConnectorKind::kManifold && i == s) && manifold_at(x, key, i, m)) out[count++] = {i, m, manifold_rate(key, i + m, k)};
     }
   return st;
 }

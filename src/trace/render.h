@@ -197,6 +197,18 @@ struct StrategySet {
 
 Result<StrategySet> runnable_strategies(const Profile& profile);
 
+// --manifold-rate's and --manifold-seeds' defaults (issue 40), which render() and the shard header resolve:
+// where the profile has a plain strategy whose light subpath leaves the light (s >= 2: light tracing at
+// t = 1, or bdpt's joins), which also samples the paths whose eye end the camera sees directly or past a
+// diffuse vertex, the connector runs there in kShareWithOtherPaths of the samples with one seed a batch
+// (measured best on lamp-glass.json, also on the caustic seen through glass: bench/README.md, issue 40);
+// else in every sample with kManifoldSeeds (pt-nee+manifold: the connector alone samples such paths
+// across the chain, a lower rate only loses).
+inline constexpr double kShareWithOtherPaths = 0.125;
+inline constexpr int kManifoldSeeds = 4;
+bool manifold_shares_paths(const Profile& profile);
+ManifoldOptions resolved_manifold(const Profile& profile, ManifoldOptions o);
+
 // A render of `plan` (trace/plan.h, plan_render()): its strategies, its lights' emission
 // narrowing, and only the paths its filter records.
 Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Classifier* classifier,

@@ -6,6 +6,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "trace/accel/eye_packets.h"
@@ -29,6 +30,19 @@ Result<StrategySet> runnable_strategies(const Profile& profile) {
     set.strategies.push_back(st);
   }
   return set;
+}
+
+bool manifold_shares_paths(const Profile& profile) {
+  return std::any_of(profile.strategies.begin(), profile.strategies.end(), [](const Strategy& st) {
+    return st.connector == ConnectorKind::kNone && (st.s.hi == Range::kOpen || st.s.hi >= 2);
+  });
+}
+
+ManifoldOptions resolved_manifold(const Profile& profile, ManifoldOptions o) {
+  const bool shares = manifold_shares_paths(profile);
+  if (!o.rate) o.rate = shares ? kShareWithOtherPaths : 1.0;
+  if (!o.seeds) o.seeds = shares ? 1 : kManifoldSeeds;
+  return o;
 }
 
 namespace tracer {
@@ -63,6 +77,7 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
                                              ") must divide the batch count (" + std::to_string(o.batches) + ")");
   // The same rule as the checker's: an explicit bound overrides the profile's own.
   if (!o.max_bounces) o.max_bounces = profile.max_bounces.value_or(16);
+  o.manifold = resolved_manifold(profile, o.manifold);
   HistogramLayout layout;
   layout.num_batches = o.batches;
   layout.groups = o.batches / o.replicates;

@@ -61,12 +61,14 @@ TEST(ManifoldOptions, HelpStatesTheLibraryDefaults) {
   const pathex::ManifoldOptions d;
   EXPECT_EQ(d.max_iterations, 64);  // what the README states
   EXPECT_EQ(d.max_trials, 2000);
-  EXPECT_EQ(d.seeds, 4);
+  EXPECT_FALSE(d.seeds);  // resolved from the profile: 1 in bdpt+manifold, 4 in pt-nee+manifold (below)
   EXPECT_EQ(d.biased_trials, 0);  // unbiased by default
+  EXPECT_FALSE(d.rate);            // resolved from the profile: 0.125 in bdpt+manifold, 1 in pt-nee+manifold
   for (const std::string line : {"--manifold-iterations INT:INT in [1 - 10000]=64", "--manifold-threshold FLOAT:FLOAT in (0, 1)=1e-05",
                                  "--manifold-min-segment FLOAT:FLOAT in [0, 1)=0.001",
                                  "--manifold-singular FLOAT:FLOAT in [0, 1)=1e-07", "--manifold-trials INT:INT in [1 - 100000]=2000",
-                                 "--manifold-seeds INT:INT in [1 - 64]=4", "--manifold-biased-trials INT:INT in [0 - 100000]=0"})
+                                 "--manifold-seeds INT:INT in [1 - 64]", "--manifold-biased-trials INT:INT in [0 - 100000]=0",
+                                 "--manifold-rate FLOAT:FLOAT in (0, 1]"})
     EXPECT_NE(r.out.find("  " + line + "\n"), std::string::npos) << line << "\n" << r.out;
 }
 
@@ -84,6 +86,9 @@ TEST(ManifoldOptions, BadValuesAreOneMessageAndExitTwo) {
       {"--manifold-seeds 0", "--manifold-seeds: Value 0 not in range 1 to 64"},
       {"--manifold-biased-trials 100001", "--manifold-biased-trials: Value 100001 not in range 0 to 100000"},
       {"--manifold-biased-trials -1", "--manifold-biased-trials: expected a non-negative integer, got '-1'"},
+      {"--manifold-rate 0", "--manifold-rate: expected a number in (0, 1], got '0'"},
+      {"--manifold-rate 1.5", "--manifold-rate: expected a number in (0, 1], got '1.5'"},
+      {"--manifold-rate nan", "--manifold-rate: expected a number in (0, 1], got 'nan'"},
   };
   for (const auto& [args, message] : cases) {
     const CliRun r = run("trace " + kScene + " --renderer pt-nee+manifold --spp 1 --out " + out_dir("bad") + " " + args);
@@ -160,14 +165,29 @@ TEST(ManifoldOptions, MergeRefusesRendersWithOtherLimits) {
   const CliRun u = run("merge " + a + " " + e + " --out " + m);
   EXPECT_EQ(u.code, 2);
   EXPECT_NE(u.err.find("are not of one render: another --manifold-biased-trials (8 against 0)\n"), std::string::npos) << u.err;
-  for (const std::string& dir : {a, b, c, e, s0, s1, m}) std::filesystem::remove_all(dir);
+  // So is a rate below 1 (its samples weigh the connector by it).
+  const std::string q = out_dir("q");
+  ASSERT_EQ(run(common + q + " --manifold-rate 0.25").code, 0);
+  EXPECT_EQ(shard_header(q)["options"]["manifold"]["rate"], 0.25);
+  EXPECT_FALSE(shard_header(a)["options"]["manifold"].contains("rate"));
+  const CliRun v = run("merge " + a + " " + q + " --out " + m);
+  EXPECT_EQ(v.code, 2);
+  EXPECT_NE(v.err.find("are not of one render: another --manifold-rate (0.25 against 1)\n"), std::string::npos) << v.err;
+  // bdpt+manifold's defaults (its light tracing and joins also sample the paths the camera sees directly):
+  // recorded resolved, so its shards and a merge agree on them.
+  const std::string bm = out_dir("bm");
+  ASSERT_EQ(run("trace " + kScene + " --renderer bdpt+manifold --spp 1 --resolution 8x8 --no-images --quiet --out " + bm).code, 0);
+  EXPECT_EQ(shard_header(bm)["options"]["manifold"]["rate"], 0.125);
+  EXPECT_EQ(shard_header(bm)["options"]["manifold"]["seeds"], 1);
+  for (const std::string& dir : {a, b, c, e, q, s0, s1, m, bm}) std::filesystem::remove_all(dir);
 }
 
 TEST(ManifoldOptions, ResumeTakesTheLimitsFromTheFolder) {
   const std::string a = out_dir("resume");
   ASSERT_EQ(run("trace " + kScene + " --renderer bdpt --spp 1 --resolution 8x8 --no-images --quiet --out " + a).code, 0);
   for (const std::string o : {"--manifold-iterations 8", "--manifold-threshold 0.001", "--manifold-min-segment 0",
-                               "--manifold-singular 0", "--manifold-trials 3", "--manifold-seeds 2", "--manifold-biased-trials 4"}) {
+                               "--manifold-singular 0", "--manifold-trials 3", "--manifold-seeds 2", "--manifold-biased-trials 4",
+                               "--manifold-rate 0.5"}) {
     const CliRun r = run("trace --resume " + a + " " + o);
     EXPECT_EQ(r.code, 2) << o;
     EXPECT_EQ(r.err, "pathex: error: --resume takes the render's settings from " + a + "; " + o.substr(0, o.find(' ')) +

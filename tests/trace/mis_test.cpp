@@ -547,6 +547,9 @@ struct ManifoldRig {
 // renderer's weight of each plain join (its subpaths' stored densities, changed across a chain the
 // manifold could build: chain_densities()) must equal the whole path's. With the lamps sampled by
 // area and (issue 39) by the cone they subtend, x0's density then next-event estimation's from x1.
+// And with the connector run for a share of the samples (--manifold-rate 0.25, issue 40): that
+// share is the factor of its density where light tracing could join the path (the camera sees the
+// chain's eye end directly, or past a diffuse vertex), 1 where the camera sees it through glass.
 TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
   const Profile profile = parse_profile(R"({"name": "bdpt+manifold", "strategies": [
       {"name": "bdpt", "s": "0..", "chain": "DD", "t": "0.."},
@@ -554,10 +557,13 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
                                         "bdpt+manifold.json", Limits{})
                               .expect("a valid profile");
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
+  for (const double rate : {1.0, 0.25})
   for (const LightSampling light_sampling : {LightSampling::kArea, LightSampling::kSolidAngle})
   for (const char* name : {"point-glass.json", "lamp-glass.json"}) {
+    if (rate < 1.0 && light_sampling != LightSampling::kArea) continue;
     const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + name).expect("the sample");
     ManifoldRig rig(scene, strategies, 5, light_sampling);
+    rig.o.manifold.rate = rate;  // the integrator reads its options by reference
     const Integrator& integrator = rig.in;
     const RenderScene& rs = rig.rs;
     const RenderOptions& o = rig.o;
@@ -575,7 +581,7 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
           const double sum = A::whole_path_weight_sum(integrator, th, s, t, &chains);
           ++checked;
           if (chains > 0) ++shared;
-          const std::string where = std::string(name) + " " + to_string(light_sampling) + " " + A::label(integrator, th, s, t) + " (s=" + std::to_string(s) +
+          const std::string where = std::string(name) + " " + to_string(light_sampling) + " rate " + std::to_string(rate) + " " + A::label(integrator, th, s, t) + " (s=" + std::to_string(s) +
                                     ", t=" + std::to_string(t) + ")";
           EXPECT_NEAR(sum, 1.0, 1e-4) << where;
           // The join's own densities read the cosines at its ends: where the join runs along a

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -38,12 +39,15 @@ struct ManifoldOptions {
   double threshold = 1e-5;         // largest |tangential half vector| accepted as solved (SMS: 1e-5)
   double min_segment = 1e-3;       // shortest segment, as a fraction of the scene's size (Cycles: 1e-3)
   double singular = 1e-7;          // smallest |pivot| / largest |pivot| of the constraint Jacobian
-  int seeds = 4;                   // seeds per batch: the first batch's distinct chains are the join's contributions
+  std::optional<int> seeds;        // seeds per batch (the first's distinct chains: the contributions); unset: ditto
   int max_trials = 2000;           // seeds spent finding them again (their inverse probability), at most
   // Biased when > 0 (Zeltner et al. 2020's fixed-trials variant): a join draws this many seeds and
   // counts every distinct chain they find once, with no inverse-probability estimate (a chain a
   // join finds with probability p < 1 is underweighted by p). 0: the unbiased estimator above.
   int biased_trials = 0;
+  // The share of eye subpaths whose joins run the connector (a coin per sample, its own stream; unbiased:
+  // a contribution is divided by it, MIS counts it in n_i p_i). Unset: the profile's (trace/render.h).
+  std::optional<double> rate;
   bool operator==(const ManifoldOptions&) const = default;
 };
 

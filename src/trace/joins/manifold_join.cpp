@@ -33,6 +33,11 @@ bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const
   return true;
 }
 
+double Integrator::manifold_rate(PathKey key, int b, int k) const {
+  bool through = b + 1 <= k - 1;  // the camera sees x_b through S vertices only (x_v's letter is c(v+1))
+  for (int v = b + 1; v <= k - 1 && through; ++v) through = !packed_is_d(key, v + 1);
+  return through ? 1.0 : o_.manifold.rate.value_or(1.0);
+}
 
 void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, ConnectorKind self, int lo, int hi) const {
   const int k = x.size() - 1;
@@ -181,6 +186,11 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
 void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = manifold_of(s, t);
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
+  // manifold_rate() from the eye subpath; below 1, one coin per sample (from a stream of its own).
+  bool through = t >= 3;
+  for (int j = 1; j <= t - 2 && through; ++j) through = th.eye[static_cast<std::size_t>(j)].letter == 'S';
+  const double rate = through ? 1.0 : o_.manifold.rate.value_or(1.0);
+  if (rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate) return;
   const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
   if (b->kind != Kind::kSurface || !b->finite) return;
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kManifoldLight);
@@ -279,7 +289,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   // --- the first batch: `seeds` seeds, each an attempt; the distinct chains they solve to (the
   //     biased variant: `biased_trials` seeds, and no batches after it) ---
   const bool biased = o_.manifold.biased_trials > 0;
-  const int per_batch = biased ? o_.manifold.biased_trials : std::max(1, o_.manifold.seeds);
+  const int per_batch = biased ? o_.manifold.biased_trials : std::max(1, o_.manifold.seeds.value_or(kManifoldSeeds));
   found.clear();
   wrong.clear();
   for (int j = 0; j < per_batch; ++j) {
@@ -310,7 +320,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   //     until one finds it again (geometric, E[K] = 1 / P(a batch finds it)); the batches are
   //     shared, and run until every chain is found again or max_trials seeds are spent ---
   if (biased) {  // every distinct chain once
-    for (const ManifoldSolution& x : found) emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db);
+    for (const ManifoldSolution& x : found) emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db / rate);
     return;
   }
   std::size_t left = found.size();
@@ -330,7 +340,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   }
   stats.truncated += left;  // weighed by the batches run, an underestimate of their inverse probability
   for (const ManifoldSolution& x : found)
-    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)));
+    emit_manifold(th, s, t, batch, strategy_index, *a, *b, x.chain, x.dw_db * static_cast<double>(x.batches > 0 ? x.batches : std::max(batches, 1)) / rate);
 }
 
 void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a_end, const Vertex& b_end,
