@@ -25,6 +25,15 @@
 
 namespace pathex::tracer {
 
+// The manifold connector runs for this share of the samples where the camera sees its eye end x_b
+// directly or past a diffuse vertex (--manifold-rate), for every sample where it sees x_b through
+// specular vertices only: the factor of its density in the weight (n_i p_i).
+double Integrator::manifold_rate(PathKey key, int b, int k) const {
+  bool through = b + 1 <= k - 1;  // the camera sees x_b through S vertices only (x_v's letter is c(v+1))
+  for (int v = b + 1; v <= k - 1 && through; ++v) through = !packed_is_d(key, v + 1);
+  return through ? 1.0 : o_.manifold.rate.value_or(1.0);
+}
+
 void Integrator::store_densities(Thread& th, int ns, int nt) const {
   for (int i = 0; i < ns; ++i) {
     const Vertex& y = th.light[static_cast<std::size_t>(i)];

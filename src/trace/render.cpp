@@ -278,11 +278,7 @@ void Integrator::trace_shadows(Thread& th) const {
 
 // --splits N: the sample's runs after one camera ray (trace/accel/first_vertex_split.h).
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
-  if (o_.splits == 1) return sample_run(th, px, py, pass);
-  for (int run = 0; run < o_.splits; ++run) {
-    th.split.begin(o_.splits, run, sobol_stream(pass, static_cast<std::uint64_t>(o_.replicates)).index);
-    sample_run(th, px, py, pass);
-  }
+  th.split.runs(o_.splits, pass, static_cast<std::uint64_t>(o_.replicates), [&] { sample_run(th, px, py, pass); });
 }
 
 void Integrator::sample_run(Thread& th, int px, int py, std::uint64_t pass) const {

@@ -80,4 +80,23 @@ inline float shading_cos(const Vertex& v, const vec3& w) {
   return std::fabs(glm::dot(v.ns, w)) + static_cast<float>(!v.has_normal());
 }
 
+// A full path x0 … xk in light-to-eye order as the integrator's joins form it, without copying a
+// vertex: s light vertices (y0 replaced by a fresh sample light0 when given), the m vertices a
+// connector constructs, t eye vertices in reverse (z0 replaced by eye0 when given).
+struct PathView {
+  const Vertex* light = nullptr;
+  const Vertex* light0 = nullptr;
+  const Vertex* chain = nullptr;
+  const Vertex* eye = nullptr;
+  const Vertex* eye0 = nullptr;
+  int s = 0, m = 0, t = 0;
+  int size() const { return s + m + t; }
+  const Vertex& operator[](int i) const {
+    if (i < s) return i == 0 && light0 ? *light0 : light[i];
+    if (i < s + m) return chain[i - s];
+    const int j = s + m + t - 1 - i;
+    return j == 0 && eye0 ? *eye0 : eye[j];
+  }
+};
+
 }  // namespace pathex::tracer

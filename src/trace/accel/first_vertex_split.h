@@ -39,6 +39,16 @@ class FirstVertexSplit {
     weight_ = 1.0f / static_cast<float>(runs);
     point_ = point * static_cast<std::uint32_t>(runs) + static_cast<std::uint32_t>(run);
   }
+  // The runs of pass `pass`'s sample: run_one() once without splitting (no bookkeeping), else
+  // `runs` times, each after begin() at the pass's point in its replicate (sobol_stream()).
+  template <class RunOne>
+  void runs(int runs, std::uint64_t pass, std::uint64_t replicates, RunOne run_one) {
+    if (runs == 1) return run_one();
+    for (int run = 0; run < runs; ++run) {
+      begin(runs, run, sobol_stream(pass, replicates).index);
+      run_one();
+    }
+  }
   bool splitting() const { return runs_ > 1; }
   // The weight of every contribution of this run: 1 / N (exactly 1 without splitting).
   float weight() const { return weight_; }

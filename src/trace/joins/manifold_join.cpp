@@ -33,12 +33,6 @@ bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const
   return true;
 }
 
-double Integrator::manifold_rate(PathKey key, int b, int k) const {
-  bool through = b + 1 <= k - 1;  // the camera sees x_b through S vertices only (x_v's letter is c(v+1))
-  for (int v = b + 1; v <= k - 1 && through; ++v) through = !packed_is_d(key, v + 1);
-  return through ? 1.0 : o_.manifold.rate.value_or(1.0);
-}
-
 void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, ConnectorKind self, int lo, int hi) const {
   const int k = x.size() - 1;
   const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S: x(i-1) is a Dirac vertex
