@@ -139,6 +139,9 @@ def main():
                                stderr=subprocess.DEVNULL)
             if r.returncode != 0:
                 failed.append(seed)
+            # Each seed's outcome as it happens (stderr), so that a sweep stopped early still tells
+            # what it found: the table row comes only when a test's last seed has run.
+            print(f"{exe} {flt} seed {seed}: {'FAILED' if r.returncode != 0 else 'ok'}", file=sys.stderr, flush=True)
         per_run = (time.time() - t0) / args.seeds
         rate = len(failed) / args.seeds
         worst = max(worst, rate)
