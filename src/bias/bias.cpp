@@ -134,10 +134,8 @@ UnderSampling compare_estimates(std::vector<UnderSampled> pairs, double rate, do
     const double diff = p.renderer.luminance - p.reference.luminance;
     if (sigma == 0 || std::fabs(diff) < min_difference) continue;  // equal, or too little light to matter
     p.z = diff / sigma;
-    const double welch = (vr + vref) * (vr + vref);
     const int dr = std::max(std::min(p.renderer.dof, r_dof), 1), dref = std::max(std::min(p.reference.dof, ref_dof), 1);
-    const double denominator = vr * vr / dr + vref * vref / dref;
-    p.dof = denominator > 0 ? std::clamp(welch / denominator, 1.0, 1e6) : dref;
+    p.dof = vr + vref > 0 ? welch_dof(vr, dr, vref, dref) : dref;
     if (student_two_sided_tail(std::fabs(p.z), static_cast<int>(std::lround(p.dof))) < u.each) u.flagged.push_back(std::move(p));
   }
   std::stable_sort(u.flagged.begin(), u.flagged.end(),

@@ -37,4 +37,11 @@ double sidak_sigmas(int checks, double family_rate, int dof) {
   return hi;
 }
 
+double welch_dof(double va, int dof_a, double vb, int dof_b) {
+  const double denominator = va * va / dof_a + vb * vb / dof_b;
+  if (!(denominator > 0)) return std::min(dof_a, dof_b);
+  return std::clamp((va + vb) * (va + vb) / denominator, static_cast<double>(std::min(dof_a, dof_b)),
+                    static_cast<double>(dof_a + dof_b));
+}
+
 }  // namespace pathex

@@ -19,4 +19,10 @@ double normal_equivalent(double x, int dof);
 // `family_rate` when nothing is wrong (Šidák: each at 1 − (1 − family_rate)^(1/checks)).
 double sidak_sigmas(int checks, double family_rate, int dof);
 
+// The Welch–Satterthwaite degrees of freedom of the difference of two estimates with variances
+// `va`, `vb` (their squared stderrs) of `dof_a`, `dof_b` ≥ 1 degrees of freedom:
+// (va + vb)² / (va² / dof_a + vb² / dof_b), in [min(dof_a, dof_b), dof_a + dof_b]; the smaller dof
+// where both variances are 0.
+double welch_dof(double va, int dof_a, double vb, int dof_b);
+
 }  // namespace pathex

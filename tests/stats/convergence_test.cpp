@@ -85,6 +85,18 @@ TEST(Convergence, StderrCheckReadsBatchMeansZAsStudentsT) {
   EXPECT_NEAR(check_stderr(rungs, 1.0, 0.0).chi2, 4 * 3.5 * 3.5, 1e-6);
 }
 
+// The Welch–Satterthwaite degrees of freedom of a difference: equal variances add their dof; one
+// variance alone gives its own; one that dominates gives nearly its own; both 0 give the fewer.
+TEST(Significance, WelchDofOfADifference) {
+  EXPECT_DOUBLE_EQ(welch_dof(1.0, 16, 1.0, 16), 32.0);
+  EXPECT_DOUBLE_EQ(welch_dof(4.0, 16, 0.0, 31), 16.0);
+  EXPECT_DOUBLE_EQ(welch_dof(0.0, 16, 4.0, 31), 31.0);
+  EXPECT_DOUBLE_EQ(welch_dof(0.0, 16, 0.0, 31), 16.0);
+  // (va + vb)² / (va²/da + vb²/db) = 1.21 / (1/16 + 0.01/16) = 19.168…
+  EXPECT_NEAR(welch_dof(1.0, 16, 0.1, 16), 1.21 / (1.01 / 16), 1e-12);
+  EXPECT_NEAR(welch_dof(1.0, 16, 1e-4, 16), 16.0, 0.01);
+}
+
 // Issue 36: the lower tail. χ²_2's lower point at p is −2 ln(1 − p) in closed form (its survival
 // function is e^(−x/2)); a ladder whose errors are far inside their error bars — a stderr 30×
 // the true error at every rung — is flagged as too large, and an honest one is not. Rungs with a

@@ -173,12 +173,11 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
           continue;
         }
         const double va = a.std_error * a.std_error, vb = b.std_error * b.std_error;
-        const double welch = (va + vb) * (va + vb) / (va * va / a.dof + vb * vb / b.dof);
         comparisons.push_back({where + ": " + p.path + " bdpt " + std::to_string(a.luminance) + " ± " + std::to_string(a.std_error) +
                                    " (" + std::to_string(a.dof) + " dof), " + name + " " + std::to_string(b.luminance) + " ± " +
                                    std::to_string(b.std_error) + " (" + std::to_string(b.dof) + " dof)",
                                std::fabs(a.luminance - b.luminance), std::sqrt(va + vb),
-                               std::isfinite(welch) ? static_cast<int>(welch) : std::min(a.dof, b.dof)});
+                               static_cast<int>(welch_dof(va, a.dof, vb, b.dof))});
       }
     }
   }

@@ -30,7 +30,8 @@ nlohmann::json read_json(const std::string& path) {
 
 // One seed (test::stat_seed_from), 128 spp (a few seconds): the manifold's estimate of the class
 // and the reference agree within family_sigmas(1) combined standard errors (0.1 %, Student's t on
-// the 31 degrees of freedom of 32 batches: 3.6; the manifold's 2 %: a bias of 8 % or more fails).
+// the 16 degrees of freedom of the default 16 pixel groups of two replicates: 4.0; the manifold's
+// 2 %: a bias of 8 % or more fails).
 TEST(ManifoldReference, SeenThroughCausticAgreesWithTheQuadrature) {
   const std::string scene = "tests/trace/scenes/point-glass-through.json";
   const nlohmann::json ref = read_json(std::string(PATHEX_SOURCE_DIR) + "/tests/trace/scenes/point-glass-through.reference.json");
