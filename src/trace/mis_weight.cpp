@@ -153,8 +153,8 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
   };
   const bool has_qsm = s > 1, has_ptm = t > 1;
   if (s > 0 && t > 0) {
-    const Vertex& qs = x[s - 1];
-    const Vertex& pt = x[s];
+    const Vertex& qs = x.light_at(s - 1);  // (a plain or projection join's path has no chain)
+    const Vertex& pt = x.eye_at(t - 1);
     JoinDensity own;
     if (join == nullptr) {
       const vec3 e = pt.p - qs.p;
@@ -178,8 +178,8 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
     if (self == ConnectorKind::kOrthoProjection) set_eye(s - 1, parallel_jacobian(qs, pt, w));
     else if (needed(s - 1)) set_eye(s - 1, area(at_pt.known ? at_pt.to_wi : pdf_dir(pt, has_ptm ? &pt.wo : nullptr, back), qs, w, d2));
     // x(s+1) as pt samples it, having come from qs; x(s-2) as qs does, having come from pt.
-    if (has_ptm && needed(s + 1)) set_light(s + 1, area(at_pt.known ? at_pt.to_wo : pdf_dir(pt, &back, pt.wo), x[s + 1], pt.wo, pt.d2_wo));
-    if (has_qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(qs, &w, qs.wo), x[s - 2], qs.wo, qs.d2_wo));
+    if (has_ptm && needed(s + 1)) set_light(s + 1, area(at_pt.known ? at_pt.to_wo : pdf_dir(pt, &back, pt.wo), x.eye_at(t - 2), pt.wo, pt.d2_wo));
+    if (has_qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(qs, &w, qs.wo), x.light_at(s - 2), qs.wo, qs.d2_wo));
   } else if (t > 0) {  // s = 0: pt lies on an area light
     const Vertex& pt = x[0];
     const int li = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];

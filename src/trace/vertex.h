@@ -97,11 +97,14 @@ struct PathView {
   int s = 0, m = 0, t = 0;
   int size() const { return s + m + t; }
   const Vertex& operator[](int i) const {
-    if (i < s) return i == 0 && light0 ? *light0 : light[i];
+    if (i < s) return light_at(i);
     if (i < s + m) return chain[i - s];
-    const int j = s + m + t - 1 - i;
-    return j == 0 && eye0 ? *eye0 : eye[j];
+    return eye_at(s + m + t - 1 - i);
   }
+  // Light subpath vertex x_i (i < s), and eye subpath vertex j, x(s+m+t-1-j) (j < t): where a
+  // caller knows which side a vertex is on, without operator[]'s two tests.
+  const Vertex& light_at(int i) const { return i == 0 && light0 ? *light0 : light[i]; }
+  const Vertex& eye_at(int j) const { return j == 0 && eye0 ? *eye0 : eye[j]; }
 };
 
 }  // namespace pathex::tracer
