@@ -81,8 +81,20 @@ float Integrator::pdf(const Vertex* prev, const Vertex& v, const Vertex& next) c
 }
 
 mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
-  const int n = x.size(), k = n - 1, s = x.s;
+  const int n = x.size(), s = x.s;
   mis::Strategies st;
+  st.own = {s, 0, 1.0};  // the strategy that sampled the path: a plain join's (a connector's: below)
+  // --- the plain joins whose two join letters are D ---
+  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
+  // (The split s = n, t = 0, only when light paths can hit the lens.)
+  st.plain = table_.plain_splits(n) & d_pairs & ~(lens_hits_ ? 0 : std::uint64_t{1} << n);
+  if (self == ConnectorKind::kNone) st.plain &= ~(std::uint64_t{1} << s);
+  if (has_connectors_ || self != ConnectorKind::kNone) connector_techniques(th, x, key, self, st);
+  return st;
+}
+
+void Integrator::connector_techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self, mis::Strategies& st) const {
+  const int n = x.size(), k = n - 1, s = x.s;
   const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
   const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };   // c_i c(i+1) c(i+2) = DSD
   const auto light_pos = [&] { return static_cast<double>(rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos); };
@@ -92,20 +104,15 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
     while (i + m <= k - 1 && letter_s(i + m + 1)) ++m;
     return m;
   };
-  // --- the strategy that sampled the path ---
+  // --- the connector that sampled the path ---
   switch (self) {
-    case ConnectorKind::kNone: st.own = {s, 0, 1.0}; break;
+    case ConnectorKind::kNone: break;
     case ConnectorKind::kDistantProjection: st.own = {1, 0, 1.0 / light_pos()}; break;
     case ConnectorKind::kOrthoProjection: st.own = {n - 1, 0, 1.0 / cam_.pdf_pos}; break;
     case ConnectorKind::kMirror: st.own = {s, x.m, 1.0}; break;
     case ConnectorKind::kManifold: st.own = {s, x.m, manifold_rate(key, s + x.m, k)}; break;  // run for that share of the samples
   }
-  // --- the plain joins whose two join letters are D ---
-  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
-  // (The split s = n, t = 0, only when light paths can hit the lens.)
-  st.plain = table_.plain_splits(n) & d_pairs & ~(lens_hits_ ? 0 : std::uint64_t{1} << n);
-  if (self == ConnectorKind::kNone) st.plain &= ~(std::uint64_t{1} << s);
-  if (!has_connectors_) return st;
+  if (!has_connectors_) return;
   // --- the connectors: one term each, the plain density with their constructed vertices left out ---
   mis::Technique* out = th.techniques.data();
   int& count = st.count;
@@ -128,7 +135,6 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
       const int m = s_run(i);
       if (m > 0 && !letter_s(i) && !(self == ConnectorKind::kManifold && i == s) && manifold_at(x, key, i, m)) out[count++] = {i, m, manifold_rate(key, i + m, k)};
     }
-  return st;
 }
 
 void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const {
