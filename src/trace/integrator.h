@@ -307,6 +307,7 @@ class Integrator {
   bool nee_pair() const { return nee_pair_; }
   // The strategies that sample path x, `self` the own one (connectors listed in th.techniques).
   mis::Strategies techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const;
+  void connector_techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self, mis::Strategies& st) const;  // its connectors
   // th.densities[lo … hi) of a plain or projection join's path: the subpaths' stored densities
   // copied, the four the join changes recomputed in the copy.
   void join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const;

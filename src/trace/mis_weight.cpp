@@ -81,8 +81,20 @@ float Integrator::pdf(const Vertex* prev, const Vertex& v, const Vertex& next) c
 }
 
 mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self) const {
-  const int n = x.size(), k = n - 1, s = x.s;
+  const int n = x.size(), s = x.s;
   mis::Strategies st;
+  st.own = {s, 0, 1.0};  // the strategy that sampled the path: a plain join's (a connector's: below)
+  // --- the plain joins whose two join letters are D ---
+  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
+  // (The split s = n, t = 0, only when light paths can hit the lens.)
+  st.plain = table_.plain_splits(n) & d_pairs & ~(lens_hits_ ? 0 : std::uint64_t{1} << n);
+  if (self == ConnectorKind::kNone) st.plain &= ~(std::uint64_t{1} << s);
+  if (has_connectors_ || self != ConnectorKind::kNone) connector_techniques(th, x, key, self, st);
+  return st;
+}
+
+void Integrator::connector_techniques(Thread& th, const PathView& x, PathKey key, ConnectorKind self, mis::Strategies& st) const {
+  const int n = x.size(), k = n - 1, s = x.s;
   const auto letter_s = [&](int i) { return !packed_is_d(key, i); };  // c_i is S
   const auto dsd_at = [&](int i) { return ((key >> i) & 7) == 2; };   // c_i c(i+1) c(i+2) = DSD
   const auto light_pos = [&] { return static_cast<double>(rs_.lights[static_cast<std::size_t>(x[0].light)].pdf_pos); };
@@ -92,20 +104,15 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
     while (i + m <= k - 1 && letter_s(i + m + 1)) ++m;
     return m;
   };
-  // --- the strategy that sampled the path ---
+  // --- the connector that sampled the path ---
   switch (self) {
-    case ConnectorKind::kNone: st.own = {s, 0, 1.0}; break;
+    case ConnectorKind::kNone: break;
     case ConnectorKind::kDistantProjection: st.own = {1, 0, 1.0 / light_pos()}; break;
     case ConnectorKind::kOrthoProjection: st.own = {n - 1, 0, 1.0 / cam_.pdf_pos}; break;
     case ConnectorKind::kMirror: st.own = {s, x.m, 1.0}; break;
     case ConnectorKind::kManifold: st.own = {s, x.m, manifold_rate(key, s + x.m, k)}; break;  // run for that share of the samples
   }
-  // --- the plain joins whose two join letters are D ---
-  const std::uint64_t d_pairs = ~static_cast<std::uint64_t>(key | (key >> 1));  // bit i: c_i and c(i+1) are D
-  // (The split s = n, t = 0, only when light paths can hit the lens.)
-  st.plain = table_.plain_splits(n) & d_pairs & ~(lens_hits_ ? 0 : std::uint64_t{1} << n);
-  if (self == ConnectorKind::kNone) st.plain &= ~(std::uint64_t{1} << s);
-  if (!has_connectors_) return st;
+  if (!has_connectors_) return;
   // --- the connectors: one term each, the plain density with their constructed vertices left out ---
   mis::Technique* out = th.techniques.data();
   int& count = st.count;
@@ -128,7 +135,6 @@ mis::Strategies Integrator::techniques(Thread& th, const PathView& x, PathKey ke
       const int m = s_run(i);
       if (m > 0 && !letter_s(i) && !(self == ConnectorKind::kManifold && i == s) && manifold_at(x, key, i, m)) out[count++] = {i, m, manifold_rate(key, i + m, k)};
     }
-  return st;
 }
 
 void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind self, const JoinDensity* join, int lo, int hi) const {
@@ -153,8 +159,8 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
   };
   const bool has_qsm = s > 1, has_ptm = t > 1;
   if (s > 0 && t > 0) {
-    const Vertex& qs = x[s - 1];
-    const Vertex& pt = x[s];
+    const Vertex& qs = x.light_at(s - 1);  // (a plain or projection join's path has no chain)
+    const Vertex& pt = x.eye_at(t - 1);
     JoinDensity own;
     if (join == nullptr) {
       const vec3 e = pt.p - qs.p;
@@ -178,8 +184,8 @@ void Integrator::join_densities(Thread& th, const PathView& x, ConnectorKind sel
     if (self == ConnectorKind::kOrthoProjection) set_eye(s - 1, parallel_jacobian(qs, pt, w));
     else if (needed(s - 1)) set_eye(s - 1, area(at_pt.known ? at_pt.to_wi : pdf_dir(pt, has_ptm ? &pt.wo : nullptr, back), qs, w, d2));
     // x(s+1) as pt samples it, having come from qs; x(s-2) as qs does, having come from pt.
-    if (has_ptm && needed(s + 1)) set_light(s + 1, area(at_pt.known ? at_pt.to_wo : pdf_dir(pt, &back, pt.wo), x[s + 1], pt.wo, pt.d2_wo));
-    if (has_qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(qs, &w, qs.wo), x[s - 2], qs.wo, qs.d2_wo));
+    if (has_ptm && needed(s + 1)) set_light(s + 1, area(at_pt.known ? at_pt.to_wo : pdf_dir(pt, &back, pt.wo), x.eye_at(t - 2), pt.wo, pt.d2_wo));
+    if (has_qsm && needed(s - 2)) set_eye(s - 2, area(at_qs.known ? at_qs.to_wo : pdf_dir(qs, &w, qs.wo), x.light_at(s - 2), qs.wo, qs.d2_wo));
   } else if (t > 0) {  // s = 0: pt lies on an area light
     const Vertex& pt = x[0];
     const int li = rs_.light_of_shape[static_cast<std::size_t>(pt.shape)];

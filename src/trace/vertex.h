@@ -2,6 +2,7 @@
 // letter and its two area densities), and the throughput that reached it.
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 
@@ -36,8 +37,12 @@ struct Vertex {
   glm::vec2 uv{0.0f};    // surfaces: the hit's surface parameters when the scene has textures (Hit::uv), else zero
   int light = -1;        // light vertices
   // Without short-circuits: which components are zero follows the scene's orientation, which no
-  // branch predictor guesses (this test was an eighth of the tracer's mispredicted branches).
-  bool has_normal() const { return (n.x != 0.0f) | (n.y != 0.0f) | (n.z != 0.0f); }
+  // branch predictor guesses (this test was an eighth of the tracer's mispredicted branches). On
+  // the bits, signs cleared: a component is != 0 exactly when it has a bit besides its sign (NaN
+  // too), and three float comparisons cost twice the instructions (each needs its NaN test).
+  bool has_normal() const {
+    return ((std::bit_cast<std::uint32_t>(n.x) | std::bit_cast<std::uint32_t>(n.y) | std::bit_cast<std::uint32_t>(n.z)) & 0x7fffffffu) != 0;
+  }
 };
 
 // Sets v.wo and v.d2_wo from its predecessor's position.
@@ -92,11 +97,14 @@ struct PathView {
   int s = 0, m = 0, t = 0;
   int size() const { return s + m + t; }
   const Vertex& operator[](int i) const {
-    if (i < s) return i == 0 && light0 ? *light0 : light[i];
+    if (i < s) return light_at(i);
     if (i < s + m) return chain[i - s];
-    const int j = s + m + t - 1 - i;
-    return j == 0 && eye0 ? *eye0 : eye[j];
+    return eye_at(s + m + t - 1 - i);
   }
+  // Light subpath vertex x_i (i < s), and eye subpath vertex j, x(s+m+t-1-j) (j < t): where a
+  // caller knows which side a vertex is on, without operator[]'s two tests.
+  const Vertex& light_at(int i) const { return i == 0 && light0 ? *light0 : light[i]; }
+  const Vertex& eye_at(int j) const { return j == 0 && eye0 ? *eye0 : eye[j]; }
 };
 
 }  // namespace pathex::tracer
