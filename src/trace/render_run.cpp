@@ -91,6 +91,9 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
   Integrator integrator(*rs, *strategies, o, plan.filter);
   // --splits auto: each pixel's counts, the same for every shard (trace/accel/split_plan.h).
   std::shared_ptr<const tracer::SplitMap> split_map;
+  if (o.splits == 0 && o.split_map && (o.split_map->width != rs->camera.width || o.split_map->height != rs->camera.height ||
+                                        o.split_map->counts.size() != pixels))
+    return make_error(ErrorCode::kUsage, "the split map is not of the sensor's size");
   if (o.splits == 0) split_map = o.split_map ? o.split_map : tracer::plan_splits(*rs, *strategies, o, plan.filter, layout);
   const std::size_t area_lights = rs->lights.size() - scene.lights.size();  // the emissive shapes come first
   for (const int i : plan.aimed_lights)
