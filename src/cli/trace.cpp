@@ -242,7 +242,8 @@ Command add_trace(CLI::App& app) {
             if (digits && std::stoi(value) >= 1 && std::stoi(value) <= 1024) return "";
             return "expected auto or a whole number from 1 to 1024, got '" + value + "'";
           },
-          /*validator_desc=*/"{auto,1..1024}", /*validator_name=*/"splits"));
+          /*validator_desc=*/"", /*validator_name=*/"splits"))
+      ->type_name("N|auto");
   sub->add_option("--resolution", args->options.job.resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
       ->type_name("WxH");
   sub->add_option("--max-paths", args->options.job.max_paths,
