@@ -230,8 +230,20 @@ Command add_trace(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
   sub->add_option("--splits", args->options.job.splits,
                   "Runs of each sample after its camera ray and first hit, each weighted 1/N: more paths of indirect light "
-                  "per camera ray (issue 39, docs/efficiency.md)")
-      ->capture_default_str()->check(CLI::Range(1, 1024));
+                  "per camera ray; auto: camera rays and runs per pixel from a pilot's variances (issue 39, docs/efficiency.md)")
+      ->capture_default_str()
+      ->transform(CLI::Validator(
+          [](std::string& value) -> std::string {
+            if (value == "auto") {
+              value = "0";  // RenderOptions::splits
+              return "";
+            }
+            const bool digits = !value.empty() && value.size() <= 4 && value.find_first_not_of("0123456789") == std::string::npos;
+            if (digits && std::stoi(value) >= 1 && std::stoi(value) <= 1024) return "";
+            return "expected auto or a whole number from 1 to 1024, got '" + value + "'";
+          },
+          /*validator_desc=*/"", /*validator_name=*/"splits"))
+      ->type_name("N|auto");
   sub->add_option("--resolution", args->options.job.resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
       ->type_name("WxH");
   sub->add_option("--max-paths", args->options.job.max_paths,

@@ -32,7 +32,7 @@
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
 // {max_bounces, sampler, light_sampling (absent in files written before issue 39's solid-angle
 // sampling: then "area"), rr_depth, rr_threshold, rr_light_threshold (absent in files written before
-// issue 39: then rr_threshold's), splits (absent in files written before issue 39's
+// issue 39: then rr_threshold's), splits (0: --splits auto; absent in files written before issue 39's
 // splitting: then 1), batches, replicates (absent in files written before issue 39's
 // pixel groups: then batches, plain batch means), width, height, images, max_paths, manifold (null, or the
 // manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds,

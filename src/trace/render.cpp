@@ -276,9 +276,9 @@ void Integrator::trace_shadows(Thread& th) const {
   th.shadow.clear();
 }
 
-// --splits N: the sample's runs after one camera ray (trace/accel/first_vertex_split.h).
+// --splits: the sample's camera rays and runs after each (trace/accel/first_vertex_split.h).
 void Integrator::sample(Thread& th, int px, int py, std::uint64_t pass) const {
-  th.split.runs(o_.splits, pass, static_cast<std::uint64_t>(o_.replicates), [&] { sample_run(th, px, py, pass); });
+  th.split.runs(px, py, pass, static_cast<std::uint64_t>(o_.replicates), [&] { sample_run(th, px, py, pass); });
 }
 
 void Integrator::sample_run(Thread& th, int px, int py, std::uint64_t pass) const {

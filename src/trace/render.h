@@ -29,6 +29,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -43,6 +44,7 @@
 #include "schedule/pass_set.h"
 #include "reach/profile.h"
 #include "scene/scene.h"
+#include "trace/accel/split_counts.h"
 #include "trace/joins/manifold.h"
 #include "trace/rng.h"
 
@@ -92,8 +94,11 @@ struct RenderOptions {
   float rr_threshold = 0.3f;
   float rr_light_threshold = 1.0f;
   // --splits: runs of each sample after its camera ray and first hit, each weighted 1 / splits
-  // (trace/accel/first_vertex_split.h; issue 39, docs/efficiency.md).
+  // (trace/accel/first_vertex_split.h; issue 39, docs/efficiency.md). 0 (`--splits auto`): counts
+  // per pixel (camera rays, runs after each), from a pilot (trace/accel/split_plan.h), or from
+  // split_map when one is given (tests).
   int splits = 1;
+  std::shared_ptr<const tracer::SplitMap> split_map;
   SamplerKind sampler = SamplerKind::kSobol;  // --sampler
   // --light-sampling; the default chosen by efficiency on several scenes (issue 39, docs/tracer.md).
   LightSampling light_sampling = LightSampling::kSphereCone;

@@ -10,6 +10,7 @@
 #include <chrono>
 
 #include "trace/accel/eye_packets.h"
+#include "trace/accel/split_plan.h"
 #include "trace/integrator.h"
 #include "trace/plan.h"
 #include "trace/render.h"
@@ -88,6 +89,12 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
                             : ClassImages(0, 0, nullptr, {}),
                    layout.strategies};
   Integrator integrator(*rs, *strategies, o, plan.filter);
+  // --splits auto: each pixel's counts, the same for every shard (trace/accel/split_plan.h).
+  std::shared_ptr<const tracer::SplitMap> split_map;
+  if (o.splits == 0 && o.split_map && (o.split_map->width != rs->camera.width || o.split_map->height != rs->camera.height ||
+                                        o.split_map->counts.size() != pixels))
+    return make_error(ErrorCode::kUsage, "the split map is not of the sensor's size");
+  if (o.splits == 0) split_map = o.split_map ? o.split_map : tracer::plan_splits(*rs, *strategies, o, plan.filter, layout);
   const std::size_t area_lights = rs->lights.size() - scene.lights.size();  // the emissive shapes come first
   for (const int i : plan.aimed_lights)
     if (const std::optional<EmissionCones>& c = rs->lights[area_lights + static_cast<std::size_t>(i)].aim)
@@ -110,6 +117,7 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
         th.images = &out.images;
         th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
         th.connectors.resize(strategies->strategies.size());
+        th.split.set(o.splits, split_map);
         return th;
       });
   const int w = rs->camera.width, h = rs->camera.height;

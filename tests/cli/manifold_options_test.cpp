@@ -97,6 +97,22 @@ TEST(ManifoldOptions, BadValuesAreOneMessageAndExitTwo) {
   }
 }
 
+// Issue 39: --splits takes a count or auto (per-pixel counts from a pilot, trace/accel/split_plan.h),
+// recorded in the shard header as 0; anything else is one message and exit 2.
+TEST(SplitsOption, TakesACountOrAutoAndNothingElse) {
+  const std::string d = out_dir("splits-auto");
+  const CliRun ok = run("trace samples/scenes/cornell.json --renderer pt-nee --spp 2 --resolution 16x16 --quiet --splits auto --out " + d);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  std::ifstream shard(d + "/render.shard", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(shard)), std::istreambuf_iterator<char>());
+  EXPECT_NE(bytes.find("\"splits\": 0,"), std::string::npos);
+  for (const std::string bad : {"0", "1025", "-1", "Auto", "2x", "", "auto8"}) {
+    const CliRun r = run("trace " + kScene + " --spp 1 --out " + out_dir("bad") + " --splits '" + bad + "'");
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_EQ(r.err, "--splits: expected auto or a whole number from 1 to 1024, got '" + bad + "'\nRun with --help for more information.\n") << bad;
+  }
+}
+
 // Each limit reaches the walk: at its extreme every walk fails for the reason it governs.
 TEST(ManifoldOptions, TheLimitsReachTheWalk) {
   const nlohmann::json d = manifold_stats("");

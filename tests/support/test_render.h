@@ -33,10 +33,11 @@ struct Sampling {
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
   LightSampling light_sampling = RenderOptions{}.light_sampling;
   int splits = RenderOptions{}.splits;
+  std::shared_ptr<const tracer::SplitMap> split_map{};  // with splits 0: these counts instead of the pilot's
   std::string name() const {
     return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
            std::to_string(rr_threshold) + " rr-light-threshold " + std::to_string(rr_light_threshold) + " light-sampling " +
-           to_string(light_sampling) + " splits " + std::to_string(splits);
+           to_string(light_sampling) + " splits " + (splits != 0 ? std::to_string(splits) : split_map ? "map" : "auto");
   }
 };
 
@@ -58,6 +59,7 @@ inline Rendered render_scene(Result<Scene> scene, const std::string& renderer, c
   o.rr_light_threshold = sampling.rr_light_threshold;
   o.light_sampling = sampling.light_sampling;
   o.splits = sampling.splits;
+  o.split_map = sampling.split_map;
   RenderOutput out = render(s, profile, keep.back()->classifier.get(), o).expect("a render");
   RunInfo info;
   info.spp = spp;
