@@ -62,8 +62,8 @@ void add_manifold_options(CLI::App* app, ManifoldOptions* o) {
                   "Seeds spent finding a join's chains again, their inverse-probability estimate (a cap: a chain not found again by then is counted as truncated)")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(1, 100000))->group(group);
   app->add_option(name[5], o->seeds,
-                  "Seeds per batch: the first batch's distinct chains are a join's contributions; default: 1 where "
-                  "--manifold-rate's default is below 1, else 4")
+                  "Seeds per batch: the first batch's distinct chains are a join's contributions; default: 1 if the "
+                  "profile has a plain strategy with s >= 2 (light tracing or bdpt's joins), else 4")
       ->check(non_negative())->check(CLI::Range(1, 64))->group(group);
   app->add_option(name[6], o->biased_trials,
                   "BIASED when > 0: a join draws this many seeds and counts each distinct chain they find once, "
@@ -72,8 +72,9 @@ void add_manifold_options(CLI::App* app, ManifoldOptions* o) {
   app->add_option(name[7], o->rate,
                   "Share of the eye subpaths whose joins run the connector where the camera sees its eye end directly or "
                   "past a diffuse vertex (a coin per sample; unbiased: the contribution is divided by it and MIS weighs the "
-                  "connector by it); default: 0.125 if the profile has a plain strategy with s >= 2 (light tracing or "
-                  "bdpt's joins, which also sample those paths; with --manifold-seeds 1), else 1")
+                  "connector by it), and where another strategy samples the path too: always in a profile with light "
+                  "subpaths (light tracing, bdpt's joins), else where the light end is not a point (an eye path can hit "
+                  "the light); elsewhere every sample runs it; default 0.125")
       ->check(real_in(0, true, 1, false))->group(group);
 }
 

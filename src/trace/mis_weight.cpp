@@ -31,7 +31,8 @@ namespace pathex::tracer {
 double Integrator::manifold_rate(PathKey key, int b, int k) const {
   bool through = b + 1 <= k - 1;  // the camera sees x_b through S vertices only (x_v's letter is c(v+1))
   for (int v = b + 1; v <= k - 1 && through; ++v) through = !packed_is_d(key, v + 1);
-  return through ? 1.0 : o_.manifold.rate.value_or(1.0);
+  // Nor where x0 is a point (c0 = S) and no light subpath's join shares the path (pt-nee+manifold: the connector's alone).
+  return through || (max_light_ < 2 && !packed_is_d(key, 0)) ? 1.0 : o_.manifold.rate.value_or(1.0);
 }
 
 void Integrator::store_densities(Thread& th, int ns, int nt) const {

@@ -202,13 +202,14 @@ struct StrategySet {
 
 Result<StrategySet> runnable_strategies(const Profile& profile);
 
-// --manifold-rate's and --manifold-seeds' defaults (issue 40), which render() and the shard header resolve:
-// where the profile has a plain strategy whose light subpath leaves the light (s >= 2: light tracing at
-// t = 1, or bdpt's joins), which also samples the paths whose eye end the camera sees directly or past a
-// diffuse vertex, the connector runs there in kShareWithOtherPaths of the samples with one seed a batch
-// (measured best on lamp-glass.json, also on the caustic seen through glass: bench/README.md, issue 40);
-// else in every sample with kManifoldSeeds (pt-nee+manifold: the connector alone samples such paths
-// across the chain, a lower rate only loses).
+// --manifold-rate's and --manifold-seeds' defaults (issue 40), which render() and the shard header resolve.
+// The rate applies where the camera sees the join's eye end directly or past a diffuse vertex and another
+// strategy of the profile samples the path too (Integrator::manifold_rate()): always where the profile has
+// light subpaths (s >= 2: light tracing, bdpt's joins), else (pt-nee+manifold) where the light end is not a
+// point (an eye path hits an area light); there the connector runs in kShareWithOtherPaths of the samples
+// (measured best on lamp-glass.json: bench/README.md, issue 40, tenth and eleventh sessions). One seed a
+// batch where the profile has light subpaths, else kManifoldSeeds (pt-nee+manifold: its caustics seen
+// through the glass and under a point light have no other strategy; one seed measured 0.3-0.7x there).
 inline constexpr double kShareWithOtherPaths = 0.125;
 inline constexpr int kManifoldSeeds = 4;
 bool manifold_shares_paths(const Profile& profile);

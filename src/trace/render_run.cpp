@@ -41,7 +41,7 @@ bool manifold_shares_paths(const Profile& profile) {
 
 ManifoldOptions resolved_manifold(const Profile& profile, ManifoldOptions o) {
   const bool shares = manifold_shares_paths(profile);
-  if (!o.rate) o.rate = shares ? kShareWithOtherPaths : 1.0;
+  if (!o.rate) o.rate = kShareWithOtherPaths;  // (where another strategy samples the path too: Integrator::manifold_rate())
   if (!o.seeds) o.seeds = shares ? 1 : kManifoldSeeds;
   return o;
 }

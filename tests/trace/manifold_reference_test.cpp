@@ -147,20 +147,27 @@ TEST(ManifoldReference, LampGlassSeenThroughAgreesWithTheQuadrature) {
 // swept seeds. With both strategies: 5.6 % (bench/README.md, issue 36, eighth session).
 // The same with the connector run for an eighth of the samples with one seed a batch (bdpt+manifold's
 // defaults since issue 40: its contributions times 8, its MIS density times 1/8 where light tracing can
-// join), 32 spp, and at every sample with 4 seeds (the defaults before), 16 spp: a family of the two.
+// join), 32 spp, and at every sample with 4 seeds (the defaults before), 16 spp; and pt-nee+manifold at
+// its defaults since the eleventh session (the rate 1/8 where the light end is not a point: its MIS
+// density times 1/8 against the eye's hits of the lamp), 256 spp (at 64 the tail's skew put 8 seeds' mean
+// 5.0σ low at PATHEX_STAT_SEED 18, and the former default's 4.1σ): a family of the three.
 TEST(ManifoldReference, BdptManifoldDirectCausticAgreesWithBdpt) {
   const std::string scene = "samples/scenes/lamp-glass.json";
   const SeedMean plain = seed_mean(scene, "bdpt", "LDDSSDDSE", 64, 8);
   ASSERT_GT(plain.mean, 0.0);
-  const double k = pathex::test::family_sigmas(2, 1e-3, 7);
-  for (const auto& [renderer, spp] : {std::pair<std::string, int>{"bdpt+manifold --manifold-rate 1 --manifold-seeds 4", 16}, {"bdpt+manifold", 32}}) {
+  const double k = pathex::test::family_sigmas(3, 1e-3, 7);
+  for (const auto& [renderer, spp] : {std::pair<std::string, int>{"bdpt+manifold --manifold-rate 1 --manifold-seeds 4", 16},
+                                      {"bdpt+manifold", 32}, {"pt-nee+manifold", 256}}) {
     const SeedMean both = seed_mean(scene, renderer, "LDDSSDDSE", spp, 8);
     ASSERT_GT(both.mean, 0.0) << renderer;
     const double v1 = both.stderr_ * both.stderr_, v2 = plain.stderr_ * plain.stderr_;
     pathex::test::stat_log(renderer + " against bdpt", (both.mean - plain.mean) / std::sqrt(v1 + v2), k);
     EXPECT_LE(std::abs(both.mean - plain.mean), k * std::sqrt(v1 + v2))
         << renderer << " " << both.mean << " ± " << both.stderr_ << ", bdpt " << plain.mean << " ± " << plain.stderr_;
-    EXPECT_EQ(both.strategies, nlohmann::json({{"bdpt (4, DD, 1)", true}, {"manifold (1, DSSD, 2)", true}})) << both.strategies.dump();
+    if (renderer == "pt-nee+manifold")  // (and the eye's rare hits of the lamp through the ball)
+      EXPECT_TRUE(both.strategies.contains("manifold-nee (1, DSSD, 2)")) << both.strategies.dump();
+    else
+      EXPECT_EQ(both.strategies, nlohmann::json({{"bdpt (4, DD, 1)", true}, {"manifold (1, DSSD, 2)", true}})) << both.strategies.dump();
   }
 }
 

@@ -7,9 +7,8 @@
 #include <optional>
 
 #include <glm/geometric.hpp>
-#include <glm/mat2x2.hpp>
-#include <glm/matrix.hpp>
 
+#include "trace/block_tridiagonal.h"
 #include "trace/differential.h"
 #include "trace/joins/join.h"
 
@@ -17,8 +16,8 @@ namespace pathex {
 namespace {
 
 using glm::dvec3;
-
 constexpr std::size_t kCap = static_cast<std::size_t>(tracer::kMaxChain);  // vertices of a chain, at most
+using Blocks = TridiagonalBlocks<kCap>;  // ∂C/∂X: vertex v's constraint against v - 1 (l), v (d), v + 1 (u); b: ∂C/∂b
 constexpr std::size_t kDim = 2 * kCap;                                    // its unknowns
 
 // One vertex's local state at given positions: its surface's derivatives, the unit directions to
@@ -64,38 +63,6 @@ double largest(const double* c, std::size_t n) {
   double m = 0.0;
   for (std::size_t i = 0; i < n; ++i) m = std::max(m, std::fabs(c[i]));
   return m;
-}
-
-// The constraint Jacobian ∂C/∂X, block-tridiagonal in 2 × 2 blocks (glm: [column][row]): vertex v's
-// constraint against the moves of vertex v - 1 (l), its own (d) and v + 1 (u); `b` (with sb, tb): ∂C/∂b,
-// which only the last vertex's constraint sees.
-struct Blocks {
-  std::array<glm::dmat2, kCap> l, d, u;
-  glm::dmat2 b{0.0};
-};
-
-// The system Σ J_vw x_w = r_v solved in place of r (a dvec2 or, for two right-hand sides, a dmat2
-// per vertex) by block elimination, each pivot block factored with partial pivoting within it:
-// returns min |pivot| / max |pivot| (0: singular).
-template <class R>
-double solve_blocks(const Blocks& j, std::size_t m, R* r) {
-  std::array<glm::dmat2, kCap> inv;
-  double lo = INFINITY, hi = 0.0;
-  for (std::size_t v = 0; v < m; ++v) {
-    glm::dmat2 s = j.d[v];
-    if (v > 0) {
-      const glm::dmat2 f = j.l[v] * inv[v - 1];
-      s -= f * j.u[v - 1];
-      r[v] -= f * r[v - 1];
-    }
-    const double p = std::max(std::fabs(s[0][0]), std::fabs(s[0][1])), det = glm::determinant(s);
-    if (!(p > 0.0) || !(det != 0.0)) return 0.0;
-    lo = std::min({lo, p, std::fabs(det) / p});
-    hi = std::max({hi, p, std::fabs(det) / p});
-    inv[v] = glm::inverse(s);
-  }
-  for (std::size_t v = m; v-- > 0;) r[v] = inv[v] * (v + 1 < m ? r[v] - j.u[v] * r[v + 1] : r[v]);
-  return std::isfinite(lo / hi) ? lo / hi : 0.0;
 }
 
 // The constraint Jacobian (Jakob and Marschner 2012), analytic: each vertex moves along its tangent

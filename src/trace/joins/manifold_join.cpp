@@ -180,15 +180,18 @@ ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std:
 void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = manifold_of(s, t);
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
-  // manifold_rate() from the eye subpath; below 1, one coin per sample (from a stream of its own).
+  // manifold_rate() from the eye subpath and the light; below 1, one coin per sample (from a stream of its own).
   bool through = t >= 3;
   for (int j = 1; j <= t - 2 && through; ++j) through = th.eye[static_cast<std::size_t>(j)].letter == 'S';
-  const double rate = through ? 1.0 : o_.manifold.rate.value_or(1.0);
-  if (rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate) return;
+  double rate = through ? 1.0 : o_.manifold.rate.value_or(1.0);
+  const bool skip = rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate;
+  if (skip && max_light_ >= 2) return;  // light subpaths' joins share every such path: the rate applies whatever the light
   const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
   if (b->kind != Kind::kSurface || !b->finite) return;
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kManifoldLight);
   if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
+  if (max_light_ < 2 && (s >= 2 ? th.light[0] : *a).pos_letter == 'S') rate = 1.0;  // from a point: the connector's alone
+  else if (skip) return;
   // A one-sided emitter at a (a fresh light point) whose every specular shape lies behind it sends no
   // chain any light: the chain's first vertex would leave a at a negative cosine (no transport).
   if (s == 1 && !is_black(vec3(a->n)) && is_black(end_f(*a, -a->n, TransportMode::kImportance))) {
