@@ -900,7 +900,7 @@ TEST(Sampling, SplitSamplesMatchTheClosedForms) {
 // Issue 39: --splits auto (trace/accel/split_plan.h) is unbiased: its pilot's counts (on these
 // uniform spheres every pixel takes the most runs per camera ray), and a map of counts that differ
 // pixel by pixel, camera rays and runs (what the pilot gives a lamp's edge and the rest), both
-// samplers, the three estimators, the same 9 closed forms: 108 checks at 6 sigma, about 0.013 %
+// samplers, the three estimators, the same 9 closed forms: 108 checks at family_sigmas(108), 0.1 %
 // family-wise (as above).
 TEST(Sampling, AutoSplitSamplesMatchTheClosedForms) {
   auto map = std::make_shared<tracer::SplitMap>(tracer::SplitMap{12, 12, {}});  // the closed spheres' 12 x 12
