@@ -11,6 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -110,6 +113,26 @@ TEST(SplitsOption, TakesACountOrAutoAndNothingElse) {
     const CliRun r = run("trace " + kScene + " --spp 1 --out " + out_dir("bad") + " --splits '" + bad + "'");
     EXPECT_EQ(r.code, 2) << bad;
     EXPECT_EQ(r.err, "--splits: expected auto or a whole number from 1 to 1024, got '" + bad + "'\nRun with --help for more information.\n") << bad;
+  }
+}
+
+// Issue 39: --splits' default is the profile's (resolved_splits(), trace/render.h), recorded resolved:
+// auto (0) without a light subpath or a manifold connector, else 1; an explicit --splits wins.
+TEST(SplitsOption, DefaultsPerProfileAndAnExplicitCountWins) {
+  const std::vector<std::pair<std::string, int>> cases = {
+      {"--renderer pt", 0},           {"--renderer pt-nee", 0},          {"--renderer pt-nee+distant", 0},
+      {"--renderer pt-nee+mirror", 0}, {"--renderer pbrt-v4-path", 0},   {"--renderer mitsuba3-path", 0},
+      {"--renderer pt-nee+manifold", 1}, {"--renderer lt", 1},           {"--renderer bdpt", 1},
+      {"--renderer pbrt-v4-bdpt", 1}, {"--renderer mitsuba3-ptracer", 1}, {"--renderer pt-nee --splits 1", 1},
+      {"--renderer bdpt --splits auto", 0}, {"--renderer pt-nee --splits 4", 4}};
+  int n = 0;
+  for (const auto& [args, splits] : cases) {
+    const std::string d = out_dir("splits-default-" + std::to_string(n++));
+    const CliRun r = run("trace samples/scenes/cornell.json --spp 1 --resolution 8x8 --no-images --quiet " + args + " --out " + d);
+    ASSERT_EQ(r.code, 0) << args << r.err;
+    std::ifstream shard(d + "/render.shard", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(shard)), std::istreambuf_iterator<char>());
+    EXPECT_NE(bytes.find("\"splits\": " + std::to_string(splits) + ","), std::string::npos) << args;
   }
 }
 
