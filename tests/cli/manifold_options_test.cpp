@@ -136,6 +136,23 @@ TEST(SplitsOption, DefaultsPerProfileAndAnExplicitCountWins) {
   }
 }
 
+// --splits auto's pilot reads the pixels' sums whatever the render keeps: with --no-images (as
+// `pathex bias` renders R) the counts, and so the histogram, are those of the render with images.
+TEST(SplitsOption, AutoSplitsAlikeWithoutImages) {
+  const std::string common = "trace samples/scenes/small-light-caustic.json --renderer pt-nee --spp 4 --quiet --json --out ";
+  const CliRun with = run(common + out_dir("auto-images"));
+  const CliRun without = run(common + out_dir("auto-no-images") + " --no-images");
+  const CliRun unsplit = run(common + out_dir("auto-unsplit") + " --no-images --splits 1");
+  ASSERT_EQ(with.code, 0) << with.err;
+  ASSERT_EQ(without.code, 0) << without.err;
+  ASSERT_EQ(unsplit.code, 0) << unsplit.err;
+  const nlohmann::json a = nlohmann::json::parse(with.out), b = nlohmann::json::parse(without.out),
+                       c = nlohmann::json::parse(unsplit.out);
+  EXPECT_EQ(a["total"], b["total"]);
+  EXPECT_EQ(a["paths"], b["paths"]);
+  EXPECT_NE(a["total"], c["total"]);  // and auto is not --splits 1 there
+}
+
 // Each limit reaches the walk: at its extreme every walk fails for the reason it governs.
 TEST(ManifoldOptions, TheLimitsReachTheWalk) {
   const nlohmann::json d = manifold_stats("");
