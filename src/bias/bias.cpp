@@ -297,6 +297,7 @@ Result<BiasRun> run_bias(const Scene& scene, const std::string& scene_name, cons
       rro.threads = o.threads;
       rro.max_bounces = r_bound ? std::min(*r_bound, *bound) : *bound;  // the light the reference measures
       rro.images = false;
+      rro.splits = o.renderer_splits;
       rro.cancel = o.cancel;
       Result<RenderPlan> r_plan = plan_render(scene, renderer, *rro.max_bounces, {}, o.limits);
       if (!r_plan) return r_plan.error();

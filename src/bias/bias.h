@@ -87,6 +87,7 @@ struct BiasOptions {
   // `renderer_histogram` is given, R's render already made (`trace --missed`: the same spp and seed).
   // Neither: no comparison.
   std::uint64_t renderer_spp = 0;
+  std::optional<int> renderer_splits;  // that render's --splits; unset: the profile's (resolved_splits())
   const Histogram* renderer_histogram = nullptr;
   // The false-alarm rate of the comparison over all its checks (a correct R with an honest stderr
   // is flagged somewhere with this probability).

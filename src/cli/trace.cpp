@@ -230,8 +230,9 @@ Command add_trace(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
   sub->add_option("--splits", args->options.job.splits,
                   "Runs of each sample after its camera ray and first hit, each weighted 1/N: more paths of indirect light "
-                  "per camera ray; auto: camera rays and runs per pixel from a pilot's variances (issue 39, docs/efficiency.md)")
-      ->capture_default_str()
+                  "per camera ray; auto: camera rays and runs per pixel from a pilot's variances (issue 39, docs/efficiency.md); "
+                  "default: auto if the profile has no light subpath (no strategy with s >= 1 but next-event estimation's "
+                  "s = 1, t >= 2: pt, pt-nee) and no manifold connector, else 1 (light tracing, bdpt's joins, manifold walks)")
       ->transform(CLI::Validator(
           [](std::string& value) -> std::string {
             if (value == "auto") {

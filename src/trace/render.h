@@ -96,8 +96,8 @@ struct RenderOptions {
   // --splits: runs of each sample after its camera ray and first hit, each weighted 1 / splits
   // (trace/accel/first_vertex_split.h; issue 39, docs/efficiency.md). 0 (`--splits auto`): counts
   // per pixel (camera rays, runs after each), from a pilot (trace/accel/split_plan.h), or from
-  // split_map when one is given (tests).
-  int splits = 1;
+  // split_map when one is given (tests). Unset: the profile's, resolved_splits() (below).
+  std::optional<int> splits;
   std::shared_ptr<const tracer::SplitMap> split_map;
   SamplerKind sampler = SamplerKind::kSobol;  // --sampler
   // --light-sampling; the default chosen by efficiency on several scenes (issue 39, docs/tracer.md).
@@ -214,6 +214,15 @@ inline constexpr double kShareWithOtherPaths = 0.125;
 inline constexpr int kManifoldSeeds = 4;
 bool manifold_shares_paths(const Profile& profile);
 ManifoldOptions resolved_manifold(const Profile& profile, ManifoldOptions o);
+
+// --splits' default (issue 39), which render() and the shard header resolve: auto (0) where the
+// profile has no light subpath, that is no strategy with s >= 1 but next-event estimation's one
+// light point joined to an eye vertex (s = 1, t >= 2: pt, pt-nee and its connectors, pbrt-v4-path,
+// mitsuba3-path); else 1. Under light tracing or bdpt's joins a run repeats the light subpath and
+// its joins, which the pilot neither prices nor sees (its splats), and auto lost there (0.30x on
+// Tungsten's box, 0.39x on point-glass.json; bench/README.md, issue 39, eleventh session).
+bool has_light_subpath(const Profile& profile);
+int resolved_splits(const Profile& profile, std::optional<int> splits);
 
 // A render of `plan` (trace/plan.h, plan_render()): its strategies, its lights' emission
 // narrowing, and only the paths its filter records.

@@ -46,6 +46,21 @@ ManifoldOptions resolved_manifold(const Profile& profile, ManifoldOptions o) {
   return o;
 }
 
+bool has_light_subpath(const Profile& profile) {
+  return std::any_of(profile.strategies.begin(), profile.strategies.end(), [](const Strategy& st) {
+    return st.s.hi == Range::kOpen || st.s.hi >= 2 || (st.s.contains(1) && st.t.lo < 2);
+  });
+}
+
+// With the manifold connector too, 1 (pt-nee+manifold): a walk is not priced by the pilot's rays,
+// and auto took 6x the CPU on point-glass.json for 0.46x the efficiency (lamp-glass.json: 3.4x at
+// 16 spp; bench/README.md, issue 39, eleventh session); render.h's comment says the rest.
+int resolved_splits(const Profile& profile, std::optional<int> splits) {
+  const bool manifold = std::any_of(profile.strategies.begin(), profile.strategies.end(),
+                                    [](const Strategy& st) { return st.connector == ConnectorKind::kManifold; });
+  return splits.value_or(has_light_subpath(profile) || manifold ? 1 : 0);
+}
+
 namespace tracer {
 namespace {
 // Paths a thread's histogram has room for before it first regrows (address space only).
@@ -79,6 +94,8 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
   // The same rule as the checker's: an explicit bound overrides the profile's own.
   if (!o.max_bounces) o.max_bounces = profile.max_bounces.value_or(16);
   o.manifold = resolved_manifold(profile, o.manifold);
+  const int splits = resolved_splits(profile, o.splits);
+  o.splits = splits;
   HistogramLayout layout;
   layout.num_batches = o.batches;
   layout.groups = o.batches / o.replicates;
@@ -91,10 +108,10 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
   Integrator integrator(*rs, *strategies, o, plan.filter);
   // --splits auto: each pixel's counts, the same for every shard (trace/accel/split_plan.h).
   std::shared_ptr<const tracer::SplitMap> split_map;
-  if (o.splits == 0 && o.split_map && (o.split_map->width != rs->camera.width || o.split_map->height != rs->camera.height ||
+  if (splits == 0 && o.split_map && (o.split_map->width != rs->camera.width || o.split_map->height != rs->camera.height ||
                                         o.split_map->counts.size() != pixels))
     return make_error(ErrorCode::kUsage, "the split map is not of the sensor's size");
-  if (o.splits == 0) split_map = o.split_map ? o.split_map : tracer::plan_splits(*rs, *strategies, o, plan.filter, layout);
+  if (splits == 0) split_map = o.split_map ? o.split_map : tracer::plan_splits(*rs, *strategies, o, plan.filter, layout);
   const std::size_t area_lights = rs->lights.size() - scene.lights.size();  // the emissive shapes come first
   for (const int i : plan.aimed_lights)
     if (const std::optional<EmissionCones>& c = rs->lights[area_lights + static_cast<std::size_t>(i)].aim)
@@ -117,7 +134,7 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
         th.images = &out.images;
         th.splats = ClassImages::SplatBuffer(out.images.splat_entries(), out.images.splat_keys());
         th.connectors.resize(strategies->strategies.size());
-        th.split.set(o.splits, split_map);
+        th.split.set(splits, split_map);
         return th;
       });
   const int w = rs->camera.width, h = rs->camera.height;

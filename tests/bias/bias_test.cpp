@@ -292,6 +292,9 @@ BiasRun undersampling(const std::string& renderer, std::uint64_t renderer_spp) {
   o.spp = 256;  // the reference: at 64 spp its own caustic is a few heavy samples at some seeds
   o.seed = test::stat_seed(7);
   o.renderer_spp = renderer_spp;
+  // pt-nee unsplit, the under-sampler of issue 36: its default, --splits auto, meets the caustic more
+  // often (at this seed it did, and the stderr of that heavy sample admitted the difference).
+  o.renderer_splits = 1;
   const Profile r = profile(renderer);
   Result<Profile> ref = choose_reference("bdpt", scene, r, o);  // bdpt samples the caustic from the lamp's side
   EXPECT_TRUE(ref.ok());

@@ -11,6 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -111,6 +114,43 @@ TEST(SplitsOption, TakesACountOrAutoAndNothingElse) {
     EXPECT_EQ(r.code, 2) << bad;
     EXPECT_EQ(r.err, "--splits: expected auto or a whole number from 1 to 1024, got '" + bad + "'\nRun with --help for more information.\n") << bad;
   }
+}
+
+// Issue 39: --splits' default is the profile's (resolved_splits(), trace/render.h), recorded resolved:
+// auto (0) without a light subpath or a manifold connector, else 1; an explicit --splits wins.
+TEST(SplitsOption, DefaultsPerProfileAndAnExplicitCountWins) {
+  const std::vector<std::pair<std::string, int>> cases = {
+      {"--renderer pt", 0},           {"--renderer pt-nee", 0},          {"--renderer pt-nee+distant", 0},
+      {"--renderer pt-nee+mirror", 0}, {"--renderer pbrt-v4-path", 0},   {"--renderer mitsuba3-path", 0},
+      {"--renderer pt-nee+manifold", 1}, {"--renderer lt", 1},           {"--renderer bdpt", 1},
+      {"--renderer pbrt-v4-bdpt", 1}, {"--renderer mitsuba3-ptracer", 1}, {"--renderer pt-nee --splits 1", 1},
+      {"--renderer bdpt --splits auto", 0}, {"--renderer pt-nee --splits 4", 4}};
+  int n = 0;
+  for (const auto& [args, splits] : cases) {
+    const std::string d = out_dir("splits-default-" + std::to_string(n++));
+    const CliRun r = run("trace samples/scenes/cornell.json --spp 1 --resolution 8x8 --no-images --quiet " + args + " --out " + d);
+    ASSERT_EQ(r.code, 0) << args << r.err;
+    std::ifstream shard(d + "/render.shard", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(shard)), std::istreambuf_iterator<char>());
+    EXPECT_NE(bytes.find("\"splits\": " + std::to_string(splits) + ","), std::string::npos) << args;
+  }
+}
+
+// --splits auto's pilot reads the pixels' sums whatever the render keeps: with --no-images (as
+// `pathex bias` renders R) the counts, and so the histogram, are those of the render with images.
+TEST(SplitsOption, AutoSplitsAlikeWithoutImages) {
+  const std::string common = "trace samples/scenes/small-light-caustic.json --renderer pt-nee --spp 4 --quiet --json --out ";
+  const CliRun with = run(common + out_dir("auto-images"));
+  const CliRun without = run(common + out_dir("auto-no-images") + " --no-images");
+  const CliRun unsplit = run(common + out_dir("auto-unsplit") + " --no-images --splits 1");
+  ASSERT_EQ(with.code, 0) << with.err;
+  ASSERT_EQ(without.code, 0) << without.err;
+  ASSERT_EQ(unsplit.code, 0) << unsplit.err;
+  const nlohmann::json a = nlohmann::json::parse(with.out), b = nlohmann::json::parse(without.out),
+                       c = nlohmann::json::parse(unsplit.out);
+  EXPECT_EQ(a["total"], b["total"]);
+  EXPECT_EQ(a["paths"], b["paths"]);
+  EXPECT_NE(a["total"], c["total"]);  // and auto is not --splits 1 there
 }
 
 // Each limit reaches the walk: at its extreme every walk fails for the reason it governs.

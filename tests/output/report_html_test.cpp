@@ -108,7 +108,7 @@ TEST(ReportContent, EveryClassAndTopPathWithHistogramJsonsNumbers) {
   EXPECT_NE(html.find("alt=\"the rendered image, tone-mapped\""), std::string::npos);
   EXPECT_NE(html.find("tone-mapped: linear values × "), std::string::npos);
   EXPECT_NE(html.find("<pre class=\"cmd\" id=\"command\">pathex trace --renderer bdpt --spp 16 --seed 1 --max-bounces 16 "
-                      "--sampler sobol --batches 32 --replicates 2 --resolution 64x64</pre>"),
+                      "--sampler sobol --batches 32 --replicates 2 --resolution 64x64 --splits 1</pre>"),
             std::string::npos);
   // the strategies the checker narrowed (run.json's "pruned")
   EXPECT_NE(html.find("<td>bdpt</td><td class=\"mono\">(0.., DD, 0..)</td><td class=\"mono\">(0.., DD, 1..)</td>"), std::string::npos);

@@ -32,12 +32,12 @@ struct Sampling {
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
   LightSampling light_sampling = RenderOptions{}.light_sampling;
-  int splits = RenderOptions{}.splits;
+  std::optional<int> splits;  // unset: the profile's (resolved_splits())
   std::shared_ptr<const tracer::SplitMap> split_map{};  // with splits 0: these counts instead of the pilot's
   std::string name() const {
     return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
            std::to_string(rr_threshold) + " rr-light-threshold " + std::to_string(rr_light_threshold) + " light-sampling " +
-           to_string(light_sampling) + " splits " + (splits != 0 ? std::to_string(splits) : split_map ? "map" : "auto");
+           to_string(light_sampling) + " splits " + (!splits ? "default" : *splits != 0 ? std::to_string(*splits) : split_map ? "map" : "auto");
   }
 };
 

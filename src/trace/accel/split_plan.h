@@ -144,6 +144,7 @@ inline std::shared_ptr<const SplitMap> plan_splits(const RenderScene& rs, const 
   RenderOptions po = o;
   po.sampler = SamplerKind::kIndependent;
   po.seed = mix64(o.seed ^ 0x8a2e03707344a409ULL);  // streams of its own (trace/rng.h)
+  po.images = true;  // the pilot reads the pixels' sums: a --no-images render splits as the render with images
   const Integrator pilot(rs, strategies, po, filter);
   if (!pilot.traces_eye_rays()) return std::make_shared<SplitMap>(SplitMap{w, h, std::vector<SplitCounts>(pixels)});
   // Per pilot pixel: the runs' within-ray squared differences, each camera ray's mean, the rays.
