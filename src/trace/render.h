@@ -215,12 +215,16 @@ inline constexpr int kManifoldSeeds = 4;
 bool manifold_shares_paths(const Profile& profile);
 ManifoldOptions resolved_manifold(const Profile& profile, ManifoldOptions o);
 
-// --splits' default (issue 39), which render() and the shard header resolve: auto (0) where the
-// profile has no light subpath, that is no strategy with s >= 1 but next-event estimation's one
-// light point joined to an eye vertex (s = 1, t >= 2: pt, pt-nee and its connectors, pbrt-v4-path,
-// mitsuba3-path); else 1. Under light tracing or bdpt's joins a run repeats the light subpath and
-// its joins, which the pilot neither prices nor sees (its splats), and auto lost there (0.30x on
-// Tungsten's box, 0.39x on point-glass.json; bench/README.md, issue 39, eleventh session).
+// --splits' default (issue 39), which render() and the shard header resolve: auto (0) where every
+// eye vertex samples a light (next-event estimation, s = 1, t >= 2) and the profile has no light
+// subpath beyond that one light point and no manifold connector: pt-nee, pt-nee+distant,
+// pt-nee+mirror, pbrt-v4-path, mitsuba3-path. Else 1: under light tracing or bdpt's joins a run
+// repeats the light subpath and its joins, which the pilot neither prices nor sees (its splats),
+// and auto lost there (0.30x on Tungsten's box, 0.39x on point-glass.json); a manifold walk is not
+// priced by the pilot's rays either (pt-nee+manifold 0.46x on point-glass.json); and without
+// next-event estimation (pt) a run finds the light by chance, a heavy tail the pilot's few runs
+// underrate (pt 0.88x / 0.67x on cornell.json at 16 / 64 spp; bench/README.md, issue 39, eleventh
+// and twelfth sessions).
 bool has_light_subpath(const Profile& profile);
 int resolved_splits(const Profile& profile, std::optional<int> splits);
 

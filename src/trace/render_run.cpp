@@ -52,13 +52,14 @@ bool has_light_subpath(const Profile& profile) {
   });
 }
 
-// With the manifold connector too, 1 (pt-nee+manifold): a walk is not priced by the pilot's rays,
-// and auto took 6x the CPU on point-glass.json for 0.46x the efficiency (lamp-glass.json: 3.4x at
-// 16 spp; bench/README.md, issue 39, eleventh session); render.h's comment says the rest.
+// render.h says why; under the manifold connector auto took 6x the CPU on point-glass.json for
+// 0.46x the efficiency (lamp-glass.json: 3.4x at 16 spp).
 int resolved_splits(const Profile& profile, std::optional<int> splits) {
   const bool manifold = std::any_of(profile.strategies.begin(), profile.strategies.end(),
                                     [](const Strategy& st) { return st.connector == ConnectorKind::kManifold; });
-  return splits.value_or(has_light_subpath(profile) || manifold ? 1 : 0);
+  const bool nee = std::any_of(profile.strategies.begin(), profile.strategies.end(),
+                               [](const Strategy& st) { return st.s.contains(1) && st.connector == ConnectorKind::kNone; });
+  return splits.value_or(nee && !has_light_subpath(profile) && !manifold ? 0 : 1);
 }
 
 namespace tracer {

@@ -117,10 +117,11 @@ TEST(SplitsOption, TakesACountOrAutoAndNothingElse) {
 }
 
 // Issue 39: --splits' default is the profile's (resolved_splits(), trace/render.h), recorded resolved:
-// auto (0) without a light subpath or a manifold connector, else 1; an explicit --splits wins.
+// auto (0) with next-event estimation and without a light subpath or a manifold connector, else 1
+// (pt too: it finds the light by chance); an explicit --splits wins.
 TEST(SplitsOption, DefaultsPerProfileAndAnExplicitCountWins) {
   const std::vector<std::pair<std::string, int>> cases = {
-      {"--renderer pt", 0},           {"--renderer pt-nee", 0},          {"--renderer pt-nee+distant", 0},
+      {"--renderer pt", 1},           {"--renderer pt-nee", 0},          {"--renderer pt-nee+distant", 0},
       {"--renderer pt-nee+mirror", 0}, {"--renderer pbrt-v4-path", 0},   {"--renderer mitsuba3-path", 0},
       {"--renderer pt-nee+manifold", 1}, {"--renderer lt", 1},           {"--renderer bdpt", 1},
       {"--renderer pbrt-v4-bdpt", 1}, {"--renderer mitsuba3-ptracer", 1}, {"--renderer pt-nee --splits 1", 1},

@@ -32,7 +32,7 @@ struct Sampling {
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
   LightSampling light_sampling = RenderOptions{}.light_sampling;
-  std::optional<int> splits;  // unset: the profile's (resolved_splits())
+  std::optional<int> splits{};  // unset: the profile's (resolved_splits())
   std::shared_ptr<const tracer::SplitMap> split_map{};  // with splits 0: these counts instead of the pilot's
   std::string name() const {
     return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
