@@ -283,13 +283,6 @@ class Integrator {
   void emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a, const Vertex& b,
                      const std::vector<ChainVertex>& chain, double weight) const;
   int manifold_of(int s, int t) const { return table_.at(s, ConnectorKind::kManifold, t); }
-  // A seed chain from end `from` (the light end a when from_light, else the eye end b): the ray
-  // towards a specular shape (drawn by RenderScene::specular's seed_cdf; a point on its area, or a
-  // direction in the cone of a sphere), followed through every specular surface it meets (a mirror reflects; glass
-  // reflects with the Fresnel probability, else refracts) until it leaves them; its hits, light
-  // side first. Random numbers from counter-based `stream`.
-  ManifoldFailure seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
-                             std::vector<ChainVertex>& chain) const;
   // Whether the manifold connector (s, DS^mD, ·) could build the chain x_s … x(s+m-1) of path x
   // (letters `key`): the profile runs it there, its eye end is a surface, and every chain vertex is
   // a reflection or refraction on smooth glass or a reflection on a mirror.
