@@ -16,11 +16,12 @@ namespace pathex::tracer {
 bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const {
   const int k = x.size() - 1;
   const int t = k + 1 - i - m;  // letters after the chain
-  if (i < 1 || m < 1 || m > kMaxChain || t < 2 || manifold_of(i, t) < 0) return false;
+  if (i < 1 || m < 1 || m > kMaxChain || t < 1 || manifold_of(i, t) < 0) return false;
+  // (At t = 1, c(i+m+1) is the sensor's direction letter: D for a pinhole's and a thin lens's.)
   if (!packed_is_d(key, i) || !packed_is_d(key, i + m + 1)) return false;
   const Vertex& a = x[i - 1];
   const Vertex& b = x[i + m];
-  if (b.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(b.shape)]) return false;
+  if (t >= 2 && (b.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(b.shape)])) return false;
   if (i >= 2 && (a.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(a.shape)])) return false;
   for (int v = i; v < i + m; ++v) {
     const Vertex& c = x[v];
@@ -70,8 +71,9 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
       eye_picks *= picks(c, to_eye, reflect);
     }
     const vec3 wa = glm::normalize(x[i].p - a.p), wb = glm::normalize(x[i + m - 1].p - b.p);
-    const double cos_a = abs_cos(a, wa), cos_b = abs_cos(b, wb);
-    const double ab = chain_dw_db(chain, glm::dvec3(a.p), glm::dvec3(b.p), glm::dvec3(b.n), 0.0);  // |dω_a / dA_b|
+    const vec3 nb = b.has_normal() ? b.n : cam_.axis();  // a pinhole's area across its axis, as the connector's (t = 1)
+    const double cos_a = abs_cos(a, wa), cos_b = std::fabs(glm::dot(nb, wb));
+    const double ab = chain_dw_db(chain, glm::dvec3(a.p), glm::dvec3(b.p), glm::dvec3(nb), 0.0);  // |dω_a / dA_b|
     // |dω_b / dA_a| by reciprocity: the étendue η² cos dA dω is the same at both ends of the chain.
     const double eta_a = chain.front().eta_light, eta_b = chain.back().eta_eye;
     const double ba = ab * (eta_a * eta_a * cos_a) / (eta_b * eta_b * cos_b);
@@ -84,7 +86,8 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
       const vec3 wp = glm::normalize(x[i - 2].p - a.p);
       pa = pdf_dir(a, &wp, wa);
     }
-    const vec3 wn = glm::normalize(x[i + m + 1].p - b.p);
+    // b's BSDF's, or (b = xk, a sensor point) the sensor's direction density.
+    const vec3 wn = b.kind == Kind::kCamera ? vec3(0.0f) : glm::normalize(x[i + m + 1].p - b.p);
     const float pb = pdf_dir(b, &wn, wb);
     const double light_b = pa * light_picks * ab, eye_a = pb * eye_picks * ba;
     // Where the chain's term is undefined, the walks' densities stay (a function of the path
@@ -107,7 +110,13 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   const bool skip = rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate;
   if (skip && max_light_ >= 2) return;  // light subpaths' joins share every such path: the rate applies whatever the light
   const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
-  if (b->kind != Kind::kSurface || !b->finite) return;
+  if (t == 1) {  // a fresh point of a sensor with a finite direction (a pinhole's, one drawn on a thin lens)
+    if (cam_.letters[0] != 'D') return;
+    join_numbers(rng, JoinBlock::kManifoldEye, s);
+    b = &sensor_vertex(th.join.eye0, sensor_point(cam_.params, rng.get2d_if(reads_lens_numbers(cam_.params))), cam_.axis(), 'D');
+  } else if (b->kind != Kind::kSurface || !b->finite) {
+    return;
+  }
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kManifoldLight);
   if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
   if (max_light_ < 2 && (s >= 2 ? th.light[0] : *a).pos_letter == 'S') rate = 1.0;  // from a point: the connector's alone
@@ -124,7 +133,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   const std::uint64_t stream = stream_key(rng.key(), th.pass, 0x6d616e69666f6c64ULL + static_cast<std::uint64_t>(s) * kMaxRuns +
                                                                static_cast<std::uint64_t>(t));
   std::uint64_t drawn = 0;
-  const glm::dvec3 pa(a->p), pb(b->p), nb(b->n);
+  const glm::dvec3 pa(a->p), pb(b->p), nb(b->has_normal() ? b->n : cam_.axis());  // a pinhole's area across its axis
   std::vector<ManifoldSolution>& found = th.manifold_found;
   // A seed keeps its vertices' shapes and types (reflection or refraction) through Newton's
   // method, so a seed of another signature than every chain still sought cannot find one again:
@@ -322,20 +331,32 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
   const vec3 w_b = glm::normalize(jr.chain_vertices[static_cast<std::size_t>(m - 1)].p - b->p);
   // f at a towards the chain: the light's directional emission (a's beta holds the spatial part), or the BSDF.
   const vec3 fa = end_f(*a, w_a, TransportMode::kImportance);
-  const vec3 fb = end_f(*b, w_b, TransportMode::kRadiance);
   // Flux leaving a into dω lands on dA_b = dω / |dω_a/dA_b|: the generalized geometry term, here
   // times the chain's estimated inverse probability (`weight`). Its cosine at b is the area
-  // measure's (geometric); b's shading cosine replaces it (shading_cos, vertex.h).
-  const float cos_b = abs_cos(*b, w_b);
-  const float shade_b = cos_b > 0.0f ? shading_cos(*b, w_b) / cos_b : 0.0f;
-  const vec3 contrib = a->beta * fa * shading_cos(*a, w_a) * transmit * fb * b->beta *
+  // measure's (geometric); b's shading cosine replaces it (shading_cos, vertex.h). At a sensor
+  // point (t = 1) dA_b lies across the sensor's axis, as connect_finite()'s weight We cos / (p d²)
+  // has it: b's factor is We towards the chain over the point's density (a pinhole's 1), splatted.
+  vec3 fb(1.0f), beta_b(1.0f);
+  float shade_b = 1.0f;
+  glm::vec2 raster{0.0f};
+  if (t == 1) {
+    fb = importance(cam_.params, b->p, w_b, &raster) / (cam_.pdf_pos > 0.0f ? cam_.pdf_pos : 1.0f);
+  } else {
+    fb = end_f(*b, w_b, TransportMode::kRadiance);
+    beta_b = b->beta;
+    const float cos_b = abs_cos(*b, w_b);
+    shade_b = cos_b > 0.0f ? shading_cos(*b, w_b) / cos_b : 0.0f;
+  }
+  const vec3 contrib = a->beta * fa * shading_cos(*a, w_a) * transmit * fb * beta_b *
                        (static_cast<float>(weight) * shade_b);
   if (is_black(contrib)) {
     ++stats.no_transport;
     return;
   }
-  // b is a surface vertex: t >= 2, no eye0.
+  // b is a surface vertex (t >= 2), or the sensor point eye0.
   jr.set_connector(ConnectorKind::kManifold, s, t, strategy_index, chain_key(th, *a, s, t, m), contrib, m, a, b);
+  jr.splat = t == 1;
+  if (jr.splat) cam_.to_pixels(raster, &jr.rx, &jr.ry);
   estimate(th, batch);
 }
 
