@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <filesystem>
@@ -615,6 +616,14 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
   }
 }
 
+// The renderer's weights of the three strategies that sample one path, against the power heuristic of
+// their densities computed independently; and their sum, 1.
+void expect_power_heuristic(const std::array<float, 3>& weights, const std::array<double, 3>& densities, const std::string& where) {
+  const double sum2 = densities[0] * densities[0] + densities[1] * densities[1] + densities[2] * densities[2];
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(weights[i], densities[i] * densities[i] / sum2, 2e-3) << where << " (strategy " << i << ")";
+  EXPECT_NEAR(weights[0] + weights[1] + weights[2], 1.0, 1e-4) << where;
+}
+
 // Where light tracing, the emitter hit and the manifold connector sample one path through the
 // glass ball of lamp-glass.json (LDDSSDDSE: lamp x0, the ball's two refractions x1 x2, the floor
 // x3, the camera x4), their densities are over the areas of x0, x3 and x4, the chain a function of
@@ -669,7 +678,6 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
     const double manifold = lamp * e3;
     const double light_tracing = lamp * lamp_dir * choices * to_floor.dw_db;
     const double emitter_hit = floor_dir * choices * to_lamp.dw_db * e3;
-    const double sum2 = manifold * manifold + light_tracing * light_tracing + emitter_hit * emitter_hit;
     const PathKey key = in.path_key(th, 4, 1, nullptr);
     const float w_lt = A::own_weight(in, th, 4, 1);
     const A::WholePath whole(x);
@@ -677,11 +685,8 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
     const float w_manifold = A::recomputed_weight(in, th, whole, 1, 2, key, ConnectorKind::kManifold);
     const float w_hit = A::recomputed_weight(in, th, whole, 0, 0, key, ConnectorKind::kNone);
     const std::string where = "sample " + std::to_string(i) + ", |dω0/dA3| " + std::to_string(to_floor.dw_db);
-    EXPECT_NEAR(w_lt, light_tracing * light_tracing / sum2, 2e-3) << where;
     EXPECT_NEAR(w_lt_whole, w_lt, 1e-4) << where;
-    EXPECT_NEAR(w_manifold, manifold * manifold / sum2, 2e-3) << where;
-    EXPECT_NEAR(w_hit, emitter_hit * emitter_hit / sum2, 2e-3) << where;
-    EXPECT_NEAR(w_lt + w_manifold + w_hit, 1.0, 1e-4) << where;
+    expect_power_heuristic({w_lt, w_manifold, w_hit}, {light_tracing, manifold, emitter_hit}, where);
     ++checked;
     lt_leads += w_lt > 0.5f ? 1 : 0;
     manifold_leads += w_manifold > 0.5f ? 1 : 0;
@@ -743,17 +748,13 @@ TEST(Mis, ManifoldAtTheCameraWeighsTheEyeWalksChainDensity) {
     const double nee = lamp * eye_1;
     const double emitter_hit = (cos1 / pi) * cos0 / d2 * eye_1;   // the floor's cosine density towards x0
     const double manifold = lamp * (cos0 / pi) * cos1 / d2;       // the lamp's cosine emission towards x1
-    const double sum2 = nee * nee + emitter_hit * emitter_hit + manifold * manifold;
     const PathKey key = in.path_key(th, 1, 4, nullptr);
     const A::WholePath whole(x);
     const float w_nee = A::recomputed_weight(in, th, whole, 1, 0, key, ConnectorKind::kNone);
     const float w_hit = A::recomputed_weight(in, th, whole, 0, 0, key, ConnectorKind::kNone);
     const float w_manifold = A::recomputed_weight(in, th, whole, 2, 2, key, ConnectorKind::kManifold);
     const std::string where = "sample " + std::to_string(i) + ", |dω4/dA1| " + std::to_string(to_floor.dw_db);
-    EXPECT_NEAR(w_nee, nee * nee / sum2, 2e-3) << where;
-    EXPECT_NEAR(w_hit, emitter_hit * emitter_hit / sum2, 2e-3) << where;
-    EXPECT_NEAR(w_manifold, manifold * manifold / sum2, 2e-3) << where;
-    EXPECT_NEAR(w_nee + w_hit + w_manifold, 1.0, 1e-4) << where;
+    expect_power_heuristic({w_nee, w_hit, w_manifold}, {nee, emitter_hit, manifold}, where);
     ++checked;
     nee_leads += w_nee > 0.5f ? 1 : 0;
     manifold_leads += w_manifold > 0.5f ? 1 : 0;
