@@ -616,6 +616,13 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
   }
 }
 
+// lamp-glass.json under the built-in bdpt+manifold, seed 3 (the rig keeps references to both).
+struct LampGlassRig {
+  Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json").expect("the sample");
+  StrategySet strategies = runnable_strategies(resolve_profile("bdpt+manifold", Limits{}).expect("a built-in profile")).expect("runs");
+  ManifoldRig rig{scene, strategies, 3};
+};
+
 // The renderer's weights of the three strategies that sample one path, against the power heuristic of
 // their densities computed independently; and their sum, 1.
 void expect_power_heuristic(const std::array<float, 3>& weights, const std::array<double, 3>& densities, const std::string& where) {
@@ -635,10 +642,8 @@ void expect_power_heuristic(const std::array<float, 3>& weights, const std::arra
 // weights of all three strategies, as the renderer computes them (light tracing's from its
 // subpaths' stored densities too), must be the power heuristic of these densities. Fixed seed.
 TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
-  const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json").expect("the sample");
-  const Profile profile = resolve_profile("bdpt+manifold", Limits{}).expect("a built-in profile");
-  const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
-  ManifoldRig rig(scene, strategies, 3);
+  LampGlassRig lamp_glass;
+  ManifoldRig& rig = lamp_glass.rig;
   const Integrator& in = rig.in;
   const RenderScene& rs = rig.rs;
   Integrator::Thread& th = rig.th;
@@ -707,10 +712,8 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
 // the manifold draws x1 from the lamp. The three weights must be the power heuristic of these
 // densities. Fixed seed.
 TEST(Mis, ManifoldAtTheCameraWeighsTheEyeWalksChainDensity) {
-  const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json").expect("the sample");
-  const Profile profile = resolve_profile("bdpt+manifold", Limits{}).expect("a built-in profile");
-  const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
-  ManifoldRig rig(scene, strategies, 3);
+  LampGlassRig lamp_glass;
+  ManifoldRig& rig = lamp_glass.rig;
   rig.o.manifold.rate = 1.0;
   const Integrator& in = rig.in;
   const RenderScene& rs = rig.rs;
