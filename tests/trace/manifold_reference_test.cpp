@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -78,23 +79,28 @@ struct SeedMean {
   double mean = 0.0, stderr_ = 0.0;
   nlohmann::json strategies;
 };
-SeedMean seed_mean(const std::string& scene, const std::string& renderer, const std::string& cls, int spp, int seeds) {
+// One render of class `cls` alone (--only) of `scene` under `renderer` at `spp` and `seed`: the
+// class's entry of its JSON (its run exits 0 and has no non-finite sample).
+nlohmann::json only_class(const std::string& scene, const std::string& renderer, const std::string& cls, int spp, std::uint64_t seed) {
   const std::string dir =
-      (std::filesystem::temp_directory_path() / ("pathex-manifold-seeds-" + std::to_string(::getpid()))).string();
+      (std::filesystem::temp_directory_path() / ("pathex-manifold-only-class-" + std::to_string(::getpid()))).string();
+  std::filesystem::remove_all(dir);
+  const pathex::test::CliRun r = pathex::test::run_pathex("trace " + scene + " --renderer " + renderer + " --only " + cls +
+                                                          " --spp " + std::to_string(spp) + " --seed " + std::to_string(seed) +
+                                                          " --no-images --quiet --json --out " + dir);
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  const nlohmann::json h = nlohmann::json::parse(r.out);
+  EXPECT_EQ(h["nonfinite_samples"], 0);
+  const nlohmann::json c = h["classes"].back();
+  EXPECT_EQ(c["expr"], cls);
+  return c;
+}
+SeedMean seed_mean(const std::string& scene, const std::string& renderer, const std::string& cls, int spp, int seeds) {
   std::vector<double> v;
   SeedMean out;
   for (int seed = 1; seed <= seeds; ++seed) {
-    std::filesystem::remove_all(dir);
-    const std::uint64_t run_seed = pathex::test::stat_seed_from(static_cast<std::uint64_t>(seed));
-    const pathex::test::CliRun r = pathex::test::run_pathex("trace " + scene + " --renderer " + renderer + " --only " + cls +
-                                                            " --spp " + std::to_string(spp) + " --seed " + std::to_string(run_seed) +
-                                                            " --no-images --quiet --json --out " + dir);
-    std::filesystem::remove_all(dir);
-    EXPECT_EQ(r.code, 0) << r.err;
-    const nlohmann::json h = nlohmann::json::parse(r.out);
-    EXPECT_EQ(h["nonfinite_samples"], 0);
-    const nlohmann::json& c = h["classes"].back();
-    EXPECT_EQ(c["expr"], cls);
+    const nlohmann::json c = only_class(scene, renderer, cls, spp, pathex::test::stat_seed_from(static_cast<std::uint64_t>(seed)));
     v.push_back(c["luminance"].get<double>());
     for (const auto& [name, value] : c["strategies"].items()) out.strategies[name] = true;
   }
@@ -104,6 +110,17 @@ SeedMean seed_mean(const std::string& scene, const std::string& renderer, const 
   for (double x : v) sq += (x - out.mean) * (x - out.mean);
   out.stderr_ = std::sqrt(sq / static_cast<double>(v.size() - 1) / static_cast<double>(v.size()));
   return out;
+}
+
+// A class's reference on lamp-glass.json stored in tests/trace/scenes/`file`: its luminance and stderr.
+std::pair<double, double> lamp_glass_reference(const std::string& file, const std::string& cls) {
+  const nlohmann::json ref = read_json(std::string(PATHEX_SOURCE_DIR) + "/tests/trace/scenes/" + file);
+  EXPECT_EQ(ref["class"], cls);
+  EXPECT_EQ(ref["scene"], "samples/scenes/lamp-glass.json");
+  const double l0 = ref["reference"]["luminance"].get<double>(), s0 = ref["reference"]["stderr"].get<double>();
+  EXPECT_GT(l0, 0.0);
+  EXPECT_GT(s0, 0.0);
+  return {l0, s0};
 }
 
 // Issue 40's scene: a spherical lamp of radius 0.04 and a glass ball on a floor. The caustic seen
@@ -119,12 +136,7 @@ SeedMean seed_mean(const std::string& scene, const std::string& renderer, const 
 // through the ball (pt-nee's emitter hit (0, DD, 7), MIS-weighted against it: in 2 of the first 8
 // swept seeds' 8 renders).
 TEST(ManifoldReference, LampGlassSeenThroughAgreesWithTheQuadrature) {
-  const nlohmann::json ref = read_json(std::string(PATHEX_SOURCE_DIR) + "/tests/trace/scenes/lamp-glass.reference.json");
-  ASSERT_EQ(ref["class"], "LDDSSDSSDSE");
-  ASSERT_EQ(ref["scene"], "samples/scenes/lamp-glass.json");
-  const double l0 = ref["reference"]["luminance"].get<double>(), s0 = ref["reference"]["stderr"].get<double>();
-  ASSERT_GT(l0, 0.0);
-  ASSERT_GT(s0, 0.0);
+  const auto [l0, s0] = lamp_glass_reference("lamp-glass.reference.json", "LDDSSDSSDSE");
   const SeedMean m = seed_mean("samples/scenes/lamp-glass.json", "pt-nee+manifold", "LDDSSDSSDSE", 32, 8);
   ASSERT_GT(m.mean, 0.0);
   ASSERT_GT(m.stderr_, 0.0);
@@ -206,17 +218,8 @@ TEST(ManifoldReference, PinholeSeesALampThroughABallAsTheParaxialClosedForm) {
   const double area = 4.0 * std::pow(std::tan(2.0 * std::numbers::pi / 180.0), 2);
   const double closed = lamp * (1.0 - f0) * (1.0 - f0) * std::numbers::pi * (radius / b) * (radius / b) / area;
 
-  const std::string dir = (std::filesystem::temp_directory_path() / ("pathex-manifold-ball-" + std::to_string(::getpid()))).string();
-  std::filesystem::remove_all(dir);
-  const pathex::test::CliRun r = pathex::test::run_pathex(
-      "trace tests/trace/scenes/ball-lamp-axis.json --renderer bdpt+manifold --only LDDSSDSE --spp 256 --seed " +
-      std::to_string(pathex::test::stat_seed_from(1)) + " --no-images --quiet --json --out " + dir);
-  std::filesystem::remove_all(dir);
-  ASSERT_EQ(r.code, 0) << r.err;
-  const nlohmann::json h = nlohmann::json::parse(r.out);
-  EXPECT_EQ(h["nonfinite_samples"], 0);
-  const nlohmann::json& c = h["classes"].back();
-  ASSERT_EQ(c["expr"], "LDDSSDSE");
+  const nlohmann::json c =
+      only_class("tests/trace/scenes/ball-lamp-axis.json", "bdpt+manifold", "LDDSSDSE", 256, pathex::test::stat_seed_from(1));
   const double l = c["luminance"].get<double>(), s = c["stderr"].get<double>();
   ASSERT_GT(s, 0.0);
   const double k = pathex::test::family_sigmas(1);
@@ -235,12 +238,7 @@ TEST(ManifoldReference, PinholeSeesALampThroughABallAsTheParaxialClosedForm) {
 // family_sigmas(1) combined standard errors on the seeds' 15 degrees of freedom (the seeds' spread,
 // not a run's batch means: the inverse probability of a chain a seed rarely finds is heavy-tailed).
 TEST(ManifoldReference, BdptManifoldLampSeenThroughTheBallAgreesWithPt) {
-  const nlohmann::json ref = read_json(std::string(PATHEX_SOURCE_DIR) + "/tests/trace/scenes/lamp-glass-lamp-through.reference.json");
-  ASSERT_EQ(ref["class"], "LDDSSSDSE");
-  ASSERT_EQ(ref["scene"], "samples/scenes/lamp-glass.json");
-  const double l0 = ref["reference"]["luminance"].get<double>(), s0 = ref["reference"]["stderr"].get<double>();
-  ASSERT_GT(l0, 0.0);
-  ASSERT_GT(s0, 0.0);
+  const auto [l0, s0] = lamp_glass_reference("lamp-glass-lamp-through.reference.json", "LDDSSSDSE");
   const SeedMean m = seed_mean("samples/scenes/lamp-glass.json", "bdpt+manifold", "LDDSSSDSE", 64, 16);
   ASSERT_GT(m.stderr_, 0.0);
   const double combined = std::sqrt(m.stderr_ * m.stderr_ + s0 * s0), k = pathex::test::family_sigmas(1, 1e-3, 15);

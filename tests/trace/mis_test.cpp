@@ -621,15 +621,29 @@ struct LampGlassRig {
   Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json").expect("the sample");
   StrategySet strategies = runnable_strategies(resolve_profile("bdpt+manifold", Limits{}).expect("a built-in profile")).expect("runs");
   ManifoldRig rig{scene, strategies, 3};
+  // Sample i's subpaths at seed 3 (pixel i of the frame, row by row): the eye subpath's length; *ns the light's.
+  int trace(int i, int* ns) {
+    Sampler rng(3, static_cast<std::uint64_t>(i), 0);
+    return IntegratorTestAccess::trace_subpaths(rig.in, rig.th, rng, i % rig.rs.camera.width, (i / rig.rs.camera.width) % rig.rs.camera.height, ns);
+  }
 };
 
 // The renderer's weights of the three strategies that sample one path, against the power heuristic of
 // their densities computed independently; and their sum, 1.
-void expect_power_heuristic(const std::array<float, 3>& weights, const std::array<double, 3>& densities, const std::string& where) {
-  const double sum2 = densities[0] * densities[0] + densities[1] * densities[1] + densities[2] * densities[2];
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(weights[i], densities[i] * densities[i] / sum2, 2e-3) << where << " (strategy " << i << ")";
-  EXPECT_NEAR(weights[0] + weights[1] + weights[2], 1.0, 1e-4) << where;
-}
+// Counted: the paths checked, and how often each strategy took the lead (a weight above ½).
+struct PowerHeuristicChecks {
+  int checked = 0;
+  std::array<int, 3> leads{};
+  void expect(const std::array<float, 3>& weights, const std::array<double, 3>& densities, const std::string& where) {
+    const double sum2 = densities[0] * densities[0] + densities[1] * densities[1] + densities[2] * densities[2];
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_NEAR(weights[i], densities[i] * densities[i] / sum2, 2e-3) << where << " (strategy " << i << ")";
+      leads[i] += weights[i] > 0.5f ? 1 : 0;
+    }
+    EXPECT_NEAR(weights[0] + weights[1] + weights[2], 1.0, 1e-4) << where;
+    ++checked;
+  }
+};
 
 // Where light tracing, the emitter hit and the manifold connector sample one path through the
 // glass ball of lamp-glass.json (LDDSSDDSE: lamp x0, the ball's two refractions x1 x2, the floor
@@ -649,11 +663,10 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
   Integrator::Thread& th = rig.th;
   using A = IntegratorTestAccess;
   const double pi = std::numbers::pi;
-  int checked = 0, lt_leads = 0, manifold_leads = 0;
+  PowerHeuristicChecks checks;  // light tracing, the manifold, the emitter hit
   for (int i = 0; i < 20000; ++i) {
-    Sampler rng(3, static_cast<std::uint64_t>(i), 0);
     int ns = 0;
-    A::trace_subpaths(in, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
+    lamp_glass.trace(i, &ns);
     if (ns < 4 || !th.light[3].finite || A::label(in, th, 4, 1) != "LDDSSDDSE") continue;
     const std::vector<Vertex> x = A::gather(in, th, 4, 1);
     const glm::dvec3 p0(x[0].p), p3(x[3].p), n0(x[0].n), n3(x[3].n);
@@ -691,15 +704,12 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
     const float w_hit = A::recomputed_weight(in, th, whole, 0, 0, key, ConnectorKind::kNone);
     const std::string where = "sample " + std::to_string(i) + ", |dω0/dA3| " + std::to_string(to_floor.dw_db);
     EXPECT_NEAR(w_lt_whole, w_lt, 1e-4) << where;
-    expect_power_heuristic({w_lt, w_manifold, w_hit}, {light_tracing, manifold, emitter_hit}, where);
-    ++checked;
-    lt_leads += w_lt > 0.5f ? 1 : 0;
-    manifold_leads += w_manifold > 0.5f ? 1 : 0;
+    checks.expect({w_lt, w_manifold, w_hit}, {light_tracing, manifold, emitter_hit}, where);
   }
-  EXPECT_GT(checked, 30);
+  EXPECT_GT(checks.checked, 30);
   // Both light tracing and the manifold take the lead somewhere on the caustic.
-  EXPECT_GT(lt_leads, 3);
-  EXPECT_GT(manifold_leads, 3);
+  EXPECT_GT(checks.leads[0], 3);
+  EXPECT_GT(checks.leads[1], 3);
 }
 
 // The connector ending at the camera (t = 1, issue 40's twelfth session) on paths of lamp-glass.json
@@ -720,11 +730,10 @@ TEST(Mis, ManifoldAtTheCameraWeighsTheEyeWalksChainDensity) {
   Integrator::Thread& th = rig.th;
   using A = IntegratorTestAccess;
   const double pi = std::numbers::pi;
-  int checked = 0, nee_leads = 0, manifold_leads = 0;
+  PowerHeuristicChecks checks;  // next-event estimation, the emitter hit, the manifold
   for (int i = 0; i < 20000; ++i) {
-    Sampler rng(3, static_cast<std::uint64_t>(i), 0);
     int ns = 0;
-    const int nt = A::trace_subpaths(in, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
+    const int nt = lamp_glass.trace(i, &ns);
     if (ns < 1 || nt < 4 || A::label(in, th, 1, 4) != "LDDDSSDSE") continue;
     const std::vector<Vertex> x = A::gather(in, th, 1, 4);
     const glm::dvec3 p1(x[1].p), p4(x[4].p), n1(x[1].n);
@@ -757,15 +766,11 @@ TEST(Mis, ManifoldAtTheCameraWeighsTheEyeWalksChainDensity) {
     const float w_hit = A::recomputed_weight(in, th, whole, 0, 0, key, ConnectorKind::kNone);
     const float w_manifold = A::recomputed_weight(in, th, whole, 2, 2, key, ConnectorKind::kManifold);
     const std::string where = "sample " + std::to_string(i) + ", |dω4/dA1| " + std::to_string(to_floor.dw_db);
-    expect_power_heuristic({w_nee, w_hit, w_manifold}, {nee, emitter_hit, manifold}, where);
-    ++checked;
-    nee_leads += w_nee > 0.5f ? 1 : 0;
-    manifold_leads += w_manifold > 0.5f ? 1 : 0;
+    checks.expect({w_nee, w_hit, w_manifold}, {nee, emitter_hit, manifold}, where);
   }
-  EXPECT_GT(checked, 30);
-  // Each of next-event estimation and the manifold takes the lead somewhere.
-  EXPECT_GT(nee_leads, 3);
-  EXPECT_GT(manifold_leads, 3);
+  EXPECT_GT(checks.checked, 30);
+  EXPECT_GT(checks.leads[0], 3);  // next-event estimation and the manifold each lead somewhere
+  EXPECT_GT(checks.leads[2], 3);
 }
 
 }  // namespace
