@@ -95,6 +95,8 @@ STATISTICAL_TESTS = [
     ("manifold_reference_test", "ManifoldReference.SeenThroughCausticAgreesWithTheQuadrature"),
     ("manifold_reference_test", "ManifoldReference.LampGlassSeenThroughAgreesWithTheQuadrature"),
     ("manifold_reference_test", "ManifoldReference.BdptManifoldDirectCausticAgreesWithBdpt"),
+    ("manifold_reference_test", "ManifoldReference.PinholeSeesALampThroughABallAsTheParaxialClosedForm"),
+    ("manifold_reference_test", "ManifoldReference.BdptManifoldLampSeenThroughTheBallAgreesWithPt"),
 ]
 # tests/meta/stat_registry_test.cpp checks that every test reaching test::stat_seed is listed here.
 

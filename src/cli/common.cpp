@@ -51,7 +51,7 @@ void add_manifold_options(CLI::App* app, ManifoldOptions* o) {
   const char* group = "Manifold connector";
   app->add_option(name[0], o->max_iterations, "Newton iterations of one walk before it fails (iteration_limit)")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(1, 10000))->group(group);
-  app->add_option(name[1], o->threshold, "Largest constraint (tangential generalized half vector) of a solved chain")
+  app->add_option(name[1], o->threshold, "Largest constraint (tangential generalized half vector) of a solved chain, which must then polish to a root (a near miss past a fold is no chain)")
       ->capture_default_str()->check(real_in(0, true, 1, true))->group(group);
   app->add_option(name[2], o->min_segment,
                   "Shortest segment of a solution, as a fraction of the scene's bounding-box diagonal (too_short)")

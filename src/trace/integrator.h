@@ -226,7 +226,7 @@ class Integrator {
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;  // the most joins of one kind per sample
   // --- joins (trace/joins/): each makes th.join from the two subpaths, or returns false ---
   // Random numbers: each join draws from a block of its own, per kind and subpath length (render.cpp).
-  enum class JoinBlock : std::uint64_t { kEmitter, kLens, kSplat, kNee, kShadow, kDistant, kOrtho, kMirrorLight, kMirrorEye, kManifoldLight };
+  enum class JoinBlock : std::uint64_t { kEmitter, kLens, kSplat, kNee, kShadow, kDistant, kOrtho, kMirrorLight, kMirrorEye, kManifoldLight, kManifoldEye };
   static constexpr std::uint64_t kJoinDims = 2048;  // after the eye's and the light subpath's blocks
   static constexpr std::uint64_t kDimsPerJoin = 4;
   static void join_numbers(Sampler& rng, JoinBlock block, int index) {
@@ -275,21 +275,14 @@ class Integrator {
   // The letters of the path that a connector's chain of m specular vertices (the mirror's one, the
   // manifold's) makes between a (c(s): y(s-1), or the fresh light end for s = 1) and z(t-1).
   PathKey chain_key(Thread& th, const Vertex& a, int s, int t, int m) const;
-  // The manifold connector (s, DS+D, t), s >= 1, t >= 2 (trace/joins/manifold.h): y(s-1) (a
-  // fresh light sample for s = 1) joined to z(t-1) across a chain of smooth glass by specular
-  // manifold sampling. Defined in trace/joins/manifold_join.cpp.
+  // The manifold connector (s, DS+D, t), s, t >= 1 (trace/joins/manifold.h): y(s-1) (a fresh light
+  // sample for s = 1) joined to z(t-1) (a fresh sensor point for t = 1, a pinhole or thin lens,
+  // splatted) across a chain of smooth glass by specular manifold sampling (manifold_join.cpp).
   void connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const;
   // One chain's contribution between a and b, its |dω_a/dA_b| times its inverse probability `weight`.
   void emit_manifold(Thread& th, int s, int t, int batch, int strategy_index, const Vertex& a, const Vertex& b,
                      const std::vector<ChainVertex>& chain, double weight) const;
   int manifold_of(int s, int t) const { return table_.at(s, ConnectorKind::kManifold, t); }
-  // A seed chain from end `from` (the light end a when from_light, else the eye end b): the ray
-  // towards a specular shape (drawn by RenderScene::specular's seed_cdf; a point on its area, or a
-  // direction in the cone of a sphere), followed through every specular surface it meets (a mirror reflects; glass
-  // reflects with the Fresnel probability, else refracts) until it leaves them; its hits, light
-  // side first. Random numbers from counter-based `stream`.
-  ManifoldFailure seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
-                             std::vector<ChainVertex>& chain) const;
   // Whether the manifold connector (s, DS^mD, ·) could build the chain x_s … x(s+m-1) of path x
   // (letters `key`): the profile runs it there, its eye end is a surface, and every chain vertex is
   // a reflection or refraction on smooth glass or a reflection on a mirror.

@@ -337,9 +337,9 @@ void Integrator::sample_run(Thread& th, int px, int py, std::uint64_t pass) cons
     for (int t = 1; t <= nt; ++t)
       for (int s = 1; s <= std::min(s_max, max_bounces_ + 1 - t); ++s)
         if (mirror_of(s, t) >= 0) connect_mirror(th, rng, s, t, batch);
-  // The manifold connector's eye end is a surface vertex z(t-1), t >= 2.
+  // The manifold connector's eye end: a surface vertex z(t-1), or (t = 1) a fresh sensor point.
   if (has_manifold_)
-    for (int t = 2; t <= nt; ++t)
+    for (int t = 1; t <= nt; ++t)
       for (int s = 1; s <= std::min(s_max, max_bounces_ + 1 - t); ++s)
         if (manifold_of(s, t) >= 0) connect_manifold(th, rng, s, t, batch);
 }

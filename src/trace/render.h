@@ -192,9 +192,8 @@ struct RenderOutput {
   std::vector<AimedLight> aimed{};                   // the lights whose emission was aimed
 };
 
-// The strategies of a profile the tracer runs: plain joins and the mirror and projection
-// connectors, and the manifold connector with its eye end on a surface (t >= 2); runnable_strategies()
-// refuses a profile with a manifold strategy at t = 1 by name.
+// The strategies of a profile the tracer runs: plain joins and the mirror, projection and manifold
+// connectors (the manifold's eye end a surface, t >= 2, or a pinhole's or thin lens's point, t = 1).
 // The tracer looks them up by (s, chain, t) in a StrategyTable (trace/strategy_table.h).
 struct StrategySet {
   std::vector<Strategy> strategies;

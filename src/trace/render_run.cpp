@@ -21,16 +21,9 @@ namespace pathex {
 // --- strategies the tracer runs ---
 
 Result<StrategySet> runnable_strategies(const Profile& profile) {
-  StrategySet set;
-  for (const Strategy& st : profile.strategies) {
-    // The manifold connector's seed leaves a surface vertex of the eye subpath (trace/joins/manifold.h).
-    if (st.connector == ConnectorKind::kManifold && st.t.contains(1))
-      return make_error(ErrorCode::kUsage, "renderer '" + profile.name + "' runs the manifold connector with t = 1 (strategy '" +
-                                               st.name + "'), which the tracer does not run: its eye end must be a surface "
-                                               "vertex of the eye subpath, t >= 2");
-    set.strategies.push_back(st);
-  }
-  return set;
+  // Every strategy the checker accepts (the manifold connector at t = 1 too: its eye end a fresh
+  // sensor point, trace/joins/manifold_join.cpp).
+  return StrategySet{profile.strategies};
 }
 
 bool manifold_shares_paths(const Profile& profile) {

@@ -102,6 +102,15 @@ struct RenderSensor {
     return sample_ray(params, raster, ul);
   }
   glm::vec3 origin_normal(const EndpointRay& r) const { return pdf_pos == 0.0f ? glm::vec3(0.0f) : r.normal; }
+  // The axis of a sensor with a finite direction (a pinhole's, a thin lens's `forward`; 0 for the
+  // others): the normal of the plane over which a join that ends on its point measures area there,
+  // as connect_finite()'s cosine does (the manifold connector at t = 1, whose direction at the point
+  // the walk finds).
+  glm::vec3 axis() const {
+    if (const auto* p = std::get_if<PinholeParams>(&params)) return p->forward;
+    if (const auto* l = std::get_if<ThinLensParams>(&params)) return l->forward;
+    return glm::vec3(0.0f);
+  }
 };
 
 // Room for a material with its textured parameters evaluated (RenderScene::material_at): a

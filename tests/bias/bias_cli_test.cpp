@@ -104,13 +104,6 @@ TEST(BiasCli, BadInputIsLocated) {
   EXPECT_EQ(reserved.err, "pathex: error: " + classes +
                               ":/classes/1/name: the class name 'missed' is reserved for what the renderer misses "
                               "(missed.exr), expected another name\n");
-  const std::string profile = out_dir("lt-manifold") + ".json";
-  std::ofstream(profile) << R"({"name": "lt+manifold", "strategies": [
-      {"name": "splat-manifold", "s": "1..", "chain": "DS+D", "t": "1..", "connector": "manifold"}]})";
-  const CliRun ref = run_pathex("bias samples/scenes/cornell.json --renderer pt --reference " + profile + " --out " +
-                                out_dir("manifold"));
-  EXPECT_EQ(ref.code, 2);
-  EXPECT_NE(ref.err.find("renderer 'lt+manifold' runs the manifold connector with t = 1"), std::string::npos) << ref.err;
 }
 
 TEST(BiasCli, TraceMissedLine) {

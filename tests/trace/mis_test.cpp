@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "io/profile_json.h"
+#include "support/cli_run.h"
 #include "scene/scene.h"
 #include "optics/fresnel.h"
 #include "trace/integrator.h"
@@ -149,7 +151,7 @@ struct IntegratorTestAccess {
   // density recomputed, as each strategy that could sample it, the plain joins (s2, DD, ·) whose
   // letters are D and the manifold's chains, each computed as its own strategy. *chains: how many
   // manifold chains could build it. Must sum to 1.
-  static double whole_path_weight_sum(const Integrator& in, Integrator::Thread& th, int s, int t, int* chains) {
+  static double whole_path_weight_sum(const Integrator& in, Integrator::Thread& th, int s, int t, int* chains, int* at_sensor = nullptr) {
     const WholePath path(gather(in, th, s, t));
     const PathKey key = in.path_key(th, s, t, nullptr);
     const int k = static_cast<int>(path.x.size()) - 1, n = k + 1;
@@ -163,6 +165,7 @@ struct IntegratorTestAccess {
       while (i + m <= k - 1 && !packed_is_d(key, i + m + 1)) ++m;
       if (m > 0 && in.manifold_at(path.at(i, m), key, i, m)) {
         ++*chains;
+        if (at_sensor && i + m == k) ++*at_sensor;  // the chain ends at the camera: the connector at t = 1
         sum += recomputed_weight(in, th, path, i, m, key, ConnectorKind::kManifold);
       }
     }
@@ -550,18 +553,29 @@ struct ManifoldRig {
 // And with the connector run for a share of the samples (--manifold-rate 0.25, issue 40): that
 // share is the factor of its density where light tracing could join the path (the camera sees the
 // chain's eye end directly, or past a diffuse vertex), 1 where the camera sees it through glass.
+// With the connector ending at the camera too (t = 1, issue 40's twelfth session: the lamp seen
+// through the ball, the floor seen through it), at a pinhole and at a thin lens (lamp-glass.json
+// with a lens, whose light paths may also hit the lens: the strategy t = 0): the eye walk's density
+// of the chain's light end is the sensor's direction density times |dω_b/dA_a| across its axis.
 TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
   const Profile profile = parse_profile(R"({"name": "bdpt+manifold", "strategies": [
       {"name": "bdpt", "s": "0..", "chain": "DD", "t": "0.."},
-      {"name": "manifold", "s": "1..", "chain": "DS+D", "t": "2..", "connector": "manifold"}]})",
+      {"name": "manifold", "s": "1..", "chain": "DS+D", "t": "1..", "connector": "manifold"}]})",
                                         "bdpt+manifold.json", Limits{})
                               .expect("a valid profile");
   const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
+  const std::string lamp_glass = test::read_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json");
+  std::string with_lens = lamp_glass;
+  const std::string pinhole = R"("type": "pinhole")";
+  ASSERT_NE(with_lens.find(pinhole), std::string::npos);
+  with_lens.replace(with_lens.find(pinhole), pinhole.size(), R"("type": "lens", "aperture_radius": 0.05, "focus_distance": 3.5)");
   for (const double rate : {1.0, 0.25})
   for (const LightSampling light_sampling : {LightSampling::kArea, LightSampling::kSolidAngle})
-  for (const char* name : {"point-glass.json", "lamp-glass.json"}) {
+  for (const char* name : {"point-glass.json", "lamp-glass.json", "lamp-glass.json with a thin lens"}) {
     if (rate < 1.0 && light_sampling != LightSampling::kArea) continue;
-    const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + name).expect("the sample");
+    const bool lens = std::string(name).find("lens") != std::string::npos;
+    const Scene scene = lens ? load_scene_json(with_lens, std::string(PATHEX_SOURCE_DIR) + "/samples/scenes", "lamp-glass-lens").expect("the variant")
+                             : load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/" + name).expect("the sample");
     ManifoldRig rig(scene, strategies, 5, light_sampling);
     rig.o.manifold.rate = rate;  // the integrator reads its options by reference
     const Integrator& integrator = rig.in;
@@ -569,18 +583,21 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
     const RenderOptions& o = rig.o;
     Integrator::Thread& th = rig.th;
     using A = IntegratorTestAccess;
-    int checked = 0, shared = 0;
+    int checked = 0, shared = 0, at_sensor = 0;
     for (int i = 0; i < 10000; ++i) {
       Sampler rng(5, static_cast<std::uint64_t>(i), 0);
       int ns = 0;
       const int nt = A::trace_subpaths(integrator, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
       for (int t = 0; t <= nt; ++t)
         for (int s = 0; s <= ns; ++s) {
-          if (s == 1 || t == 1 || s + t < 2 || s + t - 2 > *o.max_bounces || !A::joinable(integrator, th, s, t)) continue;
-          int chains = 0;
-          const double sum = A::whole_path_weight_sum(integrator, th, s, t, &chains);
+          if (t == 1 || s + t < 2 || s + t - 2 > *o.max_bounces || !A::joinable(integrator, th, s, t)) continue;
+          // (s = 1: the light subpath's y0 stands for next-event estimation's fresh point, whose
+          // path the whole-path weights take alike; the join's own weight is checked below s = 1.)
+          int chains = 0, sensor_chains = 0;
+          const double sum = A::whole_path_weight_sum(integrator, th, s, t, &chains, &sensor_chains);
           ++checked;
           if (chains > 0) ++shared;
+          if (sensor_chains > 0) ++at_sensor;
           const std::string where = std::string(name) + " " + to_string(light_sampling) + " rate " + std::to_string(rate) + " " + A::label(integrator, th, s, t) + " (s=" + std::to_string(s) +
                                     ", t=" + std::to_string(t) + ")";
           EXPECT_NEAR(sum, 1.0, 1e-4) << where;
@@ -588,15 +605,45 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
           // surface (two points of one planar face) they are rounding, and the two sources differ.
           const std::vector<Vertex> x = A::gather(integrator, th, s, t);
           const vec3 w = s > 0 && t > 0 ? glm::normalize(x[static_cast<std::size_t>(s)].p - x[static_cast<std::size_t>(s - 1)].p) : vec3(0.0f);
-          if (s > 0 && t > 0 && std::min(abs_cos(x[static_cast<std::size_t>(s - 1)], w), abs_cos(x[static_cast<std::size_t>(s)], w)) < 1e-3f) continue;
+          if (s == 1 || (s > 0 && t > 0 && std::min(abs_cos(x[static_cast<std::size_t>(s - 1)], w), abs_cos(x[static_cast<std::size_t>(s)], w)) < 1e-3f)) continue;
           const float general = A::general_weight(integrator, th, s, t);
           EXPECT_NEAR(A::own_weight(integrator, th, s, t), general, 1e-4 * std::max(1.0f, general)) << where;
         }
     }
     EXPECT_GT(checked, 1000) << name;
     EXPECT_GT(shared, 50) << name;  // paths that the manifold and the plain joins both sample
+    EXPECT_GT(at_sensor, 50) << name;  // paths whose chain ends at the camera (the floor seen through the ball)
   }
 }
+
+// lamp-glass.json under the built-in bdpt+manifold, seed 3 (the rig keeps references to both).
+struct LampGlassRig {
+  Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json").expect("the sample");
+  StrategySet strategies = runnable_strategies(resolve_profile("bdpt+manifold", Limits{}).expect("a built-in profile")).expect("runs");
+  ManifoldRig rig{scene, strategies, 3};
+  // Sample i's subpaths at seed 3 (pixel i of the frame, row by row): the eye subpath's length; *ns the light's.
+  int trace(int i, int* ns) {
+    Sampler rng(3, static_cast<std::uint64_t>(i), 0);
+    return IntegratorTestAccess::trace_subpaths(rig.in, rig.th, rng, i % rig.rs.camera.width, (i / rig.rs.camera.width) % rig.rs.camera.height, ns);
+  }
+};
+
+// The renderer's weights of the three strategies that sample one path, against the power heuristic of
+// their densities computed independently; and their sum, 1.
+// Counted: the paths checked, and how often each strategy took the lead (a weight above ½).
+struct PowerHeuristicChecks {
+  int checked = 0;
+  std::array<int, 3> leads{};
+  void expect(const std::array<float, 3>& weights, const std::array<double, 3>& densities, const std::string& where) {
+    const double sum2 = densities[0] * densities[0] + densities[1] * densities[1] + densities[2] * densities[2];
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_NEAR(weights[i], densities[i] * densities[i] / sum2, 2e-3) << where << " (strategy " << i << ")";
+      leads[i] += weights[i] > 0.5f ? 1 : 0;
+    }
+    EXPECT_NEAR(weights[0] + weights[1] + weights[2], 1.0, 1e-4) << where;
+    ++checked;
+  }
+};
 
 // Where light tracing, the emitter hit and the manifold connector sample one path through the
 // glass ball of lamp-glass.json (LDDSSDDSE: lamp x0, the ball's two refractions x1 x2, the floor
@@ -609,20 +656,17 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
 // weights of all three strategies, as the renderer computes them (light tracing's from its
 // subpaths' stored densities too), must be the power heuristic of these densities. Fixed seed.
 TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
-  const Scene scene = load_scene_file(std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/lamp-glass.json").expect("the sample");
-  const Profile profile = resolve_profile("bdpt+manifold", Limits{}).expect("a built-in profile");
-  const StrategySet strategies = runnable_strategies(profile).expect("a profile the tracer runs");
-  ManifoldRig rig(scene, strategies, 3);
+  LampGlassRig lamp_glass;
+  ManifoldRig& rig = lamp_glass.rig;
   const Integrator& in = rig.in;
   const RenderScene& rs = rig.rs;
   Integrator::Thread& th = rig.th;
   using A = IntegratorTestAccess;
   const double pi = std::numbers::pi;
-  int checked = 0, lt_leads = 0, manifold_leads = 0;
+  PowerHeuristicChecks checks;  // light tracing, the manifold, the emitter hit
   for (int i = 0; i < 20000; ++i) {
-    Sampler rng(3, static_cast<std::uint64_t>(i), 0);
     int ns = 0;
-    A::trace_subpaths(in, th, rng, i % rs.camera.width, (i / rs.camera.width) % rs.camera.height, &ns);
+    lamp_glass.trace(i, &ns);
     if (ns < 4 || !th.light[3].finite || A::label(in, th, 4, 1) != "LDDSSDDSE") continue;
     const std::vector<Vertex> x = A::gather(in, th, 4, 1);
     const glm::dvec3 p0(x[0].p), p3(x[3].p), n0(x[0].n), n3(x[3].n);
@@ -652,7 +696,6 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
     const double manifold = lamp * e3;
     const double light_tracing = lamp * lamp_dir * choices * to_floor.dw_db;
     const double emitter_hit = floor_dir * choices * to_lamp.dw_db * e3;
-    const double sum2 = manifold * manifold + light_tracing * light_tracing + emitter_hit * emitter_hit;
     const PathKey key = in.path_key(th, 4, 1, nullptr);
     const float w_lt = A::own_weight(in, th, 4, 1);
     const A::WholePath whole(x);
@@ -660,19 +703,74 @@ TEST(Mis, ManifoldWeightsUseTheChainsGeneralizedGeometryTerm) {
     const float w_manifold = A::recomputed_weight(in, th, whole, 1, 2, key, ConnectorKind::kManifold);
     const float w_hit = A::recomputed_weight(in, th, whole, 0, 0, key, ConnectorKind::kNone);
     const std::string where = "sample " + std::to_string(i) + ", |dω0/dA3| " + std::to_string(to_floor.dw_db);
-    EXPECT_NEAR(w_lt, light_tracing * light_tracing / sum2, 2e-3) << where;
     EXPECT_NEAR(w_lt_whole, w_lt, 1e-4) << where;
-    EXPECT_NEAR(w_manifold, manifold * manifold / sum2, 2e-3) << where;
-    EXPECT_NEAR(w_hit, emitter_hit * emitter_hit / sum2, 2e-3) << where;
-    EXPECT_NEAR(w_lt + w_manifold + w_hit, 1.0, 1e-4) << where;
-    ++checked;
-    lt_leads += w_lt > 0.5f ? 1 : 0;
-    manifold_leads += w_manifold > 0.5f ? 1 : 0;
+    checks.expect({w_lt, w_manifold, w_hit}, {light_tracing, manifold, emitter_hit}, where);
   }
-  EXPECT_GT(checked, 30);
+  EXPECT_GT(checks.checked, 30);
   // Both light tracing and the manifold take the lead somewhere on the caustic.
-  EXPECT_GT(lt_leads, 3);
-  EXPECT_GT(manifold_leads, 3);
+  EXPECT_GT(checks.leads[0], 3);
+  EXPECT_GT(checks.leads[1], 3);
+}
+
+// The connector ending at the camera (t = 1, issue 40's twelfth session) on paths of lamp-glass.json
+// where the floor is seen through the ball (LDDDSSDSE: lamp x0, floor x1, the ball's two
+// refractions x2 x3, the pinhole x4), which next-event estimation (1, DD, 4), the emitter hit
+// (0, DD, 5) and the manifold (2, DSSD, 1) from the light subpath's floor vertex all sample: the
+// eye walk draws x1 through the chain with the pinhole's direction density times the refractions'
+// choices times |dω_4/dA_1|, computed here by solving the chain from the pinhole's end (the
+// renderer solves it from x1 and takes the camera's side by reciprocity, across the camera's axis);
+// the manifold draws x1 from the lamp. The three weights must be the power heuristic of these
+// densities. Fixed seed.
+TEST(Mis, ManifoldAtTheCameraWeighsTheEyeWalksChainDensity) {
+  LampGlassRig lamp_glass;
+  ManifoldRig& rig = lamp_glass.rig;
+  rig.o.manifold.rate = 1.0;
+  const Integrator& in = rig.in;
+  const RenderScene& rs = rig.rs;
+  Integrator::Thread& th = rig.th;
+  using A = IntegratorTestAccess;
+  const double pi = std::numbers::pi;
+  PowerHeuristicChecks checks;  // next-event estimation, the emitter hit, the manifold
+  for (int i = 0; i < 20000; ++i) {
+    int ns = 0;
+    const int nt = lamp_glass.trace(i, &ns);
+    if (ns < 1 || nt < 4 || A::label(in, th, 1, 4) != "LDDDSSDSE") continue;
+    const std::vector<Vertex> x = A::gather(in, th, 1, 4);
+    const glm::dvec3 p1(x[1].p), p4(x[4].p), n1(x[1].n);
+    std::vector<ChainVertex> from_camera;  // x3, x2: the chain with its ends swapped
+    double choices = 1.0;
+    bool refractions = true;  // (not a reflection off the ball and one inside it)
+    for (int v = 3; v >= 2; --v) {
+      const float towards_floor = glm::dot(x[v - 1].p - x[v].p, x[v].n), towards_camera = glm::dot(x[v + 1].p - x[v].p, x[v].n);
+      refractions = refractions && towards_floor * towards_camera < 0.0f;
+      from_camera.push_back({&rs.geometry->shape_geometry(x[v].shape), x[v].shape, 0, 1.5, towards_camera > 0.0f ? 1.0 : 1.5,
+                             towards_floor > 0.0f ? 1.0 : 1.5, false, glm::dvec3(x[v].p), 0});
+      choices *= 1.0 - fresnel_dielectric(glm::dot(glm::normalize(x[v + 1].p - x[v].p), x[v].n), 1.5f);
+    }
+    if (!refractions) continue;
+    const ManifoldWalk to_floor = solve_chain(from_camera, p4, p1, n1, 1.0, ManifoldOptions{});  // |dω_4 / dA_1|
+    if (to_floor.failure != ManifoldFailure::kNone) continue;
+    const double camera_dir = in.sensor_pdf_dir(x[4], glm::normalize(x[3].p - x[4].p));
+    const vec3 e01 = x[1].p - x[0].p;
+    if (!(glm::dot(e01, x[0].n) > 0.0f)) continue;  // the light subpath's lamp point faces away from x1: no path
+    const double d2 = glm::dot(e01, e01);
+    const double lamp = A::light_pick(in) * rs.lights[static_cast<std::size_t>(x[0].light)].pdf_pos;
+    const double cos0 = std::fabs(glm::dot(glm::normalize(e01), x[0].n)), cos1 = std::fabs(glm::dot(glm::normalize(e01), x[1].n));
+    const double eye_1 = camera_dir * choices * to_floor.dw_db;  // the eye walk's density of x1
+    const double nee = lamp * eye_1;
+    const double emitter_hit = (cos1 / pi) * cos0 / d2 * eye_1;   // the floor's cosine density towards x0
+    const double manifold = lamp * (cos0 / pi) * cos1 / d2;       // the lamp's cosine emission towards x1
+    const PathKey key = in.path_key(th, 1, 4, nullptr);
+    const A::WholePath whole(x);
+    const float w_nee = A::recomputed_weight(in, th, whole, 1, 0, key, ConnectorKind::kNone);
+    const float w_hit = A::recomputed_weight(in, th, whole, 0, 0, key, ConnectorKind::kNone);
+    const float w_manifold = A::recomputed_weight(in, th, whole, 2, 2, key, ConnectorKind::kManifold);
+    const std::string where = "sample " + std::to_string(i) + ", |dω4/dA1| " + std::to_string(to_floor.dw_db);
+    checks.expect({w_nee, w_hit, w_manifold}, {nee, emitter_hit, manifold}, where);
+  }
+  EXPECT_GT(checks.checked, 30);
+  EXPECT_GT(checks.leads[0], 3);  // next-event estimation and the manifold each lead somewhere
+  EXPECT_GT(checks.leads[2], 3);
 }
 
 }  // namespace

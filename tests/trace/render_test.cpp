@@ -781,17 +781,21 @@ TEST(Labels, PointLightWithPinholeOnlyProducesSDprefixAndDSsuffix) {
   EXPECT_NEAR(r.report.classes[0].share, 1.0, 1e-12);
 }
 
-TEST(Profiles, ConnectorsTheTracerDoesNotRunAreRefusedByName) {
-  // The manifold connector's eye end is a surface vertex of the eye subpath: t = 1 is refused.
+// Every connector the checker accepts the tracer runs: since issue 40's twelfth session the manifold
+// connector at t = 1 too (its eye end a fresh pinhole or lens point), which a profile of its own
+// runs alone, and bdpt+manifold lists.
+TEST(Profiles, EveryConnectorTheCheckerAcceptsRuns) {
   Result<Profile> p = parse_profile(R"({"name": "lt+manifold", "strategies": [
       {"name": "splat-manifold", "s": "1..", "chain": "DS+D", "t": "1..", "connector": "manifold"}]})",
                                     "lt+manifold.json", Limits{});
   ASSERT_TRUE(p.ok()) << p.error().render();
-  Result<StrategySet> s = runnable_strategies(*p);
-  ASSERT_FALSE(s.ok());
-  EXPECT_EQ(s.error().message,
-            "renderer 'lt+manifold' runs the manifold connector with t = 1 (strategy 'splat-manifold'), which the tracer does "
-            "not run: its eye end must be a surface vertex of the eye subpath, t >= 2");
+  const StrategySet s = runnable_strategies(*p).expect("the manifold connector at t = 1");
+  ASSERT_EQ(s.strategies.size(), 1u);
+  EXPECT_TRUE(s.strategies[0].t.contains(1));
+  const StrategySet bdpt = runnable_strategies(resolve_profile("bdpt+manifold", Limits{}).expect("built in")).expect("runs");
+  EXPECT_TRUE(std::any_of(bdpt.strategies.begin(), bdpt.strategies.end(), [](const Strategy& st) {
+    return st.connector == ConnectorKind::kManifold && st.t.contains(1) && !st.t.contains(2) && st.s.contains(1);
+  }));
   for (const char* name : {"pt-nee+distant", "bdpt+ortho", "bdpt+mirror", "pt-nee+mirror", "pt-nee+manifold", "pbrt-v4-path",
                            "pbrt-v4-bdpt", "mitsuba3-path"})
     EXPECT_TRUE(runnable_strategies(resolve_profile(name, Limits{}).expect("a test input")).ok()) << name;

@@ -170,6 +170,7 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
   };
   bool solved = false;
   int polish = 0;
+  const double root = std::max(1e-4 * o.threshold, 1e-12);  // what polishing reaches at a root (rounding bounds it)
   bool evaluated = false;  // loc holds p's state (a step taken: its trial's), c still to be put on p's own tangent pairs
   for (w.iterations = 0; w.iterations <= o.max_iterations; ++w.iterations) {
     if (evaluated) {
@@ -181,7 +182,11 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
     evaluated = false;
     const double err = largest(c.data(), n);
     // Solved below the threshold; up to three more steps polish it (Newton converges
-    // quadratically there), so that the same solution found from two seeds compares equal.
+    // quadratically there), so that the same solution found from two seeds compares equal. A
+    // point whose polishing stalls above `root` is no root but a near miss: beyond
+    // a fold of the chains (a caustic's edge) the constraints' smallest value is small, not zero,
+    // and such points, their |dω_a/dA_b| near the fold's divergence, were counted as chains (a
+    // bias: issue 40, twelfth session, bench/README.md).
     const bool within = err < o.threshold;
     // Solved to the wrong type: polishing moves it by about the threshold, which keeps its type
     // (a neighbour that close to a vertex's tangent plane aside), so it is not polished.
@@ -189,15 +194,16 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
       w.failure = ManifoldFailure::kWrongType;
       return w;
     }
-    if (within && (err < 1e-4 * o.threshold || polish == 3)) {
+    if (within && err < root) {
       solved = true;
       break;
     }
-    polish += within ? 1 : 0;
-    if (w.iterations == o.max_iterations) {
-      solved = within;
-      break;
+    if (polish == 3) {  // a polish that stalled: no root (above)
+      w.failure = ManifoldFailure::kNoSolution;
+      return w;
     }
+    polish += within ? 1 : 0;
+    if (w.iterations == o.max_iterations) break;  // (not solved)
     jacobian(x, loc, j);
     for (std::size_t v = 0; v < m; ++v) step[v] = -glm::dvec2(c[2 * v], c[2 * v + 1]);
     if (solve_blocks(j, m, step.data()) <= o.singular) {
@@ -225,7 +231,6 @@ ManifoldWalk solve_chain(std::vector<ChainVertex>& x, const dvec3& a, const dvec
       }
     }
     if (!moved) {
-      if (within) { solved = true; break; }  // as good as rounding allows
       w.failure = ManifoldFailure::kNoSolution;
       return w;
     }

@@ -36,7 +36,7 @@ namespace pathex {
 // Limits of the walk (pathex trace --manifold-*), defaults from the published implementations.
 struct ManifoldOptions {
   int max_iterations = 64;         // Newton iterations (Cycles' MNEE: 64; SMS: 20)
-  double threshold = 1e-5;         // largest |tangential half vector| accepted as solved (SMS: 1e-5)
+  double threshold = 1e-5;         // largest |tangential half vector| accepted as solved (SMS: 1e-5), then polished to a root
   double min_segment = 1e-3;       // shortest segment, as a fraction of the scene's size (Cycles: 1e-3)
   double singular = 1e-7;          // smallest |pivot| / largest |pivot| of the constraint Jacobian
   std::optional<int> seeds;        // seeds per batch (the first's distinct chains: the contributions); unset: ditto
@@ -54,7 +54,7 @@ struct ManifoldOptions {
 // Why a walk failed; kNone when it succeeded.
 enum class ManifoldFailure : std::uint8_t {
   kNone,
-  kNoSolution,      // a step left its surface, or halving could not reduce the constraints
+  kNoSolution,      // a step left its surface, halving could not reduce the constraints, or polishing stalled short of a root
   kOccluded,        // the seed met a surface that is not smooth glass, or a built segment is blocked
   kSingular,        // the constraint Jacobian is (nearly) singular
   kWrongType,       // the solution reflects where the seed refracted, or the reverse

@@ -1,25 +1,27 @@
-// The manifold connector in the integrator (trace/joins/manifold.h for the walk): the seed, the
-// contribution through the solved chain, and which paths it could build (for MIS).
+// The manifold connector in the integrator (trace/joins/manifold.h for the walk, trace/specular_seed.h
+// for its seeds): the batches of seeds, the contribution through the solved chain, and which paths
+// it could build (for MIS).
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "trace/media.h"
-#include "trace/frame.h"
 #include "optics/fresnel.h"
 #include "trace/integrator.h"
 #include "trace/joins/manifold.h"
+#include "trace/specular_seed.h"
 
 namespace pathex::tracer {
 
 bool Integrator::manifold_at(const PathView& x, PathKey key, int i, int m) const {
   const int k = x.size() - 1;
   const int t = k + 1 - i - m;  // letters after the chain
-  if (i < 1 || m < 1 || m > kMaxChain || t < 2 || manifold_of(i, t) < 0) return false;
+  if (i < 1 || m < 1 || m > kMaxChain || t < 1 || manifold_of(i, t) < 0) return false;
+  // (At t = 1, c(i+m+1) is the sensor's direction letter: D for a pinhole's and a thin lens's.)
   if (!packed_is_d(key, i) || !packed_is_d(key, i + m + 1)) return false;
   const Vertex& a = x[i - 1];
   const Vertex& b = x[i + m];
-  if (b.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(b.shape)]) return false;
+  if (t >= 2 && (b.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(b.shape)])) return false;
   if (i >= 2 && (a.kind != Kind::kSurface || !finite_of_shape_[static_cast<std::size_t>(a.shape)])) return false;
   for (int v = i; v < i + m; ++v) {
     const Vertex& c = x[v];
@@ -69,8 +71,9 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
       eye_picks *= picks(c, to_eye, reflect);
     }
     const vec3 wa = glm::normalize(x[i].p - a.p), wb = glm::normalize(x[i + m - 1].p - b.p);
-    const double cos_a = abs_cos(a, wa), cos_b = abs_cos(b, wb);
-    const double ab = chain_dw_db(chain, glm::dvec3(a.p), glm::dvec3(b.p), glm::dvec3(b.n), 0.0);  // |dω_a / dA_b|
+    const vec3 nb = b.has_normal() ? b.n : cam_.axis();  // a pinhole's area across its axis, as the connector's (t = 1)
+    const double cos_a = abs_cos(a, wa), cos_b = std::fabs(glm::dot(nb, wb));
+    const double ab = chain_dw_db(chain, glm::dvec3(a.p), glm::dvec3(b.p), glm::dvec3(nb), 0.0);  // |dω_a / dA_b|
     // |dω_b / dA_a| by reciprocity: the étendue η² cos dA dω is the same at both ends of the chain.
     const double eta_a = chain.front().eta_light, eta_b = chain.back().eta_eye;
     const double ba = ab * (eta_a * eta_a * cos_a) / (eta_b * eta_b * cos_b);
@@ -83,7 +86,8 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
       const vec3 wp = glm::normalize(x[i - 2].p - a.p);
       pa = pdf_dir(a, &wp, wa);
     }
-    const vec3 wn = glm::normalize(x[i + m + 1].p - b.p);
+    // b's BSDF's, or (b = xk, a sensor point) the sensor's direction density.
+    const vec3 wn = b.kind == Kind::kCamera ? vec3(0.0f) : glm::normalize(x[i + m + 1].p - b.p);
     const float pb = pdf_dir(b, &wn, wb);
     const double light_b = pa * light_picks * ab, eye_a = pb * eye_picks * ba;
     // Where the chain's term is undefined, the walks' densities stay (a function of the path
@@ -96,87 +100,6 @@ void Integrator::chain_densities(Thread& th, const PathView& x, PathKey key, Con
   }
 }
 
-ManifoldFailure Integrator::seed_chain(const Vertex& from, bool from_light, std::uint64_t stream, std::uint64_t* drawn,
-                                       std::vector<ChainVertex>& chain) const {
-  const auto u = [&] { return bits_to_unit_float(stream_bits(stream, (*drawn)++)); };
-  chain.clear();
-  const float u_shape = u();
-  const glm::vec2 u_point(u(), u());
-  const std::size_t pick = static_cast<std::size_t>(std::upper_bound(rs_.specular.seed_cdf.begin(), rs_.specular.seed_cdf.end() - 1, u_shape) - rs_.specular.seed_cdf.begin());
-  const int shape = rs_.specular.shapes[pick];
-  vec3 o = from.p, no = from.n, eo = from.err;
-  vec3 d;
-  const auto* sphere = std::get_if<SphereShape>(&rs_.geometry->shape_geometry(shape));
-  const vec3 to_centre = sphere ? sphere->center - from.p : vec3(0.0f);
-  const float d2 = glm::dot(to_centre, to_centre);
-  if (sphere && d2 > sphere->radius * sphere->radius) {
-    // A sphere seen from outside: a direction uniform in the cone it subtends, so every seed meets it.
-    const float cos_max = std::sqrt(std::max(0.0f, 1.0f - sphere->radius * sphere->radius / d2));
-    d = Frame::from_normal(to_centre / std::sqrt(d2)).to_world(sample_uniform_cone(u_point, cos_max));
-  } else {  // otherwise towards a point uniform on the shape's area
-    d = rs_.geometry->sample_shape(shape, u_point).position - from.p;
-    if (!(glm::dot(d, d) > 0.0f)) return ManifoldFailure::kNoSolution;
-  }
-  d = glm::normalize(d);
-  // The sphere the ray meets next without a ray traced: the cone's, entered at the near root (what
-  // lies before it the chain's shadow rays see), then a hollow one it runs inside
-  // (SpecularSurfaces::hollow), left at t = -2 (o - c)·d.
-  int within = sphere && d2 > sphere->radius * sphere->radius ? shape : -1;
-  bool entering = within >= 0;
-  for (;;) {
-    std::optional<Hit> hit;
-    if (within >= 0) {
-      const SphereShape& ball = std::get<SphereShape>(rs_.geometry->shape_geometry(within));
-      const vec3 f = o - ball.center, across = f - glm::dot(f, d) * d;
-      const float t = entering ? -glm::dot(f, d) - std::sqrt(std::max(0.0f, ball.radius * ball.radius - glm::dot(across, across))) : -2.0f * glm::dot(f, d);
-      hit = Hit{.position = vec3(0.0f), .normal = glm::normalize(f + t * d), .shape = within, .primitive = 0};
-      hit->position = ball.center + ball.radius * hit->normal;
-      entering = false;
-      hit->error = error_gamma(8) * (glm::abs(ball.center) + ball.radius * glm::abs(hit->normal));  // EmbreeScene's sphere hit's
-    } else {
-      hit = rs_.geometry->intersect(o, d, no, eo, HitDetail::kNoUv);
-    }
-    if (!hit) break;
-    const float ior = rs_.specular.glass_ior[static_cast<std::size_t>(hit->shape)];
-    const bool mirror = !is_black(rs_.specular.mirror_reflectance[static_cast<std::size_t>(hit->shape)]);
-    if (ior == 0.0f && !mirror) {
-      if (chain.empty()) return ManifoldFailure::kOccluded;  // something opaque between the end and the specular surfaces
-      break;
-    }
-    if (static_cast<int>(chain.size()) == kMaxChain) return ManifoldFailure::kNoSolution;
-    // Follow the surface as light would: a mirror reflects; glass reflects with the Fresnel
-    // probability (always under total internal reflection), else refracts.
-    const float cos_o = -glm::dot(d, hit->normal);
-    const bool reflect = mirror || u() < bsdf::fresnel_dielectric(cos_o, ior);
-    const double outside = 1.0, inside = ior > 0.0f ? static_cast<double>(ior) : 1.0;
-    const double came = cos_o > 0.0f ? outside : inside;                    // the index where the ray came from
-    const double goes = reflect ? came : (cos_o > 0.0f ? inside : outside);  // and where it goes on
-    const int came_side = cos_o > 0.0f ? 1 : -1, goes_side = reflect ? came_side : -came_side;
-    chain.push_back({&rs_.geometry->shape_geometry(hit->shape), hit->shape, hit->primitive, inside, from_light ? came : goes,
-                     from_light ? goes : came, reflect, glm::dvec3(hit->position), from_light ? came_side : goes_side});
-    const vec3 n_side = cos_o > 0.0f ? hit->normal : -hit->normal;  // towards where d came from
-    if (reflect) {
-      d = glm::normalize(d + 2.0f * std::fabs(cos_o) * n_side);
-    } else {
-      const float eta = cos_o > 0.0f ? 1.0f / ior : ior;  // η_from / η_to
-      const float sin2_t = eta * eta * std::max(0.0f, 1.0f - cos_o * cos_o);
-      if (sin2_t >= 1.0f) return ManifoldFailure::kNoSolution;  // (Fresnel gave 1: not reached)
-      d = glm::normalize(eta * d + (eta * std::fabs(cos_o) - std::sqrt(1.0f - sin2_t)) * n_side);
-    }
-    o = hit->position;
-    no = hit->normal;
-    eo = hit->error;
-    within = rs_.specular.hollow[static_cast<std::size_t>(hit->shape)] && glm::dot(d, hit->normal) < 0.0f ? hit->shape : -1;
-    // The chain ends where the ray meets no more specular surfaces: when it passes every specular
-    // shape's bounding sphere by (a sphere it leaves outwards it cannot meet again), the ray that
-    // would find the opaque surface or nothing beyond is not traced.
-    if (!rs_.specular.meets(*rs_.geometry, o, d, glm::dot(d, hit->normal) > 0.0f ? hit->shape : -1)) break;
-  }
-  if (chain.empty()) return ManifoldFailure::kNoSolution;
-  if (!from_light) std::reverse(chain.begin(), chain.end());  // light side first
-  return ManifoldFailure::kNone;
-}
-
 void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int batch) const {
   const int strategy_index = manifold_of(s, t);
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
@@ -187,7 +110,13 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   const bool skip = rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate;
   if (skip && max_light_ >= 2) return;  // light subpaths' joins share every such path: the rate applies whatever the light
   const Vertex* b = &th.eye[static_cast<std::size_t>(t - 1)];
-  if (b->kind != Kind::kSurface || !b->finite) return;
+  if (t == 1) {  // a fresh point of a sensor with a finite direction (a pinhole's, one drawn on a thin lens)
+    if (cam_.letters[0] != 'D') return;
+    join_numbers(rng, JoinBlock::kManifoldEye, s);
+    b = &sensor_vertex(th.join.eye0, sensor_point(cam_.params, rng.get2d_if(reads_lens_numbers(cam_.params))), cam_.axis(), 'D');
+  } else if (b->kind != Kind::kSurface || !b->finite) {
+    return;
+  }
   const Vertex* a = s >= 2 ? &th.light[static_cast<std::size_t>(s - 1)] : fresh_light_end(th, rng, t, JoinBlock::kManifoldLight);
   if (!a || (s >= 2 && (a->kind != Kind::kSurface || !a->finite))) return;
   if (max_light_ < 2 && (s >= 2 ? th.light[0] : *a).pos_letter == 'S') rate = 1.0;  // from a point: the connector's alone
@@ -204,7 +133,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   const std::uint64_t stream = stream_key(rng.key(), th.pass, 0x6d616e69666f6c64ULL + static_cast<std::uint64_t>(s) * kMaxRuns +
                                                                static_cast<std::uint64_t>(t));
   std::uint64_t drawn = 0;
-  const glm::dvec3 pa(a->p), pb(b->p), nb(b->n);
+  const glm::dvec3 pa(a->p), pb(b->p), nb(b->has_normal() ? b->n : cam_.axis());  // a pinhole's area across its axis
   std::vector<ManifoldSolution>& found = th.manifold_found;
   // A seed keeps its vertices' shapes and types (reflection or refraction) through Newton's
   // method, so a seed of another signature than every chain still sought cannot find one again:
@@ -234,7 +163,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   const auto trial = [&](std::vector<ChainVertex>& chain, bool seeking) -> ManifoldWalk {
     ManifoldWalk w;
     const bool from_light = bits_to_unit_float(stream_bits(stream, drawn++)) < 0.5f;
-    w.failure = seed_chain(from_light ? *a : *b, from_light, stream, &drawn, chain);
+    w.failure = seed_chain(rs_, from_light ? *a : *b, from_light, stream, &drawn, chain);
     if (w.failure != ManifoldFailure::kNone) return w;
     if (s + static_cast<int>(chain.size()) + t - 2 > max_bounces_) {  // longer than the render's bound on interior vertices
       w.failure = ManifoldFailure::kNoSolution;
@@ -402,20 +331,32 @@ void Integrator::emit_manifold(Thread& th, int s, int t, int batch, int strategy
   const vec3 w_b = glm::normalize(jr.chain_vertices[static_cast<std::size_t>(m - 1)].p - b->p);
   // f at a towards the chain: the light's directional emission (a's beta holds the spatial part), or the BSDF.
   const vec3 fa = end_f(*a, w_a, TransportMode::kImportance);
-  const vec3 fb = end_f(*b, w_b, TransportMode::kRadiance);
   // Flux leaving a into dω lands on dA_b = dω / |dω_a/dA_b|: the generalized geometry term, here
   // times the chain's estimated inverse probability (`weight`). Its cosine at b is the area
-  // measure's (geometric); b's shading cosine replaces it (shading_cos, vertex.h).
-  const float cos_b = abs_cos(*b, w_b);
-  const float shade_b = cos_b > 0.0f ? shading_cos(*b, w_b) / cos_b : 0.0f;
-  const vec3 contrib = a->beta * fa * shading_cos(*a, w_a) * transmit * fb * b->beta *
+  // measure's (geometric); b's shading cosine replaces it (shading_cos, vertex.h). At a sensor
+  // point (t = 1) dA_b lies across the sensor's axis, as connect_finite()'s weight We cos / (p d²)
+  // has it: b's factor is We towards the chain over the point's density (a pinhole's 1), splatted.
+  vec3 fb(1.0f), beta_b(1.0f);
+  float shade_b = 1.0f;
+  glm::vec2 raster{0.0f};
+  if (t == 1) {
+    fb = importance(cam_.params, b->p, w_b, &raster) / (cam_.pdf_pos > 0.0f ? cam_.pdf_pos : 1.0f);
+  } else {
+    fb = end_f(*b, w_b, TransportMode::kRadiance);
+    beta_b = b->beta;
+    const float cos_b = abs_cos(*b, w_b);
+    shade_b = cos_b > 0.0f ? shading_cos(*b, w_b) / cos_b : 0.0f;
+  }
+  const vec3 contrib = a->beta * fa * shading_cos(*a, w_a) * transmit * fb * beta_b *
                        (static_cast<float>(weight) * shade_b);
   if (is_black(contrib)) {
     ++stats.no_transport;
     return;
   }
-  // b is a surface vertex: t >= 2, no eye0.
+  // b is a surface vertex (t >= 2), or the sensor point eye0.
   jr.set_connector(ConnectorKind::kManifold, s, t, strategy_index, chain_key(th, *a, s, t, m), contrib, m, a, b);
+  jr.splat = t == 1;
+  if (jr.splat) cam_.to_pixels(raster, &jr.rx, &jr.ry);
   estimate(th, batch);
 }
 
