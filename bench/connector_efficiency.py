@@ -20,7 +20,12 @@ With --reference VALUE (the class's luminance computed another way), the efficie
 time, so that a heavy-tailed estimator's understated stderr, or a rare-hit one's stderr of 0 when
 it misses every hit, cannot flatter it (issue 40). A renderer may carry its own sample count as
 NAME:SPP, so that each gets about the same CPU time, and options of its own as NAME:SPP:OPTIONS
-(`bdpt+manifold:16:--manifold-seeds=1`).
+(`bdpt+manifold:16:--manifold-seeds=1`). Several classes (each with its --reference, in order) are
+read from the same full renders, each reported as above:
+
+    python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDDSE LDDSSDSSDSE 'L[SD]{4,}E' \
+        --reference 8.555e-3 --reference 1.034e-3 --reference 0.13708 --rounds 96 \
+        --renderer bdpt:64 --renderer bdpt+manifold:48 --renderer pt-nee+manifold:24
 
     python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDSSDSE \
         --reference 1.1e-3 --only --rounds 8 \
@@ -56,15 +61,21 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("pathex")
     ap.add_argument("scene")
-    ap.add_argument("path_class", help="a full-notation class, e.g. LDSDDSE")
+    ap.add_argument("path_class", nargs="+", help="a full-notation class, e.g. LDSDDSE; several: each from the same renders")
     ap.add_argument("--renderer", action="append", required=True, help="repeat; the first is the reference")
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--max-bounces", type=int, default=8)
     ap.add_argument("--baseline", help="another pathex binary: every renderer also runs with it")
     ap.add_argument("--only", action="store_true", help="render with --only CLASS (default: the class of a full render)")
-    ap.add_argument("--reference", type=float, help="the class's value: efficiency 1 / (MSE T) over the rounds")
+    ap.add_argument("--reference", type=float, action="append",
+                    help="the class's value: efficiency 1 / (MSE T) over the rounds (repeat: one per class, in order)")
     args = ap.parse_args()
+    classes_of = args.path_class
+    if args.reference is not None and len(args.reference) != len(classes_of):
+        sys.exit("give one --reference per class")
+    if args.only and len(classes_of) > 1:
+        sys.exit("--only renders one class")
     # (label, binary, renderer) per run
     spp_of = {r: int(r.split(":")[1]) if ":" in r else args.spp for r in args.renderer}
     extra_of = {r: r.split(":", 2)[2].split() if r.count(":") >= 2 else [] for r in args.renderer}
@@ -72,10 +83,11 @@ def main():
     if args.baseline:
         runs = [x for r in args.renderer for x in ((r, args.pathex, r), (r + " @baseline", args.baseline, r))]
     with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
-        json.dump({"classes": [{"name": "c", "expr": args.path_class}]}, f)
+        json.dump({"classes": [{"name": f"c{i}", "expr": e} for i, e in enumerate(classes_of)]}, f)
         classes = f.name
-    results = {label: [] for label, _, _ in runs}
-    select = ["--only", args.path_class] if args.only else ["--classes", classes]
+    # per class, per label: (estimate, stderr, cpu, efficiency) per round; one render gives every class
+    results = [{label: [] for label, _, _ in runs} for _ in classes_of]
+    select = ["--only", classes_of[0]] if args.only else ["--classes", classes]
     try:
         for rnd in range(args.rounds):
             order = runs[rnd % len(runs):] + runs[:rnd % len(runs)]
@@ -84,19 +96,25 @@ def main():
                     doc, cpu = run([binary, "trace", args.scene, "--renderer", r.split(":")[0], "--spp", str(spp_of[r]), *extra_of[r], *select,
                                     "--seed", str(rnd + 1), "--threads", "1", "--max-bounces", str(args.max_bounces),
                                     "--no-images", "--quiet", "--json", "--out", os.path.join(out, "o")])
-                c = [c for c in doc["classes"] if c["expr"] == args.path_class or c.get("name") == "c"][0]
-                se = c["stderr"]
-                results[label].append((c["luminance"], se, cpu, 1.0 / (se * se * cpu) if se else float("inf")))
+                for i, expr in enumerate(classes_of):
+                    c = [c for c in doc["classes"] if c["expr"] == expr or c.get("name") == f"c{i}"][0]
+                    se = c["stderr"]
+                    results[i][label].append((c["luminance"], se, cpu, 1.0 / (se * se * cpu) if se else float("inf")))
     finally:
         os.unlink(classes)
-    print(f"class {args.path_class} in {args.scene}, {args.spp} spp, {args.rounds} interleaved rounds, 1 thread")
-    if args.reference is not None:  # 1 / (MSE T) against the reference, the same for every round of a renderer
+    for i, expr in enumerate(classes_of):
+        report(args, runs, expr, results[i], args.reference[i] if args.reference else None)
+
+
+def report(args, runs, path_class, results, reference):
+    print(f"class {path_class} in {args.scene}, {args.spp} spp, {args.rounds} interleaved rounds, 1 thread")
+    if reference is not None:  # 1 / (MSE T) against the reference, the same for every round of a renderer
         for label in results:
-            mse = statistics.mean((x[0] - args.reference) ** 2 for x in results[label])
+            mse = statistics.mean((x[0] - reference) ** 2 for x in results[label])
             t = statistics.mean(x[2] for x in results[label])
             results[label] = [(x[0], x[1], x[2], 1.0 / (mse * t) if mse else float("inf")) for x in results[label]]
             print(f"  {label:16s} mean {statistics.mean(x[0] for x in results[label]):.6g}  RMSE {math.sqrt(mse):.3g} "
-                  f"({math.sqrt(mse) / args.reference:.1%})  mean CPU {t:.3f} s")
+                  f"({math.sqrt(mse) / reference:.1%})  mean CPU {t:.3f} s")
     ref = statistics.median(x[3] for x in results[args.renderer[0]])
     for label, _, r in runs:
         med = lambda i: statistics.median(x[i] for x in results[label])
@@ -111,7 +129,6 @@ def main():
         best = max(args.renderer[1:], key=lambda r: statistics.median(x[3] for x in results[r]))
         best_eff = statistics.median(x[3] for x in results[best])
         print(f"  {args.renderer[0]} against the best of the others ({best}): {ref / best_eff:.3g} ×")
-
 
 if __name__ == "__main__":
     main()
