@@ -52,8 +52,9 @@ const Histogram::Cell Histogram::kEmptyCell{};
 Histogram::Histogram(HistogramLayout layout, const Classifier* classifier)
     : layout_(std::move(layout)),
       classifier_(classifier),
-      cells_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
-      row_sums_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
+      cells_(layout_.num_batches),
+      used_(static_cast<std::size_t>(std::max(layout_.num_batches, 0)), 0),
+      row_sums_(layout_.num_batches),
       batch_samples_(static_cast<std::size_t>(std::max(layout_.num_batches, 0)), 0) {}
 
 Histogram::PathId Histogram::intern(std::string_view path) {
@@ -73,7 +74,7 @@ void Histogram::reserve_paths(std::size_t paths) {
   paths_.reserve(paths);
   ids_.reserve(paths);
   sets_.reserve(paths);
-  for (std::vector<Cell>& row : cells_) row.reserve(paths);
+  cells_.reserve(paths);
   first_row_.reserve(paths);
 }
 
@@ -81,7 +82,7 @@ void Histogram::reserve_rows(std::size_t rows) {
   if (rows <= rows_.capacity()) return;
   rows = std::max(rows, 2 * rows_.capacity());
   rows_.reserve(rows);
-  for (std::vector<ExactSum>& sums : row_sums_) sums.reserve(rows);
+  row_sums_.reserve(rows);
 }
 
 std::optional<Histogram::PathId> Histogram::find(std::string_view path) const {
