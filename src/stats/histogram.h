@@ -345,6 +345,17 @@ class Histogram {
     const Cell* c = cells_.find(static_cast<std::size_t>(id), batch);
     return c != nullptr ? *c : kEmptyCell;
   }
+  // Calls f(batch, cell) for the path's cells that may be nonzero, in batch order (every other
+  // cell of it is zero): cheaper than cell() over all B batches for a path met in few.
+  template <class F>
+  void for_each_cell(PathId id, F&& f) const {
+    cells_.for_each(static_cast<std::size_t>(id), std::forward<F>(f));
+  }
+  // The same for a technique row's batch sums.
+  template <class F>
+  void for_each_row_sum(int r, F&& f) const {
+    row_sums_.for_each(static_cast<std::size_t>(r), std::forward<F>(f));
+  }
   // The path's first technique row (-1: none); follow TechniqueRow::next for the others.
   int first_row(PathId id) const { return first_row_[static_cast<std::size_t>(id)]; }
   const TechniqueRow& row(int r) const { return rows_[static_cast<std::size_t>(r)]; }

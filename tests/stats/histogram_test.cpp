@@ -499,6 +499,19 @@ TEST(BatchStore, KeepsEveryValueThroughTheMoveFromPairsToABlock) {
       }
     }
   EXPECT_EQ(present, static_cast<int>(expected.size()));
+  // for_each: every kept value once, in ascending batch order (a block's zeros too).
+  for (std::size_t key = 0; key < 9; ++key) {
+    int last = -1, nonzero = 0;
+    store.for_each(key, [&](int batch, std::uint64_t v) {
+      EXPECT_GT(batch, last) << key;
+      last = batch;
+      const auto it = expected.find({key, batch});
+      EXPECT_EQ(v, it == expected.end() ? 0u : it->second) << key << " " << batch;
+      nonzero += it != expected.end() ? 1 : 0;
+    });
+    EXPECT_EQ(nonzero, static_cast<int>(std::count_if(expected.begin(), expected.end(), [&](const auto& e) { return e.first.first == key; })))
+        << key;
+  }
   EXPECT_EQ(store.find(0, 1), nullptr);  // key 0 met in batch 0 only: a single pair
   EXPECT_NE(store.find(8, 11), nullptr);  // key 8 met in more than kSparse batches: a block
 }
