@@ -601,9 +601,6 @@ namespace {
 // at the end; the CRC-32 of the whole is that of the prefix and the index combined with the
 // frames', which the Writer kept.
 // Every technique row's nonzero batch sums, in batch order: row r's are [begin[r], begin[r + 1]).
-// Gathered batch by batch along the histogram's batch-major row sums (a batch not in use holds
-// zeros only); read row by row in path order they were loads scattered over B arrays, most of a
-// 256 x 256, 16-spp shard file's CPU time (bench/README.md, issue 19).
 struct RowBatchSums {
   std::vector<std::size_t> begin;
   std::vector<int> batch;
@@ -613,21 +610,16 @@ struct RowBatchSums {
 RowBatchSums row_batch_sums(const Histogram& h) {
   const int rows = h.num_rows();
   RowBatchSums out;
-  out.begin.assign(static_cast<std::size_t>(rows) + 1, 0);
-  const std::vector<int> used = h.batches_in_use();
-  for (int b : used)
-    for (int r = 0; r < rows; ++r) out.begin[static_cast<std::size_t>(r) + 1] += h.row_sum(r, b) != 0 ? 1 : 0;
-  for (std::size_t r = 0; r < static_cast<std::size_t>(rows); ++r) out.begin[r + 1] += out.begin[r];
-  out.batch.resize(out.begin.back());
-  out.sum.resize(out.begin.back());
-  std::vector<std::size_t> next(out.begin.begin(), out.begin.end() - 1);
-  for (int b : used)
-    for (int r = 0; r < rows; ++r)
-      if (const ExactSum s = h.row_sum(r, b); s != 0) {
-        const std::size_t i = next[static_cast<std::size_t>(r)]++;
-        out.batch[i] = b;
-        out.sum[i] = s;
-      }
+  out.begin.reserve(static_cast<std::size_t>(rows) + 1);
+  out.begin.push_back(0);
+  for (int r = 0; r < rows; ++r) {
+    h.for_each_row_sum(r, [&](int b, ExactSum s) {
+      if (s == 0) return;
+      out.batch.push_back(b);
+      out.sum.push_back(s);
+    });
+    out.begin.push_back(out.batch.size());
+  }
   return out;
 }
 
@@ -677,14 +669,14 @@ void encode_shard_into(Sink& sink, const ShardHeader& header, const RenderSums& 
   const RowBatchSums row_sums = row_batch_sums(h);
   w.u(order.size());
   w.u(static_cast<std::uint64_t>(h.num_rows()));
-  // Only the batches that hold something (a batch nothing was added to holds no cell of any path).
-  const std::vector<int> used = h.batches_in_use();
+  // Only the cells that hold something, in batch order.
   std::vector<std::pair<int, const Histogram::Cell*>> held;
   for (Histogram::PathId p : order) {
     w.text(h.path(p));
     held.clear();
-    for (int b : used)
-      if (const Histogram::Cell& c = h.cell(p, b); c.contributions != 0 || !is_zero(c.sum)) held.emplace_back(b, &c);
+    h.for_each_cell(p, [&](int b, const Histogram::Cell& c) {
+      if (c.contributions != 0 || !is_zero(c.sum)) held.emplace_back(b, &c);
+    });
     w.u(held.size());
     int previous = -1;
     for (const auto& [b, c] : held) {

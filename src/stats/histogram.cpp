@@ -52,8 +52,9 @@ const Histogram::Cell Histogram::kEmptyCell{};
 Histogram::Histogram(HistogramLayout layout, const Classifier* classifier)
     : layout_(std::move(layout)),
       classifier_(classifier),
-      cells_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
-      row_sums_(static_cast<std::size_t>(std::max(layout_.num_batches, 0))),
+      cells_(layout_.num_batches),
+      used_(static_cast<std::size_t>(std::max(layout_.num_batches, 0)), 0),
+      row_sums_(layout_.num_batches),
       batch_samples_(static_cast<std::size_t>(std::max(layout_.num_batches, 0)), 0) {}
 
 Histogram::PathId Histogram::intern(std::string_view path) {
@@ -73,7 +74,7 @@ void Histogram::reserve_paths(std::size_t paths) {
   paths_.reserve(paths);
   ids_.reserve(paths);
   sets_.reserve(paths);
-  for (std::vector<Cell>& row : cells_) row.reserve(paths);
+  cells_.reserve(paths);
   first_row_.reserve(paths);
 }
 
@@ -81,7 +82,7 @@ void Histogram::reserve_rows(std::size_t rows) {
   if (rows <= rows_.capacity()) return;
   rows = std::max(rows, 2 * rows_.capacity());
   rows_.reserve(rows);
-  for (std::vector<ExactSum>& sums : row_sums_) sums.reserve(rows);
+  row_sums_.reserve(rows);
 }
 
 std::optional<Histogram::PathId> Histogram::find(std::string_view path) const {
@@ -400,15 +401,12 @@ class TechniqueTables {
     for (const Dest& d : dests_) ++first[static_cast<std::size_t>(d.row) + 1];
     for (std::size_t r = 0; r < rows; ++r) first[r + 1] += first[r];
     sums_.assign(B * E, 0);
-    for (std::size_t b = 0; b < B; ++b) {
-      if (!h_.batch_in_use(static_cast<int>(b))) continue;
-      ExactSum* out = sums_.data() + b * E;
-      for (std::size_t r = 0; r < rows; ++r) {
-        const ExactSum s = h_.row_sum(static_cast<int>(r), static_cast<int>(b));
-        if (s == 0) continue;
+    for (std::size_t r = 0; r < rows; ++r)
+      h_.for_each_row_sum(static_cast<int>(r), [&](int b, ExactSum s) {
+        if (s == 0) return;
+        ExactSum* out = sums_.data() + static_cast<std::size_t>(b) * E;
         for (std::size_t i = first[r]; i < first[r + 1]; ++i) out[static_cast<std::size_t>(dests_[i].entry)] += s;
-      }
-    }
+      });
   }
 
   // Each technique's share of the table's whole, its samples and its part of the whole's
@@ -531,15 +529,17 @@ Result<HistogramReport> make_report(const Histogram& h, const RunInfo& run, cons
   const std::vector<int> used = h.batches_in_use();
   for (Histogram::PathId p = 0; p < h.num_paths(); ++p) {
     std::uint64_t count = 0;
-    for (int b : used) {
-      const Histogram::Cell& c = h.cell(p, b);
-      if (c.contributions != 0 && n[static_cast<std::size_t>(b)] == 0)
-        return make_error(ErrorCode::kUsage, "batch " + std::to_string(b) +
-                                                 " holds contributions but no samples were registered for it");
+    std::fill(path_sums.begin(), path_sums.end(), ExactRgb{});
+    int unregistered = -1;  // a batch that holds contributions but no samples
+    h.for_each_cell(p, [&](int b, const Histogram::Cell& c) {
+      if (c.contributions != 0 && n[static_cast<std::size_t>(b)] == 0 && unregistered < 0) unregistered = b;
       path_sums[static_cast<std::size_t>(b)] = c.sum;
       add_to(total_sums[static_cast<std::size_t>(b)], c.sum);
       count += c.contributions;
-    }
+    });
+    if (unregistered >= 0)
+      return make_error(ErrorCode::kUsage, "batch " + std::to_string(unregistered) +
+                                               " holds contributions but no samples were registered for it");
     total_count += count;
     if (!classes.empty()) {
       const std::uint32_t set = classifier->classify(h.path(p));

@@ -66,6 +66,7 @@
 
 #include "classify/classifier.h"
 #include "core/error.h"
+#include "stats/batch_store.h"
 
 namespace pathex {
 
@@ -289,11 +290,11 @@ class Histogram {
   // (merge() matches paths by string), dense from 0, and stable.
   PathId intern(std::string_view path);
   std::optional<PathId> find(std::string_view path) const;
-  // Makes room for at least `paths` paths in all (the path table and every batch's cells), growing
-  // geometrically, so that adding that many costs no reallocation: for readers that know a bound
-  // ahead (shard files).
+  // Makes room for at least `paths` paths in all (the path table, and cells for paths met in few
+  // batches), growing geometrically, so that adding that many costs no reallocation: for readers
+  // that know a bound ahead (shard files).
   void reserve_paths(std::size_t paths);
-  // The same for technique rows (the row table and every batch's row sums).
+  // The same for technique rows (the row table and their row sums).
   void reserve_rows(std::size_t rows);
   int num_paths() const { return static_cast<int>(paths_.size()); }
   const std::string& path(PathId id) const { return paths_[static_cast<std::size_t>(id)]; }
@@ -341,18 +342,29 @@ class Histogram {
 
   // --- the exact state (for reports and serialisation) ---
   const Cell& cell(PathId id, int batch) const {
-    const std::vector<Cell>& cells = cells_[static_cast<std::size_t>(batch)];
-    return static_cast<std::size_t>(id) < cells.size() ? cells[static_cast<std::size_t>(id)] : kEmptyCell;
+    const Cell* c = cells_.find(static_cast<std::size_t>(id), batch);
+    return c != nullptr ? *c : kEmptyCell;
+  }
+  // Calls f(batch, cell) for the path's cells that may be nonzero, in batch order (every other
+  // cell of it is zero): cheaper than cell() over all B batches for a path met in few.
+  template <class F>
+  void for_each_cell(PathId id, F&& f) const {
+    cells_.for_each(static_cast<std::size_t>(id), std::forward<F>(f));
+  }
+  // The same for a technique row's batch sums.
+  template <class F>
+  void for_each_row_sum(int r, F&& f) const {
+    row_sums_.for_each(static_cast<std::size_t>(r), std::forward<F>(f));
   }
   // The path's first technique row (-1: none); follow TechniqueRow::next for the others.
   int first_row(PathId id) const { return first_row_[static_cast<std::size_t>(id)]; }
   const TechniqueRow& row(int r) const { return rows_[static_cast<std::size_t>(r)]; }
   ExactSum row_sum(int r, int batch) const {
-    const std::vector<ExactSum>& sums = row_sums_[static_cast<std::size_t>(batch)];
-    return static_cast<std::size_t>(r) < sums.size() ? sums[static_cast<std::size_t>(r)] : ExactSum{0};
+    const ExactSum* sum = row_sums_.find(static_cast<std::size_t>(r), batch);
+    return sum != nullptr ? *sum : ExactSum{0};
   }
   // Whether anything was ever added to the batch's cells or row sums (the others are all zero).
-  bool batch_in_use(int batch) const { return !cells_[static_cast<std::size_t>(batch)].empty(); }
+  bool batch_in_use(int batch) const { return used_[static_cast<std::size_t>(batch)] != 0; }
   // The batches in use, ascending: a shard of fewer passes than replicates (one pass fills one
   // replicate of every group) leaves the others empty.
   std::vector<int> batches_in_use() const;
@@ -389,34 +401,21 @@ class Histogram {
     using is_transparent = void;
     std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
   };
-  static const Cell kEmptyCell;  // what cell() reads in a batch not laid out that far
-  // A batch's cells (and row sums) reach the paths (rows) seen so far when first written to.
-  // The extension is out of line: the callers run once per contribution, the extension once per
-  // new path or row in a batch.
+  static const Cell kEmptyCell;  // what cell() reads where nothing was added
   Cell& cell_of(PathId id, int batch) {
-    std::vector<Cell>& cells = cells_[static_cast<std::size_t>(batch)];
-    if (static_cast<std::size_t>(id) >= cells.size()) [[unlikely]]
-      extend_cells(batch);
-    return cells[static_cast<std::size_t>(id)];
+    used_[static_cast<std::size_t>(batch)] = 1;
+    return cells_.at(static_cast<std::size_t>(id), batch);
   }
-  ExactSum& row_sum_of(int r, int batch) {
-    std::vector<ExactSum>& sums = row_sums_[static_cast<std::size_t>(batch)];
-    if (static_cast<std::size_t>(r) >= sums.size()) [[unlikely]]
-      extend_row_sums(batch);
-    return sums[static_cast<std::size_t>(r)];
-  }
-  [[gnu::noinline]] void extend_cells(int batch) { cells_[static_cast<std::size_t>(batch)].resize(paths_.size()); }
-  [[gnu::noinline]] void extend_row_sums(int batch) { row_sums_[static_cast<std::size_t>(batch)].resize(rows_.size(), 0); }
+  ExactSum& row_sum_of(int r, int batch) { return row_sums_.at(static_cast<std::size_t>(r), batch); }
 
   HistogramLayout layout_;
   const Classifier* classifier_ = nullptr;
   std::unordered_map<std::string, PathId, StringHash, std::equal_to<>> ids_;
   std::vector<std::string> paths_;
   std::vector<std::uint32_t> sets_;
-  // Batch-major, [batch][id]: a render's passes go to batches round-robin, so the cells it adds
-  // to at a time are a few batches' rows, not a line of every path's B cells. A batch's row is
-  // empty until written to and then at most num_paths() long (cell() reads past its end as zero).
-  std::vector<std::vector<Cell>> cells_;
+  // Per path and batch, sparse while a path has been met in few batches (stats/batch_store.h).
+  BatchStore<Cell> cells_;
+  std::vector<char> used_;  // per batch: whether a cell of it was ever added to
   // Each |channel| < 2^114, so the sum of three cannot wrap before saturating.
   void add_magnitude_of(const ExactRgb& c) {
     const auto abs = [](ExactSum v) { return static_cast<SignedExactSum>(v) < 0 ? ExactSum{0} - v : v; };
@@ -425,9 +424,8 @@ class Histogram {
   }
   std::vector<int> first_row_;           // per path
   std::vector<TechniqueRow> rows_;
-  // Batch-major like cells_, [batch][row]: the rows a render adds to at a time are one batch's;
-  // laid out on first write like cells_.
-  std::vector<std::vector<ExactSum>> row_sums_;
+  // Per technique row and batch, like cells_.
+  BatchStore<ExactSum> row_sums_;
   std::vector<std::uint64_t> batch_samples_;
   std::uint64_t nonfinite_ = 0;
   ExactSum magnitude_ = 0;

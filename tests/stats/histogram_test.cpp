@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <thread>
 
@@ -465,6 +466,68 @@ TEST(Histogram, BatchesAreLaidOutOnlyWhenWritten) {
   EXPECT_EQ(a.cell(p, 2).sum, *to_exact(gray(0.25)));
   EXPECT_EQ(a.cell(q, 5).sum, *to_exact(gray(0.5)));
   EXPECT_EQ(a.cell(q, 2).contributions, 0u);
+}
+
+// The cells' store: a key holds up to kSparse (batch, value) pairs, then a block of all B values;
+// every value must survive the move, and a (key, batch) never stored must read as absent.
+TEST(BatchStore, KeepsEveryValueThroughTheMoveFromPairsToABlock) {
+  constexpr int kBatches = 12;
+  BatchStore<std::uint64_t> store(kBatches);
+  std::map<std::pair<std::size_t, int>, std::uint64_t> expected;
+  Rng rng{12345};
+  for (int i = 0; i < 4000; ++i) {
+    // Key k is met in about k + 1 batches: key 0 stays a single pair, the higher ones become blocks.
+    const std::size_t key = rng.next() % 9;
+    const int batch = static_cast<int>(rng.next() % static_cast<std::uint64_t>(std::min<std::size_t>(key + 1, kBatches)) * 7 % kBatches);
+    const std::uint64_t v = rng.next() % 1000;
+    store.at(key, batch) += v;
+    expected[{key, batch}] += v;
+  }
+  EXPECT_EQ(store.keys(), 9u);
+  int present = 0;
+  for (std::size_t key = 0; key < 10; ++key)
+    for (int batch = 0; batch < kBatches; ++batch) {
+      const std::uint64_t* v = store.find(key, batch);
+      const auto it = expected.find({key, batch});
+      if (it == expected.end()) {
+        // Absent, or a zero in a key's block.
+        EXPECT_TRUE(v == nullptr || *v == 0) << key << " " << batch;
+      } else {
+        ASSERT_NE(v, nullptr) << key << " " << batch;
+        EXPECT_EQ(*v, it->second) << key << " " << batch;
+        ++present;
+      }
+    }
+  EXPECT_EQ(present, static_cast<int>(expected.size()));
+  // for_each: every kept value once, in ascending batch order (a block's zeros too).
+  for (std::size_t key = 0; key < 9; ++key) {
+    int last = -1, nonzero = 0;
+    store.for_each(key, [&](int batch, std::uint64_t v) {
+      EXPECT_GT(batch, last) << key;
+      last = batch;
+      const auto it = expected.find({key, batch});
+      EXPECT_EQ(v, it == expected.end() ? 0u : it->second) << key << " " << batch;
+      nonzero += it != expected.end() ? 1 : 0;
+    });
+    EXPECT_EQ(nonzero, static_cast<int>(std::count_if(expected.begin(), expected.end(), [&](const auto& e) { return e.first.first == key; })))
+        << key;
+  }
+  EXPECT_EQ(store.find(0, 1), nullptr);  // key 0 met in batch 0 only: a single pair
+  EXPECT_NE(store.find(8, 11), nullptr);  // key 8 met in more than kSparse batches: a block
+}
+
+TEST(Histogram, APathMetInEveryBatchKeepsEachBatchSum) {
+  // Past the store's kSparse pairs a path's cells move to a block; the sums must not change.
+  Histogram h(HistogramLayout{32, {"nee"}});
+  const Histogram::PathId p = h.intern("LDE");
+  for (int round = 0; round < 3; ++round)
+    for (int batch = 31; batch >= 0; --batch) EXPECT_TRUE(h.add(p, batch, 0, gray(0.125 * (batch + 1))));
+  for (int batch = 0; batch < 32; ++batch) {
+    EXPECT_EQ(h.cell(p, batch).contributions, 3u) << batch;
+    EXPECT_EQ(h.cell(p, batch).sum, *to_exact(gray(0.375 * (batch + 1)))) << batch;
+    EXPECT_EQ(h.row_sum(0, batch), 3 * luminance_exact(*to_exact(gray(0.125 * (batch + 1))))) << batch;
+    EXPECT_TRUE(h.batch_in_use(batch));
+  }
 }
 
 // --- non-finite contributions ---

@@ -94,9 +94,10 @@ TEST(ClosedForm, EmittingSpherePerBounce) {
 }
 
 // The mean over the image of radiance(p) at the point p where each pixel's ray meets the plane
-// y = 0 (0 where it misses), integrated over each pixel on a 16 x 16 grid: the reference for
+// y = 0 (0 where it misses), integrated over each pixel on a 256 x 256 grid: the reference for
 // scenes whose floor radiance is known in closed form. The camera is the pinhole of the scene
-// JSON below: position (0, 1.5, 2.5), looking at the origin, fov 50, 8 x 8 pixels.
+// JSON below: position (0, 1.5, 2.5), looking at the origin, fov 50, 8 x 8 pixels. (A 16 x 16
+// grid put a sun patch's edges 0.23 % high, half the 0.5 % its test allows beside its stderr.)
 template <class F>
 double floor_reference(F radiance) {
   const glm::vec3 pos(0.0f, 1.5f, 2.5f);
@@ -105,7 +106,7 @@ double floor_reference(F radiance) {
   const glm::vec3 up = glm::cross(right, fwd);
   const double ty = std::tan(25.0 * kPi / 180.0), tx = ty;
   double sum = 0;
-  const int n = 8, sub = 16;
+  const int n = 8, sub = 256;
   for (int py = 0; py < n; ++py)
     for (int px = 0; px < n; ++px)
       for (int j = 0; j < sub; ++j)
@@ -312,7 +313,10 @@ TEST(ClosedForm, SunPatchThroughAWindowIsECosTheta) {
     return lit ? rho * irradiance * -dir.y / kPi : 0.0;
   });
   ASSERT_GT(expected, 0.0);
-  for (const auto& [renderer, spp] : {std::pair<const char*, std::uint64_t>{"pt-nee+distant", 64}, {"lt", 256}, {"bdpt", 256}}) {
+  // pt-nee+distant at 256 spp: only the patch's edge pixels vary, by whole samples, and under sobol
+  // their two replicates' counts can tie in every group, so at 64 spp 1 seed in 100 read a stderr
+  // of 0 with the estimate 0.64 % off (its spread over seeds 0.79 %; at 256 spp 0.22 %).
+  for (const auto& [renderer, spp] : {std::pair<const char*, std::uint64_t>{"pt-nee+distant", 256}, {"lt", 256}, {"bdpt", 256}}) {
     Rendered r = render_json(scene, renderer, {"LDSDDSE"}, spp);
     EXPECT_EQ(r.report.nonfinite_samples, 0u);
     expect_close(r.report.classes[0].estimate, expected, kSigmas, 0.005, std::string(renderer) + " sun patch");
