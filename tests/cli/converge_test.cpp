@@ -102,7 +102,11 @@ TEST(Converge, ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest) {
       if (check.at("chi2").is_number() && check.at("limit").is_number())
         pathex::test::stat_log(what + " chi2/limit", check.at("chi2").get<double>() / check.at("limit").get<double>(), 1);
       if (check.at("stability").is_number()) pathex::test::stat_log(what + " stability", check.at("stability").get<double>(), 0.7);
-      const bool alarm = check.at("disagrees").get<bool>() || check.at("too_large").get<bool>() || check.at("unstable").get<bool>();
+      // converge does not judge a stderr against the reference where the renderer cannot sample the
+      // whole class (cannot_sample): its χ² flags are reported there but raise no warning (seed 42:
+      // pt-nee's total, too_large); the stability check does.
+      const bool alarm = ((check.at("disagrees").get<bool>() || check.at("too_large").get<bool>()) && c.at("cannot_sample").is_null()) ||
+                         check.at("unstable").get<bool>();
       EXPECT_EQ(alarm, !c.at("warning").is_null()) << what;
       alarms += alarm ? 1 : 0;
       ASSERT_EQ(c.at("rungs").size(), 4u) << what;

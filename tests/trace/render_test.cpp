@@ -693,8 +693,11 @@ TEST(Agreement, AbsorbingRoughGlassAgreesAcrossEstimators) {
     runs.push_back(render_json(scene("[0.3, 0.8, 1.5]"), renderer, {}, 256, 0, test::stat_seed(19)));
   const Rendered clear = render_json(scene("[0, 0, 0]"), "bdpt", {}, 256, 0, test::stat_seed(19));
   expect_estimators_agree(runs, 0, 0.002);
+  // The medium is seen: without it the image is brighter than twice the agreement's tolerance (a
+  // fixed 10 sigma failed at 1 seed in 100, seed 28: 9.75 sigma, one run's stderr inflated by a rare sample).
   const Estimate& a = runs[2].report.total;
-  EXPECT_GT(clear.report.total.luminance - a.luminance, 10.0 * std::hypot(a.std_error, clear.report.total.std_error))
+  const double tolerance = test::family_sigmas(3) * std::hypot(a.std_error, clear.report.total.std_error) + 0.002 * a.luminance;
+  EXPECT_GT(clear.report.total.luminance - a.luminance, 2.0 * tolerance)
       << "absorbing " << a.luminance << ", clear " << clear.report.total.luminance;
 }
 
