@@ -25,26 +25,14 @@
 #include "reach/query.h"
 #include "scene/scene.h"
 #include "trace/render.h"
+#include "support/compare_estimates.h"
 #include "support/stat_seed.h"
 
 namespace pathex {
 namespace {
 
 constexpr int kBounces = 6;
-// The fewest nonzero samples (4 a batch of the 32) for which a path's estimate is compared by its
-// stderr: with fewer, whether a batch holds a contribution at all decides its mean, and the
-// batch-means t is far from Student's (10 % of the comparisons at the fixed seed: the lamp seen
-// in a mirror, met 12 to 16 times, and light tracing's sparse splats).
-constexpr std::uint64_t kMinSamples = 4 * 32;
-// The fewest degrees of freedom (Estimate::dof: pixel groups whose replicates hold the path) for
-// which a stderr is compared: cornell.json's lamp, seen directly, covers a few of the 256 pixels at
-// 16 x 16 and its stderr has 4; every sample there adds the lamp's radiance, and under `sobol` both
-// replicates of those pixels can meet the lamp equally often, so its stderr is at times exactly 0
-// while the seed-to-seed spread is 0.4 % of the value (issue 36's sweep: seed 70 of 100). At 5 or
-// more a stderr of 0 needs five such coincidences. (spotmeter-caustic.json's one pixel gave 1 until the
-// default groups followed the pixel count: one group of 32 replicates, 31.)
-// Each comparison's tolerance is Student's at its Welch–Satterthwaite degrees of freedom.
-constexpr int kMinDof = 5;
+// Which estimates are compared by their stderrs, and how: tests/support/compare_estimates.h.
 
 HistogramReport render_scene(const Scene& scene, const Profile& profile, std::uint64_t spp) {
   RenderOptions o;
@@ -65,12 +53,7 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
   for (Profile& p : builtin_profiles(Limits{}).expect("a test input"))
     if (p.name != "bdpt") profiles.push_back(std::move(p));
   ASSERT_EQ(profiles.size(), 14u);
-  struct Comparison {
-    std::string what;
-    double deviation, sigma;
-    int dof;  // Welch–Satterthwaite, rounded down
-  };
-  std::vector<Comparison> comparisons;
+  std::vector<test::Comparison> comparisons;
   int sparse = 0;  // paths found, but with too few samples or degrees of freedom for their stderr to mean anything
   int heavy = 0;   // paths found that the manifold walk samples (heavy-tailed: checked for being found)
   auto has_connector = [](const Profile& p, ConnectorKind kind) {
@@ -157,14 +140,11 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
         if (!(p.estimate.luminance > 0.01 * reference.total.luminance) || !reach.reachable.accepts(p.path)) continue;
         auto it = found.find(p.path);
         ASSERT_NE(it, found.end()) << where << ": bdpt finds " << p.path << " but the profile never samples it";
-        // A batch-means stderr describes an estimate made of enough samples only: light tracing meets
-        // materials.json's LDDDDDDSE (4 % of the image) about 76 times in 128 spp at 16 x 16, and a
-        // few heavy splats carry it — at seed 2 it read 0.0022 ± 0.0003 against bdpt's 0.0054, while
-        // at 2,048 spp it reads 0.0060 ± 0.0010 (issue 36's sweep: 1 of 5 seeds failed). Such a path
-        // is checked for being found, not for its value.
+        // A path with too few samples or degrees of freedom for its stderr to mean anything is
+        // checked for being found, not for its value (tests/support/compare_estimates.h).
         const Estimate& a = p.estimate;
         const Estimate& b = it->second->estimate;
-        if (std::min(a.samples, b.samples) < kMinSamples || std::min(a.dof, b.dof) < kMinDof) {
+        if (!test::comparable(a, b)) {
           ++sparse;
           continue;
         }
@@ -172,12 +152,7 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
           ++heavy;
           continue;
         }
-        const double va = a.std_error * a.std_error, vb = b.std_error * b.std_error;
-        comparisons.push_back({where + ": " + p.path + " bdpt " + std::to_string(a.luminance) + " ± " + std::to_string(a.std_error) +
-                                   " (" + std::to_string(a.dof) + " dof), " + name + " " + std::to_string(b.luminance) + " ± " +
-                                   std::to_string(b.std_error) + " (" + std::to_string(b.dof) + " dof)",
-                               std::fabs(a.luminance - b.luminance), std::sqrt(va + vb),
-                               static_cast<int>(welch_dof(va, a.dof, vb, b.dof))});
+        comparisons.push_back(test::compare(where + ": " + p.path + " bdpt against " + name, a, b));
       }
     }
   }
@@ -185,11 +160,7 @@ TEST(Agreement, TracerSamplesExactlyWhatTheCheckerAllows) {
   test::stat_log("paths found but too sparse to compare", sparse, static_cast<double>(comparisons.size()) / 4);
   EXPECT_LT(sparse, static_cast<int>(comparisons.size()) / 4) << "most comparisons must be of well-sampled paths";
   test::stat_log("paths found, sampled by the manifold walk", heavy, 0);
-  for (const Comparison& c : comparisons) {
-    const double tolerance = test::family_sigmas(static_cast<int>(comparisons.size()), 1e-3, c.dof);
-    test::stat_log(c.what, c.deviation / c.sigma, tolerance);
-    EXPECT_LE(c.deviation, tolerance * c.sigma + 1e-9) << c.what;
-  }
+  for (const std::string& failure : test::family_failures(comparisons)) ADD_FAILURE() << failure;
 }
 
 }  // namespace
