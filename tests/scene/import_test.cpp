@@ -1,10 +1,12 @@
 // Scene import (pbrt-v4 .pbrt, Mitsuba 3 .xml): the exported Cornell boxes give the JSON scene's
-// model and image (per path string within 3 standard errors, per pixel within 3 standard errors
+// model and image (cornell.pbrt's mirror as pbrt-v4 states it, a conductor; per well-sampled path
+// string within the family-wise tolerance of their stderrs, per pixel within 3 standard errors
 // of the run-to-run spread), each format's conventions (handedness, field of view, light units)
 // give exact values, and everything outside the subset is refused with its file, line, column
 // and an exact message, by the library and by the CLI (exit 2).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -152,15 +154,44 @@ PixelVerdict compare_pixels(const PixelStats& a, const PixelStats& b) {
   return v;
 }
 
+// cornell.json as pbrt-v4 can state it: pbrt-v4 has no mirror of constant reflectance, so
+// cornell.pbrt's "mirror" is a smooth conductor of reflectance 0.95 at normal incidence (eta 1,
+// k = 2 sqrt(r / (1 - r)): include/cornell-materials.pbrt), whose Fresnel dips below 0.95 towards
+// grazing before it rises to 1 — the paths through the mirror ball differ by ~0.8 % (LDDDSDSE at
+// 32 x 32, 2,048 spp: 0.004443 against the constant mirror's 0.004480, 26 σ). Mitsuba's conductor
+// of material "none" is exactly pathex's mirror, so cornell.xml is compared with cornell.json as is.
+Scene as_pbrt_states_it(Scene json) {
+  for (Material& m : json.materials)
+    if (const auto* mirror = std::get_if<Mirror>(&m)) {
+      const glm::vec3 r = mirror->reflectance;
+      Conductor c;
+      c.eta = glm::vec3(1.0f);
+      c.k = 2.0f * glm::sqrt(r / (1.0f - r));
+      m = c;
+    }
+  return json;
+}
+
 TEST(ImportCornell, ImagesMatchTheJsonSceneWithin3Sigma) {
   const Scene json = load(kScenes + "cornell.json");
   const std::uint64_t base = test::stat_seed(0);  // the seeds below, offset (PATHEX_STAT_SEED)
-  const PixelStats ref = pixel_stats(json, base + 1);
-  const HistogramReport ref_report = render_small(json, base + 1000, kSpp * kRuns).report;
   std::uint64_t seed = base + 100;
   for (const char* file : {"cornell.pbrt", "cornell.xml"}) {
     SCOPED_TRACE(file);
     const Scene scene = load(kScenes + file);
+    const bool pbrt = std::string(file) == "cornell.pbrt";
+    const Scene want = pbrt ? as_pbrt_states_it(json) : json;
+    if (pbrt) {  // the import's mirror is that conductor
+      const auto mirror = std::find(scene.material_names.begin(), scene.material_names.end(), "mirror");
+      ASSERT_NE(mirror, scene.material_names.end());
+      const auto* c = std::get_if<Conductor>(&scene.materials[static_cast<std::size_t>(mirror - scene.material_names.begin())]);
+      ASSERT_NE(c, nullptr);
+      expect_near(c->eta, glm::vec3(1.0f), "the mirror's eta");
+      expect_near(c->k, glm::vec3(2.0f * std::sqrt(0.95f / 0.05f)), "the mirror's k");
+      EXPECT_TRUE(c->smooth());
+    }
+    const PixelStats ref = pixel_stats(want, base + 1);
+    const HistogramReport ref_report = render_small(want, base + 1000, kSpp * kRuns).report;
     const PixelStats got = pixel_stats(scene, seed);
     const HistogramReport report = render_small(scene, seed + 1000, kSpp * kRuns).report;
     seed += 100;
