@@ -6,8 +6,9 @@ against new, interleaved in one run (issue 19).
         --resolution 256x256 --max-bounces 64 --renderers pt-nee,bdpt,lt --spp 16,64 --rounds 5
 
 For every scene (default: the embedded Cornell box), renderer and spp, each round runs every
-variant once (the old binary, then the new one with its default settings and with each
-`--variant LABEL:ARGS`), in an order that rotates from round to round, each with the round's seed,
+variant once (the old binary, then the new one: with its default settings when no `--variant` is
+given, else with each `--variant LABEL:ARGS` only — give `--variant "new:"` for its defaults beside
+others — and each `--binary`), in an order that rotates from round to round, each with the round's seed,
 one thread, default outputs (classes.exr and the PNGs). CPU time is the process's user + system
 time (os.wait4): start-up, rendering and writing, what a user waits for; the time the shared host
 gives to others is not counted. The error is the per-pixel MSE of the image's "total" layer
