@@ -46,13 +46,14 @@ struct Comparison {
   int dof = 0;                      // Welch–Satterthwaite, rounded down
 };
 
-// a against b (comparable(a, b) must hold); `what` names them in a failure.
+// a against b (by their stderrs: comparable(a, b) says whether that means anything); `what` names
+// them in a failure.
 inline Comparison compare(const std::string& what, const Estimate& a, const Estimate& b) {
   const double va = a.std_error * a.std_error, vb = b.std_error * b.std_error;
   return {what + ": " + std::to_string(a.luminance) + " ± " + std::to_string(a.std_error) + " (" + std::to_string(a.dof) +
               " dof) against " + std::to_string(b.luminance) + " ± " + std::to_string(b.std_error) + " (" +
               std::to_string(b.dof) + " dof)",
-          std::fabs(a.luminance - b.luminance), std::sqrt(va + vb), static_cast<int>(welch_dof(va, a.dof, vb, b.dof))};
+          std::fabs(a.luminance - b.luminance), std::sqrt(va + vb), static_cast<int>(welch_dof(va, std::max(a.dof, 1), vb, std::max(b.dof, 1)))};
 }
 
 // Every comparison within the tolerance that holds the family of them to `family_rate`

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <optional>
 #include <tuple>
 
@@ -15,6 +16,7 @@
 #include "scene/scene.h"
 #include "optics/fresnel.h"
 #include "trace/render.h"
+#include "support/compare_estimates.h"
 #include "support/scratch_files.h"
 #include "support/stat_seed.h"
 #include "support/test_classes.h"
@@ -941,12 +943,7 @@ TEST(Sampling, EverySettingAgreesWithTheIndependentSamplerOnTheSampleScenes) {
   const std::string dir = std::string(PATHEX_SOURCE_DIR) + "/samples/scenes/";
   const Sampling reference{SamplerKind::kIndependent, 3, 1.0f, 1.0f};
   const std::uint64_t seed = test::stat_seed(11);  // the reference's; every setting renders at seed + 1
-  struct Comparison {
-    std::string what;
-    double difference, sigma;
-    int dof;
-  };
-  std::vector<Comparison> comparisons;
+  std::vector<test::Comparison> comparisons;
   for (const char* file : {"cornell.json", "point-glass.json", "point-mirror-caustic.json", "sun-window.json",
                            "laser.json", "mirror-ortho.json", "spotmeter-caustic.json"}) {
     const std::string renderer = std::string(file) == "sun-window.json"    ? "pt-nee+distant"
@@ -962,60 +959,67 @@ TEST(Sampling, EverySettingAgreesWithTheIndependentSamplerOnTheSampleScenes) {
         const Estimate& a = base.report.classes[c].estimate;
         const Estimate& b = r.report.classes[c].estimate;
         if (a.luminance == 0.0 && b.luminance == 0.0) continue;
-        const double va = a.std_error * a.std_error, vb = b.std_error * b.std_error;
-        comparisons.push_back({what + ", class " + classes[c] + ": " + std::to_string(b.luminance) + " ± " +
-                                   std::to_string(b.std_error) + " against " + std::to_string(a.luminance) + " ± " +
-                                   std::to_string(a.std_error),
-                               b.luminance - a.luminance, std::sqrt(va + vb),
-                               static_cast<int>(welch_dof(va, std::max(a.dof, 1), vb, std::max(b.dof, 1)))});
+        comparisons.push_back(test::compare(what + ", class " + classes[c] + ": the independent sampler against this", a, b));
       }
     }
   }
   EXPECT_GT(comparisons.size(), 250u);
-  for (const Comparison& c : comparisons) {
-    const double k = test::family_sigmas(static_cast<int>(comparisons.size()), 1e-3, c.dof);
-    test::stat_log(c.what, c.difference / c.sigma, k);
-    EXPECT_LE(std::fabs(c.difference), k * c.sigma) << c.what << " (" << c.dof << " dof)";
-  }
+  for (const std::string& failure : test::family_failures(comparisons)) ADD_FAILURE() << failure;
 }
 
 // Issue 39: next-event estimation drawing a light's points by the solid angle it subtends
 // (--light-sampling solid-angle: a rectangle's, Ureña et al. 2013, trace/spherical_rect.h; a
 // sphere's cone, pbrt-v4) renders what area sampling renders: the sample Cornell box and Tungsten's
-// (each lamp a one-sided rectangle) and the materials scene (a spherical lamp), the lamp seen
-// directly, one, two and three or more bounces, for the renderers whose densities it changes
-// (pt-nee: next-event estimation and the emitter hit's MIS; bdpt: every strategy through x0's and
-// x1's densities; lt: the splat of the lamp itself). Each difference within the tolerance that
-// makes all 36 checks fail a correct renderer together at 0.1 % (Šidák over Student's t with the
-// render's 16 degrees of freedom: a difference of two has more, which only makes it safer).
+// (each lamp a one-sided rectangle) and the materials scene (a spherical lamp), for the renderers
+// whose densities it changes (pt-nee: next-event estimation and the emitter hit's MIS; bdpt: every
+// strategy through x0's and x1's densities; lt: the splat of the lamp itself). Every path string
+// carrying more than 1 % of an image, and the image's total, by the one rule for comparing two
+// renders' path estimates (tests/support/compare_estimates.h: Welch–Satterthwaite degrees of
+// freedom, Šidák over every comparison, 0.1 % together; a path too sparse for its stderr is checked
+// for being found). Comparing classes instead failed at seed 48 of issue 36's sweep: materials.json's
+// one-bounce class under pt-nee holds the lamp seen in a specular surface (LDDSDSE, met by emitter
+// hits alone: 103 samples), whose stderr read 4e-6 on a value of 0.0036 (its replicates tied) and
+// took the class 5.9 σ from area sampling's (169 samples, 0.0029).
 TEST(Sampling, SolidAngleLightSamplingAgreesWithAreaSampling) {
-  const std::vector<std::string> classes = {"L....E", "L.....E", "L......E", "L.......+E"};
   const std::string root = std::string(PATHEX_SOURCE_DIR) + "/";
   const std::vector<std::string> scenes = {"samples/scenes/cornell.json", "bench/scenes/tungsten-cornell-box.json",
                                            "samples/scenes/materials.json"};
   const std::vector<std::string> renderers = {"pt-nee", "bdpt", "lt"};
-  const double k = test::family_sigmas(static_cast<int>(scenes.size() * renderers.size() * classes.size()));
   Sampling area, solid;
   area.light_sampling = LightSampling::kArea;
   solid.light_sampling = LightSampling::kSolidAngle;
   const std::uint64_t seed = test::stat_seed_from(41);
+  std::vector<test::Comparison> comparisons;
+  int sparse = 0;
   for (const std::string& file : scenes)
     for (const std::string& renderer : renderers) {
       const std::uint64_t spp = renderer == "lt" ? 32 : 16;
-      const Rendered a = render_scene(load_scene_file(root + file), renderer, classes, spp, 0, seed, area, 16);
-      const Rendered b = render_scene(load_scene_file(root + file), renderer, classes, spp, 0, seed + 1, solid, 16);
+      const Rendered a = render_scene(load_scene_file(root + file), renderer, {"L.*E"}, spp, 0, seed, area, 16);
+      const Rendered b = render_scene(load_scene_file(root + file), renderer, {"L.*E"}, spp, 0, seed + 1, solid, 16);
       const std::string what = file + ", " + renderer;
       EXPECT_EQ(b.report.nonfinite_samples, 0u) << what;
-      for (std::size_t c = 0; c < classes.size(); ++c) {
-        const Estimate& x = a.report.classes[c].estimate;
-        const Estimate& y = b.report.classes[c].estimate;
-        if (x.luminance == 0.0 && y.luminance == 0.0) continue;  // (the materials scene's lamp is not in view)
-        const double z = (y.luminance - x.luminance) / std::hypot(x.std_error, y.std_error);
-        test::stat_log(what + ", class " + classes[c], z, k);
-        EXPECT_LE(std::fabs(z), k) << what << ", class " << classes[c] << ": solid angle " << y.luminance << " ± " << y.std_error
-                                   << " against area " << x.luminance << " ± " << x.std_error;
+      std::map<std::string, const PathEstimate*> by_path;
+      for (const PathEstimate& p : b.report.paths) by_path[p.path] = &p;
+      for (const PathEstimate& p : a.report.paths) {
+        if (!(p.estimate.luminance > 0.01 * a.report.total.luminance)) continue;
+        auto it = by_path.find(p.path);
+        if (it == by_path.end()) {
+          EXPECT_LT(p.estimate.samples, test::kMinSamples) << what << ": solid-angle sampling never samples " << p.path;
+          ++sparse;
+          continue;
+        }
+        if (!test::comparable(p.estimate, it->second->estimate)) {
+          ++sparse;
+          continue;
+        }
+        comparisons.push_back(test::compare(what + ", " + p.path + ": area against solid angle", p.estimate, it->second->estimate));
       }
+      comparisons.push_back(test::compare(what + ", total: area against solid angle", a.report.total, b.report.total));
     }
+  EXPECT_GT(comparisons.size(), 40u);
+  test::stat_log("paths found but too sparse to compare", sparse, static_cast<double>(comparisons.size()) / 4);
+  EXPECT_LT(sparse, static_cast<int>(comparisons.size()) / 4) << "most comparisons must be of well-sampled paths";
+  for (const std::string& failure : test::family_failures(comparisons)) ADD_FAILURE() << failure;
 }
 
 // Issue 36: the reported standard error is the seed-to-seed spread under the default sampler too
