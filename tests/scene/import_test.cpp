@@ -200,25 +200,8 @@ TEST(ImportCornell, ImagesMatchTheJsonSceneWithin3Sigma) {
     // or degrees of freedom for its stderr to mean anything — the lamp seen directly, whose stderr
     // under sobol is at times 0; a caustic pt-nee meets by chance — is checked for being found).
     // The tolerance holds the family of these checks to a 0.1 % false-failure rate. ---
-    std::map<std::string, const PathEstimate*> by_path;
-    for (const PathEstimate& p : report.paths) by_path[p.path] = &p;
     std::vector<test::Comparison> comparisons;
-    int sparse = 0;
-    for (const PathEstimate& want : ref_report.paths) {
-      if (want.estimate.luminance < 0.005 * ref_report.total.luminance) continue;
-      auto it = by_path.find(want.path);
-      if (it == by_path.end()) {  // not sampled: a failure unless the JSON scene's render met it by chance too
-        EXPECT_LT(want.estimate.samples, test::kMinSamples) << file << " never samples " << want.path;
-        ++sparse;
-        continue;
-      }
-      if (!test::comparable(want.estimate, it->second->estimate)) {
-        ++sparse;
-        continue;
-      }
-      comparisons.push_back(test::compare(std::string(file) + " " + want.path + ": JSON against the import", want.estimate,
-                                          it->second->estimate));
-    }
+    const int sparse = test::compare_paths(ref_report, report, 0.005, std::string(file) + ": JSON against the import", &comparisons);
     // At the fixed seed 9 compared and 4 found but sparse (the caustics through the spheres that
     // pt-nee meets by chance: about 100 samples, 2 to 4 degrees of freedom; the lamp seen directly).
     EXPECT_GE(comparisons.size(), 5u);

@@ -17,9 +17,12 @@
 // at the two errors' Welch–Satterthwaite degrees of freedom.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -54,6 +57,29 @@ inline Comparison compare(const std::string& what, const Estimate& a, const Esti
               " dof) against " + std::to_string(b.luminance) + " ± " + std::to_string(b.std_error) + " (" +
               std::to_string(b.dof) + " dof)",
           std::fabs(a.luminance - b.luminance), std::sqrt(va + vb), static_cast<int>(welch_dof(va, std::max(a.dof, 1), vb, std::max(b.dof, 1)))};
+}
+
+// Every path string of `a` carrying more than `share` of a's total, against the same string of `b`:
+// the comparable ones appended to `comparisons` (named "what, path"), the others counted and
+// returned. A path `b` never samples fails the test unless `a` met it too rarely for a stderr.
+inline int compare_paths(const HistogramReport& a, const HistogramReport& b, double share, const std::string& what,
+                         std::vector<Comparison>* comparisons) {
+  std::map<std::string, const PathEstimate*> by_path;
+  for (const PathEstimate& p : b.paths) by_path[p.path] = &p;
+  int sparse = 0;
+  for (const PathEstimate& p : a.paths) {
+    if (!(p.estimate.luminance > share * a.total.luminance)) continue;
+    auto it = by_path.find(p.path);
+    if (it == by_path.end()) {
+      EXPECT_LT(p.estimate.samples, kMinSamples) << what << ": " << p.path << " is never sampled";
+      ++sparse;
+    } else if (!comparable(p.estimate, it->second->estimate)) {
+      ++sparse;
+    } else {
+      comparisons->push_back(compare(what + ", " + p.path, p.estimate, it->second->estimate));
+    }
+  }
+  return sparse;
 }
 
 // Every comparison within the tolerance that holds the family of them to `family_rate`

@@ -998,22 +998,7 @@ TEST(Sampling, SolidAngleLightSamplingAgreesWithAreaSampling) {
       const Rendered b = render_scene(load_scene_file(root + file), renderer, {"L.*E"}, spp, 0, seed + 1, solid, 16);
       const std::string what = file + ", " + renderer;
       EXPECT_EQ(b.report.nonfinite_samples, 0u) << what;
-      std::map<std::string, const PathEstimate*> by_path;
-      for (const PathEstimate& p : b.report.paths) by_path[p.path] = &p;
-      for (const PathEstimate& p : a.report.paths) {
-        if (!(p.estimate.luminance > 0.01 * a.report.total.luminance)) continue;
-        auto it = by_path.find(p.path);
-        if (it == by_path.end()) {
-          EXPECT_LT(p.estimate.samples, test::kMinSamples) << what << ": solid-angle sampling never samples " << p.path;
-          ++sparse;
-          continue;
-        }
-        if (!test::comparable(p.estimate, it->second->estimate)) {
-          ++sparse;
-          continue;
-        }
-        comparisons.push_back(test::compare(what + ", " + p.path + ": area against solid angle", p.estimate, it->second->estimate));
-      }
+      sparse += test::compare_paths(a.report, b.report, 0.01, what + ": area against solid angle", &comparisons);
       comparisons.push_back(test::compare(what + ", total: area against solid angle", a.report.total, b.report.total));
     }
   EXPECT_GT(comparisons.size(), 40u);
