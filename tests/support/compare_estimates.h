@@ -1,6 +1,7 @@
 // Comparing two renders' estimates of one path string by their batch-means stderrs: the rule the
-// statistical tests share (tests/trace/agreement_test.cpp, tests/scene/import_test.cpp), so that
-// what "enough samples for a stderr to mean anything" is has one copy.
+// statistical tests share (tests/trace/agreement_test.cpp, tests/scene/import_test.cpp, and
+// render_test's Sampling.SolidAngle... and Sampling.EverySettingAgrees...), so that what "enough
+// samples for a stderr to mean anything" is has one copy.
 //
 // A batch-means stderr describes an estimate made of enough samples only (issue 36's sweeps):
 //   - with few nonzero samples, whether a batch holds a contribution at all decides its mean, and
