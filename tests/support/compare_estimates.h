@@ -48,6 +48,7 @@ struct Comparison {
   std::string what;
   double deviation = 0, sigma = 0;  // |a - b| and the combined stderr
   int dof = 0;                      // Welch–Satterthwaite, rounded down
+  double allowance = 0;             // a difference the test allows beyond the noise, stated by it
 };
 
 // a against b (by their stderrs: comparable(a, b) says whether that means anything); `what` names
@@ -84,14 +85,18 @@ inline int compare_paths(const HistogramReport& a, const HistogramReport& b, dou
 }
 
 // Every comparison within the tolerance that holds the family of them to `family_rate`
-// (family_sigmas at each one's own degrees of freedom); each logged for PATHEX_STAT_LOG.
+// (family_sigmas at each one's own degrees of freedom) plus its allowance; each logged for
+// PATHEX_STAT_LOG as (deviation - allowance) / sigma against that tolerance.
 // Returns the failures' descriptions.
 inline std::vector<std::string> family_failures(const std::vector<Comparison>& comparisons, double family_rate = 1e-3) {
   std::vector<std::string> failed;
   for (const Comparison& c : comparisons) {
     const double tolerance = family_sigmas(static_cast<int>(comparisons.size()), family_rate, std::max(c.dof, 1));
-    stat_log(c.what, c.sigma > 0 ? c.deviation / c.sigma : (c.deviation > 0 ? HUGE_VAL : 0.0), tolerance);
-    if (!(c.deviation <= tolerance * c.sigma + 1e-9)) failed.push_back(c.what + " (tolerance " + std::to_string(tolerance) + " σ)");
+    const double excess = c.deviation - c.allowance;  // logged on the tolerance's scale: fails above it
+    stat_log(c.what, c.sigma > 0 ? excess / c.sigma : (excess > 0 ? HUGE_VAL : 0.0), tolerance);
+    if (!(c.deviation <= tolerance * c.sigma + c.allowance + 1e-9))
+      failed.push_back(c.what + " (tolerance " + std::to_string(tolerance) + " σ" +
+                       (c.allowance > 0 ? " + " + std::to_string(c.allowance) : std::string()) + ")");
   }
   return failed;
 }
