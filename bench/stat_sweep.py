@@ -9,7 +9,14 @@ time, and prints its failures, the failure rate and a 95 % upper bound on it (Cl
 
     nice python3 bench/stat_sweep.py --build build --seeds 100            # every registered test
     nice python3 bench/stat_sweep.py --build build --seeds 100 --only Bias  # tests whose filter contains Bias
+    nice python3 bench/stat_sweep.py --build build --jobs 2 --keep /tmp/sweep  # two seeds at a time
     python3 bench/stat_sweep.py --list
+
+--jobs N runs N seeds at once, each process pinned to a CPU of its own (of those this process may
+use), so that a test's threads do not fight each other; a test's outcome does not depend on its
+thread count (the renders are deterministic per seed: render_test's Determinism.*). --keep DIR
+keeps a failing seed's output (DIR/<exe>.<seed>.log) and every seed's PATHEX_STAT_LOG lines in
+DIR/<exe>.tsv (seed, what, deviate, tolerance), for the deviates' distribution.
 
 A test not in STATISTICAL_TESTS below is not swept: add every test whose outcome depends on its
 seed, and make it take its seed from test::stat_seed.
@@ -19,6 +26,7 @@ import os
 import subprocess
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 # (test executable, GoogleTest filter): every test whose pass or fail depends on random sampling.
 STATISTICAL_TESTS = [
@@ -122,29 +130,53 @@ def main():
     ap.add_argument("--first-seed", type=int, default=1)
     ap.add_argument("--only", default="", help="sweep only tests whose executable or filter contains this")
     ap.add_argument("--list", action="store_true")
+    ap.add_argument("--jobs", type=int, default=1, help="seeds run at once, each pinned to one CPU")
+    ap.add_argument("--keep", default="", help="a directory for failing seeds' output and the deviates")
     args = ap.parse_args()
     tests = [t for t in STATISTICAL_TESTS if args.only in t[0] or args.only in t[1]]
     if args.list:
         for exe, flt in tests:
             print(f"{exe} --gtest_filter={flt}")
         return 0
+    cpus = sorted(os.sched_getaffinity(0))
+    jobs = max(1, min(args.jobs, len(cpus)))
+    if args.keep:
+        os.makedirs(args.keep, exist_ok=True)
+
+    def run(path, exe, flt, seed, slot):
+        env = dict(os.environ, PATHEX_STAT_SEED=str(seed))
+        if args.keep:
+            env["PATHEX_STAT_LOG"] = "1"
+        pin = (lambda: os.sched_setaffinity(0, {cpus[slot]})) if jobs > 1 else None
+        r = subprocess.run([path, f"--gtest_filter={flt}"], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                           preexec_fn=pin, text=True, errors="replace")
+        if args.keep:
+            with open(os.path.join(args.keep, f"{exe}.tsv"), "a") as f:
+                for line in r.stdout.splitlines():
+                    if line.startswith("stat-log "):
+                        f.write(f"{seed}\t{line[len('stat-log '):]}\n")
+            if r.returncode != 0:
+                with open(os.path.join(args.keep, f"{exe}.{seed}.log"), "w") as f:
+                    f.write(r.stdout)
+        # Each seed's outcome as it happens (stderr), so that a sweep stopped early still tells
+        # what it found: the table row comes only when a test's last seed has run.
+        print(f"{exe} {flt} seed {seed}: {'FAILED' if r.returncode != 0 else 'ok'}", file=sys.stderr, flush=True)
+        return r.returncode
+
     print(f"| test | seeds | failed | rate | 95 % upper bound | s per run | failing seeds |")
     print(f"|---|---|---|---|---|---|---|")
     worst = 0.0
     for exe, flt in tests:
         path = os.path.join(args.build, "tests", exe)
-        failed = []
+        seeds = list(range(args.first_seed, args.first_seed + args.seeds))
         t0 = time.time()
-        for seed in range(args.first_seed, args.first_seed + args.seeds):
-            env = dict(os.environ, PATHEX_STAT_SEED=str(seed))
-            r = subprocess.run([path, f"--gtest_filter={flt}"], env=env, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-            if r.returncode != 0:
-                failed.append(seed)
-            # Each seed's outcome as it happens (stderr), so that a sweep stopped early still tells
-            # what it found: the table row comes only when a test's last seed has run.
-            print(f"{exe} {flt} seed {seed}: {'FAILED' if r.returncode != 0 else 'ok'}", file=sys.stderr, flush=True)
-        per_run = (time.time() - t0) / args.seeds
+        with ThreadPoolExecutor(max_workers=jobs) as pool:
+            # Seed i runs on CPU slot i mod jobs: seeds of one slot run one after another.
+            by_slot = [seeds[j::jobs] for j in range(jobs)]
+            futures = [pool.submit(lambda j=j: [(s, run(path, exe, flt, s, j)) for s in by_slot[j]]) for j in range(jobs)]
+            codes = dict(pair for f in futures for pair in f.result())
+        failed = [s for s in seeds if codes[s] != 0]
+        per_run = (time.time() - t0) * jobs / args.seeds  # CPU-slot seconds a run
         rate = len(failed) / args.seeds
         worst = max(worst, rate)
         print(f"| `{exe} {flt}` | {args.seeds} | {len(failed)} | {100 * rate:.1f} % | "
