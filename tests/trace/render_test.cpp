@@ -1182,14 +1182,23 @@ TEST(Letters, ASmoothCoatReflectsAsSAndItsDiffuseLobeIsD) {
 // Estimators agree on a coated sphere (a smooth and a rough coat, a scattering slab) lit by a
 // sphere light above it and standing on a diffuse floor: pt-nee, lt and bdpt reach the paths
 // whose visible vertex is D (class L .* D DS E, pinhole) through different densities, so a pdf()
-// that disagreed with sample(), or an eval() that disagreed with either, would show here. Pairwise
-// by the shared comparison rule (tests/support/compare_estimates.h), 6 checks at 0.1 % together;
-// each render at a seed of its own (they shared one, which correlated pt-nee's camera paths with
-// bdpt's and made the check weaker than it said).
+// that disagreed with sample(), or an eval() that disagreed with either, would show here.
+//
+// Pairwise per path of the class by the shared comparison rule (tests/support/compare_estimates.h,
+// 0.1 % together over every comparison), each render at a seed of its own. Not the class as one
+// number: under the smooth coat it holds LDDSDDSE, the lamp reflected by the coat onto the floor,
+// which pt-nee meets only when a floor point's sampled direction hits the lamp through the coat
+// (about 20 samples at 1,024 spp; bdpt's light tracing about 50): a heavy tail that carries 1 %
+// of the class and most of its stderr, so a draw with few such hits read low with a small stderr
+// (issue 36's sweep, seed 62: pt-nee 0.022085 ± 0.000030 against bdpt's 0.022376 ± 0.000050,
+// 5.0σ; over 40 seeds through the CLI the three agree: 0.022379 ± 0.000017, 0.022384 ± 0.000079,
+// 0.022355 ± 0.000012). Such a path is checked for being found. (The renders shared one seed
+// before, which correlated pt-nee's camera paths with bdpt's and hid it.)
 TEST(Estimators, AgreeOnACoatedSphere) {
   const std::array<const char*, 3> renderers = {"pt-nee", "lt", "bdpt"};
   std::uint64_t seed = test::stat_seed_from(7);
   std::vector<test::Comparison> comparisons;
+  int sparse = 0;
   const char* coats[] = {
       R"({"type": "coateddiffuse", "reflectance": [0.7, 0.5, 0.3]})",
       R"({"type": "coateddiffuse", "reflectance": [0.7, 0.5, 0.3], "roughness": 0.3, "albedo": [0.8, 0.8, 0.8], "thickness": 0.2, "g": 0.3})",
@@ -1203,17 +1212,24 @@ TEST(Estimators, AgreeOnACoatedSphere) {
                  {"type": "quad", "corner": [-5, 0, -5], "edge1": [10, 0, 0], "edge2": [0, 0, 10], "material": "floor"},
                  {"type": "sphere", "center": [1.2, 3, -0.5], "radius": 0.4, "material": "lamp", "emission": [8, 8, 8]}],
       "lights": []})";
-    std::vector<Estimate> e;
+    std::vector<HistogramReport> reports;  // each the class's paths alone, its total the class's
     for (const char* renderer : renderers) {
       Rendered r = render_scene(load_scene_json(scene, ".", "test"), renderer, {"L.*DDSE"}, 1024, 0, seed++, {}, 64);
       EXPECT_EQ(r.report.nonfinite_samples, 0u) << renderer;
-      e.push_back(r.report.classes[0].estimate);
+      HistogramReport c = r.report;
+      std::erase_if(c.paths, [](const PathEstimate& p) { return !p.path.ends_with("DDSE"); });
+      c.total = r.report.classes[0].estimate;
+      EXPECT_GT(c.total.luminance, 0.0) << renderer;
+      reports.push_back(std::move(c));
     }
-    for (std::size_t i = 0; i < e.size(); ++i)
-      for (std::size_t j = i + 1; j < e.size(); ++j)
-        comparisons.push_back(
-            test::compare(std::string(coat) + ", " + renderers[i] + " against " + renderers[j], e[i], e[j]));
+    for (std::size_t i = 0; i < reports.size(); ++i)
+      for (std::size_t j = i + 1; j < reports.size(); ++j)
+        sparse += test::compare_paths(reports[i], reports[j], 0.005,
+                                      std::string(coat) + ", " + renderers[i] + " against " + renderers[j], &comparisons);
   }
+  // At the fixed seed 14 compared and 7 sparse (the smooth coat's caustic, and lt's deepest
+  // paths); every pair compares the two largest paths, LDDDDSE and LDDDDDSE (95 % of the class).
+  EXPECT_GE(comparisons.size(), 12u) << sparse << " sparse";
   for (const std::string& failure : test::family_failures(comparisons)) ADD_FAILURE() << failure;
 }
 
