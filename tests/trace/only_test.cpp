@@ -22,6 +22,7 @@
 #include "scene/scene.h"
 #include "scene/universe.h"
 #include "trace/render.h"
+#include "support/compare_estimates.h"
 #include "support/stat_seed.h"
 
 namespace pathex {
@@ -154,14 +155,11 @@ TEST(Pruning, APrunedStrategyNeverContributes) {
   EXPECT_GE(pruned_seen, 10);  // the assertion above ran on many pruned profiles
 }
 
-struct ClassValue {
-  double luminance = 0, std_error = 0;
-};
-
-// The luminance of class `expr` in a render of `scene` by `renderer`: the full profile with every
-// path recorded, or (only) the pruned profile recording only that class.
-ClassValue render_class(const Scene& scene, const std::string& renderer, const std::string& expr, bool only,
-                        std::uint64_t seed, std::uint64_t spp, int max_bounces) {
+// The paths of class `expr` in a render of `scene` by `renderer` — the full profile with every
+// path recorded, or (only) the pruned profile recording only that class — as a report whose
+// `paths` are the class's and whose `total` is the class's estimate.
+HistogramReport render_class(const Scene& scene, const std::string& renderer, const std::string& expr, bool only,
+                             std::uint64_t seed, std::uint64_t spp, int max_bounces) {
   const std::vector<const PathClass*> classes = classes_for(scene, {expr});
   const Classifier cl = Classifier::build(classes, Limits{}).expect("a classifier");
   RenderOptions o;
@@ -173,12 +171,28 @@ ClassValue render_class(const Scene& scene, const std::string& renderer, const s
   const RenderOutput out = (only ? render(scene, plan_render(scene, full, max_bounces, classes, Limits{}).expect("a plan"), &cl, o)
                                  : render(scene, full, &cl, o))
                                .expect("a render");
-  const HistogramReport rep = make_report(out.histogram, RunInfo{}, &cl, {{expr, expr}}).expect("a report");
-  return {rep.classes.at(0).estimate.luminance, rep.classes.at(0).estimate.std_error};
+  HistogramReport rep = make_report(out.histogram, RunInfo{}, &cl, {{expr, expr}}).expect("a report");
+  std::erase_if(rep.paths, [&](const PathEstimate& p) { return !classes[0]->dfa.accepts(p.path); });
+  rep.total = rep.classes.at(0).estimate;
+  return rep;
 }
 
 // An --only render of one class agrees with the class taken from a full render (independent
-// seeds; batch-means standard errors; a family-wise false-failure rate of 0.1 % over the cases).
+// seeds), path by path by the shared comparison rule (tests/support/compare_estimates.h: every
+// path of the class above 0.5 % of it, 0.1 % together), so that a path the pruned profile lost
+// shows by name.
+//
+// Per path, and at 21 x 21: issue 36's sweep failed 5 of 100 seeds when the classes were compared
+// as one number each at 16 x 16, all a stderr far below the spread over seeds (cornell.json's
+// $direct, bdpt: 0.08965 ± 0.00032 against 0.09298 ± 0.00012 at seed 17, where seeds 1-4 read
+// ± 0.0017-0.0020; mirror-ortho.json's one path LSDDSDE, ± 0.000024-0.000133 over four seeds).
+// At a width of 16 the 16 pixel groups (pixel p's group is p mod 16) are the image's columns, so
+// the variance of an edge that runs down a few columns (the lamp's, the mirror's) falls in one or
+// two groups and the stderr has one or two effective degrees of freedom, not 16. At 21 x 21 a
+// group is x + 5y mod 16, which spreads every row and column over all groups; the lamp seen
+// directly, a few pixels, is then a path of its own with its own few degrees of freedom. (At
+// 256 x 256, cornell.json's total under pt-nee: the stderr's spread over 40 seeds implies 15
+// degrees of freedom, 21 at 255 x 255: an edge is one column of many there.)
 TEST(Only, AgreesWithTheClassOfAFullRender) {
   struct Case {
     std::string scene, renderer, expr;
@@ -198,16 +212,19 @@ TEST(Only, AgreesWithTheClassOfAFullRender) {
       {"spotmeter-caustic.json", "bdpt", "L.*E"}, {"sun-window.json", "pt-nee+distant", "$direct"},
       {"sun-window.json", "bdpt", "L.{7,}E"},
   };
+  std::vector<test::Comparison> comparisons;
+  int sparse = 0;
   for (const Case& c : cases) {
-    const Scene scene = scene_at(c.scene, 16);
-    const ClassValue full = render_class(scene, c.renderer, c.expr, false, test::stat_seed(11), 32, 10);
-    const ClassValue only = render_class(scene, c.renderer, c.expr, true, test::stat_seed(11) + 1, 32, 10);
-    const double sigma = std::sqrt(full.std_error * full.std_error + only.std_error * only.std_error);
-    EXPECT_GT(full.luminance, 0.0) << c.scene << " " << c.expr;
-    EXPECT_LE(std::fabs(full.luminance - only.luminance), test::family_sigmas(static_cast<int>(cases.size())) * sigma + 1e-12)
-        << c.scene << " " << c.renderer << " " << c.expr << ": full " << full.luminance << " ± " << full.std_error
-        << ", only " << only.luminance << " ± " << only.std_error;
+    const Scene scene = scene_at(c.scene, 21);
+    const std::string what = c.scene + " " + c.renderer + " " + c.expr;
+    const HistogramReport full = render_class(scene, c.renderer, c.expr, false, test::stat_seed(11), 32, 10);
+    const HistogramReport only = render_class(scene, c.renderer, c.expr, true, test::stat_seed(11) + 1, 32, 10);
+    EXPECT_GT(full.total.luminance, 0.0) << what;
+    EXPECT_GT(only.total.luminance, 0.0) << what;
+    sparse += test::compare_paths(full, only, 0.005, what + ": full against only", &comparisons);
   }
+  EXPECT_GE(comparisons.size(), cases.size()) << sparse << " sparse";
+  for (const std::string& failure : test::family_failures(comparisons)) ADD_FAILURE() << failure;
 }
 
 Dfa union_of(const std::vector<const PathClass*>& classes) {
