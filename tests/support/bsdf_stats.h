@@ -220,6 +220,40 @@ inline Estimate albedo_by_uniform_eval(const Material& m, const glm::vec3& wo, c
   return acc.estimate();
 }
 
+// ∫ eval · |cos| over the sphere with one uniformly jittered direction in each of `samples` equal
+// cells (equal-area in cos θ × φ, about n), independent of sample() as the uniform estimate above.
+// A narrow lobe (rough glass of alpha 0.1) covers a fixed number of cells here, where uniform
+// directions hit it a Poisson number of times: their mean is skewed low with a standard error
+// that shrinks with it (MaterialsAlbedo read 4.8 σ at one seed in 48, its deviates' mean 0.57 on
+// that lobe). The variance comes from pairs of neighbouring cells, Σ (f_a − f_b)² / N²: it
+// over-states the variance by the pairs' differences in mean, never under-states it.
+inline Estimate albedo_by_stratified_eval(const Material& m, const glm::vec3& wo, const glm::vec3& n,
+                                          std::uint64_t seed, int samples) {
+  const Frame frame = Frame::from_normal(n);
+  const int rings = std::max(1, static_cast<int>(std::sqrt(samples / 2.5)));
+  const int cells = std::max(2, samples / rings / 2 * 2);  // per ring, even: the pairs
+  double sum = 0.0, pairs = 0.0;
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < cells; j += 2) {
+      double f[2];
+      for (int k = 0; k < 2; ++k) {
+        Sampler s(seed, 3, static_cast<std::uint64_t>(i) * static_cast<std::uint64_t>(cells) + static_cast<std::uint64_t>(j + k));
+        const glm::vec2 v = s.get2d();
+        const double u = -1.0 + 2.0 * (i + static_cast<double>(v.x)) / rings;
+        const double phi = 2.0 * kPiD * (j + k + static_cast<double>(v.y)) / cells;
+        const double r = std::sqrt(std::max(0.0, 1.0 - u * u));
+        const glm::vec3 wi = frame.to_world(glm::vec3(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                                                      static_cast<float>(u)));
+        f[k] = bsdf::eval(m, wo, wi, n).x * std::abs(glm::dot(wi, n)) * 4.0 * kPiD;
+      }
+      sum += f[0] + f[1];
+      pairs += (f[0] - f[1]) * (f[0] - f[1]);
+    }
+  }
+  const double count = static_cast<double>(rings) * cells;
+  return {sum / count, std::sqrt(pairs) / count};
+}
+
 // An estimate within `sigmas` of its standard errors (plus `slack`, float rounding) of the value
 // it estimates.
 inline void expect_mean(const Estimate& e, double expected, double sigmas, const std::string& what, double slack = 0.0) {

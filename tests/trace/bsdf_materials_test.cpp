@@ -186,7 +186,7 @@ TEST(MaterialsAlbedo, SamplingAgreesWithUniformEvaluationAndNeverExceedsOne) {
   for (const Case& c : cases) {
     for (const glm::vec3& wo : wos) {
       const Estimate by_sampling = albedo_by_sampling(c.material, wo, kUp, seed++, 200'000);
-      const Estimate by_eval = albedo_by_uniform_eval(c.material, wo, kUp, seed++, 400'000);
+      const Estimate by_eval = albedo_by_stratified_eval(c.material, wo, kUp, seed++, 400'000);
       expect_agree(by_sampling, by_eval, (c.name + " wo.z " + std::to_string(wo.z)).c_str(), k);
       // Radiance transport scales refracted radiance by 1/η'², which may exceed 1; importance
       // transport does not, and conserves energy.
