@@ -10,6 +10,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -88,9 +89,13 @@ struct RenderSensor {
   // Pixel coordinates of a raster position in [0,1)² (the product may round up to the width).
   void to_pixels(glm::vec2 raster, float* rx, float* ry) const {
     const float w = static_cast<float>(width), h = static_cast<float>(height);
-    *rx = std::min(raster.x * w, std::nextafter(w, 0.0f));
-    *ry = std::min(raster.y * h, std::nextafter(h, 0.0f));
+    *rx = std::min(raster.x * w, below(w));
+    *ry = std::min(raster.y * h, below(h));
   }
+  // std::nextafter(x, 0) for a finite x >= 1 (a pixel count): the float one step towards zero is
+  // the one whose bits are one less. On the bits, not libm's call: every splat takes two (bdpt
+  // made 1.6 M such calls at 4 spp on Tungsten's box, ~1 % of its instructions).
+  static float below(float x) { return std::bit_cast<float>(std::bit_cast<std::uint32_t>(x) - 1u); }
   // The eye subpath's first ray through pixel (px, py), from the sample's numbers at rng's
   // dimension (film, then lens), and its origin's normal as the sensor vertex keeps it (none for
   // a point).

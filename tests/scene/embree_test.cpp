@@ -639,3 +639,12 @@ TEST(Embree, AwayIsNextafterTowardsTheSignOfDir) {
         EXPECT_TRUE(same_bits(r.z, expected(x, -dx))) << x << " towards " << -dx << ": " << r.z;
       }
 }
+
+// RenderSensor::below() (to_pixels()' bound on the bits) is std::nextafter(x, 0) for every pixel
+// count a sensor can have, up to and past 2^24, where floats stop being every integer.
+TEST(Embree, SensorBelowIsNextafterTowardsZero) {
+  for (std::uint32_t n = 1; n <= (1u << 25); n = n < 4096 ? n + 1 : n * 3 / 2 + 1) {
+    const float x = static_cast<float>(n);
+    EXPECT_EQ(pathex::RenderSensor::below(x), std::nextafter(x, 0.0f)) << n;
+  }
+}
