@@ -25,10 +25,22 @@ Printed per spp and variant: median CPU s (process, render), M samples per CPU-s
 mean MSE (whole, off), the efficiency 1 / (mean MSE x median CPU s) whole and off, and off /
 Tungsten's with the process's CPU and with the render's. Pin the whole run
 to one CPU (taskset -c 1): the variants of a round run back to back, in an order that rotates.
+
+The rate in the table above moves with the machine's state (issue 39: the same pathex read 2.20x
+and 1.95x against it on two machines of the kind). --tungsten BIN runs Tungsten itself in every
+round too, beside the variants on the same CPU (its own scene at 256 x 256, --spp, one thread, the
+round's seed), and adds its rate in this run and pathex's off-lamp ratio against Tungsten's fixed
+MSE at that rate ("same run"): only the speed is measured again, the MSE a sample is Tungsten's
+algorithm's. Tungsten is built from its source, never committed here (bench/README.md, "Tungsten
+beside pathex"):
+
+    taskset -c 1 python3 bench/tungsten.py ... --tungsten TUNGSTEN/build/tungsten \
+        --tungsten-scene TUNGSTEN/data/example-scenes/cornell-box/scene.json
 """
 import argparse
 import json
 import os
+import re
 import shlex
 import statistics
 import sys
@@ -37,6 +49,7 @@ from types import SimpleNamespace
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from cli_ab import cpu_run  # noqa: E402
+import subprocess  # noqa: E402
 from efficiency import errors, reference, scene_args  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -49,6 +62,32 @@ TUNGSTEN = {16: (7.546e-5, 2.33e6), 64: (1.901e-5, 2.40e6)}
 def tungsten_efficiency(spp):
     mse, rate = TUNGSTEN[spp]
     return 1.0 / (mse * PIXELS * spp / rate)
+
+
+def tungsten_scene(source, work):
+    """Tungsten's Cornell box as issue 39 measured it: 256 x 256, its output in the work folder."""
+    with open(source) as f:
+        scene = json.load(f)
+    scene["camera"]["resolution"] = [256, 256]
+    scene["renderer"].update(output_file=os.path.join(work, "tungsten.png"), overwrite_output_files=True,
+                             enable_resume_render=False, checkpoint_interval="0", timeout="0")
+    path = os.path.join(work, "tungsten-scene.json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    return path
+
+
+def run_tungsten(binary, scene, spp, seed):
+    """(process CPU s, render s as Tungsten prints it: one worker thread, so its render's CPU)."""
+    proc = subprocess.Popen([binary, "-t", "1", "--spp", str(spp), "--seed", str(seed), scene],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    out = proc.stdout.read().decode()
+    _, status, usage = os.wait4(proc.pid, 0)
+    proc.stdout.close()
+    m = re.search(r"Render time ([0-9.eE+-]+)s", out)
+    if os.waitstatus_to_exitcode(status) != 0 or not m:
+        sys.exit(f"{binary} {scene}: failed or printed no render time:\n{out}")
+    return usage.ru_utime + usage.ru_stime, float(m.group(1))
 
 
 def main():
@@ -65,7 +104,12 @@ def main():
     ap.add_argument("--ref-threads", type=int, default=1)
     ap.add_argument("--image-error", default=os.path.join(HERE, "..", "build", "bench", "image_error"))
     ap.add_argument("--cache", default=os.path.expanduser("~/.cache/pathex-efficiency"))
+    ap.add_argument("--tungsten", default=None, help="Tungsten's binary: run it in every round too (see above)")
+    ap.add_argument("--tungsten-scene", default=None,
+                    help="Tungsten's data/example-scenes/cornell-box/scene.json (with --tungsten)")
     args = ap.parse_args()
+    if args.tungsten and not args.tungsten_scene:
+        ap.error("--tungsten needs --tungsten-scene (Tungsten's data/example-scenes/cornell-box/scene.json)")
     variants = [(label, args.pathex, shlex.split(extra)) for label, _, extra in (v.partition(":") for v in args.variant)]
     if not variants:
         variants = [("pathex", args.pathex, [])]
@@ -74,9 +118,13 @@ def main():
                                cache=args.cache, ref=args.ref or args.pathex, ref_threads=args.ref_threads)
     with tempfile.TemporaryDirectory(prefix="pathex-tungsten-") as work:
         halves = reference(ref_args, SCENE, work)
+        t_scene = tungsten_scene(args.tungsten_scene, work) if args.tungsten else None
         for spp in (int(s) for s in args.spp.split(",")):
             runs = {label: [] for label, _, _ in variants}  # per round: (cpu, render cpu, mse, mse_off)
+            t_runs = []  # per round: Tungsten's (process CPU, render s)
             for r in range(args.rounds):
+                if t_scene and r % 2 == 0:  # before the variants in even rounds, after them in odd ones
+                    t_runs.append(run_tungsten(args.tungsten, t_scene, spp, 1 + r))
                 order = variants[r % len(variants):] + variants[:r % len(variants)]
                 files, cpus = {}, {}
                 for label, binary, extra in order:
@@ -89,6 +137,8 @@ def main():
                     with open(os.path.join(out, "run.json")) as f:
                         cpus[label] = (cpus[label], json.load(f)["cpu_s"])
                     files[label] = os.path.join(out, "classes.exr")
+                if t_scene and r % 2 == 1:
+                    t_runs.append(run_tungsten(args.tungsten, t_scene, spp, 1 + r))
                 noise, errs = errors(args.image_error, halves, list(files.values()), 2, lamp_luminance=5)
                 for label in files:
                     runs[label].append(cpus[label] + errs[files[label]])
@@ -110,6 +160,19 @@ def main():
                 vs_render = f"{1.0 / (mse_off * render) / tungsten_efficiency(spp):.2f}x" if t else "-"
                 print(f"  {label:<16}{cpu:>7.3f}{render:>8.3f}{PIXELS * spp / cpu / 1e6:>9.3f}{mse:>12.4g}"
                       f"{mse_off:>12.4g}{1.0 / (mse * cpu):>12.4g}{eff_off:>12.4g}{vs:>16}{vs_render:>13}", flush=True)
+            if t_runs and t:
+                t_cpu = statistics.median(x[0] for x in t_runs)
+                t_render = statistics.median(x[1] for x in t_runs)
+                print(f"  Tungsten in this run: CPU s {t_cpu:.3f} (render {t_render:.3f}), "
+                      f"{PIXELS * spp / t_cpu / 1e6:.3f} M samples/CPU s ({PIXELS * spp / t_render / 1e6:.3f} its render)"
+                      f" against the fixed {t[1] / 1e6:.2f}; off / Tungsten at its MSE {t[0]:.4g} and this run's speed:")
+                for label, _, _ in variants:
+                    rs = runs[label]
+                    cpu = statistics.median(x[0] for x in rs)
+                    render = statistics.median(x[1] for x in rs)
+                    mse_off = statistics.fmean(x[3] for x in rs)
+                    print(f"    {label:<16} process / process {t[0] * t_cpu / (mse_off * cpu):.2f}x, "
+                          f"render / render {t[0] * t_render / (mse_off * render):.2f}x", flush=True)
 
 
 if __name__ == "__main__":
