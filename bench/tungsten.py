@@ -84,10 +84,20 @@ def run_tungsten(binary, scene, spp, seed):
     out = proc.stdout.read().decode()
     _, status, usage = os.wait4(proc.pid, 0)
     proc.stdout.close()
-    m = re.search(r"Render time ([0-9.eE+-]+)s", out)
+    m = re.search(r"Render time (.*)", out)
     if os.waitstatus_to_exitcode(status) != 0 or not m:
         sys.exit(f"{binary} {scene}: failed or printed no render time:\n{out}")
-    return usage.ru_utime + usage.ru_stime, float(m.group(1))
+    return usage.ru_utime + usage.ru_stime, tungsten_duration(m.group(1))
+
+
+def tungsten_duration(text):
+    """Seconds from Tungsten's StringUtils::durationToString: "0.41s" under a second, else
+    "[Nd ][Nh ][Nm ]Ns Nms" (tungsten_duration("1s 628ms") == 1.628)."""
+    units = {"d": 86400.0, "h": 3600.0, "m": 60.0, "s": 1.0, "ms": 1e-3}
+    parts = re.findall(r"([0-9.eE+-]+)(ms|d|h|m|s)\b", text)
+    if not parts:
+        sys.exit(f"Tungsten's render time {text!r}: not a duration")
+    return sum(float(n) * units[u] for n, u in parts)
 
 
 def main():
