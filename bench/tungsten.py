@@ -64,6 +64,12 @@ def tungsten_efficiency(spp):
     return 1.0 / (mse * PIXELS * spp / rate)
 
 
+def summary(rounds):
+    """A variant's rounds (cpu, render cpu, mse, mse_off) as median CPU s, median render CPU s, mean MSE, mean MSE off."""
+    return (statistics.median(x[0] for x in rounds), statistics.median(x[1] for x in rounds),
+            statistics.fmean(x[2] for x in rounds), statistics.fmean(x[3] for x in rounds))
+
+
 def tungsten_scene(source, work):
     """Tungsten's Cornell box as issue 39 measured it: 256 x 256, its output in the work folder."""
     with open(source) as f:
@@ -160,11 +166,7 @@ def main():
             print(f"  {'variant':<16}{'CPU s':>7}{'render':>8}{'M smp/s':>9}{'MSE whole':>12}{'MSE off':>12}"
                   f"{'eff whole':>12}{'eff off':>12}{'off / Tungsten':>16}{'render / T.':>13}")
             for label, _, _ in variants:
-                rs = runs[label]
-                cpu = statistics.median(x[0] for x in rs)
-                render = statistics.median(x[1] for x in rs)
-                mse = statistics.fmean(x[2] for x in rs)
-                mse_off = statistics.fmean(x[3] for x in rs)
+                cpu, render, mse, mse_off = summary(runs[label])
                 eff_off = 1.0 / (mse_off * cpu)
                 vs = f"{eff_off / tungsten_efficiency(spp):.2f}x" if t else "-"
                 vs_render = f"{1.0 / (mse_off * render) / tungsten_efficiency(spp):.2f}x" if t else "-"
@@ -177,10 +179,7 @@ def main():
                       f"{PIXELS * spp / t_cpu / 1e6:.3f} M samples/CPU s ({PIXELS * spp / t_render / 1e6:.3f} its render)"
                       f" against the fixed {t[1] / 1e6:.2f}; off / Tungsten at its MSE {t[0]:.4g} and this run's speed:")
                 for label, _, _ in variants:
-                    rs = runs[label]
-                    cpu = statistics.median(x[0] for x in rs)
-                    render = statistics.median(x[1] for x in rs)
-                    mse_off = statistics.fmean(x[3] for x in rs)
+                    cpu, render, _, mse_off = summary(runs[label])
                     print(f"    {label:<16} process / process {t[0] * t_cpu / (mse_off * cpu):.2f}x, "
                           f"render / render {t[0] * t_render / (mse_off * render):.2f}x", flush=True)
 
