@@ -31,8 +31,8 @@ and 1.95x against it on two machines of the kind). --tungsten BIN runs Tungsten 
 round too, beside the variants on the same CPU (its own scene at 256 x 256, --spp, one thread, the
 round's seed), and adds its rate in this run and pathex's off-lamp ratio against Tungsten's fixed
 MSE at that rate ("same run"): only the speed is measured again, the MSE a sample is Tungsten's
-algorithm's. Tungsten is built from its source, never committed here (bench/README.md, "Tungsten
-beside pathex"):
+algorithm's. Tungsten is built from its source, never committed here (bench/README.md, "Issue 39,
+seventeenth session: Tungsten beside pathex in the same run"):
 
     taskset -c 1 python3 bench/tungsten.py ... --tungsten TUNGSTEN/build/tungsten \
         --tungsten-scene TUNGSTEN/data/example-scenes/cornell-box/scene.json
@@ -43,13 +43,13 @@ import os
 import re
 import shlex
 import statistics
+import subprocess
 import sys
 import tempfile
 from types import SimpleNamespace
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from cli_ab import cpu_run  # noqa: E402
-import subprocess  # noqa: E402
 from efficiency import errors, reference, scene_args  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
