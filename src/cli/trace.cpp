@@ -228,6 +228,11 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--rr-light-threshold", args->options.job.rr_light_threshold,
                   "The same for light subpaths (lt, bdpt)")
       ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
+  sub->add_option("--rr-join-threshold", args->options.job.rr_join_threshold,
+                  "bdpt: an eye vertex whose throughput (as for --rr-threshold) is below this makes its joins with the light "
+                  "subpath's vertices with probability throughput / threshold, weighted by its inverse; 0: always (the default; "
+                  "docs/efficiency.md has where 1 gains and where it loses)")
+      ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
   sub->add_option("--splits", args->options.job.splits,
                   "Runs of each sample after its camera ray and first hit, each weighted 1/N: more paths of indirect light "
                   "per camera ray; auto: camera rays and runs per pixel from a pilot's variances (issue 39, docs/efficiency.md); "
@@ -275,7 +280,7 @@ Command add_trace(CLI::App& app) {
   return {sub, [args, sub] {
             for (const char* o : {"SCENE", "--renderer", "--spp", "--classes", "--only", "--seed", "--max-bounces", "--out", "--no-images", "--shard",
                                   "--resolution", "--max-paths", "--sampler", "--light-sampling", "--batches", "--replicates", "--rr-depth", "--rr-threshold",
-                                  "--rr-light-threshold", "--splits"})
+                                  "--rr-light-threshold", "--rr-join-threshold", "--splits"})
               if (sub->count(o) > 0) args->options.job.settings_given.push_back(o);
             for (const std::string& o : manifold_option_names())
               if (sub->count(o) > 0) args->options.job.settings_given.push_back(o);

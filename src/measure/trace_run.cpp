@@ -98,6 +98,7 @@ Result<TraceResult> run_trace(const TraceOptions& a, const TraceHooks& hooks) {
   ro.rr_depth = id.rr_depth;
   ro.rr_threshold = static_cast<float>(id.rr_threshold);
   ro.rr_light_threshold = static_cast<float>(id.rr_light_threshold);
+  ro.rr_join_threshold = static_cast<float>(id.rr_join_threshold);
   ro.splits = id.splits;
   ro.manifold = id.manifold.value_or(ManifoldOptions{});
   ro.batches = id.batches;

@@ -354,6 +354,8 @@ std::string trace_command(const RenderIdentity& id, std::uint64_t spp) {
   if (id.rr_threshold != defaults.rr_threshold) cmd += " --rr-threshold " + nlohmann::json(id.rr_threshold).dump();
   if (id.rr_light_threshold != defaults.rr_light_threshold)
     cmd += " --rr-light-threshold " + nlohmann::json(id.rr_light_threshold).dump();
+  if (id.rr_join_threshold != defaults.rr_join_threshold)
+    cmd += " --rr-join-threshold " + nlohmann::json(id.rr_join_threshold).dump();
   // Always: its default depends on the profile (resolved_splits()), and the header records it resolved.
   cmd += " --splits " + (id.splits == 0 ? std::string("auto") : std::to_string(id.splits));
   if (id.max_paths != defaults.max_paths) cmd += " --max-paths " + std::to_string(id.max_paths);

@@ -327,7 +327,8 @@ json identity_json(const RenderIdentity& id) {
   j["ends"] = {{"lights", id.lights}, {"sensor", id.sensor}};
   j["seed"] = id.seed;
   j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"light_sampling", id.light_sampling}, {"rr_depth", id.rr_depth},
-                  {"rr_threshold", id.rr_threshold}, {"rr_light_threshold", id.rr_light_threshold}, {"splits", id.splits}, {"batches", id.batches},
+                  {"rr_threshold", id.rr_threshold}, {"rr_light_threshold", id.rr_light_threshold},
+                  {"rr_join_threshold", id.rr_join_threshold}, {"splits", id.splits}, {"batches", id.batches},
                   {"replicates", id.replicates}, {"width", id.width},           {"height", id.height},     {"images", id.images},
                   {"max_paths", id.max_paths}};
   if (const std::optional<ManifoldOptions>& m = id.manifold) {
@@ -455,8 +456,8 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
   id.seed = rd.uint(j, "", "seed");
   h.spp = rd.uint(j, "", "spp");
   const nlohmann::json& o = j.at("options");
-  if (rd.object(o, "/options", {"max_bounces", "sampler", "light_sampling", "rr_depth", "rr_threshold", "rr_light_threshold", "splits", "batches", "replicates",
-                                "width", "height", "images", "max_paths", "manifold"})) {
+  if (rd.object(o, "/options", {"max_bounces", "sampler", "light_sampling", "rr_depth", "rr_threshold", "rr_light_threshold", "rr_join_threshold", "splits", "batches",
+                                "replicates", "width", "height", "images", "max_paths", "manifold"})) {
     id.max_bounces = rd.small(o, "/options", "max_bounces");
     id.sampler = rd.str(o, "/options", "sampler");
     // Before issue 39's solid-angle sampling (eighth session) every light was sampled by area.
@@ -465,6 +466,8 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
     id.rr_threshold = rd.number(o, "/options", "rr_threshold");
     // Before issue 39 one threshold served both subpaths.
     id.rr_light_threshold = o.contains("rr_light_threshold") ? rd.number(o, "/options", "rr_light_threshold") : id.rr_threshold;
+    // Before issue 39's join roulette every eye vertex made all its joins.
+    id.rr_join_threshold = o.contains("rr_join_threshold") ? rd.number(o, "/options", "rr_join_threshold") : 0.0;
     // Before issue 39's splitting (tenth session) no sample was split.
     id.splits = o.contains("splits") ? rd.small(o, "/options", "splits") : 1;
     id.batches = rd.small(o, "/options", "batches");
@@ -562,6 +565,8 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
     return differ("another rr_threshold", std::to_string(a.rr_threshold), std::to_string(b.rr_threshold));
   if (a.rr_light_threshold != b.rr_light_threshold)
     return differ("another rr_light_threshold", std::to_string(a.rr_light_threshold), std::to_string(b.rr_light_threshold));
+  if (a.rr_join_threshold != b.rr_join_threshold)
+    return differ("another rr_join_threshold", std::to_string(a.rr_join_threshold), std::to_string(b.rr_join_threshold));
   if (auto d = option("splits", a.splits, b.splits)) return d;
   if (auto d = option("batch count", a.batches, b.batches)) return d;
   if (auto d = option("replicate count", a.replicates, b.replicates)) return d;

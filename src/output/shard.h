@@ -32,7 +32,8 @@
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
 // {max_bounces, sampler, light_sampling (absent in files written before issue 39's solid-angle
 // sampling: then "area"), rr_depth, rr_threshold, rr_light_threshold (absent in files written before
-// issue 39: then rr_threshold's), splits (resolved, the profile's default too: 0 is --splits auto;
+// issue 39: then rr_threshold's), rr_join_threshold (absent in files written before issue 39's
+// join roulette: then 0, none), splits (resolved, the profile's default too: 0 is --splits auto;
 // absent in files written before issue 39's splitting: then 1), batches, replicates (absent in files
 // written before issue 39's pixel groups: then batches, plain batch means), width, height, images, max_paths, manifold (null, or the
 // manifold connector's limits {max_iterations, threshold, min_segment, singular, max_trials, seeds,
@@ -128,6 +129,7 @@ struct RenderIdentity {
   int rr_depth = 3;
   double rr_threshold = RenderOptions{}.rr_threshold;  // RenderOptions::rr_threshold (a float, exact as a double)
   double rr_light_threshold = RenderOptions{}.rr_light_threshold;  // RenderOptions::rr_light_threshold
+  double rr_join_threshold = RenderOptions{}.rr_join_threshold;  // RenderOptions::rr_join_threshold
   int splits = 1;  // RenderOptions::splits, resolved (resolved_splits()); 1 in files written before issue 39's
   int batches = kDefaultBatches;
   int replicates = kDefaultReplicates;  // per pixel; dividing batches (stats/histogram.h, "Batches")

@@ -70,6 +70,7 @@ Result<bool> load_fresh(const TraceJobOptions& a, TraceJob* job) {
   id.rr_depth = a.rr_depth;
   id.rr_threshold = a.rr_threshold;
   id.rr_light_threshold = a.rr_light_threshold;
+  id.rr_join_threshold = a.rr_join_threshold;
   id.splits = resolved_splits(*profile, a.splits);  // recorded resolved, as the manifold's limits below
   id.batches = a.batches;
   // Resolved here, from the resolution the render will have, so that every shard records the same R.

@@ -39,6 +39,7 @@ struct TraceJobOptions {
   int rr_depth = RenderOptions{}.rr_depth;
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
+  float rr_join_threshold = RenderOptions{}.rr_join_threshold;
   std::optional<int> splits;  // runs per camera ray (--splits; 0: auto); unset: the profile's (resolved_splits())
   int batches = RenderOptions{}.batches;  // the standard error's batches and replicates per pixel
   int replicates = RenderOptions{}.replicates;  // 0: default_replicates(batches, the sensor's pixels)

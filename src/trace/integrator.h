@@ -226,7 +226,7 @@ class Integrator {
   static constexpr std::size_t kMaxRuns = 2 * kMaxVertices;  // the most joins of one kind per sample
   // --- joins (trace/joins/): each makes th.join from the two subpaths, or returns false ---
   // Random numbers: each join draws from a block of its own, per kind and subpath length (render.cpp).
-  enum class JoinBlock : std::uint64_t { kEmitter, kLens, kSplat, kNee, kShadow, kDistant, kOrtho, kMirrorLight, kMirrorEye, kManifoldLight, kManifoldEye };
+  enum class JoinBlock : std::uint64_t { kEmitter, kLens, kSplat, kNee, kShadow, kDistant, kOrtho, kMirrorLight, kMirrorEye, kManifoldLight, kManifoldEye, kJoinRoulette };
   static constexpr std::uint64_t kJoinDims = 2048;  // after the eye's and the light subpath's blocks
   static constexpr std::uint64_t kDimsPerJoin = 4;
   static void join_numbers(Sampler& rng, JoinBlock block, int index) {
@@ -241,6 +241,9 @@ class Integrator {
   // to the aperture point on the line through it against the light (kDistantProjection).
   bool join_light(Thread& th, Sampler& rng, int t, ConnectorKind kind) const;
   bool join_shadow(Thread& th, int s, int t) const;  // (s, DD, t), s, t >= 2: a shadow ray between y(s-1) and z(t-1)
+  // Whether eye vertex z = z(t-1) makes its joins with the light subpath (s >= 2): 1 / q with
+  // probability q = min(1, z.rr_throughput / --rr-join-threshold), the weight they then carry, else 0.
+  float join_roulette(Sampler& rng, const Vertex& z, int t) const;
   // The scattering function at a join's end vertex v towards unit w (leaving v along the join): a
   // light vertex's directional emission (its beta holds the spatial part), else its BSDF, with the
   // shading-normal correction at the light end (mode kImportance); the BSDF's densities for free

@@ -98,6 +98,7 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
       beta *= beer_lambert(v.sigma, std::sqrt(v.d2_wo));
     }
     v.beta = beta;
+    v.rr_throughput = max_component(beta) * eta2 / beta_start;
     // Solid angle at prev to area at v, along the unit ray direction d.
     // 0 for coincident points (and a subnormal distance, whose inverse would overflow): no density.
     const float inv_d2 = v.d2_wo >= std::numeric_limits<float>::min() ? 1.0f / v.d2_wo : 0.0f;
@@ -262,6 +263,15 @@ void Integrator::estimate(Thread& th, int batch) const {
   if (th.shadow.full()) trace_shadows(th);
 }
 
+// 1 / q with probability q = min(1, z's throughput / --rr-join-threshold), else 0: whether eye
+// vertex z = z(t-1) makes its joins with the light subpath (s >= 2), and their weight if it does.
+float Integrator::join_roulette(Sampler& rng, const Vertex& z, int t) const {
+  const float q = o_.rr_join_threshold > 0.0f ? z.rr_throughput / o_.rr_join_threshold : 1.0f;
+  if (!(q < 1.0f)) return 1.0f;
+  join_numbers(rng, JoinBlock::kJoinRoulette, t);
+  return rng.get1d() < q ? 1.0f / q : 0.0f;
+}
+
 void Integrator::trace_shadows(Thread& th) const {
   th.shadow.trace(*rs_.geometry);
   for (int lane = 0; lane < th.shadow.size(); ++lane) {
@@ -326,8 +336,14 @@ void Integrator::sample_run(Thread& th, int px, int py, std::uint64_t pass) cons
     if (s_hi >= 0 && strategy(0, t) >= 0 && wanted(0, t)) made(join_emitter(th, t));
     if (s_hi >= 1 && strategy(1, t) >= 0 && wanted(1, t)) made(join_light(th, rng, t, ConnectorKind::kNone));
     if (s_hi >= 1 && distant_of(t) >= 0) made(join_light(th, rng, t, ConnectorKind::kDistantProjection));
-    for (int s = 2; s <= s_hi; ++s)
-      if (strategy(s, t) >= 0 && wanted(s, t)) made(join_shadow(th, s, t));
+    // z(t-1)'s joins with the light subpath's vertices, by a roulette of their own (--rr-join-threshold).
+    const float inv_q = s_hi >= 2 ? join_roulette(rng, th.eye[static_cast<std::size_t>(t - 1)], t) : 0.0f;
+    if (inv_q > 0.0f)
+      for (int s = 2; s <= s_hi; ++s)
+        if (strategy(s, t) >= 0 && wanted(s, t) && join_shadow(th, s, t)) {
+          th.join.contribution *= inv_q;
+          estimate(th, batch);
+        }
   }
   if (has_connectors_ && nt >= 1)
     for (int s = 1; s <= std::min(ns - (lens_end ? 1 : 0), max_bounces_ + 1); ++s)

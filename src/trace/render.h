@@ -93,6 +93,16 @@ struct RenderOptions {
   int rr_depth = 3;
   float rr_threshold = 0.3f;
   float rr_light_threshold = 1.0f;
+  // --rr-join-threshold: an eye vertex whose throughput r (relative to its subpath's start, as the
+  // roulette above measures it) is below this makes its joins with the light subpath's vertices
+  // (s >= 2: bdpt's shadow-ray joins) with probability r / threshold, each weighted by its
+  // inverse; 0 (the default): always. The eye walk goes on for its own joins (next-event
+  // estimation, emitter hits). Where the light subpath's joins with the eye's first vertices
+  // already reach the deep paths these would, they cost more than they lower the error (at 1:
+  // bdpt on cornell.json 1.13-1.15x, Tungsten's box 1.04x); where the deep eye vertices' joins
+  // carry the light (a closed sphere round a point light) the error grows more than the CPU
+  // falls (0.82x), so it is off by default (issue 39, docs/efficiency.md).
+  float rr_join_threshold = 0.0f;
   // --splits: runs of each sample after its camera ray and first hit, each weighted 1 / splits
   // (trace/accel/first_vertex_split.h; issue 39, docs/efficiency.md). 0 (`--splits auto`): counts
   // per pixel (camera rays, runs after each), from a pilot (trace/accel/split_plan.h), or from

@@ -27,6 +27,7 @@ struct Vertex {
   vec3 err{0.0f};        // bound on p's rounding error (Hit::error): how far a ray leaving p is offset
   vec3 ns{0.0f};         // shading normal
   vec3 beta{1.0f};       // throughput up to and including this vertex
+  float rr_throughput = 1.0f;  // beta's largest channel relative to the subpath's start, as Russian roulette measures it
   vec3 sigma{0.0f};      // σa of the medium the segment that reached this vertex crossed (trace/media.h)
   vec3 wo{0.0f};         // unit direction to the vertex before it on its subpath (zero for the first)
   float d2_wo = 0.0f;    // squared distance to that vertex

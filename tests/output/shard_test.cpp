@@ -351,6 +351,23 @@ TEST(ShardFile, LightRouletteThresholdRoundTripsAndDefaultsToTheEyeThreshold) {
   EXPECT_EQ(old->header.identity.rr_light_threshold, 0.25);
 }
 
+// Issue 39: the join roulette's threshold round-trips, and a shard written before it (no
+// rr_join_threshold) reads as 0, every eye vertex making all its joins, as it was rendered.
+TEST(ShardFile, JoinRouletteThresholdRoundTripsAndDefaultsToNone) {
+  Fixture f;
+  f.header.identity.rr_join_threshold = 2.5;
+  const std::string bytes = encode_shard(f.header, f.sums);
+  Result<ShardFile> file = parse_shard(bytes, "x.shard");
+  ASSERT_TRUE(file) << file.error().render();
+  EXPECT_EQ(file->header.identity.rr_join_threshold, 2.5);
+  nlohmann::ordered_json head = header_of(bytes);
+  ASSERT_TRUE(head["options"].contains("rr_join_threshold"));
+  head["options"].erase("rr_join_threshold");
+  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
+  ASSERT_TRUE(old) << old.error().render();
+  EXPECT_EQ(old->header.identity.rr_join_threshold, 0.0);
+}
+
 // Issue 39: the runs per camera ray (--splits) round-trip, and a shard written before them (no
 // "splits") reads as unsplit, as it was rendered.
 TEST(ShardFile, SplitsRoundTripAndDefaultToOne) {

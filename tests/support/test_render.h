@@ -31,12 +31,14 @@ struct Sampling {
   int rr_depth = RenderOptions{}.rr_depth;
   float rr_threshold = RenderOptions{}.rr_threshold;
   float rr_light_threshold = RenderOptions{}.rr_light_threshold;
+  float rr_join_threshold = RenderOptions{}.rr_join_threshold;
   LightSampling light_sampling = RenderOptions{}.light_sampling;
   std::optional<int> splits{};  // unset: the profile's (resolved_splits())
   std::shared_ptr<const tracer::SplitMap> split_map{};  // with splits 0: these counts instead of the pilot's
   std::string name() const {
     return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
-           std::to_string(rr_threshold) + " rr-light-threshold " + std::to_string(rr_light_threshold) + " light-sampling " +
+           std::to_string(rr_threshold) + " rr-light-threshold " + std::to_string(rr_light_threshold) + " rr-join-threshold " +
+           std::to_string(rr_join_threshold) + " light-sampling " +
            to_string(light_sampling) + " splits " + (!splits ? "default" : *splits != 0 ? std::to_string(*splits) : split_map ? "map" : "auto");
   }
 };
@@ -57,6 +59,7 @@ inline Rendered render_scene(Result<Scene> scene, const std::string& renderer, c
   o.rr_depth = sampling.rr_depth;
   o.rr_threshold = sampling.rr_threshold;
   o.rr_light_threshold = sampling.rr_light_threshold;
+  o.rr_join_threshold = sampling.rr_join_threshold;
   o.light_sampling = sampling.light_sampling;
   o.splits = sampling.splits;
   o.split_map = sampling.split_map;

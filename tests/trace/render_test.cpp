@@ -825,18 +825,25 @@ namespace {
 // less than a tenth), roulette from the second vertex, and none.
 std::vector<Sampling> every_sampling() {
   std::vector<Sampling> out;
-  // The default first; then the eye and light thresholds apart (issue 39) and together.
+  // The default first; then the eye and light thresholds apart (issue 39) and together, and the
+  // roulette of bdpt's joins (issue 39, off by default) at 1 and far above it (every join of an
+  // eye vertex past the first rouletted, most of them skipped).
   const RenderOptions d;
   for (SamplerKind k : {SamplerKind::kIndependent, SamplerKind::kSobol})
-    for (auto [depth, eye, light] : std::vector<std::tuple<int, float, float>>{
-             {d.rr_depth, d.rr_threshold, d.rr_light_threshold}, {3, 0.1f, 0.1f}, {2, 0.5f, 0.5f}, {3, 0.0f, 0.0f}, {3, 1.0f, 0.1f}})
-      out.push_back({k, depth, eye, light});
+    for (auto [depth, eye, light, join] : std::vector<std::tuple<int, float, float, float>>{
+             {d.rr_depth, d.rr_threshold, d.rr_light_threshold, d.rr_join_threshold},
+             {3, 0.1f, 0.1f, 0.0f},
+             {2, 0.5f, 0.5f, 1.0f},
+             {3, 0.0f, 0.0f, 0.0f},
+             {3, 1.0f, 0.1f, 1.0f},
+             {d.rr_depth, d.rr_threshold, d.rr_light_threshold, 8.0f}})
+      out.push_back({k, depth, eye, light, join});
   return out;
 }
 
 // The closed forms of DESIGN §9 per bounce, for every sampler and roulette setting and the three
-// estimators: 2 samplers x 5 roulette settings x 3 renderers x 9 classes = 270 checks, each render
-// with a seed of its own.
+// estimators: 2 samplers x 6 roulette settings x 3 renderers x 9 classes = 324 checks (270 before
+// issue 39's join roulette added the sixth), each render with a seed of its own.
 //
 // Each check is |z| <= kSigmas with z = (estimate - closed form) / sigma, sigma^2 = stderr^2 +
 // (kRoundingFloor closed form)^2: the render's stderr, plus single-precision rounding for the
@@ -894,6 +901,7 @@ TEST(Sampling, EverySamplerAndRouletteSettingMatchesTheClosedForms) {
   ASSERT_EQ(RenderOptions{}.rr_depth, every_sampling()[0].rr_depth);  // the default is the first setting
   ASSERT_EQ(RenderOptions{}.rr_threshold, every_sampling()[0].rr_threshold);
   ASSERT_EQ(RenderOptions{}.rr_light_threshold, every_sampling()[0].rr_light_threshold);
+  ASSERT_EQ(RenderOptions{}.rr_join_threshold, every_sampling()[0].rr_join_threshold);
   expect_closed_forms(every_sampling(), test::stat_seed(7) * 1000);  // 7000, 7001, … one per render
 }
 
