@@ -271,6 +271,13 @@ TEST_F(MergeRefuses, AnotherSeed) {
   expect_refusal(a_ + " " + b_, shard(b_) + " and " + shard(a_) + " are not of one render: another seed (2 against 1)");
 }
 
+// Issue 39: bdpt's join roulette changes the estimates, so shards rendered with two thresholds are two renders.
+TEST_F(MergeRefuses, AnotherJoinRouletteThreshold) {
+  ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/2 --rr-join-threshold 1 --quiet --out " + b_).code, 0);
+  expect_refusal(a_ + " " + b_, shard(b_) + " and " + shard(a_) +
+                                    " are not of one render: another rr_join_threshold (1.000000 against 0.000000)");
+}
+
 TEST_F(MergeRefuses, AnotherProfile) {
   ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/2 --renderer pt-nee --quiet --out " + b_).code, 0);
   const std::string ha = read_header(shard(a_)).json["renderer"]["hash"], hb = read_header(shard(b_)).json["renderer"]["hash"];
