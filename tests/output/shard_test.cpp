@@ -331,6 +331,20 @@ std::string with_header(const std::string& bytes, const std::string& head) {
   return out;
 }
 
+// The identity a shard with f's header reads back as, and as it reads once `option` is taken out
+// of its header's "options" (a file written before that option existed).
+std::pair<RenderIdentity, RenderIdentity> read_back_with_and_without(const Fixture& f, const std::string& option) {
+  const std::string bytes = encode_shard(f.header, f.sums);
+  Result<ShardFile> file = parse_shard(bytes, "x.shard");
+  EXPECT_TRUE(file) << (file ? "" : file.error().render());
+  nlohmann::ordered_json head = header_of(bytes);
+  EXPECT_TRUE(head["options"].contains(option)) << option;
+  head["options"].erase(option);
+  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
+  EXPECT_TRUE(old) << (old ? "" : old.error().render());
+  return {file ? file->header.identity : RenderIdentity{}, old ? old->header.identity : RenderIdentity{}};
+}
+
 // The header goes through the one JSON reader: a wrong value is refused at its JSON pointer.
 // Issue 39: the light subpaths' roulette threshold round-trips, and a shard written before it
 // existed (no rr_light_threshold) reads as one threshold for both subpaths, as it was rendered.
@@ -338,17 +352,10 @@ TEST(ShardFile, LightRouletteThresholdRoundTripsAndDefaultsToTheEyeThreshold) {
   Fixture f;
   f.header.identity.rr_threshold = 0.25;
   f.header.identity.rr_light_threshold = 0.75;
-  const std::string bytes = encode_shard(f.header, f.sums);
-  Result<ShardFile> file = parse_shard(bytes, "x.shard");
-  ASSERT_TRUE(file) << file.error().render();
-  EXPECT_EQ(file->header.identity.rr_threshold, 0.25);
-  EXPECT_EQ(file->header.identity.rr_light_threshold, 0.75);
-  nlohmann::ordered_json head = header_of(bytes);
-  ASSERT_TRUE(head["options"].contains("rr_light_threshold"));
-  head["options"].erase("rr_light_threshold");
-  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
-  ASSERT_TRUE(old) << old.error().render();
-  EXPECT_EQ(old->header.identity.rr_light_threshold, 0.25);
+  const auto [now, before] = read_back_with_and_without(f, "rr_light_threshold");
+  EXPECT_EQ(now.rr_threshold, 0.25);
+  EXPECT_EQ(now.rr_light_threshold, 0.75);
+  EXPECT_EQ(before.rr_light_threshold, 0.25);
 }
 
 // Issue 39: the join roulette's threshold round-trips, and a shard written before it (no
@@ -356,16 +363,9 @@ TEST(ShardFile, LightRouletteThresholdRoundTripsAndDefaultsToTheEyeThreshold) {
 TEST(ShardFile, JoinRouletteThresholdRoundTripsAndDefaultsToNone) {
   Fixture f;
   f.header.identity.rr_join_threshold = 2.5;
-  const std::string bytes = encode_shard(f.header, f.sums);
-  Result<ShardFile> file = parse_shard(bytes, "x.shard");
-  ASSERT_TRUE(file) << file.error().render();
-  EXPECT_EQ(file->header.identity.rr_join_threshold, 2.5);
-  nlohmann::ordered_json head = header_of(bytes);
-  ASSERT_TRUE(head["options"].contains("rr_join_threshold"));
-  head["options"].erase("rr_join_threshold");
-  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
-  ASSERT_TRUE(old) << old.error().render();
-  EXPECT_EQ(old->header.identity.rr_join_threshold, 0.0);
+  const auto [now, before] = read_back_with_and_without(f, "rr_join_threshold");
+  EXPECT_EQ(now.rr_join_threshold, 2.5);
+  EXPECT_EQ(before.rr_join_threshold, 0.0);
 }
 
 // Issue 39: the runs per camera ray (--splits) round-trip, and a shard written before them (no
@@ -373,16 +373,9 @@ TEST(ShardFile, JoinRouletteThresholdRoundTripsAndDefaultsToNone) {
 TEST(ShardFile, SplitsRoundTripAndDefaultToOne) {
   Fixture f;
   f.header.identity.splits = 8;
-  const std::string bytes = encode_shard(f.header, f.sums);
-  Result<ShardFile> file = parse_shard(bytes, "x.shard");
-  ASSERT_TRUE(file) << file.error().render();
-  EXPECT_EQ(file->header.identity.splits, 8);
-  nlohmann::ordered_json head = header_of(bytes);
-  ASSERT_TRUE(head["options"].contains("splits"));
-  head["options"].erase("splits");
-  Result<ShardFile> old = parse_shard(with_header(bytes, head.dump()), "x.shard");
-  ASSERT_TRUE(old) << old.error().render();
-  EXPECT_EQ(old->header.identity.splits, 1);
+  const auto [now, before] = read_back_with_and_without(f, "splits");
+  EXPECT_EQ(now.splits, 8);
+  EXPECT_EQ(before.splits, 1);
 }
 
 // Issue 39: the replicates per pixel round-trip; a shard written before them (no "replicates")
