@@ -4,6 +4,7 @@
 // job and its identity, the plan, the render dealt among MPI ranks, --missed, the outputs); this
 // file holds its options, the checker's warning, the table and the exit codes.
 #include <chrono>
+#include <cstdlib>
 #include <iomanip>
 #include <iostream>
 
@@ -107,6 +108,11 @@ int run(const TraceArgs& a) {
     std::cout << " (passes " << header.passes.to_string() << " of " << job.header.spp << ")";
   std::cout << ", " << std::fixed << std::setprecision(2) << r.time_s << " s" << (complete ? "" : " (interrupted)")
             << ", non-finite samples " << rep->nonfinite_samples << "\n";
+  if (const std::optional<JoinRoulette>& j = r.join_roulette) {
+    std::cout << "join roulette (--rr-join-threshold auto): ";
+    if (j->threshold > 0) std::cout << std::defaultfloat << j->threshold << ", where the pilot's model finds " << std::fixed << std::setprecision(2) << j->gain << "x the efficiency without\n";
+    else std::cout << "none (the pilot's model finds " << std::fixed << std::setprecision(2) << j->gain << "x at best)\n";
+  }
   if (!job.classes->requested.empty()) {
     std::cout << "rendered only";
     for (const PathClass* c : job.classes->requested) std::cout << " " << c->name << " (" << c->text << ")";
@@ -230,9 +236,23 @@ Command add_trace(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
   sub->add_option("--rr-join-threshold", args->options.job.rr_join_threshold,
                   "bdpt: an eye vertex whose throughput (as for --rr-threshold) is below this makes its joins with the light "
-                  "subpath's vertices with probability throughput / threshold, weighted by its inverse; 0: always (the default; "
-                  "docs/efficiency.md has where 1 gains and where it loses)")
-      ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
+                  "subpath's vertices with probability throughput / threshold, weighted by its inverse; 0: always; auto (the "
+                  "default): the threshold a pilot's model of its variance and cost finds most efficient for the scene "
+                  "(issue 39, docs/efficiency.md)")
+      ->transform(CLI::Validator(
+          [](std::string& value) -> std::string {
+            if (value == "auto") {
+              value = "-1";  // kJoinThresholdAuto
+              return "";
+            }
+            char* end = nullptr;
+            const double t = std::strtod(value.c_str(), &end);
+            if (!value.empty() && end == value.c_str() + value.size() && t >= 0 && t <= 1000) return "";
+            return "expected auto or a number from 0 to 1000, got '" + value + "'";
+          },
+          /*validator_desc=*/"", /*validator_name=*/"rr-join-threshold"))
+      ->type_name("T|auto")
+      ->default_str("auto");
   sub->add_option("--splits", args->options.job.splits,
                   "Runs of each sample after its camera ray and first hit, each weighted 1/N: more paths of indirect light "
                   "per camera ray; auto: camera rays and runs per pixel from a pilot's variances (issue 39, docs/efficiency.md); "

@@ -36,6 +36,19 @@ namespace pathex::tracer {
 using namespace accel;  // PathKey, PathIds
 static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
 
+// One sample's contributions as the pilot of `--rr-join-threshold auto` sees them
+// (trace/accel/join_plan.h): its camera contributions and its splats' Σ c² (both less the emission
+// seen directly, s + t = 2), each eye vertex z(t-1)'s plain joins with the light subpath (s >= 2,
+// their summed contribution and how many were weighed), and every join weighed.
+struct JoinTally {
+  vec3 camera{0.0f};
+  double splats = 0;
+  std::array<vec3, kMaxVertices + 1> deep{};
+  std::array<int, kMaxVertices + 1> deep_joins{};
+  int joins = 0;
+  void clear() { *this = JoinTally{}; }
+};
+
 class Integrator {
  public:
   // `filter`: the plan's (trace/plan.h), which paths are recorded (default: every path).
@@ -124,6 +137,7 @@ class Integrator {
     std::optional<NonfiniteSample> first_nonfinite{};
     FirstVertexSplit split{};  // --splits: the run of the sample in progress, its camera ray and hit
     EyeAhead ahead{};  // the eye subpath's first ray and hit, made in a packet before the sample (trace/accel/eye_packets.h)
+    JoinTally* tally = nullptr;  // set by the pilot of --rr-join-threshold auto only (trace/accel/join_plan.h)
   };
 
   // The path of join `jr` over th's subpaths.
@@ -159,6 +173,14 @@ class Integrator {
   int strategy(int s, int t) const { return table_.plain(s, t); }
 
   bool traces_eye_rays() const { return max_eye_ >= 2; }  // an eye subpath goes past z0
+  // Whether some eye vertex joins with the light subpath's vertices (s >= 2, t >= 2: bdpt's joins,
+  // which --rr-join-threshold thins).
+  bool joins_with_light_subpath() const {
+    for (int t = 2; t <= max_eye_; ++t)
+      for (int s = 2; s <= std::min(max_light_, max_bounces_ + 2 - t); ++s)
+        if (strategy(s, t) >= 0) return true;
+    return false;
+  }
   // One sample: pixel (px, py), pass `pass`. Its camera contributions collect in th.row (the
   // caller flushes them with finish_row()); light-tracing splats go through th.splats.
   void sample(Thread& th, int px, int py, std::uint64_t pass) const;
@@ -322,6 +344,7 @@ class Integrator {
   // profile, then records it, or queues its segments and records it once all are found clear.
   void estimate(Thread& th, int batch) const;
   void record(Thread& th, const Pending& r) const;
+  static void tally(JoinTally& tally, const Pending& r);  // the pilot's (JoinTally)
   // A contribution that is not finite (a bug: counted, and the first one kept for the warning).
   // Out of line and cold, so that record()'s code stays small.
   [[gnu::cold, gnu::noinline]] void record_nonfinite(Thread& th, const Pending& r) const;

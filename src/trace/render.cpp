@@ -202,12 +202,24 @@ void Integrator::record(Thread& th, const Pending& r) const {
     return;
   }
   if (is_zero(e)) return;
+  if (th.tally) tally(*th.tally, r);
   const auto [id, row] = th.ids.get(th.hist, r.key, r.technique);
   th.hist.add_exact_at_row(id, row, r.batch, e);
   if (!o_.images) return;
   const std::uint32_t set = th.hist.class_set(id);
   if (r.splat) th.splats.add(*th.images, static_cast<int>(r.rx), static_cast<int>(r.ry), set, e);
   else th.row[static_cast<std::size_t>(r.px)].add(set, e);
+}
+
+void Integrator::tally(JoinTally& tally, const Pending& r) {
+  const Technique k = Technique::from_code(r.technique);
+  if (k.s + k.t == 2) return;  // the emission seen directly
+  if (r.splat) {
+    tally.splats += double(r.c.x) * r.c.x + double(r.c.y) * r.c.y + double(r.c.z) * r.c.z;
+    return;
+  }
+  tally.camera += r.c;
+  if (!k.connector && k.s >= 2 && k.t >= 2) tally.deep[static_cast<std::size_t>(k.t)] += r.c;
 }
 
 void Integrator::record_nonfinite(Thread& th, const Pending& r) const {
@@ -245,6 +257,10 @@ void Integrator::estimate(Thread& th, int batch) const {
                             .code();
   const Pending r{jr.letters, jr.contribution * (weight * th.split.weight()), jr.strategy, batch, technique, jr.splat, connector,
                   jr.rx, jr.ry, th.px, jr.num_segments, th.pass};
+  if (th.tally) {  // the pilot of --rr-join-threshold auto (trace/accel/join_plan.h)
+    ++th.tally->joins;
+    if (!connector && jr.s >= 2 && jr.t >= 2) ++th.tally->deep_joins[static_cast<std::size_t>(jr.t)];
+  }
   if (jr.num_segments == 0) {
     record(th, r);
     return;

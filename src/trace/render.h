@@ -72,6 +72,9 @@ inline LightSampling light_sampling_named(const std::string& name) {
   return LightSampling::kArea;
 }
 
+// RenderOptions::rr_join_threshold's `auto`: chosen per scene from a pilot (trace/accel/join_plan.h).
+inline constexpr float kJoinThresholdAuto = -1.0f;
+
 struct RenderOptions {
   std::uint64_t spp = 16;              // samples (passes) per pixel
   // The passes to take (a shard's share, what a resumed render still lacks); unset: [0, spp).
@@ -96,13 +99,14 @@ struct RenderOptions {
   // --rr-join-threshold: an eye vertex whose throughput r (relative to its subpath's start, as the
   // roulette above measures it) is below this makes its joins with the light subpath's vertices
   // (s >= 2: bdpt's shadow-ray joins) with probability r / threshold, each weighted by its
-  // inverse; 0 (the default): always. The eye walk goes on for its own joins (next-event
-  // estimation, emitter hits). Where the light subpath's joins with the eye's first vertices
-  // already reach the deep paths these would, they cost more than they lower the error (at 1:
-  // bdpt on cornell.json 1.13-1.15x, Tungsten's box 1.04x); where the deep eye vertices' joins
-  // carry the light (a closed sphere round a point light) the error grows more than the CPU
-  // falls (0.82x), so it is off by default (issue 39, docs/efficiency.md).
-  float rr_join_threshold = 0.0f;
+  // inverse; 0: always. The eye walk goes on for its own joins (next-event estimation, emitter
+  // hits). Where the light subpath's joins with the eye's first vertices already reach the deep
+  // paths these would, they cost more than they lower the error (at 1: bdpt on cornell.json
+  // 1.13-1.15x, Tungsten's box 1.04x); where the deep eye vertices' joins carry the light (a closed
+  // sphere round a point light) the error grows more than the CPU falls (0.82x). So the default,
+  // kJoinThresholdAuto (`auto`), chooses it per scene from a pilot (trace/accel/join_plan.h; issue
+  // 39, docs/efficiency.md); render() resolves it before the render.
+  float rr_join_threshold = kJoinThresholdAuto;
   // --splits: runs of each sample after its camera ray and first hit, each weighted 1 / splits
   // (trace/accel/first_vertex_split.h; issue 39, docs/efficiency.md). 0 (`--splits auto`): counts
   // per pixel (camera rays, runs after each), from a pilot (trace/accel/split_plan.h), or from
@@ -188,6 +192,13 @@ struct AimedLight {
   float share = 0.0f;        // the cones' solid angles over 4π (an upper bound of the share of directions)
 };
 
+// What `--rr-join-threshold auto` took (trace/accel/join_plan.h): the threshold (0: no roulette)
+// and the efficiency its pilot's model predicts at the best threshold over none's.
+struct JoinRoulette {
+  float threshold = 0;
+  double gain = 1;
+};
+
 struct RenderOutput {
   Histogram histogram;
   ClassImages images;
@@ -200,6 +211,7 @@ struct RenderOutput {
   std::vector<ConnectorStats> connectors{};  // one per connector strategy of the profile, in its order
   std::optional<NonfiniteSample> first_nonfinite{};  // when histogram.nonfinite() > 0
   std::vector<AimedLight> aimed{};                   // the lights whose emission was aimed
+  std::optional<JoinRoulette> join_roulette{};       // under --rr-join-threshold auto
 };
 
 // The strategies of a profile the tracer runs: plain joins and the mirror, projection and manifold

@@ -10,6 +10,7 @@
 #include <chrono>
 
 #include "trace/accel/eye_packets.h"
+#include "trace/accel/join_plan.h"
 #include "trace/accel/split_plan.h"
 #include "trace/integrator.h"
 #include "trace/plan.h"
@@ -99,6 +100,11 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
                    o.images ? ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes)
                             : ClassImages(0, 0, nullptr, {}),
                    layout.strategies};
+  // --rr-join-threshold auto: the threshold from a pilot, the same for every shard (trace/accel/join_plan.h).
+  if (o.rr_join_threshold < 0.0f) {
+    out.join_roulette = tracer::plan_join_threshold(*rs, *strategies, o, plan.filter, layout);
+    o.rr_join_threshold = out.join_roulette ? out.join_roulette->threshold : 0.0f;
+  }
   Integrator integrator(*rs, *strategies, o, plan.filter);
   // --splits auto: each pixel's counts, the same for every shard (trace/accel/split_plan.h).
   std::shared_ptr<const tracer::SplitMap> split_map;

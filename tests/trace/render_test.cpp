@@ -825,9 +825,10 @@ namespace {
 // less than a tenth), roulette from the second vertex, and none.
 std::vector<Sampling> every_sampling() {
   std::vector<Sampling> out;
-  // The default first; then the eye and light thresholds apart (issue 39) and together, and the
-  // roulette of bdpt's joins (issue 39, off by default) at 1 and far above it (every join of an
-  // eye vertex past the first rouletted, most of them skipped).
+  // The default first (bdpt's join roulette `auto`: the pilot's threshold, trace/accel/join_plan.h);
+  // then the eye and light thresholds apart (issue 39) and together, and the roulette of bdpt's
+  // joins at 0 (none), 1 and far above it (every join of an eye vertex past the first rouletted,
+  // most of them skipped).
   const RenderOptions d;
   for (SamplerKind k : {SamplerKind::kIndependent, SamplerKind::kSobol})
     for (auto [depth, eye, light, join] : std::vector<std::tuple<int, float, float, float>>{
