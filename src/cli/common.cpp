@@ -12,6 +12,18 @@
 
 namespace pathex::cli {
 
+CLI::Validator auto_or(std::string sentinel, std::function<bool(const std::string&)> accepts, std::string expected, std::string name) {
+  return CLI::Validator(
+      [sentinel = std::move(sentinel), accepts = std::move(accepts), expected = std::move(expected)](std::string& value) -> std::string {
+        if (value == "auto") {
+          value = sentinel;
+          return "";
+        }
+        return accepts(value) ? "" : "expected auto or " + expected + ", got '" + value + "'";
+      },
+      /*validator_desc=*/"", std::move(name));
+}
+
 const CLI::Validator& non_negative() {
   static const CLI::Validator v(
       [](std::string& value) -> std::string {

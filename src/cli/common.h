@@ -37,6 +37,9 @@ void add_limit_options(CLI::App* app, Limits* limits);
 void add_scene_limit_options(CLI::App* app, Limits* limits);
 // Refuses a value with a minus sign: CLI11 reads "-1" into an unsigned option as 2^64 - 1.
 const CLI::Validator& non_negative();
+// An option that takes `auto` or a value: `auto` reaches the option as `sentinel`; any other value
+// must pass `accepts`, else "expected auto or `expected`, got 'VALUE'".
+CLI::Validator auto_or(std::string sentinel, std::function<bool(const std::string&)> accepts, std::string expected, std::string name);
 void add_notation_options(CLI::App* app, NotationOptions* n);
 // The manifold connector's limits (trace/joins/manifold.h), group "Manifold connector", each with
 // its default and its range: --manifold-iterations, --manifold-threshold, --manifold-min-segment,

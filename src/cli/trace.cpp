@@ -239,18 +239,14 @@ Command add_trace(CLI::App& app) {
                   "subpath's vertices with probability throughput / threshold, weighted by its inverse; 0: always; auto (the "
                   "default): the threshold a pilot's model of its variance and cost finds most efficient for the scene "
                   "(issue 39, docs/efficiency.md)")
-      ->transform(CLI::Validator(
-          [](std::string& value) -> std::string {
-            if (value == "auto") {
-              value = "-1";  // kJoinThresholdAuto
-              return "";
-            }
+      ->transform(auto_or(
+          "-1",  // kJoinThresholdAuto
+          [](const std::string& value) {
             char* end = nullptr;
             const double t = std::strtod(value.c_str(), &end);
-            if (!value.empty() && end == value.c_str() + value.size() && t >= 0 && t <= 1000) return "";
-            return "expected auto or a number from 0 to 1000, got '" + value + "'";
+            return !value.empty() && end == value.c_str() + value.size() && t >= 0 && t <= 1000;
           },
-          /*validator_desc=*/"", /*validator_name=*/"rr-join-threshold"))
+          "a number from 0 to 1000", "rr-join-threshold"))
       ->type_name("T|auto")
       ->default_str("auto");
   sub->add_option("--splits", args->options.job.splits,
@@ -258,17 +254,13 @@ Command add_trace(CLI::App& app) {
                   "per camera ray; auto: camera rays and runs per pixel from a pilot's variances (issue 39, docs/efficiency.md); "
                   "default: auto if the profile has no light subpath (no strategy with s >= 1 but next-event estimation's "
                   "s = 1, t >= 2: pt, pt-nee) and no manifold connector, else 1 (light tracing, bdpt's joins, manifold walks)")
-      ->transform(CLI::Validator(
-          [](std::string& value) -> std::string {
-            if (value == "auto") {
-              value = "0";  // RenderOptions::splits
-              return "";
-            }
+      ->transform(auto_or(
+          "0",  // RenderOptions::splits
+          [](const std::string& value) {
             const bool digits = !value.empty() && value.size() <= 4 && value.find_first_not_of("0123456789") == std::string::npos;
-            if (digits && std::stoi(value) >= 1 && std::stoi(value) <= 1024) return "";
-            return "expected auto or a whole number from 1 to 1024, got '" + value + "'";
+            return digits && std::stoi(value) >= 1 && std::stoi(value) <= 1024;
           },
-          /*validator_desc=*/"", /*validator_name=*/"splits"))
+          "a whole number from 1 to 1024", "splits"))
       ->type_name("N|auto");
   sub->add_option("--resolution", args->options.job.resolution, "Image size WIDTHxHEIGHT, such as 640x480; default: the scene's")
       ->type_name("WxH");
