@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include <tbb/global_control.h>
 
@@ -108,10 +109,18 @@ int run(const TraceArgs& a) {
     std::cout << " (passes " << header.passes.to_string() << " of " << job.header.spp << ")";
   std::cout << ", " << std::fixed << std::setprecision(2) << r.time_s << " s" << (complete ? "" : " (interrupted)")
             << ", non-finite samples " << rep->nonfinite_samples << "\n";
-  if (const std::optional<JoinRoulette>& j = r.join_roulette) {
-    std::cout << "join roulette (--rr-join-threshold auto): ";
-    if (j->threshold > 0) std::cout << std::defaultfloat << j->threshold << ", where the pilot's model finds " << std::fixed << std::setprecision(2) << j->gain << "x the efficiency without\n";
-    else std::cout << "none (the pilot's model finds " << std::fixed << std::setprecision(2) << j->gain << "x at best)\n";
+  if (const std::optional<RouletteThresholds>& j = r.roulette) {
+    const auto value = [](double t) {
+      std::ostringstream text;
+      text << std::defaultfloat << t;
+      return t > 0 ? text.str() : std::string("none");
+    };
+    const std::string first = value(id.rr_threshold < 0 ? kDefaultEyeThreshold : id.rr_threshold) + " and " +
+                              value(id.rr_join_threshold < 0 ? 0.0 : id.rr_join_threshold);
+    std::cout << "roulette (auto): --rr-threshold " << value(j->eye) << ", --rr-join-threshold " << value(j->join);
+    if (j->taken)
+      std::cout << ", where the pilot's model finds " << std::fixed << std::setprecision(2) << j->gain << "x the efficiency of " << first << "\n";
+    else std::cout << " (the pilot's model finds " << std::fixed << std::setprecision(2) << j->gain << "x at best)\n";
   }
   if (!job.classes->requested.empty()) {
     std::cout << "rendered only";
@@ -228,9 +237,21 @@ Command add_trace(CLI::App& app) {
   sub->add_option("--rr-depth", args->options.job.rr_depth,
                   "Russian roulette from this vertex of a subpath on (the camera or light point is the first)")
       ->capture_default_str()->check(CLI::Range(1, 1000));
+  // A roulette threshold: from 0 to 1000.
+  const auto threshold = [](const std::string& value) {
+    char* end = nullptr;
+    const double t = std::strtod(value.c_str(), &end);
+    return !value.empty() && end == value.c_str() + value.size() && t >= 0 && t <= 1000;
+  };
   sub->add_option("--rr-threshold", args->options.job.rr_threshold,
-                  "Russian roulette of eye subpaths only below this throughput (relative to the subpath's start); 0: no roulette")
-      ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
+                  "Russian roulette of eye subpaths only below this throughput (relative to the subpath's start); 0: no roulette; "
+                  "auto (the default): under bdpt's joins (bdpt, bdpt+manifold, the pbrt-v4 and Mitsuba bdpt profiles) the one "
+                  "of 0.3, 0.5, 1 a pilot's model of its variance and cost finds most efficient for the scene, with "
+                  "--rr-join-threshold's; else 0.3 (issue 39, docs/efficiency.md)")
+      ->transform(auto_or("-1",  // kEyeThresholdAuto
+                          threshold, "a number from 0 to 1000", "rr-threshold"))
+      ->type_name("T|auto")
+      ->default_str("auto");
   sub->add_option("--rr-light-threshold", args->options.job.rr_light_threshold,
                   "The same for light subpaths (lt, bdpt)")
       ->capture_default_str()->check(CLI::Range(0.0f, 1000.0f));
@@ -239,14 +260,8 @@ Command add_trace(CLI::App& app) {
                   "subpath's vertices with probability throughput / threshold, weighted by its inverse; 0: always; auto (the "
                   "default): the threshold a pilot's model of its variance and cost finds most efficient for the scene "
                   "(issue 39, docs/efficiency.md)")
-      ->transform(auto_or(
-          "-1",  // kJoinThresholdAuto
-          [](const std::string& value) {
-            char* end = nullptr;
-            const double t = std::strtod(value.c_str(), &end);
-            return !value.empty() && end == value.c_str() + value.size() && t >= 0 && t <= 1000;
-          },
-          "a number from 0 to 1000", "rr-join-threshold"))
+      ->transform(auto_or("-1",  // kJoinThresholdAuto
+                          threshold, "a number from 0 to 1000", "rr-join-threshold"))
       ->type_name("T|auto")
       ->default_str("auto");
   sub->add_option("--splits", args->options.job.splits,

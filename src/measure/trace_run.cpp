@@ -130,7 +130,7 @@ Result<TraceResult> run_trace(const TraceOptions& a, const TraceHooks& hooks) {
   const double cpu_s = process_cpu_seconds() - cpu_start;
   if (!out) return out.error();
   res.time_s = out->time_s;
-  res.join_roulette = out->join_roulette;
+  res.roulette = out->roulette;
   // --only: a light aimed at the shapes a requested path can reach first is listed with the
   // strategies the checker narrowed (the table's "narrowed:" lines, run.json's "pruned").
   for (const AimedLight& l : out->aimed) {

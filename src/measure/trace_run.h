@@ -69,7 +69,7 @@ struct TraceResult {
   ShardHeader header;  // as written: the passes and the run's figures, the resumed ones' added
   std::optional<RenderSums> sums;  // the render's exact sums (the resumed and the other ranks' added)
   double time_s = 0;   // this process's render time
-  std::optional<JoinRoulette> join_roulette;  // what --rr-join-threshold auto took (trace/accel/join_plan.h)
+  std::optional<RouletteThresholds> roulette;  // what --rr-threshold and --rr-join-threshold auto took (trace/accel/join_plan.h)
   std::optional<BiasReport> missed;  // with `missed`: what missed.json holds
   std::optional<WrittenReport> written;  // histogram.json as written (or as it would be, without `write`)
 };

@@ -317,6 +317,9 @@ class Reader {
 
 // --- header ---
 
+// A roulette threshold: `auto` (negative: chosen by the render's pilot, trace/accel/join_plan.h) or its value.
+json auto_or_number(double threshold) { return threshold < 0 ? json("auto") : json(threshold); }
+
 json identity_json(const RenderIdentity& id) {
   json j = json::object();
   j["pathex"] = id.pathex;
@@ -327,8 +330,8 @@ json identity_json(const RenderIdentity& id) {
   j["ends"] = {{"lights", id.lights}, {"sensor", id.sensor}};
   j["seed"] = id.seed;
   j["options"] = {{"max_bounces", id.max_bounces}, {"sampler", id.sampler}, {"light_sampling", id.light_sampling}, {"rr_depth", id.rr_depth},
-                  {"rr_threshold", id.rr_threshold}, {"rr_light_threshold", id.rr_light_threshold},
-                  {"rr_join_threshold", id.rr_join_threshold < 0 ? nlohmann::json("auto") : nlohmann::json(id.rr_join_threshold)},
+                  {"rr_threshold", auto_or_number(id.rr_threshold)}, {"rr_light_threshold", id.rr_light_threshold},
+                  {"rr_join_threshold", auto_or_number(id.rr_join_threshold)},
                   {"splits", id.splits}, {"batches", id.batches},
                   {"replicates", id.replicates}, {"width", id.width},           {"height", id.height},     {"images", id.images},
                   {"max_paths", id.max_paths}};
@@ -464,17 +467,17 @@ Result<ShardHeader> header_from_json(const nlohmann::json& j, const std::string&
     // Before issue 39's solid-angle sampling (eighth session) every light was sampled by area.
     id.light_sampling = o.contains("light_sampling") ? rd.str(o, "/options", "light_sampling") : "area";
     id.rr_depth = rd.small(o, "/options", "rr_depth");
-    id.rr_threshold = rd.number(o, "/options", "rr_threshold");
+    // `auto` (the pilot's choice, trace/accel/join_plan.h) or the threshold.
+    const auto threshold = [&](const char* name) -> double {
+      if (!o.at(name).is_string()) return rd.number(o, "/options", name);
+      if (rd.str(o, "/options", name) != "auto") rd.fail(std::string("/options/") + name, "expected auto or a number");
+      return -1.0;  // kEyeThresholdAuto, kJoinThresholdAuto
+    };
+    id.rr_threshold = threshold("rr_threshold");
     // Before issue 39 one threshold served both subpaths.
     id.rr_light_threshold = o.contains("rr_light_threshold") ? rd.number(o, "/options", "rr_light_threshold") : id.rr_threshold;
     // Before issue 39's join roulette every eye vertex made all its joins.
-    // `auto` (the pilot's choice, trace/accel/join_plan.h) or the threshold.
-    if (o.contains("rr_join_threshold") && o.at("rr_join_threshold").is_string()) {
-      if (rd.str(o, "/options", "rr_join_threshold") != "auto") rd.fail("/options/rr_join_threshold", "expected auto or a number");
-      id.rr_join_threshold = kJoinThresholdAuto;
-    } else {
-      id.rr_join_threshold = o.contains("rr_join_threshold") ? rd.number(o, "/options", "rr_join_threshold") : 0.0;
-    }
+    id.rr_join_threshold = o.contains("rr_join_threshold") ? threshold("rr_join_threshold") : 0.0;
     // Before issue 39's splitting (tenth session) no sample was split.
     id.splits = o.contains("splits") ? rd.small(o, "/options", "splits") : 1;
     id.batches = rd.small(o, "/options", "batches");
@@ -568,14 +571,11 @@ std::optional<std::string> identity_difference(const RenderIdentity& a, const Re
   if (a.sampler != b.sampler) return differ("another sampler", a.sampler, b.sampler);
   if (a.light_sampling != b.light_sampling) return differ("another light sampling", a.light_sampling, b.light_sampling);
   if (auto d = option("rr_depth", a.rr_depth, b.rr_depth)) return d;
-  if (a.rr_threshold != b.rr_threshold)
-    return differ("another rr_threshold", std::to_string(a.rr_threshold), std::to_string(b.rr_threshold));
+  const auto text = [](double t) { return t < 0 ? std::string("auto") : std::to_string(t); };
+  if (a.rr_threshold != b.rr_threshold) return differ("another rr_threshold", text(a.rr_threshold), text(b.rr_threshold));
   if (a.rr_light_threshold != b.rr_light_threshold)
     return differ("another rr_light_threshold", std::to_string(a.rr_light_threshold), std::to_string(b.rr_light_threshold));
-  if (a.rr_join_threshold != b.rr_join_threshold) {
-    const auto text = [](double t) { return t < 0 ? std::string("auto") : std::to_string(t); };
-    return differ("another rr_join_threshold", text(a.rr_join_threshold), text(b.rr_join_threshold));
-  }
+  if (a.rr_join_threshold != b.rr_join_threshold) return differ("another rr_join_threshold", text(a.rr_join_threshold), text(b.rr_join_threshold));
   if (auto d = option("splits", a.splits, b.splits)) return d;
   if (auto d = option("batch count", a.batches, b.batches)) return d;
   if (auto d = option("replicate count", a.replicates, b.replicates)) return d;

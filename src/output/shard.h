@@ -31,8 +31,8 @@
 // file's text), hash}, "ends" {lights: [...], sensor} (the scene's end types, which class files in
 // Heckbert notation compile against), "seed", "spp" (the requested samples per pixel), "options"
 // {max_bounces, sampler, light_sampling (absent in files written before issue 39's solid-angle
-// sampling: then "area"), rr_depth, rr_threshold, rr_light_threshold (absent in files written before
-// issue 39: then rr_threshold's), rr_join_threshold (absent in files written before issue 39's
+// sampling: then "area"), rr_depth, rr_threshold ("auto" or a number), rr_light_threshold (absent in files written before
+// issue 39: then rr_threshold's), rr_join_threshold ("auto" or a number; absent in files written before issue 39's
 // join roulette: then 0, none), splits (resolved, the profile's default too: 0 is --splits auto;
 // absent in files written before issue 39's splitting: then 1), batches, replicates (absent in files
 // written before issue 39's pixel groups: then batches, plain batch means), width, height, images, max_paths, manifold (null, or the

@@ -36,15 +36,20 @@ namespace pathex::tracer {
 using namespace accel;  // PathKey, PathIds
 static_assert(kMaxVertices + 1 < kLengthShift, "every string the tracer forms packs into a PathKey");
 
-// One sample's contributions as the pilot of `--rr-join-threshold auto` sees them
+// One sample's contributions as the pilot of the roulette thresholds' `auto` sees them
 // (trace/accel/join_plan.h): its camera contributions and its splats' Σ c² (both less the emission
-// seen directly, s + t = 2), each eye vertex z(t-1)'s plain joins with the light subpath (s >= 2,
-// their summed contribution and how many were weighed), and every join weighed.
+// seen directly, s + t = 2), its camera contributions by the eye vertices they use (t), each eye
+// vertex z(t-1)'s plain joins with the light subpath (s >= 2, their summed contribution and how
+// many were weighed), every join weighed (and how many by t), and the eye walk's roulette: at the
+// step that finds z(j), its survival probability before the cap at 1 (0: no roulette there).
 struct JoinTally {
   vec3 camera{0.0f};
   double splats = 0;
+  std::array<vec3, kMaxVertices + 1> by_t{};
   std::array<vec3, kMaxVertices + 1> deep{};
   std::array<int, kMaxVertices + 1> deep_joins{};
+  std::array<int, kMaxVertices + 1> joins_at{};
+  std::array<float, kMaxVertices + 1> survive{};
   int joins = 0;
   void clear() { *this = JoinTally{}; }
 };
@@ -55,6 +60,8 @@ class Integrator {
   Integrator(const RenderScene& rs, const StrategySet& strategies, const RenderOptions& o, PathFilter filter = {})
       : rs_(rs), cam_(rs.camera), strategies_(strategies), o_(o), filter_(std::move(filter)), table_(strategies.strategies) {
     max_bounces_ = std::min(o.max_bounces.value_or(16), kMaxVertices - 3);
+    // `auto` unresolved (an Integrator built outside render(), as tests build them): the fixed default.
+    eye_threshold_ = o.rr_threshold < 0.0f ? kDefaultEyeThreshold : o.rr_threshold;
     light_pick_ = rs.lights.empty() ? 0.0f : 1.0f / static_cast<float>(rs.lights.size());
     lens_hits_ = cam_.type == SensorType::kLens && table_.runs_at_t(ConnectorKind::kNone, 0);
     // Subpaths are only as long as a strategy can use: s = 1 and t = 1 take fresh samples, so a
@@ -137,7 +144,7 @@ class Integrator {
     std::optional<NonfiniteSample> first_nonfinite{};
     FirstVertexSplit split{};  // --splits: the run of the sample in progress, its camera ray and hit
     EyeAhead ahead{};  // the eye subpath's first ray and hit, made in a packet before the sample (trace/accel/eye_packets.h)
-    JoinTally* tally = nullptr;  // set by the pilot of --rr-join-threshold auto only (trace/accel/join_plan.h)
+    JoinTally* tally = nullptr;  // set by the pilot of the roulette thresholds' auto only (trace/accel/join_plan.h)
   };
 
   // The path of join `jr` over th's subpaths.
@@ -357,6 +364,7 @@ class Integrator {
   const RenderOptions& o_;
   PathFilter filter_;  // the plan's: which paths are recorded, where subpaths stop
   int max_bounces_ = 16;
+  float eye_threshold_ = kDefaultEyeThreshold;  // RenderOptions::rr_threshold, resolved
   StrategyTable table_;  // which strategy runs each (s, chain, t)
   bool has_connectors_ = false;  // a connector strategy runs (a mirror one only when the scene has a planar mirror)
   bool has_mirror_ = false;      // a mirror strategy runs and the scene has a planar mirror

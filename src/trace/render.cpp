@@ -131,9 +131,10 @@ int Integrator::random_walk(Thread& th, Sampler& rng, std::array<Vertex, kMaxVer
     // survives with probability throughput / threshold, and a survivor carries the threshold.
     if (mode == TransportMode::kRadiance && rs_.features.transmission) eta2 *= bs->eta * bs->eta;  // else η = 1
     constexpr bool kEye = mode == TransportMode::kRadiance;  // eye and light subpaths have thresholds of their own
-    const float threshold = kEye ? o_.rr_threshold : o_.rr_light_threshold;
+    const float threshold = kEye ? eye_threshold_ : o_.rr_light_threshold;
     if (count >= o_.rr_depth && threshold > 0.0f) {
       const float survive = max_component(beta) * eta2 / (beta_start * threshold);
+      if (kEye && th.tally) th.tally->survive[static_cast<std::size_t>(count)] = survive;  // the pilot's (trace/accel/join_plan.h)
       const float u_rr = rng.get1d_if(survive < 1.0f);  // its dimension taken at every vertex, so the dimensions stay aligned
       if (survive < 1.0f) {
         if (u_rr >= survive) break;
@@ -219,6 +220,7 @@ void Integrator::tally(JoinTally& tally, const Pending& r) {
     return;
   }
   tally.camera += r.c;
+  tally.by_t[static_cast<std::size_t>(k.t)] += r.c;
   if (!k.connector && k.s >= 2 && k.t >= 2) tally.deep[static_cast<std::size_t>(k.t)] += r.c;
 }
 
@@ -257,8 +259,9 @@ void Integrator::estimate(Thread& th, int batch) const {
                             .code();
   const Pending r{jr.letters, jr.contribution * (weight * th.split.weight()), jr.strategy, batch, technique, jr.splat, connector,
                   jr.rx, jr.ry, th.px, jr.num_segments, th.pass};
-  if (th.tally) {  // the pilot of --rr-join-threshold auto (trace/accel/join_plan.h)
+  if (th.tally) {  // the pilot of the roulette thresholds' auto (trace/accel/join_plan.h)
     ++th.tally->joins;
+    ++th.tally->joins_at[static_cast<std::size_t>(jr.t)];
     if (!connector && jr.s >= 2 && jr.t >= 2) ++th.tally->deep_joins[static_cast<std::size_t>(jr.t)];
   }
   if (jr.num_segments == 0) {

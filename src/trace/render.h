@@ -72,8 +72,12 @@ inline LightSampling light_sampling_named(const std::string& name) {
   return LightSampling::kArea;
 }
 
-// RenderOptions::rr_join_threshold's `auto`: chosen per scene from a pilot (trace/accel/join_plan.h).
+// RenderOptions::rr_threshold's and rr_join_threshold's `auto`: chosen per scene from a pilot
+// (trace/accel/join_plan.h) where the profile joins eye vertices with a light subpath (bdpt);
+// elsewhere the eye's is kDefaultEyeThreshold and the joins' none.
+inline constexpr float kEyeThresholdAuto = -1.0f;
 inline constexpr float kJoinThresholdAuto = -1.0f;
+inline constexpr float kDefaultEyeThreshold = 0.3f;
 
 struct RenderOptions {
   std::uint64_t spp = 16;              // samples (passes) per pixel
@@ -92,9 +96,12 @@ struct RenderOptions {
   // throughput / threshold; 0 turns roulette off. Eye subpaths use rr_threshold, light subpaths
   // rr_light_threshold: a light vertex is joined to every eye vertex (bdpt), so it costs more and
   // its walk is cut sooner. Defaults chosen by efficiency on several scenes (issue 39,
-  // docs/efficiency.md).
+  // docs/efficiency.md). The eye's default, kEyeThresholdAuto (`auto`): under bdpt's joins the
+  // threshold of kEyeThresholds (0.3, 0.5, 1) a pilot's model finds most efficient for the scene,
+  // with the join roulette's below (trace/accel/join_plan.h); elsewhere kDefaultEyeThreshold (0.3).
+  // render() resolves it before the render.
   int rr_depth = 3;
-  float rr_threshold = 0.3f;
+  float rr_threshold = kEyeThresholdAuto;
   float rr_light_threshold = 1.0f;
   // --rr-join-threshold: an eye vertex whose throughput r (relative to its subpath's start, as the
   // roulette above measures it) is below this makes its joins with the light subpath's vertices
@@ -192,11 +199,15 @@ struct AimedLight {
   float share = 0.0f;        // the cones' solid angles over 4π (an upper bound of the share of directions)
 };
 
-// What `--rr-join-threshold auto` took (trace/accel/join_plan.h): the threshold (0: no roulette)
-// and the efficiency its pilot's model predicts at the best threshold over none's.
-struct JoinRoulette {
-  float threshold = 0;
+// What the roulette thresholds' `auto` took (trace/accel/join_plan.h): the eye's and the joins'
+// (0: none); whether the pilot's model found them worth taking over the first pair (the eye's
+// default or the eye threshold given, no join roulette or the join threshold given), and the
+// efficiency it finds for its best pair against the first's.
+struct RouletteThresholds {
+  float eye = kDefaultEyeThreshold;
+  float join = 0;
   double gain = 1;
+  bool taken = false;
 };
 
 struct RenderOutput {
@@ -211,7 +222,7 @@ struct RenderOutput {
   std::vector<ConnectorStats> connectors{};  // one per connector strategy of the profile, in its order
   std::optional<NonfiniteSample> first_nonfinite{};  // when histogram.nonfinite() > 0
   std::vector<AimedLight> aimed{};                   // the lights whose emission was aimed
-  std::optional<JoinRoulette> join_roulette{};       // under --rr-join-threshold auto
+  std::optional<RouletteThresholds> roulette{};      // under --rr-threshold or --rr-join-threshold auto, where a pilot ran
 };
 
 // The strategies of a profile the tracer runs: plain joins and the mirror, projection and manifold

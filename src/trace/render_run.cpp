@@ -100,10 +100,12 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
                    o.images ? ClassImages(rs->camera.width, rs->camera.height, classifier, o.layer_classes)
                             : ClassImages(0, 0, nullptr, {}),
                    layout.strategies};
-  // --rr-join-threshold auto: the threshold from a pilot, the same for every shard (trace/accel/join_plan.h).
-  if (o.rr_join_threshold < 0.0f) {
-    out.join_roulette = tracer::plan_join_threshold(*rs, *strategies, o, plan.filter, layout);
-    o.rr_join_threshold = out.join_roulette ? out.join_roulette->threshold : 0.0f;
+  // --rr-threshold or --rr-join-threshold auto: the thresholds from a pilot, the same for every
+  // shard (trace/accel/join_plan.h); without one (no joins with a light subpath) the defaults.
+  if (o.rr_threshold < 0.0f || o.rr_join_threshold < 0.0f) {
+    out.roulette = tracer::plan_roulette(*rs, *strategies, o, plan.filter, layout);
+    o.rr_threshold = out.roulette ? out.roulette->eye : o.rr_threshold < 0.0f ? kDefaultEyeThreshold : o.rr_threshold;
+    o.rr_join_threshold = out.roulette ? out.roulette->join : o.rr_join_threshold < 0.0f ? 0.0f : o.rr_join_threshold;
   }
   Integrator integrator(*rs, *strategies, o, plan.filter);
   // --splits auto: each pixel's counts, the same for every shard (trace/accel/split_plan.h).

@@ -116,25 +116,33 @@ TEST(SplitsOption, TakesACountOrAutoAndNothingElse) {
   }
 }
 
-// Issue 39: --rr-join-threshold takes a number in [0, 1000] or auto (the default: the pilot's
-// choice, trace/accel/join_plan.h), which the trace says and the shard header records as the word;
-// anything else is one message and exit 2.
+// Issue 39: --rr-threshold and --rr-join-threshold take a number in [0, 1000] or auto (the
+// defaults: the pilot's choice, trace/accel/join_plan.h), which the trace says and the shard header
+// records as the word; anything else is one message and exit 2.
 TEST(JoinThresholdOption, TakesANumberOrAutoAndSaysWhatAutoTook) {
   const std::string d = out_dir("join-auto");
   const CliRun ok = run("trace samples/scenes/sun-window.json --renderer bdpt --spp 16 --quiet --out " + d);
   ASSERT_EQ(ok.code, 0) << ok.err;
-  EXPECT_NE(ok.out.find("\njoin roulette (--rr-join-threshold auto): 2, where the pilot's model finds "), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("\nroulette (auto): --rr-threshold 1, --rr-join-threshold 2, where the pilot's model finds "), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("x the efficiency of 0.3 and none\n"), std::string::npos) << ok.out;
   std::ifstream shard(d + "/render.shard", std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(shard)), std::istreambuf_iterator<char>());
+  EXPECT_NE(bytes.find("\"rr_threshold\": \"auto\","), std::string::npos);
   EXPECT_NE(bytes.find("\"rr_join_threshold\": \"auto\","), std::string::npos);
-  const CliRun fixed = run("trace samples/scenes/sun-window.json --renderer bdpt --spp 1 --quiet --rr-join-threshold 0.5 --out " + out_dir("join-fixed"));
+  // One given, the other auto: the pilot chooses the other against the one given.
+  const CliRun eye = run("trace samples/scenes/sun-window.json --renderer bdpt --spp 16 --quiet --rr-threshold 0.3 --out " + out_dir("eye-fixed"));
+  ASSERT_EQ(eye.code, 0) << eye.err;
+  EXPECT_NE(eye.out.find("\nroulette (auto): --rr-threshold 0.3, --rr-join-threshold 2, where the pilot's model finds "), std::string::npos) << eye.out;
+  const CliRun fixed = run("trace samples/scenes/sun-window.json --renderer bdpt --spp 1 --quiet --rr-threshold 0.3 --rr-join-threshold 0.5 --out " +
+                           out_dir("join-fixed"));
   ASSERT_EQ(fixed.code, 0) << fixed.err;
-  EXPECT_EQ(fixed.out.find("join roulette"), std::string::npos);
-  for (const std::string bad : {"-1", "1001", "Auto", "2x", "", "nan", "inf"}) {
-    const CliRun r = run("trace " + kScene + " --spp 1 --out " + out_dir("bad") + " --rr-join-threshold '" + bad + "'");
-    EXPECT_EQ(r.code, 2) << bad;
-    EXPECT_EQ(r.err, "--rr-join-threshold: expected auto or a number from 0 to 1000, got '" + bad + "'\nRun with --help for more information.\n") << bad;
-  }
+  EXPECT_EQ(fixed.out.find("roulette"), std::string::npos);
+  for (const std::string option : {"--rr-threshold", "--rr-join-threshold"})
+    for (const std::string bad : {"-1", "1001", "Auto", "2x", "", "nan", "inf"}) {
+      const CliRun r = run("trace " + kScene + " --spp 1 --out " + out_dir("bad") + " " + option + " '" + bad + "'");
+      EXPECT_EQ(r.code, 2) << bad;
+      EXPECT_EQ(r.err, option + ": expected auto or a number from 0 to 1000, got '" + bad + "'\nRun with --help for more information.\n") << bad;
+    }
 }
 
 // Issue 39: --splits' default is the profile's (resolved_splits(), trace/render.h), recorded resolved:

@@ -278,6 +278,12 @@ TEST_F(MergeRefuses, AnotherJoinRouletteThreshold) {
                                     " are not of one render: another rr_join_threshold (1.000000 against auto)");
 }
 
+TEST_F(MergeRefuses, AnotherEyeRouletteThreshold) {
+  ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/2 --rr-threshold 0.3 --quiet --out " + b_).code, 0);
+  expect_refusal(a_ + " " + b_, shard(b_) + " and " + shard(a_) +
+                                    " are not of one render: another rr_threshold (0.300000 against auto)");
+}
+
 TEST_F(MergeRefuses, AnotherProfile) {
   ASSERT_EQ(run_pathex("trace --spp 8 --shard 1/2 --renderer pt-nee --quiet --out " + b_).code, 0);
   const std::string ha = read_header(shard(a_)).json["renderer"]["hash"], hb = read_header(shard(b_)).json["renderer"]["hash"];

@@ -366,19 +366,25 @@ TEST(ShardFile, JoinRouletteThresholdRoundTripsAndDefaultsToNone) {
   const auto [now, before] = read_back_with_and_without(f, "rr_join_threshold");
   EXPECT_EQ(now.rr_join_threshold, 2.5);
   EXPECT_EQ(before.rr_join_threshold, 0.0);
-  // `auto` (the default: the pilot's choice) is written as the word and read back as it.
+  // `auto` (the default: the pilot's choice), the eye's as the joins', is written as the word and
+  // read back as it.
   f.header.identity.rr_join_threshold = kJoinThresholdAuto;
+  f.header.identity.rr_threshold = kEyeThresholdAuto;
   const std::string bytes = encode_shard(f.header, f.sums);
   EXPECT_EQ(header_of(bytes)["options"]["rr_join_threshold"], "auto");
+  EXPECT_EQ(header_of(bytes)["options"]["rr_threshold"], "auto");
   Result<ShardFile> back = parse_shard(bytes, "x.shard");
   ASSERT_TRUE(back) << back.error().render();
   EXPECT_EQ(back->header.identity.rr_join_threshold, kJoinThresholdAuto);
+  EXPECT_EQ(back->header.identity.rr_threshold, kEyeThresholdAuto);
   // Any other word is refused at its pointer.
-  nlohmann::ordered_json head = header_of(bytes);
-  head["options"]["rr_join_threshold"] = "fast";
-  Result<ShardFile> bad = parse_shard(with_header(bytes, head.dump()), "x.shard");
-  ASSERT_FALSE(bad);
-  EXPECT_EQ(bad.error().render(), "x.shard:/options/rr_join_threshold: expected auto or a number");
+  for (const std::string name : {"rr_join_threshold", "rr_threshold"}) {
+    nlohmann::ordered_json head = header_of(bytes);
+    head["options"][name] = "fast";
+    Result<ShardFile> bad = parse_shard(with_header(bytes, head.dump()), "x.shard");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().render(), "x.shard:/options/" + name + ": expected auto or a number");
+  }
 }
 
 // Issue 39: the runs per camera ray (--splits) round-trip, and a shard written before them (no

@@ -37,7 +37,7 @@ struct Sampling {
   std::shared_ptr<const tracer::SplitMap> split_map{};  // with splits 0: these counts instead of the pilot's
   std::string name() const {
     return std::string(to_string(sampler)) + " rr-depth " + std::to_string(rr_depth) + " rr-threshold " +
-           std::to_string(rr_threshold) + " rr-light-threshold " + std::to_string(rr_light_threshold) + " rr-join-threshold " +
+           (rr_threshold < 0 ? std::string("auto") : std::to_string(rr_threshold)) + " rr-light-threshold " + std::to_string(rr_light_threshold) + " rr-join-threshold " +
            (rr_join_threshold < 0 ? std::string("auto") : std::to_string(rr_join_threshold)) + " light-sampling " +
            to_string(light_sampling) + " splits " + (!splits ? "default" : *splits != 0 ? std::to_string(*splits) : split_map ? "map" : "auto");
   }

@@ -825,10 +825,10 @@ namespace {
 // less than a tenth), roulette from the second vertex, and none.
 std::vector<Sampling> every_sampling() {
   std::vector<Sampling> out;
-  // The default first (bdpt's join roulette `auto`: the pilot's threshold, trace/accel/join_plan.h);
+  // The default first (bdpt's eye and join thresholds `auto`: the pilot's, trace/accel/join_plan.h);
   // then the eye and light thresholds apart (issue 39) and together, and the roulette of bdpt's
   // joins at 0 (none), 1 and far above it (every join of an eye vertex past the first rouletted,
-  // most of them skipped).
+  // most of them skipped; the eye's `auto` beside it).
   const RenderOptions d;
   for (SamplerKind k : {SamplerKind::kIndependent, SamplerKind::kSobol})
     for (auto [depth, eye, light, join] : std::vector<std::tuple<int, float, float, float>>{
