@@ -19,7 +19,11 @@ halves, whose difference measures it).
 
 The reference is rendered once by the --ref binary (default: --old) with --ref-renderer at
 --ref-spp, and kept in --cache (default ~/.cache/pathex-efficiency, outside git), keyed by scene
-text, resolution, bounce bound, renderer and spp.
+text, resolution, bounce bound, renderer and spp. `--ref-renderer NAME=RENDERER` (repeatable) gives
+the scene file NAME (its base name) a reference renderer of its own: a reference must sample every
+path the measured renderers do (pt-nee's misses light bdpt renders on sun-window.json and
+point-glass.json, and a ratio against it is then a CPU ratio), e.g.
+    --ref-renderer sun-window.json=bdpt --ref-renderer point-glass.json=bdpt
 
 Printed per (scene, renderer, spp): the median efficiency of each variant, and per round the ratio
 of each variant to the first (the old binary) with its median and range over rounds: rounds are
@@ -55,10 +59,24 @@ def scene_args(scene, resolution, max_bounces):
     return args
 
 
+def ref_renderers(values):
+    """(the default reference renderer, {scene base name: its own}) from the --ref-renderer values."""
+    default, own = "pt-nee", {}
+    for v in values:
+        name, sep, renderer = v.rpartition("=")
+        if sep:
+            own[name] = renderer
+        else:
+            default = renderer
+    return default, own
+
+
 def reference(args, scene, work):
-    """Paths of the two cached reference halves (rendered now if missing)."""
+    """Paths of the two cached reference halves (rendered now if missing), and the renderer."""
+    default, own = ref_renderers(args.ref_renderer)
+    renderer = own.get(os.path.basename(scene), default) if scene else default
     text = open(scene, "rb").read() if scene else b"embedded cornell"
-    key = hashlib.sha256(text + repr((args.resolution, args.max_bounces, args.ref_renderer, args.ref_spp)).encode()).hexdigest()[:16]
+    key = hashlib.sha256(text + repr((args.resolution, args.max_bounces, renderer, args.ref_spp)).encode()).hexdigest()[:16]
     name = (os.path.splitext(os.path.basename(scene))[0] if scene else "cornell") + "-" + key
     halves = [os.path.join(args.cache, f"{name}-{i}.exr") for i in (1, 2)]
     for i, path in enumerate(halves):
@@ -67,12 +85,12 @@ def reference(args, scene, work):
         os.makedirs(args.cache, exist_ok=True)
         out = os.path.join(work, f"ref{i}")
         cmd = ([args.ref, "trace"] + scene_args(scene, args.resolution, args.max_bounces) +
-               ["--renderer", args.ref_renderer, "--spp", str(args.ref_spp // 2), "--seed", str(900001 + i),
+               ["--renderer", renderer, "--spp", str(args.ref_spp // 2), "--seed", str(900001 + i),
                 "--threads", str(args.ref_threads), "--quiet", "--out", out])
         print(f"reference: {shlex.join(cmd)}", file=sys.stderr, flush=True)
         cpu_run(cmd)
         os.replace(os.path.join(out, "classes.exr"), path)
-    return halves
+    return halves, renderer
 
 
 def errors(image_error, halves, files, border, lamp_luminance=None):
@@ -124,7 +142,8 @@ def main():
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--border", type=int, default=2)
     ap.add_argument("--ref", default=None, help="binary for the reference (default: --old)")
-    ap.add_argument("--ref-renderer", default="pt-nee")
+    ap.add_argument("--ref-renderer", action="append", default=[],
+                    help="the reference's renderer (default pt-nee), or NAME=RENDERER for scene file NAME alone (repeatable)")
     ap.add_argument("--ref-spp", type=int, default=2048)
     ap.add_argument("--ref-threads", type=int, default=2)
     ap.add_argument("--cache", default=os.path.expanduser("~/.cache/pathex-efficiency"))
@@ -146,7 +165,7 @@ def main():
     records = []
     with tempfile.TemporaryDirectory(prefix="pathex-eff-") as work:
         for scene in scenes:
-            halves = reference(args, scene, work)
+            halves, ref_renderer = reference(args, scene, work)
             sname = scene or "cornell (embedded)"
             for renderer in renderers:
                 for spp in spps:
@@ -170,7 +189,7 @@ def main():
                                             "reference_noise": noise[0], "reference_noise_off": noise[1]})
                     base = runs[variants[0][0]]
                     print(f"\n{sname}, {renderer}, {spp} spp, {args.rounds} rounds "
-                          f"(reference noise {noise[0]:.3g} whole, {noise[1]:.3g} off)")
+                          f"(reference {ref_renderer} at {args.ref_spp} spp; noise {noise[0]:.3g} whole, {noise[1]:.3g} off)")
                     print(f"  {'variant':<14}{'CPU s':>8}{'MSE whole':>12}{'MSE off':>12}{'eff whole':>12}{'eff off':>12}"
                           f"   {'whole / ' + variants[0][0]:<26}{'off / ' + variants[0][0]}")
                     for label, _, _ in variants:
