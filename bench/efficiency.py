@@ -62,7 +62,7 @@ def scene_args(scene, resolution, max_bounces):
 def ref_renderers(values):
     """(the default reference renderer, {scene base name: its own}) from the --ref-renderer values."""
     default, own = "pt-nee", {}
-    for v in values:
+    for v in [values] if isinstance(values, str) else values:
         name, sep, renderer = v.rpartition("=")
         if sep:
             own[name] = renderer
