@@ -133,7 +133,7 @@ def main():
     ref_args = SimpleNamespace(resolution=None, max_bounces=64, ref_renderer="pt-nee", ref_spp=args.ref_spp,
                                cache=args.cache, ref=args.ref or args.pathex, ref_threads=args.ref_threads)
     with tempfile.TemporaryDirectory(prefix="pathex-tungsten-") as work:
-        halves = reference(ref_args, SCENE, work)
+        halves, _ = reference(ref_args, SCENE, work)
         t_scene = tungsten_scene(args.tungsten_scene, work) if args.tungsten else None
         for spp in (int(s) for s in args.spp.split(",")):
             runs = {label: [] for label, _, _ in variants}  # per round: (cpu, render cpu, mse, mse_off)
