@@ -245,7 +245,7 @@ Command add_trace(CLI::App& app) {
   };
   sub->add_option("--rr-threshold", args->options.job.rr_threshold,
                   "Russian roulette of eye subpaths only below this throughput (relative to the subpath's start); 0: no roulette; "
-                  "auto (the default): under bdpt's joins (bdpt, bdpt+manifold, the pbrt-v4 and Mitsuba bdpt profiles) the one "
+                  "auto (the default): under bdpt's joins (bdpt and its connector profiles, pbrt-v4-bdpt) the one "
                   "of 0.3, 0.5, 1 a pilot's model of its variance and cost finds most efficient for the scene, with "
                   "--rr-join-threshold's; else 0.3 (issue 39, docs/efficiency.md)")
       ->transform(auto_or("-1",  // kEyeThresholdAuto
