@@ -126,10 +126,12 @@ inline void price_sample(JoinPilot& p, const JoinTally& tally, const Vertex* eye
   for (int j = kMaxVertices - 1; j >= 0; --j)
     after[static_cast<std::size_t>(j)] = after[static_cast<std::size_t>(j + 1)] + tally.by_t[static_cast<std::size_t>(j + 1)];
   const double tau0 = p.eye[0];
+  std::vector<double> dvj(p.joins.size()), dcj(p.joins.size());  // per join candidate, for one eye candidate
   for (std::size_t e = 0; e < p.eye.size(); ++e) {
     const double tau = p.eye[e];
     double p0 = 1, pe = 1, rel_before = 1, dv = 0, dc = 0;
-    std::vector<double> dvj(p.joins.size()), dcj(p.joins.size());
+    std::fill(dvj.begin(), dvj.end(), 0.0);
+    std::fill(dcj.begin(), dcj.end(), 0.0);
     for (int j = 1; j < nt; ++j) {
       const auto ju = static_cast<std::size_t>(j);
       if (const float u = tally.survive[ju]; u > 0.0f && tau0 > 0) {  // the step to z(j) took the roulette
