@@ -23,18 +23,28 @@ NAME:SPP, so that each gets about the same CPU time, and options of its own as N
 (`bdpt+manifold:16:--manifold-seeds=1`). Several classes (each with its --reference, in order) are
 read from the same full renders, each reported as above:
 
-    python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDDSE LDDSSDSSDSE 'L[SD]{4,}E' \
-        --reference 8.555e-3 --reference 1.034e-3 --reference 0.13708 --rounds 96 \
+    python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDDSE LDDSSDSSDSE 'L[SD]{4,}E' \\
+        --reference 8.555e-3 --reference 1.034e-3 --reference 0.13708 --rounds 96 \\
         --renderer bdpt:64 --renderer bdpt+manifold:48 --renderer pt-nee+manifold:24
 
-    python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDSSDSE \
-        --reference 1.1e-3 --only --rounds 8 \
+    python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDSSDSE \\
+        --reference 1.1e-3 --only --rounds 8 \\
         --renderer pt-nee+manifold:16 --renderer pt:1024 --renderer pt-nee:1024 --renderer bdpt:512
+
+A renderer given at several sample counts (NAME:64, NAME:1024; the same NAME and options) also
+gets the exponent with which its RMSE against --reference falls with the sample count (-0.5 for
+an estimator of finite variance; slower for a heavy tail, whose efficiency then falls with the
+budget; docs/manifold.md):
+
+    python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDSSDSE \\
+        --reference 1.034e-3 --only --rounds 64 --renderer pt:4096 --renderer pt-nee+manifold:64 \\
+        --renderer pt-nee+manifold:1024 --renderer bdpt+manifold:64 --renderer bdpt+manifold:1024
+
 With --baseline OLD/pathex every renderer also runs with that binary, in the same rounds (labelled
 `@baseline`), and each line compares the renderer with its baseline; --only renders the class
 alone (`--only CLASS`) instead of taking it from a full render (`--classes`).
 
-    python3 bench/connector_efficiency.py build/pathex samples/scenes/point-glass.json LSDSSDDSE \
+    python3 bench/connector_efficiency.py build/pathex samples/scenes/point-glass.json LSDSSDDSE \\
         --renderer pt-nee+manifold --baseline /work/old-8eebe78/build/pathex --only --spp 16 --rounds 5
 """
 import argparse
@@ -125,10 +135,41 @@ def report(args, runs, path_class, results, reference):
             ratios = [n[3] / b[3] for n, b in zip(results[r], results[label])]
             print(f"  {r} against its baseline: {statistics.median(ratios):.3g} × (median of the rounds' ratios, "
                   f"{min(ratios):.3g}–{max(ratios):.3g})")
+    if reference is not None:
+        decay(args, results, reference)
     if len(args.renderer) > 1:
         best = max(args.renderer[1:], key=lambda r: statistics.median(x[3] for x in results[r]))
         best_eff = statistics.median(x[3] for x in results[best])
         print(f"  {args.renderer[0]} against the best of the others ({best}): {ref / best_eff:.3g} ×")
+
+def decay(args, results, reference):
+    """How a renderer's RMSE falls with its sample count, where it ran at several (NAME:SPP with the
+    same NAME and options): the exponent of spp between its smallest and largest count, -0.5 for an
+    estimator of finite variance; a heavy tail (a variance infinite, or finite only beyond the
+    budgets measured) falls slower. A 90 % interval from 2,000 resamplings of the rounds (seeds)."""
+    groups = {}
+    for r in args.renderer:
+        if ":" in r:
+            parts = r.split(":", 2)
+            groups.setdefault((parts[0], parts[2] if len(parts) > 2 else ""), []).append((int(parts[1]), r))
+    rng = __import__("random").Random(1)
+    for (name, extra), members in groups.items():
+        if len(members) < 2:
+            continue
+        (lo, r_lo), (hi, r_hi) = min(members), max(members)
+        a = [x[0] for x in results[r_lo]]
+        b = [x[0] for x in results[r_hi]]
+        def slope(xs, ys):
+            mse_lo = statistics.mean((x - reference) ** 2 for x in xs)
+            mse_hi = statistics.mean((y - reference) ** 2 for y in ys)
+            return 0.5 * math.log(mse_hi / mse_lo) / math.log(hi / lo) if mse_lo > 0 and mse_hi > 0 else float("nan")
+        n = min(len(a), len(b))
+        boot = sorted(slope([a[k] for k in idx], [b[k] for k in idx])
+                      for idx in ([rng.randrange(n) for _ in range(n)] for _ in range(2000)))
+        label = name + (":" + extra if extra else "")
+        print(f"  {label}: RMSE falls as spp^{slope(a, b):.2f} from {lo} to {hi} spp "
+              f"(90 % of resampled rounds {boot[100]:.2f} to {boot[1899]:.2f}; -0.5 for a finite variance)")
+
 
 if __name__ == "__main__":
     main()
