@@ -37,7 +37,7 @@ an estimator of finite variance; slower for a heavy tail, whose efficiency then 
 budget; docs/manifold.md):
 
     python3 bench/connector_efficiency.py build/pathex samples/scenes/lamp-glass.json LDDSSDSSDSE \\
-        --reference 1.034e-3 --only --rounds 64 --renderer pt:4096 --renderer pt-nee+manifold:64 \\
+        --reference 1.0575e-3 --only --rounds 64 --renderer pt:4096 --renderer pt-nee+manifold:64 \\
         --renderer pt-nee+manifold:1024 --renderer bdpt+manifold:64 --renderer bdpt+manifold:1024
 
 With --baseline OLD/pathex every renderer also runs with that binary, in the same rounds (labelled
