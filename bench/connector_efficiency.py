@@ -51,6 +51,7 @@ import argparse
 import math
 import json
 import os
+import random
 import statistics
 import subprocess
 import sys
@@ -142,6 +143,7 @@ def report(args, runs, path_class, results, reference):
         best_eff = statistics.median(x[3] for x in results[best])
         print(f"  {args.renderer[0]} against the best of the others ({best}): {ref / best_eff:.3g} ×")
 
+
 def decay(args, results, reference):
     """How a renderer's RMSE falls with its sample count, where it ran at several (NAME:SPP with the
     same NAME and options): the exponent of spp between its smallest and largest count, -0.5 for an
@@ -152,7 +154,7 @@ def decay(args, results, reference):
         if ":" in r:
             parts = r.split(":", 2)
             groups.setdefault((parts[0], parts[2] if len(parts) > 2 else ""), []).append((int(parts[1]), r))
-    rng = __import__("random").Random(1)
+    rng = random.Random(1)
     for (name, extra), members in groups.items():
         if len(members) < 2:
             continue
@@ -164,11 +166,13 @@ def decay(args, results, reference):
             mse_hi = statistics.mean((y - reference) ** 2 for y in ys)
             return 0.5 * math.log(mse_hi / mse_lo) / math.log(hi / lo) if mse_lo > 0 and mse_hi > 0 else float("nan")
         n = min(len(a), len(b))
-        boot = sorted(slope([a[k] for k in idx], [b[k] for k in idx])
-                      for idx in ([rng.randrange(n) for _ in range(n)] for _ in range(2000)))
+        draws = (slope([a[k] for k in idx], [b[k] for k in idx])
+                 for idx in ([rng.randrange(n) for _ in range(n)] for _ in range(2000)))
+        boot = sorted(x for x in draws if not math.isnan(x)) or [float("nan")]
         label = name + (":" + extra if extra else "")
         print(f"  {label}: RMSE falls as spp^{slope(a, b):.2f} from {lo} to {hi} spp "
-              f"(90 % of resampled rounds {boot[100]:.2f} to {boot[1899]:.2f}; -0.5 for a finite variance)")
+              f"(90 % of resampled rounds {boot[len(boot) // 20]:.2f} to {boot[len(boot) - 1 - len(boot) // 20]:.2f}; "
+              f"-0.5 for a finite variance)")
 
 
 if __name__ == "__main__":
