@@ -40,6 +40,9 @@ budget; docs/manifold.md):
         --reference 1.0575e-3 --only --rounds 64 --renderer pt:4096 --renderer pt-nee+manifold:64 \\
         --renderer pt-nee+manifold:1024 --renderer bdpt+manifold:64 --renderer bdpt+manifold:1024
 
+Round i (from 0) renders with seed 1 + i, or FIRST + i with --first-seed FIRST (another set of seeds
+for the same command).
+
 With --baseline OLD/pathex every renderer also runs with that binary, in the same rounds (labelled
 `@baseline`), and each line compares the renderer with its baseline; --only renders the class
 alone (`--only CLASS`) instead of taking it from a full render (`--classes`).
@@ -76,6 +79,7 @@ def main():
     ap.add_argument("--renderer", action="append", required=True, help="repeat; the first is the reference")
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--first-seed", type=int, default=1, help="round i renders with seed FIRST + i (another set of seeds)")
     ap.add_argument("--max-bounces", type=int, default=8)
     ap.add_argument("--baseline", help="another pathex binary: every renderer also runs with it")
     ap.add_argument("--only", action="store_true", help="render with --only CLASS (default: the class of a full render)")
@@ -105,7 +109,7 @@ def main():
             for label, binary, r in order:
                 with tempfile.TemporaryDirectory() as out:  # each binary writes its own folder
                     doc, cpu = run([binary, "trace", args.scene, "--renderer", r.split(":")[0], "--spp", str(spp_of[r]), *extra_of[r], *select,
-                                    "--seed", str(rnd + 1), "--threads", "1", "--max-bounces", str(args.max_bounces),
+                                    "--seed", str(args.first_seed + rnd), "--threads", "1", "--max-bounces", str(args.max_bounces),
                                     "--no-images", "--quiet", "--json", "--out", os.path.join(out, "o")])
                 for i, expr in enumerate(classes_of):
                     c = [c for c in doc["classes"] if c["expr"] == expr or c.get("name") == f"c{i}"][0]
