@@ -438,6 +438,80 @@ TEST(EmbreeRobustness, ClosedSphereChordsAtEveryScale) {
   }
 }
 
+// Watertightness: rays from inside a closed surface aimed exactly at the seams its primitives
+// share (a box's edges and corners between its six quads, each quad's own diagonal, where Embree
+// splits it into two triangles; a closed octahedron mesh's edges and vertices) must hit it. A
+// ray that slips between two primitives would leave a closed room (light leaks through its
+// corners) and, inside glass, a closed object. RTC_SCENE_FLAG_ROBUST selects Embree's
+// watertight intersectors (Plücker coordinates); its default Möller tests are not watertight
+// and fail this test (bench/README.md, "Issue 39, twenty-second session").
+TEST(EmbreeRobustness, RaysAimedAtSharedEdgesAndCornersNeverSlipThrough) {
+  for (const auto& [scale, offset] : {std::pair{1.0f, vec3(0.0f)}, std::pair{1e-3f, vec3(0.0f)}, std::pair{1e3f, vec3(0.0f)},
+                                      std::pair{1.0f, vec3(300.0f, -200.0f, 100.0f)}}) {
+    Scene scene;
+    scene.materials = {Diffuse{}};
+    scene.material_names = {"m"};
+    const auto P = [&](vec3 p) { return offset + scale * p; };
+    const auto V = [&](vec3 v) { return scale * v; };
+    for (ShapeGeometry g : {ShapeGeometry{QuadShape{P({-1, -1, -1}), V({0, 0, 2}), V({2, 0, 0})}},
+                            ShapeGeometry{QuadShape{P({-1, 1, -1}), V({2, 0, 0}), V({0, 0, 2})}},
+                            ShapeGeometry{QuadShape{P({-1, -1, -1}), V({2, 0, 0}), V({0, 2, 0})}},
+                            ShapeGeometry{QuadShape{P({-1, -1, 1}), V({0, 2, 0}), V({2, 0, 0})}},
+                            ShapeGeometry{QuadShape{P({-1, -1, -1}), V({0, 2, 0}), V({0, 0, 2})}},
+                            ShapeGeometry{QuadShape{P({1, -1, -1}), V({0, 0, 2}), V({0, 2, 0})}}}) {
+      Shape shape;
+      shape.geometry = g;
+      scene.shapes.push_back(shape);
+    }
+    auto es = EmbreeScene::build(scene);
+    ASSERT_TRUE(es.ok());
+    // The octahedron |x| + |y| + |z| = 0.5, alone in a scene of its own.
+    Scene octa_scene;
+    octa_scene.materials = {Diffuse{}};
+    octa_scene.material_names = {"m"};
+    MeshShape octa;
+    for (vec3 p : {vec3(0.5f, 0, 0), vec3(-0.5f, 0, 0), vec3(0, 0.5f, 0), vec3(0, -0.5f, 0), vec3(0, 0, 0.5f), vec3(0, 0, -0.5f)})
+      octa.positions.push_back(P(p));
+    octa.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    Shape octa_shape;
+    octa_shape.geometry = std::move(octa);
+    octa_scene.shapes.push_back(std::move(octa_shape));
+    auto eo = EmbreeScene::build(octa_scene);
+    ASSERT_TRUE(eo.ok());
+    // Seams as segments (a, b) of the unit shapes; a target is a float point on one of them.
+    std::vector<std::pair<vec3, vec3>> box_seams, octa_seams;
+    const vec3 c[8] = {{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {-1, 1, 1}, {1, 1, 1}};
+    for (int i = 0; i < 8; ++i)
+      for (int j = i + 1; j < 8; ++j) {
+        const int differ = (c[i].x != c[j].x) + (c[i].y != c[j].y) + (c[i].z != c[j].z);
+        if (differ <= 2) box_seams.push_back({c[i], c[j]});  // the 12 edges and the 12 face diagonals (both of each face)
+      }
+    const vec3 o[6] = {{0.5f, 0, 0}, {-0.5f, 0, 0}, {0, 0.5f, 0}, {0, -0.5f, 0}, {0, 0, 0.5f}, {0, 0, -0.5f}};
+    for (int i = 0; i < 6; ++i)
+      for (int j = i + 1; j < 6; ++j)
+        if (glm::dot(o[i], o[j]) == 0.0f) octa_seams.push_back({o[i], o[j]});  // its 12 edges
+    Uniform u;
+    int box_slipped = 0, octa_slipped = 0, rays = 0;
+    for (int r = 0; r < 20000; ++r) {
+      for (int which = 0; which < 2; ++which) {
+        const auto& seams = which == 0 ? box_seams : octa_seams;
+        const auto& [a, b] = seams[static_cast<std::size_t>(u.next() * static_cast<float>(seams.size()))];
+        // Every 8th target a corner (a seam's end), the rest along the seam.
+        const float f = r % 8 == 0 ? 0.0f : u.next();
+        const vec3 target = P(a + f * (b - a));
+        const float reach = which == 0 ? 0.9f : 0.3f;  // origins inside either shape
+        const vec3 origin = P(reach * (2.0f * vec3(u.next(), u.next(), u.next()) - 1.0f) / (which == 0 ? 1.0f : 3.0f));
+        const vec3 d = glm::normalize(target - origin);
+        ++rays;
+        const std::optional<Hit> h = (which == 0 ? *es : *eo)->intersect(origin, d, 0.0f, INFINITY);
+        if (!h) ++(which == 0 ? box_slipped : octa_slipped);
+      }
+    }
+    EXPECT_EQ(box_slipped, 0) << "scale " << scale << " offset " << offset.x << ", " << rays << " rays";
+    EXPECT_EQ(octa_slipped, 0) << "scale " << scale << " offset " << offset.x << ", " << rays << " rays";
+  }
+}
+
 TEST(Embree, ConcurrentQueriesAgreeWithSerialOnes) {
   const Scene scene = box_scene(1.0f, vec3(0.0f));
   auto es = EmbreeScene::build(scene);
