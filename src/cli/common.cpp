@@ -82,11 +82,11 @@ void add_manifold_options(CLI::App* app, ManifoldOptions* o) {
                   "no inverse-probability estimate (Zeltner et al. 2020's fixed trials); 0: the unbiased estimator")
       ->capture_default_str()->check(non_negative())->check(CLI::Range(0, 100000))->group(group);
   app->add_option(name[7], o->rate,
-                  "Share of the eye subpaths whose joins run the connector where the camera sees its eye end directly or "
-                  "past a diffuse vertex (a coin per sample; unbiased: the contribution is divided by it and MIS weighs the "
-                  "connector by it), and where another strategy samples the path too: always in a profile with light "
-                  "subpaths (light tracing, bdpt's joins), else where the light end is not a point (an eye path can hit "
-                  "the light); elsewhere every sample runs it; default 0.125")
+                  "Share of the eye subpaths whose joins run the connector (a coin per sample; unbiased: the contribution "
+                  "is divided by it and MIS weighs the connector by it) where another strategy samples the path too: in a "
+                  "profile with light subpaths (light tracing, bdpt's joins), where the camera sees the join's eye end "
+                  "directly or past a diffuse vertex; in one without (pt-nee+manifold), where the light end is not a point "
+                  "(an eye path can hit the light), also through glass; elsewhere every sample runs it; default 0.125")
       ->check(real_in(0, true, 1, false))->group(group);
 }
 

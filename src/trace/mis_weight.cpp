@@ -25,11 +25,12 @@
 
 namespace pathex::tracer {
 
-// The manifold connector runs for this share of the samples where the camera sees its eye end x_b
-// directly or past a diffuse vertex (--manifold-rate), for every sample where it sees x_b through
-// specular vertices only: the factor of its density in the weight (n_i p_i).
+// The manifold connector runs for this share of the samples (--manifold-rate), the factor of its
+// density in the weight (n_i p_i): where the camera sees its eye end x_b directly or past a diffuse
+// vertex, and, without a light subpath (pt-nee+manifold), also where it sees x_b through specular
+// vertices only; with one (bdpt+manifold), those joins run in every sample (docs/manifold.md).
 double Integrator::manifold_rate(PathKey key, int b, int k) const {
-  bool through = b + 1 <= k - 1;  // the camera sees x_b through S vertices only (x_v's letter is c(v+1))
+  bool through = max_light_ >= 2 && b + 1 <= k - 1;  // the camera sees x_b through S vertices only (x_v's letter is c(v+1))
   for (int v = b + 1; v <= k - 1 && through; ++v) through = !packed_is_d(key, v + 1);
   // Nor where x0 is a point (c0 = S) and no light subpath's join shares the path (pt-nee+manifold: the connector's alone).
   return through || (max_light_ < 2 && !packed_is_d(key, 0)) ? 1.0 : o_.manifold.rate.value_or(1.0);

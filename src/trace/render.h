@@ -235,11 +235,14 @@ struct StrategySet {
 Result<StrategySet> runnable_strategies(const Profile& profile);
 
 // --manifold-rate's and --manifold-seeds' defaults (issue 40), which render() and the shard header resolve.
-// The rate applies where the camera sees the join's eye end directly or past a diffuse vertex and another
-// strategy of the profile samples the path too (Integrator::manifold_rate()): always where the profile has
-// light subpaths (s >= 2: light tracing, bdpt's joins), else (pt-nee+manifold) where the light end is not a
-// point (an eye path hits an area light); there the connector runs in kShareWithOtherPaths of the samples
-// (measured best on lamp-glass.json: bench/README.md, issue 40, tenth and eleventh sessions). One seed a
+// The rate applies where another strategy of the profile samples the path too (Integrator::manifold_rate()):
+// where the profile has light subpaths (s >= 2: light tracing, bdpt's joins), to the joins whose eye end the
+// camera sees directly or past a diffuse vertex (those it sees through specular vertices only run in every
+// sample: there the rate halved bdpt+manifold's caustic seen through the ball); else (pt-nee+manifold) to
+// every join whose light end is not a point (an eye path hits an area light: on the caustic seen through the
+// ball the variance then grows as q^-0.26, not 1/q, the emitter hit taking the fold). There the connector
+// runs in kShareWithOtherPaths of the samples (measured best on lamp-glass.json: bench/README.md, issue 40,
+// tenth, eleventh and twenty-second sessions). One seed a
 // batch where the profile has light subpaths, else kManifoldSeeds (pt-nee+manifold: its caustics seen
 // through the glass and under a point light have no other strategy; one seed measured 0.3-0.7x there).
 inline constexpr double kShareWithOtherPaths = 0.125;

@@ -104,7 +104,7 @@ void Integrator::connect_manifold(Thread& th, Sampler& rng, int s, int t, int ba
   const int strategy_index = manifold_of(s, t);
   ConnectorStats& stats = th.connectors[static_cast<std::size_t>(strategy_index)];
   // manifold_rate() from the eye subpath and the light; below 1, one coin per sample (from a stream of its own).
-  bool through = t >= 3;
+  bool through = max_light_ >= 2 && t >= 3;
   for (int j = 1; j <= t - 2 && through; ++j) through = th.eye[static_cast<std::size_t>(j)].letter == 'S';
   double rate = through ? 1.0 : o_.manifold.rate.value_or(1.0);
   const bool skip = rate < 1.0 && static_cast<double>(stream_bits(stream_key(rng.key(), th.pass, 0x6d616e6966726174ULL), 0) >> 11) * 0x1p-53 >= rate;
