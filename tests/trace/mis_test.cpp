@@ -81,8 +81,8 @@ struct IntegratorTestAccess {
     c(s + 1) = 'D';
     return out;
   }
-  // The factor of the manifold connector's density in the weight of the path `key` whose chain's eye
-  // end is x_b (its rate where it runs in a share of the samples).
+  // The factor of the manifold connector's density in the weights of connection (s, t)'s path for a
+  // chain whose eye end is x_b (its rate where it runs in a share of the samples).
   static double manifold_rate(const Integrator& in, const Thread& th, int s, int t, int b) {
     return in.manifold_rate(in.path_key(th, s, t, nullptr), b, s + t - 1);
   }
@@ -624,9 +624,10 @@ TEST(Mis, ManifoldAndPlainJoinWeightsSumToOne) {
 // pt-nee+manifold (no light subpath) at --manifold-rate 0.25: the rate is the factor of the
 // connector's density on every path of an area light (issue 40, twenty-second session), also where the
 // camera sees the chain's eye end through the glass (the caustic seen through the ball, which the
-// eye's hits of the lamp through the ball sample too). The whole-path weights of the emitter hit,
-// next-event estimation and every chain sum to 1, and the renderer's weight of each plain join equals
-// the whole path's; some of the paths are seen through the ball with a chain beyond it.
+// eye's hits of the lamp through the ball sample too). On eye paths that hit the lamp (s = 0), the
+// whole-path weights of the emitter hit, next-event estimation and every chain sum to 1, the
+// renderer's weight of the emitter hit equals the whole path's, and where the camera sees the chain's
+// eye end through the ball the connector's factor is the rate (98 such paths, where it was 1 before the change).
 TEST(Mis, PtNeeManifoldWeightsSumToOneWithTheRateThroughGlass) {
   const Profile profile = parse_profile(test::read_file(std::string(PATHEX_SOURCE_DIR) + "/samples/renderers/pt-nee+manifold.json"),
                                         "pt-nee+manifold.json", Limits{})
@@ -646,23 +647,21 @@ TEST(Mis, PtNeeManifoldWeightsSumToOneWithTheRateThroughGlass) {
     Sampler rng(7, static_cast<std::uint64_t>(i), 0);
     int ns = 0;
     const int nt = A::trace_subpaths(rig.in, rig.th, rng, i % rig.rs.camera.width, (i / rig.rs.camera.width) % rig.rs.camera.height, &ns);
-    for (int t = 2; t <= nt; ++t)
-      for (int s = 0; s <= std::min(ns, 1); ++s) {
-        if (s + t - 2 > *rig.o.max_bounces || !A::joinable(rig.in, rig.th, s, t)) continue;
-        int chains = 0;
-        const double sum = A::whole_path_weight_sum(rig.in, rig.th, s, t, &chains);
-        ++checked;
-        // The camera sees the eye subpath's vertex z2 through the ball (z0, z1 S) and a chain lies beyond it.
-        if (chains > 0 && t >= 4 && rig.th.eye[1].letter == 'S' && rig.th.eye[2].letter == 'S' && rig.th.eye[3].letter == 'D') {
-          ++through;
-          EXPECT_EQ(A::manifold_rate(rig.in, rig.th, s, t, s + t - 4), 0.25);  // the floor point z3 is x_(k-3)
-        }
-        const std::string where = A::label(rig.in, rig.th, s, t) + " (s=" + std::to_string(s) + ", t=" + std::to_string(t) + ")";
-        EXPECT_NEAR(sum, 1.0, 1e-4) << where;
-        if (s == 1) continue;  // (y0 stands for next-event estimation's fresh point: its own weight is checked elsewhere)
-        const float general = A::general_weight(rig.in, rig.th, s, t);
-        EXPECT_NEAR(A::own_weight(rig.in, rig.th, s, t), general, 1e-4 * std::max(1.0f, general)) << where;
+    for (int t = 2; t <= nt; ++t) {
+      if (t - 2 > *rig.o.max_bounces || !A::joinable(rig.in, rig.th, 0, t)) continue;
+      int chains = 0;
+      const double sum = A::whole_path_weight_sum(rig.in, rig.th, 0, t, &chains);
+      ++checked;
+      // The camera sees the eye subpath's vertex z3 through the ball (z1, z2 S) and a chain lies beyond it.
+      if (chains > 0 && t >= 4 && rig.th.eye[1].letter == 'S' && rig.th.eye[2].letter == 'S' && rig.th.eye[3].letter == 'D') {
+        ++through;
+        EXPECT_EQ(A::manifold_rate(rig.in, rig.th, 0, t, t - 4), 0.25);  // z3 is x_(k-3), k = t - 1
       }
+      const std::string where = A::label(rig.in, rig.th, 0, t) + " (s=0, t=" + std::to_string(t) + ")";
+      EXPECT_NEAR(sum, 1.0, 1e-4) << where;
+      const float general = A::general_weight(rig.in, rig.th, 0, t);
+      EXPECT_NEAR(A::own_weight(rig.in, rig.th, 0, t), general, 1e-4 * std::max(1.0f, general)) << where;
+    }
   }
   EXPECT_GT(checked, 5000) << through;
   EXPECT_GT(through, 40) << checked;  // emitter hits seen through the ball with a chain (the ball again) before the lamp
