@@ -47,8 +47,9 @@ inline constexpr int kReferenceExtraBounces = 8;
 inline constexpr int kMaxReferenceBounces = 1000;  // the tracer's ceiling
 
 // The default reference for a scene: the built-in `bdpt` plus, for each connector found in the
-// built-in profiles that the tracer runs, one strategy (the built-ins' widest for that connector)
-// when its language meets the scene's `universe` within `bound`. Named "bdpt+<connector>+…".
+// built-in profiles that the tracer runs, the built-ins' widest strategies for that connector (each
+// whose language no other's holds, e.g. bdpt+manifold's t >= 2 and t = 1) when their languages meet
+// the scene's `universe` within `bound`. Named "bdpt+<connector>+…", each connector once.
 Result<Profile> default_reference(const Dfa& universe, int bound, const Limits& limits);
 
 // The reference's bound: `requested`, else the default above. Fails (kUsage) when a requested

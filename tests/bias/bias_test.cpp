@@ -264,6 +264,33 @@ TEST(Bias, ReferenceIsBdptPlusTheConnectorsTheSceneNeeds) {
             "bdpt+mirror+ortho-projection+manifold");
 }
 
+// Per connector every widest strategy of the built-ins joins the reference: bdpt+manifold's t >= 2
+// and its pinhole-ending t = 1 each sample paths the other cannot (pt-nee+manifold's (1, DS+D, 2..)
+// lies within the first and stays out; so does pt-nee+mirror's within bdpt+mirror's).
+TEST(Bias, ReferenceTakesEveryWidestStrategyOfAConnector) {
+  const Profile ref = choose_reference("", load(sample("cornell.json")), profile("pt"), BiasOptions{}).expect("a reference");
+  std::vector<std::string> described;
+  for (const Strategy& st : ref.strategies) described.push_back(st.name + " " + st.describe());
+  EXPECT_EQ(described, (std::vector<std::string>{"bdpt (0.., DD, 0..)", "mirror (1.., DSD, 1..) via mirror",
+                                                  "manifold (1.., DS+D, 2..) via manifold",
+                                                  "manifold-splat (1.., DS+D, 1) via manifold"}));
+}
+
+// Under a point light above a glass ball and a pinhole, the light seen through or in the ball
+// (LSDSSDSE, LSDSDSE, …: x0 and the camera both fixed) is joined only by the manifold connector
+// at t = 1. With it in the reference every path pt-nee misses is counted: none is left unknown
+// (without it, LSDSSDSE, LSDSSSDSE, … were listed as paths neither can sample), and the light
+// seen in the ball is measured.
+TEST(Bias, TheReferenceCountsTheLightSeenInAndThroughGlassUnderAPointLight) {
+  const BiasRun run = bias(load(sample("point-glass.json")), "pt-nee", 4);
+  EXPECT_TRUE(run.report.neither.empty()) << run.report.neither.front().path;
+  EXPECT_TRUE(run.report.neither_finite);
+  const auto seen_in_ball = std::find_if(run.report.paths.begin(), run.report.paths.end(),
+                                         [](const MissedPath& p) { return p.estimate.path == "LSDSDSE"; });
+  ASSERT_NE(seen_in_ball, run.report.paths.end());
+  EXPECT_GT(seen_in_ball->estimate.estimate.luminance, 0.0);
+}
+
 TEST(Bias, TheReferenceRendersDeeperThanTheRenderersBound) {
   EXPECT_EQ(reference_bound("pt", std::nullopt, std::nullopt).expect("a bound"), 16);
   EXPECT_EQ(reference_bound("pbrt-v4-path", 5, std::nullopt).expect("a bound"), 16);
