@@ -42,6 +42,7 @@ STATISTICAL_TESTS = [
     ("converge_test", "Converge.ClosedFormSceneErrorsFallAsOneOverSqrtAndStderrIsHonest"),
     ("bias_test", "Bias.UnderSampledLightIsFoundWhereTheStderrCannotSeeIt"),
     ("bias_test", "Bias.ACorrectRendererAtItsBudgetIsNotFlagged"),
+    ("bias_test", "Bias.TheReferencesTwoJoinsOfTheLightSeenInTheMirrorSumToTheClosedForm"),
     ("far_geometry_test", "FarGeometry.LeavesTheCornellBoxUnchanged"),
     ("manifold_test", "ManifoldRender.MirrorSphereImageOnTheFloorIsTheClosedForm"),
     ("manifold_test", "ManifoldRender.TenInterfacesStayFiniteAndAreFound"),

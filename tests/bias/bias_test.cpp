@@ -276,6 +276,29 @@ TEST(Bias, ReferenceTakesEveryWidestStrategyOfAConnector) {
                                                   "manifold-splat (1.., DS+D, 1) via manifold"}));
 }
 
+// The light seen in the planar mirror (LSDSDSE) is joined at t = 1 by two connectors of the default
+// reference: the mirror's (exact: the light's image is one point) and the manifold's pinhole-ending
+// join, weighed against each other by MIS. Their sum is the closed form, the light's image of
+// intensity R I seen directly: R I / (d² cos³θ) over the film's area 4 tan² (the line of sight to
+// the image crosses the mirror at (1.2, 1.05, 0.55), inside it).
+TEST(Bias, TheReferencesTwoJoinsOfTheLightSeenInTheMirrorSumToTheClosedForm) {
+  const BiasRun run = bias(load(sample("point-mirror-caustic.json")), "pt-nee", 64, "", test::stat_seed(7));
+  const glm::dvec3 fwd = glm::normalize(glm::dvec3(0.3, 0, 0) - kCam);
+  const glm::dvec3 v = kImage - kCam;
+  const double d2 = glm::dot(v, v), cos_theta = glm::dot(v, fwd) / std::sqrt(d2);
+  const double expected = kR * kI / (d2 * cos_theta * cos_theta * cos_theta * 4.0 * kTan * kTan);  // 0.295792
+  const auto seen = std::find_if(run.report.paths.begin(), run.report.paths.end(),
+                                 [](const MissedPath& p) { return p.estimate.path == "LSDSDSE"; });
+  ASSERT_NE(seen, run.report.paths.end());
+  const Estimate& e = seen->estimate.estimate;
+  std::vector<std::string> techniques;
+  for (const TechniqueEstimate& t : seen->estimate.strategies) techniques.push_back(t.name);
+  EXPECT_EQ(techniques, (std::vector<std::string>{"mirror (1, DSD, 1)", "manifold-splat (1, DSD, 1)"}));
+  EXPECT_GT(e.std_error, 0.0);  // the manifold's share is drawn at its rate
+  EXPECT_LE(std::fabs(e.luminance - expected), 4.0 * e.std_error + 1e-6 * expected)
+      << e.luminance << " ± " << e.std_error << " vs " << expected;
+}
+
 // Under a point light above a glass ball and a pinhole, the light seen through or in the ball
 // (LSDSSDSE, LSDSDSE, …: x0 and the camera both fixed) is joined only by the manifold connector
 // at t = 1. With it in the reference every path pt-nee misses is counted: none is left unknown
