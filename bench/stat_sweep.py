@@ -69,6 +69,7 @@ STATISTICAL_TESTS = [
     ("piecewise2d_test", "Piecewise2D.SamplesFollowTheDensityAndReportIt"),
     ("emission_cones_test", "EmissionCones.SampledDensityIsThePdfAndTheEstimatorIsUnbiased"),
     ("convergence_test", "Convergence.BatchVarianceIsStableForNormalMeansAndNotForASpike"),
+    ("convergence_test", "Convergence.AnEstimatesStderrStabilityIsFlaggedWhereOneGroupCarriesIt"),
     ("histogram_test", "ReplicateGroups.StratifiedReplicatesGetAnHonestStderr"),
     # The BSDF, emitter, random-number and histogram unit tests (issue 36, seventh session).
     ("bsdf_test", "Diffuse.WhiteFurnaceAndSampleWeights"),

@@ -125,10 +125,10 @@ int run(const TraceArgs& a) {
   if (!job.classes->requested.empty()) {
     std::cout << "rendered only";
     for (const PathClass* c : job.classes->requested) std::cout << " " << c->name << " (" << c->text << ")";
-    std::cout << "\nluminance of those paths " << absolute(rep->total) << "\n"
+    std::cout << "\nluminance of those paths " << absolute(rep->total) << unstable_text(rep->total) << "\n"
               << "(shares are of the requested paths' total; luminances are absolute, comparable between renderers)\n";
   } else {
-    std::cout << "image mean luminance " << absolute(rep->total) << "\n"
+    std::cout << "image mean luminance " << absolute(rep->total) << unstable_text(rep->total) << "\n"
               << "(shares are of this render's total; luminances are absolute, comparable between renderers)\n";
   }
   for (const PrunedStrategy& p : changes)
@@ -148,7 +148,7 @@ int run(const TraceArgs& a) {
     const double err = rep->total.luminance > 0 ? c.estimate.std_error / rep->total.luminance : 0.0;
     std::cout << c.name << ": " << percent(c.share) << " of the image, ±" << percent(std::isfinite(err) ? err : 0.0, 2)
               << "; " << id.renderer << ": " << (q ? to_string(q->verdict) : "?") << "; luminance "
-              << absolute(c.estimate) << "\n";
+              << absolute(c.estimate) << unstable_text(c.estimate) << "\n";
     if (!c.strategies.empty()) std::cout << "  from " << techniques_text(c.strategies, 3) << "\n";
   }
   if (!sums.connectors.empty()) {  // the render's: with the resumed and the other ranks' passes

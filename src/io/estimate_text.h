@@ -26,6 +26,17 @@ inline std::string absolute(const Estimate& e) {
   return buf;
 }
 
+// What trace adds to an estimate whose stderr is unstable (Estimate::stability ≥ kUnstableVariance,
+// and the stderr more than rounding): "; its stderr is unstable (a few pixel groups carry it: its
+// square's relative error is 0.83)", else nothing.
+inline std::string unstable_text(const Estimate& e) {
+  if (!(std::isfinite(e.stability) && e.stability >= kUnstableVariance && e.std_error > kRoundingFloor * std::fabs(e.luminance)))
+    return "";
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "; its stderr is unstable (a few pixel groups carry it: its square's relative error is %.2f)", e.stability);
+  return buf;
+}
+
 // The techniques that carry an estimate, largest share first, at most `most` of them (the rest are
 // counted): "bdpt (2, DD, 0) 97.0 % (80.0 % of the variance), bdpt (1, DD, 1) 3.0 % (20.0 %)".
 // Where a technique's errors are correlated with the rest's (|r| ≥ kCorrelationWorthSaying) it is

@@ -161,6 +161,9 @@ class Reader {
     if (const json* se = field(obj, ptr, "stderr"); se != nullptr && !se->is_null())
       e.std_error = number(*se, ptr + "/stderr");
     if (samples_required || (obj.is_object() && obj.contains("samples"))) e.samples = uint(obj, ptr, "samples");
+    // The total's and the classes' (optional: added by the twenty-third session's format).
+    if (obj.is_object() && obj.contains("stderr_stability") && !obj["stderr_stability"].is_null())
+      e.stability = number(obj["stderr_stability"], ptr + "/stderr_stability");
     return e;
   }
 
@@ -211,6 +214,7 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
   doc["max_paths"] = r.max_paths ? json(*r.max_paths) : json(nullptr);
   json total = json::object();
   put_estimate(total, r.total);
+  total["stderr_stability"] = stderr_json(r.total.stability);
   doc["total"] = std::move(total);
   json classes = json::array();
   for (const ClassEstimate& c : r.classes) {
@@ -224,6 +228,7 @@ json to_json(const HistogramReport& r, const Histogram* raw) {
       continue;
     }
     put_estimate(j, c.estimate);
+    j["stderr_stability"] = stderr_json(c.estimate.stability);
     j["share"] = c.share;
     j["strategies"] = techniques_json(c.strategies);
     classes.push_back(std::move(j));

@@ -125,7 +125,7 @@ Result<bool> measure_rung(const RenderOutput& out, const Classifier* classifier,
     ClassMeasure c;
     c.estimate = e.luminance;
     c.std_error = e.std_error;
-    c.stability = stderr_stability(out.histogram, classifier, static_cast<int>(i) - 1);
+    c.stability = e.stability;
     c.dof = e.dof;
     if (rows[i].pixels) {
       const std::vector<float> lum = luminance_image(layers[i].image);

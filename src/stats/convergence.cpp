@@ -9,22 +9,6 @@
 
 namespace pathex {
 
-double stderr_stability(const Histogram& histogram, const Classifier* classifier, int class_index) {
-  const int batches = histogram.num_batches();
-  std::vector<ExactRgb> sums(static_cast<std::size_t>(batches), ExactRgb{});
-  for (Histogram::PathId id = 0; id < histogram.num_paths(); ++id) {
-    if (class_index >= 0) {
-      if (classifier == nullptr) return std::numeric_limits<double>::quiet_NaN();
-      const std::vector<int>& members = classifier->members(histogram.class_set(id));
-      if (std::find(members.begin(), members.end(), class_index) == members.end()) continue;
-    }
-    for (int b = 0; b < batches; ++b) add_to(sums[static_cast<std::size_t>(b)], histogram.cell(id, b).sum);
-  }
-  std::vector<double> lum(sums.size());
-  for (std::size_t b = 0; b < sums.size(); ++b) lum[b] = luminance(to_double(sums[b]));
-  return histogram.variance_design().variance_relative_error(lum);
-}
-
 namespace {
 
 // P(χ²_k > x) for an integer k, in closed form: for even k, e^(-x/2) Σ_{i<k/2} (x/2)^i / i!; for

@@ -21,13 +21,14 @@
 // within that).
 //
 // The second check needs no reference: the stability of the stderr itself, ε, the relative
-// standard error of the variance estimate (VarianceDesign::variance_relative_error(),
+// standard error of the variance estimate (Estimate::stability, VarianceDesign::variance_relative_error(),
 // stats/histogram.h): with G pixel groups of two replicates, from the spread of the groups'
 // terms, sqrt(2/G) = 0.35 for normal ones at G = 16; with B plain batch means of sample kurtosis κ,
 // sqrt((κ − (B − 3)/(B − 1)) / B), 0.25 for normal batch means at B = 32. Either is about 1 when
 // one group or batch holds nearly all of the estimate (a rare spike). The ladder is flagged as unstable when the median ε over its rungs is at
 // least kUnstableVariance: then a few batches carry the estimate and the next render's stderr may
-// differ from this one's by more than itself.
+// differ from this one's by more than itself. pathex trace says so of a single render's total
+// or class whose ε is at least kUnstableVariance.
 #pragma once
 
 #include <cstddef>
@@ -41,12 +42,6 @@
 namespace pathex {
 
 inline constexpr double kStderrCheckAlpha = 1e-3;  // false-alarm rate of the χ² check per ladder
-inline constexpr double kUnstableVariance = 0.7;   // median relative error of the batch variance
-inline constexpr double kRoundingFloor = 1e-6;     // relative error of single-precision transport
-
-// ε for one class of `classifier` (class_index ≥ 0) or the whole image (class_index < 0): the
-// relative error of its variance estimate (VarianceDesign::variance_relative_error(), stats/histogram.h).
-double stderr_stability(const Histogram& histogram, const Classifier* classifier, int class_index);
 
 // The upper quantile of the χ² distribution with `dof` ≥ 1 degrees of freedom: the x with
 // P(χ²_dof > x) = alpha (the survival function in closed form for integer dof, solved by bisection).

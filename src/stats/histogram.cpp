@@ -323,6 +323,7 @@ Estimate estimate_of(const std::vector<ExactRgb>& batch_sums, const VarianceDesi
   for (std::size_t b = 0; b < batch_sums.size(); ++b) lum[b] = luminance(to_double(batch_sums[b]));
   e.std_error = std::sqrt(design.variance(lum));
   e.dof = design.dof(lum);
+  e.stability = design.variance_relative_error(lum);
   return e;
 }
 

@@ -439,7 +439,19 @@ struct Estimate {
   double std_error = std::numeric_limits<double>::quiet_NaN();  // of luminance (VarianceDesign)
   int dof = 0;                 // std_error's degrees of freedom (VarianceDesign::dof(sums))
   std::uint64_t samples = 0;   // nonzero contributions (a BDPT sample may contribute several)
+  // The relative error of std_error² (VarianceDesign::variance_relative_error()): about 0.35 for
+  // well-behaved pixel groups, near 1 when one group holds nearly all of the variance (a rare
+  // spike: the stderr may then be several times too small; kUnstableVariance below). NaN when
+  // unknown (fewer than 4 groups with a variance).
+  double stability = std::numeric_limits<double>::quiet_NaN();
 };
+// The stability at and above which a stderr is flagged as unstable: by converge for a ladder (the
+// median over its rungs, stats/convergence.h), by pathex trace for one render's total or class.
+// Normal pixel groups reach it in 3 renders of 10,000 (16 groups: ε ≈ 0.31 at the median).
+inline constexpr double kUnstableVariance = 0.7;
+// The relative error of single-precision transport: an error or a stderr below this fraction of
+// its estimate is rounding, not noise (converge's checks, stats/convergence.h; trace's flag above).
+inline constexpr double kRoundingFloor = 1e-6;
 
 // The estimate from exact per-batch sums, its stderr by `design` (the formula above).
 Estimate estimate_of(const std::vector<ExactRgb>& batch_sums, const VarianceDesign& design, std::uint64_t contributions);

@@ -75,10 +75,10 @@ TEST(HistogramJson, HasTheDocumentedKeysInOrder) {
   EXPECT_EQ(doc["spp"], 64);
   EXPECT_EQ(doc["complete"], true);
   EXPECT_EQ(doc["nonfinite_samples"], 0);
-  EXPECT_EQ(keys(doc["total"]), (std::vector<std::string>{"estimate", "luminance", "stderr", "samples"}));
+  EXPECT_EQ(keys(doc["total"]), (std::vector<std::string>{"estimate", "luminance", "stderr", "samples", "stderr_stability"}));
   ASSERT_EQ(doc["classes"].size(), 2u);
   EXPECT_EQ(keys(doc["classes"][0]), (std::vector<std::string>{"name", "expr", "estimate", "luminance", "stderr",
-                                                                "samples", "share", "strategies"}));
+                                                                "samples", "stderr_stability", "share", "strategies"}));
   EXPECT_EQ(keys(doc["classes"][0]["strategies"]), (std::vector<std::string>{"nee (1, DD, 3)", "emitter-hit (0, DD, 3)"}));
   EXPECT_EQ(doc["classes"][1]["name"], "area");
   EXPECT_EQ(doc["classes"][1]["expr"], "LD.*E");
@@ -102,6 +102,9 @@ TEST(HistogramJson, ReportRoundTrips) {
   EXPECT_EQ(b.run, r.run);
   EXPECT_EQ(b.nonfinite_samples, r.nonfinite_samples);
   expect_same_estimate(b.total, r.total);
+  // The total's and the classes' stderr stability are written and read back (not the paths').
+  ASSERT_TRUE(std::isfinite(r.total.stability));
+  EXPECT_EQ(b.total.stability, r.total.stability);
   ASSERT_EQ(b.classes.size(), r.classes.size());
   for (std::size_t i = 0; i < r.classes.size(); ++i) {
     EXPECT_EQ(b.classes[i].name, r.classes[i].name);
@@ -109,6 +112,8 @@ TEST(HistogramJson, ReportRoundTrips) {
     EXPECT_EQ(b.classes[i].share, r.classes[i].share);
     EXPECT_EQ(b.classes[i].strategies, r.classes[i].strategies);
     expect_same_estimate(b.classes[i].estimate, r.classes[i].estimate);
+    const double s = r.classes[i].estimate.stability;
+    EXPECT_TRUE(b.classes[i].estimate.stability == s || (std::isnan(s) && std::isnan(b.classes[i].estimate.stability)));
   }
   ASSERT_EQ(b.paths.size(), r.paths.size());
   for (std::size_t i = 0; i < r.paths.size(); ++i) {

@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "io/estimate_text.h"
 #include "stats/significance.h"
 #include "support/stat_seed.h"
 
@@ -40,6 +41,38 @@ TEST(Convergence, BatchVarianceIsStableForNormalMeansAndNotForASpike) {
   EXPECT_GT(variance_relative_error(spike), kUnstableVariance);
   EXPECT_TRUE(std::isnan(variance_relative_error({1.0, 2.0, 3.0})));  // too few batches
   EXPECT_TRUE(std::isnan(variance_relative_error(std::vector<double>(8, 2.0))));
+}
+
+// Every estimate carries its stderr's stability (16 pixel groups of two replicates, as the tracer
+// writes them), and pathex trace flags it where it reaches kUnstableVariance, unless the stderr is
+// rounding: normal groups (median 0.31) are not flagged, one group holding the variance is, and an
+// estimator with no variance (the same value in every batch but one a float step off) is not.
+TEST(Convergence, AnEstimatesStderrStabilityIsFlaggedWhereOneGroupCarriesIt) {
+  const VarianceDesign design(std::vector<std::uint64_t>(32, 100), 16);
+  const auto estimate = [&](const std::vector<double>& lum) {
+    std::vector<ExactRgb> sums;
+    for (double v : lum) sums.push_back(*to_exact(Rgb{v, v, v}));
+    return estimate_of(sums, design, 3200);
+  };
+  std::mt19937_64 rng(test::stat_seed(5));
+  std::normal_distribution<double> normal(100.0, 10.0);
+  std::vector<double> lum(32);
+  for (double& v : lum) v = normal(rng);
+  const Estimate well = estimate(lum);
+  EXPECT_LT(well.stability, kUnstableVariance);  // a normal render reaches it 3 times in 10,000
+  EXPECT_EQ(unstable_text(well), "");
+  std::vector<double> spike(32, 100.0);
+  spike[10] = 400.0;  // group 5's first replicate: one rare large sample
+  const Estimate spiky = estimate(spike);
+  // One nonzero group term v of G: mean v / G, spread v² (G − 1) / G, so sqrt(spread / (G (G − 1))) / mean = 1.
+  EXPECT_NEAR(spiky.stability, 1.0, 1e-12);
+  EXPECT_EQ(unstable_text(spiky), "; its stderr is unstable (a few pixel groups carry it: its square's relative error is 1.00)");
+  std::vector<double> exact(32, 100.0);
+  exact[3] = 100.0 * (1.0 + 1e-9);
+  const Estimate rounding = estimate(exact);
+  EXPECT_GT(rounding.stability, kUnstableVariance);
+  EXPECT_LT(rounding.std_error, kRoundingFloor * rounding.luminance);
+  EXPECT_EQ(unstable_text(rounding), "");
 }
 
 TEST(Convergence, StderrCheckPassesHonestLaddersAndFlagsLyingOnes) {

@@ -127,6 +127,50 @@ TEST(TraceCli, TableShowsSharesAndVerdicts) {
   std::filesystem::remove_all(dir);
 }
 
+// histogram.json gives the total's and each class's stderr stability (Estimate::stability, in
+// [0, 1]), and the table says "its stderr is unstable" on exactly the lines whose stability is at
+// least kUnstableVariance (0.7) — here the caustic seen through the ball, whose variance a few
+// fold events carry (about 3 renders in 4 at 256 spp are flagged), and a well-spread render.
+TEST(TraceCli, TheTableFlagsExactlyTheEstimatesWhoseStderrIsUnstable) {
+  int flagged = 0;
+  for (const std::string args : {"samples/scenes/lamp-glass.json --renderer pt-nee+manifold --only LDDSSDSSDSE --spp 256 --seed 1",
+                                 "samples/scenes/point-plane.json --renderer pt-nee --spp 16 --seed 1"}) {
+    const std::string dir = out_dir("unstable");
+    const CliRun r = run("trace " + args + " --threads 1 --no-images --out " + dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream in(dir + "/histogram.json");
+    const nlohmann::json h = nlohmann::json::parse(in);
+    std::filesystem::remove_all(dir);
+    std::vector<std::pair<std::string, nlohmann::json>> rows = {{h.contains("only") ? "luminance of those paths " : "image mean luminance ", h["total"]}};
+    for (const auto& c : h["classes"])
+      if (!c.contains("rendered")) rows.emplace_back(c["name"].get<std::string>() + ": ", c);
+    for (const auto& [start, e] : rows) {
+      const std::size_t at = r.out.find("\n" + start);
+      ASSERT_NE(at, std::string::npos) << start << "\n" << r.out;
+      const std::string line = r.out.substr(at + 1, r.out.find('\n', at + 1) - at - 1);
+      if (e["stderr_stability"].is_null()) {  // unknown: an empty class (no group with a variance)
+        EXPECT_EQ(line.find("unstable"), std::string::npos) << line;
+        continue;
+      }
+      ASSERT_TRUE(e["stderr_stability"].is_number()) << line;
+      const double eps = e["stderr_stability"].get<double>();
+      EXPECT_GE(eps, 0.0);
+      EXPECT_LE(eps, 1.0 + 1e-12);
+      char text[96];
+      std::snprintf(text, sizeof text, "; its stderr is unstable (a few pixel groups carry it: its square's relative error is %.2f)", eps);
+      const bool says = line.find("its stderr is unstable") != std::string::npos;
+      EXPECT_EQ(says, eps >= 0.7) << line;
+      if (says) {
+        EXPECT_NE(line.find(text), std::string::npos) << line;
+        ++flagged;
+      }
+    }
+  }
+  // Where no line is flagged (a render whose fold events spread over the groups) the test checks
+  // the other branch only; at seed 1 on the development machine the seen-through lines are flagged.
+  RecordProperty("flagged_lines", flagged);
+}
+
 TEST(TraceCli, JsonToStdoutMatchesTheFile) {
   const std::string dir = out_dir("json");
   const CliRun r = run("trace --spp 2 --json --no-images --out " + dir);
