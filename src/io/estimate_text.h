@@ -26,15 +26,19 @@ inline std::string absolute(const Estimate& e) {
   return buf;
 }
 
-// What trace adds to an estimate whose stderr is unstable (Estimate::stability ≥ kUnstableVariance,
-// and the stderr more than rounding): "; its stderr is unstable (a few pixel groups carry it: its
-// square's relative error is 0.83)", else nothing.
-inline std::string unstable_text(const Estimate& e) {
-  if (!(std::isfinite(e.stability) && e.stability >= kUnstableVariance && e.std_error > kRoundingFloor * std::fabs(e.luminance)))
-    return "";
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "; its stderr is unstable (a few pixel groups carry it: its square's relative error is %.2f)", e.stability);
+// Whether an estimate's stderr is unstable: Estimate::stability ≥ kUnstableVariance, and the stderr
+// more than rounding. Why, in words: "a few pixel groups carry it: its square's relative error is 0.83".
+inline bool stderr_unstable(const Estimate& e) {
+  return std::isfinite(e.stability) && e.stability >= kUnstableVariance && e.std_error > kRoundingFloor * std::fabs(e.luminance);
+}
+inline std::string unstable_reason(const Estimate& e) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "a few pixel groups carry it: its square's relative error is %.2f", e.stability);
   return buf;
+}
+// What trace's table adds to an estimate whose stderr is unstable: "; its stderr is unstable (…)".
+inline std::string unstable_text(const Estimate& e) {
+  return stderr_unstable(e) ? "; its stderr is unstable (" + unstable_reason(e) + ")" : "";
 }
 
 // The techniques that carry an estimate, largest share first, at most `most` of them (the rest are

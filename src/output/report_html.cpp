@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
+#include "io/estimate_text.h"
 #include "io/histogram_json.h"
 #include "io/image_io.h"
 #include "io/input_file.h"
@@ -529,6 +530,10 @@ std::string pct(double share, int decimals = 1) {
   std::snprintf(buf, sizeof buf, "%.*f %%", decimals, 100.0 * share);
   return buf;
 }
+// data-stderr-stability="…" (histogram.json's stderr_stability), or nothing where it is unknown.
+std::string stability_attr(const Estimate& e) {
+  return std::isfinite(e.stability) ? " data-stderr-stability=\"" + exact(e.stability) + "\"" : "";
+}
 std::string lum(const Estimate& e) {
   std::string s = fixed(e.luminance, "%.5g");
   if (std::isfinite(e.std_error)) s += " ± " + fixed(e.std_error, "%.2g");
@@ -571,7 +576,7 @@ img.px{width:256px;height:auto;image-rendering:pixelated;background:#000;display
 .overlay{position:relative;width:384px}.overlay img.px{width:384px}
 .overlay img.top{position:absolute;left:0;top:0;mix-blend-mode:screen}
 #hover{position:fixed;right:1em;top:1em;background:#fffe;border:1px solid #888;padding:.4em .6em;font-size:.85em;min-width:14em}
-.verdict-reachable{color:#060}.verdict-unreachable{color:#a00}.verdict-partial{color:#a60}
+.verdict-reachable{color:#060}.verdict-unreachable{color:#a00}.verdict-partial{color:#a60}.unstable{color:#a00}
 pre.cmd{background:#f4f4f4;padding:.5em;white-space:pre-wrap;word-break:break-all}
 )css";
 
@@ -645,8 +650,10 @@ void render_section(std::ostringstream& h, const ReportData& d) {
   }
   row("non-finite samples", std::to_string(rep.nonfinite_samples) + (rep.nonfinite_samples ? " (any is a bug)" : ""),
       " data-nonfinite=\"" + std::to_string(rep.nonfinite_samples) + "\"");
-  row(d.only.empty() ? "image mean luminance" : "luminance of the requested paths", esc(lum(rep.total)),
-      " data-luminance=\"" + exact(rep.total.luminance) + "\" data-stderr=\"" + exact(rep.total.std_error) + "\"");
+  row(d.only.empty() ? "image mean luminance" : "luminance of the requested paths",
+      esc(lum(rep.total)) + (stderr_unstable(rep.total) ? " <span class=\"unstable\">its stderr is unstable (" + esc(unstable_reason(rep.total)) + ")</span>" : ""),
+      " data-luminance=\"" + exact(rep.total.luminance) + "\" data-stderr=\"" + exact(rep.total.std_error) + "\"" +
+          stability_attr(rep.total));
   row("distinct paths", std::to_string(rep.distinct_paths));
   h << "</tbody></table>\n</div>\n";
   if (!d.command.empty())
@@ -665,7 +672,7 @@ void class_tiles(std::ostringstream& h, const ReportData& d) {
     h << "<div class=\"tile\" data-class=\"" << esc(c.name) << "\" data-rendered=\"" << (c.rendered ? "true" : "false") << "\"";
     if (c.rendered)
       h << " data-share=\"" << exact(c.share) << "\" data-luminance=\"" << exact(c.estimate.luminance) << "\" data-stderr=\""
-        << exact(c.estimate.std_error) << "\"";
+        << exact(c.estimate.std_error) << "\"" << stability_attr(c.estimate);
     h << ">\n<h3>" << esc(c.name) << " <code>" << esc(c.expr) << "</code></h3>\n";
     if (!c.rendered) {
       h << "<p>not rendered: only the requested classes were estimated (--only)</p></div>\n";
@@ -676,6 +683,7 @@ void class_tiles(std::ostringstream& h, const ReportData& d) {
     const auto v = d.verdicts.find(c.name);
     h << "<dl><dt>share</dt><dd>" << pct(c.share) << " ± " << pct(err, 2) << "</dd>"
       << "<dt>luminance</dt><dd>" << esc(lum(c.estimate)) << "</dd>"
+      << (stderr_unstable(c.estimate) ? "<dt>stderr</dt><dd class=\"unstable\">unstable: " + esc(unstable_reason(c.estimate)) + "</dd>" : "")
       << "<dt>verdict</dt><dd class=\"verdict-" << (v != d.verdicts.end() ? esc(v->second) : "unknown") << "\">"
       << (v != d.verdicts.end() ? esc(v->second)
           : d.verdicts.empty()   ? "not known (the scene could not be read)"

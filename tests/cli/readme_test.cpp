@@ -207,6 +207,8 @@ TEST(ReadmeExamples, CiRunsTheReadmesTestCommand) {
   EXPECT_NE(quick.find("\n    " + main_job + "\n"), std::string::npos);
   EXPECT_NE(quick.find("\n    " + test_command + "\n"), std::string::npos);
   EXPECT_NE(source_file(".ci/run").find("\n" + test_command + "\n"), std::string::npos);
+  // Its failure ends the run: errexit ignores a failed setup or build inside the && list.
+  EXPECT_NE(source_file(".ci/run").find("\n" + test_command + "\n} || exit 1\n"), std::string::npos);
   // setup.sh builds `pathex` alone (the first render comes before the tests are built).
   EXPECT_NE(source_file("setup.sh").find("--target pathex pathex_docs\n"), std::string::npos);
 }
