@@ -1,8 +1,6 @@
-// Hashes. mix64, the SplitMix64 finaliser, scrambles words: the tracer's counter-based random
-// numbers (trace/rng.h) and the standard error's pixel groups (stats/histogram.h). IntVectorHash
-// keys the subset construction (sets of NFA states) and the classifier's product construction
-// (tuples of DFA states); Fnv64 is a streaming 64-bit FNV-1a over bytes, for content hashes that
-// name what a render was made from (scene, profile, classes).
+// FNV-1a hashes. IntVectorHash keys the subset construction (sets of NFA states) and the
+// classifier's product construction (tuples of DFA states); Fnv64 is a streaming 64-bit FNV-1a
+// over bytes, for content hashes that name what a render was made from (scene, profile, classes).
 #pragma once
 
 #include <cstddef>
@@ -14,16 +12,6 @@
 #include <vector>
 
 namespace pathex {
-
-// Stafford's Mix13, the SplitMix64 finaliser: a bijection on 64-bit words in which every input
-// bit affects every output bit with probability close to 1/2. mix64(0) == 0, hence the offsets.
-constexpr std::uint64_t mix64(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
-inline constexpr std::uint64_t kGoldenGamma = 0x9e3779b97f4a7c15ULL;  // 2^64 / φ, SplitMix64's increment
 
 struct IntVectorHash {
   std::size_t operator()(const std::vector<int>& v) const {

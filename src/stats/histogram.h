@@ -22,10 +22,10 @@
 //
 // Batches, and the standard error (issues 36 and 39). Samples are grouped into B batches (default
 // 32): batch b is replicate r = b mod R of pixel group g = b div R, with G = B / R groups
-// (HistogramLayout::groups). The renderer puts the sample of pixel p and pass s in p's group
-// (pixel_group() below: p mod G, rotated per block of G pixels) and replicate s mod R
-// (batch_of()); under the `sobol` sampler each replicate of a pixel is an independently
-// scrambled sequence whose point index is s div R (trace/rng.h), so a replicate of 16 spp / R points keeps the quasi-Monte Carlo gain of that many points. Pixels are
+// (HistogramLayout::groups). The renderer puts the sample of pixel p and pass s in group p mod G
+// and replicate s mod R (batch_of() below); under the `sobol` sampler each replicate
+// of a pixel is an independently scrambled sequence whose point index is s div R (trace/rng.h), so
+// a replicate of 16 spp / R points keeps the quasi-Monte Carlo gain of that many points. Pixels are
 // independent of each other, and the R replicates of a group are independent and identically
 // distributed, whatever the strategy (a light-tracing splat counts in the group of the sample
 // that made it, wherever it lands). With S_gr the sum of a group's replicate, n_gr its sample
@@ -66,7 +66,6 @@
 
 #include "classify/classifier.h"
 #include "core/error.h"
-#include "core/hash.h"
 #include "stats/batch_store.h"
 
 namespace pathex {
@@ -104,39 +103,14 @@ inline int default_replicates(int batches, std::uint64_t pixels) {
   return batches / std::max(groups, 1);
 }
 
-// The pixel group of pixel `pixel` among G = `groups` (see "Batches" above). The pixels are dealt
-// in blocks of G consecutive ones, each block one of every group in a rotation drawn by a hash of
-// the block's index: every group holds N div G or one more of N pixels (group_pixels()), two
-// neighbours in a row are in different groups, and the pixels of a column, or of any edge, fall
-// in all groups alike. Plain `pixel mod G` made the groups columns wherever the width is a multiple
-// of G: the two vertical edges of a lamp, which carry all of its class's variance, lay in two
-// groups, and the stderr had about two degrees of freedom where sixteen were counted (its square's
-// relative error ~1 at any spp, so `pathex trace` flagged it unstable even at 4,096 spp).
-inline std::uint64_t pixel_group(std::uint64_t pixel, std::uint64_t groups) {
-  const std::uint64_t rotation = mix64(pixel / groups + kGoldenGamma) % groups;  // mix64(0) == 0: offset
-  return (pixel % groups + rotation) % groups;
-}
-
-// How many of `pixels` pixels pixel_group() puts in group g: N div G, and one more for the groups
-// of the last, partial block (its rest = N mod G pixels, from its rotation on).
-inline std::uint64_t group_pixels(std::uint64_t g, std::uint64_t pixels, std::uint64_t groups) {
-  const std::uint64_t full = pixels / groups, rest = pixels % groups;
-  const std::uint64_t first = pixel_group(full * groups, groups);
-  return full + ((g + groups - first) % groups < rest ? 1 : 0);
-}
-
-// The batch of pass `pass` of a pixel in group `group`: replicate pass mod R of that group,
-// G = batches / replicates. Passes go to replicates round-robin, so an interrupted render still
-// spreads what it has over all of them (and its error is defined). Replicates are independent:
-// under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
-inline int group_batch(std::uint64_t group, std::uint64_t pass, int replicates) {
-  const auto R = static_cast<std::uint64_t>(replicates);
-  return static_cast<int>(group * R + pass % R);
-}
-
-// The batch of pixel `pixel`'s pass `pass`.
+// The batch of pixel `pixel`'s pass `pass` (see "Batches" above): replicate pass mod R of pixel
+// group pixel mod G, G = batches / replicates. Passes go to replicates round-robin, so an
+// interrupted render still spreads what it has over all of them (and its error is defined);
+// neighbouring pixels go to different groups, so every group covers the whole image. Replicates
+// are independent: under `sobol` each is a sequence scrambled on its own (trace/rng.h, sobol_stream()).
 inline int batch_of(std::uint64_t pixel, std::uint64_t pass, int batches, int replicates) {
-  return group_batch(pixel_group(pixel, static_cast<std::uint64_t>(batches / replicates)), pass, replicates);
+  const auto R = static_cast<std::uint64_t>(replicates), G = static_cast<std::uint64_t>(batches / replicates);
+  return static_cast<int>((pixel % G) * R + pass % R);
 }
 
 // Rec. 709 luminance.

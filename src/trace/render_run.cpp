@@ -169,12 +169,11 @@ Result<RenderOutput> render(const Scene& scene, const RenderPlan& plan, const Cl
         integrator.finish_row(th, out.images, y);
       }
     });
-    // Each pass adds one sample per pixel: to each group as many as it holds pixels (group_pixels()).
+    // Each pass adds one sample per pixel: pixels / G to every group, one more to the first pixels mod G.
     const auto groups = static_cast<std::uint64_t>(layout.groups);
     for (std::uint64_t p = first; p < end; ++p)
-      for (std::uint64_t g = 0; g < groups; ++g)
-        if (const std::uint64_t n = group_pixels(g, pixels, groups); n > 0)
-          out.histogram.add_samples(group_batch(g, p, o.replicates), n);
+      for (std::uint64_t g = 0; g < std::min(groups, pixels); ++g)
+        out.histogram.add_samples(batch_of(g, p, o.batches, o.replicates), pixels / groups + (g < pixels % groups ? 1 : 0));
     out.passes_done.add(first, end);
     if (o.progress) o.progress(deal.dealt() * pixels, deal.total() * pixels);
   }

@@ -30,14 +30,21 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "core/hash.h"
 #include "trace/sobol.h"
 
 namespace pathex {
 
 // --- counter-based random numbers ---
 
-// mix64 (Stafford's Mix13) and kGoldenGamma are core/hash.h's.
+// Stafford's Mix13, the SplitMix64 finaliser: a bijection on 64-bit words in which every input
+// bit affects every output bit with probability close to 1/2. mix64(0) == 0, hence the offsets.
+constexpr std::uint64_t mix64(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+inline constexpr std::uint64_t kGoldenGamma = 0x9e3779b97f4a7c15ULL;
 
 // The key of one sample's stream. Asymmetric in its arguments: (p, s) and (s, p) differ.
 constexpr std::uint64_t stream_key(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample) {

@@ -251,49 +251,6 @@ TEST(ReplicateGroups, TheDefaultGroupsFollowThePixelCount) {
     }
 }
 
-// pixel_group() deals each block of G consecutive pixels one of every group (so the groups are
-// equal to one pixel and neighbours in a row differ), group_pixels() counts them, and batch_of()
-// is the group's batch of the pass's replicate.
-TEST(ReplicateGroups, EachBlockOfGPixelsHoldsEveryGroupOnce) {
-  for (std::uint64_t G : {1u, 2u, 3u, 8u, 16u, 32u}) {
-    for (std::uint64_t block = 0; block < 200; ++block) {
-      std::vector<int> seen(G, 0);
-      for (std::uint64_t i = 0; i < G; ++i) ++seen[pixel_group(block * G + i, G)];
-      EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(G)) << G << " " << block;
-    }
-    for (std::uint64_t pixels : {1u, 2u, 5u, 15u, 16u, 17u, 144u, 441u, 1000u, 65025u}) {
-      std::vector<std::uint64_t> count(G, 0);
-      for (std::uint64_t p = 0; p < pixels; ++p) ++count[pixel_group(p, G)];
-      for (std::uint64_t g = 0; g < G; ++g) EXPECT_EQ(group_pixels(g, pixels, G), count[g]) << G << " " << pixels << " " << g;
-    }
-  }
-  for (std::uint64_t p : {0u, 1u, 17u, 4095u})
-    for (std::uint64_t pass : {0u, 1u, 2u, 7u}) {
-      EXPECT_EQ(batch_of(p, pass, 32, 2), group_batch(pixel_group(p, 16), pass, 2));
-      EXPECT_EQ(batch_of(p, pass, 32, 2) % 2, static_cast<int>(pass % 2));
-    }
-}
-
-// The pixels of a column, a row and a diagonal of a 256-wide image (a width that is a multiple of
-// G = 16) fall in all groups alike: Satterthwaite's effective count (Σ n_g)² / Σ n_g² of the
-// groups' shares, 16 for an even spread, is at least 12 for each. With the groups of before
-// (p mod 16) a column was one group: 1. A lamp's vertical edge carries its class's variance, so
-// its stderr had about that many degrees of freedom (docs/tracer.md, "The groups").
-TEST(ReplicateGroups, AnEdgeInAnyDirectionFallsInAllGroupsAlike) {
-  const std::uint64_t W = 256, G = 16;
-  auto effective = [&](auto pixel_at) {
-    std::vector<double> n(G, 0.0);
-    for (std::uint64_t i = 0; i < W; ++i) n[pixel_group(pixel_at(i), G)] += 1.0;
-    double sum = 0, squares = 0;
-    for (double x : n) sum += x, squares += x * x;
-    return sum * sum / squares;
-  };
-  for (std::uint64_t x : {0u, 5u, 100u, 255u}) EXPECT_GE(effective([&](std::uint64_t y) { return y * W + x; }), 12.0) << "column " << x;
-  for (std::uint64_t y : {0u, 37u, 255u}) EXPECT_EQ(effective([&](std::uint64_t x) { return y * W + x; }), 16.0) << "row " << y;
-  EXPECT_GE(effective([&](std::uint64_t i) { return i * W + i; }), 12.0) << "diagonal";
-  EXPECT_GE(effective([&](std::uint64_t i) { return i * W + (W - 1 - i); }), 12.0) << "antidiagonal";
-}
-
 TEST(ReplicateGroups, RendersFillEveryGroupAndTheHistogramReadsItsDesign) {
   HistogramLayout layout{8, {}, 4};  // four groups of two replicates
   EXPECT_EQ(layout.replicates(), 2);

@@ -927,11 +927,10 @@ TEST(Sampling, SplitSamplesMatchTheClosedForms) {
 // samplers, the three estimators, the same 9 closed forms: 108 checks at family_sigmas(108), 0.1 %
 // family-wise (as above).
 //
-// The map's counts cycle with the pixel's group and with its block p / 16 (stats/histogram.h,
-// pixel_group: each block of 16 pixels holds one of every group), so that each of the 16 pixel
-// groups holds every count two or three times and the groups' variances are alike, which the 16
-// degrees of freedom of family_sigmas assume. An earlier map, counts[(x + 2y) mod 4] on this
-// 12-wide sensor, aliased with the groups of then (p mod 16):
+// The map's counts cycle with the pixel index p and with p / 16, so that each of the 16 pixel
+// groups (pixel p's group is p mod 16: stats/histogram.h, batch_of) holds every count two or three
+// times and the groups' variances are alike, which the 16 degrees of freedom of family_sigmas
+// assume. An earlier map, counts[(x + 2y) mod 4] on this 12-wide sensor, aliased with p mod 16:
 // half the groups held only {1, 1} and {1, 5}, half only {3, 1} and {2, 3}, whose variances differ
 // 2-3 times, so the stderr had Satterthwaite's (Σ v_g)² / Σ v_g² ≈ 10 effective degrees of
 // freedom, not 16, and issue 36's sweep failed at seed 70 (pt-nee, sobol, the emitting sphere's
@@ -941,7 +940,7 @@ TEST(Sampling, SplitSamplesMatchTheClosedForms) {
 TEST(Sampling, AutoSplitSamplesMatchTheClosedForms) {
   auto map = std::make_shared<tracer::SplitMap>(tracer::SplitMap{12, 12, {}});  // the closed spheres' 12 x 12
   const std::array<tracer::SplitCounts, 4> counts = {{{1, 1}, {3, 1}, {1, 5}, {2, 3}}};
-  for (std::size_t p = 0; p < 12 * 12; ++p) map->counts.push_back(counts[(pixel_group(p, 16) + p / 16) % 4]);
+  for (std::size_t p = 0; p < 12 * 12; ++p) map->counts.push_back(counts[(p + p / 16) % 4]);
   std::vector<Sampling> settings;
   for (SamplerKind k : {SamplerKind::kIndependent, SamplerKind::kSobol})
     for (bool given : {false, true}) {
