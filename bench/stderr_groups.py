@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""How well a render's stderr describes its error, per class, over many seeds (the pixel groups of
-stats/histogram.h, pixel_group(); twenty-fourth session).
+"""How well a render's stderr describes its error, per class, over many seeds: for comparing two
+builds whose standard errors differ (the stderr's pixel groups, stats/histogram.h "Batches"; the
+twenty-fourth session's trial, bench/README.md).
 
 For each binary: --seeds renders (one thread, the seed 1..N, --no-images) of --scene (the
 embedded Cornell box without one) under --renderer at --spp, any extra trace arguments after
