@@ -700,7 +700,7 @@ TEST(Agreement, AbsorbingRoughGlassAgreesAcrossEstimators) {
   // The medium is seen: without it the image is brighter than twice the agreement's tolerance (a
   // fixed 10 sigma failed at 1 seed in 100, seed 28: 9.75 sigma, one run's stderr inflated by a rare
   // sample). 1,024 spp: at 256 the medium's 10 % came within 2 x (3.3 sigma + 0.2 %) at seeds 29
-  // and 100 of 100 (twenty-fourth session's sweep; the test's code had changed since its last).
+  // and 100 of 100 (twenty-fourth session's sweep; swept 0 of 100 on 2026-12-06's renderer).
   const Estimate& a = runs[2].report.total;
   const double tolerance = test::family_sigmas(3) * std::hypot(a.std_error, clear.report.total.std_error) + 0.002 * a.luminance;
   EXPECT_GT(clear.report.total.luminance - a.luminance, 2.0 * tolerance)
